@@ -1,0 +1,67 @@
+// `quadcosim lqr` and `quadcosim params`.
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "app/commands.hpp"
+#include "control/care.hpp"
+#include "control/parameters.hpp"
+#include "io/scenario.hpp"
+
+namespace quadcosim::app {
+
+namespace {
+std::string complex_str(const std::complex<double>& c) {
+  if (c.imag() == 0.0) return fmt::format("{:.6g}", c.real());
+  return fmt::format("{:.6g} {} {:.6g}i", c.real(), c.imag() < 0 ? '-' : '+', std::abs(c.imag()));
+}
+}  // namespace
+
+int lqr_command(const LqrOptions& opt) {
+  try {
+    model::VehicleParams vehicle;
+    if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
+    control::ControllerConfig cfg;
+    cfg.params.vehicle = vehicle;
+    if (!opt.params.empty()) cfg = io::load_controller(opt.params, vehicle);
+    const control::FlightController fc(cfg.params);
+    const char* names[3] = {"roll", "pitch", "yaw"};
+    const double inertia[3] = {vehicle.Ixx_kg_m2, vehicle.Iyy_kg_m2, vehicle.Izz_kg_m2};
+    for (int i = 0; i < 3; ++i) {
+      const control::AxisLqr& a = fc.axis(i);
+      std::cout << fmt::format("{} axis (I = {:g} kg m^2), state [e, rate], U = -K x\n", names[i], inertia[i]);
+      std::cout << fmt::format("  A = [[{:g}, {:g}], [{:g}, {:g}]]\n", a.A(0, 0), a.A(0, 1), a.A(1, 0), a.A(1, 1));
+      std::cout << fmt::format("  B = [{:g}, {:.6g}]\n", a.B(0), a.B(1));
+      std::cout << fmt::format("  Q = diag({:g}, {:g})   R = {:g}\n", a.Q(0, 0), a.Q(1, 1), a.R);
+      std::cout << fmt::format("  K = [{:.6g}, {:.6g}]   (Algorithm 1: k1 = {:.6g}, k2 = {:.6g})\n", a.K(0),
+                               a.K(1), -a.K(0), a.K(1));
+      std::cout << fmt::format("  closed-loop poles: {}, {}\n", complex_str(a.closed_loop_poles(0)),
+                               complex_str(a.closed_loop_poles(1)));
+    }
+    return 0;
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const control::CareError& e) {
+    std::cerr << "error: LQR design failed: " << e.what() << '\n';
+    return 2;
+  }
+}
+
+int params_command() {
+  const control::ControllerConfig defaults;
+  std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", "name", "unit", "range", "default", "meaning");
+  for (const auto& p : control::controller_parameters()) {
+    std::string range;
+    if (p.is_choice()) {
+      for (auto c : p.choices) range += (range.empty() ? "" : "|") + std::string(c);
+    } else {
+      range = fmt::format("[{:g}, {:g}]", p.min, p.max);
+    }
+    std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", p.name, p.is_choice() ? "" : p.unit,
+                             range, control::to_string(p.get(defaults)), p.description);
+  }
+  return 0;
+}
+
+}  // namespace quadcosim::app

@@ -1,0 +1,111 @@
+// `quadcosim run SCENARIO --out DIR`
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "app/commands.hpp"
+#include "control/care.hpp"
+#include "io/scenario.hpp"
+#include "io/step_report.hpp"
+#include "io/trajectory_csv.hpp"
+#include "model/attitude.hpp"
+#include "sim/simulation.hpp"
+
+namespace quadcosim::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+io::ControlColumns control_columns(const sim::TickRecord& r) {
+  const auto& sp = r.controller_config.setpoint;
+  const bool position = sp.mode == control::Mode::kPosition;
+  return {sp.p_des_W.x(),
+          sp.p_des_W.y(),
+          sp.p_des_W.z(),
+          position ? r.last_command.roll_des_rad : sp.roll_des_rad,
+          position ? r.last_command.pitch_des_rad : sp.pitch_des_rad,
+          sp.yaw_des_rad,
+          r.last_command.U,
+          r.last_command.safety};
+}
+
+void record_series(io::Series& s, const sim::TickRecord& r, const io::ControlColumns& c) {
+  const model::Euler e = model::euler_from_quaternion(r.state.q_WB);
+  s.t_s.push_back(r.t_s);
+  s.append("x", r.state.p_W.x());
+  s.append("y", r.state.p_W.y());
+  s.append("z", r.state.p_W.z());
+  s.append("roll", e.roll_rad);
+  s.append("pitch", e.pitch_rad);
+  s.append("yaw", e.yaw_rad);
+  s.append("x_des", c.x_des);
+  s.append("y_des", c.y_des);
+  s.append("z_des", c.z_des);
+  s.append("roll_des", c.roll_des);
+  s.append("pitch_des", c.pitch_des);
+  s.append("yaw_des", c.yaw_des);
+}
+
+}  // namespace
+
+int run_command(const RunOptions& opt) {
+  io::Scenario sc;
+  try {
+    sc = io::load_scenario(opt.scenario);
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  }
+
+  std::error_code ec;
+  fs::create_directories(opt.out_dir, ec);
+  if (ec) {
+    std::cerr << "error: cannot create output directory " << opt.out_dir << ": " << ec.message() << '\n';
+    return 3;
+  }
+  const fs::path out(opt.out_dir);
+
+  try {
+    fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
+    model::Quadrotor probe(sc.vehicle);
+    const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
+    sim::Simulation simulation(sc.simulation, sc.vehicle, x0, sc.controller, sc.schedule);
+
+    io::TrajectoryWriter csv((out / "trajectory.csv").string());
+    io::Series series;
+    simulation.run([&](const sim::TickRecord& r) {
+      const io::ControlColumns c = control_columns(r);
+      csv.write(r.t_s, r.state, r.applied_command, c);
+      record_series(series, r, c);
+    });
+    csv.close();
+
+    const auto results = io::evaluate_steps(sc.steps, series);
+    io::write_metrics_json((out / "metrics.json").string(), sc, results);
+    const std::string table = io::format_step_table(sc, results);
+    std::ofstream((out / "metrics.txt").string()) << table;
+    std::cout << table;
+    if (simulation.plant().stats().commands_rejected > 0) {
+      std::cout << fmt::format("plant rejected {} of {} motor commands\n",
+                               simulation.plant().stats().commands_rejected,
+                               simulation.plant().stats().commands_received);
+    }
+    std::cout << "wrote " << (out / "trajectory.csv").string() << ", metrics.json, metrics.txt\n";
+    if (opt.plots && !make_plots(opt.out_dir)) return 3;
+    return io::all_passed(results) ? 0 : 1;
+  } catch (const control::CareError& e) {
+    std::cerr << "error: " << opt.scenario << ": controller design failed: " << e.what() << '\n';
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << opt.scenario << ": " << e.what() << '\n';
+    return 2;
+  } catch (const std::runtime_error& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 3;
+  }
+}
+
+}  // namespace quadcosim::app

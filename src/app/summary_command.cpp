@@ -1,0 +1,79 @@
+// `quadcosim summary RUN_DIR... [--out FILE.md]`: our step figures beside the reference ones.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.hpp"
+
+namespace quadcosim::app {
+
+namespace {
+std::string num(const nlohmann::json& v) {
+  return v.is_number() ? fmt::format("{:.2f}", v.get<double>()) : "-";
+}
+std::string band(const nlohmann::json& criteria, const std::string& fig) {
+  for (const auto& c : criteria) {
+    if (c.value("figure", "") != fig) continue;
+    const std::string lo = c["min"].is_number() ? fmt::format("{:g}", c["min"].get<double>()) : "";
+    const std::string hi = c["max"].is_number() ? fmt::format("{:g}", c["max"].get<double>()) : "";
+    if (lo.empty()) return "≤ " + hi;
+    if (hi.empty()) return "≥ " + lo;
+    return lo + " – " + hi;
+  }
+  return "";
+}
+}  // namespace
+
+int summary_command(const SummaryOptions& opt) {
+  const std::vector<std::pair<std::string, std::string>> figs = {
+      {"overshoot_pct", "overshoot %"},     {"peak_time_s", "peak s"},
+      {"t95_s", "95 % s"},                  {"settling_time_2pct_s", "2 % settling s"},
+      {"steady_state_error_pct", "error %"}};
+  std::string md = "| run | step | figure | ours | reference | accepted | verdict |\n|---|---|---|---|---|---|---|\n";
+  bool all_ok = true;
+  for (const auto& dir : opt.run_dirs) {
+    const auto path = std::filesystem::path(dir) / "metrics.json";
+    std::ifstream in(path);
+    nlohmann::json j;
+    try {
+      if (!in) throw std::runtime_error("cannot open");
+      in >> j;
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << path.string() << ": " << e.what() << '\n';
+      return 2;
+    }
+    for (const auto& s : j.value("steps", nlohmann::json::array())) {
+      const std::string step = fmt::format("{} {:g} → {:g}", s.value("channel", "?"),
+                                           s.value("initial", 0.0), s.value("target", 0.0));
+      const auto ref = s.value("reference", nlohmann::json::object());
+      for (const auto& [key, label] : figs) {
+        const std::string accepted = band(s["criteria"], key);
+        std::string verdict;
+        for (const auto& c : s["criteria"]) {
+          if (c.value("figure", "") == key) verdict = c.value("passed", false) ? "pass" : "**FAIL**";
+        }
+        md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", j.value("scenario", dir), step, label,
+                          num(s["figures"][key]), ref.contains(key) ? num(ref[key]) : "", accepted, verdict);
+      }
+    }
+    all_ok = all_ok && j.value("passed", false);
+  }
+  std::cout << md;
+  if (!opt.out.empty()) {
+    std::ofstream out(opt.out);
+    out << "# Step figures: quadcosim beside the paper\n\n"
+        << "Reference values are read off the paper's text for Figs. 4-7; \"accepted\" is the band the "
+           "scenario checks.\n\n"
+        << md;
+    if (!out) {
+      std::cerr << "error: cannot write " << opt.out << '\n';
+      return 3;
+    }
+  }
+  return all_ok ? 0 : 1;
+}
+
+}  // namespace quadcosim::app

@@ -1,0 +1,240 @@
+#include "io/scenario.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include "analysis/step_metrics.hpp"
+#include "io/yaml_reader.hpp"
+#include "sim/topics.hpp"
+
+namespace quadcosim::io {
+
+namespace {
+
+constexpr double kHuge = 1e12;
+
+void read_vehicle(YamlSection& s, model::VehicleParams& v) {
+  v.mass_kg = s.number("mass_kg", v.mass_kg, 1e-6, kHuge);
+  v.gravity_m_s2 = s.number("gravity_m_s2", v.gravity_m_s2, 0.0, 1e3);
+  v.Ixx_kg_m2 = s.number("Ixx_kg_m2", v.Ixx_kg_m2, 1e-12, kHuge);
+  v.Iyy_kg_m2 = s.number("Iyy_kg_m2", v.Iyy_kg_m2, 1e-12, kHuge);
+  v.Izz_kg_m2 = s.number("Izz_kg_m2", v.Izz_kg_m2, 1e-12, kHuge);
+  v.arm_length_m = s.number("arm_length_m", v.arm_length_m, 1e-6, 1e3);
+  v.kt_N_per_rad2_s2 = s.number("kt_N_per_rad2_s2", v.kt_N_per_rad2_s2, 1e-20, 1.0);
+  v.km_Nm_per_rad2_s2 = s.number("km_Nm_per_rad2_s2", v.km_Nm_per_rad2_s2, 1e-20, 1.0);
+  v.layout = s.choice("layout", model::to_string(v.layout), {"plus", "x"}) == "plus"
+                 ? model::RotorLayout::kPlus
+                 : model::RotorLayout::kX;
+  v.gyroscopic = s.choice("gyroscopic", model::to_string(v.gyroscopic), {"full", "simplified"}) == "full"
+                     ? model::GyroscopicModel::kFull
+                     : model::GyroscopicModel::kSimplified;
+  if (s.has("spin")) {
+    const auto spin = s.numbers("spin", {}, 4);
+    for (int i = 0; i < 4; ++i) {
+      if (spin[i] != 1.0 && spin[i] != -1.0) s.fail("spin", "expected four entries, each 1 or -1");
+      v.spin[i] = static_cast<int>(spin[i]);
+    }
+    if (v.spin[0] + v.spin[1] + v.spin[2] + v.spin[3] != 0) {
+      s.fail("spin", "expected two rotors of each direction (two 1 and two -1)");
+    }
+  }
+  if (auto m = s.section("motor")) {
+    v.motor.model = m->choice("model", model::to_string(v.motor.model), {"ideal", "first_order"}) == "ideal"
+                        ? model::MotorModel::kIdeal
+                        : model::MotorModel::kFirstOrder;
+    v.motor.tau_up_s = m->number("tau_up_s", v.motor.tau_up_s, 1e-6, 1e3);
+    v.motor.tau_down_s = m->number("tau_down_s", v.motor.tau_down_s, 1e-6, 1e3);
+    v.motor.omega_min_rad_s = m->number("omega_min_rad_s", v.motor.omega_min_rad_s, 0.0, 1e7);
+    v.motor.omega_max_rad_s = m->number("omega_max_rad_s", v.motor.omega_max_rad_s, 1e-3, 1e7);
+    if (v.motor.omega_min_rad_s >= v.motor.omega_max_rad_s) {
+      m->fail("omega_min_rad_s", "got " + std::to_string(v.motor.omega_min_rad_s) +
+                                     ", expected less than omega_max_rad_s (" +
+                                     std::to_string(v.motor.omega_max_rad_s) + ")");
+    }
+    m->reject_unknown_keys();
+  }
+  s.reject_unknown_keys();
+  if (std::string err = model::validate(v); !err.empty()) s.fail("", err);
+}
+
+control::ParameterValue parameter_value(YamlSection& s, const std::string& key,
+                                        const control::ParameterSpec& spec, const YAML::Node& n) {
+  if (!n.IsScalar()) s.fail(key, "expected a single value");
+  if (spec.is_choice()) return n.Scalar();
+  try {
+    return n.as<double>();
+  } catch (const YAML::Exception&) {
+    s.fail(key, "got '" + n.Scalar() + "', expected a number");
+  }
+}
+
+// Applies every leaf of a (possibly nested) mapping as a controller parameter: `altitude: {kp: 4}`
+// and `altitude.kp: 4` are the same.
+void read_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
+                     std::vector<std::pair<std::string, control::ParameterValue>>* out) {
+  for (const std::string& key : s.keys()) {
+    const YAML::Node n = s.raw(key);
+    const std::string name = prefix.empty() ? key : prefix + "." + key;
+    if (n.IsMap()) {
+      YamlSection child(n, s.file(), s.key_path(key));
+      read_parameters(child, name, c, out);
+      continue;
+    }
+    const control::ParameterSpec* spec = control::find_parameter(name);
+    if (!spec) s.fail(key, "unknown controller parameter '" + name + "' (see `quadcosim params`)");
+    const control::ParameterValue value = parameter_value(s, key, *spec, n);
+    if (std::string err = control::set_parameter(c, name, value); !err.empty()) s.fail(key, err);
+    if (out) out->emplace_back(name, value);
+  }
+}
+
+// A time in seconds that must fall on a whole plant tick.
+sim::Tick tick_at(YamlSection& s, const std::string& key, double seconds, std::int64_t period_ns) {
+  const double ticks = seconds * 1e9 / static_cast<double>(period_ns);
+  const double whole = std::round(ticks);
+  if (std::abs(ticks - whole) > 1e-6) {
+    s.fail(key, "got " + std::to_string(seconds) + " s, expected a whole number of plant periods (" +
+                    std::to_string(static_cast<double>(period_ns) / 1e9) + " s)");
+  }
+  return static_cast<sim::Tick>(whole);
+}
+
+void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duration_s) {
+  const double plant_hz = s.number("plant_rate_hz", 100.0, 1e-3, 1e6);
+  const double period_ns = 1e9 / plant_hz;
+  if (std::abs(period_ns - std::round(period_ns)) > 1e-6) {
+    s.fail("plant_rate_hz", "got " + std::to_string(plant_hz) +
+                                ", expected a rate whose period is a whole number of nanoseconds");
+  }
+  cfg.plant.clock.period_ns = static_cast<std::int64_t>(std::round(period_ns));
+  const double controller_hz = s.number("controller_rate_hz", 50.0, 1e-3, plant_hz);
+  const double divider = plant_hz / controller_hz;
+  if (std::abs(divider - std::round(divider)) > 1e-9) {
+    s.fail("controller_rate_hz", "got " + std::to_string(controller_hz) +
+                                     ", expected a whole divisor of plant_rate_hz (" +
+                                     std::to_string(plant_hz) + ")");
+  }
+  cfg.controller_divider = static_cast<int>(std::round(divider));
+  cfg.plant.substeps = static_cast<int>(s.integer("substeps", 1, 1, 10000));
+  cfg.plant.command_delay_ticks = static_cast<int>(s.integer("command_delay_ticks", 0, 0, 100000));
+  duration_s = s.number("duration_s", 15.0, 0.0, 1e7);
+  cfg.duration_ticks = tick_at(s, "duration_s", duration_s, cfg.plant.clock.period_ns);
+  cfg.ns = s.text("namespace", cfg.ns);
+  if (std::string err = sim::validate_namespace(cfg.ns); !err.empty()) s.fail("namespace", err);
+  s.reject_unknown_keys();
+}
+
+void read_steps(YamlSection& analysis, std::vector<StepSpec>& steps, double duration_s) {
+  const std::vector<std::string> channels = {"x", "y", "z", "roll", "pitch", "yaw"};
+  int index = 0;
+  for (const YAML::Node& n : analysis.sequence("steps")) {
+    const std::string where = "steps[" + std::to_string(index++) + "]";
+    if (!n.IsMap()) analysis.fail(where, "expected a mapping with channel, at_s, criteria");
+    YamlSection s(n, analysis.file(), analysis.key_path(where));
+    StepSpec step;
+    step.channel = s.choice("channel", "", channels);
+    if (step.channel.empty()) s.fail("channel", "missing; expected one of x y z roll pitch yaw");
+    step.t_step_s = s.number("at_s", 0.0, 0.0, duration_s);
+    if (auto c = s.section("criteria")) {
+      for (const std::string& fig : c->keys()) {
+        bool known = false;
+        for (const auto& f : analysis::figure_names()) known = known || f == fig;
+        if (!known) c->fail(fig, "unknown step figure (expected overshoot_pct, peak_time_s, rise_time_s, t95_s, settling_time_2pct_s or steady_state_error_pct)");
+        const YAML::Node b = c->raw(fig);
+        if (!b.IsSequence() || b.size() != 2) c->fail(fig, "expected [min, max] (null for no bound)");
+        Criterion crit{fig, std::nullopt, std::nullopt};
+        for (int i = 0; i < 2; ++i) {
+          if (b[i].IsNull()) continue;
+          try {
+            (i == 0 ? crit.min : crit.max) = b[i].as<double>();
+          } catch (const YAML::Exception&) {
+            c->fail(fig, "got '" + b[i].Scalar() + "', expected a number or null");
+          }
+        }
+        if (crit.min && crit.max && *crit.min > *crit.max) c->fail(fig, "min is above max");
+        step.criteria.push_back(crit);
+      }
+    }
+    if (auto r = s.section("reference")) {
+      for (const std::string& key : r->keys()) {
+        if (key == "source") {
+          step.reference_source = r->text("source", "");
+          continue;
+        }
+        step.reference[key] = r->number(key, 0.0, -kHuge, kHuge);
+      }
+    }
+    s.reject_unknown_keys();
+    steps.push_back(step);
+  }
+  analysis.reject_unknown_keys();
+}
+
+void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
+  int index = 0;
+  for (const YAML::Node& n : root.sequence("schedule")) {
+    const std::string where = "schedule[" + std::to_string(index++) + "]";
+    if (!n.IsMap()) root.fail(where, "expected a mapping with at_s and set");
+    YamlSection s(n, root.file(), root.key_path(where));
+    const double at = s.number("at_s", 0.0, 0.0, duration_s);
+    const sim::Tick tick = tick_at(s, "at_s", at, sc.simulation.plant.clock.period_ns);
+    auto set = s.section("set");
+    if (!set) s.fail("set", "missing; expected a mapping of parameter: value");
+    // Validate against a scratch config, so errors name this entry.
+    control::ControllerConfig scratch = sc.controller;
+    std::vector<std::pair<std::string, control::ParameterValue>> values;
+    read_parameters(*set, "", scratch, &values);
+    for (auto& [name, value] : values) sc.schedule.push_back({tick, name, value});
+    s.reject_unknown_keys();
+  }
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::string& path) {
+  YamlSection root = YamlSection::load_file(path);
+  Scenario sc;
+  sc.path = path;
+  sc.name = root.text("name", std::filesystem::path(path).stem().string());
+  sc.description = root.text("description", "");
+  if (auto v = root.section("vehicle")) read_vehicle(*v, sc.vehicle);
+  sc.controller.params.vehicle = sc.vehicle;
+
+  double duration_s = 15.0;
+  if (auto s = root.section("simulation")) {
+    read_simulation(*s, sc.simulation, duration_s);
+  } else {
+    sc.simulation.duration_ticks = 1500;
+  }
+
+  if (auto i = root.section("initial")) {
+    const auto p = i->numbers("position_m", {0.0, 0.0, 0.0}, 3);
+    sc.initial.p_W = {p[0], p[1], p[2]};
+    if (sc.initial.p_W.z() < 0.0) i->fail("position_m", "z must be >= 0 (the ground is z = 0)");
+    sc.initial.yaw_rad = i->number("yaw_rad", 0.0, -10.0, 10.0);
+    sc.initial.hover = i->boolean("hover", false);
+    i->reject_unknown_keys();
+  }
+  if (auto c = root.section("controller")) read_parameters(*c, "", sc.controller, nullptr);
+  read_schedule(root, sc, duration_s);
+  if (auto a = root.section("analysis")) read_steps(*a, sc.steps, duration_s);
+  root.reject_unknown_keys();
+  return sc;
+}
+
+model::VehicleParams load_vehicle(const std::string& path) {
+  YamlSection root = YamlSection::load_file(path);
+  model::VehicleParams v;
+  read_vehicle(root, v);
+  return v;
+}
+
+control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle) {
+  YamlSection root = YamlSection::load_file(path);
+  control::ControllerConfig c;
+  c.params.vehicle = vehicle;
+  read_parameters(root, "", c, nullptr);
+  return c;
+}
+
+}  // namespace quadcosim::io

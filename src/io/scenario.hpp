@@ -1,0 +1,69 @@
+// Scenario files (YAML): vehicle, controller parameters, rates, duration, initial state, a schedule of
+// parameter changes, and the step figures to check. See docs/scenarios.md for every key.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "control/parameters.hpp"
+#include "model/vehicle_params.hpp"
+#include "sim/simulation.hpp"
+
+namespace quadcosim::io {
+
+/// Bad file content. what() names the file, the key path, the value and what was expected, e.g.
+/// "scenarios/x.yaml: simulation.plant_rate_hz: got 'fast', expected a number > 0".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct InitialState {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< [m]
+  double yaw_rad = 0.0;
+  bool hover = false;  ///< rotors start at hover speed (airborne trimmed start) instead of stopped
+};
+
+/// A pass band on one step figure; either bound may be absent.
+struct Criterion {
+  std::string figure;  ///< one of analysis::figure_names()
+  std::optional<double> min, max;
+};
+
+/// A step to analyse: the channel's setpoint changes at t_step_s.
+struct StepSpec {
+  std::string channel;   ///< x, y, z, roll, pitch or yaw
+  double t_step_s = 0.0;
+  std::vector<Criterion> criteria;
+  std::string reference_source;             ///< where the reference figures come from
+  std::map<std::string, double> reference;  ///< published figures to compare with
+};
+
+struct Scenario {
+  std::string path;  ///< file it was read from ("" for built-in defaults)
+  std::string name;
+  std::string description;
+  model::VehicleParams vehicle;
+  control::ControllerConfig controller;  ///< initial parameters and setpoints
+  sim::SimulationConfig simulation;
+  InitialState initial;
+  std::vector<sim::ScheduledParameter> schedule;
+  std::vector<StepSpec> steps;
+};
+
+/// Loads and validates a scenario. Throws ConfigError (file unreadable, YAML syntax, unknown key,
+/// wrong type, value out of range, a rate that is not a whole divisor, ...).
+Scenario load_scenario(const std::string& path);
+
+/// Loads a vehicle file: the keys of a scenario's `vehicle:` section at top level. Throws ConfigError.
+model::VehicleParams load_vehicle(const std::string& path);
+
+/// Loads a controller parameter file: the keys of a scenario's `controller:` section, on top of the
+/// defaults (whose vehicle knowledge comes from `vehicle`). Throws ConfigError.
+control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle);
+
+}  // namespace quadcosim::io

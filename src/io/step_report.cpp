@@ -1,0 +1,105 @@
+#include "io/step_report.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace quadcosim::io {
+
+std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series) {
+  std::vector<StepResult> out;
+  for (const StepSpec& spec : steps) {
+    StepResult r;
+    r.spec = spec;
+    const auto y = series.values.find(spec.channel);
+    const auto sp = series.values.find(spec.channel + "_des");
+    if (y == series.values.end() || sp == series.values.end() || series.t_s.empty()) {
+      throw std::logic_error("no recorded series for channel " + spec.channel);
+    }
+    const auto it = std::lower_bound(series.t_s.begin(), series.t_s.end(), spec.t_step_s);
+    const std::size_t i = std::min<std::size_t>(it - series.t_s.begin(), series.t_s.size() - 1);
+    r.figures = analysis::step_figures(series.t_s, y->second, spec.t_step_s, sp->second[i]);
+    for (const Criterion& c : spec.criteria) {
+      CriterionResult cr{c, analysis::figure(r.figures, c.figure), false};
+      cr.passed = cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
+      r.passed = r.passed && cr.passed;
+      r.criteria.push_back(cr);
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+bool all_passed(const std::vector<StepResult>& results) {
+  return std::all_of(results.begin(), results.end(), [](const auto& r) { return r.passed; });
+}
+
+namespace {
+nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
+}  // namespace
+
+void write_metrics_json(const std::string& path, const Scenario& scenario,
+                        const std::vector<StepResult>& results) {
+  nlohmann::json j;
+  j["scenario"] = scenario.name;
+  j["description"] = scenario.description;
+  j["scenario_file"] = scenario.path;
+  j["steps"] = nlohmann::json::array();
+  for (const StepResult& r : results) {
+    nlohmann::json s;
+    s["channel"] = r.spec.channel;
+    s["t_step_s"] = r.spec.t_step_s;
+    s["initial"] = r.figures.initial;
+    s["target"] = r.figures.target;
+    nlohmann::json figs = nlohmann::json::object();
+    for (const auto& name : analysis::figure_names()) figs[name] = opt(analysis::figure(r.figures, name));
+    s["figures"] = figs;
+    s["criteria"] = nlohmann::json::array();
+    for (const auto& c : r.criteria) {
+      s["criteria"].push_back({{"figure", c.criterion.figure},
+                               {"min", opt(c.criterion.min)},
+                               {"max", opt(c.criterion.max)},
+                               {"value", opt(c.value)},
+                               {"passed", c.passed}});
+    }
+    if (!r.spec.reference.empty()) {
+      nlohmann::json ref = {{"source", r.spec.reference_source}};
+      for (const auto& [k, v] : r.spec.reference) ref[k] = v;
+      s["reference"] = ref;
+    }
+    s["passed"] = r.passed;
+    j["steps"].push_back(s);
+  }
+  j["passed"] = all_passed(results);
+  std::ofstream out(path);
+  out << j.dump(2) << '\n';
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results) {
+  std::string s = fmt::format("scenario {}\n", scenario.name);
+  for (const StepResult& r : results) {
+    s += fmt::format("step {} {:g} -> {:g} at t = {:g} s: {}\n", r.spec.channel, r.figures.initial,
+                     r.figures.target, r.spec.t_step_s, r.passed ? "PASS" : "FAIL");
+    s += fmt::format("  {:<24} {:>10} {:>22} {:>7} {:>10}\n", "figure", "value", "criterion", "", "reference");
+    for (const auto& name : analysis::figure_names()) {
+      const auto v = analysis::figure(r.figures, name);
+      std::string crit, verdict;
+      for (const auto& c : r.criteria) {
+        if (c.criterion.figure != name) continue;
+        crit = fmt::format("[{}, {}]", c.criterion.min ? fmt::format("{:g}", *c.criterion.min) : "-",
+                           c.criterion.max ? fmt::format("{:g}", *c.criterion.max) : "-");
+        verdict = c.passed ? "ok" : "FAIL";
+      }
+      const auto ref = r.spec.reference.find(name);
+      s += fmt::format("  {:<24} {:>10} {:>22} {:>7} {:>10}\n", name, v ? fmt::format("{:.3f}", *v) : "-",
+                       crit, verdict, ref != r.spec.reference.end() ? fmt::format("{:g}", ref->second) : "");
+    }
+  }
+  return s;
+}
+
+}  // namespace quadcosim::io

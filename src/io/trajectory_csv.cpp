@@ -1,0 +1,130 @@
+#include "io/trajectory_csv.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "model/attitude.hpp"
+
+namespace quadcosim::io {
+
+ControlColumns ControlColumns::none() {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {nan, nan, nan, nan, nan, nan, Eigen::Vector4d::Constant(nan), false};
+}
+
+const std::vector<std::string>& TrajectoryWriter::columns() {
+  static const std::vector<std::string> c = {
+      "t",     "x",      "y",       "z",       "vx",       "vy",       "vz",   "qw",  "qx",
+      "qy",    "qz",     "roll",    "pitch",   "yaw",      "p",        "q",    "r",   "w1",
+      "w2",    "w3",     "w4",      "cmd1",    "cmd2",     "cmd3",     "cmd4", "x_des", "y_des",
+      "z_des", "roll_des", "pitch_des", "yaw_des", "U1",   "U2",       "U3",   "U4",  "safety"};
+  return c;
+}
+
+TrajectoryWriter::TrajectoryWriter(const std::string& path) : path_(path) {
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) throw std::runtime_error(path + ": cannot open for writing");
+  std::string header;
+  for (const auto& c : columns()) header += (header.empty() ? "" : ",") + c;
+  header += '\n';
+  std::fwrite(header.data(), 1, header.size(), file_);
+}
+
+TrajectoryWriter::~TrajectoryWriter() {
+  if (file_) {
+    std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+    std::fclose(file_);
+  }
+}
+
+void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vector4d& cmd,
+                             const ControlColumns& c) {
+  const model::Euler e = model::euler_from_quaternion(x.q_WB);
+  auto out = std::back_inserter(buffer_);
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},", t, x.p_W.x(), x.p_W.y(),
+                 x.p_W.z(), x.v_W.x(), x.v_W.y(), x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(),
+                 x.q_WB.z(), e.roll_rad, e.pitch_rad, e.yaw_rad, x.w_B.x(), x.w_B.y(), x.w_B.z());
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1],
+                 x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{}\n", c.x_des, c.y_des, c.z_des, c.roll_des,
+                 c.pitch_des, c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0);
+  if (buffer_.size() > (1 << 16)) {
+    std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+    buffer_.clear();
+  }
+}
+
+void TrajectoryWriter::close() {
+  if (!file_) return;
+  const bool ok = std::fwrite(buffer_.data(), 1, buffer_.size(), file_) == buffer_.size();
+  buffer_.clear();
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!ok || !closed) throw std::runtime_error(path_ + ": write failed");
+}
+
+std::vector<CommandRow> read_command_schedule(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open the file");
+  std::string line;
+  int line_no = 0;
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " + what);
+  };
+  auto trim = [](std::string s) {
+    while (!s.empty() && (s.back() == '\r' || s.back() == ' ')) s.pop_back();
+    while (!s.empty() && s.front() == ' ') s.erase(s.begin());
+    return s;
+  };
+  if (!std::getline(in, line)) {
+    line_no = 1;
+    fail("empty file, expected the header t,w1,w2,w3,w4");
+  }
+  line_no = 1;
+  {
+    std::vector<std::string> cols;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cols.push_back(trim(c));
+    if (cols != std::vector<std::string>{"t", "w1", "w2", "w3", "w4"}) {
+      fail("header is '" + trim(line) + "', expected t,w1,w2,w3,w4");
+    }
+  }
+  std::vector<CommandRow> rows;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (trim(line).empty()) continue;
+    std::stringstream ss(line);
+    std::vector<double> v;
+    for (std::string cell; std::getline(ss, cell, ',');) {
+      cell = trim(cell);
+      std::size_t used = 0;
+      double d = 0.0;
+      try {
+        d = std::stod(cell, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != cell.size()) fail("'" + cell + "' is not a number");
+      v.push_back(d);
+    }
+    if (v.size() != 5) fail("expected 5 values (t,w1,w2,w3,w4), got " + std::to_string(v.size()));
+    for (double d : v) {
+      if (!std::isfinite(d)) fail("values must be finite");
+    }
+    if (v[0] < 0.0) fail("time must be >= 0");
+    if (!rows.empty() && v[0] <= rows.back().t_s) fail("times must increase strictly");
+    for (int i = 1; i <= 4; ++i) {
+      if (v[i] < 0.0) fail("w" + std::to_string(i) + " must be >= 0 rad/s");
+    }
+    rows.push_back({v[0], Eigen::Vector4d(v[1], v[2], v[3], v[4])});
+  }
+  if (rows.empty()) fail("no command rows after the header");
+  return rows;
+}
+
+}  // namespace quadcosim::io

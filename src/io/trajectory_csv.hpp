@@ -1,0 +1,53 @@
+// trajectory.csv: one row per plant tick, numbers in shortest round-trip form (the same double
+// always prints the same text, so identical runs give identical files).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "model/quadrotor.hpp"
+
+namespace quadcosim::io {
+
+/// Setpoints and controller outputs shown beside the state; NaN where there is none (open loop).
+struct ControlColumns {
+  double x_des, y_des, z_des, roll_des, pitch_des, yaw_des;
+  Eigen::Vector4d U;  ///< U1 [N], U2..U4 [N m]
+  bool safety;
+  static ControlColumns none();
+};
+
+class TrajectoryWriter {
+ public:
+  /// Opens (truncates) `path`; throws std::runtime_error naming the path when it cannot.
+  explicit TrajectoryWriter(const std::string& path);
+  ~TrajectoryWriter();
+  TrajectoryWriter(const TrajectoryWriter&) = delete;
+  TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
+
+  static const std::vector<std::string>& columns();
+
+  /// `command` is the rotor command acting over the next interval [rad/s].
+  void write(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c);
+  /// Flushes and closes; throws std::runtime_error on a write error.
+  void close();
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  std::string buffer_;
+};
+
+/// One row of a motor command schedule (openloop input).
+struct CommandRow {
+  double t_s;
+  Eigen::Vector4d omega_rad_s;
+};
+
+/// Reads a CSV with header `t,w1,w2,w3,w4` (times strictly increasing, starting at or after 0;
+/// speeds finite and >= 0). Throws std::runtime_error naming file, line and the problem.
+std::vector<CommandRow> read_command_schedule(const std::string& path);
+
+}  // namespace quadcosim::io

@@ -1,0 +1,165 @@
+#include "io/yaml_reader.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace quadcosim::io {
+
+YamlSection::YamlSection(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+YamlSection YamlSection::load_file(const std::string& file) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(file + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(file + ": line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(file + ": expected a mapping of keys at the top level");
+  return YamlSection(root, file, "");
+}
+
+std::string YamlSection::key_path(const std::string& key) const {
+  if (key.empty()) return path_;
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void YamlSection::fail(const std::string& key, const std::string& message) const {
+  const std::string where = key_path(key);
+  throw ConfigError(file_ + ": " + (where.empty() ? "" : where + ": ") + message);
+}
+
+std::string YamlSection::shown(const YAML::Node& n) const {
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+bool YamlSection::has(const std::string& key) const { return node_[key].IsDefined(); }
+
+YAML::Node YamlSection::get(const std::string& key) {
+  used_.insert(key);
+  return node_[key];
+}
+
+YAML::Node YamlSection::raw(const std::string& key) { return get(key); }
+
+double YamlSection::number(const std::string& key, double fallback, double min, double max) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined()) return fallback;
+  std::ostringstream expected;
+  expected << "expected a number in [" << min << ", " << max << "]";
+  double v = 0.0;
+  try {
+    if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
+    v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    fail(key, "got " + shown(n) + ", " + expected.str());
+  }
+  if (!std::isfinite(v) || v < min || v > max) fail(key, "got " + shown(n) + ", " + expected.str());
+  return v;
+}
+
+long long YamlSection::integer(const std::string& key, long long fallback, long long min, long long max) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined()) return fallback;
+  const std::string expected =
+      "expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  long long v = 0;
+  try {
+    if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
+    v = n.as<long long>();
+  } catch (const YAML::Exception&) {
+    fail(key, "got " + shown(n) + ", " + expected);
+  }
+  if (v < min || v > max) fail(key, "got " + shown(n) + ", " + expected);
+  return v;
+}
+
+bool YamlSection::boolean(const std::string& key, bool fallback) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined()) return fallback;
+  try {
+    if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
+    return n.as<bool>();
+  } catch (const YAML::Exception&) {
+    fail(key, "got " + shown(n) + ", expected true or false");
+  }
+}
+
+std::string YamlSection::text(const std::string& key, const std::string& fallback) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined()) return fallback;
+  if (!n.IsScalar()) fail(key, "got " + shown(n) + ", expected text");
+  return n.Scalar();
+}
+
+std::string YamlSection::choice(const std::string& key, const std::string& fallback,
+                                const std::vector<std::string>& choices) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined()) return fallback;
+  std::string expected = "expected one of";
+  for (const auto& c : choices) expected += " '" + c + "'";
+  if (n.IsScalar()) {
+    for (const auto& c : choices) {
+      if (n.Scalar() == c) return c;
+    }
+  }
+  fail(key, "got " + shown(n) + ", " + expected);
+}
+
+std::vector<double> YamlSection::numbers(const std::string& key, std::vector<double> fallback,
+                                         std::size_t count) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined()) return fallback;
+  const std::string expected = "expected a list of " + std::to_string(count) + " numbers";
+  if (!n.IsSequence() || n.size() != count) fail(key, "got " + shown(n) + ", " + expected);
+  std::vector<double> out;
+  for (const auto& e : n) {
+    double v = 0.0;
+    try {
+      if (!e.IsScalar()) throw YAML::Exception(e.Mark(), "");
+      v = e.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(key, "got an entry " + shown(e) + ", " + expected);
+    }
+    if (!std::isfinite(v)) fail(key, "got an entry " + shown(e) + ", " + expected + " (finite)");
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::optional<YamlSection> YamlSection::section(const std::string& key) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined() || n.IsNull()) return std::nullopt;
+  if (!n.IsMap()) fail(key, "got " + shown(n) + ", expected a mapping of keys");
+  return YamlSection(n, file_, key_path(key));
+}
+
+std::vector<YAML::Node> YamlSection::sequence(const std::string& key) {
+  const YAML::Node n = get(key);
+  if (!n.IsDefined() || n.IsNull()) return {};
+  if (!n.IsSequence()) fail(key, "got " + shown(n) + ", expected a list");
+  return {n.begin(), n.end()};
+}
+
+std::vector<std::string> YamlSection::keys() {
+  std::vector<std::string> out;
+  for (const auto& kv : node_) {
+    out.push_back(kv.first.as<std::string>());
+    used_.insert(out.back());
+  }
+  return out;
+}
+
+void YamlSection::reject_unknown_keys() const {
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (!used_.count(key)) fail(key, "unknown key");
+  }
+}
+
+}  // namespace quadcosim::io

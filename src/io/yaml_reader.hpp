@@ -1,0 +1,62 @@
+// A thin checked view of a YAML mapping: every read names file and key path in its error, and
+// keys nobody asked for are reported as unknown (catches typos such as `mas_kg`).
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "io/scenario.hpp"
+
+namespace quadcosim::io {
+
+class YamlSection {
+ public:
+  YamlSection(YAML::Node node, std::string file, std::string path);
+
+  /// Parses `file`; throws ConfigError when it cannot be read or parsed or is not a mapping.
+  static YamlSection load_file(const std::string& file);
+
+  bool has(const std::string& key) const;
+  /// A number in [min, max] (NaN/inf refused); `fallback` when the key is absent.
+  double number(const std::string& key, double fallback, double min, double max);
+  /// An integer in [min, max]; `fallback` when absent.
+  long long integer(const std::string& key, long long fallback, long long min, long long max);
+  bool boolean(const std::string& key, bool fallback);
+  std::string text(const std::string& key, const std::string& fallback);
+  /// One of `choices`; `fallback` when absent.
+  std::string choice(const std::string& key, const std::string& fallback,
+                     const std::vector<std::string>& choices);
+  /// A list of exactly n numbers; `fallback` when absent.
+  std::vector<double> numbers(const std::string& key, std::vector<double> fallback, std::size_t n);
+  /// The mapping under `key`, or nothing when absent.
+  std::optional<YamlSection> section(const std::string& key);
+  /// The sequence under `key` as raw nodes (empty when absent); throws when not a sequence.
+  std::vector<YAML::Node> sequence(const std::string& key);
+  /// Raw access for callers that walk the mapping themselves (marks the key as used).
+  YAML::Node raw(const std::string& key);
+  /// All keys, in file order (marks them used).
+  std::vector<std::string> keys();
+
+  /// Throws ConfigError naming the first key that no read asked for.
+  void reject_unknown_keys() const;
+
+  /// "file: path.key: message".
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+  std::string key_path(const std::string& key) const;
+  const std::string& file() const { return file_; }
+
+ private:
+  YAML::Node get(const std::string& key);
+  std::string shown(const YAML::Node& n) const;
+
+  YAML::Node node_;
+  std::string file_;
+  std::string path_;
+  std::set<std::string> used_;
+};
+
+}  // namespace quadcosim::io

@@ -1,0 +1,87 @@
+// The 6-DOF quadrotor plant as a const function dx = f(t, x, u; params), plus its fixed-step RK4
+// integrator and the measured outputs. Frames: world ENU (W), body FLU (B).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "model/mixer.hpp"
+#include "model/vehicle_params.hpp"
+
+namespace quadcosim::model {
+
+/// Full plant state. Plain data: the integrator owns it, the model never stores it.
+struct State {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();               ///< position [m]
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();               ///< velocity [m/s]
+  Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();    ///< attitude, body -> world
+  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();               ///< body angular velocity [rad/s]
+  Vector4 omega_rad_s = Vector4::Zero();                       ///< rotor speeds [rad/s]
+};
+
+/// Time derivative of State; the quaternion derivative is kept as 4 raw coefficients (w, x, y, z).
+struct StateDerivative {
+  Eigen::Vector3d p_W;
+  Eigen::Vector3d v_W;
+  Eigen::Vector4d q_WB_wxyz;
+  Eigen::Vector3d w_B;
+  Vector4 omega_rad_s;
+};
+
+/// What the plant's sensors see at one instant (noise-free).
+struct Outputs {
+  Eigen::Vector3d p_W;
+  Eigen::Quaterniond q_WB;
+  Eigen::Vector3d v_W;
+  Eigen::Vector3d w_B;
+  Eigen::Vector3d specific_force_B;  ///< accelerometer reading [m/s^2]: R_BW (a_W - g_W)
+};
+
+/// Rotor speeds [rad/s] into collective thrust U1 [N] and body torques U2..U4 [N m] (eq. (4)).
+struct Wrench {
+  double thrust_N;
+  Eigen::Vector3d torque_B_Nm;
+};
+
+class Quadrotor {
+ public:
+  explicit Quadrotor(const VehicleParams& params);
+
+  const VehicleParams& params() const { return params_; }
+  const Matrix4& mixer() const { return mixer_; }
+
+  /// Command clamped to [omega_min, omega_max]; non-finite entries become omega_min.
+  Vector4 clamp_command(const Vector4& omega_cmd_rad_s) const;
+
+  /// Eq. (4) for the given rotor speeds.
+  Wrench wrench(const Vector4& omega_rad_s) const;
+
+  /// dx/dt at state x under the (already clamped) commanded rotor speeds:
+  ///  - translation, eq. (7) in vector form: dv_W = R_WB (0, 0, U1) / m + (0, 0, -g);
+  ///  - rotation, eq. (8): dw_B = I^-1 (tau - w x I w), or eq. (11) without the gyroscopic term;
+  ///  - attitude: dq = 1/2 q (0, w_B);
+  ///  - rotors: ideal (derivative 0, speeds = command) or first-order lag.
+  /// Ground contact: while resting on z = 0 and the forces would push it down, the ground (with
+  /// friction) holds the vehicle: all accelerations are zero.
+  StateDerivative derivative(double t_s, const State& x, const Vector4& omega_cmd_rad_s) const;
+
+  /// Sensor outputs at state x under the given command (the command sets the acceleration that the
+  /// accelerometer measures).
+  Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s) const;
+
+  /// Advances x by dt_s with `substeps` classical RK4 steps, command held constant. After each step
+  /// the quaternion is renormalised and ground contact is enforced (z >= 0; an impact is inelastic).
+  void step(State& x, double t_s, const Vector4& omega_cmd_rad_s, double dt_s, int substeps) const;
+
+  /// A state at rest at p_W with rotors stopped (or at hover speed when `hover` is true).
+  State initial_state(const Eigen::Vector3d& p_W, double yaw_rad, bool hover) const;
+
+ private:
+  bool on_ground(const State& x) const;
+
+  VehicleParams params_;
+  Matrix4 mixer_;
+  Eigen::Vector3d inertia_diag_;
+};
+
+}  // namespace quadcosim::model

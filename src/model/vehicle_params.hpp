@@ -1,0 +1,68 @@
+// Physical parameters of a quadrotor. Defaults are the paper's vehicle (Table 1).
+#pragma once
+
+#include <array>
+#include <string>
+
+namespace quadcosim::model {
+
+/// Arrangement of the four rotors in the body (FLU) frame.
+enum class RotorLayout {
+  /// '+': rotor 1 on +x (nose), 2 on -y (right), 3 on -x, 4 on +y (left); the paper's eq. (4).
+  kPlus,
+  /// 'x': the '+' arrangement turned 45 deg counter-clockwise seen from above: rotor 1 front-left,
+  /// 2 front-right, 3 rear-right, 4 rear-left.
+  kX,
+};
+
+/// How the motor speed follows the commanded speed.
+enum class MotorModel {
+  kIdeal,        ///< speed equals the (clamped) command instantly, as in the paper.
+  kFirstOrder,   ///< first-order lag with separate time constants for spinning up and down.
+};
+
+/// Which rotational dynamics the plant integrates.
+enum class GyroscopicModel {
+  kFull,        ///< eq. (8)/(10): I dw = tau - w x (I w).
+  kSimplified,  ///< eq. (11): I dw = tau (gyroscopic coupling dropped).
+};
+
+struct MotorParams {
+  MotorModel model = MotorModel::kIdeal;
+  double tau_up_s = 0.02;     ///< [s] time constant when the command is above the current speed.
+  double tau_down_s = 0.04;   ///< [s] time constant when the command is below the current speed.
+  double omega_min_rad_s = 0.0;      ///< [rad/s] lowest speed a motor turns at (0: may stop).
+  /// [rad/s] highest speed. 12000 rad/s gives a thrust-to-weight ratio of about 6.2 with Table 1's
+  /// k_t, above the peak the paper's altitude step asks for (about 8400 rad/s).
+  double omega_max_rad_s = 12000.0;
+};
+
+struct VehicleParams {
+  double mass_kg = 1.96;
+  double gravity_m_s2 = 9.81;
+  double Ixx_kg_m2 = 0.0149;
+  double Iyy_kg_m2 = 0.0153;
+  double Izz_kg_m2 = 0.0532;
+  double arm_length_m = 0.59;   ///< [m] rotor axis to centre of mass (L).
+  double kt_N_per_rad2_s2 = 2.06e-7;    ///< thrust coefficient k_t [N/(rad/s)^2], eq. (1).
+  double km_Nm_per_rad2_s2 = 1.01e-10;  ///< drag-torque coefficient k_m [N m/(rad/s)^2], eq. (2).
+  RotorLayout layout = RotorLayout::kPlus;
+  /// Sign of each rotor's reaction torque about +z_B (+1: the rotor spins clockwise seen from above,
+  /// so its drag pushes the body counter-clockwise). The paper's eq. (4): rotors 1 and 3 positive.
+  std::array<int, 4> spin = {+1, -1, +1, -1};
+  MotorParams motor;
+  GyroscopicModel gyroscopic = GyroscopicModel::kFull;
+
+  /// [rad/s] speed at which four equal rotors carry the weight: sqrt(m g / (4 k_t)).
+  double hover_omega_rad_s() const;
+};
+
+/// Returns an empty string when `p` is physically meaningful, else a message naming the first bad field
+/// (e.g. "mass_kg must be > 0, got -1").
+std::string validate(const VehicleParams& p);
+
+const char* to_string(RotorLayout layout);
+const char* to_string(MotorModel model);
+const char* to_string(GyroscopicModel model);
+
+}  // namespace quadcosim::model

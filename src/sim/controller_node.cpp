@@ -1,0 +1,57 @@
+#include "sim/controller_node.hpp"
+
+#include <algorithm>
+
+#include "model/attitude.hpp"
+
+namespace quadcosim::sim {
+
+ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
+                               const control::ControllerConfig& config)
+    : config_(config), controller_(config.params) {
+  command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
+  command_msg_.data.resize(4);
+  transport.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) {
+    estimate_.p_W = {m.position.x, m.position.y, m.position.z};
+    pose_stamp_ns_ = m.header.stamp.to_ns();
+  });
+  transport.subscribe<msg::TwistStamped>(topics.velocity, [this](const msg::TwistStamped& m) {
+    estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
+    velocity_stamp_ns_ = m.header.stamp.to_ns();
+  });
+  transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
+    const Eigen::Quaterniond q(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
+    const model::Euler e = model::euler_from_quaternion(q);
+    estimate_.roll_rad = e.roll_rad;
+    estimate_.pitch_rad = e.pitch_rad;
+    estimate_.yaw_rad = e.yaw_rad;
+    estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
+    imu_stamp_ns_ = m.header.stamp.to_ns();
+  });
+}
+
+const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
+  const std::int64_t oldest = std::min({pose_stamp_ns_, velocity_stamp_ns_, imu_stamp_ns_});
+  estimate_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
+                                     : static_cast<double>(now_ns - oldest) / 1e9;
+  command_ = controller_.step(estimate_, config_.setpoint, dt_s);
+  for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];
+  command_pub_.publish(command_msg_);
+  return command_;
+}
+
+std::string ControllerNode::set_parameter(const std::string& name, const control::ParameterValue& value) {
+  control::ControllerConfig next = config_;
+  if (std::string err = control::set_parameter(next, name, value); !err.empty()) return err;
+  if (control::find_parameter(name)->affects_design) {
+    try {
+      controller_.set_params(next.params);
+    } catch (const std::exception& e) {
+      return name + ": " + e.what();
+    }
+  }
+  config_ = next;
+  return {};
+}
+
+}  // namespace quadcosim::sim

@@ -1,0 +1,76 @@
+// The messages the nodes exchange, shaped field for field like their ROS 2 types (see
+// docs/ros2-wire.md in the shared docs), so a DDS transport maps them one to one and the in-process
+// transport carries exactly the numbers the wire would.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace quadcosim::msg {
+
+/// builtin_interfaces/msg/Time
+struct Time {
+  std::int32_t sec = 0;
+  std::uint32_t nanosec = 0;
+
+  static Time from_ns(std::int64_t ns);
+  std::int64_t to_ns() const { return std::int64_t{sec} * 1'000'000'000 + nanosec; }
+};
+
+/// std_msgs/msg/Header
+struct Header {
+  Time stamp;
+  std::string frame_id;
+};
+
+struct Vector3 {
+  double x = 0, y = 0, z = 0;
+};
+struct Quaternion {
+  double x = 0, y = 0, z = 0, w = 1;
+};
+
+/// geometry_msgs/msg/PoseStamped: position in the world frame, orientation q_WB.
+struct PoseStamped {
+  static constexpr std::string_view kRosType = "geometry_msgs/msg/PoseStamped";
+  Header header;
+  Vector3 position;  // geometry_msgs/Point
+  Quaternion orientation;
+};
+
+/// geometry_msgs/msg/TwistStamped: linear velocity in the world frame, angular velocity in body.
+struct TwistStamped {
+  static constexpr std::string_view kRosType = "geometry_msgs/msg/TwistStamped";
+  Header header;
+  Vector3 linear;
+  Vector3 angular;
+};
+
+/// sensor_msgs/msg/Imu: orientation q_WB, body rates, specific force in body.
+struct Imu {
+  static constexpr std::string_view kRosType = "sensor_msgs/msg/Imu";
+  Header header;
+  Quaternion orientation;
+  std::array<double, 9> orientation_covariance{};
+  Vector3 angular_velocity;
+  std::array<double, 9> angular_velocity_covariance{};
+  Vector3 linear_acceleration;
+  std::array<double, 9> linear_acceleration_covariance{};
+};
+
+/// std_msgs/msg/Float64MultiArray (the layout is left empty, as the paper's nodes do).
+struct Float64MultiArray {
+  static constexpr std::string_view kRosType = "std_msgs/msg/Float64MultiArray";
+  std::vector<double> data;
+};
+
+/// rosgraph_msgs/msg/Clock
+struct Clock {
+  static constexpr std::string_view kRosType = "rosgraph_msgs/msg/Clock";
+  Time clock;
+};
+
+}  // namespace quadcosim::msg

@@ -1,0 +1,75 @@
+#include "sim/plant_node.hpp"
+
+#include <cmath>
+
+namespace quadcosim::sim {
+
+namespace {
+msg::Vector3 to_msg(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
+}  // namespace
+
+PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
+                     const PlantOptions& options, const model::State& initial)
+    : model_(vehicle), options_(options), state_(initial), applied_(initial.omega_rad_s) {
+  clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
+  pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
+  velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
+  imu_pub_ = transport.advertise<msg::Imu>(topics.imu);
+  transport.subscribe<msg::Float64MultiArray>(
+      topics.motor_commands, [this](const msg::Float64MultiArray& m) { on_command(m); });
+}
+
+void PlantNode::on_command(const msg::Float64MultiArray& m) {
+  ++stats_.commands_received;
+  bool ok = m.data.size() == 4;
+  for (std::size_t i = 0; ok && i < 4; ++i) ok = std::isfinite(m.data[i]);
+  if (!ok) {
+    ++stats_.commands_rejected;
+    return;
+  }
+  pending_.push_back({current_tick_ + options_.command_delay_ticks,
+                      model::Vector4(m.data[0], m.data[1], m.data[2], m.data[3])});
+}
+
+void PlantNode::publish_outputs(Tick k) {
+  current_tick_ = k;
+  const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
+  const msg::Header header{stamp, options_.frame_id};
+  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_);
+
+  clock_pub_.publish(msg::Clock{stamp});
+
+  msg::PoseStamped pose;
+  pose.header = header;
+  pose.position = to_msg(y.p_W);
+  pose.orientation = to_msg(y.q_WB);
+  pose_pub_.publish(pose);
+
+  msg::TwistStamped twist;
+  twist.header = header;
+  twist.linear = to_msg(y.v_W);
+  twist.angular = to_msg(y.w_B);
+  velocity_pub_.publish(twist);
+
+  msg::Imu imu;
+  imu.header = msg::Header{stamp, "base_link"};
+  imu.orientation = to_msg(y.q_WB);
+  imu.angular_velocity = to_msg(y.w_B);
+  imu.linear_acceleration = to_msg(y.specific_force_B);
+  imu_pub_.publish(imu);
+}
+
+void PlantNode::latch_command(Tick k) {
+  while (!pending_.empty() && pending_.front().effective_tick <= k) {
+    applied_ = pending_.front().omega;
+    pending_.pop_front();
+  }
+}
+
+void PlantNode::integrate(Tick k) {
+  model_.step(state_, options_.clock.seconds(k), applied_, options_.clock.period_s(),
+              options_.substeps);
+}
+
+}  // namespace quadcosim::sim

@@ -1,0 +1,66 @@
+// The plant as a node: integrates the model on integer ticks, publishes the paper's sensor topics and
+// /clock, and takes rotor speed commands from /<ns>/motor_commands (zero-order hold).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+
+#include "model/quadrotor.hpp"
+#include "sim/clock.hpp"
+#include "sim/messages.hpp"
+#include "sim/topics.hpp"
+#include "sim/transport.hpp"
+
+namespace quadcosim::sim {
+
+struct PlantOptions {
+  TickClock clock;
+  int substeps = 1;              ///< RK4 steps per plant tick
+  int command_delay_ticks = 0;   ///< a command received during tick k takes effect at tick k + delay
+  std::string frame_id = "world";
+};
+
+struct PlantStats {
+  std::uint64_t commands_received = 0;
+  std::uint64_t commands_rejected = 0;  ///< wrong length or non-finite: ignored, last good one held
+};
+
+class PlantNode {
+ public:
+  PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
+            const PlantOptions& options, const model::State& initial);
+
+  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k.
+  void publish_outputs(Tick k);
+  /// Fixes the command that acts over [t_k, t_k+1): the newest one whose delay has elapsed.
+  void latch_command(Tick k);
+  /// Integrates the state from t_k to t_k+1 under the latched command.
+  void integrate(Tick k);
+
+  const model::State& state() const { return state_; }
+  const model::Quadrotor& model() const { return model_; }
+  /// The command latched for the current interval, as received (before the model's clamping).
+  const model::Vector4& applied_command() const { return applied_; }
+  const PlantStats& stats() const { return stats_; }
+
+ private:
+  void on_command(const msg::Float64MultiArray& m);
+
+  model::Quadrotor model_;
+  PlantOptions options_;
+  model::State state_;
+  Tick current_tick_ = 0;
+  model::Vector4 applied_ = model::Vector4::Zero();
+  struct Pending {
+    Tick effective_tick;
+    model::Vector4 omega;
+  };
+  std::deque<Pending> pending_;
+  PlantStats stats_;
+  Publisher<msg::Clock> clock_pub_;
+  Publisher<msg::PoseStamped> pose_pub_;
+  Publisher<msg::TwistStamped> velocity_pub_;
+  Publisher<msg::Imu> imu_pub_;
+};
+
+}  // namespace quadcosim::sim

@@ -1,0 +1,22 @@
+// Topic names of one vehicle. The namespace is a setting so several vehicles share a domain.
+#pragma once
+
+#include <string>
+
+namespace quadcosim::sim {
+
+struct Topics {
+  std::string motor_commands;  ///< controller -> plant, std_msgs/Float64MultiArray
+  std::string pose;            ///< plant ->, geometry_msgs/PoseStamped
+  std::string velocity;        ///< plant ->, geometry_msgs/TwistStamped
+  std::string imu;             ///< plant ->, sensor_msgs/Imu
+  std::string clock;           ///< plant ->, rosgraph_msgs/Clock (global, not namespaced)
+
+  /// Topics under `ns` ("/drone" gives "/drone/Pose", ...). `ns` must start with '/'.
+  static Topics for_namespace(const std::string& ns = "/drone");
+};
+
+/// Empty when `ns` is a valid ROS namespace ("/drone", "/uav1"), else why not.
+std::string validate_namespace(const std::string& ns);
+
+}  // namespace quadcosim::sim

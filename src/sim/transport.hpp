@@ -1,0 +1,65 @@
+// The seam between nodes and whatever carries their messages. Nodes publish and subscribe by topic
+// name and message type only; they never learn which transport is underneath.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <typeindex>
+
+namespace quadcosim::sim {
+
+/// A message type as a transport sees it: its ROS 2 type name and its C++ identity.
+struct TopicType {
+  std::string_view ros_type;  ///< e.g. "geometry_msgs/msg/PoseStamped"
+  std::type_index cpp_type;
+};
+
+template <class T>
+TopicType topic_type() {
+  return {T::kRosType, std::type_index(typeid(T))};
+}
+
+class Transport;
+
+/// Typed handle for publishing on one topic.
+template <class T>
+class Publisher {
+ public:
+  Publisher() = default;
+  void publish(const T& message) const { sink_(&message); }
+  explicit operator bool() const { return static_cast<bool>(sink_); }
+
+ private:
+  friend class Transport;
+  explicit Publisher(std::function<void(const void*)> sink) : sink_(std::move(sink)) {}
+  std::function<void(const void*)> sink_;
+};
+
+class Transport {
+ public:
+  virtual ~Transport() = default;
+
+  template <class T>
+  Publisher<T> advertise(const std::string& topic) {
+    return Publisher<T>(make_sink(topic, topic_type<T>()));
+  }
+
+  /// `callback` runs for every message on `topic`, in publication order. When it runs is up to the
+  /// transport: in-process, during publish(); over a network, when the node polls.
+  template <class T>
+  void subscribe(const std::string& topic, std::function<void(const T&)> callback) {
+    add_subscription(topic, topic_type<T>(), [cb = std::move(callback)](const void* m) {
+      cb(*static_cast<const T*>(m));
+    });
+  }
+
+ protected:
+  /// Returns the function that sends one message (passed as a pointer to the T of `type`).
+  virtual std::function<void(const void*)> make_sink(const std::string& topic, const TopicType& type) = 0;
+  virtual void add_subscription(const std::string& topic, const TopicType& type,
+                                std::function<void(const void*)> deliver) = 0;
+};
+
+}  // namespace quadcosim::sim

@@ -1,0 +1,681 @@
+#!/usr/bin/python3
+"""Plot a quadcosim run directory.
+
+Usage: plot_run.py RUN_DIR
+
+Reads RUN_DIR/trajectory.csv (required) and RUN_DIR/metrics.json (optional) and
+writes PNG figures into RUN_DIR, printing the path of every file written:
+
+  step_<channel>.png  one per entry of metrics.json "steps" (or, without
+                      metrics.json, one per channel whose <channel>_des column
+                      changes during the run, or is constant but differs from
+                      the channel's value in the first row), in the style of the paper's
+                      Figs. 4-7: variable (red) and its rate (blue) vs. time,
+                      setpoint dashed grey, +-2 % band around the target,
+                      peak / 2 % settling markers and a box with the step
+                      figures next to the paper's reference figures.
+                      A channel stepped more than once gets
+                      step_<channel>.png, step_<channel>_2.png, ...
+  overview.png        2x3 grid: 3D path, position, attitude, body rates,
+                      rotor speeds, vertical speed.
+
+Conventions assumed for metrics.json: the time figures (peak_time_s, rise_time_s,
+t95_s, settling_time_2pct_s) are measured from the step time t_step_s; the
++-2 % band is 2 % of the step size |target - initial| (of |target| if the step
+size is zero).
+
+Only the Python standard library, numpy and matplotlib (Debian 12 packages)
+are used; the Agg backend is forced, so no display is needed.
+
+Exit status: 0 on success, 1 when an input file is missing or malformed
+(the message names the file, and the column / key when relevant), 2 on a
+command-line usage error.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+import warnings
+
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (backend must be chosen first)
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+PROG = "plot_run.py"
+
+# Columns this script uses (looked up by name; any other column is ignored).
+REQUIRED_COLUMNS = (
+    "t", "x", "y", "z", "vx", "vy", "vz",
+    "roll", "pitch", "yaw", "p", "q", "r",
+    "w1", "w2", "w3", "w4",
+    "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
+)
+
+# channel -> display metadata
+CHANNELS = {
+    "x": dict(name="X position", sym="x", unit="m", rate="vx", rate_sym="vx", rate_unit="m/s"),
+    "y": dict(name="Y position", sym="y", unit="m", rate="vy", rate_sym="vy", rate_unit="m/s"),
+    "z": dict(name="Altitude", sym="z", unit="m", rate="vz", rate_sym="vz = dz/dt", rate_unit="m/s"),
+    "roll": dict(name="Roll", sym="roll φ", unit="rad", rate="p", rate_sym="p (roll rate)",
+                 rate_unit="rad/s"),
+    "pitch": dict(name="Pitch", sym="pitch θ", unit="rad", rate="q", rate_sym="q (pitch rate)",
+                  rate_unit="rad/s"),
+    "yaw": dict(name="Yaw", sym="yaw ψ", unit="rad", rate="r", rate_sym="r (yaw rate)",
+                rate_unit="rad/s"),
+}
+CHANNEL_ORDER = ("x", "y", "z", "roll", "pitch", "yaw")
+
+# figure key -> (short label, unit, format)
+FIGURE_INFO = {
+    "overshoot_pct": ("overshoot", "%", "{:.1f}"),
+    "peak_time_s": ("peak time", "s", "{:.2f}"),
+    "rise_time_s": ("rise time", "s", "{:.2f}"),
+    "t95_s": ("t95", "s", "{:.2f}"),
+    "settling_time_2pct_s": ("settle 2%", "s", "{:.2f}"),
+    "steady_state_error_pct": ("ss error", "%", "{:.2f}"),
+}
+FIGURE_ORDER = tuple(FIGURE_INFO)
+
+STEP_FIGSIZE = (8.0, 5.0)
+OVERVIEW_FIGSIZE = (15.0, 9.0)
+DPI = 150
+
+COLOR_VAR = "#d62728"     # red, as in the paper
+COLOR_RATE = "#1f4fd6"    # blue, as in the paper
+COLOR_SETPOINT = "0.45"   # grey
+COLOR_BAND = "#2ca02c"
+COLOR_SETTLE = "#2a7f2a"
+COLOR_PEAK = "#7a0000"
+
+
+class InputError(Exception):
+    """An input file is missing or malformed; the message names the file."""
+
+
+# --------------------------------------------------------------------------- input
+
+
+class Trajectory:
+    """Column-name access to the numeric columns of trajectory.csv."""
+
+    def __init__(self, path, columns, data):
+        self.path = path
+        self._index = {name: i for i, name in enumerate(columns)}
+        self._data = data
+
+    def __getitem__(self, name):
+        return self._data[:, self._index[name]]
+
+    def __len__(self):
+        return self._data.shape[0]
+
+
+def _find_bad_line(path, header_len, indices):
+    """Slow path, only after numpy failed: locate the first unparsable line."""
+    needed = max(indices) + 1
+    with open(path, newline="", encoding="utf-8", errors="replace") as f:
+        f.readline()
+        for lineno, line in enumerate(f, start=2):
+            if not line.strip():
+                continue
+            fields = line.rstrip("\r\n").split(",")
+            if len(fields) < needed:
+                return (f"line {lineno} has {len(fields)} fields, the header has {header_len}")
+            for i in indices:
+                try:
+                    float(fields[i])
+                except ValueError:
+                    return f"line {lineno}: cannot parse {fields[i].strip()!r} as a number"
+    return None
+
+
+def load_trajectory(path):
+    if not os.path.isfile(path):
+        raise InputError(f"{path}: file not found (trajectory.csv is required)")
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            header = f.readline()
+            if not header.strip():
+                raise InputError(f"{path}: empty file or empty header line")
+            names = [h.strip().strip('"') for h in header.lstrip("\ufeff").rstrip("\r\n").split(",")]
+            index = {}
+            for i, name in enumerate(names):
+                if name in index and name in REQUIRED_COLUMNS:
+                    raise InputError(f"{path}: column {name!r} appears more than once in the header")
+                index.setdefault(name, i)
+            missing = [c for c in REQUIRED_COLUMNS if c not in index]
+            if missing:
+                raise InputError(
+                    f"{path}: missing required column{'s' if len(missing) > 1 else ''} "
+                    + ", ".join(repr(c) for c in missing)
+                    + f" (header has: {', '.join(names)})")
+            usecols = [index[c] for c in REQUIRED_COLUMNS]
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "input contained no data"
+                try:
+                    data = np.loadtxt(f, delimiter=",", usecols=usecols, ndmin=2, dtype=np.float64,
+                                      comments=None, encoding="utf-8")
+                except ValueError as exc:
+                    detail = _find_bad_line(path, len(names), usecols) or str(exc)
+                    raise InputError(f"{path}: malformed data: {detail}") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not a UTF-8 text file ({exc})") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc}") from None
+    if data.shape[0] == 0:
+        raise InputError(f"{path}: no data rows after the header")
+    traj = Trajectory(path, REQUIRED_COLUMNS, data)
+    t = traj["t"]
+    if not np.all(np.isfinite(t)):
+        raise InputError(f"{path}: column 't' contains non-finite values")
+    if len(t) > 1 and np.any(np.diff(t) < 0):
+        print(f"{PROG}: warning: {path}: column 't' is not monotonically non-decreasing",
+              file=sys.stderr)
+    return traj
+
+
+def _is_number(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _num_or_none(v, where):
+    if v is None:
+        return None
+    if not _is_number(v):
+        raise InputError(f"{where}: expected a number or null, got {v!r}")
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+def load_metrics(path):
+    """Returns the validated metrics dict, or None when the file does not exist."""
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path, encoding="utf-8") as f:
+            obj = json.load(f)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}: invalid JSON: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read: {exc}") from None
+    if not isinstance(obj, dict):
+        raise InputError(f"{path}: top level must be a JSON object")
+    steps = obj.get("steps")
+    if not isinstance(steps, list):
+        raise InputError(f"{path}: missing or non-list key 'steps'")
+    clean = []
+    for i, s in enumerate(steps):
+        where = f"{path}: steps[{i}]"
+        if not isinstance(s, dict):
+            raise InputError(f"{where}: must be a JSON object")
+        ch = s.get("channel")
+        if ch not in CHANNELS:
+            raise InputError(f"{where}: key 'channel' must be one of {', '.join(CHANNEL_ORDER)}, "
+                             f"got {ch!r}")
+        step = {"channel": ch}
+        for key in ("t_step_s", "initial", "target"):
+            v = s.get(key)
+            if not _is_number(v) or not math.isfinite(float(v)):
+                raise InputError(f"{where}: key {key!r} must be a finite number, got {v!r}")
+            step[key] = float(v)
+        figures = s.get("figures") or {}
+        if not isinstance(figures, dict):
+            raise InputError(f"{where}: key 'figures' must be an object")
+        step["figures"] = {k: _num_or_none(v, f"{where}.figures.{k}") for k, v in figures.items()}
+        reference = s.get("reference") or {}
+        if not isinstance(reference, dict):
+            raise InputError(f"{where}: key 'reference' must be an object")
+        ref = {}
+        for k, v in reference.items():
+            if k == "source":
+                ref[k] = str(v)
+            elif _is_number(v) or v is None:
+                ref[k] = _num_or_none(v, f"{where}.reference.{k}")
+        step["reference"] = ref
+        criteria = s.get("criteria") or []
+        if not isinstance(criteria, list) or not all(isinstance(c, dict) for c in criteria):
+            raise InputError(f"{where}: key 'criteria' must be a list of objects")
+        step["criteria"] = criteria
+        passed = s.get("passed")
+        if not isinstance(passed, bool):
+            flags = [c.get("passed") for c in criteria if isinstance(c.get("passed"), bool)]
+            passed = all(flags) if flags else None
+        step["passed"] = passed
+        clean.append(step)
+    return {
+        "scenario": str(obj.get("scenario", "")),
+        "description": str(obj.get("description", "")),
+        "passed": obj.get("passed") if isinstance(obj.get("passed"), bool) else None,
+        "steps": clean,
+    }
+
+
+def detect_steps(traj):
+    """Without metrics.json: one step per channel whose setpoint changes."""
+    t = traj["t"]
+    steps = []
+    for ch in CHANNEL_ORDER:
+        des = traj[f"{ch}_des"]
+        finite = np.isfinite(des)
+        if not finite.any():
+            continue
+        d = des[finite]
+        first = d[0]
+        tol = 1e-9 * max(1.0, float(np.max(np.abs(d))))
+        changed = np.nonzero(np.abs(d - first) > tol)[0]
+        if changed.size == 0:
+            # Setpoint constant from the first row (e.g. z_des = 10 from t = 0)
+            # but the state starts elsewhere (by > 1 mm or 1 mrad): a step at the start.
+            y0 = traj[ch][finite][0]
+            if np.isfinite(y0) and abs(first - y0) > max(1e-3, 1e-3 * abs(first)):
+                steps.append({
+                    "channel": ch, "t_step_s": float(t[finite][0]),
+                    "initial": float(y0), "target": float(first),
+                    "figures": {}, "reference": {}, "criteria": [], "passed": None,
+                })
+            continue
+        k = changed[0]
+        steps.append({
+            "channel": ch,
+            "t_step_s": float(t[finite][k]),
+            "initial": float(first),
+            "target": float(d[-1]),
+            "figures": {}, "reference": {}, "criteria": [], "passed": None,
+        })
+    return steps
+
+
+# --------------------------------------------------------------------------- plotting helpers
+
+
+def _fmt_num(v):
+    """Compact number for titles: 10 -> '10', 0.1 -> '0.1', -0.15 -> '−0.15'."""
+    s = f"{v:.4g}"
+    if s in ("-0", "-0.0"):
+        s = "0"
+    return s.replace("-", "−")
+
+
+def _figure_cell(key, value):
+    if value is None:
+        return "—"
+    label, unit, fmt = FIGURE_INFO.get(key, (None, _unit_from_key(key), "{:.4g}"))
+    return f"{fmt.format(value)} {unit}".strip()
+
+
+def _unit_from_key(key):
+    if key.endswith("_pct"):
+        return "%"
+    if key.endswith("_s"):
+        return "s"
+    return ""
+
+
+def _figure_label(key):
+    if key in FIGURE_INFO:
+        return FIGURE_INFO[key][0]
+    base = key
+    for suffix in ("_pct", "_s"):
+        if base.endswith(suffix):
+            base = base[: -len(suffix)]
+    return base.replace("_", " ")
+
+
+def _criterion_line(c):
+    fig = str(c.get("figure", "?"))
+    lo, hi = c.get("min"), c.get("max")
+    lo = lo if _is_number(lo) else None
+    hi = hi if _is_number(hi) else None
+    if lo is not None and hi is not None:
+        rng = f"in [{lo:g}, {hi:g}]"
+    elif lo is not None:
+        rng = f"≥ {lo:g}"
+    elif hi is not None:
+        rng = f"≤ {hi:g}"
+    else:
+        rng = "defined"
+    passed = c.get("passed")
+    mark = "✓" if passed is True else ("✗" if passed is False else "?")
+    return f"{mark} {_figure_label(fig)} {rng}"
+
+
+def _align_zero(ax_left, ax_right):
+    """Put y = 0 at the same height on both axes of a twinx pair (as on a
+    single shared axis in the paper's figures), without clipping data."""
+    a0, a1 = ax_left.get_ylim()
+    b0, b1 = ax_right.get_ylim()
+    a0, a1 = min(a0, 0.0), max(a1, 0.0)
+    b0, b1 = min(b0, 0.0), max(b1, 0.0)
+    if a1 <= a0 or b1 <= b0:
+        return
+    f = max(-a0 / (a1 - a0), -b0 / (b1 - b0))  # fraction of the height below zero
+    if not 0.0 < f < 1.0:
+        ax_left.set_ylim(a0, a1)
+        ax_right.set_ylim(b0, b1)
+        return
+    sa = max(a1 / (1.0 - f), -a0 / f)
+    sb = max(b1 / (1.0 - f), -b0 / f)
+    ax_left.set_ylim(-f * sa, (1.0 - f) * sa)
+    ax_right.set_ylim(-f * sb, (1.0 - f) * sb)
+
+
+def _finite_minmax(*arrays):
+    vals = [a[np.isfinite(a)] for a in arrays]
+    vals = [v for v in vals if v.size]
+    if not vals:
+        return None
+    return min(float(v.min()) for v in vals), max(float(v.max()) for v in vals)
+
+
+# --------------------------------------------------------------------------- step figure
+
+
+def plot_step(traj, step, window, out_path, metrics, has_metrics):
+    ch = step["channel"]
+    meta = CHANNELS[ch]
+    t_all = traj["t"]
+    lo, hi = window
+    sel = (t_all >= lo) & (t_all <= hi)
+    if np.count_nonzero(sel) < 2:
+        sel = np.ones_like(t_all, dtype=bool)
+    t = t_all[sel]
+    y = traj[ch][sel]
+    rate = traj[meta["rate"]][sel]
+    des = traj[f"{ch}_des"][sel]
+
+    t_step, initial, target = step["t_step_s"], step["initial"], step["target"]
+    figs = step["figures"]
+    ref = step["reference"]
+    unit = meta["unit"]
+
+    fig = plt.figure(figsize=STEP_FIGSIZE, dpi=DPI)
+    ax = fig.add_axes([0.085, 0.115, 0.545, 0.745])
+    ax2 = ax.twinx()
+
+    handles = []
+    # +-2 % band around the target, from the step time on
+    span = abs(target - initial)
+    half = 0.02 * (span if span > 0 else abs(target))
+    t_end = float(t[-1])
+    if half > 0 and t_end > t_step:
+        ax.fill_between([max(t_step, float(t[0])), t_end], target - half, target + half,
+                        color=COLOR_BAND, alpha=0.15, lw=0, zorder=1)
+        handles.append(Patch(facecolor=COLOR_BAND, alpha=0.25,
+                             label=f"±2 % band ({_fmt_num(target)} ± {half:.3g} {unit})"))
+
+    h_des, = ax.plot(t, des, ls="--", color=COLOR_SETPOINT, lw=1.3, zorder=2,
+                     label=f"setpoint {ch}_des")
+    h_var, = ax.plot(t, y, color=COLOR_VAR, lw=1.8, zorder=4, label=f"{meta['sym']} [{unit}]")
+    h_rate, = ax2.plot(t, rate, color=COLOR_RATE, lw=1.4, zorder=3,
+                       label=f"{meta['rate_sym']} [{meta['rate_unit']}]")
+    handles = [h_var, h_rate, h_des] + handles
+
+    # Peak marker (time figures are measured from the step time)
+    peak_t = figs.get("peak_time_s")
+    peak_line = None
+    if peak_t is not None:
+        tp = t_step + peak_t
+        if t[0] <= tp <= t[-1]:
+            yp = float(np.interp(tp, t, y))
+            peak_line = (tp, yp)
+            label = f"peak {yp:.4g} {unit} at {peak_t:.2f} s"
+            if figs.get("overshoot_pct") is not None:
+                label += f" ({figs['overshoot_pct']:.1f} %)"
+            hp, = ax.plot([tp], [yp], marker="v", ms=8, color=COLOR_PEAK, ls="none", zorder=6,
+                          label=label)
+            handles.append(hp)
+
+    # 2 % settling time
+    ts_rel = figs.get("settling_time_2pct_s")
+    if ts_rel is not None:
+        ts = t_step + ts_rel
+        if t[0] <= ts <= t[-1]:
+            ys = float(np.interp(ts, t, y))
+            ax.axvline(ts, color=COLOR_SETTLE, lw=1.2, ls="-.", zorder=3)
+            hs, = ax.plot([ts], [ys], marker="o", ms=7, mfc="white", mec=COLOR_SETTLE, mew=1.8,
+                          ls="none", zorder=6, label=f"2 % settling at {ts_rel:.2f} s")
+            handles.append(hs)
+
+    ax.set_xlim(float(t[0]), float(t[-1]) if t[-1] > t[0] else float(t[0]) + 1.0)
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel(f"{meta['sym']} [{unit}]", color=COLOR_VAR)
+    ax2.set_ylabel(f"{meta['rate_sym']} [{meta['rate_unit']}]", color=COLOR_RATE)
+    ax.tick_params(axis="y", colors=COLOR_VAR)
+    ax2.tick_params(axis="y", colors=COLOR_RATE)
+    ax.grid(True, color="0.88", lw=0.6)
+    ax.set_zorder(ax2.get_zorder() + 1)  # red curve and markers above the blue one
+    ax.patch.set_visible(False)
+    _align_zero(ax, ax2)
+    ax2.axhline(0.0, color="0.6", lw=0.6, zorder=0)
+    if peak_line is not None:  # drop line from the peak to the time axis (after final y limits)
+        tp, yp = peak_line
+        ax.plot([tp, tp], [ax.get_ylim()[0], yp], color=COLOR_PEAK, lw=0.8, ls=":", zorder=3)
+
+    title = f"{meta['name']} step {_fmt_num(initial)} → {_fmt_num(target)} {unit}"
+    fig.text(0.085, 0.955, title, fontsize=13, fontweight="bold", ha="left", va="center")
+    sub = []
+    if metrics and metrics.get("scenario"):
+        sub.append(f"scenario {metrics['scenario']}")
+    sub.append(f"step at t = {t_step:.2f} s")
+    if step.get("passed") is not None:
+        sub.append("criteria PASSED" if step["passed"] else "criteria FAILED")
+    fig.text(0.085, 0.905, "  ·  ".join(sub), fontsize=8.5, color="0.3", ha="left", va="center")
+
+    # Right panel: legend, then the figures box below it
+    x_panel = 0.735
+    leg = fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(x_panel - 0.008, 0.875),
+                     fontsize=7.2, frameon=False, handlelength=2.2, borderaxespad=0.0,
+                     labelspacing=0.45)
+    fig.canvas.draw()
+    bb = leg.get_window_extent(fig.canvas.get_renderer()).transformed(fig.transFigure.inverted())
+    box_top = bb.y0 - 0.03
+
+    fig.text(x_panel, box_top, _figures_text(step, has_metrics), family="DejaVu Sans Mono",
+             fontsize=7.3, ha="left", va="top", linespacing=1.35,
+             bbox=dict(boxstyle="round,pad=0.5", facecolor="#f7f7f7",
+                       edgecolor=(COLOR_SETTLE if step.get("passed") else
+                                  (COLOR_VAR if step.get("passed") is False else "0.6")),
+                       lw=0.9))
+
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
+def _figures_text(step, has_metrics):
+    figs, ref = step["figures"], step["reference"]
+    if not has_metrics:
+        return "no metrics.json:\nstep figures not available"
+    keys = [k for k in FIGURE_ORDER if k in figs] + [k for k in figs if k not in FIGURE_INFO]
+    ref_keys = [k for k in ref if k != "source"]
+    keys += [k for k in FIGURE_ORDER if k in ref_keys and k not in keys]
+    keys += [k for k in ref_keys if k not in keys]
+    if not keys:
+        return "no step figures in metrics.json"
+    has_ref = bool(ref_keys)
+    lw, cw = 10, 9
+    lines = ["step figures".ljust(lw) + "run".rjust(cw) + ("paper".rjust(cw) if has_ref else "")]
+    for k in keys:
+        row = _figure_label(k)[:lw].ljust(lw) + _figure_cell(k, figs.get(k)).rjust(cw)
+        if has_ref:
+            row += (_figure_cell(k, ref[k]) if k in ref else "").rjust(cw)
+        lines.append(row.rstrip())
+    if ref.get("source"):
+        lines.append(f"paper: {ref['source']}"[: lw + 2 * cw])
+    crit = step["criteria"]
+    if crit:
+        npass = sum(1 for c in crit if c.get("passed") is True)
+        lines.append("")
+        lines.append(f"criteria {npass}/{len(crit)} passed")
+        lines.extend(_criterion_line(c)[: lw + 2 * cw] for c in crit)
+    return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- overview
+
+
+def plot_overview(traj, out_path, metrics, run_dir):
+    t = traj["t"]
+    fig = plt.figure(figsize=OVERVIEW_FIGSIZE, dpi=DPI)
+    gs = fig.add_gridspec(2, 3, left=0.05, right=0.985, bottom=0.065, top=0.885,
+                          wspace=0.26, hspace=0.32)
+    xyz_colors = ("#d62728", "#2ca02c", "#1f4fd6")
+    leg_kw = dict(fontsize=8, loc="upper right", framealpha=0.85, ncol=2, handlelength=1.8,
+                  columnspacing=1.0)
+
+    # 1. 3D path
+    ax3 = fig.add_subplot(gs[0, 0], projection="3d")
+    x, y, z = traj["x"], traj["y"], traj["z"]
+    xd, yd, zd = traj["x_des"], traj["y_des"], traj["z_des"]
+    ax3.plot(x, y, z, color="#d62728", lw=1.4, label="path")
+    ax3.plot(xd, yd, zd, color=COLOR_SETPOINT, lw=1.0, ls="--", label="setpoint")
+    ax3.scatter([x[0]], [y[0]], [z[0]], color="k", marker="o", s=18, label="start", depthshade=False)
+    ax3.scatter([x[-1]], [y[-1]], [z[-1]], color="#1f4fd6", marker="s", s=18, label="end",
+                depthshade=False)
+    lims = [_finite_minmax(a, b) or (0.0, 0.0) for a, b in ((x, xd), (y, yd), (z, zd))]
+    half = max(0.5, max((b - a) for a, b in lims) / 2.0) * 1.05
+    for setter, (a, b) in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), lims):
+        c = 0.5 * (a + b)
+        setter(c - half, c + half)
+    ax3.set_box_aspect((1, 1, 1))
+    ax3.set_xlabel("x [m]", fontsize=8, labelpad=-2)
+    ax3.set_ylabel("y [m]", fontsize=8, labelpad=-2)
+    ax3.set_zlabel("z [m]", fontsize=8, labelpad=-2)
+    ax3.tick_params(labelsize=7, pad=-1)
+    ax3.set_title("3D path (equal axes)", fontsize=10)
+    ax3.legend(fontsize=7, loc="upper left", framealpha=0.85)
+
+    def timeplot(ax, cols, labels, colors, ylabel, title, des_cols=None):
+        handles = []
+        for i, (c, lab, col) in enumerate(zip(cols, labels, colors)):
+            h, = ax.plot(t, traj[c], color=col, lw=1.3, label=lab)
+            handles.append(h)
+            if des_cols:
+                ax.plot(t, traj[des_cols[i]], color=col, lw=1.0, ls="--", alpha=0.8)
+        if des_cols:
+            handles.append(Line2D([], [], color=COLOR_SETPOINT, lw=1.0, ls="--", label="setpoint"))
+        ax.set_xlabel("time t [s]", fontsize=9)
+        ax.set_ylabel(ylabel, fontsize=9)
+        ax.set_title(title, fontsize=10)
+        ax.tick_params(labelsize=8)
+        ax.grid(True, color="0.88", lw=0.6)
+        if t[-1] > t[0]:
+            ax.set_xlim(float(t[0]), float(t[-1]))
+        lo_hi = _finite_minmax(*(traj[c] for c in cols + (tuple(des_cols) if des_cols else ())))
+        if lo_hi is not None:
+            lo, hi = lo_hi
+            pad = 0.08 * (hi - lo) if hi > lo else max(0.05, abs(hi) * 0.1)
+            # headroom at the top for the legend
+            ax.set_ylim(lo - pad, hi + pad + 0.3 * max(hi - lo, 2 * pad))
+        ax.legend(handles=handles, **leg_kw)
+
+    timeplot(fig.add_subplot(gs[0, 1]), ("x", "y", "z"), ("x", "y", "z"), xyz_colors,
+             "position [m]", "Position (dashed: setpoint)", ("x_des", "y_des", "z_des"))
+    timeplot(fig.add_subplot(gs[0, 2]), ("roll", "pitch", "yaw"), ("roll φ", "pitch θ", "yaw ψ"),
+             xyz_colors, "attitude [rad]", "Attitude (dashed: setpoint)",
+             ("roll_des", "pitch_des", "yaw_des"))
+    timeplot(fig.add_subplot(gs[1, 0]), ("p", "q", "r"), ("p", "q", "r"), xyz_colors,
+             "body rate [rad/s]", "Body rates")
+    timeplot(fig.add_subplot(gs[1, 1]), ("w1", "w2", "w3", "w4"), ("ω1", "ω2", "ω3", "ω4"),
+             ("#d62728", "#2ca02c", "#1f4fd6", "#ff7f0e"), "rotor speed [rad/s]", "Rotor speeds")
+    timeplot(fig.add_subplot(gs[1, 2]), ("vz",), ("vz",), ("#1f4fd6",),
+             "vertical speed vz [m/s]", "Vertical speed")
+
+    title = f"Run overview — {os.path.basename(os.path.abspath(run_dir))}"
+    sub = [f"{len(t)} samples, t = {t[0]:.2f} … {t[-1]:.2f} s"]
+    if metrics:
+        if metrics.get("scenario"):
+            sub.insert(0, f"scenario {metrics['scenario']}")
+        if metrics.get("passed") is not None:
+            sub.append("PASSED" if metrics["passed"] else "FAILED")
+        if metrics.get("description"):
+            d = metrics["description"]
+            sub.append(d if len(d) <= 90 else d[:87] + "…")
+    fig.text(0.05, 0.968, title, fontsize=14, fontweight="bold", ha="left", va="center")
+    fig.text(0.05, 0.937, "  ·  ".join(sub), fontsize=9, color="0.3", ha="left", va="center")
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
+# --------------------------------------------------------------------------- main
+
+
+def step_windows(steps, t):
+    """Time window per step: the whole run, unless the same channel is stepped
+    again, in which case each plot ends at the next step of that channel."""
+    t0, t1 = float(t[0]), float(t[-1])
+    windows = []
+    for i, s in enumerate(steps):
+        same = sorted(o["t_step_s"] for j, o in enumerate(steps)
+                      if j != i and o["channel"] == s["channel"])
+        if not same:
+            windows.append((t0, t1))
+            continue
+        prev = [v for v in same if v < s["t_step_s"]]
+        nxt = [v for v in same if v > s["t_step_s"]]
+        lo = prev[-1] if prev else t0
+        lo = max(lo, s["t_step_s"] - 0.1 * (t1 - t0)) if prev else lo
+        hi = nxt[0] if nxt else t1
+        windows.append((lo, hi))
+    return windows
+
+
+def run(run_dir):
+    if not os.path.isdir(run_dir):
+        raise InputError(f"{run_dir}: run directory not found")
+    traj = load_trajectory(os.path.join(run_dir, "trajectory.csv"))
+    metrics_path = os.path.join(run_dir, "metrics.json")
+    metrics = load_metrics(metrics_path)
+    if metrics is not None:
+        steps = metrics["steps"]
+        if not steps:
+            print(f"{PROG}: note: {metrics_path} lists no steps; no step plots", file=sys.stderr)
+    else:
+        steps = detect_steps(traj)
+        if not steps:
+            print(f"{PROG}: note: no metrics.json and no setpoint changes; no step plots",
+                  file=sys.stderr)
+
+    written = []
+    counts = {}
+    for step, window in zip(steps, step_windows(steps, traj["t"])):
+        ch = step["channel"]
+        counts[ch] = counts.get(ch, 0) + 1
+        name = f"step_{ch}.png" if counts[ch] == 1 else f"step_{ch}_{counts[ch]}.png"
+        out = os.path.join(run_dir, name)
+        plot_step(traj, step, window, out, metrics, metrics is not None)
+        written.append(out)
+        print(out, flush=True)
+
+    out = os.path.join(run_dir, "overview.png")
+    plot_overview(traj, out, metrics, run_dir)
+    written.append(out)
+    print(out, flush=True)
+    return written
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="Plot RUN_DIR/trajectory.csv (+ metrics.json) into PNGs in RUN_DIR.")
+    parser.add_argument("run_dir", metavar="RUN_DIR", help="directory holding trajectory.csv")
+    args = parser.parse_args(argv)
+    try:
+        run(args.run_dir)
+    except InputError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:  # e.g. RUN_DIR not writable
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,297 @@
+#!/usr/bin/python3
+"""Tests for tools/plot_run.py.
+
+Run:  /usr/bin/python3 tools/test_plot_run.py   (stdlib unittest; numpy needed
+for the synthetic data; plot_run.py itself is run as a subprocess with an
+interpreter that has matplotlib).
+
+The helpers make_run()/second_order() are also handy to produce a synthetic
+run directory by hand:
+    /usr/bin/python3 -c 'import sys; sys.path.insert(0, "tools"); \
+        import test_plot_run as t; t.make_run("/tmp/run", steps=[("z", 0, 0, 10)])'
+"""
+
+import importlib.util
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCRIPT = os.path.join(HERE, "plot_run.py")
+
+COLUMNS = ["t", "x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz",
+           "roll", "pitch", "yaw", "p", "q", "r", "w1", "w2", "w3", "w4",
+           "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des"]
+RATE = {"x": "vx", "y": "vy", "z": "vz", "roll": "p", "pitch": "q", "yaw": "r"}
+# (zeta, wn) per channel, roughly the paper's responses
+DYNAMICS = {"x": (0.7, 1.0), "y": (0.7, 1.0), "z": (0.479, 1.43),
+            "roll": (1.0, 1.2), "pitch": (1.0, 1.25), "yaw": (1.0, 0.6)}
+REFERENCE = {
+    "z": {"source": "paper Fig. 4", "overshoot_pct": 18.0, "peak_time_s": 2.5,
+          "settling_time_2pct_s": 8.0},
+    "roll": {"source": "paper Fig. 5", "overshoot_pct": 0.0, "t95_s": 4.0,
+             "settling_time_2pct_s": 6.0},
+    "pitch": {"source": "paper Fig. 6", "overshoot_pct": 0.0},
+    "yaw": {"source": "paper Fig. 7", "overshoot_pct": 0.0, "settling_time_2pct_s": 8.0},
+}
+
+
+def plot_python():
+    """An interpreter that can import matplotlib (the pyenv python in PATH cannot)."""
+    if importlib.util.find_spec("matplotlib") is not None:
+        return sys.executable
+    return "/usr/bin/python3"
+
+
+def second_order(t, zeta, wn):
+    """Unit step response s(t) and its derivative, s = 0 for t < 0."""
+    tt = np.maximum(t, 0.0)
+    if zeta < 1.0:
+        wd = wn * math.sqrt(1.0 - zeta ** 2)
+        phi = math.acos(zeta)
+        e = np.exp(-zeta * wn * tt)
+        s = 1.0 - e / math.sqrt(1.0 - zeta ** 2) * np.sin(wd * tt + phi)
+        ds = wn / math.sqrt(1.0 - zeta ** 2) * e * np.sin(wd * tt)
+    else:  # critically damped
+        e = np.exp(-wn * tt)
+        s = 1.0 - (1.0 + wn * tt) * e
+        ds = wn ** 2 * tt * e
+    s[t < 0] = 0.0
+    ds[t < 0] = 0.0
+    return s, ds
+
+
+def step_figures(t, y, t_step, initial, target):
+    """Classic step figures, measured from t_step (what plot_run.py assumes)."""
+    m = t >= t_step
+    tr, yr = t[m] - t_step, y[m]
+    span = target - initial
+    e = (yr - initial) / span  # normalised response
+    k = int(np.argmax(e))
+    over = float(max(0.0, (e[k] - 1.0) * 100.0))
+    peak = float(tr[k]) if e[k] > 1.0 else None
+
+    def first(cond):
+        idx = np.nonzero(cond)[0]
+        return float(tr[idx[0]]) if idx.size else None
+
+    r10, r90 = first(e >= 0.1), first(e >= 0.9)
+    outside = np.nonzero(np.abs(e - 1.0) > 0.02)[0]
+    settle = float(tr[outside[-1] + 1]) if outside.size and outside[-1] + 1 < len(tr) else (
+        0.0 if not outside.size else None)
+    return {"overshoot_pct": round(over, 2), "peak_time_s": peak,
+            "rise_time_s": None if r10 is None or r90 is None else round(r90 - r10, 3),
+            "t95_s": first(e >= 0.95), "settling_time_2pct_s": settle,
+            "steady_state_error_pct": round(float(abs(1.0 - e[-1])) * 100.0, 3)}
+
+
+def make_run(run_dir, steps, n_rows=1501, dt=0.01, with_metrics=True, drop=(),
+             extra_columns=True, scenario="synthetic"):
+    """Writes run_dir/trajectory.csv (+ metrics.json). steps: (channel, t_step, initial, target)."""
+    os.makedirs(run_dir, exist_ok=True)
+    t = np.arange(n_rows) * dt
+    cols = {c: np.zeros(n_rows) for c in COLUMNS}
+    cols["t"] = t
+    for ch, t_step, initial, target in steps:
+        zeta, wn = DYNAMICS[ch]
+        s, ds = second_order(t - t_step, zeta, wn)
+        cols[ch] = initial + (target - initial) * s
+        cols[RATE[ch]] = (target - initial) * ds
+        cols[f"{ch}_des"] = np.where(t >= t_step, target, initial)
+    # a little sensor-like noise on the off-axis channels
+    rng = np.random.default_rng(1)
+    stepped = {s[0] for s in steps}
+    for ch in ("x", "y", "roll", "pitch", "yaw"):
+        if ch not in stepped:
+            cols[ch] = 1e-4 * rng.standard_normal(n_rows).cumsum() / math.sqrt(n_rows)
+    cr, sr = np.cos(cols["roll"] / 2), np.sin(cols["roll"] / 2)
+    cp, sp = np.cos(cols["pitch"] / 2), np.sin(cols["pitch"] / 2)
+    cy, sy = np.cos(cols["yaw"] / 2), np.sin(cols["yaw"] / 2)
+    cols["qw"] = cr * cp * cy + sr * sp * sy
+    cols["qx"] = sr * cp * cy - cr * sp * sy
+    cols["qy"] = cr * sp * cy + sr * cp * sy
+    cols["qz"] = cr * cp * sy - sr * sp * cy
+    hover = math.sqrt(1.96 * 9.81 / (4 * 2.06e-7))
+    az = np.gradient(cols["vz"], dt)
+    for i, c in enumerate(("w1", "w2", "w3", "w4")):
+        sign = (-1) ** i
+        cols[c] = hover * np.sqrt(np.maximum(0.05, 1.0 + az / 9.81)) + 40 * sign * cols["r"] \
+            + 25 * sign * (cols["p"] - cols["q"])
+
+    names = [c for c in COLUMNS if c not in drop]
+    data = [cols[c] for c in names]
+    if extra_columns:  # unknown columns in the middle and at the end, must be ignored
+        names.insert(11, "thrust_cmd")
+        data.insert(11, 4 * 2.06e-7 * cols["w1"] ** 2)
+    with open(os.path.join(run_dir, "trajectory.csv"), "w") as f:
+        f.write(",".join(names) + (",safety" if extra_columns else "") + "\n")
+        arr = np.column_stack(data)
+        flags = np.where(np.arange(n_rows) % 7 == 0, "clamped", "ok")
+        for i, row in enumerate(arr):
+            f.write(",".join(repr(float(v)) for v in row)
+                    + (f",{flags[i]}" if extra_columns else "") + "\n")
+
+    if with_metrics:
+        entries = []
+        for ch, t_step, initial, target in steps:
+            figs = step_figures(t, cols[ch], t_step, initial, target)
+            crit = [{"figure": "overshoot_pct", "min": 15, "max": 21,
+                     "value": figs["overshoot_pct"], "passed": 15 <= figs["overshoot_pct"] <= 21}] \
+                if ch == "z" else [{"figure": "overshoot_pct", "max": 2.0,
+                                    "value": figs["overshoot_pct"],
+                                    "passed": figs["overshoot_pct"] <= 2.0}]
+            if figs["settling_time_2pct_s"] is not None:
+                crit.append({"figure": "settling_time_2pct_s", "max": 10.0,
+                             "value": figs["settling_time_2pct_s"],
+                             "passed": figs["settling_time_2pct_s"] <= 10.0})
+            entry = {"channel": ch, "t_step_s": t_step, "initial": initial, "target": target,
+                     "figures": figs, "criteria": crit,
+                     "passed": all(c["passed"] for c in crit)}
+            if ch in REFERENCE:
+                entry["reference"] = REFERENCE[ch]
+            entries.append(entry)
+        with open(os.path.join(run_dir, "metrics.json"), "w") as f:
+            json.dump({"scenario": scenario, "description": "synthetic second-order responses",
+                       "steps": entries, "passed": all(e["passed"] for e in entries)}, f, indent=2)
+
+
+def png_size(path):
+    """(width, height) from the IHDR chunk; raises AssertionError if not a PNG."""
+    with open(path, "rb") as f:
+        head = f.read(33)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n", f"{path}: bad PNG signature"
+    length, ctype = struct.unpack(">I4s", head[8:16])
+    assert ctype == b"IHDR" and length == 13, f"{path}: first chunk is not IHDR"
+    return struct.unpack(">II", head[16:24])
+
+
+class PlotRunTest(unittest.TestCase):
+    def setUp(self):
+        self._tmp = tempfile.TemporaryDirectory(prefix="plot_run_test_")
+        self.tmp = self._tmp.name
+
+    def tearDown(self):
+        self._tmp.cleanup()
+
+    def run_script(self, run_dir, timeout=120):
+        env = dict(os.environ, MPLCONFIGDIR=os.path.join(self.tmp, "mplconfig"))
+        return subprocess.run([plot_python(), SCRIPT, run_dir], capture_output=True, text=True,
+                              timeout=timeout, env=env)
+
+    def assert_png(self, path, min_wh, max_wh):
+        self.assertTrue(os.path.isfile(path), f"{path} not written")
+        w, h = png_size(path)
+        self.assertTrue(min_wh[0] <= w <= max_wh[0] and min_wh[1] <= h <= max_wh[1],
+                        f"{path}: implausible size {w}x{h}")
+        self.assertGreater(os.path.getsize(path), 10_000, f"{path}: suspiciously small")
+
+    def assert_step_png(self, path):  # 8x5 in at 150 dpi = 1200x750
+        self.assert_png(path, (900, 560), (1600, 1000))
+
+    def assert_overview_png(self, path):  # 15x9 in at 150 dpi
+        self.assert_png(path, (1500, 900), (3000, 2000))
+
+    def test_with_metrics(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("z", 0.0, 0.0, 10.0)])
+        res = self.run_script(run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        for name in ("step_z.png", "overview.png"):
+            self.assertIn(os.path.join(run, name), res.stdout.splitlines())
+        self.assert_step_png(os.path.join(run, "step_z.png"))
+        self.assert_overview_png(os.path.join(run, "overview.png"))
+        self.assertFalse(os.path.exists(os.path.join(run, "step_roll.png")))
+
+    def test_without_metrics_detects_changed_setpoints(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("roll", 1.0, 0.0, 0.1), ("yaw", 0.5, 0.0, 0.2)], with_metrics=False)
+        res = self.run_script(run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        for name in ("step_roll.png", "step_yaw.png"):
+            self.assert_step_png(os.path.join(run, name))
+        self.assert_overview_png(os.path.join(run, "overview.png"))
+        for name in ("step_z.png", "step_pitch.png", "step_x.png"):
+            self.assertFalse(os.path.exists(os.path.join(run, name)), name)
+
+    def test_null_figures_and_repeated_channel(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("pitch", 0.0, 0.0, 0.15)])
+        with open(os.path.join(run, "metrics.json")) as f:
+            m = json.load(f)
+        m["steps"][0]["figures"]["peak_time_s"] = None
+        m["steps"][0]["figures"]["settling_time_2pct_s"] = None
+        m["steps"].append(dict(m["steps"][0], t_step_s=10.0, initial=0.15, target=0.0))
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            json.dump(m, f)
+        res = self.run_script(run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        self.assert_step_png(os.path.join(run, "step_pitch.png"))
+        self.assert_step_png(os.path.join(run, "step_pitch_2.png"))
+
+    def test_missing_column_is_an_error(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("z", 0.0, 0.0, 10.0)], n_rows=200, drop=("z",))
+        res = self.run_script(run)
+        self.assertNotEqual(res.returncode, 0)
+        self.assertIn("trajectory.csv", res.stderr)
+        self.assertIn("'z'", res.stderr)
+        self.assertFalse(os.path.exists(os.path.join(run, "overview.png")))
+
+    def test_missing_trajectory_is_an_error(self):
+        run = os.path.join(self.tmp, "empty")
+        os.makedirs(run)
+        res = self.run_script(run)
+        self.assertNotEqual(res.returncode, 0)
+        self.assertIn("trajectory.csv", res.stderr)
+
+    def test_malformed_row_is_an_error(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("z", 0.0, 0.0, 10.0)], n_rows=50, with_metrics=False,
+                 extra_columns=False)
+        with open(os.path.join(run, "trajectory.csv"), "a") as f:
+            f.write("0.5,1,2\n")
+        res = self.run_script(run)
+        self.assertNotEqual(res.returncode, 0)
+        self.assertIn("trajectory.csv", res.stderr)
+        self.assertIn("line 52", res.stderr)
+
+    def test_malformed_metrics_is_an_error(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("z", 0.0, 0.0, 10.0)], n_rows=200)
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            f.write('{"steps": [ {"channel": "z", ')
+        res = self.run_script(run)
+        self.assertNotEqual(res.returncode, 0)
+        self.assertIn("metrics.json", res.stderr)
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            json.dump({"steps": [{"channel": "altitude", "t_step_s": 0, "initial": 0,
+                                  "target": 1}]}, f)
+        res = self.run_script(run)
+        self.assertNotEqual(res.returncode, 0)
+        self.assertIn("metrics.json", res.stderr)
+        self.assertIn("channel", res.stderr)
+
+    def test_long_file(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("z", 0.0, 0.0, 10.0), ("yaw", 300.0, 0.0, 0.2)], n_rows=100_000,
+                 with_metrics=False)
+        start = time.monotonic()
+        res = self.run_script(run, timeout=300)
+        elapsed = time.monotonic() - start
+        self.assertEqual(res.returncode, 0, res.stderr)
+        self.assert_step_png(os.path.join(run, "step_z.png"))
+        self.assert_step_png(os.path.join(run, "step_yaw.png"))
+        self.assert_overview_png(os.path.join(run, "overview.png"))
+        self.assertLess(elapsed, 120.0)
+
+
+if __name__ == "__main__":
+    unittest.main()
