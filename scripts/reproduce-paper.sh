@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds, and runs the paper's four experiments (altitude, roll, pitch, yaw
+# steps). Writes results/<experiment>/ (trajectory.csv, metrics.json, metrics.txt, PNG plots) and
+# results/paper_comparison.md (our step figures beside the paper's). Exit status 1 if any experiment
+# misses its accepted band.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/install-deps.sh
+./scripts/build.sh > build.log 2>&1 || { tail -50 build.log; echo "build failed (see build.log)"; exit 2; }
+
+mkdir -p results
+status=0
+dirs=()
+for experiment in altitude_step roll_step pitch_step yaw_step; do
+  echo "=== ${experiment}"
+  ./build/bin/quadcosim run "scenarios/paper/${experiment}.yaml" --out "results/${experiment}" || status=1
+  dirs+=("results/${experiment}")
+done
+echo "=== our step figures beside the paper's (results/paper_comparison.md)"
+./build/bin/quadcosim summary "${dirs[@]}" --out results/paper_comparison.md || status=1
+exit $status
