@@ -1,5 +1,6 @@
 #include "control/parameters.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -82,10 +83,9 @@ const ParameterSpec* find_parameter(std::string_view name) {
 
 std::string to_string(const ParameterValue& value) {
   if (const auto* s = std::get_if<std::string>(&value)) return *s;
-  std::ostringstream o;
-  o.precision(17);
-  o << std::get<double>(value);
-  return o.str();
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, std::get<double>(value));  // shortest round trip
+  return std::string(buf, r.ptr);
 }
 
 std::string set_parameter(ControllerConfig& config, std::string_view name, const ParameterValue& value) {
