@@ -16,6 +16,9 @@ writes PNG figures into RUN_DIR, printing the path of every file written:
                       figures next to the paper's reference figures.
                       A channel stepped more than once gets
                       step_<channel>.png, step_<channel>_2.png, ...
+                      Each step plot spans the whole run, except that it ends
+                      at the next step of the same channel and, in long runs,
+                      at max(15 s, 2.5 x settling time) after the step.
   overview.png        2x3 grid: 3D path, position, attitude, body rates,
                       rotor speeds, vertical speed.
 
@@ -37,6 +40,7 @@ import json
 import math
 import os
 import sys
+import textwrap
 import warnings
 
 import numpy as np
@@ -221,7 +225,9 @@ def load_metrics(path):
                              f"got {ch!r}")
         step = {"channel": ch}
         for key in ("t_step_s", "initial", "target"):
-            v = s.get(key)
+            if key not in s:
+                raise InputError(f"{where}: missing key {key!r}")
+            v = s[key]
             if not _is_number(v) or not math.isfinite(float(v)):
                 raise InputError(f"{where}: key {key!r} must be a finite number, got {v!r}")
             step[key] = float(v)
@@ -348,22 +354,49 @@ def _criterion_line(c):
 
 def _align_zero(ax_left, ax_right):
     """Put y = 0 at the same height on both axes of a twinx pair (as on a
-    single shared axis in the paper's figures), without clipping data."""
+    single shared axis in the paper's figures), without clipping data. The
+    height of the zero line is chosen so that the data of both axes fill as
+    much of their axis as possible; if aligning would squeeze either curve
+    into less than half of the height, the axes are left independent."""
     a0, a1 = ax_left.get_ylim()
     b0, b1 = ax_right.get_ylim()
     a0, a1 = min(a0, 0.0), max(a1, 0.0)
     b0, b1 = min(b0, 0.0), max(b1, 0.0)
     if a1 <= a0 or b1 <= b0:
         return
-    f = max(-a0 / (a1 - a0), -b0 / (b1 - b0))  # fraction of the height below zero
-    if not 0.0 < f < 1.0:
-        ax_left.set_ylim(a0, a1)
-        ax_right.set_ylim(b0, b1)
+
+    def span(lo, hi, f):  # smallest axis span with 0 at fraction f holding [lo, hi]
+        return max(hi / (1.0 - f), -lo / f)
+
+    best_f, best_fill = None, 0.0
+    for f in np.linspace(0.02, 0.98, 97):
+        fill = min((a1 - a0) / span(a0, a1, f), (b1 - b0) / span(b0, b1, f))
+        if fill > best_fill:
+            best_f, best_fill = float(f), fill
+    if best_f is None or best_fill < 0.5:
         return
-    sa = max(a1 / (1.0 - f), -a0 / f)
-    sb = max(b1 / (1.0 - f), -b0 / f)
-    ax_left.set_ylim(-f * sa, (1.0 - f) * sa)
-    ax_right.set_ylim(-f * sb, (1.0 - f) * sb)
+    sa, sb = span(a0, a1, best_f), span(b0, b1, best_f)
+    ax_left.set_ylim(-best_f * sa, (1.0 - best_f) * sa)
+    ax_right.set_ylim(-best_f * sb, (1.0 - best_f) * sb)
+
+
+def _fit_twin_axes(fig, ax, ax2, left_min, right_max):
+    """Shrink/shift a twinx pair horizontally so that its decorations (tick
+    labels, axis labels) lie within [left_min, right_max] in figure coords."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    inv = fig.transFigure.inverted()
+    left = ax.get_tightbbox(renderer).transformed(inv).x0
+    right = ax2.get_tightbbox(renderer).transformed(inv).x1
+    pos = ax.get_position()
+    x0, x1 = pos.x0, pos.x1
+    if left < left_min:
+        x0 += left_min - left
+    if right > right_max:
+        x1 -= right - right_max
+    if (x0, x1) != (pos.x0, pos.x1) and x1 - x0 > 0.2:
+        for a in (ax, ax2):
+            a.set_position([x0, pos.y0, x1 - x0, pos.height])
 
 
 def _finite_minmax(*arrays):
@@ -392,7 +425,6 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
 
     t_step, initial, target = step["t_step_s"], step["initial"], step["target"]
     figs = step["figures"]
-    ref = step["reference"]
     unit = meta["unit"]
 
     fig = plt.figure(figsize=STEP_FIGSIZE, dpi=DPI)
@@ -425,10 +457,10 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
         if t[0] <= tp <= t[-1]:
             yp = float(np.interp(tp, t, y))
             peak_line = (tp, yp)
-            label = f"peak {yp:.4g} {unit} at {peak_t:.2f} s"
+            label = f"peak {_fmt_num(yp)} {unit} at {peak_t:.2f} s"
             if figs.get("overshoot_pct") is not None:
                 label += f" ({figs['overshoot_pct']:.1f} %)"
-            hp, = ax.plot([tp], [yp], marker="v", ms=8, color=COLOR_PEAK, ls="none", zorder=6,
+            hp, = ax.plot([tp], [yp], marker="v" if target >= initial else "^", ms=8, color=COLOR_PEAK, ls="none", zorder=6,
                           label=label)
             handles.append(hp)
 
@@ -468,8 +500,11 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
         sub.append("criteria PASSED" if step["passed"] else "criteria FAILED")
     fig.text(0.085, 0.905, "  ·  ".join(sub), fontsize=8.5, color="0.3", ha="left", va="center")
 
-    # Right panel: legend, then the figures box below it
+    # Keep wide tick labels / axis labels inside the figure and clear of the right panel
     x_panel = 0.735
+    _fit_twin_axes(fig, ax, ax2, left_min=0.012, right_max=x_panel - 0.015)
+
+    # Right panel: legend, then the figures box below it
     leg = fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(x_panel - 0.008, 0.875),
                      fontsize=7.2, frameon=False, handlelength=2.2, borderaxespad=0.0,
                      labelspacing=0.45)
@@ -507,7 +542,9 @@ def _figures_text(step, has_metrics):
             row += (_figure_cell(k, ref[k]) if k in ref else "").rjust(cw)
         lines.append(row.rstrip())
     if ref.get("source"):
-        lines.append(f"paper: {ref['source']}"[: lw + 2 * cw])
+        src = textwrap.wrap(f"source: {ref['source']}", width=lw + 2 * cw,
+                            subsequent_indent="  ", max_lines=3, placeholder=" …")
+        lines.extend(src)
     crit = step["criteria"]
     if crit:
         npass = sum(1 for c in crit if c.get("passed") is True)
@@ -606,22 +643,40 @@ def plot_overview(traj, out_path, metrics, run_dir):
 # --------------------------------------------------------------------------- main
 
 
-def step_windows(steps, t):
-    """Time window per step: the whole run, unless the same channel is stepped
-    again, in which case each plot ends at the next step of that channel."""
+def _settle_estimate(t, y, t_step, initial, target, t_hi):
+    """Rough 2 % settling time (for choosing the plot window only)."""
+    m = (t >= t_step) & (t <= t_hi)
+    if not m.any():
+        return 0.0
+    span = abs(target - initial) or abs(target) or 1.0
+    outside = np.nonzero(~(np.abs(y[m] - target) <= 0.02 * span))[0]
+    if outside.size == 0:
+        return 0.0
+    return float(t[m][outside[-1]] - t_step)
+
+
+def step_windows(steps, traj):
+    """Time window [lo, hi] per step. It ends at the next step of the same
+    channel (or the end of the run), and in long runs is cut to
+    max(15 s, 2.5 x settling time) after the step, so the response stays
+    readable; a short lead-in before the step is kept."""
+    t = traj["t"]
     t0, t1 = float(t[0]), float(t[-1])
     windows = []
     for i, s in enumerate(steps):
-        same = sorted(o["t_step_s"] for j, o in enumerate(steps)
-                      if j != i and o["channel"] == s["channel"])
-        if not same:
-            windows.append((t0, t1))
-            continue
-        prev = [v for v in same if v < s["t_step_s"]]
-        nxt = [v for v in same if v > s["t_step_s"]]
-        lo = prev[-1] if prev else t0
-        lo = max(lo, s["t_step_s"] - 0.1 * (t1 - t0)) if prev else lo
-        hi = nxt[0] if nxt else t1
+        ts = s["t_step_s"]
+        same = [o["t_step_s"] for j, o in enumerate(steps)
+                if j != i and o["channel"] == s["channel"]]
+        hi_lim = min([v for v in same if v > ts], default=t1)
+        settle = s["figures"].get("settling_time_2pct_s")
+        if settle is None:
+            settle = _settle_estimate(t, traj[s["channel"]], ts, s["initial"], s["target"], hi_lim)
+        hi = min(hi_lim, ts + max(15.0, 2.5 * settle))
+        if hi_lim - hi < 0.25 * (hi - ts):  # not worth cutting
+            hi = hi_lim
+        lo_lim = max([v for v in same if v < ts], default=t0)
+        pre = 0.1 * (hi - ts)
+        lo = lo_lim if ts - lo_lim <= 2.0 * pre else ts - pre
         windows.append((lo, hi))
     return windows
 
@@ -644,7 +699,7 @@ def run(run_dir):
 
     written = []
     counts = {}
-    for step, window in zip(steps, step_windows(steps, traj["t"])):
+    for step, window in zip(steps, step_windows(steps, traj)):
         ch = step["channel"]
         counts[ch] = counts.get(ch, 0) + 1
         name = f"step_{ch}.png" if counts[ch] == 1 else f"step_{ch}_{counts[ch]}.png"
