@@ -54,7 +54,10 @@ int params_command() {
   for (const auto& p : control::controller_parameters()) {
     std::string range;
     if (p.is_choice()) {
-      for (auto c : p.choices) range += (range.empty() ? "" : "|") + std::string(c);
+      for (auto c : p.choices) {
+        if (!range.empty()) range += '|';
+        range.append(c);
+      }
     } else {
       range = fmt::format("[{:g}, {:g}]", p.min, p.max);
     }

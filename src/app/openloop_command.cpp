@@ -26,6 +26,10 @@ int openloop_command(const OpenloopOptions& opt) {
     return 2;
   }
   const sim::TickClock clock{static_cast<std::int64_t>(std::round(period_ns))};
+  if (std::string err = model::validate_step(vehicle, clock.period_s(), opt.substeps); !err.empty()) {
+    std::cerr << "error: --substeps " << opt.substeps << ": " << err << '\n';
+    return 2;
+  }
   const double duration = opt.duration_s >= 0.0 ? opt.duration_s : rows.back().t_s;
   const auto last_tick = static_cast<sim::Tick>(std::floor(duration / clock.period_s() + 1e-9));
 

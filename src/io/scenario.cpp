@@ -1,5 +1,7 @@
 #include "io/scenario.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <filesystem>
 
@@ -30,12 +32,13 @@ void read_vehicle(YamlSection& s, model::VehicleParams& v) {
                      : model::GyroscopicModel::kSimplified;
   if (s.has("spin")) {
     const auto spin = s.numbers("spin", {}, 4);
+    const std::string got = fmt::format("got [{:g}, {:g}, {:g}, {:g}], ", spin[0], spin[1], spin[2], spin[3]);
     for (int i = 0; i < 4; ++i) {
-      if (spin[i] != 1.0 && spin[i] != -1.0) s.fail("spin", "expected four entries, each 1 or -1");
+      if (spin[i] != 1.0 && spin[i] != -1.0) s.fail("spin", got + "expected four entries, each 1 or -1");
       v.spin[i] = static_cast<int>(spin[i]);
     }
     if (v.spin[0] + v.spin[1] + v.spin[2] + v.spin[3] != 0) {
-      s.fail("spin", "expected two rotors of each direction (two 1 and two -1)");
+      s.fail("spin", got + "expected two rotors of each direction (two 1 and two -1)");
     }
   }
   if (auto m = s.section("motor")) {
@@ -47,9 +50,9 @@ void read_vehicle(YamlSection& s, model::VehicleParams& v) {
     v.motor.omega_min_rad_s = m->number("omega_min_rad_s", v.motor.omega_min_rad_s, 0.0, 1e7);
     v.motor.omega_max_rad_s = m->number("omega_max_rad_s", v.motor.omega_max_rad_s, 1e-3, 1e7);
     if (v.motor.omega_min_rad_s >= v.motor.omega_max_rad_s) {
-      m->fail("omega_min_rad_s", "got " + std::to_string(v.motor.omega_min_rad_s) +
+      m->fail("omega_min_rad_s", "got " + fmt::format("{:g}", v.motor.omega_min_rad_s) +
                                      ", expected less than omega_max_rad_s (" +
-                                     std::to_string(v.motor.omega_max_rad_s) + ")");
+                                     fmt::format("{:g}", v.motor.omega_max_rad_s) + ")");
     }
     m->reject_unknown_keys();
   }
@@ -93,8 +96,8 @@ sim::Tick tick_at(YamlSection& s, const std::string& key, double seconds, std::i
   const double ticks = seconds * 1e9 / static_cast<double>(period_ns);
   const double whole = std::round(ticks);
   if (std::abs(ticks - whole) > 1e-6) {
-    s.fail(key, "got " + std::to_string(seconds) + " s, expected a whole number of plant periods (" +
-                    std::to_string(static_cast<double>(period_ns) / 1e9) + " s)");
+    s.fail(key, "got " + fmt::format("{:g}", seconds) + " s, expected a whole number of plant periods (" +
+                    fmt::format("{:g}", static_cast<double>(period_ns) / 1e9) + " s)");
   }
   return static_cast<sim::Tick>(whole);
 }
@@ -103,16 +106,16 @@ void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duratio
   const double plant_hz = s.number("plant_rate_hz", 100.0, 1e-3, 1e6);
   const double period_ns = 1e9 / plant_hz;
   if (std::abs(period_ns - std::round(period_ns)) > 1e-6) {
-    s.fail("plant_rate_hz", "got " + std::to_string(plant_hz) +
+    s.fail("plant_rate_hz", "got " + fmt::format("{:g}", plant_hz) +
                                 ", expected a rate whose period is a whole number of nanoseconds");
   }
   cfg.plant.clock.period_ns = static_cast<std::int64_t>(std::round(period_ns));
   const double controller_hz = s.number("controller_rate_hz", 50.0, 1e-3, plant_hz);
   const double divider = plant_hz / controller_hz;
   if (std::abs(divider - std::round(divider)) > 1e-9) {
-    s.fail("controller_rate_hz", "got " + std::to_string(controller_hz) +
+    s.fail("controller_rate_hz", "got " + fmt::format("{:g}", controller_hz) +
                                      ", expected a whole divisor of plant_rate_hz (" +
-                                     std::to_string(plant_hz) + ")");
+                                     fmt::format("{:g}", plant_hz) + ")");
   }
   cfg.controller_divider = static_cast<int>(std::round(divider));
   cfg.plant.substeps = static_cast<int>(s.integer("substeps", 1, 1, 10000));
@@ -205,6 +208,12 @@ Scenario load_scenario(const std::string& path) {
     read_simulation(*s, sc.simulation, duration_s);
   } else {
     sc.simulation.duration_ticks = 1500;
+  }
+
+  if (std::string err = model::validate_step(sc.vehicle, sc.simulation.plant.clock.period_s(),
+                                             sc.simulation.plant.substeps);
+      !err.empty()) {
+    root.fail("simulation.substeps", err);
   }
 
   if (auto i = root.section("initial")) {

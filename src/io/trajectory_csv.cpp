@@ -88,6 +88,7 @@ std::vector<CommandRow> read_command_schedule(const std::string& path) {
   line_no = 1;
   {
     std::vector<std::string> cols;
+    if (trim(line).back() == ',') fail("header '" + trim(line) + "' has a trailing comma, expected t,w1,w2,w3,w4");
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) cols.push_back(trim(c));
     if (cols != std::vector<std::string>{"t", "w1", "w2", "w3", "w4"}) {
@@ -98,6 +99,7 @@ std::vector<CommandRow> read_command_schedule(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_no;
     if (trim(line).empty()) continue;
+    if (trim(line).back() == ',') fail("trailing comma: expected exactly 5 values (t,w1,w2,w3,w4)");
     std::stringstream ss(line);
     std::vector<double> v;
     for (std::string cell; std::getline(ss, cell, ',');) {

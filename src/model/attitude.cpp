@@ -22,15 +22,17 @@ Euler euler_from_quaternion(const Eigen::Quaterniond& q_in) {
   if (!(n > 0.0) || !std::isfinite(n)) return {};
   const double w = q_in.w() / n, x = q_in.x() / n, y = q_in.y() / n, z = q_in.z() / n;
   Euler e;
-  // R(2,0) = -sin(pitch) = 2 (x z - w y)
-  const double s = std::clamp(2.0 * (w * y - x * z), -1.0, 1.0);
-  if (std::abs(s) >= 1.0 - 1e-12) {
+  // sin(pitch) = -R(2,0) = 2 (w y - x z); cos(pitch) = |(R(0,0), R(1,0))|. atan2 of the two keeps full
+  // precision near +-pi/2, where asin would lose half the digits.
+  const double s = 2.0 * (w * y - x * z);
+  const double c = std::hypot(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z));
+  if (c < 1e-12) {  // gimbal lock: only yaw -+ roll is defined; report roll = 0
     e.pitch_rad = std::copysign(std::numbers::pi / 2.0, s);
     e.roll_rad = 0.0;
     e.yaw_rad = wrap_pi(-2.0 * std::copysign(1.0, s) * std::atan2(x, w));
     return e;
   }
-  e.pitch_rad = std::asin(s);
+  e.pitch_rad = std::atan2(s, c);
   e.roll_rad = std::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
   e.yaw_rad = std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
   return e;

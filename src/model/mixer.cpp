@@ -9,9 +9,17 @@ Eigen::Vector3d rotor_position_B(const VehicleParams& p, int i) {
   // Rotors are numbered clockwise seen from above, starting at the nose ('+') or front-left ('x').
   const double offset = p.layout == RotorLayout::kPlus ? 0.0 : std::numbers::pi / 4.0;
   const double angle = offset - i * (std::numbers::pi / 2.0);
-  // Exact zeros on the axes, so the '+' matrix has the structural zeros of eq. (4).
-  auto snap = [](double v) { return std::abs(v) < 1e-12 ? 0.0 : v; };
-  return {snap(p.arm_length_m * std::cos(angle)), snap(p.arm_length_m * std::sin(angle)), 0.0};
+  // Exact direction cosines on the axes and diagonals: the '+' matrix gets the structural zeros of
+  // eq. (4), and the 'x' rotors equal lever arms (cos and sin of the diagonals differ in the last
+  // bit, which would leave a torque at four equal rotor speeds).
+  auto snap = [](double v) {
+    const double diag = std::sqrt(0.5);
+    if (std::abs(v) < 1e-12) return 0.0;
+    if (std::abs(std::abs(v) - diag) < 1e-12) return std::copysign(diag, v);
+    if (std::abs(std::abs(v) - 1.0) < 1e-12) return std::copysign(1.0, v);
+    return v;
+  };
+  return {p.arm_length_m * snap(std::cos(angle)), p.arm_length_m * snap(std::sin(angle)), 0.0};
 }
 
 Matrix4 mixer_matrix(const VehicleParams& p) {

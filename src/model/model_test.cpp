@@ -1,7 +1,7 @@
 // Unit tests for the model library: parameters, mixer, attitude conventions and the plant's
-// derivative, integrator, ground contact, motors and outputs. Every expected number is computed here
-// from the paper's equations written out by hand, an analytic solution, or an independent Eigen
-// construction, never by calling the function under test a second time.
+// derivative, integrator, ground contact, motors and outputs. Every expected number is computed
+// here from the paper's equations written out by hand, an analytic solution, or an independent
+// Eigen construction, never by calling the function under test a second time.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -34,11 +34,13 @@ using quadcosim::model::VehicleParams;
 constexpr double kPi = std::numbers::pi;
 constexpr double kDt = 0.01;  // [s] the plant tick (100 Hz)
 
-// Table 1 of the paper, typed in again so the defaults are checked against the source, not themselves.
+// Table 1 of the paper, typed in again so the defaults are checked against the source, not
+// themselves.
 constexpr double kMass = 1.96, kG = 9.81, kIxx = 0.0149, kIyy = 0.0153, kIzz = 0.0532;
 constexpr double kL = 0.59, kKt = 2.06e-7, kKm = 1.01e-10;
 
-// R_WB = Rz(yaw) Ry(pitch) Rx(roll), built from Eigen's axis-angle type (independent of attitude.cpp).
+// R_WB = Rz(yaw) Ry(pitch) Rx(roll), built from Eigen's axis-angle type (independent of
+// attitude.cpp).
 Eigen::Matrix3d rotation_zyx(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
@@ -69,7 +71,7 @@ State airborne_state(const Quadrotor& quad, const Eigen::Vector3d& p_W, const Eu
   return x;
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // VehicleParams and validate()
 
 TEST(VehicleParams, DefaultsAreTable1) {
@@ -185,7 +187,8 @@ TEST(Validate, RejectsBadSpinSigns) {
     expect_rejected(p, "spin");
   }
   // Sum zero but not alternating: adjacent rotors turning the same way. The yaw row is then a
-  // combination of the others (rank 3), for either layout, so M^-1 in the allocation does not exist.
+  // combination of the others (rank 3), for either layout, so M^-1 in the allocation does not
+  // exist.
   for (RotorLayout layout : {RotorLayout::kPlus, RotorLayout::kX}) {
     for (auto spin : {std::array<int, 4>{+1, +1, -1, -1}, std::array<int, 4>{+1, -1, -1, +1}}) {
       VehicleParams p;
@@ -198,9 +201,12 @@ TEST(Validate, RejectsBadSpinSigns) {
       expect_rejected(p, "spin");
     }
   }
+  VehicleParams p;
+  p.spin = {+1, +1, -1, -1};
+  EXPECT_NE(quadcosim::model::validate(p).find("[1, 1, -1, -1]"), std::string::npos);
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // Mixer
 
 TEST(Mixer, PlusLayoutIsEq4ElementByElement) {
@@ -237,7 +243,8 @@ TEST(Mixer, RotorPositionsFollowTheLayouts) {
   // '+': 1 nose (+x), 2 right (-y), 3 tail (-x), 4 left (+y).
   const Eigen::Vector3d plus[4] = {{kL, 0, 0}, {0, -kL, 0}, {-kL, 0, 0}, {0, kL, 0}};
   for (int i = 0; i < 4; ++i) {
-    EXPECT_LT((quadcosim::model::rotor_position_B(p, i) - plus[i]).norm(), 1e-15) << "rotor " << i + 1;
+    EXPECT_LT((quadcosim::model::rotor_position_B(p, i) - plus[i]).norm(), 1e-15)
+        << "rotor " << i + 1;
   }
   // 'x': 1 front-left, 2 front-right, 3 rear-right, 4 rear-left, all at distance L.
   p.layout = RotorLayout::kX;
@@ -254,7 +261,8 @@ TEST(Mixer, InverseRoundTrip) {
     p.layout = layout;
     const Eigen::Matrix4d M = quadcosim::model::mixer_matrix(p);
     const Eigen::Matrix4d Minv = M.inverse();
-    const std::vector<Vector4> speeds = {Vector4(4000, 5000, 4500, 4800), Vector4(0, 12000, 300, 9000),
+    const std::vector<Vector4> speeds = {Vector4(4000, 5000, 4500, 4800),
+                                         Vector4(0, 12000, 300, 9000),
                                          Vector4::Constant(p.hover_omega_rad_s())};
     for (const Vector4& w : speeds) {
       const Vector4 w2 = w.cwiseProduct(w);
@@ -292,7 +300,7 @@ TEST(Mixer, XLayoutHasTorquesOfRotorsAt45DegreesAndFullRank) {
   }
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // Attitude conventions
 
 std::vector<double> grid(double lo, double hi, int n) {
@@ -401,8 +409,8 @@ TEST(WrapPi, ExactValues) {
   EXPECT_EQ(wrap_pi(0.0), 0.0);
   EXPECT_EQ(wrap_pi(1.0), 1.0);
   EXPECT_EQ(wrap_pi(-1.0), -1.0);
-  EXPECT_EQ(wrap_pi(kPi), kPi);    // the interval is (-pi, pi]: +pi stays
-  EXPECT_EQ(wrap_pi(-kPi), kPi);   // and -pi maps to +pi
+  EXPECT_EQ(wrap_pi(kPi), kPi);   // the interval is (-pi, pi]: +pi stays
+  EXPECT_EQ(wrap_pi(-kPi), kPi);  // and -pi maps to +pi
   EXPECT_EQ(wrap_pi(2.0 * kPi), 0.0);
   EXPECT_EQ(wrap_pi(-2.0 * kPi), 0.0);
   EXPECT_NEAR(wrap_pi(7.0), 7.0 - 2.0 * kPi, 1e-15);
@@ -428,7 +436,7 @@ TEST(WrapPi, AgreesWithAtan2OfSinCos) {
   }
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // Plant: hover, free fall, ground contact
 
 TEST(Hover, ZeroAccelerationAndStaysPutFor10s) {
@@ -443,17 +451,19 @@ TEST(Hover, ZeroAccelerationAndStaysPutFor10s) {
     const State x0 = x;
 
     const StateDerivative d = quad.derivative(0.0, x, x.omega_rad_s);
-    EXPECT_LT(d.v_W.norm(), 1e-13);
-    EXPECT_LT(d.w_B.norm(), 1e-12);
+    // U1/m - g is zero up to an ulp of g (4 k_t w_h^2 rounds); the torques of a symmetric layout
+    // at four equal speeds cancel exactly.
+    EXPECT_LT(d.v_W.norm(), 1e-14);
+    EXPECT_EQ(d.w_B, Eigen::Vector3d::Zero()) << quadcosim::model::to_string(layout);
     EXPECT_EQ(d.p_W.norm(), 0.0);
     EXPECT_EQ(d.q_WB_wxyz.norm(), 0.0);
 
     for (int k = 0; k < 1000; ++k) quad.step(x, k * kDt, x0.omega_rad_s, kDt, 1);
-    // A residual of a few ulp in U1/m - g integrates to < 1e-12 m over 10 s.
-    EXPECT_LT((x.p_W - x0.p_W).norm(), 1e-10) << quadcosim::model::to_string(layout);
-    EXPECT_LT(x.v_W.norm(), 1e-11);
-    EXPECT_LT(x.w_B.norm(), 1e-11);
-    EXPECT_LT(x.q_WB.angularDistance(x0.q_WB), 1e-10);
+    // That ulp residual integrates to at most 0.5 * 2e-15 * 10^2 = 1e-13 m over 10 s.
+    EXPECT_LT((x.p_W - x0.p_W).norm(), 1e-11) << quadcosim::model::to_string(layout);
+    EXPECT_LT(x.v_W.norm(), 1e-12);
+    EXPECT_EQ(x.w_B, Eigen::Vector3d::Zero());
+    EXPECT_LT(x.q_WB.angularDistance(x0.q_WB), 1e-15);
   }
 }
 
@@ -518,7 +528,8 @@ TEST(GroundContact, LandedAtRestStaysExactlyAtRestBelowHover) {
       Vector4::Constant(0.9 * w_h),
       Vector4::Constant(w_h * (1.0 - 1e-9)),
       // sub-hover with a roll and a yaw torque: friction holds the airframe, nothing rotates
-      Vector4(0.9 * w_h, std::sqrt(0.81 * w_h * w_h - d), 0.9 * w_h, std::sqrt(0.81 * w_h * w_h + d)),
+      Vector4(0.9 * w_h, std::sqrt(0.81 * w_h * w_h - d), 0.9 * w_h,
+              std::sqrt(0.81 * w_h * w_h + d)),
       Vector4(0.95 * w_h, 0.8 * w_h, 0.95 * w_h, 0.8 * w_h),
   };
   for (const Vector4& cmd : commands) {
@@ -551,7 +562,7 @@ TEST(GroundContact, AboveHoverLiftsOffWithAnalyticAcceleration) {
   EXPECT_EQ(x.p_W.y(), 0.0);
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // Plant: torques and forces against eqs. (4), (7), (10), (11) written out by hand
 
 TEST(TorqueResponse, PureRollPitchYawTorquesGiveUOverI) {
@@ -581,9 +592,12 @@ TEST(TorqueResponse, PureRollPitchYawTorquesGiveUOverI) {
       EXPECT_NEAR(dx.w_B[i], i == c.axis ? expected : 0.0, 1e-12 * std::abs(expected))
           << c.name << " component " << i;
     }
-    // The thrust is unchanged (sum of w^2 is the hover value), so no net linear acceleration.
+    // The thrust is unchanged (sum of w^2 is the hover value): the linear acceleration is that of
+    // hover thrust tilted by the attitude, g (R_WB e_z - e_z).
     EXPECT_NEAR(U[0], kMass * kG, 1e-12);
-    EXPECT_LT(dx.v_W.norm(), 1e-12) << c.name;
+    const Eigen::Vector3d a_expected =
+        kG * (rotation_zyx(0.2, -0.1, 0.5).col(2) - Eigen::Vector3d::UnitZ());
+    EXPECT_LT((dx.v_W - a_expected).norm(), 1e-12) << c.name;
   }
 }
 
@@ -603,7 +617,8 @@ TEST(TorqueResponse, GyroscopicCouplingIsEq10AndDroppedInEq11) {
     const Eigen::Vector3d expected((U[1] + (full ? (kIyy - kIzz) * Q * R : 0.0)) / kIxx,
                                    (U[2] + (full ? (kIzz - kIxx) * P * R : 0.0)) / kIyy,
                                    (U[3] + (full ? (kIxx - kIyy) * P * Q : 0.0)) / kIzz);
-    EXPECT_LT((dx.w_B - expected).norm(), 1e-12 * expected.norm()) << quadcosim::model::to_string(g);
+    EXPECT_LT((dx.w_B - expected).norm(), 1e-12 * expected.norm())
+        << quadcosim::model::to_string(g);
   }
 }
 
@@ -612,8 +627,8 @@ TEST(TranslationalDynamics, MatchesEq7AtTiltedAttitudes) {
   const Quadrotor quad(p);
   const Vector4 w(5000.0, 4700.0, 5200.0, 4900.0);
   const double U1 = eq4_by_hand(p, w)[0];
-  const Euler attitudes[] = {{0.0, 0.0, 0.0},   {0.3, -0.2, 1.0},  {-0.5, 0.4, -2.0},
-                             {1.2, -0.9, 2.8},  {-2.5, 1.3, 0.1},  {0.0, 0.6, -3.0}};
+  const Euler attitudes[] = {{0.0, 0.0, 0.0},  {0.3, -0.2, 1.0}, {-0.5, 0.4, -2.0},
+                             {1.2, -0.9, 2.8}, {-2.5, 1.3, 0.1}, {0.0, 0.6, -3.0}};
   for (const Euler& e : attitudes) {
     State x = airborne_state(quad, {1, 2, 30}, e, {0.4, -0.3, 0.9});
     x.v_W = {2.0, -1.0, 0.5};
@@ -644,11 +659,13 @@ TEST(AttitudeKinematics, QuaternionRateIsHalfQTimesOmega) {
   EXPECT_LT((dx.q_WB_wxyz - expected).norm(), 1e-15);
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // Motors
 
 // RK4 amplification factor for y' = -y/tau over one step h: the Taylor series of exp(-z) to z^4.
-double rk4_factor(double z) { return 1.0 - z + z * z / 2.0 - z * z * z / 6.0 + z * z * z * z / 24.0; }
+double rk4_factor(double z) {
+  return 1.0 - z + z * z / 2.0 - z * z * z / 6.0 + z * z * z * z / 24.0;
+}
 
 TEST(MotorLag, SpinUpAndSpinDownFollowTheirTimeConstants) {
   VehicleParams p;
@@ -700,7 +717,12 @@ TEST(MotorLag, SpeedsStayWithinLimits) {
   const Quadrotor quad(p);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
+  // initial_state() with rotors stopped starts at 0 rad/s, below omega_min: one tick later the
+  // speeds are already inside the limits.
   State x = quad.initial_state({0, 0, 1e4}, 0.0, false);
+  ASSERT_EQ(x.omega_rad_s, Vector4::Zero());
+  quad.step(x, 0.0, Vector4::Constant(300.0), kDt, 1);
+  EXPECT_EQ(x.omega_rad_s, Vector4::Constant(300.0));
   x.omega_rad_s = Vector4::Constant(4000.0);
   for (int k = 0; k < 100; ++k) {
     quad.step(x, k * kDt, Vector4(20000.0, inf, 8000.0, 7999.0), kDt, 1);
@@ -736,7 +758,7 @@ TEST(ClampCommand, ClampsAndReplacesNonFiniteWithOmegaMin) {
   EXPECT_TRUE(x.p_W.allFinite() && x.v_W.allFinite() && x.w_B.allFinite());
 }
 
-// ---------------------------------------------------------------------------------------------------
+// -------------------------------------------------------------------------------------------------
 // Outputs
 
 TEST(SpecificForce, HoverReadsGUpInBodyAtAnyAttitude) {

@@ -1,5 +1,6 @@
 #include "model/vehicle_params.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -50,7 +51,27 @@ std::string validate(const VehicleParams& p) {
   }
   int sum = p.spin[0] + p.spin[1] + p.spin[2] + p.spin[3];
   if (sum != 0) return must("spin", "two +1 and two -1 entries (sum 0)", sum);
+  // Adjacent rotors turning the same way make the yaw row of eq. (4) a combination of the other
+  // rows (for either layout): the mixer is singular and yaw cannot be allocated.
+  if (p.spin[0] != p.spin[2]) {
+    std::ostringstream s;
+    s << "spin must alternate around the frame (rotors 1 and 3 one way, 2 and 4 the other), got ["
+      << p.spin[0] << ", " << p.spin[1] << ", " << p.spin[2] << ", " << p.spin[3] << "]";
+    return s.str();
+  }
   return {};
+}
+
+std::string validate_step(const VehicleParams& p, double period_s, int substeps) {
+  if (p.motor.model != MotorModel::kFirstOrder) return {};
+  const double tau = std::min(p.motor.tau_up_s, p.motor.tau_down_s);
+  const double h = period_s / substeps;
+  if (h <= 2.0 * tau) return {};
+  std::ostringstream s;
+  s << "motor time constant " << tau << " s is too short for an RK4 step of " << h
+    << " s (plant period " << period_s << " s / " << substeps << " substeps): use at least "
+    << static_cast<int>(std::ceil(period_s / (2.0 * tau))) << " substeps";
+  return s.str();
 }
 
 const char* to_string(RotorLayout layout) { return layout == RotorLayout::kPlus ? "plus" : "x"; }

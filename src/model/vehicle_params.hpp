@@ -49,6 +49,7 @@ struct VehicleParams {
   RotorLayout layout = RotorLayout::kPlus;
   /// Sign of each rotor's reaction torque about +z_B (+1: the rotor spins clockwise seen from above,
   /// so its drag pushes the body counter-clockwise). The paper's eq. (4): rotors 1 and 3 positive.
+  /// The signs must alternate around the frame; any other pattern makes the mixer singular.
   std::array<int, 4> spin = {+1, -1, +1, -1};
   MotorParams motor;
   GyroscopicModel gyroscopic = GyroscopicModel::kFull;
@@ -60,6 +61,11 @@ struct VehicleParams {
 /// Returns an empty string when `p` is physically meaningful, else a message naming the first bad field
 /// (e.g. "mass_kg must be > 0, got -1").
 std::string validate(const VehicleParams& p);
+
+/// Empty when RK4 with step `step_s` [s] is stable for the motor lag (step <= 2 tau; RK4's limit on a
+/// decaying mode is 2.785 tau), else a message naming the time constant and the substeps needed.
+/// Always empty for ideal motors.
+std::string validate_step(const VehicleParams& p, double step_s, int substeps);
 
 const char* to_string(RotorLayout layout);
 const char* to_string(MotorModel model);

@@ -1,0 +1,834 @@
+// Tests of the file layer: scenario loading and its error messages, the trajectory CSV, command
+// schedules, and the step report (criteria and metrics.json).
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "io/scenario.hpp"
+#include "io/step_report.hpp"
+#include "io/trajectory_csv.hpp"
+#include "model/attitude.hpp"
+
+namespace quadcosim::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSourceDir = QUADCOSIM_SOURCE_DIR;
+
+/// A fresh directory under the system temp dir, removed with everything in it at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "quadcosim_io_test_XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  /// Writes `text` to `name` inside the directory; returns the full path.
+  std::string write(const std::string& name, const std::string& text) const {
+    const fs::path p = path_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The paper's scenarios.
+
+struct PaperScenario {
+  std::string file;
+  std::string name;
+  std::string channel;  ///< the stepped channel, also the scheduled parameter's stem
+  double step_to;       ///< the scheduled setpoint value
+  double z0;            ///< initial height [m]
+  bool hover;
+  double z_des;
+  std::vector<Criterion> criteria;  ///< in file order
+};
+
+std::vector<PaperScenario> paper_scenarios() {
+  const auto none = std::nullopt;
+  const std::vector<Criterion> attitude = {{"overshoot_pct", none, 2.0},
+                                           {"t95_s", 3.5, 4.5},
+                                           {"settling_time_2pct_s", 5.0, 7.0},
+                                           {"steady_state_error_pct", none, 1.0}};
+  return {
+      {"altitude_step.yaml", "altitude_step", "z", 10.0, 0.0, false, 0.0,
+       {{"overshoot_pct", 15.0, 21.0},
+        {"peak_time_s", 2.0, 3.0},
+        {"settling_time_2pct_s", none, 8.5},
+        {"steady_state_error_pct", none, 1.0}}},
+      {"roll_step.yaml", "roll_step", "roll", 0.1, 10.0, true, 10.0, attitude},
+      {"pitch_step.yaml", "pitch_step", "pitch", 0.15, 10.0, true, 10.0, attitude},
+      {"yaw_step.yaml", "yaw_step", "yaw", 0.2, 10.0, true, 10.0,
+       {{"overshoot_pct", none, 2.0},
+        {"settling_time_2pct_s", 7.0, 9.0},
+        {"steady_state_error_pct", none, 1.0}}},
+  };
+}
+
+class PaperScenarioTest : public ::testing::TestWithParam<PaperScenario> {};
+
+TEST_P(PaperScenarioTest, LoadsWithTheDocumentedValues) {
+  const PaperScenario& e = GetParam();
+  const std::string path = (kSourceDir / "scenarios" / "paper" / e.file).string();
+  const Scenario sc = load_scenario(path);
+
+  EXPECT_EQ(sc.path, path);
+  EXPECT_EQ(sc.name, e.name);
+  EXPECT_FALSE(sc.description.empty());
+
+  // Rates: 100 Hz plant (10 ms), 50 Hz controller (every 2nd tick), 15 s = 1500 ticks.
+  EXPECT_EQ(sc.simulation.plant.clock.period_ns, 10'000'000);
+  EXPECT_EQ(sc.simulation.controller_divider, 2);
+  EXPECT_EQ(sc.simulation.duration_ticks, 1500);
+  EXPECT_EQ(sc.simulation.plant.substeps, 1);
+  EXPECT_EQ(sc.simulation.plant.command_delay_ticks, 0);
+  EXPECT_EQ(sc.simulation.ns, "/drone");
+
+  // The paper's vehicle (Table 1), unchanged.
+  const model::VehicleParams table1;
+  EXPECT_EQ(sc.vehicle.mass_kg, table1.mass_kg);
+  EXPECT_EQ(sc.vehicle.kt_N_per_rad2_s2, table1.kt_N_per_rad2_s2);
+  EXPECT_EQ(sc.controller.params.vehicle.mass_kg, table1.mass_kg);
+
+  EXPECT_EQ(sc.initial.p_W, Eigen::Vector3d(0.0, 0.0, e.z0));
+  EXPECT_EQ(sc.initial.yaw_rad, 0.0);
+  EXPECT_EQ(sc.initial.hover, e.hover);
+
+  EXPECT_EQ(sc.controller.setpoint.mode, control::Mode::kAttitude);
+  EXPECT_EQ(sc.controller.setpoint.p_des_W.z(), e.z_des);
+  EXPECT_EQ(sc.controller.setpoint.roll_des_rad, 0.0);
+  EXPECT_EQ(sc.controller.setpoint.pitch_des_rad, 0.0);
+  EXPECT_EQ(sc.controller.setpoint.yaw_des_rad, 0.0);
+
+  // One scheduled change at t = 0: <channel>_des to the step value.
+  ASSERT_EQ(sc.schedule.size(), 1u);
+  EXPECT_EQ(sc.schedule[0].tick, 0);
+  EXPECT_EQ(sc.schedule[0].name, e.channel + "_des");
+  ASSERT_TRUE(std::holds_alternative<double>(sc.schedule[0].value));
+  EXPECT_EQ(std::get<double>(sc.schedule[0].value), e.step_to);
+
+  ASSERT_EQ(sc.steps.size(), 1u);
+  const StepSpec& step = sc.steps[0];
+  EXPECT_EQ(step.channel, e.channel);
+  EXPECT_EQ(step.t_step_s, 0.0);
+  ASSERT_EQ(step.criteria.size(), e.criteria.size());
+  for (std::size_t i = 0; i < e.criteria.size(); ++i) {
+    SCOPED_TRACE(e.criteria[i].figure);
+    EXPECT_EQ(step.criteria[i].figure, e.criteria[i].figure);
+    EXPECT_EQ(step.criteria[i].min, e.criteria[i].min);
+    EXPECT_EQ(step.criteria[i].max, e.criteria[i].max);
+  }
+  EXPECT_NE(step.reference_source.find("paper"), std::string::npos);
+  EXPECT_TRUE(step.reference.count("settling_time_2pct_s"));
+  EXPECT_FALSE(step.reference.count("source"));  // the source is text, not a figure
+}
+
+INSTANTIATE_TEST_SUITE_P(Paper, PaperScenarioTest, ::testing::ValuesIn(paper_scenarios()),
+                         [](const auto& info) { return info.param.name; });
+
+TEST(ScenarioTest, AltitudeStepReferenceFigures) {
+  const Scenario sc = load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string());
+  ASSERT_EQ(sc.steps.size(), 1u);
+  const std::map<std::string, double> expected = {
+      {"overshoot_pct", 18.0}, {"peak_time_s", 2.5}, {"settling_time_2pct_s", 8.0}};
+  EXPECT_EQ(sc.steps[0].reference, expected);
+  EXPECT_EQ(sc.steps[0].reference_source, "paper, Sec. IV-ii and Fig. 4");
+}
+
+TEST(ScenarioTest, EmptyMappingGivesTheDefaults) {
+  TempDir dir;
+  const std::string path = dir.write("minimal.yaml", "name: minimal\n");
+  const Scenario sc = load_scenario(path);
+  EXPECT_EQ(sc.name, "minimal");
+  EXPECT_EQ(sc.simulation.plant.clock.period_ns, 10'000'000);
+  EXPECT_EQ(sc.simulation.controller_divider, 2);
+  EXPECT_EQ(sc.simulation.duration_ticks, 1500);
+  EXPECT_TRUE(sc.schedule.empty());
+  EXPECT_TRUE(sc.steps.empty());
+
+  // Without a name, the file's stem.
+  EXPECT_EQ(load_scenario(dir.write("unnamed.yaml", "description: x\n")).name, "unnamed");
+}
+
+TEST(ScenarioTest, ScheduleTimesBecomeTicks) {
+  TempDir dir;
+  const std::string path = dir.write("sched.yaml", R"(simulation: {plant_rate_hz: 200, controller_rate_hz: 50, duration_s: 3}
+schedule:
+  - at_s: 0.5
+    set: {z_des: 2, altitude: {kp: 5}}
+  - at_s: 1.25
+    set: {mode: position}
+)");
+  const Scenario sc = load_scenario(path);
+  EXPECT_EQ(sc.simulation.plant.clock.period_ns, 5'000'000);
+  EXPECT_EQ(sc.simulation.controller_divider, 4);
+  EXPECT_EQ(sc.simulation.duration_ticks, 600);
+  ASSERT_EQ(sc.schedule.size(), 3u);
+  EXPECT_EQ(sc.schedule[0].tick, 100);
+  EXPECT_EQ(sc.schedule[0].name, "z_des");
+  EXPECT_EQ(std::get<double>(sc.schedule[0].value), 2.0);
+  EXPECT_EQ(sc.schedule[1].tick, 100);
+  EXPECT_EQ(sc.schedule[1].name, "altitude.kp");
+  EXPECT_EQ(std::get<double>(sc.schedule[1].value), 5.0);
+  EXPECT_EQ(sc.schedule[2].tick, 250);
+  EXPECT_EQ(sc.schedule[2].name, "mode");
+  EXPECT_EQ(std::get<std::string>(sc.schedule[2].value), "position");
+  // Scheduled values do not change the initial configuration.
+  EXPECT_EQ(sc.controller.setpoint.p_des_W.z(), 0.0);
+  EXPECT_EQ(sc.controller.params.altitude.kp, control::ControllerConfig{}.params.altitude.kp);
+}
+
+TEST(ScenarioTest, NestedAndDottedControllerKeysAreEquivalent) {
+  TempDir dir;
+  const Scenario nested = load_scenario(dir.write("nested.yaml", R"(controller:
+  mode: position
+  altitude: {kp: 5.5, kd: 3.25}
+  lqr:
+    roll: {q_angle: 2.0, r: 50}
+    yaw: {q_rate: 7}
+  position: {max_tilt: 0.3}
+schedule:
+  - at_s: 1
+    set:
+      lqr: {pitch: {q_angle: 4}}
+)"));
+  const Scenario dotted = load_scenario(dir.write("dotted.yaml", R"(controller:
+  mode: position
+  altitude.kp: 5.5
+  altitude.kd: 3.25
+  lqr.roll.q_angle: 2.0
+  lqr.roll.r: 50
+  lqr.yaw.q_rate: 7
+  position.max_tilt: 0.3
+schedule:
+  - at_s: 1
+    set: {lqr.pitch.q_angle: 4}
+)"));
+  const Scenario mixed = load_scenario(dir.write("mixed.yaml", R"(controller:
+  mode: position
+  altitude: {kp: 5.5}
+  altitude.kd: 3.25
+  lqr: {roll.q_angle: 2.0, roll: {r: 50}, yaw.q_rate: 7}
+  position.max_tilt: 0.3
+schedule:
+  - at_s: 1
+    set: {lqr.pitch: {q_angle: 4}}
+)"));
+  for (const Scenario* sc : {&nested, &dotted, &mixed}) {
+    SCOPED_TRACE(sc->path);
+    const auto& p = sc->controller.params;
+    EXPECT_EQ(sc->controller.setpoint.mode, control::Mode::kPosition);
+    EXPECT_EQ(p.altitude.kp, 5.5);
+    EXPECT_EQ(p.altitude.kd, 3.25);
+    EXPECT_EQ(p.roll.q_angle, 2.0);
+    EXPECT_EQ(p.roll.r, 50.0);
+    EXPECT_EQ(p.yaw.q_rate, 7.0);
+    EXPECT_EQ(p.position.max_tilt_rad, 0.3);
+    EXPECT_EQ(p.pitch.q_angle, control::ControllerConfig{}.params.pitch.q_angle);
+    ASSERT_EQ(sc->schedule.size(), 1u);
+    EXPECT_EQ(sc->schedule[0].tick, 100);
+    EXPECT_EQ(sc->schedule[0].name, "lqr.pitch.q_angle");
+    EXPECT_EQ(std::get<double>(sc->schedule[0].value), 4.0);
+  }
+}
+
+TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {
+  TempDir dir;
+  const Scenario sc = load_scenario(dir.write("vehicle.yaml", R"(vehicle:
+  mass_kg: 2.5
+  layout: x
+  spin: [-1, 1, -1, 1]
+  motor: {model: first_order, tau_up_s: 0.03}
+)"));
+  EXPECT_EQ(sc.vehicle.mass_kg, 2.5);
+  EXPECT_EQ(sc.vehicle.layout, model::RotorLayout::kX);
+  EXPECT_EQ(sc.vehicle.spin, (std::array<int, 4>{-1, 1, -1, 1}));
+  EXPECT_EQ(sc.vehicle.motor.model, model::MotorModel::kFirstOrder);
+  EXPECT_EQ(sc.vehicle.motor.tau_up_s, 0.03);
+  EXPECT_EQ(sc.controller.params.vehicle.mass_kg, 2.5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed scenarios: each error names the file, the key path and the bad value.
+
+struct BadScenario {
+  std::string label;
+  std::string yaml;
+  std::vector<std::string> must_mention;  ///< besides the file name
+};
+
+class BadScenarioTest : public ::testing::TestWithParam<BadScenario> {};
+
+TEST_P(BadScenarioTest, ConfigErrorNamesFileKeyAndValue) {
+  const BadScenario& b = GetParam();
+  TempDir dir;
+  const std::string path = dir.write(b.label + ".yaml", b.yaml);
+  try {
+    load_scenario(path);
+    FAIL() << "no error for\n" << b.yaml;
+  } catch (const ConfigError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << "message does not start with the file: " << msg;
+    for (const std::string& s : b.must_mention) {
+      EXPECT_NE(msg.find(s), std::string::npos) << "'" << s << "' missing from: " << msg;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenario, BadScenarioTest,
+    ::testing::Values(
+        BadScenario{"unknown_top_level_key", "name: x\nsimulaton: {duration_s: 1}\n",
+                    {"simulaton: unknown key"}},
+        BadScenario{"unknown_nested_key", "vehicle:\n  mas_kg: 2\n", {"vehicle.mas_kg: unknown key"}},
+        BadScenario{"unknown_motor_key", "vehicle:\n  motor: {tau_upp_s: 0.1}\n",
+                    {"vehicle.motor.tau_upp_s: unknown key"}},
+        BadScenario{"string_for_number", "simulation:\n  plant_rate_hz: fast\n",
+                    {"simulation.plant_rate_hz: ", "'fast'", "expected a number"}},
+        BadScenario{"list_for_number", "simulation:\n  duration_s: [1, 2]\n",
+                    {"simulation.duration_s: ", "a list", "expected a number"}},
+        BadScenario{"negative_mass", "vehicle: {mass_kg: -1}\n", {"vehicle.mass_kg: ", "'-1'"}},
+        BadScenario{"motor_lag_too_fast_for_step",
+                    "vehicle:\n  motor: {model: first_order, tau_up_s: 0.002}\nsimulation: {substeps: 1}\n",
+                    {"simulation.substeps: ", "0.002", "at least 3 substeps"}},
+        BadScenario{"rate_not_a_divisor",
+                    "simulation: {plant_rate_hz: 100, controller_rate_hz: 30}\n",
+                    {"simulation.controller_rate_hz: ", "30", "divisor"}},
+        BadScenario{"controller_faster_than_plant",
+                    "simulation: {plant_rate_hz: 100, controller_rate_hz: 200}\n",
+                    {"simulation.controller_rate_hz: ", "200"}},
+        BadScenario{"duration_not_on_a_tick", "simulation: {duration_s: 1.005}\n",
+                    {"simulation.duration_s: ", "1.005"}},
+        BadScenario{"schedule_time_not_on_a_tick",
+                    "schedule:\n  - at_s: 0.0125\n    set: {z_des: 1}\n",
+                    {"schedule[0].at_s: ", "0.0125", "whole number of plant periods"}},
+        BadScenario{"schedule_time_after_the_end",
+                    "simulation: {duration_s: 2}\nschedule:\n  - at_s: 0\n    set: {z_des: 1}\n"
+                    "  - at_s: 3\n    set: {z_des: 2}\n",
+                    {"schedule[1].at_s: ", "'3'"}},
+        BadScenario{"schedule_without_set", "schedule:\n  - at_s: 1\n", {"schedule[0].set: "}},
+        BadScenario{"schedule_unknown_parameter",
+                    "schedule:\n  - at_s: 1\n    set: {z_dse: 1}\n",
+                    {"schedule[0].set.z_dse: ", "z_dse"}},
+        BadScenario{"unknown_controller_parameter", "controller:\n  z_dse: 3\n",
+                    {"controller.z_dse: ", "unknown controller parameter 'z_dse'"}},
+        BadScenario{"unknown_nested_controller_parameter", "controller:\n  altitude: {kq: 3}\n",
+                    {"controller.altitude.kq: ", "'altitude.kq'"}},
+        BadScenario{"parameter_out_of_range", "controller:\n  roll_des: 5\n",
+                    {"controller.roll_des: ", "got 5", "[-1.5, 1.5]"}},
+        BadScenario{"parameter_not_a_number", "controller:\n  altitude.kp: strong\n",
+                    {"controller.altitude.kp: ", "'strong'", "number"}},
+        BadScenario{"bad_choice", "controller:\n  mode: hover\n",
+                    {"controller.mode: ", "'hover'", "'attitude'", "'position'"}},
+        BadScenario{"bad_layout", "vehicle: {layout: h}\n", {"vehicle.layout: ", "'h'", "'plus'"}},
+        BadScenario{"spin_not_unit", "vehicle:\n  spin: [1, -1, 2, -1]\n", {"vehicle.spin: ", "2"}},
+        BadScenario{"spin_unbalanced", "vehicle:\n  spin: [1, 1, 1, -1]\n",
+                    {"vehicle.spin: ", "[1, 1, 1, -1]"}},
+        BadScenario{"spin_too_short", "vehicle:\n  spin: [1, -1]\n", {"vehicle.spin: ", "a list", "4"}},
+        BadScenario{"initial_below_ground", "initial: {position_m: [0, 0, -1]}\n",
+                    {"initial.position_m: ", "z must be >= 0"}},
+        BadScenario{"unknown_step_channel",
+                    "analysis:\n  steps:\n    - {channel: altitude, at_s: 0}\n",
+                    {"analysis.steps[0].channel: ", "'altitude'"}},
+        BadScenario{"unknown_step_figure",
+                    "analysis:\n  steps:\n    - channel: z\n      criteria: {overshoot: [0, 1]}\n",
+                    {"analysis.steps[0].criteria.overshoot: "}},
+        BadScenario{"criterion_not_a_pair",
+                    "analysis:\n  steps:\n    - channel: z\n      criteria: {overshoot_pct: 5}\n",
+                    {"analysis.steps[0].criteria.overshoot_pct: ", "[min, max]"}},
+        BadScenario{"criterion_bound_not_a_number",
+                    "analysis:\n  steps:\n    - channel: z\n      criteria: {overshoot_pct: [0, lots]}\n",
+                    {"analysis.steps[0].criteria.overshoot_pct: ", "'lots'"}},
+        BadScenario{"criterion_min_above_max",
+                    "analysis:\n  steps:\n    - channel: z\n      criteria: {t95_s: [3, 1]}\n",
+                    {"analysis.steps[0].criteria.t95_s: ", "min is above max"}},
+        BadScenario{"top_level_not_a_mapping", "- 1\n- 2\n", {"mapping"}},
+        BadScenario{"section_not_a_mapping", "simulation: 100\n", {"simulation: ", "'100'", "mapping"}},
+        BadScenario{"yaml_syntax_error",
+                    "name: broken\nsimulation:\n  plant_rate_hz: 100\n  duration_s: 15: 3\n"
+                    "controller:\n  mode: attitude\n",
+                    {"line 4", "YAML syntax error"}}),
+    [](const auto& info) { return info.param.label; });
+
+TEST(ScenarioTest, MissingFileIsAConfigErrorNamingIt) {
+  TempDir dir;
+  const std::string path = dir.file("does_not_exist.yaml");
+  try {
+    load_scenario(path);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
+  TempDir dir;
+  const model::VehicleParams v = load_vehicle(dir.write("v.yaml", "mass_kg: 3\nIzz_kg_m2: 0.06\n"));
+  EXPECT_EQ(v.mass_kg, 3.0);
+  EXPECT_EQ(v.Izz_kg_m2, 0.06);
+  const control::ControllerConfig c =
+      load_controller(dir.write("c.yaml", "lqr: {roll: {r: 20}}\nyaw_des: 0.5\n"), v);
+  EXPECT_EQ(c.params.roll.r, 20.0);
+  EXPECT_EQ(c.setpoint.yaw_des_rad, 0.5);
+  EXPECT_EQ(c.params.vehicle.mass_kg, 3.0);
+
+  const std::string bad_vehicle = dir.write("bad_v.yaml", "mass_kg: 0\n");
+  try {
+    load_vehicle(bad_vehicle);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(bad_vehicle + ": mass_kg: "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("'0'"), std::string::npos) << msg;
+  }
+  const std::string bad_controller = dir.write("bad_c.yaml", "lqr:\n  roll: {r: -1}\n");
+  try {
+    load_controller(bad_controller, v);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(bad_controller + ": lqr.roll.r: "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("-1"), std::string::npos) << msg;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// trajectory.csv
+
+std::vector<std::string> split(const std::string& line, char sep = ',') {
+  std::vector<std::string> out;
+  std::string cell;
+  std::stringstream ss(line);
+  while (std::getline(ss, cell, sep)) out.push_back(cell);
+  if (!line.empty() && line.back() == sep) out.emplace_back();
+  return out;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string l; std::getline(ss, l);) out.push_back(l);
+  return out;
+}
+
+std::uint64_t bits(double d) {
+  std::uint64_t b;
+  std::memcpy(&b, &d, sizeof b);
+  return b;
+}
+
+/// Parses a whole cell with strtod; fails the test when the cell is not entirely a number.
+double parse_cell(const std::string& cell) {
+  char* end = nullptr;
+  const double v = std::strtod(cell.c_str(), &end);
+  EXPECT_TRUE(!cell.empty() && *end == '\0') << "not a number: '" << cell << "'";
+  return v;
+}
+
+TEST(TrajectoryWriterTest, HeaderHasTheDocumentedColumns) {
+  const std::vector<std::string> required = {
+      "t",  "x",  "y",  "z",  "vx", "vy", "vz", "qw", "qx", "qy",    "qz",    "roll",     "pitch", "yaw",
+      "p",  "q",  "r",  "w1", "w2", "w3", "w4", "x_des", "y_des", "z_des", "roll_des", "pitch_des",
+      "yaw_des"};
+  TempDir dir;
+  const std::string path = dir.file("trajectory.csv");
+  {
+    TrajectoryWriter w(path);
+    w.close();
+  }
+  const auto lines = lines_of(read_text(path));
+  ASSERT_EQ(lines.size(), 1u);
+  const auto header = split(lines[0]);
+  EXPECT_EQ(header, TrajectoryWriter::columns());
+  for (const auto& c : required) {
+    EXPECT_EQ(std::count(header.begin(), header.end(), c), 1) << c;
+  }
+  EXPECT_EQ(header.front(), "t");
+}
+
+TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
+  const std::vector<double> awkward = {0.1,
+                                       1.0 / 3.0,
+                                       -2.0 / 7.0,
+                                       3.141592653589793,
+                                       1e-300,
+                                       std::numeric_limits<double>::denorm_min(),
+                                       std::numeric_limits<double>::max(),
+                                       -std::numeric_limits<double>::min(),
+                                       -0.0,
+                                       0.0,
+                                       4830.6078372347,
+                                       std::nextafter(1.0, 2.0),
+                                       123456789.0123456789,
+                                       -9.81e-17};
+  TempDir dir;
+  const std::string path = dir.file("trajectory.csv");
+  std::vector<std::vector<double>> expected;
+  {
+    TrajectoryWriter w(path);
+    for (std::size_t k = 0; k < 40; ++k) {
+      auto a = [&](std::size_t i) { return awkward[(k + i) % awkward.size()]; };
+      model::State x;
+      x.p_W = {a(0), a(1), a(2)};
+      x.v_W = {a(3), a(4), a(5)};
+      x.q_WB = Eigen::Quaterniond(0.5 + 1e-3 * k, std::sqrt(0.2) / (k + 1), -1.0 / 3.0, 0.1 * k).normalized();
+      x.w_B = {a(6), a(7), a(8)};
+      x.omega_rad_s = model::Vector4(a(9), a(10), a(11), a(12));
+      const Eigen::Vector4d cmd(a(13), a(0) * 3.0, a(5) / 7.0, 1e10 / 3.0);
+      ControlColumns c{a(1), a(2), a(3), a(4), a(5), a(6), Eigen::Vector4d(a(7), a(8), a(9), a(10)),
+                       k % 2 == 1};
+      const double t = static_cast<double>(k) * 1e7 / 1e9;
+      w.write(t, x, cmd, c);
+      const model::Euler e = model::euler_from_quaternion(x.q_WB);
+      expected.push_back({t,          x.p_W.x(),      x.p_W.y(),      x.p_W.z(),      x.v_W.x(),
+                          x.v_W.y(),  x.v_W.z(),      x.q_WB.w(),     x.q_WB.x(),     x.q_WB.y(),
+                          x.q_WB.z(), e.roll_rad,     e.pitch_rad,    e.yaw_rad,      x.w_B.x(),
+                          x.w_B.y(),  x.w_B.z(),      x.omega_rad_s[0], x.omega_rad_s[1],
+                          x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3],
+                          c.x_des,    c.y_des,        c.z_des,        c.roll_des,     c.pitch_des,
+                          c.yaw_des,  c.U[0],         c.U[1],         c.U[2],         c.U[3],
+                          c.safety ? 1.0 : 0.0});
+    }
+    w.close();
+  }
+  const auto lines = lines_of(read_text(path));
+  ASSERT_EQ(lines.size(), expected.size() + 1);
+  const auto& columns = TrajectoryWriter::columns();
+  ASSERT_EQ(columns.size(), expected[0].size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    const auto cells = split(lines[k + 1]);
+    ASSERT_EQ(cells.size(), columns.size()) << "row " << k;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      const double v = parse_cell(cells[i]);
+      EXPECT_EQ(bits(v), bits(expected[k][i]))
+          << "row " << k << " column " << columns[i] << ": wrote " << expected[k][i] << " as '" << cells[i] << "'";
+    }
+  }
+}
+
+TEST(TrajectoryWriterTest, OpenLoopColumnsAreNan) {
+  TempDir dir;
+  const std::string path = dir.file("trajectory.csv");
+  {
+    TrajectoryWriter w(path);
+    w.write(0.0, model::State{}, Eigen::Vector4d::Zero(), ControlColumns::none());
+    w.close();
+  }
+  const auto lines = lines_of(read_text(path));
+  ASSERT_EQ(lines.size(), 2u);
+  const auto header = split(lines[0]);
+  const auto cells = split(lines[1]);
+  ASSERT_EQ(cells.size(), header.size());
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const double v = parse_cell(cells[i]);
+    const bool control = header[i].ends_with("_des") || header[i].starts_with("U");
+    if (control) {
+      EXPECT_TRUE(std::isnan(v)) << header[i];
+    } else {
+      EXPECT_TRUE(std::isfinite(v)) << header[i];
+    }
+  }
+}
+
+TEST(TrajectoryWriterTest, DestructorFlushesWithoutClose) {
+  TempDir dir;
+  const std::string path = dir.file("trajectory.csv");
+  {
+    TrajectoryWriter w(path);
+    for (int k = 0; k < 3000; ++k) w.write(k * 0.01, model::State{}, Eigen::Vector4d::Zero(), ControlColumns::none());
+  }
+  EXPECT_EQ(lines_of(read_text(path)).size(), 3001u);
+}
+
+TEST(TrajectoryWriterTest, UnwritablePathThrowsNamingIt) {
+  TempDir dir;
+  const std::string path = dir.file("no/such/dir/trajectory.csv");
+  try {
+    TrajectoryWriter w(path);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Command schedules (openloop input)
+
+TEST(CommandScheduleTest, ReadsAGoodFile) {
+  TempDir dir;
+  const std::string path = dir.write("cmd.csv",
+                                     "t,w1,w2,w3,w4\r\n"
+                                     "0,4830.5,4830.5,4830.5,4830.5\r\n"
+                                     "\r\n"
+                                     " 0.5 , 0, 1e3, 2.25 ,3\n"
+                                     "1.25,10,20,30,40\n");
+  const auto rows = read_command_schedule(path);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].t_s, 0.0);
+  EXPECT_EQ(rows[0].omega_rad_s, Eigen::Vector4d::Constant(4830.5));
+  EXPECT_EQ(rows[1].t_s, 0.5);
+  EXPECT_EQ(rows[1].omega_rad_s, Eigen::Vector4d(0.0, 1000.0, 2.25, 3.0));
+  EXPECT_EQ(rows[2].t_s, 1.25);
+  EXPECT_EQ(rows[2].omega_rad_s, Eigen::Vector4d(10.0, 20.0, 30.0, 40.0));
+}
+
+struct BadSchedule {
+  std::string label;
+  std::string text;
+  int line;
+  std::string must_mention;
+};
+
+class BadScheduleTest : public ::testing::TestWithParam<BadSchedule> {};
+
+TEST_P(BadScheduleTest, RejectedWithFileAndLine) {
+  const BadSchedule& b = GetParam();
+  TempDir dir;
+  const std::string path = dir.write(b.label + ".csv", b.text);
+  try {
+    read_command_schedule(path);
+    FAIL() << "no error for\n" << b.text;
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(path + ":" + std::to_string(b.line) + ": ", 0), 0u) << msg;
+    EXPECT_NE(msg.find(b.must_mention), std::string::npos) << msg;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Csv, BadScheduleTest,
+    ::testing::Values(
+        BadSchedule{"bad_header", "time,w1,w2,w3,w4\n0,1,1,1,1\n", 1, "header"},
+        BadSchedule{"header_missing_column", "t,w1,w2,w3\n0,1,1,1\n", 1, "t,w1,w2,w3,w4"},
+        BadSchedule{"empty_file", "", 1, "empty"},
+        BadSchedule{"no_rows", "t,w1,w2,w3,w4\n", 1, "no command rows"},
+        BadSchedule{"not_a_number", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,fast,1,1\n", 3, "'fast'"},
+        BadSchedule{"number_with_junk", "t,w1,w2,w3,w4\n0,1,1,1,1x\n", 2, "'1x'"},
+        BadSchedule{"empty_cell", "t,w1,w2,w3,w4\n0,1,,1,1\n", 2, "not a number"},
+        BadSchedule{"equal_times", "t,w1,w2,w3,w4\n0,1,1,1,1\n0.5,1,1,1,1\n0.5,2,2,2,2\n", 4, "increase"},
+        BadSchedule{"decreasing_times", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,1,1\n\n0.5,2,2,2,2\n", 5,
+                    "increase"},
+        BadSchedule{"negative_time", "t,w1,w2,w3,w4\n-1,1,1,1,1\n", 2, "time"},
+        BadSchedule{"negative_speed", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,-5,1\n", 3, "w3"},
+        BadSchedule{"infinite_speed", "t,w1,w2,w3,w4\n0,1,inf,1,1\n", 2, "finite"},
+        BadSchedule{"nan_time", "t,w1,w2,w3,w4\nnan,1,1,1,1\n", 2, "finite"},
+        BadSchedule{"too_few_columns", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,1\n", 3, "got 4"},
+        BadSchedule{"too_many_columns", "t,w1,w2,w3,w4\n0,1,1,1,1,1\n", 2, "got 6"},
+        BadSchedule{"trailing_comma_row", "t,w1,w2,w3,w4\n0,1,1,1,1,\n", 2, "trailing comma"},
+        BadSchedule{"trailing_comma_header", "t,w1,w2,w3,w4,\n0,1,1,1,1\n", 1, "trailing comma"}),
+    [](const auto& info) { return info.param.label; });
+
+TEST(CommandScheduleTest, MissingFileNamesIt) {
+  TempDir dir;
+  const std::string path = dir.file("none.csv");
+  try {
+    read_command_schedule(path);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Step report
+
+/// 10 s at 100 Hz of channel z: at 0 until t_step, then a first-order rise (time constant T) to
+/// `final`, with the setpoint z_des stepping from 0 to 10 at t_step. Also a flat "roll" channel.
+Series first_order_series(double t_step, double T, double final_value) {
+  Series s;
+  for (int k = 0; k <= 1000; ++k) {
+    const double t = k / 100.0;
+    s.t_s.push_back(t);
+    s.append("z", t < t_step ? 0.0 : final_value * (1.0 - std::exp(-(t - t_step) / T)));
+    s.append("z_des", t < t_step ? 0.0 : 10.0);
+    s.append("roll", 0.0);
+    s.append("roll_des", 0.0);
+  }
+  return s;
+}
+
+StepSpec z_step(double at, std::vector<Criterion> criteria) {
+  return StepSpec{.channel = "z", .t_step_s = at, .criteria = std::move(criteria), .reference_source = {},
+                  .reference = {}};
+}
+
+TEST(StepReportTest, CriteriaPassAndFail) {
+  // T = 0.5 s: t95 = 0.5 ln 20 = 1.498 -> 1.5 s on the grid; no overshoot; no peak time.
+  const Series series = first_order_series(1.0, 0.5, 10.0);
+  const auto none = std::nullopt;
+  const std::vector<StepSpec> steps = {
+      z_step(1.0, {{"t95_s", 1.4, 1.6}, {"overshoot_pct", none, 1.0}, {"overshoot_pct", 0.0, 0.0}}),
+      z_step(1.0, {{"t95_s", 1.6, none}}),                     // too fast for a lower bound
+      z_step(1.0, {{"t95_s", none, 1.4}}),                     // too slow for an upper bound
+      z_step(1.0, {{"peak_time_s", none, none}}),              // no value: fails even unbounded
+      z_step(1.0, {}),                                         // nothing to check: passes
+      z_step(1.0, {{"t95_s", 1.5, 1.5}}),                      // bounds are inclusive
+  };
+  const auto results = evaluate_steps(steps, series);
+  ASSERT_EQ(results.size(), steps.size());
+
+  const StepResult& r0 = results[0];
+  EXPECT_EQ(r0.figures.initial, 0.0);
+  EXPECT_EQ(r0.figures.target, 10.0);  // the setpoint at the step time
+  ASSERT_TRUE(r0.figures.t95_s.has_value());
+  EXPECT_NEAR(*r0.figures.t95_s, 1.5, 1e-12);
+  ASSERT_EQ(r0.criteria.size(), 3u);
+  for (const auto& c : r0.criteria) EXPECT_TRUE(c.passed) << c.criterion.figure;
+  EXPECT_EQ(r0.criteria[0].value, r0.figures.t95_s);
+  EXPECT_TRUE(r0.passed);
+
+  EXPECT_FALSE(results[1].passed);
+  EXPECT_FALSE(results[1].criteria[0].passed);
+  EXPECT_FALSE(results[2].passed);
+  EXPECT_FALSE(results[3].passed);
+  EXPECT_FALSE(results[3].criteria[0].value.has_value());
+  EXPECT_TRUE(results[4].passed);
+  EXPECT_TRUE(results[4].criteria.empty());
+  ASSERT_TRUE(results[5].figures.t95_s.has_value());
+  EXPECT_EQ(*results[5].figures.t95_s, 1.5);  // t[250] - 1.0, exact
+  EXPECT_TRUE(results[5].passed);
+
+  EXPECT_FALSE(all_passed(results));
+  EXPECT_TRUE(all_passed({results[0], results[4]}));
+  EXPECT_TRUE(all_passed({}));
+}
+
+TEST(StepReportTest, SteadyStateErrorCriterion) {
+  const Series short_of_target = first_order_series(0.0, 0.3, 9.5);  // 5 % short
+  const auto results = evaluate_steps(
+      {z_step(0.0, {{"steady_state_error_pct", std::nullopt, 1.0}}),
+       z_step(0.0, {{"steady_state_error_pct", 4.9, 5.1}})},
+      short_of_target);
+  ASSERT_TRUE(results[0].figures.steady_state_error_pct.has_value());
+  EXPECT_NEAR(*results[0].figures.steady_state_error_pct, 5.0, 1e-6);
+  EXPECT_FALSE(results[0].passed);
+  EXPECT_TRUE(results[1].passed);
+}
+
+TEST(StepReportTest, MissingChannelIsALogicError) {
+  const Series series = first_order_series(0.0, 0.5, 10.0);
+  StepSpec s = z_step(0.0, {});
+  s.channel = "yaw";
+  EXPECT_THROW(evaluate_steps({s}, series), std::logic_error);
+}
+
+TEST(StepReportTest, MetricsJsonHasTheDocumentedKeys) {
+  const Series series = first_order_series(1.0, 0.5, 10.0);
+  Scenario sc;
+  sc.name = "report_test";
+  sc.description = "hand-made series";
+  StepSpec pass = z_step(1.0, {{"t95_s", 1.4, 1.6}, {"overshoot_pct", std::nullopt, 1.0}});
+  pass.reference_source = "made up";
+  pass.reference = {{"t95_s", 1.5}};
+  StepSpec fail = z_step(1.0, {{"peak_time_s", 0.0, 10.0}});
+  StepSpec roll;
+  roll.channel = "roll";  // zero step: every figure empty
+  const auto results = evaluate_steps({pass, fail, roll}, series);
+
+  TempDir dir;
+  const std::string path = dir.file("metrics.json");
+  write_metrics_json(path, sc, results);
+  const nlohmann::json j = nlohmann::json::parse(read_text(path));
+
+  EXPECT_EQ(j.at("scenario"), "report_test");
+  EXPECT_EQ(j.at("passed"), false);
+  ASSERT_TRUE(j.at("steps").is_array());
+  ASSERT_EQ(j.at("steps").size(), 3u);
+
+  const auto& s0 = j["steps"][0];
+  EXPECT_EQ(s0.at("channel"), "z");
+  EXPECT_EQ(s0.at("passed"), true);
+  EXPECT_EQ(s0.at("target"), 10.0);
+  EXPECT_EQ(s0.at("t_step_s"), 1.0);
+  const auto& figs = s0.at("figures");
+  for (const auto& name : analysis::figure_names()) EXPECT_TRUE(figs.contains(name)) << name;
+  EXPECT_EQ(figs.size(), analysis::figure_names().size());
+  EXPECT_NEAR(figs.at("t95_s").get<double>(), 1.5, 1e-12);
+  EXPECT_EQ(figs.at("overshoot_pct"), 0.0);
+  EXPECT_TRUE(figs.at("peak_time_s").is_null());
+  ASSERT_EQ(s0.at("criteria").size(), 2u);
+  const auto& c0 = s0["criteria"][0];
+  EXPECT_EQ(c0.at("figure"), "t95_s");
+  EXPECT_EQ(c0.at("min"), 1.4);
+  EXPECT_EQ(c0.at("max"), 1.6);
+  EXPECT_NEAR(c0.at("value").get<double>(), 1.5, 1e-12);
+  EXPECT_EQ(c0.at("passed"), true);
+  const auto& c1 = s0["criteria"][1];
+  EXPECT_TRUE(c1.at("min").is_null());
+  EXPECT_EQ(c1.at("max"), 1.0);
+  EXPECT_EQ(s0.at("reference").at("source"), "made up");
+  EXPECT_EQ(s0.at("reference").at("t95_s"), 1.5);
+
+  const auto& s1 = j["steps"][1];
+  EXPECT_EQ(s1.at("passed"), false);
+  EXPECT_TRUE(s1.at("criteria")[0].at("value").is_null());
+  EXPECT_EQ(s1.at("criteria")[0].at("passed"), false);
+  EXPECT_FALSE(s1.contains("reference"));
+
+  const auto& s2 = j["steps"][2];
+  EXPECT_EQ(s2.at("channel"), "roll");
+  EXPECT_EQ(s2.at("passed"), true);
+  EXPECT_TRUE(s2.at("criteria").is_array());
+  EXPECT_TRUE(s2.at("criteria").empty());
+  for (const auto& name : analysis::figure_names()) EXPECT_TRUE(s2.at("figures").at(name).is_null()) << name;
+
+  // All passing: top-level passed is true.
+  write_metrics_json(path, sc, {results[0], results[2]});
+  EXPECT_EQ(nlohmann::json::parse(read_text(path)).at("passed"), true);
+}
+
+TEST(StepReportTest, MetricsJsonToAnUnwritablePathThrows) {
+  TempDir dir;
+  const Scenario sc;
+  EXPECT_THROW(write_metrics_json(dir.file("no/such/dir/metrics.json"), sc, {}), std::runtime_error);
+}
+
+TEST(StepReportTest, TableShowsVerdicts) {
+  const Series series = first_order_series(1.0, 0.5, 10.0);
+  Scenario sc;
+  sc.name = "table";
+  const auto results = evaluate_steps({z_step(1.0, {{"t95_s", 1.4, 1.6}}), z_step(1.0, {{"t95_s", 2, 3}})}, series);
+  const std::string table = format_step_table(sc, results);
+  EXPECT_NE(table.find("scenario table"), std::string::npos) << table;
+  EXPECT_NE(table.find("PASS"), std::string::npos) << table;
+  EXPECT_NE(table.find("FAIL"), std::string::npos) << table;
+  EXPECT_NE(table.find("[1.4, 1.6]"), std::string::npos) << table;
+}
+
+}  // namespace
+}  // namespace quadcosim::io
