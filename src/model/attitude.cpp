@@ -26,7 +26,9 @@ Euler euler_from_quaternion(const Eigen::Quaterniond& q_in) {
   // precision near +-pi/2, where asin would lose half the digits.
   const double s = 2.0 * (w * y - x * z);
   const double c = std::hypot(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z));
-  if (c < 1e-12) {  // gimbal lock: only yaw -+ roll is defined; report roll = 0
+  // Within ~sqrt(eps) of the lock roll and yaw are ill-conditioned (their atan2 arguments are all
+  // ~cos(pitch)); treating it as the lock keeps the rebuilt rotation accurate to ~1e-8 everywhere.
+  if (c < 1.5e-8) {  // gimbal lock: only yaw -+ roll is defined; report roll = 0
     e.pitch_rad = std::copysign(std::numbers::pi / 2.0, s);
     e.roll_rad = 0.0;
     e.yaw_rad = wrap_pi(-2.0 * std::copysign(1.0, s) * std::atan2(x, w));
