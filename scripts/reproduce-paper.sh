@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
-./scripts/build.sh > build.log 2>&1 || { tail -50 build.log; echo "build failed (see build.log)"; exit 2; }
+./scripts/build.sh quadcosim > build.log 2>&1 || { tail -50 build.log; echo "build failed (see build.log)"; exit 2; }
 
 mkdir -p results
 status=0
