@@ -81,7 +81,11 @@ Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
   if (!X.allFinite()) throw CareError("CARE: no finite solution");
   const Eigen::MatrixXd Acl = A - G * X;
   Eigen::EigenSolver<Eigen::MatrixXd> es(Acl, false);
-  if (es.eigenvalues().real().maxCoeff() >= 0.0) {
+  // Computed eigenvalues carry rounding errors of order eps ||Acl|| (times their condition number):
+  // a pole closer to the imaginary axis than this margin cannot be told from one on it (e.g. an
+  // uncontrollable undamped mode, which feedback cannot move), so it does not count as stable.
+  const double margin = 1e-10 * (1.0 + Acl.norm());
+  if (es.eigenvalues().real().maxCoeff() >= -margin) {
     throw CareError("CARE: the solution does not stabilise the system; (A, B) is not stabilisable");
   }
   return X;

@@ -39,7 +39,7 @@ struct ControllerParams {
   model::VehicleParams vehicle;
   LqrWeights roll{1.3, 2.4, 100.0};
   LqrWeights pitch{1.3, 2.4, 100.0};
-  LqrWeights yaw{3.7, 14.0, 100.0};
+  LqrWeights yaw{0.16, 0.65, 100.0};
   AltitudeGains altitude;
   PositionGains position;
   double stale_limit_s = 0.1;  ///< sensor data older than this triggers the safety command [s]
