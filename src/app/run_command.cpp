@@ -19,18 +19,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-io::ControlColumns control_columns(const sim::TickRecord& r) {
-  const auto& sp = r.controller_config.setpoint;
-  const bool position = sp.mode == control::Mode::kPosition;
-  return {sp.p_des_W.x(),
-          sp.p_des_W.y(),
-          sp.p_des_W.z(),
-          position ? r.last_command.roll_des_rad : sp.roll_des_rad,
-          position ? r.last_command.pitch_des_rad : sp.pitch_des_rad,
-          sp.yaw_des_rad,
-          r.last_command.U,
-          r.last_command.safety};
-}
 
 void record_series(io::Series& s, const sim::TickRecord& r, const io::ControlColumns& c) {
   const model::Euler e = model::euler_from_quaternion(r.state.q_WB);
@@ -77,7 +65,7 @@ int run_command(const RunOptions& opt) {
     io::TrajectoryWriter csv((out / "trajectory.csv").string());
     io::Series series;
     simulation.run([&](const sim::TickRecord& r) {
-      const io::ControlColumns c = control_columns(r);
+      const io::ControlColumns c = io::ControlColumns::from(r.status);
       csv.write(r.t_s, r.state, r.applied_command, c);
       record_series(series, r, c);
     });

@@ -17,6 +17,11 @@ ControlColumns ControlColumns::none() {
   return {nan, nan, nan, nan, nan, nan, Eigen::Vector4d::Constant(nan), false};
 }
 
+ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
+  const auto& s = m.setpoint;
+  return {s[0], s[1], s[2], s[3], s[4], s[5], Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]), m.safety};
+}
+
 const std::vector<std::string>& TrajectoryWriter::columns() {
   static const std::vector<std::string> c = {
       "t",     "x",      "y",       "z",       "vx",       "vy",       "vz",   "qw",  "qx",

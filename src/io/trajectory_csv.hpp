@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "model/quadrotor.hpp"
+#include "sim/messages.hpp"
 
 namespace quadcosim::io {
 
@@ -17,6 +18,8 @@ struct ControlColumns {
   Eigen::Vector4d U;  ///< U1 [N], U2..U4 [N m]
   bool safety;
   static ControlColumns none();
+  /// The columns of a controller status message.
+  static ControlColumns from(const msg::ControllerStatus& status);
 };
 
 class TrajectoryWriter {

@@ -9,6 +9,7 @@ namespace quadcosim::sim {
 ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
                                const control::ControllerConfig& config)
     : config_(config), controller_(config.params) {
+  status_pub_ = transport.advertise<msg::ControllerStatus>(topics.controller_status);
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
   transport.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) {
@@ -35,6 +36,26 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   estimate_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
                                      : static_cast<double>(now_ns - oldest) / 1e9;
   command_ = controller_.step(estimate_, config_.setpoint, dt_s);
+
+  const auto& sp = config_.setpoint;
+  const bool position = sp.mode == control::Mode::kPosition;
+  status_.header.stamp = msg::Time::from_ns(now_ns);
+  status_.mode = control::to_string(sp.mode);
+  status_.setpoint = {sp.p_des_W.x(),
+                      sp.p_des_W.y(),
+                      sp.p_des_W.z(),
+                      position ? command_.roll_des_rad : sp.roll_des_rad,
+                      position ? command_.pitch_des_rad : sp.pitch_des_rad,
+                      sp.yaw_des_rad};
+  for (int i = 0; i < 4; ++i) {
+    status_.u[i] = command_.U[i];
+    status_.error[i] = command_.error[i];
+    status_.rotor_saturated[i] = command_.rotor_saturated[i];
+  }
+  status_.tilt_saturated = command_.tilt_saturated;
+  status_.safety = command_.safety;
+  status_pub_.publish(status_);
+
   for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];
   command_pub_.publish(command_msg_);
   return command_;

@@ -22,7 +22,8 @@ class ControllerNode {
   ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config);
 
   /// One control period ending now. `now_ns` is the node's current (simulated) time, `dt_s` its
-  /// period; the age of the sensor data is measured against now_ns.
+  /// period; the age of the sensor data is measured against now_ns. Publishes the status, then the
+  /// motor command.
   const control::Command& step(std::int64_t now_ns, double dt_s);
 
   /// Sets one parameter; returns "" on success, else the reason it was refused (nothing changed).
@@ -33,6 +34,8 @@ class ControllerNode {
   const control::FlightController& controller() const { return controller_; }
   /// The estimate the last step used.
   const control::Estimate& estimate() const { return estimate_; }
+  /// The status published by the last step.
+  const msg::ControllerStatus& status() const { return status_; }
 
  private:
   static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
@@ -42,6 +45,8 @@ class ControllerNode {
   control::Estimate estimate_;
   control::Command command_;
   std::int64_t pose_stamp_ns_ = kNever, velocity_stamp_ns_ = kNever, imu_stamp_ns_ = kNever;
+  msg::ControllerStatus status_;
+  Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;
   msg::Float64MultiArray command_msg_;
 };

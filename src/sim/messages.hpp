@@ -67,6 +67,20 @@ struct Float64MultiArray {
   std::vector<double> data;
 };
 
+/// quadcosim_msgs/msg/ControllerStatus: what the controller decided in one step (for recording and
+/// monitoring). Published by the controller after every step, before its motor command.
+struct ControllerStatus {
+  static constexpr std::string_view kRosType = "quadcosim_msgs/msg/ControllerStatus";
+  Header header;                    ///< stamp: the (simulated) time of the step
+  std::string mode;                 ///< "attitude" | "position"
+  std::array<double, 6> setpoint{};  ///< x, y, z [m], roll, pitch, yaw [rad] actually tracked
+  std::array<double, 4> u{};        ///< U1 [N], U2..U4 [N m] requested
+  std::array<double, 4> error{};    ///< e_z [m], e_roll, e_pitch, e_yaw [rad]
+  std::array<bool, 4> rotor_saturated{};
+  bool tilt_saturated = false;
+  bool safety = false;              ///< the stale-data safety command was sent
+};
+
 /// rosgraph_msgs/msg/Clock
 struct Clock {
   static constexpr std::string_view kRosType = "rosgraph_msgs/msg/Clock";

@@ -12,6 +12,9 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
       plant_(transport_, Topics::for_namespace(config.ns), vehicle, config.plant, initial),
       controller_(transport_, Topics::for_namespace(config.ns), controller),
       schedule_(std::move(schedule)) {
+  transport_.subscribe<msg::ControllerStatus>(
+      Topics::for_namespace(config.ns).controller_status,
+      [this](const msg::ControllerStatus& m) { status_ = m; });
   std::stable_sort(schedule_.begin(), schedule_.end(),
                    [](const auto& a, const auto& b) { return a.tick < b.tick; });
 }
@@ -31,8 +34,7 @@ void Simulation::run(const std::function<void(const TickRecord&)>& on_tick) {
     if (k % config_.controller_divider == 0) controller_.step(clock.ns(k), control_dt_s);
     plant_.latch_command(k);
     if (on_tick) {
-      on_tick(TickRecord{k, clock.seconds(k), plant_.state(), plant_.applied_command(),
-                         controller_.config(), controller_.last_command()});
+      on_tick(TickRecord{k, clock.seconds(k), plant_.state(), plant_.applied_command(), status_});
     }
     if (k < config_.duration_ticks) plant_.integrate(k);
   }

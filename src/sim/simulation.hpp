@@ -6,7 +6,8 @@
 //   2. the plant publishes /clock, Pose, Velocity, Imu for x(t_k);
 //   3. on every `controller_divider`-th tick the controller steps and publishes a command;
 //   4. the plant latches the command in effect (zero-order hold, after the configured delay);
-//   5. the tick is recorded (state at t_k, command over [t_k, t_k+1));
+//   5. the tick is recorded (state at t_k, command over [t_k, t_k+1), the controller's latest status
+//      as received on its status topic);
 //   6. the plant integrates to t_k+1 (not after the last tick).
 // Same inputs, same bytes: nothing here reads a wall clock or a random source.
 #pragma once
@@ -42,8 +43,7 @@ struct TickRecord {
   double t_s;
   const model::State& state;
   const model::Vector4& applied_command;  ///< rotor command acting over [t_k, t_k+1) [rad/s]
-  const control::ControllerConfig& controller_config;  ///< active setpoints and gains
-  const control::Command& last_command;  ///< the controller's latest decision
+  const msg::ControllerStatus& status;    ///< the controller's latest step, as published
 };
 
 class Simulation {
@@ -65,6 +65,7 @@ class Simulation {
   PlantNode plant_;
   ControllerNode controller_;
   std::vector<ScheduledParameter> schedule_;
+  msg::ControllerStatus status_;
 };
 
 }  // namespace quadcosim::sim

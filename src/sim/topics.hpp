@@ -11,6 +11,7 @@ struct Topics {
   std::string velocity;        ///< plant ->, geometry_msgs/TwistStamped
   std::string imu;             ///< plant ->, sensor_msgs/Imu
   std::string clock;           ///< plant ->, rosgraph_msgs/Clock (global, not namespaced)
+  std::string controller_status;  ///< controller ->, quadcosim_msgs/ControllerStatus
 
   /// Topics under `ns` ("/drone" gives "/drone/Pose", ...). `ns` must start with '/'.
   static Topics for_namespace(const std::string& ns = "/drone");

@@ -34,8 +34,8 @@ Flight simulate(const io::Scenario& sc) {
     r.roll.push_back(e.roll_rad);
     r.pitch.push_back(e.pitch_rad);
     r.yaw.push_back(e.yaw_rad);
-    r.any_safety = r.any_safety || rec.last_command.safety;
-    for (bool sat : rec.last_command.rotor_saturated) r.any_rotor_saturated = r.any_rotor_saturated || sat;
+    r.any_safety = r.any_safety || rec.status.safety;
+    for (bool sat : rec.status.rotor_saturated) r.any_rotor_saturated = r.any_rotor_saturated || sat;
     r.finite = r.finite && rec.state.p_W.allFinite() && rec.state.q_WB.coeffs().allFinite();
   });
   return r;
