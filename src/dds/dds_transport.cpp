@@ -1,0 +1,132 @@
+#include "dds/dds_transport.hpp"
+
+#include <chrono>
+
+namespace quadcosim::dds {
+
+std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_topic; }
+
+DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
+  waitset_ = check(dds_create_waitset(participant_.handle()), "dds_create_waitset");
+}
+
+DdsTransport::~DdsTransport() {
+  // Entities go with the participant (Participant's destructor).
+}
+
+QosProfile DdsTransport::qos_for(const std::string& ros_topic) const {
+  const auto it = qos_.find(ros_topic);
+  return it == qos_.end() ? QosProfile::ros_default() : it->second;
+}
+
+dds_entity_t DdsTransport::topic_for(const std::string& ros_topic, const sim::TopicType& type,
+                                     const TypeOps*& ops) {
+  ops = type_ops(type.cpp_type);
+  if (!ops) throw DdsError("no DDS mapping for message type " + std::string(type.ros_type));
+  auto it = topics_.find(ros_topic);
+  if (it != topics_.end()) return it->second;
+  const std::string name = dds_topic_name(ros_topic);
+  const dds_entity_t t =
+      check(dds_create_topic(participant_.handle(), ops->descriptor, name.c_str(), nullptr, nullptr),
+            ("dds_create_topic " + name).c_str());
+  topics_.emplace(ros_topic, t);
+  return t;
+}
+
+std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic,
+                                                          const sim::TopicType& type) {
+  const TypeOps* ops = nullptr;
+  const dds_entity_t topic = topic_for(ros_topic, type, ops);
+  const QosProfile p = qos_for(ros_topic);
+  dds_qos_t* qos = ros_qos(p.depth, p.reliable);
+  const dds_entity_t writer = dds_create_writer(participant_.handle(), topic, qos, nullptr);
+  dds_delete_qos(qos);
+  check(writer, ("dds_create_writer " + ros_topic).c_str());
+  writers_[ros_topic].push_back(writer);
+  return [writer, ops, ros_topic](const void* message) {
+    check(ops->write(writer, message), ("dds_write " + ros_topic).c_str());
+  };
+}
+
+void DdsTransport::add_subscription(const std::string& ros_topic, const sim::TopicType& type,
+                                    std::function<void(const void*)> deliver) {
+  const TypeOps* ops = nullptr;
+  const dds_entity_t topic = topic_for(ros_topic, type, ops);
+  const QosProfile p = qos_for(ros_topic);
+  dds_qos_t* qos = ros_qos(p.depth, p.reliable);
+  const dds_entity_t reader = dds_create_reader(participant_.handle(), topic, qos, nullptr);
+  dds_delete_qos(qos);
+  check(reader, ("dds_create_reader " + ros_topic).c_str());
+  auto r = std::make_unique<Reader>();
+  r->topic = ros_topic;
+  r->reader = reader;
+  r->condition = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
+  r->ops = ops;
+  r->deliver = std::move(deliver);
+  check(dds_waitset_attach(waitset_, r->condition, static_cast<dds_attach_t>(readers_.size())),
+        "dds_waitset_attach");
+  readers_.push_back(std::move(r));
+}
+
+int DdsTransport::drain(Reader& r) {
+  constexpr int kBatch = 16;
+  int delivered = 0;
+  for (;;) {
+    void* samples[kBatch] = {nullptr};
+    dds_sample_info_t infos[kBatch];
+    const dds_return_t n = dds_take(r.reader, samples, infos, kBatch, kBatch);
+    check(n, ("dds_take " + r.topic).c_str());
+    if (n == 0) break;
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      r.ops->deliver(samples[i], r.deliver);
+      ++delivered;
+    }
+    dds_return_loan(r.reader, samples, n);
+    if (n < kBatch) break;
+  }
+  return delivered;
+}
+
+int DdsTransport::spin_once(std::int64_t timeout_ns) {
+  if (readers_.empty()) return 0;
+  const dds_return_t rc = dds_waitset_wait(waitset_, nullptr, 0, timeout_ns);
+  check(rc, "dds_waitset_wait");
+  int delivered = 0;
+  for (auto& r : readers_) delivered += drain(*r);
+  return delivered;
+}
+
+bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t timeout_ns) {
+  using clock = std::chrono::steady_clock;
+  const auto deadline = clock::now() + std::chrono::nanoseconds(timeout_ns);
+  while (!done()) {
+    const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - clock::now()).count();
+    if (left <= 0) return done();
+    spin_once(left);
+  }
+  return true;
+}
+
+int DdsTransport::matched_writers(const std::string& ros_topic) const {
+  int n = 0;
+  for (const auto& r : readers_) {
+    if (r->topic != ros_topic) continue;
+    dds_subscription_matched_status_t s;
+    if (dds_get_subscription_matched_status(r->reader, &s) >= 0) n += static_cast<int>(s.current_count);
+  }
+  return n;
+}
+
+int DdsTransport::matched_readers(const std::string& ros_topic) const {
+  int n = 0;
+  const auto it = writers_.find(ros_topic);
+  if (it == writers_.end()) return 0;
+  for (dds_entity_t w : it->second) {
+    dds_publication_matched_status_t s;
+    if (dds_get_publication_matched_status(w, &s) >= 0) n += static_cast<int>(s.current_count);
+  }
+  return n;
+}
+
+}  // namespace quadcosim::dds

@@ -1,0 +1,76 @@
+// Transport over Cyclone DDS speaking the ROS 2 wire format: topic "/drone/Pose" travels as DDS
+// topic "rt/drone/Pose" with type "geometry_msgs::msg::dds_::PoseStamped_", XCDR1, and the ROS QoS
+// set explicitly. Subscriptions are delivered by spin_once() on the caller's thread, so a node never
+// sees a callback while it is in the middle of a step.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dds/participant.hpp"
+#include "dds/ros_types.hpp"
+#include "sim/transport.hpp"
+
+namespace quadcosim::dds {
+
+struct QosProfile {
+  int depth = 10;         ///< KEEP_LAST depth
+  bool reliable = true;   ///< RELIABLE (ROS default) or BEST_EFFORT (ROS sensor data)
+  static QosProfile ros_default() { return {10, true}; }
+  static QosProfile sensor_data() { return {5, false}; }
+};
+
+/// "/drone/Pose" -> "rt/drone/Pose".
+std::string dds_topic_name(const std::string& ros_topic);
+
+class DdsTransport final : public sim::Transport {
+ public:
+  explicit DdsTransport(const RosEnvironment& env);
+  ~DdsTransport() override;
+
+  /// QoS for endpoints created later on `ros_topic` (default: ROS default QoS).
+  void set_qos(const std::string& ros_topic, QosProfile qos) { qos_[ros_topic] = qos; }
+
+  /// Waits up to timeout_ns for data on any subscription, then delivers every sample that has
+  /// arrived, reader by reader in subscription order. Returns how many messages were delivered.
+  int spin_once(std::int64_t timeout_ns);
+
+  /// Spins until `done()` holds or timeout_ns passes; returns done().
+  bool spin_until(const std::function<bool()>& done, std::int64_t timeout_ns);
+
+  /// Writers matched by our readers of `ros_topic` / readers matched by our writers of it.
+  int matched_writers(const std::string& ros_topic) const;
+  int matched_readers(const std::string& ros_topic) const;
+
+  const Participant& participant() const { return participant_; }
+
+ protected:
+  std::function<void(const void*)> make_sink(const std::string& topic, const sim::TopicType& type) override;
+  void add_subscription(const std::string& topic, const sim::TopicType& type,
+                        std::function<void(const void*)> deliver) override;
+
+ private:
+  struct Reader {
+    std::string topic;
+    dds_entity_t reader;
+    dds_entity_t condition;
+    const TypeOps* ops;
+    std::function<void(const void*)> deliver;
+  };
+  dds_entity_t topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops);
+  QosProfile qos_for(const std::string& ros_topic) const;
+  int drain(Reader& r);
+
+  Participant participant_;
+  dds_entity_t waitset_ = 0;
+  std::map<std::string, dds_entity_t> topics_;
+  std::vector<std::unique_ptr<Reader>> readers_;
+  std::map<std::string, std::vector<dds_entity_t>> writers_;
+  std::map<std::string, QosProfile> qos_;
+};
+
+}  // namespace quadcosim::dds

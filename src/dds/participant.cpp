@@ -1,0 +1,110 @@
+#include "dds/participant.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <sstream>
+
+namespace quadcosim::dds {
+
+dds_return_t check(dds_return_t rc, const char* what) {
+  if (rc < 0) {
+    throw DdsError(std::string(what) + " failed: " + dds_strretcode(rc) + " (" + std::to_string(rc) + ")");
+  }
+  return rc;
+}
+
+namespace {
+std::string env(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? v : "";
+}
+}  // namespace
+
+RosEnvironment read_ros_environment() {
+  RosEnvironment e;
+  const std::string id = env("ROS_DOMAIN_ID");
+  if (!id.empty()) {
+    errno = 0;
+    char* end = nullptr;
+    const unsigned long v = std::strtoul(id.c_str(), &end, 0);
+    // 232 is the largest id whose RTPS ports stay below 65535 with the default port mapping.
+    if (errno != 0 || end == id.c_str() || *end != '\0' || v > 232) {
+      throw DdsError("ROS_DOMAIN_ID='" + id + "': expected a whole number in [0, 232]");
+    }
+    e.domain_id = static_cast<std::uint32_t>(v);
+  }
+  const std::string range = env("ROS_AUTOMATIC_DISCOVERY_RANGE");
+  if (range.empty() || range == "SUBNET") {
+    e.range = DiscoveryRange::kSubnet;
+  } else if (range == "LOCALHOST") {
+    e.range = DiscoveryRange::kLocalhost;
+  } else if (range == "OFF") {
+    e.range = DiscoveryRange::kOff;
+  } else if (range == "SYSTEM_DEFAULT") {
+    e.range = DiscoveryRange::kSystemDefault;
+  } else {
+    throw DdsError("ROS_AUTOMATIC_DISCOVERY_RANGE='" + range +
+                   "': expected SUBNET, LOCALHOST, OFF or SYSTEM_DEFAULT");
+  }
+  if (env("ROS_LOCALHOST_ONLY") == "1") e.range = DiscoveryRange::kLocalhost;
+  e.static_peers = env("ROS_STATIC_PEERS");
+  e.cyclonedds_uri = env("CYCLONEDDS_URI");
+  return e;
+}
+
+std::string cyclone_config(const RosEnvironment& e) {
+  std::ostringstream x;
+  x << "<CycloneDDS><Domain id=\"any\">";
+  if (e.range == DiscoveryRange::kLocalhost || e.range == DiscoveryRange::kOff) {
+    x << "<General><AllowMulticast>false</AllowMulticast></General>";
+  }
+  x << "<Discovery>";
+  if (e.range != DiscoveryRange::kSystemDefault) {
+    x << "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>";
+  }
+  std::string peers;
+  if (e.range == DiscoveryRange::kLocalhost) peers += "<Peer address=\"localhost\"/>";
+  std::stringstream sp(e.static_peers);
+  for (std::string p; std::getline(sp, p, ';');) {
+    if (!p.empty()) peers += "<Peer address=\"" + p + "\"/>";
+  }
+  if (!peers.empty()) x << "<Peers>" << peers << "</Peers>";
+  x << "</Discovery></Domain></CycloneDDS>";
+  std::string config = x.str();
+  if (!e.cyclonedds_uri.empty()) config += "," + e.cyclonedds_uri;
+  return config;
+}
+
+Participant::Participant(const RosEnvironment& env) : domain_id_(env.domain_id) {
+  const std::string config = cyclone_config(env);
+  domain_ = dds_create_domain(env.domain_id, config.c_str());
+  // A domain with this id may already exist in this process (e.g. two nodes in one test): then the
+  // participant joins it with the configuration it already has.
+  if (domain_ < 0 && domain_ != DDS_RETCODE_PRECONDITION_NOT_MET) check(domain_, "dds_create_domain");
+  dds_qos_t* qos = dds_create_qos();
+  static const char kUserData[] = "enclave=/;";
+  dds_qset_userdata(qos, kUserData, sizeof(kUserData) - 1);
+  participant_ = dds_create_participant(env.domain_id, qos, nullptr);
+  dds_delete_qos(qos);
+  check(participant_, "dds_create_participant");
+}
+
+Participant::~Participant() {
+  if (participant_ > 0) dds_delete(participant_);
+  if (domain_ > 0) dds_delete(domain_);
+}
+
+dds_qos_t* ros_qos(int depth, bool reliable) {
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+  dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+                       DDS_INFINITY);
+  dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_INFINITY);
+  dds_qset_writer_data_lifecycle(q, false);
+  const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
+  dds_qset_data_representation(q, 1, xcdr1);
+  return q;
+}
+
+}  // namespace quadcosim::dds

@@ -1,0 +1,64 @@
+// A DDS domain participant that looks like a ROS 2 node's to other ROS 2 participants: domain id from
+// ROS_DOMAIN_ID, discovery range from ROS_AUTOMATIC_DISCOVERY_RANGE / ROS_LOCALHOST_ONLY /
+// ROS_STATIC_PEERS (as rmw_cyclonedds maps them onto Cyclone's configuration), USER_DATA
+// "enclave=/;".
+#pragma once
+
+#include <dds/dds.h>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace quadcosim::dds {
+
+/// A failure of the DDS layer; what() names the call and Cyclone's return code.
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Throws DdsError when `rc` is a Cyclone error code; returns it otherwise.
+dds_return_t check(dds_return_t rc, const char* what);
+
+enum class DiscoveryRange { kSubnet, kLocalhost, kOff, kSystemDefault };
+
+/// The ROS 2 environment, parsed (see ros2-wire.md section 6).
+struct RosEnvironment {
+  std::uint32_t domain_id = 0;
+  DiscoveryRange range = DiscoveryRange::kSubnet;
+  std::string static_peers;  ///< ';'-separated addresses
+  std::string cyclonedds_uri;
+};
+
+/// Reads ROS_DOMAIN_ID (base 0 like strtoul; unset or empty: 0), ROS_AUTOMATIC_DISCOVERY_RANGE,
+/// ROS_LOCALHOST_ONLY=1 (forces LOCALHOST), ROS_STATIC_PEERS and CYCLONEDDS_URI. Throws DdsError
+/// naming the variable and value when one is malformed (e.g. a domain id above 232).
+RosEnvironment read_ros_environment();
+
+/// The Cyclone configuration XML for the environment, as rmw_cyclonedds builds it.
+std::string cyclone_config(const RosEnvironment& env);
+
+/// RAII participant. Not copyable; deleting it deletes every entity it created.
+class Participant {
+ public:
+  /// Creates the domain (with the configuration for `env`) and the participant.
+  explicit Participant(const RosEnvironment& env);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  dds_entity_t handle() const { return participant_; }
+  std::uint32_t domain_id() const { return domain_id_; }
+
+ private:
+  dds_entity_t domain_ = 0;
+  dds_entity_t participant_ = 0;
+  std::uint32_t domain_id_ = 0;
+};
+
+/// The QoS rmw uses for `depth` KEEP_LAST, RELIABLE (or BEST_EFFORT), VOLATILE, XCDR1 only.
+/// Caller owns the result (dds_delete_qos).
+dds_qos_t* ros_qos(int depth, bool reliable);
+
+}  // namespace quadcosim::dds
