@@ -11,6 +11,8 @@ struct RunOptions {
   std::string scenario;
   std::string out_dir;
   bool plots = true;
+  std::string transport = "inproc";  ///< "inproc" or "dds" (plant and controller as two processes)
+  double timeout_s = 10.0;           ///< dds: lockstep wait for one command before the policy applies
 };
 int run_command(const RunOptions& options);
 
@@ -39,6 +41,26 @@ struct SummaryOptions {
   std::string out;  ///< markdown file, "" for stdout only
 };
 int summary_command(const SummaryOptions& options);
+
+struct PlantCommandOptions {
+  std::string scenario;     ///< vehicle, rates, duration, initial state ("" for defaults)
+  std::string ns;           ///< overrides the scenario's namespace when set
+  bool lockstep = true;     ///< false: real time
+  double rate_factor = 1.0; ///< real time: run k times faster than the wall clock
+  double duration_s = -1.0; ///< overrides the scenario's duration when >= 0
+  std::string record;       ///< trajectory CSV to write ("" for none)
+  double timeout_s = 10.0;  ///< lockstep: how long to wait for a controller / for one command
+  std::string on_timeout = "abort";  ///< lockstep: "abort" (exit 4) or "hold" (last command, go on)
+};
+int plant_command(const PlantCommandOptions& options);
+
+struct ControllerCommandOptions {
+  std::string scenario;  ///< controller parameters, rates, schedule ("" for defaults)
+  std::string params;    ///< controller parameter file, applied over the scenario's
+  std::string ns;
+  bool lockstep = true;
+};
+int controller_command(const ControllerCommandOptions& options);
 
 /// Runs the plotting script on a run directory; returns false (after printing why) on failure.
 bool make_plots(const std::string& run_dir);

@@ -14,6 +14,34 @@ int main(int argc, char** argv) {
   run_cmd->add_option("scenario", run.scenario, "scenario YAML file")->required()->check(CLI::ExistingFile);
   run_cmd->add_option("--out", run.out_dir, "output directory (created)")->required();
   run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots");
+  run_cmd->add_option("--transport", run.transport,
+                      "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
+      ->check(CLI::IsMember({"inproc", "dds"}));
+  run_cmd->add_option("--timeout", run.timeout_s, "dds: lockstep wait for a command [s]")
+      ->check(CLI::Range(0.01, 3600.0));
+
+  PlantCommandOptions plant;
+  auto* plant_cmd = app.add_subcommand("plant", "the plant as a ROS 2 node over DDS (until done or Ctrl-C)");
+  plant_cmd->add_option("--scenario", plant.scenario, "scenario YAML (vehicle, rates, duration, initial state)")
+      ->check(CLI::ExistingFile);
+  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1");
+  plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
+  plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
+      ->check(CLI::Range(1e-3, 1e6));
+  plant_cmd->add_option("--duration", plant.duration_s, "simulated time [s]")->check(CLI::Range(0.0, 1e9));
+  plant_cmd->add_option("--record", plant.record, "write the trajectory CSV here");
+  plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
+      ->check(CLI::Range(0.01, 3600.0));
+  plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
+      ->check(CLI::IsMember({"abort", "hold"}));
+
+  ControllerCommandOptions ctl;
+  auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
+  ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
+      ->check(CLI::ExistingFile);
+  ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
+  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
+  ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
 
   OpenloopOptions ol;
   auto* ol_cmd = app.add_subcommand("openloop", "the plant alone under a rotor speed schedule");
@@ -43,6 +71,8 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   if (*run_cmd) return run_command(run);
+  if (*plant_cmd) return plant_command(plant);
+  if (*ctl_cmd) return controller_command(ctl);
   if (*ol_cmd) return openloop_command(ol);
   if (*lqr_cmd) return lqr_command(lqr);
   if (*params_cmd) return params_command();

@@ -4,8 +4,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
+#include "app/child_process.hpp"
 #include "app/commands.hpp"
+#include "app/signals.hpp"
 #include "control/care.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
@@ -37,6 +40,36 @@ void record_series(io::Series& s, const sim::TickRecord& r, const io::ControlCol
   s.append("yaw_des", c.yaw_des);
 }
 
+// Plant and controller as two child processes over DDS, lockstep; the plant records. Both are ended
+// on every path (ChildProcess), also on Ctrl-C.
+int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
+  install_stop_handlers();
+  const std::string self = self_executable();
+  const std::string timeout = fmt::format("{}", opt.timeout_s);
+  ChildProcess controller({self, "controller", "--scenario", opt.scenario});
+  ChildProcess plant({self, "plant", "--scenario", opt.scenario, "--record", csv_path, "--timeout", timeout});
+  std::optional<int> plant_status;
+  while (!(plant_status = plant.wait(0.1))) {
+    if (stop_requested()) {
+      std::cerr << "run: interrupted; stopping plant and controller\n";
+      plant.stop();
+      controller.stop();
+      return 130;
+    }
+    if (auto c = controller.wait(0.0)) {
+      std::cerr << "run: the controller exited early (status " << *c << "); stopping the plant\n";
+      plant.stop();
+      return 4;
+    }
+  }
+  controller.stop();
+  if (*plant_status != 0) {
+    std::cerr << "run: the plant exited with status " << *plant_status << '\n';
+    return 4;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_command(const RunOptions& opt) {
@@ -58,29 +91,34 @@ int run_command(const RunOptions& opt) {
 
   try {
     fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
-    model::Quadrotor probe(sc.vehicle);
-    const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
-    sim::Simulation simulation(sc.simulation, sc.vehicle, x0, sc.controller, sc.schedule);
-
-    io::TrajectoryWriter csv((out / "trajectory.csv").string());
+    const std::string csv_path = (out / "trajectory.csv").string();
     io::Series series;
-    simulation.run([&](const sim::TickRecord& r) {
-      const io::ControlColumns c = io::ControlColumns::from(r.status);
-      csv.write(r.t_s, r.state, r.applied_command, c);
-      record_series(series, r, c);
-    });
-    csv.close();
+    if (opt.transport == "dds") {
+      if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
+      series = io::read_series(csv_path);
+    } else {
+      model::Quadrotor probe(sc.vehicle);
+      const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
+      sim::Simulation simulation(sc.simulation, sc.vehicle, x0, sc.controller, sc.schedule);
+      io::TrajectoryWriter csv(csv_path);
+      simulation.run([&](const sim::TickRecord& r) {
+        const io::ControlColumns c = io::ControlColumns::from(r.status);
+        csv.write(r.t_s, r.state, r.applied_command, c);
+        record_series(series, r, c);
+      });
+      csv.close();
+      if (simulation.plant().stats().commands_rejected > 0) {
+        std::cout << fmt::format("plant rejected {} of {} motor commands\n",
+                                 simulation.plant().stats().commands_rejected,
+                                 simulation.plant().stats().commands_received);
+      }
+    }
 
     const auto results = io::evaluate_steps(sc.steps, series);
     io::write_metrics_json((out / "metrics.json").string(), sc, results);
     const std::string table = io::format_step_table(sc, results);
     std::ofstream((out / "metrics.txt").string()) << table;
     std::cout << table;
-    if (simulation.plant().stats().commands_rejected > 0) {
-      std::cout << fmt::format("plant rejected {} of {} motor commands\n",
-                               simulation.plant().stats().commands_rejected,
-                               simulation.plant().stats().commands_received);
-    }
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir)) return 3;
     return io::all_passed(results) ? 0 : 1;

@@ -43,6 +43,9 @@ std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_
   dds_delete_qos(qos);
   check(writer, ("dds_create_writer " + ros_topic).c_str());
   writers_[ros_topic].push_back(writer);
+  // Matching changes wake spin_once, so waits for a peer need no polling.
+  check(dds_set_status_mask(writer, DDS_PUBLICATION_MATCHED_STATUS), "dds_set_status_mask");
+  check(dds_waitset_attach(waitset_, writer, 0), "dds_waitset_attach");
   return [writer, ops, ros_topic](const void* message) {
     check(ops->write(writer, message), ("dds_write " + ros_topic).c_str());
   };
@@ -65,6 +68,8 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
   r->deliver = std::move(deliver);
   check(dds_waitset_attach(waitset_, r->condition, static_cast<dds_attach_t>(readers_.size())),
         "dds_waitset_attach");
+  check(dds_set_status_mask(reader, DDS_SUBSCRIPTION_MATCHED_STATUS), "dds_set_status_mask");
+  check(dds_waitset_attach(waitset_, reader, 0), "dds_waitset_attach");
   readers_.push_back(std::move(r));
 }
 
@@ -89,9 +94,15 @@ int DdsTransport::drain(Reader& r) {
 }
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
-  if (readers_.empty()) return 0;
+  if (readers_.empty() && writers_.empty()) return 0;
   const dds_return_t rc = dds_waitset_wait(waitset_, nullptr, 0, timeout_ns);
   check(rc, "dds_waitset_wait");
+  // Clear the matched-status triggers (the counts stay readable).
+  std::uint32_t status = 0;
+  for (const auto& [topic, ws] : writers_) {
+    for (dds_entity_t w : ws) dds_take_status(w, &status, DDS_PUBLICATION_MATCHED_STATUS);
+  }
+  for (const auto& r : readers_) dds_take_status(r->reader, &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
   int delivered = 0;
   for (auto& r : readers_) delivered += drain(*r);
   return delivered;

@@ -1,6 +1,8 @@
 #include "dds/ros_types.hpp"
 
 #include <map>
+#include <type_traits>
+#include <vector>
 
 #include "geometry_msgs.h"
 #include "quadcosim_msgs.h"
@@ -124,14 +126,26 @@ template <>
 struct Wire<msg::Float64MultiArray> {
   using C = std_msgs_msg_dds__Float64MultiArray_;
   static const dds_topic_descriptor_t* desc() { return &std_msgs_msg_dds__Float64MultiArray__desc; }
-  static void to(const msg::Float64MultiArray& m, C& c) {
-    c.layout.dim = {0, 0, nullptr, false};  // no dimensions, as the paper's nodes send it
-    c.layout.data_offset = 0;
+  // Holds the C view of the dimensions while dds_write runs (at most a few; one in practice).
+  static void to(const msg::Float64MultiArray& m, C& c, std::vector<std_msgs_msg_dds__MultiArrayDimension_>& dims) {
+    dims.resize(m.dim.size());
+    for (std::size_t i = 0; i < m.dim.size(); ++i) {
+      dims[i] = {borrow(m.dim[i].label), m.dim[i].size, m.dim[i].stride};
+    }
+    const auto nd = static_cast<uint32_t>(dims.size());
+    c.layout.dim = {nd, nd, dims.empty() ? nullptr : dims.data(), false};
+    c.layout.data_offset = m.data_offset;
     const auto n = static_cast<uint32_t>(m.data.size());
     c.data = {n, n, const_cast<double*>(m.data.data()), false};
   }
   static void from(const C& c, msg::Float64MultiArray& m) {
     m.data.assign(c.data._buffer, c.data._buffer + c.data._length);
+    m.dim.resize(c.layout.dim._length);
+    for (std::uint32_t i = 0; i < c.layout.dim._length; ++i) {
+      const auto& d = c.layout.dim._buffer[i];
+      m.dim[i] = {own(d.label), d.size, d.stride};
+    }
+    m.data_offset = c.layout.data_offset;
   }
 };
 
@@ -175,8 +189,14 @@ TypeOps ops_for() {
       Wire<T>::desc(),
       [](dds_entity_t writer, const void* message) -> dds_return_t {
         typename Wire<T>::C c{};
-        Wire<T>::to(*static_cast<const T*>(message), c);
-        return dds_write(writer, &c);
+        if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
+          std::vector<std_msgs_msg_dds__MultiArrayDimension_> dims;
+          Wire<T>::to(*static_cast<const T*>(message), c, dims);
+          return dds_write(writer, &c);
+        } else {
+          Wire<T>::to(*static_cast<const T*>(message), c);
+          return dds_write(writer, &c);
+        }
       },
       [](const void* sample, const std::function<void(const void*)>& to) {
         T m;

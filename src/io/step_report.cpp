@@ -3,11 +3,56 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
 namespace quadcosim::io {
+
+Series read_series(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file");
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) header.push_back(c);
+  }
+  const std::vector<std::string> wanted = {"x",      "y",     "z",     "roll",      "pitch",     "yaw",
+                                           "x_des",  "y_des", "z_des", "roll_des",  "pitch_des", "yaw_des"};
+  std::vector<int> index;
+  auto column = [&](const std::string& name) {
+    for (std::size_t i = 0; i < header.size(); ++i) {
+      if (header[i] == name) return static_cast<int>(i);
+    }
+    throw std::runtime_error(path + ": no column '" + name + "'");
+  };
+  const int t_col = column("t");
+  for (const auto& w : wanted) index.push_back(column(w));
+  Series s;
+  int line_no = 1;
+  std::vector<double> row;
+  while (std::getline(in, line)) {
+    ++line_no;
+    row.clear();
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) {
+      char* end = nullptr;
+      row.push_back(std::strtod(c.c_str(), &end));
+      if (end == c.c_str()) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad number '" + c + "'");
+    }
+    if (row.size() != header.size()) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected " +
+                               std::to_string(header.size()) + " values");
+    }
+    s.t_s.push_back(row[t_col]);
+    for (std::size_t i = 0; i < wanted.size(); ++i) s.append(wanted[i], row[index[i]]);
+  }
+  return s;
+}
 
 std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series) {
   std::vector<StepResult> out;

@@ -33,6 +33,10 @@ struct StepResult {
   bool passed = true;
 };
 
+/// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des). Throws
+/// std::runtime_error naming the file and the missing column or bad line.
+Series read_series(const std::string& trajectory_csv);
+
 /// Evaluates every step of the scenario. The target is the channel's setpoint at the step time.
 std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series);
 

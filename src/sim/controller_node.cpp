@@ -12,13 +12,16 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   status_pub_ = transport.advertise<msg::ControllerStatus>(topics.controller_status);
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
+  command_msg_.dim = {{"", 4, 4}};
   transport.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) {
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
+    pose_ref_ns_ = reference(pose_stamp_ns_);
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this](const msg::TwistStamped& m) {
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
+    velocity_ref_ns_ = reference(velocity_stamp_ns_);
   });
   transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
     const Eigen::Quaterniond q(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -28,18 +31,21 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.yaw_rad = e.yaw_rad;
     estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
+    imu_ref_ns_ = reference(imu_stamp_ns_);
   });
 }
 
 const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
-  const std::int64_t oldest = std::min({pose_stamp_ns_, velocity_stamp_ns_, imu_stamp_ns_});
+  const std::int64_t oldest = std::min({pose_ref_ns_, velocity_ref_ns_, imu_ref_ns_});
   estimate_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
                                      : static_cast<double>(now_ns - oldest) / 1e9;
   command_ = controller_.step(estimate_, config_.setpoint, dt_s);
 
   const auto& sp = config_.setpoint;
   const bool position = sp.mode == control::Mode::kPosition;
-  status_.header.stamp = msg::Time::from_ns(now_ns);
+  // The status is stamped with simulated time: the step's time, or the newest sample's in real time.
+  const std::int64_t sim_now_ns = receipt_clock_ ? std::max<std::int64_t>(newest_stamp_ns(), 0) : now_ns;
+  status_.header.stamp = msg::Time::from_ns(sim_now_ns);
   status_.mode = control::to_string(sp.mode);
   status_.setpoint = {sp.p_des_W.x(),
                       sp.p_des_W.y(),
@@ -57,8 +63,27 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   status_pub_.publish(status_);
 
   for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];
+  command_msg_.dim[0].label = msg::command_label(sim_now_ns);
   command_pub_.publish(command_msg_);
+  last_step_ns_ = now_ns;
   return command_;
+}
+
+void ControllerNode::republish() {
+  status_pub_.publish(status_);
+  command_pub_.publish(command_msg_);
+}
+
+std::int64_t ControllerNode::newest_stamp_ns() const {
+  const std::int64_t newest = std::max({pose_stamp_ns_, velocity_stamp_ns_, imu_stamp_ns_});
+  return newest == kNever ? -1 : newest;
+}
+
+std::int64_t ControllerNode::synchronized_stamp_ns() const {
+  if (pose_stamp_ns_ == kNever || pose_stamp_ns_ != velocity_stamp_ns_ || pose_stamp_ns_ != imu_stamp_ns_) {
+    return -1;
+  }
+  return pose_stamp_ns_;
 }
 
 std::string ControllerNode::set_parameter(const std::string& name, const control::ParameterValue& value) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -26,6 +27,20 @@ class ControllerNode {
   /// motor command.
   const control::Command& step(std::int64_t now_ns, double dt_s);
 
+  /// Real time: measure the age of sensor data by when it arrived on `clock` [ns] instead of by its
+  /// stamp, so a plant that stops publishing is noticed even though its simulated time stops too.
+  /// step() then takes now_ns on that clock.
+  void use_receipt_clock(std::function<std::int64_t()> clock) { receipt_clock_ = std::move(clock); }
+
+  /// The newest stamp [ns] among Pose, Velocity, Imu (simulated time), or -1 before any arrived.
+  std::int64_t newest_stamp_ns() const;
+
+  /// Publishes the last status and command again (a lockstep peer that asked twice for one tick).
+  void republish();
+
+  /// Time [ns] of the last step, or INT64_MIN before the first.
+  std::int64_t last_step_ns() const { return last_step_ns_; }
+
   /// Sets one parameter; returns "" on success, else the reason it was refused (nothing changed).
   std::string set_parameter(const std::string& name, const control::ParameterValue& value);
 
@@ -34,6 +49,10 @@ class ControllerNode {
   const control::FlightController& controller() const { return controller_; }
   /// The estimate the last step used.
   const control::Estimate& estimate() const { return estimate_; }
+  /// The stamp [ns] shared by the newest Pose, Velocity and Imu, when all three have arrived with the
+  /// same stamp (a complete sample of one plant tick); -1 otherwise.
+  std::int64_t synchronized_stamp_ns() const;
+
   /// The status published by the last step.
   const msg::ControllerStatus& status() const { return status_; }
 
@@ -44,7 +63,13 @@ class ControllerNode {
   control::FlightController controller_;
   control::Estimate estimate_;
   control::Command command_;
+  /// Header stamps of the newest samples, and the times their age is measured from (the stamps, or
+  /// the receipt times under use_receipt_clock).
   std::int64_t pose_stamp_ns_ = kNever, velocity_stamp_ns_ = kNever, imu_stamp_ns_ = kNever;
+  std::int64_t pose_ref_ns_ = kNever, velocity_ref_ns_ = kNever, imu_ref_ns_ = kNever;
+  std::function<std::int64_t()> receipt_clock_;
+  std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
+  std::int64_t last_step_ns_ = kNever;
   msg::ControllerStatus status_;
   Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;

@@ -61,11 +61,27 @@ struct Imu {
   std::array<double, 9> linear_acceleration_covariance{};
 };
 
-/// std_msgs/msg/Float64MultiArray (the layout is left empty, as the paper's nodes do).
+/// std_msgs/msg/MultiArrayDimension
+struct MultiArrayDimension {
+  std::string label;
+  std::uint32_t size = 0;
+  std::uint32_t stride = 0;
+};
+
+/// std_msgs/msg/Float64MultiArray
 struct Float64MultiArray {
   static constexpr std::string_view kRosType = "std_msgs/msg/Float64MultiArray";
   std::vector<double> data;
+  std::vector<MultiArrayDimension> dim;  ///< layout.dim
+  std::uint32_t data_offset = 0;         ///< layout.data_offset
 };
+
+/// Motor commands from quadcosim's controller carry one dimension labelled "rotors@<ns>": the
+/// simulated time [ns] of the sensor data the command answers. Lockstep uses it to match commands to
+/// ticks; commands without it (any other ROS 2 controller) are matched by arrival.
+std::string command_label(std::int64_t stamp_ns);
+/// The stamp of a command's label, or -1 when it has none.
+std::int64_t command_stamp_ns(const Float64MultiArray& m);
 
 /// quadcosim_msgs/msg/ControllerStatus: what the controller decided in one step (for recording and
 /// monitoring). Published by the controller after every step, before its motor command.

@@ -28,6 +28,12 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     ++stats_.commands_rejected;
     return;
   }
+  const std::int64_t stamp = msg::command_stamp_ns(m);
+  if (options_.drop_stale_commands && stamp >= 0 && stamp < options_.clock.ns(current_tick_)) {
+    ++stats_.commands_stale;
+    return;
+  }
+  last_command_stamp_ns_ = stamp;
   pending_.push_back({current_tick_ + options_.command_delay_ticks,
                       model::Vector4(m.data[0], m.data[1], m.data[2], m.data[3])});
 }

@@ -18,11 +18,15 @@ struct PlantOptions {
   int substeps = 1;              ///< RK4 steps per plant tick
   int command_delay_ticks = 0;   ///< a command received during tick k takes effect at tick k + delay
   std::string frame_id = "world";
+  /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
+  /// (a repeat) and is dropped instead of overriding the current one.
+  bool drop_stale_commands = false;
 };
 
 struct PlantStats {
   std::uint64_t commands_received = 0;
   std::uint64_t commands_rejected = 0;  ///< wrong length or non-finite: ignored, last good one held
+  std::uint64_t commands_stale = 0;     ///< lockstep repeats of an earlier tick's command, dropped
 };
 
 class PlantNode {
@@ -42,6 +46,10 @@ class PlantNode {
   /// The command latched for the current interval, as received (before the model's clamping).
   const model::Vector4& applied_command() const { return applied_; }
   const PlantStats& stats() const { return stats_; }
+  /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet).
+  std::int64_t last_command_stamp_ns() const { return last_command_stamp_ns_; }
+  const PlantOptions& options() const { return options_; }
+  Tick current_tick() const { return current_tick_; }
 
  private:
   void on_command(const msg::Float64MultiArray& m);
@@ -50,6 +58,7 @@ class PlantNode {
   PlantOptions options_;
   model::State state_;
   Tick current_tick_ = 0;
+  std::int64_t last_command_stamp_ns_ = -1;
   model::Vector4 applied_ = model::Vector4::Zero();
   struct Pending {
     Tick effective_tick;

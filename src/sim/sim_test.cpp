@@ -80,7 +80,9 @@ struct PlantRig {
     cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
     plant = std::make_unique<PlantNode>(bus, topics, vehicle, opt, x0);
   }
-  void send(std::vector<double> w) { cmd.publish(msg::Float64MultiArray{std::move(w)}); }
+  void send(std::vector<double> w) { msg::Float64MultiArray m;
+    m.data = std::move(w);
+    cmd.publish(m); }
 };
 
 TEST(PlantNodeTest, PublishesStampedOutputsOfTheState) {

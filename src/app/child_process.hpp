@@ -1,0 +1,37 @@
+// Child processes that are always ended: a ChildProcess kills (SIGTERM, then SIGKILL) and reaps its
+// process when it goes out of scope, whatever path the parent takes.
+#pragma once
+
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace quadcosim::app {
+
+class ChildProcess {
+ public:
+  /// Starts `argv` (argv[0] is the program path) with the parent's environment and stdio.
+  /// Throws std::runtime_error when it cannot.
+  explicit ChildProcess(const std::vector<std::string>& argv);
+  ~ChildProcess();
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  pid_t pid() const { return pid_; }
+  /// Waits up to timeout_s for the process to end; its exit status (128 + signal when killed), or
+  /// nothing when it is still running.
+  std::optional<int> wait(double timeout_s);
+  /// SIGTERM, a grace period, then SIGKILL; returns the exit status.
+  int stop(double grace_s = 3.0);
+
+ private:
+  pid_t pid_ = -1;
+  std::optional<int> status_;
+};
+
+/// Path of the running executable (/proc/self/exe).
+std::string self_executable();
+
+}  // namespace quadcosim::app

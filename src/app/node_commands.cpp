@@ -1,0 +1,233 @@
+// `quadcosim plant` and `quadcosim controller`: the two nodes as long-running processes over DDS,
+// in lockstep (deterministic, as fast as the pair can go) or in real time.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "app/commands.hpp"
+#include "app/signals.hpp"
+#include "control/care.hpp"
+#include "dds/dds_transport.hpp"
+#include "io/scenario.hpp"
+#include "io/trajectory_csv.hpp"
+#include "sim/controller_node.hpp"
+#include "sim/plant_node.hpp"
+
+namespace quadcosim::app {
+
+namespace {
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+constexpr std::int64_t kMs = 1'000'000;
+
+io::Scenario scenario_or_defaults(const std::string& path) {
+  if (!path.empty()) return io::load_scenario(path);
+  io::Scenario sc;
+  sc.name = "defaults";
+  sc.controller.params.vehicle = sc.vehicle;
+  return sc;
+}
+
+}  // namespace
+
+int plant_command(const PlantCommandOptions& o) {
+  install_stop_handlers();
+  try {
+    io::Scenario sc = scenario_or_defaults(o.scenario);
+    if (!o.ns.empty()) sc.simulation.ns = o.ns;
+    if (o.duration_s >= 0.0) {
+      sc.simulation.duration_ticks =
+          static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
+    }
+    const sim::TickClock clock = sc.simulation.plant.clock;
+    const int divider = sc.simulation.controller_divider;
+    const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
+
+    dds::DdsTransport transport(dds::read_ros_environment());
+    sim::PlantOptions po = sc.simulation.plant;
+    po.drop_stale_commands = o.lockstep;
+    const model::Quadrotor probe(sc.vehicle);
+    sim::PlantNode plant(transport, topics, sc.vehicle, po,
+                         probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover));
+    msg::ControllerStatus status;
+    status.header.stamp = msg::Time::from_ns(-1);
+    bool have_status = false;
+    transport.subscribe<msg::ControllerStatus>(topics.controller_status, [&](const msg::ControllerStatus& m) {
+      status = m;
+      have_status = true;
+    });
+    std::unique_ptr<io::TrajectoryWriter> csv;
+    if (!o.record.empty()) csv = std::make_unique<io::TrajectoryWriter>(o.record);
+    auto record = [&](sim::Tick k) {
+      if (csv) {
+        csv->write(clock.seconds(k), plant.state(), plant.applied_command(),
+                   have_status ? io::ControlColumns::from(status) : io::ControlColumns::none());
+      }
+    };
+
+    std::cerr << fmt::format("plant: domain {}, namespace {}, {} mode, {} ticks of {} s\n",
+                             transport.participant().domain_id(), sc.simulation.ns,
+                             o.lockstep ? "lockstep" : "real-time", sc.simulation.duration_ticks,
+                             clock.period_s());
+    if (o.lockstep) {
+      // Wait until a controller is there to answer, so tick 0 is not published into the void.
+      const bool found = transport.spin_until(
+          [&] {
+            return stop_requested() || (transport.matched_writers(topics.motor_commands) > 0 &&
+                              transport.matched_readers(topics.pose) > 0 &&
+                              transport.matched_readers(topics.velocity) > 0 &&
+                              transport.matched_readers(topics.imu) > 0);
+          },
+          static_cast<std::int64_t>(o.timeout_s * 1e9));
+      if (!found) {
+        std::cerr << fmt::format("plant: no controller on {} within {} s (matched command writers: {}, "
+                                 "pose readers: {}); is it running on ROS_DOMAIN_ID {}?\n",
+                                 topics.motor_commands, o.timeout_s, transport.matched_writers(topics.motor_commands),
+                                 transport.matched_readers(topics.pose), transport.participant().domain_id());
+        return 4;
+      }
+    }
+
+    const std::int64_t loop_start = steady_ns();
+    std::int64_t next_wall = loop_start;
+    const auto period_wall = static_cast<std::int64_t>(static_cast<double>(clock.period_ns) / o.rate_factor);
+    // Under the hold policy a timeout switches waiting off until a command arrives again, so a
+    // vanished controller costs one timeout, not one per tick.
+    bool waiting = true;
+    for (sim::Tick k = 0; k <= sc.simulation.duration_ticks && !stop_requested(); ++k) {
+      const std::int64_t t_ns = clock.ns(k);
+      const std::uint64_t received_before = plant.stats().commands_received;
+      plant.publish_outputs(k);
+      if (o.lockstep && !waiting) transport.spin_once(0);  // collect without waiting
+      if (o.lockstep && !waiting && plant.stats().commands_received > received_before) {
+        std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
+        waiting = true;
+      }
+      if (o.lockstep && waiting && k % divider == 0) {
+        const bool status_expected = transport.matched_writers(topics.controller_status) > 0;
+        auto answered = [&] {
+          const bool command = plant.last_command_stamp_ns() == t_ns ||
+                               (plant.last_command_stamp_ns() < 0 && plant.stats().commands_received > received_before);
+          return stop_requested() || (command && (!status_expected || status.header.stamp.to_ns() == t_ns));
+        };
+        const std::int64_t deadline = steady_ns() + static_cast<std::int64_t>(o.timeout_s * 1e9);
+        // Ask again every 50 ms: a sample sent while discovery was still settling may not arrive.
+        while (!transport.spin_until(answered, 50 * kMs)) {
+          if (steady_ns() >= deadline) {
+            std::cerr << fmt::format(
+                "plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
+                "matched command writers: {}; policy: {}\n",
+                topics.motor_commands, k, clock.seconds(k), o.timeout_s,
+                transport.matched_writers(topics.motor_commands), o.on_timeout);
+            if (o.on_timeout == "abort") {
+              if (csv) csv->close();
+              return 4;
+            }
+            waiting = false;  // hold the last command and go on
+            break;
+          }
+          plant.publish_outputs(k);
+        }
+      } else if (!o.lockstep) {
+        next_wall += period_wall;
+        while (!stop_requested()) {
+          const std::int64_t left = next_wall - steady_ns();
+          if (left <= 0) break;
+          transport.spin_once(left);
+        }
+      }
+      plant.latch_command(k);
+      record(k);
+      if (k < sc.simulation.duration_ticks) plant.integrate(k);
+    }
+    if (csv) csv->close();
+    const auto& st = plant.stats();
+    const double wall_s = static_cast<double>(steady_ns() - loop_start) / 1e9;
+    const double sim_s = clock.seconds(sc.simulation.duration_ticks);
+    std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
+                             "rejected {}, stale {}\n",
+                             sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
+                             st.commands_stale);
+    return stop_requested() ? 130 : 0;
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: plant: " << e.what() << '\n';
+    return 3;
+  }
+}
+
+int controller_command(const ControllerCommandOptions& o) {
+  install_stop_handlers();
+  try {
+    io::Scenario sc = scenario_or_defaults(o.scenario);
+    if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
+    if (!o.ns.empty()) sc.simulation.ns = o.ns;
+    const sim::TickClock clock = sc.simulation.plant.clock;
+    const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
+    const double dt_s = static_cast<double>(control_period_ns) / 1e9;
+    const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
+
+    dds::DdsTransport transport(dds::read_ros_environment());
+    sim::ControllerNode node(transport, topics, sc.controller);
+    auto next_event = sc.schedule.begin();
+    auto apply_schedule = [&](std::int64_t now_ns) {
+      for (; next_event != sc.schedule.end() && clock.ns(next_event->tick) <= now_ns; ++next_event) {
+        if (std::string err = node.set_parameter(next_event->name, next_event->value); !err.empty()) {
+          throw std::invalid_argument("scheduled parameter refused: " + err);
+        }
+      }
+    };
+    std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
+                             transport.participant().domain_id(), sc.simulation.ns,
+                             o.lockstep ? "lockstep" : "real-time", dt_s);
+
+    if (o.lockstep) {
+      // Step once per complete sample of a control tick, on the sample's own time.
+      while (!stop_requested()) {
+        const int delivered = transport.spin_once(100 * kMs);
+        const std::int64_t s = node.synchronized_stamp_ns();
+        if (s < 0 || s % control_period_ns != 0) continue;
+        if (s > node.last_step_ns()) {
+          apply_schedule(s);
+          node.step(s, dt_s);
+        } else if (s == node.last_step_ns() && delivered > 0) {
+          node.republish();  // the plant asked again for a tick we answered
+        }
+      }
+    } else {
+      // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
+      node.use_receipt_clock(steady_ns);
+      std::int64_t next = steady_ns();
+      while (!stop_requested()) {
+        next += control_period_ns;
+        for (std::int64_t left; !stop_requested() && (left = next - steady_ns()) > 0;) transport.spin_once(left);
+        const std::int64_t sim_now = node.newest_stamp_ns();
+        apply_schedule(sim_now < 0 ? 0 : sim_now);
+        node.step(steady_ns(), dt_s);
+      }
+    }
+    std::cerr << "controller: stopped\n";
+    return 0;
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const control::CareError& e) {
+    std::cerr << "error: controller design failed: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: controller: " << e.what() << '\n';
+    return 3;
+  }
+}
+
+}  // namespace quadcosim::app

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# Co-simulation over DDS with real processes. Usage: dds_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID
+# Every case runs on its own ROS_DOMAIN_ID with localhost-only discovery, and ends every process it
+# started (trap), also on failure.
+set -euo pipefail
+bin="$1"; src="$2"; case_name="$3"
+export ROS_DOMAIN_ID="$4" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
+tmp="$(mktemp -d)"
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+fail() { echo "FAIL [$case_name]: $*"; for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done; exit 1; }
+paper="$src/scenarios/paper"
+
+identical() {  # in-process and DDS lockstep give the same bytes
+  local s="$1"
+  "$bin" run "$paper/$s.yaml" --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process run failed"
+  "$bin" run "$paper/$s.yaml" --out "$tmp/dds" --no-plots --transport dds > "$tmp/dds.log" 2>&1 \
+    || fail "DDS run failed"
+  cmp "$tmp/in/trajectory.csv" "$tmp/dds/trajectory.csv" || fail "trajectories differ"
+  cmp "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "metrics differ"
+  [ "$(wc -l < "$tmp/dds/trajectory.csv")" -eq 1502 ] || fail "expected 1501 rows"
+}
+
+case "$case_name" in
+  identical_altitude) identical altitude_step ;;
+  identical_roll) identical roll_step ;;
+  identical_pitch) identical pitch_step ;;
+  identical_yaw) identical yaw_step ;;
+
+  no_controller)  # lockstep with nobody to answer: a diagnostic and a non-zero exit, no hang
+    set +e
+    timeout 30 "$bin" plant --scenario "$paper/altitude_step.yaml" --timeout 1 > "$tmp/plant.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 4 ] || fail "expected exit 4, got $rc"
+    grep -q "no controller on /drone/motor_commands" "$tmp/plant.log" || fail "no diagnostic"
+    grep -q "ROS_DOMAIN_ID $ROS_DOMAIN_ID" "$tmp/plant.log" || fail "diagnostic does not name the domain"
+    ;;
+
+  controller_lost_abort|controller_lost_hold)  # the controller dies mid-run
+    policy="${case_name#controller_lost_}"
+    "$bin" controller --scenario "$paper/altitude_step.yaml" > "$tmp/controller.log" 2>&1 &
+    cpid=$!; pids+=("$cpid")
+    "$bin" plant --scenario "$paper/altitude_step.yaml" --duration 1000 --timeout 1 --on-timeout "$policy" \
+      --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1 &
+    ppid=$!; pids+=("$ppid")
+    for _ in $(seq 100); do [ -s "$tmp/t.csv" ] && break; sleep 0.05; done
+    sleep 0.3
+    kill -KILL "$cpid"
+    set +e
+    timeout 120 tail --pid="$ppid" -f /dev/null
+    wait "$ppid"; rc=$?
+    set -e
+    grep -q "lockstep timeout: no motor command on /drone/motor_commands for tick" "$tmp/plant.log" \
+      || fail "no timeout diagnostic"
+    # A SIGKILLed writer stays matched until Cyclone's participant lease (10 s) runs out.
+    grep -Eq "matched command writers: [0-9]+; policy: $policy" "$tmp/plant.log" || fail "diagnostic lacks matches/policy"
+    if [ "$policy" = abort ]; then
+      [ "$rc" -eq 4 ] || fail "abort policy: expected exit 4, got $rc"
+    else
+      [ "$rc" -eq 0 ] || fail "hold policy: expected exit 0, got $rc"
+      grep -q "100000 ticks" "$tmp/plant.log" || fail "unexpected run length"
+      [ "$(wc -l < "$tmp/t.csv")" -eq 100002 ] || fail "hold policy did not finish the run"
+    fi
+    ;;
+
+  two_namespaces)  # two vehicles on one domain, /uav1 and /uav2: no cross-talk
+    "$bin" run "$paper/altitude_step.yaml" --out "$tmp/in1" --no-plots > /dev/null
+    "$bin" run "$paper/roll_step.yaml" --out "$tmp/in2" --no-plots > /dev/null
+    "$bin" controller --scenario "$paper/altitude_step.yaml" --namespace /uav1 > "$tmp/c1.log" 2>&1 &
+    pids+=($!)
+    "$bin" controller --scenario "$paper/roll_step.yaml" --namespace /uav2 > "$tmp/c2.log" 2>&1 &
+    pids+=($!)
+    "$bin" plant --scenario "$paper/altitude_step.yaml" --namespace /uav1 --record "$tmp/p1.csv" > "$tmp/p1.log" 2>&1 &
+    p1=$!; pids+=("$p1")
+    "$bin" plant --scenario "$paper/roll_step.yaml" --namespace /uav2 --record "$tmp/p2.csv" > "$tmp/p2.log" 2>&1 &
+    p2=$!; pids+=("$p2")
+    wait "$p1" || fail "plant /uav1 failed"
+    wait "$p2" || fail "plant /uav2 failed"
+    cmp "$tmp/in1/trajectory.csv" "$tmp/p1.csv" || fail "/uav1 differs from its in-process run"
+    cmp "$tmp/in2/trajectory.csv" "$tmp/p2.csv" || fail "/uav2 differs from its in-process run"
+    ;;
+
+  *) fail "unknown case" ;;
+esac
+echo "ok [$case_name]"
