@@ -11,6 +11,7 @@
 #include "app/signals.hpp"
 #include "control/care.hpp"
 #include "dds/dds_transport.hpp"
+#include "dds/node_announcer.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
@@ -73,6 +74,8 @@ int plant_command(const PlantCommandOptions& o) {
       }
     };
 
+    dds::NodeAnnouncer announcer(transport.participant().handle(), "quadrotor_plant");
+    announcer.announce();  // `ros2 node list` shows /quadrotor_plant
     std::cerr << fmt::format("plant: domain {}, namespace {}, {} mode, {} ticks of {} s\n",
                              transport.participant().domain_id(), sc.simulation.ns,
                              o.lockstep ? "lockstep" : "real-time", sc.simulation.duration_ticks,
@@ -187,6 +190,8 @@ int controller_command(const ControllerCommandOptions& o) {
         }
       }
     };
+    dds::NodeAnnouncer announcer(transport.participant().handle(), "attitude_controller");
+    announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
     std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
                              transport.participant().domain_id(), sc.simulation.ns,
                              o.lockstep ? "lockstep" : "real-time", dt_s);

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <unistd.h>
 
 #include "dds/dds_transport.hpp"
@@ -45,7 +46,9 @@ TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
   i.header = {{1, 2}, "base_link"};
   i.orientation_covariance[8] = 7.0;
   i.linear_acceleration = {0.0, -0.0, 9.81};
-  msg::Float64MultiArray c{{4830.5, 1.0 / 3.0, 0.0, 1e9}};
+  msg::Float64MultiArray c;
+  c.data = {4830.5, 1.0 / 3.0, 0.0, 1e9};
+  c.dim = {{"rotors@5", 4, 4}};
   msg::ControllerStatus s;
   s.header.stamp = {3, 4};
   s.mode = "position";
@@ -68,6 +71,9 @@ TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
   EXPECT_EQ(imu_in.orientation_covariance[8], 7.0);
   EXPECT_TRUE(std::signbit(imu_in.linear_acceleration.y));
   EXPECT_EQ(cmd_in.data, c.data);
+  ASSERT_EQ(cmd_in.dim.size(), 1u);
+  EXPECT_EQ(cmd_in.dim[0].label, "rotors@5");
+  EXPECT_EQ(msg::command_stamp_ns(cmd_in), 5);
   EXPECT_EQ(status_in.mode, "position");
   EXPECT_EQ(status_in.setpoint, s.setpoint);
   EXPECT_EQ(status_in.rotor_saturated, s.rotor_saturated);
@@ -113,6 +119,77 @@ TEST(RosEnvironmentTest, ReadsDomainAndRange) {
   unsetenv("ROS_LOCALHOST_ONLY");
   unsetenv("ROS_STATIC_PEERS");
   unsetenv("ROS_DOMAIN_ID");
+}
+
+}  // namespace
+}  // namespace quadcosim::dds
+
+#include "dds/node_announcer.hpp"
+#include "rmw_dds_common.h"
+
+namespace quadcosim::dds {
+namespace {
+
+TEST(NodeAnnouncerTest, PublishesTheNodeWithItsEndpointGids) {
+  DdsTransport node(test_env());
+  auto pub = node.advertise<msg::PoseStamped>("/n/Pose");
+  node.subscribe<msg::Clock>("/clock_n", [](const msg::Clock&) {});
+  NodeAnnouncer announcer(node.participant().handle(), "quadrotor_plant");
+  announcer.announce();
+  EXPECT_EQ(announcer.writers(), 1u);
+  EXPECT_EQ(announcer.readers(), 1u);
+
+  // A late-joining reader of ros_discovery_info (transient local) still gets it.
+  Participant other(test_env());
+  const dds_entity_t topic = dds_create_topic(other.handle(), &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc,
+                                              "ros_discovery_info", nullptr, nullptr);
+  ASSERT_GT(topic, 0);
+  dds_qos_t* qos = ros_qos(100, true);
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
+  const dds_entity_t reader = dds_create_reader(other.handle(), topic, qos, nullptr);
+  dds_delete_qos(qos);
+  ASSERT_GT(reader, 0);
+  dds_guid_t participant_guid;
+  ASSERT_EQ(dds_get_guid(node.participant().handle(), &participant_guid), DDS_RETCODE_OK);
+
+  bool found = false;
+  for (int attempt = 0; attempt < 100 && !found; ++attempt) {
+    const dds_entity_t ws = dds_create_waitset(other.handle());
+    const dds_entity_t rc = dds_create_readcondition(reader, DDS_ANY_STATE);
+    dds_waitset_attach(ws, rc, 0);
+    dds_waitset_wait(ws, nullptr, 0, DDS_MSECS(100));
+    void* samples[8] = {nullptr};
+    dds_sample_info_t infos[8];
+    const dds_return_t n = dds_take(reader, samples, infos, 8, 8);
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      const auto* info = static_cast<const rmw_dds_common_msg_dds__ParticipantEntitiesInfo_*>(samples[i]);
+      if (std::memcmp(info->gid.data, participant_guid.v, 16) != 0) continue;
+      ASSERT_EQ(info->node_entities_info_seq._length, 1u);
+      const auto& n0 = info->node_entities_info_seq._buffer[0];
+      EXPECT_STREQ(n0.node_name, "quadrotor_plant");
+      EXPECT_STREQ(n0.node_namespace, "/");
+      EXPECT_EQ(n0.reader_gid_seq._length, 1u);
+      EXPECT_EQ(n0.writer_gid_seq._length, 1u);
+      found = true;
+    }
+    if (n > 0) dds_return_loan(reader, samples, n);
+    dds_delete(ws);
+  }
+  EXPECT_TRUE(found);
+}
+
+TEST(ParticipantTest, UserDataSaysEnclave) {
+  Participant p(test_env());
+  dds_qos_t* qos = dds_create_qos();
+  ASSERT_EQ(dds_get_qos(p.handle(), qos), DDS_RETCODE_OK);
+  void* data = nullptr;
+  size_t size = 0;
+  ASSERT_TRUE(dds_qget_userdata(qos, &data, &size));
+  EXPECT_EQ(std::string(static_cast<char*>(data), size), "enclave=/;");
+  dds_free(data);
+  dds_delete_qos(qos);
 }
 
 }  // namespace
