@@ -12,6 +12,8 @@ struct RunOptions {
   std::string out_dir;
   bool plots = true;
   std::string transport = "inproc";  ///< "inproc" or "dds" (plant and controller as two processes)
+  bool realtime = false;             ///< dds: real time instead of lockstep
+  double rate_factor = 1.0;          ///< dds real time: k times faster than the wall clock
   double timeout_s = 10.0;           ///< dds: lockstep wait for one command before the policy applies
 };
 int run_command(const RunOptions& options);
@@ -51,6 +53,7 @@ struct PlantCommandOptions {
   std::string record;       ///< trajectory CSV to write ("" for none)
   double timeout_s = 10.0;  ///< lockstep: how long to wait for a controller / for one command
   std::string on_timeout = "abort";  ///< lockstep: "abort" (exit 4) or "hold" (last command, go on)
+  bool wait_for_controller = false;  ///< real time: start the clock only once a controller is matched
 };
 int plant_command(const PlantCommandOptions& options);
 
@@ -59,6 +62,7 @@ struct ControllerCommandOptions {
   std::string params;    ///< controller parameter file, applied over the scenario's
   std::string ns;
   bool lockstep = true;
+  double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
 };
 int controller_command(const ControllerCommandOptions& options);
 

@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"inproc", "dds"}));
   run_cmd->add_option("--timeout", run.timeout_s, "dds: lockstep wait for a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
+  run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
+  run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
+      ->check(CLI::Range(1e-3, 1e6));
 
   PlantCommandOptions plant;
   auto* plant_cmd = app.add_subcommand("plant", "the plant as a ROS 2 node over DDS (until done or Ctrl-C)");
@@ -32,6 +35,8 @@ int main(int argc, char** argv) {
   plant_cmd->add_option("--record", plant.record, "write the trajectory CSV here");
   plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
+  plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
+                      "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
 
@@ -42,6 +47,8 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
   ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
+  ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
+      ->check(CLI::Range(1e-3, 1e6));
 
   OpenloopOptions ol;
   auto* ol_cmd = app.add_subcommand("openloop", "the plant alone under a rotor speed schedule");

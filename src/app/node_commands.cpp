@@ -80,7 +80,7 @@ int plant_command(const PlantCommandOptions& o) {
                              transport.participant().domain_id(), sc.simulation.ns,
                              o.lockstep ? "lockstep" : "real-time", sc.simulation.duration_ticks,
                              clock.period_s());
-    if (o.lockstep) {
+    if (o.lockstep || o.wait_for_controller) {
       // Wait until a controller is there to answer, so tick 0 is not published into the void.
       const bool found = transport.spin_until(
           [&] {
@@ -212,9 +212,11 @@ int controller_command(const ControllerCommandOptions& o) {
     } else {
       // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
       node.use_receipt_clock(steady_ns);
+      const auto wall_period_ns =
+          static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
       std::int64_t next = steady_ns();
       while (!stop_requested()) {
-        next += control_period_ns;
+        next += wall_period_ns;
         for (std::int64_t left; !stop_requested() && (left = next - steady_ns()) > 0;) transport.spin_once(left);
         const std::int64_t sim_now = node.newest_stamp_ns();
         apply_schedule(sim_now < 0 ? 0 : sim_now);

@@ -46,8 +46,17 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
   install_stop_handlers();
   const std::string self = self_executable();
   const std::string timeout = fmt::format("{}", opt.timeout_s);
-  ChildProcess controller({self, "controller", "--scenario", opt.scenario});
-  ChildProcess plant({self, "plant", "--scenario", opt.scenario, "--record", csv_path, "--timeout", timeout});
+  std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario};
+  std::vector<std::string> plant_args = {self, "plant", "--scenario", opt.scenario, "--record", csv_path,
+                                         "--timeout", timeout};
+  if (opt.realtime) {
+    for (std::string a : {"--realtime", "--rate-factor"}) controller_args.push_back(a);
+    controller_args.push_back(fmt::format("{}", opt.rate_factor));
+    for (std::string a : {"--realtime", "--wait-for-controller", "--rate-factor"}) plant_args.push_back(a);
+    plant_args.push_back(fmt::format("{}", opt.rate_factor));
+  }
+  ChildProcess controller(controller_args);
+  ChildProcess plant(plant_args);
   std::optional<int> plant_status;
   while (!(plant_status = plant.wait(0.1))) {
     if (stop_requested()) {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -65,7 +66,10 @@ std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const
       throw std::logic_error("no recorded series for channel " + spec.channel);
     }
     const auto it = std::lower_bound(series.t_s.begin(), series.t_s.end(), spec.t_step_s);
-    const std::size_t i = std::min<std::size_t>(it - series.t_s.begin(), series.t_s.size() - 1);
+    std::size_t i = std::min<std::size_t>(it - series.t_s.begin(), series.t_s.size() - 1);
+    // The setpoint in effect at the step; in real time the controller's first status may arrive a
+    // few ticks after it, so take the first recorded value from the step on.
+    while (i + 1 < sp->second.size() && !std::isfinite(sp->second[i])) ++i;
     r.figures = analysis::step_figures(series.t_s, y->second, spec.t_step_s, sp->second[i]);
     for (const Criterion& c : spec.criteria) {
       CriterionResult cr{c, analysis::figure(r.figures, c.figure), false};
