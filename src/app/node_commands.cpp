@@ -2,7 +2,9 @@
 // in lockstep (deterministic, as fast as the pair can go) or in real time.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <vector>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -105,6 +107,8 @@ int plant_command(const PlantCommandOptions& o) {
     // Under the hold policy a timeout switches waiting off until a command arrives again, so a
     // vanished controller costs one timeout, not one per tick.
     bool waiting = true;
+    std::vector<std::int64_t> round_trip_ns;  // lockstep: sensor publication -> command back
+    round_trip_ns.reserve(static_cast<std::size_t>(sc.simulation.duration_ticks / divider + 1));
     for (sim::Tick k = 0; k <= sc.simulation.duration_ticks && !stop_requested(); ++k) {
       const std::int64_t t_ns = clock.ns(k);
       const std::uint64_t received_before = plant.stats().commands_received;
@@ -121,7 +125,8 @@ int plant_command(const PlantCommandOptions& o) {
                                (plant.last_command_stamp_ns() < 0 && plant.stats().commands_received > received_before);
           return stop_requested() || (command && (!status_expected || status.header.stamp.to_ns() == t_ns));
         };
-        const std::int64_t deadline = steady_ns() + static_cast<std::int64_t>(o.timeout_s * 1e9);
+        const std::int64_t asked = steady_ns();
+        const std::int64_t deadline = asked + static_cast<std::int64_t>(o.timeout_s * 1e9);
         // Ask again every 50 ms: a sample sent while discovery was still settling may not arrive.
         while (!transport.spin_until(answered, 50 * kMs)) {
           if (steady_ns() >= deadline) {
@@ -139,6 +144,7 @@ int plant_command(const PlantCommandOptions& o) {
           }
           plant.publish_outputs(k);
         }
+        round_trip_ns.push_back(steady_ns() - asked);
       } else if (!o.lockstep) {
         next_wall += period_wall;
         while (!stop_requested()) {
@@ -154,6 +160,15 @@ int plant_command(const PlantCommandOptions& o) {
     if (csv) csv->close();
     const auto& st = plant.stats();
     const double wall_s = static_cast<double>(steady_ns() - loop_start) / 1e9;
+    if (!round_trip_ns.empty()) {
+      std::sort(round_trip_ns.begin(), round_trip_ns.end());
+      auto pct = [&](double q) {
+        return static_cast<double>(round_trip_ns[static_cast<std::size_t>(q * (round_trip_ns.size() - 1))]) / 1e3;
+      };
+      std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
+                               "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
+                               round_trip_ns.size(), pct(0.5), pct(0.99), pct(1.0));
+    }
     const double sim_s = clock.seconds(sc.simulation.duration_ticks);
     std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
                              "rejected {}, stale {}\n",
