@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# End to end, as a user runs it: the four paper scenarios through the binary, with plots, then the
+# End to end, as the README's main command runs it: the four paper scenarios over DDS (two processes,
+# lockstep), with plots, then the
 # comparison table. Checks exit codes and that every promised file exists and is non-trivial.
 set -euo pipefail
 bin="$1"
@@ -7,9 +8,10 @@ src="$2"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 
+export ROS_DOMAIN_ID=119 ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST  # as scripts/reproduce-paper.sh, own domain
 dirs=()
 for e in altitude_step roll_step pitch_step yaw_step; do
-  "$bin" run "$src/scenarios/paper/$e.yaml" --out "$tmp/$e" > "$tmp/$e.log" || {
+  "$bin" run "$src/scenarios/paper/$e.yaml" --out "$tmp/$e" --transport dds > "$tmp/$e.log" 2>&1 || {
     cat "$tmp/$e.log"; echo "FAIL: $e exited non-zero"; exit 1; }
   for f in trajectory.csv metrics.json metrics.txt scenario.yaml overview.png; do
     [ -s "$tmp/$e/$f" ] || { echo "FAIL: $e did not write $f"; exit 1; }
