@@ -5,6 +5,10 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class App;
+}
+
 namespace quadcosim::app {
 
 struct RunOptions {
@@ -63,8 +67,43 @@ struct ControllerCommandOptions {
   std::string ns;
   bool lockstep = true;
   double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
+  std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
 };
 int controller_command(const ControllerCommandOptions& options);
+
+/// `quadcosim param get|set|list|describe NODE [NAME [VALUE]]` (param_command.cpp): the ROS 2
+/// parameter services of a node over DDS, printed as `ros2 param` prints them. Exit 0 on success,
+/// 1 when the node refuses a set or lacks the parameter, 2 on bad input, 4 when the node is not
+/// found or does not answer within timeout_s.
+struct ParamOptions {
+  std::string verb;        ///< "get", "set", "list" or "describe" (set by the subcommand parsed)
+  std::string node;        ///< "/attitude_controller" or "attitude_controller"
+  std::string name;        ///< the parameter (get, set, describe)
+  std::string value;       ///< set: read as `ros2 param set` reads it (10 integer, 10.0 double, ...)
+  std::vector<std::string> prefixes;  ///< list: only names under these prefixes
+  double timeout_s = 5.0;  ///< how long to look for the node and wait for its answer
+};
+/// Adds the `param` subcommand with get/set/list/describe under `app`, parsing into `options`.
+CLI::App* add_param_subcommand(CLI::App& app, ParamOptions& options);
+int param_command(const ParamOptions& options);
+/// "" when `text` is a valid ROS node name (NAME or /NAMESPACE/NAME), else why not (a CLI check).
+std::string check_node_name(const std::string& text);
+
+/// `quadcosim topic list|echo|hz` (topic_command.cpp). Negative wait_s: the verb's default.
+struct TopicOptions {
+  std::string verb;          ///< "list", "echo" or "hz" (set by the subcommand parsed)
+  bool show_types = false;   ///< list -t
+  bool include_hidden = false;
+  double wait_s = -1.0;      ///< list: discovery time (1 s); echo/hz: how long to look for the topic (5 s)
+  std::string topic;
+  int count = 0;             ///< echo: stop after this many messages (0: until Ctrl-C)
+  std::string qos;           ///< "default" (reliable) or "sensor" (best effort); "": the verb's default
+  int window = 10000;        ///< hz: intervals the statistics cover
+  double duration_s = 0.0;   ///< hz: stop after this long (0: until Ctrl-C)
+};
+/// Adds the `topic` subcommand with list/echo/hz under `app`, parsing into `options`.
+CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& options);
+int topic_command(TopicOptions options);
 
 /// Runs the plotting script on a run directory; returns false (after printing why) on failure.
 bool make_plots(const std::string& run_dir);

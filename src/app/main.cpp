@@ -49,6 +49,8 @@ int main(int argc, char** argv) {
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
+  ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
+      ->check(CLI::Validator(check_node_name, "NAME"));
 
   OpenloopOptions ol;
   auto* ol_cmd = app.add_subcommand("openloop", "the plant alone under a rotor speed schedule");
@@ -76,6 +78,12 @@ int main(int argc, char** argv) {
   sum_cmd->add_option("run_dirs", sum.run_dirs, "run directories (with metrics.json)")->required();
   sum_cmd->add_option("--out", sum.out, "also write the table to this Markdown file");
 
+  TopicOptions topic;
+  auto* topic_cmd = add_topic_subcommand(app, topic);
+
+  ParamOptions param;
+  auto* param_cmd = add_param_subcommand(app, param);
+
   CLI11_PARSE(app, argc, argv);
   if (*run_cmd) return run_command(run);
   if (*plant_cmd) return plant_command(plant);
@@ -84,5 +92,7 @@ int main(int argc, char** argv) {
   if (*lqr_cmd) return lqr_command(lqr);
   if (*params_cmd) return params_command();
   if (*sum_cmd) return summary_command(sum);
+  if (*topic_cmd) return topic_command(topic);
+  if (*param_cmd) return param_command(param);
   return 2;
 }

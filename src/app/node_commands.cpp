@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
 #include "control/care.hpp"
 #include "dds/dds_transport.hpp"
@@ -197,6 +198,9 @@ int controller_command(const ControllerCommandOptions& o) {
 
     dds::DdsTransport transport(dds::read_ros_environment());
     sim::ControllerNode node(transport, topics, sc.controller);
+    const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
+    // The ROS 2 parameter services, answered inside transport.spin_once (both loops below).
+    dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
     auto next_event = sc.schedule.begin();
     auto apply_schedule = [&](std::int64_t now_ns) {
       for (; next_event != sc.schedule.end() && clock.ns(next_event->tick) <= now_ns; ++next_event) {
@@ -205,7 +209,7 @@ int controller_command(const ControllerCommandOptions& o) {
         }
       }
     };
-    dds::NodeAnnouncer announcer(transport.participant().handle(), "attitude_controller");
+    dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
     announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
     std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
                              transport.participant().domain_id(), sc.simulation.ns,

@@ -194,3 +194,217 @@ TEST(ParticipantTest, UserDataSaysEnclave) {
 
 }  // namespace
 }  // namespace quadcosim::dds
+
+#include "dds/graph.hpp"
+#include "dds/topic_tools.hpp"
+
+namespace quadcosim::dds {
+namespace {
+
+TEST(GraphTest, DemanglesRosTypesAsRmwCyclonedds) {
+  EXPECT_EQ(demangle_ros_type("geometry_msgs::msg::dds_::PoseStamped_"), "geometry_msgs/msg/PoseStamped");
+  EXPECT_EQ(demangle_ros_type("sensor_msgs::msg::dds_::Imu_"), "sensor_msgs/msg/Imu");
+  EXPECT_EQ(demangle_ros_type("rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"),
+            "rmw_dds_common/msg/ParticipantEntitiesInfo");
+  EXPECT_EQ(demangle_ros_type("rcl_interfaces::srv::dds_::SetParameters_Request_"),
+            "rcl_interfaces/srv/SetParameters_Request");
+  // Not mangled ROS types: unchanged.
+  EXPECT_EQ(demangle_ros_type("HelloWorldData::Msg"), "HelloWorldData::Msg");
+  EXPECT_EQ(demangle_ros_type("pkg::msg::dds_::Name"), "pkg::msg::dds_::Name");
+  EXPECT_EQ(demangle_ros_type(""), "");
+  // Every type quadcosim writes demangles to its ROS name.
+  EXPECT_EQ(demangle_ros_type(type_ops(typeid(msg::ControllerStatus))->descriptor->m_typename),
+            msg::ControllerStatus::kRosType);
+  EXPECT_EQ(demangle_ros_type(type_ops(typeid(msg::Float64MultiArray))->descriptor->m_typename),
+            msg::Float64MultiArray::kRosType);
+}
+
+TEST(GraphTest, OnlyRtTopicsAreRosTopics) {
+  EXPECT_EQ(ros_topic_name("rt/drone/Pose"), "/drone/Pose");
+  EXPECT_EQ(ros_topic_name("rt/clock"), "/clock");
+  EXPECT_EQ(ros_topic_name("ros_discovery_info"), std::nullopt);
+  EXPECT_EQ(ros_topic_name("rq/attitude_controller/set_parametersRequest"), std::nullopt);
+  EXPECT_EQ(ros_topic_name("rt/"), std::nullopt);
+  EXPECT_EQ(ros_topic_name("rtx/a"), std::nullopt);
+  EXPECT_TRUE(is_hidden_topic("/_secret"));
+  EXPECT_TRUE(is_hidden_topic("/drone/_debug/x"));
+  EXPECT_FALSE(is_hidden_topic("/drone/motor_commands"));
+}
+
+TEST(GraphTest, ListsTopicsSortedUniqueWithTypes) {
+  const std::vector<Endpoint> endpoints = {
+      {"rt/drone/Pose", "geometry_msgs::msg::dds_::PoseStamped_", true, true},
+      {"rt/clock", "rosgraph_msgs::msg::dds_::Clock_", true, false},
+      {"ros_discovery_info", "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_", true, true},
+      {"rt/drone/Pose", "geometry_msgs::msg::dds_::PoseStamped_", false, true},
+      {"rt/drone/Imu", "sensor_msgs::msg::dds_::Imu_", true, true},
+      {"rt/drone/_internal", "std_msgs::msg::dds_::Float64MultiArray_", true, true},
+      {"rt/mixed", "b::msg::dds_::B_", true, true},
+      {"rt/mixed", "a::msg::dds_::A_", false, true},
+      {"rq/x/get_parametersRequest", "rcl_interfaces::srv::dds_::GetParameters_Request_", true, true},
+  };
+  const auto topics = ros_topics(endpoints);
+  ASSERT_EQ(topics.size(), 5u);
+  EXPECT_EQ(topics[0].name, "/clock");
+  EXPECT_EQ(topics[0].best_effort_publishers, 1);
+  EXPECT_EQ(topics[2].name, "/drone/Pose");
+  EXPECT_EQ(topics[2].publishers, 1);
+  EXPECT_EQ(topics[2].subscribers, 1);
+  EXPECT_EQ(format_topic_list(topics, false), "/clock\n/drone/Imu\n/drone/Pose\n/mixed\n");
+  EXPECT_EQ(format_topic_list(topics, true),
+            "/clock [rosgraph_msgs/msg/Clock]\n"
+            "/drone/Imu [sensor_msgs/msg/Imu]\n"
+            "/drone/Pose [geometry_msgs/msg/PoseStamped]\n"
+            "/mixed [a/msg/A, b/msg/B]\n");
+  EXPECT_EQ(format_topic_list(topics, false, true), "/clock\n/drone/Imu\n/drone/Pose\n/drone/_internal\n/mixed\n");
+  EXPECT_EQ(format_topic_list({}, true), "");
+}
+
+TEST(GraphTest, DiscoversAnotherParticipantsEndpoints) {
+  DdsTransport node(test_env());
+  auto pub = node.advertise<msg::PoseStamped>("/g/Pose");
+  node.set_qos("/g/Imu", QosProfile::sensor_data());
+  node.subscribe<msg::Imu>("/g/Imu", [](const msg::Imu&) {});
+  Participant tool(test_env());
+  auto has_both = [](const std::vector<Endpoint>& es) {
+    int n = 0;
+    for (const auto& e : es) n += (e.dds_topic == "rt/g/Pose" && e.writer) + (e.dds_topic == "rt/g/Imu" && !e.writer);
+    return n == 2;
+  };
+  const auto es = discover_endpoints(tool.handle(), DDS_SECS(10), has_both);
+  ASSERT_TRUE(has_both(es));
+  for (const auto& e : es) {
+    if (e.dds_topic == "rt/g/Pose") {
+      EXPECT_EQ(e.dds_type, "geometry_msgs::msg::dds_::PoseStamped_");
+      EXPECT_TRUE(e.reliable);
+    }
+    if (e.dds_topic == "rt/g/Imu") {
+      EXPECT_FALSE(e.reliable);
+    }
+  }
+  // The participant's own endpoints are not listed.
+  for (const auto& e : discover_endpoints(node.participant().handle(), DDS_MSECS(200))) {
+    EXPECT_NE(e.dds_topic, "rt/g/Pose");
+  }
+  // Without `done`, it waits out the whole time.
+  const auto t0 = dds_time();
+  discover_endpoints(tool.handle(), DDS_MSECS(300));
+  EXPECT_GE(dds_time() - t0, DDS_MSECS(290));
+}
+
+TEST(TopicToolsTest, FloatsAsPythonReprThroughPyYaml) {
+  EXPECT_EQ(yaml_float(0.0), "0.0");
+  EXPECT_EQ(yaml_float(-0.0), "-0.0");
+  EXPECT_EQ(yaml_float(1.0), "1.0");
+  EXPECT_EQ(yaml_float(0.1), "0.1");
+  EXPECT_EQ(yaml_float(-9.81), "-9.81");
+  EXPECT_EQ(yaml_float(0.0001), "0.0001");
+  EXPECT_EQ(yaml_float(0.00001), "1.0e-05");
+  EXPECT_EQ(yaml_float(1.5e-7), "1.5e-07");
+  EXPECT_EQ(yaml_float(1e-300), "1.0e-300");
+  EXPECT_EQ(yaml_float(1e15), "1000000000000000.0");
+  EXPECT_EQ(yaml_float(1e16), "1.0e+16");
+  EXPECT_EQ(yaml_float(123456.789), "123456.789");
+  EXPECT_EQ(yaml_float(1.0 / 3.0), "0.3333333333333333");
+  EXPECT_EQ(yaml_float(std::nan("")), ".nan");
+  EXPECT_EQ(yaml_float(INFINITY), ".inf");
+  EXPECT_EQ(yaml_float(-INFINITY), "-.inf");
+}
+
+TEST(TopicToolsTest, StringsQuotedOnlyWhenNeeded) {
+  EXPECT_EQ(yaml_string("world"), "world");
+  EXPECT_EQ(yaml_string("rotors@100000000"), "rotors@100000000");
+  EXPECT_EQ(yaml_string("it's"), "it's");
+  EXPECT_EQ(yaml_string(""), "''");
+  EXPECT_EQ(yaml_string("123"), "'123'");
+  EXPECT_EQ(yaml_string("1.5"), "'1.5'");
+  EXPECT_EQ(yaml_string("true"), "'true'");
+  EXPECT_EQ(yaml_string("null"), "'null'");
+  EXPECT_EQ(yaml_string("a: b"), "'a: b'");
+  EXPECT_EQ(yaml_string("'q'"), "'''q'''");
+  EXPECT_EQ(yaml_string("@x"), "'@x'");
+  EXPECT_EQ(yaml_string("a\nb"), "\"a\\nb\"");
+}
+
+TEST(TopicToolsTest, MessagesAsRos2TopicEcho) {
+  msg::PoseStamped p;
+  p.header.stamp = {12, 345};
+  p.header.frame_id = "world";
+  p.position = {1.5, 0.0, -2.0};
+  EXPECT_EQ(to_yaml(p),
+            "header:\n"
+            "  stamp:\n"
+            "    sec: 12\n"
+            "    nanosec: 345\n"
+            "  frame_id: world\n"
+            "pose:\n"
+            "  position:\n"
+            "    x: 1.5\n"
+            "    y: 0.0\n"
+            "    z: -2.0\n"
+            "  orientation:\n"
+            "    x: 0.0\n"
+            "    y: 0.0\n"
+            "    z: 0.0\n"
+            "    w: 1.0\n");
+
+  msg::Float64MultiArray c;
+  c.data = {400.0, 400.5};
+  c.dim = {{"rotors@10000000", 4, 4}};
+  EXPECT_EQ(to_yaml(c),
+            "layout:\n"
+            "  dim:\n"
+            "  - label: rotors@10000000\n"
+            "    size: 4\n"
+            "    stride: 4\n"
+            "  data_offset: 0\n"
+            "data:\n"
+            "- 400.0\n"
+            "- 400.5\n");
+  EXPECT_EQ(to_yaml(msg::Float64MultiArray{}), "layout:\n  dim: []\n  data_offset: 0\ndata: []\n");
+
+  msg::Clock k;
+  k.clock = {3, 10000000};
+  EXPECT_EQ(to_yaml(k), "clock:\n  sec: 3\n  nanosec: 10000000\n");
+
+  msg::Imu imu;
+  imu.header.frame_id = "base_link";
+  const std::string y = to_yaml(imu);
+  EXPECT_NE(y.find("  frame_id: base_link\norientation:\n  x: 0.0\n"), std::string::npos);
+  EXPECT_NE(y.find("orientation_covariance:\n- 0.0\n- 0.0\n"), std::string::npos);
+  EXPECT_NE(y.find("\nlinear_acceleration_covariance:\n- 0.0\n"), std::string::npos);
+
+  msg::ControllerStatus s;
+  s.mode = "attitude";
+  s.rotor_saturated[1] = true;
+  const std::string sy = to_yaml(s);
+  EXPECT_NE(sy.find("mode: attitude\nsetpoint:\n- 0.0\n"), std::string::npos);
+  EXPECT_NE(sy.find("rotor_saturated:\n- false\n- true\n- false\n- false\ntilt_saturated: false\nsafety: false\n"),
+            std::string::npos);
+  EXPECT_NE(to_yaml(msg::TwistStamped{}).find("twist:\n  linear:\n    x: 0.0\n"), std::string::npos);
+}
+
+TEST(TopicToolsTest, RateWindowAsRos2TopicHz) {
+  RateWindow w(3);
+  EXPECT_FALSE(w.stats());
+  w.add(0);
+  EXPECT_FALSE(w.stats());
+  w.add(10'000'000);
+  w.add(20'000'000);
+  w.add(32'000'000);
+  w.add(40'000'000);  // the window keeps the last 3 intervals: 10, 12, 8 ms
+  const auto s = w.stats();
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->window, 3u);
+  EXPECT_NEAR(s->rate_hz, 100.0, 1e-9);
+  EXPECT_NEAR(s->min_s, 0.008, 1e-12);
+  EXPECT_NEAR(s->max_s, 0.012, 1e-12);
+  EXPECT_NEAR(s->std_dev_s, std::sqrt(8.0 / 3.0) * 1e-3, 1e-12);
+  EXPECT_EQ(w.messages(), 5u);
+  EXPECT_EQ(format_rate(*s), "average rate: 100.000\n\tmin: 0.008s max: 0.012s std dev: 0.00163s window: 3\n");
+  w.add(1'000);  // the clock went back: start over
+  EXPECT_FALSE(w.stats());
+}
+
+}  // namespace
+}  // namespace quadcosim::dds

@@ -94,7 +94,7 @@ int DdsTransport::drain(Reader& r) {
 }
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
-  if (readers_.empty() && writers_.empty()) return 0;
+  if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
   const dds_return_t rc = dds_waitset_wait(waitset_, nullptr, 0, timeout_ns);
   check(rc, "dds_waitset_wait");
   // Clear the matched-status triggers (the counts stay readable).
@@ -105,7 +105,25 @@ int DdsTransport::spin_once(std::int64_t timeout_ns) {
   for (const auto& r : readers_) dds_take_status(r->reader, &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
   int delivered = 0;
   for (auto& r : readers_) delivered += drain(*r);
+  // Copy the callbacks first: one may add or remove extra work.
+  std::vector<std::function<void()>> serve;
+  for (const auto& [id, w] : extra_) serve.push_back(w.serve);
+  for (const auto& f : serve) f();
   return delivered;
+}
+
+int DdsTransport::add_extra_work(const std::vector<dds_entity_t>& wake_on, std::function<void()> serve) {
+  const int id = next_extra_id_++;
+  for (dds_entity_t e : wake_on) check(dds_waitset_attach(waitset_, e, 0), "dds_waitset_attach");
+  extra_[id] = ExtraWork{wake_on, std::move(serve)};
+  return id;
+}
+
+void DdsTransport::remove_extra_work(int id) {
+  const auto it = extra_.find(id);
+  if (it == extra_.end()) return;
+  for (dds_entity_t e : it->second.wake_on) dds_waitset_detach(waitset_, e);
+  extra_.erase(it);
 }
 
 bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t timeout_ns) {

@@ -48,6 +48,16 @@ class DdsTransport final : public sim::Transport {
 
   const Participant& participant() const { return participant_; }
 
+  /// Extra DDS work served by spin_once beside the subscriptions, e.g. ROS 2 services on this
+  /// participant. Each entity in `wake_on` (a read condition, or a reader/writer whose status mask is
+  /// set) joins the waitset, so it wakes spin_once; `serve` runs after every wait, after the
+  /// subscriptions are delivered, on the caller's thread. `serve` must clear what woke it (take the
+  /// samples, dds_take_status) or spin_once stops blocking. What it handles is not counted in
+  /// spin_once's result. Returns an id for remove_extra_work.
+  int add_extra_work(const std::vector<dds_entity_t>& wake_on, std::function<void()> serve);
+  /// Detaches the entities and forgets `serve` (call before deleting the entities).
+  void remove_extra_work(int id);
+
  protected:
   std::function<void(const void*)> make_sink(const std::string& topic, const sim::TopicType& type) override;
   void add_subscription(const std::string& topic, const sim::TopicType& type,
@@ -71,6 +81,12 @@ class DdsTransport final : public sim::Transport {
   std::vector<std::unique_ptr<Reader>> readers_;
   std::map<std::string, std::vector<dds_entity_t>> writers_;
   std::map<std::string, QosProfile> qos_;
+  struct ExtraWork {
+    std::vector<dds_entity_t> wake_on;
+    std::function<void()> serve;
+  };
+  std::map<int, ExtraWork> extra_;
+  int next_extra_id_ = 1;
 };
 
 }  // namespace quadcosim::dds

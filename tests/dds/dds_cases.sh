@@ -98,6 +98,64 @@ case "$case_name" in
     cmp "$tmp/in2/trajectory.csv" "$tmp/p2.csv" || fail "/uav2 differs from its in-process run"
     ;;
 
+  topic_tools)  # quadcosim topic list/echo/hz against a real-time plant (on the ground, 100 Hz)
+    # The plant runs longer than the checks need (about 5 s): the trap ends it.
+    "$bin" plant --realtime --duration 10 > "$tmp/plant.log" 2>&1 &
+    pids+=($!)
+    "$bin" topic list -t --wait 2 > "$tmp/list.log" 2>&1 || fail "topic list failed"
+    for line in "/drone/Pose [geometry_msgs/msg/PoseStamped]" "/drone/Imu [sensor_msgs/msg/Imu]" \
+                "/clock [rosgraph_msgs/msg/Clock]"; do
+      grep -qxF "$line" "$tmp/list.log" || fail "topic list -t lacks '$line'"
+    done
+    "$bin" topic list --wait 0.5 > "$tmp/list_plain.log" 2>&1 || fail "topic list (no -t) failed"
+    grep -qx "/drone/Velocity" "$tmp/list_plain.log" || fail "topic list (no -t) lacks /drone/Velocity"
+    timeout 30 "$bin" topic echo /drone/Pose --count 2 > "$tmp/echo.log" 2>&1 || fail "topic echo failed"
+    [ "$(grep -cx -- '---' "$tmp/echo.log")" -eq 2 ] || fail "expected two messages"
+    [ "$(grep -cx '  frame_id: world' "$tmp/echo.log")" -eq 2 ] || fail "expected frame_id: world twice"
+    grep -qx '    w: 1.0' "$tmp/echo.log" || fail "no orientation w: 1.0"
+    timeout 30 "$bin" topic hz /drone/Imu --duration 2 > "$tmp/hz.log" 2>&1 || fail "topic hz failed"
+    rate="$(awk '/^average rate:/ { r = $3 } END { print r }' "$tmp/hz.log")"
+    [ -n "$rate" ] || fail "topic hz printed no rate"
+    awk -v r="$rate" 'BEGIN { exit !(r >= 90 && r <= 110) }' || fail "rate $rate Hz outside 90-110 Hz"
+    grep -q "window: " "$tmp/hz.log" || fail "no window in the hz report"
+    set +e
+    "$bin" topic echo /drone/nothing --wait 0.5 > "$tmp/missing.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 2 ] || fail "unknown topic: expected exit 2, got $rc"
+    grep -q "topic /drone/nothing not found on ROS_DOMAIN_ID $ROS_DOMAIN_ID" "$tmp/missing.log" \
+      || fail "unknown topic: no clear error"
+    ;;
+
+  param_set_climbs)  # ROS 2 parameter services: `quadcosim param set` raises z_des of a real-time flight
+    "$bin" controller --realtime > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    # Also waits for the node to come up (--timeout 5 s by default).
+    "$bin" param get /attitude_controller z_des > "$tmp/get0.log" 2> "$tmp/get0.err.log" || fail "param get (before) failed"
+    grep -qx "Double value is: 0.0" "$tmp/get0.log" || fail "z_des does not start at 0.0: $(cat "$tmp/get0.log")"
+    "$bin" plant --realtime --duration 8 --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1 &
+    ppid=$!; pids+=("$ppid")
+    sleep 1
+    "$bin" param set /attitude_controller z_des 3.0 > "$tmp/set.log" 2>&1 || fail "param set failed"
+    grep -qx "Set parameter successful" "$tmp/set.log" || fail "param set: unexpected output"
+    "$bin" param get /attitude_controller z_des > "$tmp/get.log" 2>&1 || fail "param get failed"
+    grep -qx "Double value is: 3.0" "$tmp/get.log" || fail "param get: expected 3.0, got $(cat "$tmp/get.log")"
+    # A refusal: non-zero exit and the table's reason.
+    set +e
+    "$bin" param set /attitude_controller z_des high > "$tmp/refused.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 1 ] || fail "refused set: expected exit 1, got $rc"
+    grep -q "Setting parameter failed: z_des must be a number, got 'high'" "$tmp/refused.log" \
+      || fail "refused set: no reason"
+    timeout 60 tail --pid="$ppid" -f /dev/null || fail "plant did not finish"
+    wait "$ppid" || fail "plant failed"
+    z_end="$(tail -1 "$tmp/t.csv" | cut -d, -f4)"
+    z_start="$(sed -n 2p "$tmp/t.csv" | cut -d, -f4)"
+    awk -v z="$z_start" 'BEGIN { exit !(z < 0.01) }' || fail "did not start on the ground (z = $z_start)"
+    awk -v z="$z_end" 'BEGIN { exit !(z > 2.0) }' || fail "did not climb: z at the end = $z_end"
+    ;;
+
   *) fail "unknown case" ;;
 esac
 echo "ok [$case_name]"

@@ -1,0 +1,92 @@
+// A client of one ROS 2 node's parameter services on the DDS wire, as an rmw_cyclonedds client
+// calls them (see parameter_service.hpp for the names, types and QoS): each request carries the
+// in-band header {guid = this client's request-writer instance handle, seq = a fresh number}, and
+// only the reply echoing both is taken. The request writer and reply reader of a service carry
+// USER_DATA "clientid=<id>;" so an rmw_cyclonedds server holds its reply until it has matched our
+// reader. Works with quadcosim's ParameterServer and with nodes on rmw_cyclonedds_cpp, not with
+// rmw_fastrtps_cpp nodes (they correlate replies differently; ros2/rmw_cyclonedds#184).
+#pragma once
+
+#include <dds/dds.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dds/parameter_types.hpp"
+#include "dds/participant.hpp"
+
+namespace quadcosim::dds {
+
+/// A call that could not be made or was not answered in time; what() names the node, the service
+/// and what was matched.
+class ParameterCallError : public DdsError {
+ public:
+  using DdsError::DdsError;
+};
+
+class ParameterClient {
+ public:
+  /// A client on its own participant (domain and discovery from `env`).
+  ParameterClient(const RosEnvironment& env, NodeName node);
+  /// A client on an existing participant (not owned).
+  ParameterClient(dds_entity_t participant, NodeName node);
+  ~ParameterClient();
+  ParameterClient(const ParameterClient&) = delete;
+  ParameterClient& operator=(const ParameterClient&) = delete;
+
+  // Each call waits up to `timeout_ns` in all: first for the service (a matched request reader and
+  // reply writer), then for the reply. Throws ParameterCallError on timeout.
+
+  /// Values in the order of `names`; empty when the node has not declared one of them.
+  std::vector<ParamValue> get(const std::vector<std::string>& names, std::int64_t timeout_ns);
+  /// Types in the order of `names`; empty when one is not declared.
+  std::vector<ParamType> get_types(const std::vector<std::string>& names, std::int64_t timeout_ns);
+  /// One result per parameter, each applied on its own.
+  std::vector<SetResult> set(const std::vector<Param>& parameters, std::int64_t timeout_ns);
+  /// All or none.
+  SetResult set_atomically(const std::vector<Param>& parameters, std::int64_t timeout_ns);
+  /// Descriptors in the order of `names`; empty when one is not declared.
+  std::vector<ParamDescriptor> describe(const std::vector<std::string>& names, std::int64_t timeout_ns);
+  ListResult list(const std::vector<std::string>& prefixes, std::uint64_t depth, std::int64_t timeout_ns);
+
+  /// Waits up to `timeout_ns` until `service` is matched; false on timeout.
+  bool wait_for_service(ParamService service, std::int64_t timeout_ns);
+
+  /// The in-band header of the last request sent.
+  struct Header {
+    std::uint64_t guid = 0;
+    std::int64_t seq = 0;
+  };
+  Header last_request() const { return last_; }
+  const NodeName& node() const { return node_; }
+
+ private:
+  struct Endpoints {
+    dds_entity_t writer = 0, reader = 0, read_condition = 0;
+    dds_instance_handle_t writer_handle = 0;
+  };
+  Endpoints& endpoints(ParamService service);
+  bool matched(const Endpoints& e) const;
+  /// Waits for the waitset (at most until `deadline_ns`, steady clock), clears the match triggers
+  /// and drops stale replies in every reader but `active`'s.
+  void wait(std::int64_t deadline_ns, const Endpoints* active);
+  /// Sends `request` (a generated request sample; its header is filled in here) and passes the
+  /// matching reply sample to `on_reply` before returning.
+  void call(ParamService service, void* request, std::int64_t timeout_ns,
+            const std::function<void(const void* reply)>& on_reply);
+  std::string describe_matches(ParamService service) const;
+
+  std::unique_ptr<Participant> own_participant_;
+  dds_entity_t participant_;
+  NodeName node_;
+  dds_entity_t waitset_ = 0;
+  std::array<Endpoints, 6> ep_{};
+  std::int64_t next_seq_ = 0;
+  Header last_;
+};
+
+}  // namespace quadcosim::dds
