@@ -58,6 +58,9 @@ struct PlantCommandOptions {
   double timeout_s = 10.0;  ///< lockstep: how long to wait for a controller / for one command
   std::string on_timeout = "abort";  ///< lockstep: "abort" (exit 4) or "hold" (last command, go on)
   bool wait_for_controller = false;  ///< real time: start the clock only once a controller is matched
+  /// Lockstep: apply the scenario's schedule through this node's ROS 2 parameter services, each
+  /// change before the tick it is due at ("" = the plant leaves the schedule to the controller).
+  std::string schedule_node;
 };
 int plant_command(const PlantCommandOptions& options);
 
@@ -68,6 +71,7 @@ struct ControllerCommandOptions {
   bool lockstep = true;
   double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
   std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
+  bool apply_schedule = true;  ///< apply the scenario's schedule itself (off when the plant does it)
 };
 int controller_command(const ControllerCommandOptions& options);
 

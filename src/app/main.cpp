@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   plant_cmd->add_option("--record", plant.record, "write the trajectory CSV here");
   plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
+  plant_cmd->add_option("--schedule-via", plant.schedule_node,
+                        "lockstep: apply the scenario's schedule through this node's parameter services");
   plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
@@ -47,6 +49,8 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
   ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
+  ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
+                    "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
   ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <variant>
 #include <vector>
 #include <iostream>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "control/care.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
+#include "dds/parameter_client.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
@@ -110,8 +112,33 @@ int plant_command(const PlantCommandOptions& o) {
     bool waiting = true;
     std::vector<std::int64_t> round_trip_ns;  // lockstep: sensor publication -> command back
     round_trip_ns.reserve(static_cast<std::size_t>(sc.simulation.duration_ticks / divider + 1));
+    // The schedule through the controller's parameter services: each change is acknowledged before
+    // the tick it is due at is published, so the run stays deterministic.
+    std::unique_ptr<dds::ParameterClient> scheduler;
+    if (!o.schedule_node.empty()) {
+      scheduler = std::make_unique<dds::ParameterClient>(transport.participant().handle(),
+                                                         dds::parse_node_name(o.schedule_node));
+    }
+    auto next_event = sc.schedule.begin();
     for (sim::Tick k = 0; k <= sc.simulation.duration_ticks && !stop_requested(); ++k) {
       const std::int64_t t_ns = clock.ns(k);
+      for (; scheduler && next_event != sc.schedule.end() && next_event->tick <= k; ++next_event) {
+        dds::ParamValue v;
+        if (const auto* d = std::get_if<double>(&next_event->value)) {
+          v.type = dds::ParamType::kDouble;
+          v.double_value = *d;
+        } else {
+          v.type = dds::ParamType::kString;
+          v.string_value = std::get<std::string>(next_event->value);
+        }
+        const auto r = scheduler->set({{next_event->name, v}}, static_cast<std::int64_t>(o.timeout_s * 1e9));
+        if (r.size() != 1 || !r[0].successful) {
+          std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event->name,
+                                   clock.seconds(k), o.schedule_node, r.empty() ? "no result" : r[0].reason);
+          if (csv) csv->close();
+          return 2;
+        }
+      }
       const std::uint64_t received_before = plant.stats().commands_received;
       plant.publish_outputs(k);
       if (o.lockstep && !waiting) transport.spin_once(0);  // collect without waiting
@@ -201,6 +228,7 @@ int controller_command(const ControllerCommandOptions& o) {
     const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
     // The ROS 2 parameter services, answered inside transport.spin_once (both loops below).
     dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
+    if (!o.apply_schedule) sc.schedule.clear();
     auto next_event = sc.schedule.begin();
     auto apply_schedule = [&](std::int64_t now_ns) {
       for (; next_event != sc.schedule.end() && clock.ns(next_event->tick) <= now_ns; ++next_event) {

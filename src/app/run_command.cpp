@@ -46,9 +46,15 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
   install_stop_handlers();
   const std::string self = self_executable();
   const std::string timeout = fmt::format("{}", opt.timeout_s);
+  // The plant owns simulated time, so in lockstep it applies the schedule through the controller's
+  // parameter services, each change before its tick; in real time the controller applies it itself.
   std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario};
   std::vector<std::string> plant_args = {self, "plant", "--scenario", opt.scenario, "--record", csv_path,
                                          "--timeout", timeout};
+  if (!opt.realtime) {
+    controller_args.push_back("--no-schedule");
+    for (std::string a : {"--schedule-via", "/attitude_controller"}) plant_args.push_back(a);
+  }
   if (opt.realtime) {
     for (std::string a : {"--realtime", "--rate-factor"}) controller_args.push_back(a);
     controller_args.push_back(fmt::format("{}", opt.rate_factor));
