@@ -50,7 +50,9 @@ int summary_command(const SummaryOptions& options);
 
 struct PlantCommandOptions {
   std::string scenario;     ///< vehicle, rates, duration, initial state ("" for defaults)
+  std::string vehicle;      ///< vehicle file, replaces the scenario's vehicle when set
   std::string ns;           ///< overrides the scenario's namespace when set
+  bool sensor_qos = false;  ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
   bool lockstep = true;     ///< false: real time
   double rate_factor = 1.0; ///< real time: run k times faster than the wall clock
   double duration_s = -1.0; ///< overrides the scenario's duration when >= 0
@@ -67,7 +69,9 @@ int plant_command(const PlantCommandOptions& options);
 struct ControllerCommandOptions {
   std::string scenario;  ///< controller parameters, rates, schedule ("" for defaults)
   std::string params;    ///< controller parameter file, applied over the scenario's
+  std::string vehicle;   ///< vehicle file (the controller's model of the vehicle)
   std::string ns;
+  bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
   bool lockstep = true;
   double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
   std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)

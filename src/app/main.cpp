@@ -27,7 +27,10 @@ int main(int argc, char** argv) {
   auto* plant_cmd = app.add_subcommand("plant", "the plant as a ROS 2 node over DDS (until done or Ctrl-C)");
   plant_cmd->add_option("--scenario", plant.scenario, "scenario YAML (vehicle, rates, duration, initial state)")
       ->check(CLI::ExistingFile);
+  plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
+      ->check(CLI::ExistingFile);
   plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1");
+  plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
   plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
@@ -47,7 +50,10 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
+  ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
+      ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
+  ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");

@@ -34,12 +34,24 @@ std::int64_t steady_ns() {
 
 constexpr std::int64_t kMs = 1'000'000;
 
-io::Scenario scenario_or_defaults(const std::string& path) {
-  if (!path.empty()) return io::load_scenario(path);
+// The scenario (or the defaults), with its vehicle replaced by `vehicle_file` when one is given.
+io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file) {
   io::Scenario sc;
-  sc.name = "defaults";
+  if (!path.empty()) {
+    sc = io::load_scenario(path);
+  } else {
+    sc.name = "defaults";
+  }
+  if (!vehicle_file.empty()) sc.vehicle = io::load_vehicle(vehicle_file);
   sc.controller.params.vehicle = sc.vehicle;
   return sc;
+}
+
+// ROS sensor-data QoS (KEEP_LAST 5, BEST_EFFORT) on the three sensor topics.
+void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics) {
+  for (const auto* t : {&topics.pose, &topics.velocity, &topics.imu}) {
+    transport.set_qos(*t, dds::QosProfile::sensor_data());
+  }
 }
 
 }  // namespace
@@ -47,7 +59,7 @@ io::Scenario scenario_or_defaults(const std::string& path) {
 int plant_command(const PlantCommandOptions& o) {
   install_stop_handlers();
   try {
-    io::Scenario sc = scenario_or_defaults(o.scenario);
+    io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;
     if (o.duration_s >= 0.0) {
       sc.simulation.duration_ticks =
@@ -58,6 +70,7 @@ int plant_command(const PlantCommandOptions& o) {
     const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
 
     dds::DdsTransport transport(dds::read_ros_environment());
+    if (o.sensor_qos) use_sensor_qos(transport, topics);
     sim::PlantOptions po = sc.simulation.plant;
     po.drop_stale_commands = o.lockstep;
     const model::Quadrotor probe(sc.vehicle);
@@ -215,7 +228,7 @@ int plant_command(const PlantCommandOptions& o) {
 int controller_command(const ControllerCommandOptions& o) {
   install_stop_handlers();
   try {
-    io::Scenario sc = scenario_or_defaults(o.scenario);
+    io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;
     const sim::TickClock clock = sc.simulation.plant.clock;
@@ -224,6 +237,7 @@ int controller_command(const ControllerCommandOptions& o) {
     const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
 
     dds::DdsTransport transport(dds::read_ros_environment());
+    if (o.sensor_qos) use_sensor_qos(transport, topics);
     sim::ControllerNode node(transport, topics, sc.controller);
     const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
     // The ROS 2 parameter services, answered inside transport.spin_once (both loops below).

@@ -85,6 +85,24 @@ case "$case_name" in
     fi
     ;;
 
+  sensor_qos)  # best-effort sensor topics (ROS sensor-data QoS) on both sides: still the same bytes
+    "$bin" run "$paper/roll_step.yaml" --out "$tmp/in" --no-plots > /dev/null
+    "$bin" controller --scenario "$paper/roll_step.yaml" --sensor-qos > "$tmp/c.log" 2>&1 &
+    pids+=($!)
+    "$bin" plant --scenario "$paper/roll_step.yaml" --sensor-qos --record "$tmp/p.csv" > "$tmp/p.log" 2>&1 \
+      || fail "plant failed"
+    cmp "$tmp/in/trajectory.csv" "$tmp/p.csv" || fail "differs from the in-process run"
+    # A reliable reader does not match a best-effort writer: a default controller is not found.
+    "$bin" controller --scenario "$paper/roll_step.yaml" --namespace /other > "$tmp/c2.log" 2>&1 &
+    pids+=($!)
+    set +e
+    "$bin" plant --scenario "$paper/roll_step.yaml" --namespace /other --sensor-qos --timeout 2 > "$tmp/p2.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 4 ] || fail "QoS mismatch should leave the plant without a controller (exit 4), got $rc"
+    grep -q "no controller" "$tmp/p2.log" || fail "no diagnostic for the QoS mismatch"
+    ;;
+
   two_namespaces)  # two vehicles on one domain, /uav1 and /uav2: no cross-talk
     "$bin" run "$paper/altitude_step.yaml" --out "$tmp/in1" --no-plots > /dev/null
     "$bin" run "$paper/roll_step.yaml" --out "$tmp/in2" --no-plots > /dev/null
