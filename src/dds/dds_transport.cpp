@@ -33,19 +33,27 @@ dds_entity_t DdsTransport::topic_for(const std::string& ros_topic, const sim::To
   return t;
 }
 
-std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic,
-                                                          const sim::TopicType& type) {
-  const TypeOps* ops = nullptr;
+dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const sim::TopicType& type,
+                                           bool writer, const TypeOps*& ops) {
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
   const QosProfile p = qos_for(ros_topic);
   dds_qos_t* qos = ros_qos(p.depth, p.reliable);
-  const dds_entity_t writer = dds_create_writer(participant_.handle(), topic, qos, nullptr);
+  const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos, nullptr)
+                                : dds_create_reader(participant_.handle(), topic, qos, nullptr);
   dds_delete_qos(qos);
-  check(writer, ("dds_create_writer " + ros_topic).c_str());
-  writers_[ros_topic].push_back(writer);
+  check(e, ((writer ? "dds_create_writer " : "dds_create_reader ") + ros_topic).c_str());
   // Matching changes wake spin_once, so waits for a peer need no polling.
-  check(dds_set_status_mask(writer, DDS_PUBLICATION_MATCHED_STATUS), "dds_set_status_mask");
-  check(dds_waitset_attach(waitset_, writer, 0), "dds_waitset_attach");
+  check(dds_set_status_mask(e, writer ? DDS_PUBLICATION_MATCHED_STATUS : DDS_SUBSCRIPTION_MATCHED_STATUS),
+        "dds_set_status_mask");
+  check(dds_waitset_attach(waitset_, e, 0), "dds_waitset_attach");
+  return e;
+}
+
+std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic,
+                                                          const sim::TopicType& type) {
+  const TypeOps* ops = nullptr;
+  const dds_entity_t writer = create_endpoint(ros_topic, type, true, ops);
+  writers_[ros_topic].push_back(writer);
   return [writer, ops, ros_topic](const void* message) {
     check(ops->write(writer, message), ("dds_write " + ros_topic).c_str());
   };
@@ -54,12 +62,7 @@ std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_
 void DdsTransport::add_subscription(const std::string& ros_topic, const sim::TopicType& type,
                                     std::function<void(const void*)> deliver) {
   const TypeOps* ops = nullptr;
-  const dds_entity_t topic = topic_for(ros_topic, type, ops);
-  const QosProfile p = qos_for(ros_topic);
-  dds_qos_t* qos = ros_qos(p.depth, p.reliable);
-  const dds_entity_t reader = dds_create_reader(participant_.handle(), topic, qos, nullptr);
-  dds_delete_qos(qos);
-  check(reader, ("dds_create_reader " + ros_topic).c_str());
+  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
   auto r = std::make_unique<Reader>();
   r->topic = ros_topic;
   r->reader = reader;
@@ -68,8 +71,6 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
   r->deliver = std::move(deliver);
   check(dds_waitset_attach(waitset_, r->condition, static_cast<dds_attach_t>(readers_.size())),
         "dds_waitset_attach");
-  check(dds_set_status_mask(reader, DDS_SUBSCRIPTION_MATCHED_STATUS), "dds_set_status_mask");
-  check(dds_waitset_attach(waitset_, reader, 0), "dds_waitset_attach");
   readers_.push_back(std::move(r));
 }
 

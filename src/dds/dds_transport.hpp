@@ -71,6 +71,9 @@ class DdsTransport final : public sim::Transport {
     const TypeOps* ops;
     std::function<void(const void*)> deliver;
   };
+  /// A writer or reader on `ros_topic` with its QoS, attached to the waitset for matching changes.
+  dds_entity_t create_endpoint(const std::string& ros_topic, const sim::TopicType& type, bool writer,
+                               const TypeOps*& ops);
   dds_entity_t topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops);
   QosProfile qos_for(const std::string& ros_topic) const;
   int drain(Reader& r);
