@@ -57,6 +57,7 @@ struct PlantCommandOptions {
   double rate_factor = 1.0; ///< real time: run k times faster than the wall clock
   double duration_s = -1.0; ///< overrides the scenario's duration when >= 0
   std::string record;       ///< trajectory CSV to write ("" for none)
+  std::string mcap;         ///< MCAP file to record the topics into, metadata.yaml beside it ("" for none)
   double timeout_s = 10.0;  ///< lockstep: how long to wait for a controller / for one command
   std::string on_timeout = "abort";  ///< lockstep: "abort" (exit 4) or "hold" (last command, go on)
   bool wait_for_controller = false;  ///< real time: start the clock only once a controller is matched

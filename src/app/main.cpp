@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 1e6));
   plant_cmd->add_option("--duration", plant.duration_s, "simulated time [s]")->check(CLI::Range(0.0, 1e9));
   plant_cmd->add_option("--record", plant.record, "write the trajectory CSV here");
+  plant_cmd->add_option("--mcap", plant.mcap, "record the topics as MCAP here (metadata.yaml beside it)");
   plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
   plant_cmd->add_option("--schedule-via", plant.schedule_node,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <variant>
 #include <vector>
 #include <iostream>
@@ -17,6 +18,7 @@
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_client.hpp"
+#include "io/mcap_recorder.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
@@ -85,6 +87,8 @@ int plant_command(const PlantCommandOptions& o) {
     });
     std::unique_ptr<io::TrajectoryWriter> csv;
     if (!o.record.empty()) csv = std::make_unique<io::TrajectoryWriter>(o.record);
+    std::unique_ptr<io::McapRecorder> mcap;
+    if (!o.mcap.empty()) mcap = std::make_unique<io::McapRecorder>(o.mcap, transport, topics);
     auto record = [&](sim::Tick k) {
       if (csv) {
         csv->write(clock.seconds(k), plant.state(), plant.applied_command(),
@@ -102,10 +106,12 @@ int plant_command(const PlantCommandOptions& o) {
       // Wait until a controller is there to answer, so tick 0 is not published into the void.
       const bool found = transport.spin_until(
           [&] {
+            // The recorder's own readers (same participant) match too: look for one more.
+            const int own = mcap ? 1 : 0;
             return stop_requested() || (transport.matched_writers(topics.motor_commands) > 0 &&
-                              transport.matched_readers(topics.pose) > 0 &&
-                              transport.matched_readers(topics.velocity) > 0 &&
-                              transport.matched_readers(topics.imu) > 0);
+                                        transport.matched_readers(topics.pose) > own &&
+                                        transport.matched_readers(topics.velocity) > own &&
+                                        transport.matched_readers(topics.imu) > own);
           },
           static_cast<std::int64_t>(o.timeout_s * 1e9));
       if (!found) {
@@ -196,9 +202,17 @@ int plant_command(const PlantCommandOptions& o) {
       }
       plant.latch_command(k);
       record(k);
+      if (mcap) mcap->flush_before(t_ns - 100'000'000);
       if (k < sc.simulation.duration_ticks) plant.integrate(k);
     }
     if (csv) csv->close();
+    if (mcap) {
+      while (transport.spin_once(0) > 0) {  // what is still in the readers
+      }
+      mcap->close();
+      const std::filesystem::path p(o.mcap);
+      mcap->write_bag_metadata(p.parent_path().empty() ? "." : p.parent_path().string(), p.filename().string());
+    }
     const auto& st = plant.stats();
     const double wall_s = static_cast<double>(steady_ns() - loop_start) / 1e9;
     if (!round_trip_ns.empty()) {

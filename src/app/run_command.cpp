@@ -10,6 +10,7 @@
 #include "app/commands.hpp"
 #include "app/signals.hpp"
 #include "control/care.hpp"
+#include "io/mcap_recorder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
@@ -19,6 +20,9 @@
 namespace quadcosim::app {
 
 namespace fs = std::filesystem;
+
+/// Messages are written to the MCAP file once they are this much older than the current tick [ns].
+constexpr std::int64_t kRecordLagNs = 100'000'000;
 
 namespace {
 
@@ -49,8 +53,9 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
   // The plant owns simulated time, so in lockstep it applies the schedule through the controller's
   // parameter services, each change before its tick; in real time the controller applies it itself.
   std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario};
+  const std::string mcap_path = (std::filesystem::path(csv_path).parent_path() / "run.mcap").string();
   std::vector<std::string> plant_args = {self, "plant", "--scenario", opt.scenario, "--record", csv_path,
-                                         "--timeout", timeout};
+                                         "--mcap", mcap_path, "--timeout", timeout};
   if (!opt.realtime) {
     controller_args.push_back("--no-schedule");
     for (std::string a : {"--schedule-via", "/attitude_controller"}) plant_args.push_back(a);
@@ -116,12 +121,17 @@ int run_command(const RunOptions& opt) {
       const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
       sim::Simulation simulation(sc.simulation, sc.vehicle, x0, sc.controller, sc.schedule);
       io::TrajectoryWriter csv(csv_path);
+      io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
+                            sim::Topics::for_namespace(sc.simulation.ns));
       simulation.run([&](const sim::TickRecord& r) {
         const io::ControlColumns c = io::ControlColumns::from(r.status);
         csv.write(r.t_s, r.state, r.applied_command, c);
         record_series(series, r, c);
+        mcap.flush_before(sc.simulation.plant.clock.ns(r.tick) - kRecordLagNs);
       });
       csv.close();
+      mcap.close();
+      mcap.write_bag_metadata(out.string(), "run.mcap");
       if (simulation.plant().stats().commands_rejected > 0) {
         std::cout << fmt::format("plant rejected {} of {} motor commands\n",
                                  simulation.plant().stats().commands_rejected,
@@ -134,7 +144,7 @@ int run_command(const RunOptions& opt) {
     const std::string table = io::format_step_table(sc, results);
     std::ofstream((out / "metrics.txt").string()) << table;
     std::cout << table;
-    std::cout << "wrote " << (out / "trajectory.csv").string() << ", metrics.json, metrics.txt\n";
+    std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir)) return 3;
     return io::all_passed(results) ? 0 : 1;
   } catch (const control::CareError& e) {

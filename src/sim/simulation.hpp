@@ -57,6 +57,8 @@ class Simulation {
   void run(const std::function<void(const TickRecord&)>& on_tick);
 
   const PlantNode& plant() const { return plant_; }
+  /// The bus the nodes talk on, for observers such as recorders (subscribe before run()).
+  Transport& transport() { return transport_; }
   const ControllerNode& controller() const { return controller_; }
 
  private:

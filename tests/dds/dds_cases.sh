@@ -24,6 +24,7 @@ identical() {  # in-process and DDS lockstep give the same bytes
     || fail "DDS run failed"
   cmp "$tmp/in/trajectory.csv" "$tmp/dds/trajectory.csv" || fail "trajectories differ"
   cmp "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "metrics differ"
+  cmp "$tmp/in/run.mcap" "$tmp/dds/run.mcap" || fail "MCAP recordings differ"
   [ "$(wc -l < "$tmp/dds/trajectory.csv")" -gt 500 ] || fail "trajectory too short"
 }
 

@@ -1,0 +1,63 @@
+// Records a run's ROS 2 traffic as MCAP (ROS 2 profile: ros2msg schemas, cdr messages) with log
+// time = simulated time, and writes the metadata.yaml that lets `ros2 bag` open the run directory.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "io/mcap_writer.hpp"
+#include "sim/topics.hpp"
+#include "sim/transport.hpp"
+
+namespace quadcosim::io {
+
+class McapRecorder {
+ public:
+  /// Opens `path` and subscribes, through `transport`, to the vehicle's topics: /clock, Pose,
+  /// Velocity, Imu, motor_commands and controller_status. Throws std::runtime_error naming the path.
+  McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics);
+  ~McapRecorder();
+  McapRecorder(const McapRecorder&) = delete;
+  McapRecorder& operator=(const McapRecorder&) = delete;
+
+  /// Writes every buffered message stamped before `sim_ns` [ns], in (time, channel, arrival) order.
+  /// Messages are stamped with their header time (motor commands: the time in their label, or the
+  /// last header time seen); buffering makes the file independent of the order messages arrive in.
+  void flush_before(std::int64_t sim_ns);
+  /// Writes everything left and finishes the file (summary, footer). Idempotent.
+  void close();
+  /// Writes `dir`/metadata.yaml describing the file for `ros2 bag info|play` (call after close).
+  void write_bag_metadata(const std::string& dir, const std::string& mcap_file_name) const;
+
+  std::uint64_t messages() const { return written_; }
+
+ private:
+  struct Pending {
+    std::int64_t t_ns;
+    std::uint16_t channel;
+    std::uint64_t arrival;
+    std::vector<std::uint8_t> cdr;
+  };
+  struct ChannelInfo {
+    std::string topic, type;
+    std::uint16_t id;
+    std::uint64_t count = 0;
+    std::uint32_t sequence = 0;
+  };
+  template <class T>
+  void add(sim::Transport& transport, const std::string& topic);
+  void push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr);
+
+  McapWriter writer_;
+  std::vector<ChannelInfo> channels_;  // indexed by position, not by MCAP id
+  std::vector<Pending> pending_;
+  std::uint64_t arrivals_ = 0, written_ = 0;
+  std::int64_t last_stamp_ns_ = 0;
+  std::int64_t first_ns_ = -1, last_ns_ = -1;
+  bool closed_ = false;
+};
+
+}  // namespace quadcosim::io

@@ -1,0 +1,409 @@
+// MCAP writer and ROS 2 CDR tests. The CDR bytes are checked against Cyclone DDS's own serialiser
+// (an independent implementation, the one rmw_cyclonedds uses); the MCAP files against the MCAP
+// reference reader in mcap_interop_test.sh. Here: the writer's structure, errors and crash safety.
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "dds/participant.hpp"
+#include "dds/ros_types.hpp"
+#include "io/mcap_test_messages.hpp"
+#include "io/mcap_writer.hpp"
+#include "io/ros2_cdr.hpp"
+
+namespace quadcosim::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// CDR against Cyclone DDS
+
+dds::RosEnvironment test_env() {
+  dds::RosEnvironment e;
+  e.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);  // apart from other test runs
+  e.range = dds::DiscoveryRange::kLocalhost;
+  return e;
+}
+
+// Writes `m` through a Cyclone DDS writer (the generated C type, via the transport's conversion) and
+// returns the serialized sample a reader of the same participant takes with dds_takecdr: Cyclone's
+// own CDR, with its 4-byte encapsulation header.
+template <class T>
+std::vector<std::uint8_t> cyclone_cdr(const dds::Participant& p, const T& m) {
+  static int topic_count = 0;  // test-local: unique topic per sample
+  const dds::TypeOps* ops = dds::type_ops(typeid(T));
+  EXPECT_NE(ops, nullptr);
+  const std::string name = "rt/mcap_test/cdr" + std::to_string(++topic_count);
+  const dds_entity_t topic =
+      dds::check(dds_create_topic(p.handle(), ops->descriptor, name.c_str(), nullptr, nullptr), "dds_create_topic");
+  dds_qos_t* qos = dds::ros_qos(10, true);
+  const dds_entity_t reader = dds::check(dds_create_reader(p.handle(), topic, qos, nullptr), "dds_create_reader");
+  const dds_entity_t writer = dds::check(dds_create_writer(p.handle(), topic, qos, nullptr), "dds_create_writer");
+  dds_delete_qos(qos);
+  dds::check(ops->write(writer, &m), "dds_write");
+
+  const dds_entity_t ws = dds::check(dds_create_waitset(p.handle()), "dds_create_waitset");
+  const dds_entity_t cond = dds::check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
+  dds::check(dds_waitset_attach(ws, cond, 0), "dds_waitset_attach");
+  EXPECT_GT(dds_waitset_wait(ws, nullptr, 0, DDS_SECS(5)), 0) << "no sample arrived on " << name;
+
+  std::vector<std::uint8_t> bytes;
+  ddsi_serdata* sd = nullptr;
+  dds_sample_info_t info;
+  if (dds_takecdr(reader, &sd, 1, &info, DDS_ANY_STATE) == 1) {
+    bytes.resize(ddsi_serdata_size(sd));
+    ddsi_serdata_to_ser(sd, 0, bytes.size(), bytes.data());
+    ddsi_serdata_unref(sd);
+  }
+  dds_delete(ws);
+  dds_delete(writer);
+  dds_delete(reader);
+  dds_delete(topic);
+  return bytes;
+}
+
+std::string hex(const std::vector<std::uint8_t>& b) {
+  std::string s;
+  char buf[4];
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%02x", b[i]);
+    s += buf;
+    s += (i % 16 == 15) ? "\n" : " ";
+  }
+  return s;
+}
+
+// Compares ours with Cyclone's. Cyclone (0.10.2 here) pads the serialized sample to a multiple of 4
+// bytes with zeros and puts the pad count in the low two bits of the encapsulation options (XTypes
+// 1.3, 7.4.3.5.3): of our types only ControllerStatus, whose six trailing booleans leave it 2 bytes
+// short, comes out as 00 01 00 02 + payload + 00 00. to_cdr keeps the options 00 00 and adds no
+// padding (what the brief asks for; CDR readers ignore trailing bytes either way, and the options
+// carry no meaning for XCDR1 decoding). So: the representation identifier 00 01 (CDR_LE) must match;
+// Cyclone's options must be 00 0p with p exactly the padding a 4-byte multiple needs; the payloads
+// must match byte for byte; the p pad bytes must be zero.
+void expect_same_cdr(const std::vector<std::uint8_t>& ours, const std::vector<std::uint8_t>& cyclone,
+                     const std::string& what) {
+  ASSERT_GE(cyclone.size(), 4u) << what;
+  ASSERT_GE(ours.size(), 4u) << what;
+  EXPECT_EQ(ours[0], 0x00) << what;
+  EXPECT_EQ(ours[1], 0x01) << what;
+  EXPECT_EQ(ours[2], 0x00) << what;
+  EXPECT_EQ(ours[3], 0x00) << what;
+  EXPECT_EQ(cyclone[0], 0x00) << what;
+  EXPECT_EQ(cyclone[1], 0x01) << what << ": Cyclone did not use CDR_LE";
+  EXPECT_EQ(cyclone[2], 0x00) << what;
+  const std::size_t pad = cyclone[3] & 0x3;
+  EXPECT_EQ(cyclone[3] & ~0x3, 0) << what;
+  EXPECT_EQ(pad, (4 - ours.size() % 4) % 4) << what << ": Cyclone's pad count";
+  ASSERT_EQ(ours.size() + pad, cyclone.size()) << what << "\nours:\n" << hex(ours) << "\ncyclone:\n" << hex(cyclone);
+  EXPECT_TRUE(std::equal(ours.begin() + 4, ours.end(), cyclone.begin() + 4)) << what << "\nours:\n"
+                                                                             << hex(ours) << "\ncyclone:\n"
+                                                                             << hex(cyclone);
+  for (std::size_t i = ours.size(); i < cyclone.size(); ++i) EXPECT_EQ(cyclone[i], 0) << what << " pad byte " << i;
+}
+
+class CdrTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { participant_ = new dds::Participant(test_env()); }
+  static void TearDownTestSuite() {
+    delete participant_;
+    participant_ = nullptr;
+  }
+  template <class T>
+  void check(const T& m, const std::string& what) {
+    expect_same_cdr(to_cdr(m), cyclone_cdr(*participant_, m), std::string(T::kRosType) + " " + what);
+  }
+  static dds::Participant* participant_;
+};
+dds::Participant* CdrTest::participant_ = nullptr;
+
+// Frame ids of every length mod 8 move the doubles after the string through each alignment case.
+const std::vector<std::string> kFrames = {"", "a", "ab", "abc", "abcd", "world", "odom_xy", "base_lnk", "base_link"};
+
+TEST_F(CdrTest, PoseStampedMatchesCyclone) {
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::PoseStamped m = testing::sample_pose(static_cast<int>(k) * 37 + 1);
+    m.header.frame_id = kFrames[k];
+    check(m, "frame '" + kFrames[k] + "'");
+  }
+  msg::PoseStamped odd;
+  odd.header.stamp = {-3, 999'999'999};
+  odd.position = {-0.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()};
+  odd.orientation = {std::numeric_limits<double>::denorm_min(), 1e-300, -1e300, 1.0};
+  check(odd, "special values");
+}
+
+TEST_F(CdrTest, TwistStampedMatchesCyclone) {
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::TwistStamped m = testing::sample_twist(static_cast<int>(k) + 5);
+    m.header.frame_id = kFrames[k];
+    check(m, "frame '" + kFrames[k] + "'");
+  }
+}
+
+TEST_F(CdrTest, ImuMatchesCyclone) {
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::Imu m = testing::sample_imu(static_cast<int>(k) + 11);
+    m.header.frame_id = kFrames[k];
+    for (std::size_t j = 0; j < 9; ++j) m.linear_acceleration_covariance[j] = 0.5 * static_cast<double>(j + k);
+    check(m, "frame '" + kFrames[k] + "'");
+  }
+}
+
+TEST_F(CdrTest, Float64MultiArrayMatchesCyclone) {
+  check(msg::Float64MultiArray{}, "empty");
+  check(testing::sample_command(123), "command");
+  msg::Float64MultiArray m;
+  m.data = {1.0 / 3.0, -0.0, 1e9};
+  m.dim = {{"x", 3, 3}, {"", 1, 1}, {"rotor_group_label", 7, 2}};
+  m.data_offset = 5;
+  check(m, "three dims");
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::Float64MultiArray one;
+    one.dim = {{kFrames[k], static_cast<std::uint32_t>(k), 1}};
+    one.data.assign(k, 0.25 * static_cast<double>(k));
+    check(one, "label '" + kFrames[k] + "'");
+  }
+}
+
+TEST_F(CdrTest, ClockMatchesCyclone) {
+  check(testing::sample_clock(0), "zero");
+  check(testing::sample_clock(123456), "t");
+  check(msg::Clock{{-1, 5}}, "negative");
+}
+
+TEST_F(CdrTest, ControllerStatusMatchesCyclone) {
+  const std::vector<std::string> modes = {"", "attitude", "position", "pos"};
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::ControllerStatus m = testing::sample_status(static_cast<int>(k) * 13);
+    m.header.frame_id = kFrames[k];
+    m.mode = modes[k % modes.size()];
+    check(m, "frame '" + kFrames[k] + "' mode '" + m.mode + "'");
+  }
+}
+
+TEST(CdrLayoutTest, ClockIsTheHeaderAndTwoIntegers) {
+  const std::vector<std::uint8_t> want = {0x00, 0x01, 0x00, 0x00, 0x02, 0, 0, 0, 0x03, 0, 0, 0};
+  EXPECT_EQ(to_cdr(msg::Clock{{2, 3}}), want);
+}
+
+TEST(CdrLayoutTest, StringsCountTheirNulAndDoublesAlignAfterTheHeader) {
+  msg::PoseStamped m;
+  m.header.frame_id = "w";
+  const auto b = to_cdr(m);
+  // header 4 | sec 4 | nanosec 4 | len=2 4 | 'w' 0 | pad to 8 (2 + 4 bytes: offset 14 -> 16) | 7 doubles
+  ASSERT_EQ(b.size(), 4u + 16u + 56u);
+  EXPECT_EQ(b[12], 2);
+  EXPECT_EQ(b[16], 'w');
+  EXPECT_EQ(b[17], 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// ros2msg schema text
+
+TEST(Ros2MsgTest, PoseStampedHasItsFieldsThenEachDependencyOnce) {
+  const std::string sep = std::string(80, '=') + "\n";
+  const std::string want = "std_msgs/Header header\nPose pose\n" + sep +
+                           "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n" + sep +
+                           "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n" + sep +
+                           "MSG: geometry_msgs/Pose\nPoint position\nQuaternion orientation\n" + sep +
+                           "MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n" + sep +
+                           "MSG: geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n";
+  EXPECT_EQ(ros2msg_definition("geometry_msgs/msg/PoseStamped"), want);
+}
+
+std::vector<std::string> msg_blocks(const std::string& text) {
+  std::vector<std::string> names;
+  for (std::size_t at = text.find("MSG: "); at != std::string::npos; at = text.find("MSG: ", at + 1)) {
+    names.push_back(text.substr(at + 5, text.find('\n', at) - at - 5));
+  }
+  return names;
+}
+
+TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
+  using V = std::vector<std::string>;
+  EXPECT_EQ(msg_blocks(ros2msg_definition(msg::TwistStamped::kRosType)),
+            (V{"std_msgs/Header", "builtin_interfaces/Time", "geometry_msgs/Twist", "geometry_msgs/Vector3"}));
+  EXPECT_EQ(msg_blocks(ros2msg_definition(msg::Imu::kRosType)),
+            (V{"std_msgs/Header", "builtin_interfaces/Time", "geometry_msgs/Quaternion", "geometry_msgs/Vector3"}));
+  EXPECT_EQ(msg_blocks(ros2msg_definition(msg::Float64MultiArray::kRosType)),
+            (V{"std_msgs/MultiArrayLayout", "std_msgs/MultiArrayDimension"}));
+  EXPECT_EQ(msg_blocks(ros2msg_definition(msg::Clock::kRosType)), (V{"builtin_interfaces/Time"}));
+  const std::string& status = ros2msg_definition(msg::ControllerStatus::kRosType);
+  EXPECT_EQ(msg_blocks(status), (V{"std_msgs/Header", "builtin_interfaces/Time"}));
+  EXPECT_EQ(status.substr(0, status.find("====")),
+            "std_msgs/Header header\nstring mode\nfloat64[6] setpoint\nfloat64[4] u\nfloat64[4] error\n"
+            "bool[4] rotor_saturated\nbool tilt_saturated\nbool safety\n");
+  EXPECT_THROW(ros2msg_definition("geometry_msgs/msg/PoseWithCovariance"), std::invalid_argument);
+  EXPECT_THROW(ros2msg_definition("geometry_msgs/PoseStamped"), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// McapWriter
+
+class McapWriterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("quadcosim_mcap_test_" + std::to_string(getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+std::vector<std::uint8_t> read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::uint64_t le64(const std::vector<std::uint8_t>& b, std::size_t at) {
+  std::uint64_t v = 0;
+  for (int i = 7; i >= 0; --i) v = (v << 8) | b[at + i];
+  return v;
+}
+
+// Top-level records after the leading magic, as (opcode, offset), up to the footer or the end of the
+// complete records.
+std::vector<std::pair<int, std::size_t>> top_level_records(const std::vector<std::uint8_t>& b) {
+  std::vector<std::pair<int, std::size_t>> r;
+  std::size_t at = 8;
+  while (at + 9 <= b.size()) {
+    const std::uint64_t len = le64(b, at + 1);
+    if (at + 9 + len > b.size()) break;
+    r.emplace_back(b[at], at);
+    if (b[at] == 0x02) break;
+    at += 9 + len;
+  }
+  return r;
+}
+
+std::vector<std::uint8_t> pose_bytes(int i) { return to_cdr(testing::sample_pose(i)); }
+
+TEST_F(McapWriterTest, OpeningFailsWithThePathInTheMessage) {
+  const std::string bad = path("no/such/dir/x.mcap");
+  try {
+    McapWriter w(bad);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(McapWriterTest, RejectsUnknownIdsAndEncodingsOutsideTheRos2Profile) {
+  McapWriter w(path("bad.mcap"));
+  EXPECT_THROW(w.add_schema("x/msg/Y", "jsonschema", "{}"), std::invalid_argument);
+  const auto s =
+      w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
+  EXPECT_EQ(s, 1);
+  EXPECT_EQ(
+      w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped")), s);
+  EXPECT_THROW(w.add_channel("/p", 2, "cdr"), std::invalid_argument);
+  EXPECT_THROW(w.add_channel("/p", s, "json"), std::invalid_argument);
+  const auto c = w.add_channel("/p", s, "cdr");
+  EXPECT_EQ(c, 1);
+  EXPECT_EQ(w.add_channel("/p", s, "cdr"), c);
+  const auto b = pose_bytes(1);
+  EXPECT_THROW(w.write(2, 0, 0, 0, b.data(), b.size()), std::invalid_argument);
+  EXPECT_THROW(w.write(0, 0, 0, 0, b.data(), b.size()), std::invalid_argument);
+  w.write(c, 1, 5, 5, b.data(), b.size());
+  EXPECT_EQ(w.messages(), 1u);
+  w.close();
+  w.close();  // no-op
+  EXPECT_THROW(w.write(c, 2, 6, 6, b.data(), b.size()), std::logic_error);
+}
+
+TEST_F(McapWriterTest, ChunksReachTheFileAsSoonAsTheyFillAndFlushEndsTheOpenOne) {
+  const std::string file = path("safety.mcap");
+  McapWriter w(file, {"ros2", 4096, true});
+  const auto s =
+      w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
+  const auto c = w.add_channel("/drone/Pose", s, "cdr");
+  const auto count_chunks = [&] {
+    int n = 0;
+    for (const auto& [op, at] : top_level_records(read_file(file))) n += op == 0x06;
+    return n;
+  };
+  EXPECT_EQ(count_chunks(), 0);
+  const std::uintmax_t before = fs::file_size(file);  // header, schema and channel are on disk
+  EXPECT_GT(before, 8u + 9u);
+  int i = 0;
+  while (count_chunks() == 0) {
+    ASSERT_LT(i, 1000) << "no chunk written after 1000 messages of a 4 KiB chunk";
+    const auto b = pose_bytes(i);
+    w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+    ++i;
+  }
+  EXPECT_GE(static_cast<std::size_t>(i) * (pose_bytes(0).size() + 31), 4096u);  // only once full
+  const std::uintmax_t after_chunk = fs::file_size(file);
+  const auto b = pose_bytes(i);
+  w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+  EXPECT_EQ(fs::file_size(file), after_chunk) << "a single message went to disk before its chunk filled";
+  w.flush();
+  EXPECT_EQ(count_chunks(), 2);
+  // Each chunk is followed at once by its message index.
+  const auto records = top_level_records(read_file(file));
+  for (std::size_t k = 0; k + 1 < records.size(); ++k) {
+    if (records[k].first == 0x06) {
+      EXPECT_EQ(records[k + 1].first, 0x07);
+    }
+  }
+}
+
+TEST_F(McapWriterTest, ClosedFileHasDataEndSummaryOffsetsFooterAndMagic) {
+  const std::string file = path("layout.mcap");
+  {
+    McapWriter w(file, {"ros2", 2048, false});
+    const auto s =
+        w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
+    const auto c = w.add_channel("/drone/Pose", s, "cdr");
+    for (int i = 0; i < 50; ++i) {
+      const auto b = pose_bytes(i);
+      w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+    }
+    // no close(): the destructor finishes the file
+  }
+  const auto b = read_file(file);
+  const std::vector<std::uint8_t> magic = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
+  ASSERT_GT(b.size(), 16u);
+  EXPECT_TRUE(std::equal(magic.begin(), magic.end(), b.begin()));
+  EXPECT_TRUE(std::equal(magic.begin(), magic.end(), b.end() - 8));
+  std::vector<int> ops;
+  for (const auto& [op, at] : top_level_records(b)) ops.push_back(op);
+  ASSERT_GE(ops.size(), 6u);
+  EXPECT_EQ(ops[0], 0x01);  // Header
+  EXPECT_EQ(ops[1], 0x03);  // Schema before its first use
+  EXPECT_EQ(ops[2], 0x04);  // Channel before its first use
+  EXPECT_EQ(ops[3], 0x06);
+  EXPECT_EQ(ops.back(), 0x02);
+  // After Data End: Schema, Channel, one Chunk Index per chunk, Statistics, 4 Summary Offsets, Footer.
+  const auto data_end = std::find(ops.begin(), ops.end(), 0x0F);
+  ASSERT_NE(data_end, ops.end());
+  EXPECT_EQ(*(data_end + 1), 0x03);
+  EXPECT_EQ(*(data_end + 2), 0x04);
+  const long chunks = std::count(ops.begin(), data_end, 0x06);
+  EXPECT_GE(chunks, 2);
+  EXPECT_EQ(std::count(data_end, ops.end(), 0x08), chunks);
+  EXPECT_EQ(std::count(data_end, ops.end(), 0x0B), 1);
+  EXPECT_EQ(std::count(data_end, ops.end(), 0x0E), 4);
+  // Footer: summary_start is the record after Data End.
+  const auto records = top_level_records(b);
+  const std::size_t footer_at = records.back().second;
+  const std::size_t data_end_at = records[static_cast<std::size_t>(data_end - ops.begin())].second;
+  EXPECT_EQ(le64(b, footer_at + 9), data_end_at + 9 + 4);
+  EXPECT_EQ(b[le64(b, footer_at + 17)], 0x0E);
+}
+
+}  // namespace
+}  // namespace quadcosim::io

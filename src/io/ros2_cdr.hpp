@@ -1,0 +1,43 @@
+// ROS 2 serialized messages without a ROS 2 installation: the CDR bytes rosbag2 stores for a message
+// (what rmw_serialize gives) and the `ros2msg` schema text MCAP's ros2 profile asks for.
+//
+// Wire format (OMG CDR as XCDR1, as ROS 2 puts it on DDS and in bags): a 4-byte encapsulation header
+// 00 01 00 00 (CDR_LE, no options), then the fields in IDL order (src/dds/idl/*.idl), little-endian,
+// each primitive aligned to its size counted from the end of the header; string: uint32 length
+// including the terminating NUL, the bytes, NUL; sequence: uint32 count, then the elements; fixed
+// array: the elements only; bool: one byte 0 or 1. No padding after the last field.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sim/messages.hpp"
+
+namespace quadcosim::io {
+
+/// The CDR (little-endian, with encapsulation header) bytes of a message, byte for byte what
+/// Cyclone DDS / rmw_cyclonedds serialise for the same ROS 2 type.
+std::vector<std::uint8_t> to_cdr(const msg::PoseStamped& m);
+std::vector<std::uint8_t> to_cdr(const msg::TwistStamped& m);
+std::vector<std::uint8_t> to_cdr(const msg::Imu& m);
+std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m);
+std::vector<std::uint8_t> to_cdr(const msg::Clock& m);
+std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m);
+
+/// The full `ros2msg` schema text of a ROS 2 message type named "pkg/msg/Type" (e.g.
+/// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType): the type's own .msg fields,
+/// then every type it depends on, depth first in field order, each once, as a line of 80 '=', a line
+/// "MSG: pkg/Type" and that type's fields (the ros1msg/ros2msg convention of the MCAP registry and
+/// rosbag2). Known: the six message types of sim/messages.hpp and the types they contain. Throws
+/// std::invalid_argument naming `ros_type` for any other.
+const std::string& ros2msg_definition(std::string_view ros_type);
+
+/// The `offered_qos_profiles` channel metadata the MCAP ros2 profile requires, in rosbag2's YAML
+/// (bag format version 9, Jazzy): one publisher offering KEEP_LAST `depth`, RELIABLE or BEST_EFFORT,
+/// VOLATILE, infinite deadline/lifespan/lease, AUTOMATIC liveliness — what quadcosim's nodes offer
+/// (dds/participant.hpp ros_qos). An empty string ("unknown, use defaults") is also valid for rosbag2.
+std::string ros2_offered_qos_profiles(std::uint32_t depth, bool reliable);
+
+}  // namespace quadcosim::io
