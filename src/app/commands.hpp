@@ -114,6 +114,14 @@ struct TopicOptions {
 CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& options);
 int topic_command(TopicOptions options);
 
+struct RecordOptions {
+  std::string out;                  ///< MCAP file (metadata.yaml is written beside it)
+  std::string ns = "/drone";        ///< the vehicle's namespace
+  std::vector<std::string> topics;  ///< subset of the vehicle's topics (default: all)
+  double duration_s = -1.0;         ///< stop after this wall time [s] (default: Ctrl-C)
+};
+int record_command(const RecordOptions& options);
+
 /// Runs the plotting script on a run directory; returns false (after printing why) on failure.
 bool make_plots(const std::string& run_dir);
 

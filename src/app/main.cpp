@@ -95,7 +95,16 @@ int main(int argc, char** argv) {
   ParamOptions param;
   auto* param_cmd = add_param_subcommand(app, param);
 
+  RecordOptions rec;
+  auto* rec_cmd = app.add_subcommand("record", "record a vehicle's topics over DDS into MCAP (like ros2 bag record)");
+  rec_cmd->add_option("--out", rec.out, "MCAP file to write (metadata.yaml beside it)")->required();
+  rec_cmd->add_option("--namespace", rec.ns, "the vehicle's namespace");
+  rec_cmd->add_option("--topics", rec.topics, "only these topics (default: /clock and all of the vehicle's)");
+  rec_cmd->add_option("--duration", rec.duration_s, "stop after this many seconds (default: Ctrl-C)")
+      ->check(CLI::Range(0.0, 1e9));
+
   CLI11_PARSE(app, argc, argv);
+  if (*rec_cmd) return record_command(rec);
   if (*run_cmd) return run_command(run);
   if (*plant_cmd) return plant_command(plant);
   if (*ctl_cmd) return controller_command(ctl);

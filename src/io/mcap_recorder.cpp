@@ -25,14 +25,15 @@ std::int64_t stamp_of(const T& m, std::int64_t fallback) {
 
 }  // namespace
 
-McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics)
+McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics,
+                           const std::vector<std::string>& only)
     : writer_(path, McapOptions{"ros2", 64 * 1024, true}) {  // small chunks: little to lose on a crash
-  add<msg::Clock>(transport, topics.clock);
-  add<msg::PoseStamped>(transport, topics.pose);
-  add<msg::TwistStamped>(transport, topics.velocity);
-  add<msg::Imu>(transport, topics.imu);
-  add<msg::ControllerStatus>(transport, topics.controller_status);
-  add<msg::Float64MultiArray>(transport, topics.motor_commands);
+  add<msg::Clock>(transport, topics.clock, only);
+  add<msg::PoseStamped>(transport, topics.pose, only);
+  add<msg::TwistStamped>(transport, topics.velocity, only);
+  add<msg::Imu>(transport, topics.imu, only);
+  add<msg::ControllerStatus>(transport, topics.controller_status, only);
+  add<msg::Float64MultiArray>(transport, topics.motor_commands, only);
 }
 
 McapRecorder::~McapRecorder() {
@@ -43,7 +44,8 @@ McapRecorder::~McapRecorder() {
 }
 
 template <class T>
-void McapRecorder::add(sim::Transport& transport, const std::string& topic) {
+void McapRecorder::add(sim::Transport& transport, const std::string& topic, const std::vector<std::string>& only) {
+  if (!only.empty() && std::find(only.begin(), only.end(), topic) == only.end()) return;
   const std::string type(T::kRosType);
   const std::uint16_t schema = writer_.add_schema(type, "ros2msg", ros2msg_definition(type));
   const std::uint16_t id =

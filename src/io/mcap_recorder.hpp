@@ -18,7 +18,9 @@ class McapRecorder {
  public:
   /// Opens `path` and subscribes, through `transport`, to the vehicle's topics: /clock, Pose,
   /// Velocity, Imu, motor_commands and controller_status. Throws std::runtime_error naming the path.
-  McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics);
+  /// `only`, when not empty, limits the recording to those topic names.
+  McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics,
+               const std::vector<std::string>& only = {});
   ~McapRecorder();
   McapRecorder(const McapRecorder&) = delete;
   McapRecorder& operator=(const McapRecorder&) = delete;
@@ -27,6 +29,9 @@ class McapRecorder {
   /// Messages are stamped with their header time (motor commands: the time in their label, or the
   /// last header time seen); buffering makes the file independent of the order messages arrive in.
   void flush_before(std::int64_t sim_ns);
+  /// Newest message time seen so far [ns] (0 before any).
+  std::int64_t newest_ns() const { return last_stamp_ns_; }
+
   /// Writes everything left and finishes the file (summary, footer). Idempotent.
   void close();
   /// Writes `dir`/metadata.yaml describing the file for `ros2 bag info|play` (call after close).
@@ -48,7 +53,7 @@ class McapRecorder {
     std::uint32_t sequence = 0;
   };
   template <class T>
-  void add(sim::Transport& transport, const std::string& topic);
+  void add(sim::Transport& transport, const std::string& topic, const std::vector<std::string>& only);
   void push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr);
 
   McapWriter writer_;

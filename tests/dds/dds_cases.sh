@@ -104,6 +104,30 @@ case "$case_name" in
     grep -q "no controller" "$tmp/p2.log" || fail "no diagnostic for the QoS mismatch"
     ;;
 
+  record)  # quadcosim record over DDS next to a real-time plant; read back by the MCAP reference reader
+    "$bin" plant --realtime --duration 4 > "$tmp/plant.log" 2>&1 &
+    pids+=($!)
+    "$bin" record --out "$tmp/bag/rec.mcap" --topics /drone/Pose /clock --duration 3 > "$tmp/rec.log" 2>&1 \
+      || fail "record failed"
+    [ -s "$tmp/bag/metadata.yaml" ] || fail "no metadata.yaml beside the recording"
+    if command -v node > /dev/null && [ -d "$src/tools/mcap_verify/node_modules" ]; then
+      node "$src/tools/mcap_verify/verify.mjs" "$tmp/bag/rec.mcap" > "$tmp/summary.json" || fail "unreadable MCAP"
+      /usr/bin/python3 - "$tmp/summary.json" <<'PY' || fail "recording content"
+import json, sys
+ch = json.load(open(sys.argv[1]))["channels"]
+assert set(ch) == {"/drone/Pose", "/clock"}, sorted(ch)
+n = ch["/drone/Pose"]["last"]["sequence"]
+assert 100 <= n <= 401, n  # ~3 s of a 100 Hz real-time plant
+assert ch["/drone/Pose"]["last"]["message"]["header"]["frame_id"] == "world"
+PY
+    fi
+    set +e
+    "$bin" record --out "$tmp/x.mcap" --topics /nope --duration 1 > "$tmp/bad.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 2 ] && grep -q "cannot record '/nope'" "$tmp/bad.log" || fail "unknown topic not refused"
+    ;;
+
   two_namespaces)  # two vehicles on one domain, /uav1 and /uav2: no cross-talk
     "$bin" run "$paper/altitude_step.yaml" --out "$tmp/in1" --no-plots > /dev/null
     "$bin" run "$paper/roll_step.yaml" --out "$tmp/in2" --no-plots > /dev/null
