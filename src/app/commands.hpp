@@ -122,7 +122,14 @@ struct RecordOptions {
 };
 int record_command(const RecordOptions& options);
 
-/// Runs the plotting script on a run directory; returns false (after printing why) on failure.
+/// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
+/// override); returns false (after printing why) when it fails.
+bool run_tool(const std::string& script, const std::vector<std::string>& args);
+
+/// `quadcosim plot RUN_DIR`: regenerates the figures of a run.
+int plot_command(const std::string& run_dir);
+
+/// The PNG plots of a run directory (tools/plot_run.py).
 bool make_plots(const std::string& run_dir);
 
 }  // namespace quadcosim::app

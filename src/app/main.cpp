@@ -95,6 +95,11 @@ int main(int argc, char** argv) {
   ParamOptions param;
   auto* param_cmd = add_param_subcommand(app, param);
 
+  std::string plot_dir;
+  auto* plot_cmd = app.add_subcommand("plot", "regenerate a run directory's figures");
+  plot_cmd->add_option("run_dir", plot_dir, "run directory (trajectory.csv, metrics.json)")
+      ->required()->check(CLI::ExistingDirectory);
+
   RecordOptions rec;
   auto* rec_cmd = app.add_subcommand("record", "record a vehicle's topics over DDS into MCAP (like ros2 bag record)");
   rec_cmd->add_option("--out", rec.out, "MCAP file to write (metadata.yaml beside it)")->required();
@@ -105,6 +110,7 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   if (*rec_cmd) return record_command(rec);
+  if (*plot_cmd) return plot_command(plot_dir);
   if (*run_cmd) return run_command(run);
   if (*plant_cmd) return plant_command(plant);
   if (*ctl_cmd) return controller_command(ctl);

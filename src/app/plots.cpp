@@ -1,3 +1,5 @@
+// The Python tools (tools/*.py: plots, report, comparison) run with Debian's /usr/bin/python3,
+// where python3-matplotlib lives.
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -21,18 +23,28 @@ std::string shell_quote(const std::string& s) {
 }
 }  // namespace
 
-bool make_plots(const std::string& run_dir) {
-  // Debian's matplotlib lives with the system interpreter, so that is the default.
+bool run_tool(const std::string& script, const std::vector<std::string>& args) {
   const std::string python = env_or("QUADCOSIM_PYTHON", "/usr/bin/python3");
-  const std::string script = env_or("QUADCOSIM_PLOT_SCRIPT", QUADCOSIM_PLOT_SCRIPT);
-  const std::string cmd = shell_quote(python) + " " + shell_quote(script) + " " + shell_quote(run_dir);
+  const std::string tools = env_or("QUADCOSIM_TOOLS_DIR", QUADCOSIM_TOOLS_DIR);
+  std::string cmd = shell_quote(python);
+  cmd += ' ';
+  cmd += shell_quote(tools + "/" + script);
+  for (const auto& a : args) {
+    cmd += ' ';
+    cmd += shell_quote(a);
+  }
   std::cout.flush();
   const int status = std::system(cmd.c_str());
   if (status != 0) {
-    std::cerr << "error: plotting failed (" << cmd << "); install python3-matplotlib or pass --no-plots\n";
+    std::cerr << "error: " << script << " failed (" << cmd
+              << "); it needs /usr/bin/python3 with python3-matplotlib (scripts/install-deps.sh)\n";
     return false;
   }
   return true;
 }
+
+bool make_plots(const std::string& run_dir) { return run_tool("plot_run.py", {run_dir}); }
+
+int plot_command(const std::string& run_dir) { return make_plots(run_dir) ? 0 : 3; }
 
 }  // namespace quadcosim::app

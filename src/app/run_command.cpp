@@ -1,6 +1,9 @@
 // `quadcosim run SCENARIO --out DIR`
 #include <fmt/format.h>
 
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -43,6 +46,36 @@ void record_series(io::Series& s, const sim::TickRecord& r, const io::ControlCol
   s.append("pitch_des", c.pitch_des);
   s.append("yaw_des", c.yaw_des);
 }
+
+struct Interrupted {};
+
+// A progress line on stderr for runs that take a while, only when stderr is a terminal.
+class Progress {
+ public:
+  explicit Progress(double total_s)
+      : total_s_(total_s), tty_(isatty(STDERR_FILENO) == 1), start_(std::chrono::steady_clock::now()),
+        last_(start_) {}
+  void update(double t_s) {
+    if (!tty_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(200) || now - start_ < std::chrono::milliseconds(500)) return;
+    last_ = now;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    std::cerr << fmt::format("\r  t = {:.1f} / {:.1f} s simulated ({:.0f}x real time)   ", t_s, total_s_,
+                             t_s / wall)
+              << std::flush;
+    shown_ = true;
+  }
+  void done() {
+    if (shown_) std::cerr << '\n';
+  }
+
+ private:
+  double total_s_;
+  bool tty_;
+  std::chrono::steady_clock::time_point start_, last_;
+  bool shown_ = false;
+};
 
 // Plant and controller as two child processes over DDS, lockstep; the plant records. Both are ended
 // on every path (ChildProcess), also on Ctrl-C.
@@ -123,12 +156,26 @@ int run_command(const RunOptions& opt) {
       io::TrajectoryWriter csv(csv_path);
       io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
                             sim::Topics::for_namespace(sc.simulation.ns));
-      simulation.run([&](const sim::TickRecord& r) {
-        const io::ControlColumns c = io::ControlColumns::from(r.status);
-        csv.write(r.t_s, r.state, r.applied_command, c);
-        record_series(series, r, c);
-        mcap.flush_before(sc.simulation.plant.clock.ns(r.tick) - kRecordLagNs);
-      });
+      install_stop_handlers();
+      Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
+      try {
+        simulation.run([&](const sim::TickRecord& r) {
+          const io::ControlColumns c = io::ControlColumns::from(r.status);
+          csv.write(r.t_s, r.state, r.applied_command, c);
+          record_series(series, r, c);
+          mcap.flush_before(sc.simulation.plant.clock.ns(r.tick) - kRecordLagNs);
+          progress.update(r.t_s);
+          if (stop_requested()) throw Interrupted{};
+        });
+      } catch (const Interrupted&) {
+        // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.
+        csv.close();
+        mcap.close();
+        mcap.write_bag_metadata(out.string(), "run.mcap");
+        std::cerr << "\nrun: interrupted; " << csv_path << " and run.mcap hold what ran\n";
+        return 130;
+      }
+      progress.done();
       csv.close();
       mcap.close();
       mcap.write_bag_metadata(out.string(), "run.mcap");
