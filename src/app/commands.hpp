@@ -126,10 +126,13 @@ int record_command(const RecordOptions& options);
 /// override); returns false (after printing why) when it fails.
 bool run_tool(const std::string& script, const std::vector<std::string>& args);
 
-/// `quadcosim plot RUN_DIR`: regenerates the figures of a run.
+/// `quadcosim plot RUN_DIR`: regenerates the figures and report.html of a run.
 int plot_command(const std::string& run_dir);
 
-/// The PNG plots of a run directory (tools/plot_run.py).
+/// `quadcosim compare RUN_A RUN_B [--out DIR]`: overlays two runs and tabulates their step figures.
+int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out);
+
+/// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py).
 bool make_plots(const std::string& run_dir);
 
 }  // namespace quadcosim::app

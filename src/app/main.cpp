@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   auto* run_cmd = app.add_subcommand("run", "run a scenario: trajectory.csv, metrics.json, plots");
   run_cmd->add_option("scenario", run.scenario, "scenario YAML file")->required()->check(CLI::ExistingFile);
   run_cmd->add_option("--out", run.out_dir, "output directory (created)")->required();
-  run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots");
+  run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots and report.html");
   run_cmd->add_option("--transport", run.transport,
                       "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
       ->check(CLI::IsMember({"inproc", "dds"}));
@@ -100,6 +100,12 @@ int main(int argc, char** argv) {
   plot_cmd->add_option("run_dir", plot_dir, "run directory (trajectory.csv, metrics.json)")
       ->required()->check(CLI::ExistingDirectory);
 
+  std::string cmp_a, cmp_b, cmp_out;
+  auto* cmp_cmd = app.add_subcommand("compare", "overlay two runs (e.g. two gain sets) and tabulate their step figures");
+  cmp_cmd->add_option("run_a", cmp_a, "first run directory")->required()->check(CLI::ExistingDirectory);
+  cmp_cmd->add_option("run_b", cmp_b, "second run directory")->required()->check(CLI::ExistingDirectory);
+  cmp_cmd->add_option("--out", cmp_out, "output directory (default: RUN_B/compare_with_<RUN_A>)");
+
   RecordOptions rec;
   auto* rec_cmd = app.add_subcommand("record", "record a vehicle's topics over DDS into MCAP (like ros2 bag record)");
   rec_cmd->add_option("--out", rec.out, "MCAP file to write (metadata.yaml beside it)")->required();
@@ -111,6 +117,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
+  if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);
   if (*run_cmd) return run_command(run);
   if (*plant_cmd) return plant_command(plant);
   if (*ctl_cmd) return controller_command(ctl);

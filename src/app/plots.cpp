@@ -43,8 +43,21 @@ bool run_tool(const std::string& script, const std::vector<std::string>& args) {
   return true;
 }
 
-bool make_plots(const std::string& run_dir) { return run_tool("plot_run.py", {run_dir}); }
+bool make_plots(const std::string& run_dir) {
+  // The report embeds the figures, so it comes after them.
+  return run_tool("plot_run.py", {run_dir}) &&
+         run_tool("report.py", {run_dir, "--version-text", std::string("quadcosim ") + QUADCOSIM_VERSION});
+}
 
 int plot_command(const std::string& run_dir) { return make_plots(run_dir) ? 0 : 3; }
+
+int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out) {
+  std::vector<std::string> args = {run_a, run_b};
+  if (!out.empty()) {
+    args.push_back("--out");
+    args.push_back(out);
+  }
+  return run_tool("compare_runs.py", args) ? 0 : 3;
+}
 
 }  // namespace quadcosim::app

@@ -13,7 +13,7 @@ dirs=()
 for e in altitude_step roll_step pitch_step yaw_step; do
   "$bin" run "$src/scenarios/paper/$e.yaml" --out "$tmp/$e" --transport dds > "$tmp/$e.log" 2>&1 || {
     cat "$tmp/$e.log"; echo "FAIL: $e exited non-zero"; exit 1; }
-  for f in trajectory.csv metrics.json metrics.txt scenario.yaml overview.png; do
+  for f in trajectory.csv metrics.json metrics.txt scenario.yaml overview.png report.html run.mcap metadata.yaml; do
     [ -s "$tmp/$e/$f" ] || { echo "FAIL: $e did not write $f"; exit 1; }
   done
   ls "$tmp/$e"/step_*.png > /dev/null 2>&1 || { echo "FAIL: $e wrote no step plot"; exit 1; }
@@ -23,4 +23,12 @@ done
 "$bin" summary "${dirs[@]}" --out "$tmp/paper_comparison.md" > /dev/null
 grep -q "overshoot" "$tmp/paper_comparison.md"
 if grep -q "FAIL" "$tmp/paper_comparison.md"; then echo "FAIL: a paper figure is outside its band"; exit 1; fi
-echo "ok: four experiments reproduced with plots and table"
+# Two runs compared (here: altitude against roll), as `quadcosim compare` promises.
+"$bin" compare "$tmp/altitude_step" "$tmp/roll_step" --out "$tmp/cmp" > "$tmp/cmp.md" 2> /dev/null
+grep -q "overshoot" "$tmp/cmp.md" || { echo "FAIL: compare printed no table"; exit 1; }
+ls "$tmp/cmp"/compare_*.png > /dev/null || { echo "FAIL: compare wrote no plot"; exit 1; }
+rm "$tmp/altitude_step/report.html" "$tmp/altitude_step/step_z.png"
+"$bin" plot "$tmp/altitude_step" > /dev/null
+[ -s "$tmp/altitude_step/report.html" ] && [ -s "$tmp/altitude_step/step_z.png" ] \
+  || { echo "FAIL: plot did not regenerate the figures and report"; exit 1; }
+echo "ok: four experiments reproduced with plots, reports and table; compare and plot work"

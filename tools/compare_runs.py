@@ -1,0 +1,188 @@
+#!/usr/bin/python3
+"""Compare two quadcosim run directories.
+
+Usage: compare_runs.py RUN_A RUN_B [--out DIR]
+
+For each channel stepped in either run (the steps of metrics.json, or, without
+metrics.json, the setpoint changes found in trajectory.csv), writes
+DIR/compare_<channel>.png: the variable against time, run A solid, run B
+dashed, the setpoints grey. Prints a Markdown table of the step figures side
+by side (figure, A, B, difference B - A) to stdout and writes it to
+DIR/compare.md. Steps are paired by channel and order of occurrence.
+
+DIR defaults to RUN_B/compare_with_<name of RUN_A>. Loading helpers come from
+plot_run.py (imported as a module). Exit status: 0 on success, 1 when an input
+file is missing or malformed (the message names the file), 2 on a usage error.
+"""
+
+import argparse
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+
+import plot_run  # noqa: E402  (sets the Agg backend)
+from plot_run import InputError  # noqa: E402
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+PROG = "compare_runs.py"
+COLOR_A = "#d62728"
+COLOR_B = "#1f4fd6"
+
+
+def load_run(run_dir):
+    if not os.path.isdir(run_dir):
+        raise InputError(f"{run_dir}: run directory not found")
+    traj = plot_run.load_trajectory(os.path.join(run_dir, "trajectory.csv"))
+    metrics = plot_run.load_metrics(os.path.join(run_dir, "metrics.json"))
+    steps = metrics["steps"] if metrics is not None else plot_run.detect_steps(traj)
+    return traj, metrics, steps
+
+
+def run_label(run_dir, metrics):
+    name = os.path.basename(os.path.normpath(os.path.abspath(run_dir)))
+    if metrics and metrics.get("scenario") and metrics["scenario"] != name:
+        return f"{name} ({metrics['scenario']})"
+    return name
+
+
+def channels_of(*step_lists):
+    stepped = {s["channel"] for steps in step_lists for s in steps}
+    return [ch for ch in plot_run.CHANNEL_ORDER if ch in stepped]
+
+
+def plot_channel(ch, traj_a, traj_b, label_a, label_b, out_path):
+    meta = plot_run.CHANNELS[ch]
+    fig, ax = plt.subplots(figsize=plot_run.STEP_FIGSIZE, dpi=plot_run.DPI)
+    ax.plot(traj_a["t"], traj_a[f"{ch}_des"], color=plot_run.COLOR_SETPOINT, lw=1.0, ls="-",
+            alpha=0.7, label="setpoint A")
+    ax.plot(traj_b["t"], traj_b[f"{ch}_des"], color=plot_run.COLOR_SETPOINT, lw=1.0, ls="--",
+            alpha=0.7, label="setpoint B")
+    ax.plot(traj_a["t"], traj_a[ch], color=COLOR_A, lw=1.5, ls="-", label=f"A: {label_a}")
+    ax.plot(traj_b["t"], traj_b[ch], color=COLOR_B, lw=1.5, ls="--", label=f"B: {label_b}")
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel(f"{meta['sym']} [{meta['unit']}]")
+    ax.set_title(f"{meta['name']}: A (solid) vs B (dashed)", fontsize=12, fontweight="bold")
+    ax.grid(True, color="0.88", lw=0.6)
+    t_lo = min(float(np.nanmin(traj_a["t"])), float(np.nanmin(traj_b["t"])))
+    t_hi = max(float(np.nanmax(traj_a["t"])), float(np.nanmax(traj_b["t"])))
+    if t_hi > t_lo:
+        ax.set_xlim(t_lo, t_hi)
+    ax.legend(fontsize=8, loc="best", framealpha=0.85)
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=plot_run.DPI)
+    plt.close(fig)
+
+
+def _pair_steps(steps_a, steps_b):
+    """[(title, step_a or None, step_b or None)] paired by channel and occurrence."""
+    def numbered(steps):
+        counts, out = {}, {}
+        for s in steps:
+            counts[s["channel"]] = counts.get(s["channel"], 0) + 1
+            out[(s["channel"], counts[s["channel"]])] = s
+        return out
+    na, nb = numbered(steps_a), numbered(steps_b)
+    keys = sorted(set(na) | set(nb), key=lambda k: (plot_run.CHANNEL_ORDER.index(k[0]), k[1]))
+    pairs = []
+    for ch, n in keys:
+        title = plot_run.CHANNELS[ch]["name"] + " step" + (f" #{n}" if n > 1 else "")
+        pairs.append((title, na.get((ch, n)), nb.get((ch, n))))
+    return pairs
+
+
+def _diff_cell(key, a, b):
+    if a is None or b is None:
+        return "—"
+    d = b - a
+    _, unit, fmt = plot_run.FIGURE_INFO.get(key, (None, plot_run._unit_from_key(key), "{:.4g}"))
+    s = fmt.format(d)
+    if s.lstrip("-").strip("0.") == "":
+        s = s.lstrip("-")  # rounds to zero: no sign
+    elif not s.startswith("-"):
+        s = "+" + s
+    return f"{s} {unit}".strip()
+
+
+def markdown_table(steps_a, steps_b, label_a, label_b):
+    lines = [f"# Step figures: A = {label_a}, B = {label_b}", ""]
+    pairs = _pair_steps(steps_a, steps_b)
+    if not pairs:
+        lines.append("No steps in either run.")
+        return "\n".join(lines) + "\n"
+    for title, sa, sb in pairs:
+        fa = sa["figures"] if sa else {}
+        fb = sb["figures"] if sb else {}
+        keys = [k for k in plot_run.FIGURE_ORDER if k in fa or k in fb]
+        for k in list(fa) + list(fb):
+            if k not in keys:
+                keys.append(k)
+        lines.append(f"## {title}")
+        lines.append("")
+        if sa is None or sb is None:
+            lines.append(f"(only in run {'A' if sb is None else 'B'})")
+            lines.append("")
+        if not keys:
+            lines.append("No step figures (no metrics.json).")
+            lines.append("")
+            continue
+        lines.append("| figure | A | B | difference (B − A) |")
+        lines.append("|---|---:|---:|---:|")
+        for k in keys:
+            a, b = fa.get(k), fb.get(k)
+            lines.append(f"| {plot_run._figure_label(k)} | "
+                         f"{plot_run._figure_cell(k, a) if sa else '—'} | "
+                         f"{plot_run._figure_cell(k, b) if sb else '—'} | {_diff_cell(k, a, b)} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def run(run_a, run_b, out_dir=None):
+    traj_a, metrics_a, steps_a = load_run(run_a)
+    traj_b, metrics_b, steps_b = load_run(run_b)
+    if out_dir is None:
+        name_a = os.path.basename(os.path.normpath(os.path.abspath(run_a)))
+        out_dir = os.path.join(run_b, f"compare_with_{name_a}")
+    os.makedirs(out_dir, exist_ok=True)
+    label_a, label_b = run_label(run_a, metrics_a), run_label(run_b, metrics_b)
+
+    written = []
+    for ch in channels_of(steps_a, steps_b):
+        out = os.path.join(out_dir, f"compare_{ch}.png")
+        plot_channel(ch, traj_a, traj_b, label_a, label_b, out)
+        written.append(out)
+
+    table = markdown_table(steps_a, steps_b, label_a, label_b)
+    md = os.path.join(out_dir, "compare.md")
+    with open(md, "w", encoding="utf-8", newline="\n") as f:
+        f.write(table)
+    written.append(md)
+    sys.stdout.write(table)
+    sys.stdout.flush()
+    for p in written:
+        print(f"{PROG}: wrote {p}", file=sys.stderr)
+    return written
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog=PROG, description="Overlay two run directories and tabulate their step figures.")
+    parser.add_argument("run_a", metavar="RUN_A", help="first run directory (solid lines)")
+    parser.add_argument("run_b", metavar="RUN_B", help="second run directory (dashed lines)")
+    parser.add_argument("--out", metavar="DIR", default=None,
+                        help="output directory (default RUN_B/compare_with_<name of RUN_A>)")
+    args = parser.parse_args(argv)
+    try:
+        run(args.run_a, args.run_b, args.out)
+    except (InputError, OSError) as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

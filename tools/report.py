@@ -1,0 +1,278 @@
+#!/usr/bin/python3
+"""Write a self-contained HTML report of a quadcosim run directory.
+
+Usage: report.py RUN_DIR [--version-text TEXT]
+
+Writes RUN_DIR/report.html: one page that opens offline (inline CSS, the PNGs
+embedded as base64 data URIs, no external URL) with
+
+  - the scenario name and description (from metrics.json),
+  - a verdict banner (PASSED / FAILED),
+  - per analysed step a table of the step figures: our value, the criterion
+    band, ok/FAIL, and the reference value and its source when metrics.json
+    has a "reference",
+  - every step_*.png and overview.png present in RUN_DIR,
+  - the scenario YAML (RUN_DIR/scenario.yaml) in a <pre>,
+  - versions: quadcosim (the text given with --version-text, e.g. the output of
+    `quadcosim --version`), Python, numpy, matplotlib.
+
+No date is written, so the same inputs give a byte-identical file. The loading
+helpers come from plot_run.py (imported as a module). Prints the path of the
+report. Exit status: 0 on success, 1 when metrics.json (required) or another
+input is missing or malformed (the message names the file), 2 on a usage error.
+"""
+
+import argparse
+import base64
+import glob
+import html
+import os
+import platform
+import re
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+
+import plot_run  # noqa: E402  (sets the Agg backend)
+from plot_run import InputError  # noqa: E402
+
+import matplotlib  # noqa: E402
+import numpy as np  # noqa: E402
+
+PROG = "report.py"
+
+CSS = """
+body { font-family: "DejaVu Sans", Arial, Helvetica, sans-serif; margin: 24px auto;
+       max-width: 1150px; color: #222; line-height: 1.4; }
+h1 { margin-bottom: 0.2em; }
+h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 1.6em; }
+.description { color: #555; margin-top: 0; }
+.verdict { font-size: 1.6em; font-weight: bold; padding: 0.5em 0.8em; border-radius: 6px;
+           margin: 0.8em 0; color: #fff; }
+.verdict.passed { background: #2a7f2a; }
+.verdict.failed { background: #c62828; }
+.verdict.none { background: #777; }
+table { border-collapse: collapse; margin: 0.5em 0 0.3em 0; }
+th, td { border: 1px solid #bbb; padding: 4px 10px; text-align: left; }
+th { background: #eee; }
+td.num { text-align: right; font-family: "DejaVu Sans Mono", monospace; }
+td.ok { color: #2a7f2a; font-weight: bold; }
+td.fail { color: #c62828; font-weight: bold; }
+.source { color: #555; font-size: 0.9em; margin-top: 0; }
+figure { margin: 1em 0; }
+figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { color: #555; font-size: 0.9em; }
+pre { background: #f6f6f6; border: 1px solid #ddd; padding: 10px; overflow-x: auto;
+      font-size: 0.85em; }
+.versions td { font-family: "DejaVu Sans Mono", monospace; }
+"""
+
+
+def esc(s):
+    return html.escape(str(s), quote=True)
+
+
+def _band(c):
+    lo, hi = c.get("min"), c.get("max")
+    lo = lo if plot_run._is_number(lo) else None
+    hi = hi if plot_run._is_number(hi) else None
+    if lo is not None and hi is not None:
+        return f"[{lo:g}, {hi:g}]"
+    if lo is not None:
+        return f"≥ {lo:g}"
+    if hi is not None:
+        return f"≤ {hi:g}"
+    return "—"
+
+
+def step_rows(step):
+    """Rows (figure key, ours, band, status, reference) of one step's table."""
+    figs, ref = step["figures"], step["reference"]
+    crit = {}
+    for c in step["criteria"]:
+        crit.setdefault(str(c.get("figure", "?")), c)
+    keys = [k for k in plot_run.FIGURE_ORDER if k in figs]
+    keys += [k for k in figs if k not in keys]
+    for k in list(crit) + [k for k in ref if k != "source"]:
+        if k not in keys:
+            keys.append(k)
+    rows = []
+    for k in keys:
+        value = figs.get(k)
+        c = crit.get(k)
+        if value is None and c is not None and plot_run._is_number(c.get("value")):
+            value = float(c["value"])
+        if c is None:
+            band, status = "—", ""
+        else:
+            band = _band(c)
+            p = c.get("passed")
+            status = "ok" if p is True else ("FAIL" if p is False else "?")
+        reference = plot_run._figure_cell(k, ref[k]) if k in ref else ""
+        rows.append((k, plot_run._figure_cell(k, value), band, status, reference))
+    return rows
+
+
+def overall_verdict(metrics):
+    if metrics["passed"] is not None:
+        return metrics["passed"]
+    flags = [s["passed"] for s in metrics["steps"] if s["passed"] is not None]
+    return all(flags) if flags else None
+
+
+def png_data_uri(path):
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc}") from None
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise InputError(f"{path}: not a PNG file")
+    return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
+
+
+def _figure_sort_key(path):
+    """step_z.png, step_z_2.png ... in channel order, overview.png last."""
+    name = os.path.basename(path)
+    if name == "overview.png":
+        return (2, 0, 0, name)
+    m = re.fullmatch(r"step_([a-z]+)(?:_(\d+))?\.png", name)
+    if m and m.group(1) in plot_run.CHANNEL_ORDER:
+        return (0, plot_run.CHANNEL_ORDER.index(m.group(1)), int(m.group(2) or 1), name)
+    return (1, 0, 0, name)
+
+
+def figure_files(run_dir):
+    files = glob.glob(os.path.join(glob.escape(run_dir), "step_*.png"))
+    ov = os.path.join(run_dir, "overview.png")
+    if os.path.isfile(ov):
+        files.append(ov)
+    return sorted(files, key=_figure_sort_key)
+
+
+def step_title(step, n):
+    meta = plot_run.CHANNELS[step["channel"]]
+    title = (f"{meta['name']} step {plot_run._fmt_num(step['initial'])} → "
+             f"{plot_run._fmt_num(step['target'])} {meta['unit']} at t = {step['t_step_s']:.2f} s")
+    return f"{title} (#{n})" if n > 1 else title
+
+
+def build_html(run_dir, metrics, version_text):
+    verdict = overall_verdict(metrics)
+    name = metrics["scenario"] or os.path.basename(os.path.abspath(run_dir))
+    out = []
+    w = out.append
+    w("<!DOCTYPE html>")
+    w('<html lang="en">')
+    w("<head>")
+    w('<meta charset="utf-8">')
+    w(f"<title>quadcosim report: {esc(name)}</title>")
+    w(f"<style>{CSS}</style>")
+    w("</head>")
+    w("<body>")
+    w(f"<h1>quadcosim run report: {esc(name)}</h1>")
+    if metrics["description"]:
+        w(f'<p class="description">{esc(metrics["description"])}</p>')
+    if verdict is True:
+        w('<div class="verdict passed" id="verdict">PASSED</div>')
+    elif verdict is False:
+        w('<div class="verdict failed" id="verdict">FAILED</div>')
+    else:
+        w('<div class="verdict none" id="verdict">NO CRITERIA</div>')
+
+    w("<h2>Step figures</h2>")
+    if not metrics["steps"]:
+        w("<p>metrics.json lists no steps.</p>")
+    counts = {}
+    for step in metrics["steps"]:
+        ch = step["channel"]
+        counts[ch] = counts.get(ch, 0) + 1
+        sp = step["passed"]
+        mark = "" if sp is None else (" — ok" if sp else " — FAIL")
+        w(f"<h3>{esc(step_title(step, counts[ch]))}{esc(mark)}</h3>")
+        rows = step_rows(step)
+        if not rows:
+            w("<p>No step figures.</p>")
+            continue
+        has_ref = any(r[4] for r in rows)
+        w("<table>")
+        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th>"
+          + ("<th>reference</th>" if has_ref else "") + "</tr>")
+        for key, ours, band, status, reference in rows:
+            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+            w(f"<tr><td>{esc(plot_run._figure_label(key))}</td><td class=\"num\">{esc(ours)}</td>"
+              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td>"
+              + (f"<td class=\"num\">{esc(reference)}</td>" if has_ref else "") + "</tr>")
+        w("</table>")
+        if step["reference"].get("source"):
+            w(f'<p class="source">reference source: {esc(step["reference"]["source"])}</p>')
+
+    w("<h2>Figures</h2>")
+    files = figure_files(run_dir)
+    if not files:
+        w("<p>No figures in the run directory (run tools/plot_run.py first).</p>")
+    for path in files:
+        base = os.path.basename(path)
+        w(f'<figure><img src="{png_data_uri(path)}" alt="{esc(base)}">'
+          f"<figcaption>{esc(base)}</figcaption></figure>")
+
+    w("<h2>Scenario</h2>")
+    scen = os.path.join(run_dir, "scenario.yaml")
+    if os.path.isfile(scen):
+        try:
+            with open(scen, encoding="utf-8", errors="replace") as f:
+                text = f.read()
+        except OSError as exc:
+            raise InputError(f"{scen}: cannot read: {exc}") from None
+        w(f"<pre>{esc(text)}</pre>")
+    else:
+        w("<p>scenario.yaml not found in the run directory.</p>")
+
+    w("<h2>Versions</h2>")
+    w('<table class="versions">')
+    qv = version_text.strip() if version_text and version_text.strip() else "unknown"
+    for label, value in (("quadcosim", qv), ("Python", platform.python_version()),
+                         ("numpy", np.__version__), ("matplotlib", matplotlib.__version__)):
+        w(f"<tr><th>{esc(label)}</th><td>{esc(value)}</td></tr>")
+    w("</table>")
+    w("</body>")
+    w("</html>")
+    return "\n".join(out) + "\n"
+
+
+def run(run_dir, version_text=None):
+    if not os.path.isdir(run_dir):
+        raise InputError(f"{run_dir}: run directory not found")
+    metrics_path = os.path.join(run_dir, "metrics.json")
+    metrics = plot_run.load_metrics(metrics_path)
+    if metrics is None:
+        raise InputError(f"{metrics_path}: file not found (metrics.json is required)")
+    page = build_html(run_dir, metrics, version_text)
+    out = os.path.join(run_dir, "report.html")
+    tmp = out + ".tmp"
+    with open(tmp, "w", encoding="utf-8", newline="\n") as f:
+        f.write(page)
+    os.replace(tmp, out)
+    print(out, flush=True)
+    return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog=PROG, description="Write RUN_DIR/report.html, a self-contained HTML run report.")
+    parser.add_argument("run_dir", metavar="RUN_DIR", help="run directory holding metrics.json")
+    parser.add_argument("--version-text", default=None, metavar="TEXT",
+                        help="quadcosim version text (e.g. the output of `quadcosim --version`)")
+    args = parser.parse_args(argv)
+    try:
+        run(args.run_dir, args.version_text)
+    except (InputError, OSError) as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,214 @@
+#!/usr/bin/python3
+"""Tests for tools/report.py and tools/compare_runs.py.
+
+Run:  /usr/bin/python3 tools/test_report.py   (stdlib unittest; the synthetic
+run directories come from test_plot_run.make_run()). The headless-Chromium
+rendering test is skipped when /usr/bin/chromium is absent.
+"""
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+from test_plot_run import make_run, plot_python, png_size  # noqa: E402
+
+REPORT = os.path.join(HERE, "report.py")
+COMPARE = os.path.join(HERE, "compare_runs.py")
+PLOT = os.path.join(HERE, "plot_run.py")
+CHROMIUM = "/usr/bin/chromium"
+
+SCENARIO_YAML = """\
+# synthetic scenario for the report test: <b>not bold</b> & escaped
+name: synthetic
+description: "altitude step 0 -> 10 m"
+schedule:
+  - at_s: 0
+    set: {z_des: 10.0}
+"""
+
+
+class ToolTestBase(unittest.TestCase):
+    def setUp(self):
+        self._tmp = tempfile.TemporaryDirectory(prefix="report_test_")
+        self.tmp = self._tmp.name
+        self.env = dict(os.environ, MPLCONFIGDIR=os.path.join(self.tmp, "mplconfig"))
+
+    def tearDown(self):
+        self._tmp.cleanup()
+
+    def run_tool(self, *args, timeout=180):
+        return subprocess.run([plot_python(), *args], capture_output=True, text=True,
+                              timeout=timeout, env=self.env)
+
+    def make_plotted_run(self, name, steps, **kw):
+        run = os.path.join(self.tmp, name)
+        make_run(run, steps, n_rows=1001, **kw)
+        res = self.run_tool(PLOT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        return run
+
+
+class ReportTest(ToolTestBase):
+    def make_report(self):
+        run = self.make_plotted_run("run", [("z", 0.0, 0.0, 10.0)])
+        with open(os.path.join(run, "scenario.yaml"), "w") as f:
+            f.write(SCENARIO_YAML)
+        res = self.run_tool(REPORT, run, "--version-text", "quadcosim 9.8.7\n")
+        self.assertEqual(res.returncode, 0, res.stderr)
+        path = os.path.join(run, "report.html")
+        self.assertIn(path, res.stdout.splitlines())
+        with open(path, encoding="utf-8") as f:
+            page = f.read()
+        with open(os.path.join(run, "metrics.json")) as f:
+            metrics = json.load(f)
+        return run, path, page, metrics
+
+    def test_report_contents(self):
+        run, path, page, metrics = self.make_report()
+        step = metrics["steps"][0]
+        self.assertIn("synthetic", page)
+        self.assertIn("synthetic second-order responses", page)
+        self.assertIn("PASSED", page)
+        # our values, the criterion band, the reference value and its source
+        self.assertIn(f"{step['figures']['overshoot_pct']:.1f} %", page)
+        self.assertIn(f"{step['figures']['settling_time_2pct_s']:.2f} s", page)
+        self.assertIn("[15, 21]", page)
+        self.assertIn("≤ 10", page)
+        self.assertIn(">ok<", page)
+        self.assertIn("18.0 %", page)  # reference overshoot
+        self.assertIn("paper Fig. 4", page)
+        # figures embedded: step_z.png and overview.png
+        self.assertEqual(page.count("data:image/png;base64,"), 2)
+        # nothing external
+        self.assertIsNone(re.search(r"""(src|href)\s*=\s*["']?\s*https?://""", page, re.I))
+        self.assertNotIn("http://", page)
+        self.assertNotIn("https://", page)
+        # scenario YAML escaped, versions present
+        self.assertIn("&lt;b&gt;not bold&lt;/b&gt; &amp; escaped", page)
+        self.assertNotIn("<b>not bold</b>", page)
+        self.assertIn("quadcosim 9.8.7", page)
+        self.assertIn("matplotlib", page)
+
+    def test_report_is_reproducible(self):
+        run, path, page, _ = self.make_report()
+        res = self.run_tool(REPORT, run, "--version-text", "quadcosim 9.8.7\n")
+        self.assertEqual(res.returncode, 0, res.stderr)
+        with open(path, encoding="utf-8") as f:
+            self.assertEqual(f.read(), page)
+
+    def test_failed_verdict(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
+        with open(os.path.join(run, "metrics.json")) as f:
+            m = json.load(f)
+        m["steps"][0]["criteria"][0]["passed"] = False
+        m["steps"][0]["passed"] = False
+        m["passed"] = False
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            json.dump(m, f)
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
+            page = f.read()
+        self.assertIn(">FAILED<", page)
+        self.assertIn(">FAIL<", page)
+        self.assertNotIn("data:image/png;base64,", page)  # no plots were made
+
+    def test_missing_or_malformed_metrics_is_an_error(self):
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("z", 0.0, 0.0, 10.0)], n_rows=200, with_metrics=False)
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 1)
+        self.assertIn("metrics.json", res.stderr)
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            f.write('{"steps": [')
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 1)
+        self.assertIn("metrics.json", res.stderr)
+        self.assertFalse(os.path.exists(os.path.join(run, "report.html")))
+
+    @unittest.skipUnless(os.path.exists(CHROMIUM), f"{CHROMIUM} not installed")
+    def test_renders_in_headless_chromium(self):
+        run, path, page, _ = self.make_report()
+        shot = os.path.join(self.tmp, "shot.png")
+        url = "file://" + os.path.abspath(path)
+
+        def chromium(*extra, profile):
+            return subprocess.run(
+                [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                 "--no-first-run", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync",
+                 f"--user-data-dir={os.path.join(self.tmp, profile)}", *extra, url],
+                capture_output=True, text=True, timeout=120)
+
+        res = chromium(f"--screenshot={shot}", "--window-size=1200,2000", profile="profile1")
+        self.assertTrue(os.path.isfile(shot), f"no screenshot; chromium stderr:\n{res.stderr}")
+        w, h = png_size(shot)
+        self.assertEqual((w, h), (1200, 2000))
+        self.assertGreater(os.path.getsize(shot), 20_000, "screenshot suspiciously small")
+
+        res = chromium("--dump-dom", profile="profile2")
+        self.assertEqual(res.returncode, 0, res.stderr)
+        self.assertIn("PASSED", res.stdout)
+        self.assertIn('id="verdict"', res.stdout)
+
+
+class CompareTest(ToolTestBase):
+    def test_compare_two_runs(self):
+        run_a = self.make_plotted_run("run_a", [("z", 0.0, 0.0, 10.0)])
+        run_b = self.make_plotted_run("run_b", [("z", 0.0, 0.0, 10.0)])
+        # B: a different overshoot (as if retuned)
+        mpath = os.path.join(run_b, "metrics.json")
+        with open(mpath) as f:
+            m = json.load(f)
+        m["steps"][0]["figures"]["overshoot_pct"] = 12.34
+        with open(mpath, "w") as f:
+            json.dump(m, f)
+        with open(os.path.join(run_a, "metrics.json")) as f:
+            over_a = json.load(f)["steps"][0]["figures"]["overshoot_pct"]
+
+        res = self.run_tool(COMPARE, run_a, run_b)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        out_dir = os.path.join(run_b, "compare_with_run_a")
+        png = os.path.join(out_dir, "compare_z.png")
+        self.assertTrue(os.path.isfile(png))
+        self.assertGreater(os.path.getsize(png), 10_000)
+        png_size(png)
+        self.assertFalse(os.path.exists(os.path.join(out_dir, "compare_roll.png")))
+        row = [ln for ln in res.stdout.splitlines() if ln.startswith("| overshoot |")]
+        self.assertEqual(len(row), 1, res.stdout)
+        self.assertIn(f"{over_a:.1f} %", row[0])
+        self.assertIn("12.3 %", row[0])
+        self.assertIn(f"{12.34 - over_a:+.1f} %", row[0])
+        with open(os.path.join(out_dir, "compare.md"), encoding="utf-8") as f:
+            self.assertEqual(f.read(), res.stdout)
+
+    def test_compare_out_dir_and_channel_in_one_run(self):
+        run_a = self.make_plotted_run("a", [("z", 0.0, 0.0, 10.0)])
+        run_b = self.make_plotted_run("b", [("z", 0.0, 0.0, 10.0), ("yaw", 5.0, 0.0, 0.2)])
+        out = os.path.join(self.tmp, "cmp")
+        res = self.run_tool(COMPARE, run_a, run_b, "--out", out)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        for ch in ("z", "yaw"):
+            self.assertTrue(os.path.isfile(os.path.join(out, f"compare_{ch}.png")), ch)
+        self.assertIn("Yaw step", res.stdout)
+        self.assertIn("only in run B", res.stdout)
+
+    def test_compare_missing_run_is_an_error(self):
+        run_a = os.path.join(self.tmp, "a")
+        make_run(run_a, [("z", 0.0, 0.0, 10.0)], n_rows=200)
+        res = self.run_tool(COMPARE, run_a, os.path.join(self.tmp, "nope"))
+        self.assertEqual(res.returncode, 1)
+        self.assertIn("nope", res.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
