@@ -17,7 +17,6 @@
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
-#include "model/attitude.hpp"
 #include "sim/simulation.hpp"
 
 namespace quadcosim::app {
@@ -28,24 +27,6 @@ namespace fs = std::filesystem;
 constexpr std::int64_t kRecordLagNs = 100'000'000;
 
 namespace {
-
-
-void record_series(io::Series& s, const sim::TickRecord& r, const io::ControlColumns& c) {
-  const model::Euler e = model::euler_from_quaternion(r.state.q_WB);
-  s.t_s.push_back(r.t_s);
-  s.append("x", r.state.p_W.x());
-  s.append("y", r.state.p_W.y());
-  s.append("z", r.state.p_W.z());
-  s.append("roll", e.roll_rad);
-  s.append("pitch", e.pitch_rad);
-  s.append("yaw", e.yaw_rad);
-  s.append("x_des", c.x_des);
-  s.append("y_des", c.y_des);
-  s.append("z_des", c.z_des);
-  s.append("roll_des", c.roll_des);
-  s.append("pitch_des", c.pitch_des);
-  s.append("yaw_des", c.yaw_des);
-}
 
 struct Interrupted {};
 
@@ -145,10 +126,8 @@ int run_command(const RunOptions& opt) {
   try {
     fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
     const std::string csv_path = (out / "trajectory.csv").string();
-    io::Series series;
     if (opt.transport == "dds") {
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
-      series = io::read_series(csv_path);
     } else {
       model::Quadrotor probe(sc.vehicle);
       const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
@@ -162,7 +141,6 @@ int run_command(const RunOptions& opt) {
         simulation.run([&](const sim::TickRecord& r) {
           const io::ControlColumns c = io::ControlColumns::from(r.status);
           csv.write(r.t_s, r.state, r.applied_command, c);
-          record_series(series, r, c);
           mcap.flush_before(sc.simulation.plant.clock.ns(r.tick) - kRecordLagNs);
           progress.update(r.t_s);
           if (stop_requested()) throw Interrupted{};
@@ -186,7 +164,8 @@ int run_command(const RunOptions& opt) {
       }
     }
 
-    const auto results = io::evaluate_steps(sc.steps, series);
+    // Both transports are judged from what was recorded: the exact doubles of trajectory.csv.
+    const auto results = io::evaluate_steps(sc.steps, io::read_series(csv_path));
     io::write_metrics_json((out / "metrics.json").string(), sc, results);
     const std::string table = io::format_step_table(sc, results);
     std::ofstream((out / "metrics.txt").string()) << table;
