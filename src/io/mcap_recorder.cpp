@@ -54,6 +54,16 @@ void McapRecorder::add(sim::Transport& transport, const std::string& topic, cons
   channels_.push_back({topic, type, id});
   transport.subscribe<T>(topic, [this, index](const T& m) {
     const std::int64_t t = stamp_of(m, last_stamp_ns_);
+    bool stamped = true;  // the message carries its own time (header, clock, or command label)
+    if constexpr (std::is_same_v<T, msg::Float64MultiArray>) stamped = msg::command_stamp_ns(m) >= 0;
+    ChannelInfo& c = channels_[index];
+    // Lockstep may repeat a tick (a republished sample or its repeated answer): one copy is recorded,
+    // so the file does not depend on whether a repeat happened.
+    if (stamped && c.newest_ns >= 0 && t <= c.newest_ns) {
+      ++repeats_;
+      return;
+    }
+    if (stamped) c.newest_ns = t;
     if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) last_stamp_ns_ = std::max(last_stamp_ns_, t);
     push(static_cast<std::uint16_t>(index), t, to_cdr(m));
   });

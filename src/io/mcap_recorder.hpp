@@ -28,6 +28,7 @@ class McapRecorder {
   /// Writes every buffered message stamped before `sim_ns` [ns], in (time, channel, arrival) order.
   /// Messages are stamped with their header time (motor commands: the time in their label, or the
   /// last header time seen); buffering makes the file independent of the order messages arrive in.
+  /// A stamped message no newer than the last one on its channel is a repeat and is not recorded.
   void flush_before(std::int64_t sim_ns);
   /// Newest message time seen so far [ns] (0 before any).
   std::int64_t newest_ns() const { return last_stamp_ns_; }
@@ -38,6 +39,8 @@ class McapRecorder {
   void write_bag_metadata(const std::string& dir, const std::string& mcap_file_name) const;
 
   std::uint64_t messages() const { return written_; }
+  /// Repeated samples (same channel, stamp not newer than the last) that were not recorded again.
+  std::uint64_t repeats() const { return repeats_; }
 
  private:
   struct Pending {
@@ -51,6 +54,7 @@ class McapRecorder {
     std::uint16_t id;
     std::uint64_t count = 0;
     std::uint32_t sequence = 0;
+    std::int64_t newest_ns = -1;  ///< newest own stamp accepted on this channel
   };
   template <class T>
   void add(sim::Transport& transport, const std::string& topic, const std::vector<std::string>& only);
@@ -59,7 +63,7 @@ class McapRecorder {
   McapWriter writer_;
   std::vector<ChannelInfo> channels_;  // indexed by position, not by MCAP id
   std::vector<Pending> pending_;
-  std::uint64_t arrivals_ = 0, written_ = 0;
+  std::uint64_t arrivals_ = 0, written_ = 0, repeats_ = 0;
   std::int64_t last_stamp_ns_ = 0;
   std::int64_t first_ns_ = -1, last_ns_ = -1;
   bool closed_ = false;

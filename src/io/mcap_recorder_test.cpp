@@ -1,0 +1,54 @@
+// McapRecorder: repeats of a lockstep tick are recorded once; unlabelled commands are all kept.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "io/mcap_recorder.hpp"
+#include "sim/inprocess_transport.hpp"
+#include "sim/messages.hpp"
+
+namespace quadcosim::io {
+namespace {
+
+TEST(McapRecorderTest, RecordsARepeatedTickOnceAndKeepsUnlabelledCommands) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mcap_rec_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  sim::InProcessTransport bus;
+  const sim::Topics topics = sim::Topics::for_namespace("/drone");
+  McapRecorder rec((dir / "run.mcap").string(), bus, topics);
+  auto pose = bus.advertise<msg::PoseStamped>(topics.pose);
+  auto cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
+
+  msg::PoseStamped p;
+  p.header.stamp = msg::Time::from_ns(10'000'000);
+  pose.publish(p);
+  pose.publish(p);  // the plant republished tick 1
+  p.header.stamp = msg::Time::from_ns(20'000'000);
+  pose.publish(p);
+
+  msg::Float64MultiArray labelled;
+  labelled.data = {1, 2, 3, 4};
+  labelled.dim = {{msg::command_label(20'000'000), 4, 4}};
+  cmd.publish(labelled);
+  cmd.publish(labelled);  // the controller answered the repeat again
+  msg::Float64MultiArray plain;  // a foreign controller: no label, all kept
+  plain.data = {5, 6, 7, 8};
+  cmd.publish(plain);
+  cmd.publish(plain);
+
+  rec.close();
+  EXPECT_EQ(rec.messages(), 2u + 1u + 2u);
+  EXPECT_EQ(rec.repeats(), 2u);
+  rec.write_bag_metadata(dir.string(), "run.mcap");
+  std::ifstream y(dir / "metadata.yaml");
+  const std::string meta((std::istreambuf_iterator<char>(y)), std::istreambuf_iterator<char>());
+  EXPECT_NE(meta.find("message_count: 5"), std::string::npos) << meta;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace quadcosim::io
