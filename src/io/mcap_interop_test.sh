@@ -24,17 +24,7 @@ fail() {
   exit 1
 }
 
-# The reader's npm packages, pinned by package-lock.json; installed once (node_modules is not
-# committed). A lock keeps concurrent test runs in the same tree from installing at the same time.
-if [[ ! -f $VERIFY_DIR/node_modules/@mcap/core/package.json ]]; then
-  (
-    flock 9
-    if [[ ! -f $VERIFY_DIR/node_modules/@mcap/core/package.json ]]; then
-      npm ci --prefix "$VERIFY_DIR" --no-audit --no-fund >"$TMP/npm.log" 2>&1 ||
-        { cat "$TMP/npm.log" >&2; fail "npm ci in $VERIFY_DIR failed (is the npm registry reachable?)"; }
-    fi
-  ) 9>"${TMPDIR:-/tmp}/quadcosim-mcap-verify-npm.lock"
-fi
+bash "$VERIFY_DIR/install.sh" || fail "cannot install the MCAP reader's npm packages"
 
 verify() {  # verify [--stream] FILE > JSON
   node "$VERIFY_DIR/verify.mjs" "$@"

@@ -7,10 +7,7 @@ bin="$1"; src="$2"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 verify="$src/tools/mcap_verify"
-if [ ! -d "$verify/node_modules" ]; then
-  ( flock 9; [ -d "$verify/node_modules" ] || npm ci --prefix "$verify" --no-audit --no-fund > /dev/null ) \
-    9> "$verify/.npm-ci.lock"
-fi
+bash "$verify/install.sh"
 "$bin" run "$src/scenarios/paper/altitude_step.yaml" --out "$tmp/run" --no-plots > /dev/null
 node "$verify/verify.mjs" "$tmp/run/run.mcap" > "$tmp/summary.json"
 /usr/bin/python3 - "$tmp/summary.json" "$tmp/run/trajectory.csv" "$tmp/run/metadata.yaml" <<'PY'
