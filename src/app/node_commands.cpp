@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <variant>
 #include <vector>
 #include <iostream>
 #include <memory>
@@ -142,15 +141,8 @@ int plant_command(const PlantCommandOptions& o) {
     for (sim::Tick k = 0; k <= sc.simulation.duration_ticks && !stop_requested(); ++k) {
       const std::int64_t t_ns = clock.ns(k);
       for (; scheduler && next_event != sc.schedule.end() && next_event->tick <= k; ++next_event) {
-        dds::ParamValue v;
-        if (const auto* d = std::get_if<double>(&next_event->value)) {
-          v.type = dds::ParamType::kDouble;
-          v.double_value = *d;
-        } else {
-          v.type = dds::ParamType::kString;
-          v.string_value = std::get<std::string>(next_event->value);
-        }
-        const auto r = scheduler->set({{next_event->name, v}}, static_cast<std::int64_t>(o.timeout_s * 1e9));
+        const auto r = scheduler->set({{next_event->name, to_ros(next_event->value)}},
+                                      static_cast<std::int64_t>(o.timeout_s * 1e9));
         if (r.size() != 1 || !r[0].successful) {
           std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event->name,
                                    clock.seconds(k), o.schedule_node, r.empty() ? "no result" : r[0].reason);

@@ -4,12 +4,12 @@
 
 namespace quadcosim::app {
 
-namespace {
-
 dds::ParamValue to_ros(const control::ParameterValue& v) {
   if (const auto* s = std::get_if<std::string>(&v)) return dds::ParamValue::of_string(*s);
   return dds::ParamValue::of_double(std::get<double>(v));
 }
+
+namespace {
 
 // What set_parameter is given for a ROS value: numbers as doubles, text as text, anything else as
 // its type name, so the table refuses it with its usual reason ("z_des must be a number, got 'boolean'").

@@ -8,6 +8,9 @@
 
 namespace quadcosim::app {
 
+/// A declared parameter's value as a ROS 2 ParameterValue: numbers DOUBLE, choices STRING.
+dds::ParamValue to_ros(const control::ParameterValue& value);
+
 /// Callbacks bound to `node` (which must outlive them).
 dds::ParameterCallbacks controller_parameter_callbacks(sim::ControllerNode& node);
 
