@@ -194,7 +194,7 @@ int plant_command(const PlantCommandOptions& o) {
       }
       plant.latch_command(k);
       record(k);
-      if (mcap) mcap->flush_before(t_ns - 100'000'000);
+      if (mcap) mcap->flush_settled(t_ns);
       if (k < sc.simulation.duration_ticks) plant.integrate(k);
     }
     if (csv) csv->close();

@@ -23,9 +23,6 @@ namespace quadcosim::app {
 
 namespace fs = std::filesystem;
 
-/// Messages are written to the MCAP file once they are this much older than the current tick [ns].
-constexpr std::int64_t kRecordLagNs = 100'000'000;
-
 namespace {
 
 struct Interrupted {};
@@ -141,7 +138,7 @@ int run_command(const RunOptions& opt) {
         simulation.run([&](const sim::TickRecord& r) {
           const io::ControlColumns c = io::ControlColumns::from(r.status);
           csv.write(r.t_s, r.state, r.applied_command, c);
-          mcap.flush_before(sc.simulation.plant.clock.ns(r.tick) - kRecordLagNs);
+          mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
           progress.update(r.t_s);
           if (stop_requested()) throw Interrupted{};
         });

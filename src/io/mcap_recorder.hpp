@@ -30,6 +30,12 @@ class McapRecorder {
   /// last header time seen); buffering makes the file independent of the order messages arrive in.
   /// A stamped message no newer than the last one on its channel is a repeat and is not recorded.
   void flush_before(std::int64_t sim_ns);
+  /// How long [ns] messages stay buffered behind the current simulated time, so late arrivals of a
+  /// tick still go in order (several ticks; lockstep answers within one).
+  static constexpr std::int64_t kHoldNs = 100'000'000;
+  /// flush_before(now_ns - kHoldNs): the call to make once per tick.
+  void flush_settled(std::int64_t now_ns) { flush_before(now_ns - kHoldNs); }
+
   /// Newest message time seen so far [ns] (0 before any).
   std::int64_t newest_ns() const { return last_stamp_ns_; }
 
