@@ -74,9 +74,7 @@ int plant_command(const PlantCommandOptions& o) {
     if (o.sensor_qos) use_sensor_qos(transport, topics);
     sim::PlantOptions po = sc.simulation.plant;
     po.drop_stale_commands = o.lockstep;
-    const model::Quadrotor probe(sc.vehicle);
-    sim::PlantNode plant(transport, topics, sc.vehicle, po,
-                         probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover));
+    sim::PlantNode plant(transport, topics, sc.vehicle, po, io::initial_state(sc));
     msg::ControllerStatus status;
     status.header.stamp = msg::Time::from_ns(-1);
     bool have_status = false;

@@ -126,9 +126,7 @@ int run_command(const RunOptions& opt) {
     if (opt.transport == "dds") {
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
     } else {
-      model::Quadrotor probe(sc.vehicle);
-      const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
-      sim::Simulation simulation(sc.simulation, sc.vehicle, x0, sc.controller, sc.schedule);
+      sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
       io::TrajectoryWriter csv(csv_path);
       io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
                             sim::Topics::for_namespace(sc.simulation.ns));

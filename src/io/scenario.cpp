@@ -194,6 +194,10 @@ void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
 
 }  // namespace
 
+model::State initial_state(const Scenario& sc) {
+  return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
+}
+
 Scenario load_scenario(const std::string& path) {
   YamlSection root = YamlSection::load_file(path);
   Scenario sc;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "control/parameters.hpp"
+#include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
 
@@ -54,6 +55,9 @@ struct Scenario {
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
 };
+
+/// The plant state the scenario starts from (its `initial` section on its vehicle).
+model::State initial_state(const Scenario& scenario);
 
 /// Loads and validates a scenario. Throws ConfigError (file unreadable, YAML syntax, unknown key,
 /// wrong type, value out of range, a rate that is not a whole divisor, ...).

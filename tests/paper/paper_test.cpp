@@ -21,9 +21,7 @@ struct Flight {
 };
 
 Flight simulate(const io::Scenario& sc) {
-  model::Quadrotor probe(sc.vehicle);
-  const model::State x0 = probe.initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
-  sim::Simulation s(sc.simulation, sc.vehicle, x0, sc.controller, sc.schedule);
+  sim::Simulation s(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
   Flight r;
   s.run([&](const sim::TickRecord& rec) {
     const model::Euler e = model::euler_from_quaternion(rec.state.q_WB);
