@@ -8,7 +8,7 @@ src="$2"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 
-export ROS_DOMAIN_ID=119 ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST  # as scripts/reproduce-paper.sh, own domain
+export ROS_DOMAIN_ID="${3:-119}" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST  # own domain, localhost only
 dirs=()
 for e in altitude_step roll_step pitch_step yaw_step; do
   "$bin" run "$src/scenarios/paper/$e.yaml" --out "$tmp/$e" --transport dds > "$tmp/$e.log" 2>&1 || {
