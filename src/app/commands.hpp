@@ -64,6 +64,8 @@ struct PlantCommandOptions {
   /// Lockstep: apply the scenario's schedule through this node's ROS 2 parameter services, each
   /// change before the tick it is due at ("" = the plant leaves the schedule to the controller).
   std::string schedule_node;
+  double watchdog_s = -1.0;     ///< overrides simulation.watchdog_s when >= 0 (0: off)
+  std::string watchdog_policy;  ///< overrides simulation.watchdog_policy when set: "hold" or "stop"
 };
 int plant_command(const PlantCommandOptions& options);
 

@@ -23,6 +23,7 @@ int controller_command(const ControllerCommandOptions& o) {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;
+    refuse_faults_over_dds(sc);
     const sim::TickClock clock = sc.simulation.plant.clock;
     const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
     const double dt_s = static_cast<double>(control_period_ns) / 1e9;
@@ -67,13 +68,25 @@ int controller_command(const ControllerCommandOptions& o) {
       node.use_receipt_clock(steady_ns);
       const auto wall_period_ns =
           static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
+      // Until the first sensor sample arrives it commands nothing: a controller (re)started beside a
+      // flying plant must not send it the stale-data safety command before it has seen the vehicle.
+      // After that, Algorithm 1 as everywhere: stale data -> the safety command.
       std::int64_t next = steady_ns();
+      bool safety = false;
       while (!stop_requested()) {
         next += wall_period_ns;
         for (std::int64_t left; !stop_requested() && (left = next - steady_ns()) > 0;) transport.spin_once(left);
         const std::int64_t sim_now = node.newest_stamp_ns();
-        apply_schedule(sim_now < 0 ? 0 : sim_now);
-        node.step(steady_ns(), dt_s);
+        if (sim_now < 0) continue;
+        apply_schedule(sim_now);
+        const std::int64_t now = steady_ns();
+        if (node.step(now, dt_s).safety != safety) {
+          safety = !safety;
+          std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
+                                   safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
+                                   node.estimate().age_s, node.config().params.stale_limit_s,
+                                   static_cast<double>(now) / 1e9);
+        }
       }
     }
     std::cerr << "controller: stopped\n";

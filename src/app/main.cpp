@@ -45,6 +45,13 @@ int main(int argc, char** argv) {
                       "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
+  plant_cmd->add_option("--watchdog", plant.watchdog_s,
+                        "no valid motor command for this long [s] -> the watchdog policy (0: off; "
+                        "default: the scenario's simulation.watchdog_s, 0.5)")
+      ->check(CLI::Range(0.0, 1e6));
+  plant_cmd->add_option("--watchdog-policy", plant.watchdog_policy,
+                        "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
+      ->check(CLI::IsMember({"hold", "stop"}));
 
   ControllerCommandOptions ctl;
   auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");

@@ -14,6 +14,13 @@ io::Scenario scenario_or_defaults(const std::string& path, const std::string& ve
   return sc;
 }
 
+void refuse_faults_over_dds(const io::Scenario& sc) {
+  if (!sc.simulation.faults.active()) return;
+  throw io::ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) +
+                        ": faults: message loss and delay are injected by the in-process transport only "
+                        "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
+}
+
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics) {
   for (const auto* t : {&topics.pose, &topics.velocity, &topics.imu}) {
     transport.set_qos(*t, dds::QosProfile::sensor_data());

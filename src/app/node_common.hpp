@@ -25,6 +25,10 @@ inline std::int64_t steady_ns() {
 /// `vehicle_file` when given. Throws io::ConfigError.
 io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file);
 
+/// Throws io::ConfigError when the scenario asks for injected faults, which only the in-process
+/// transport can inject (over DDS, faults come from the network: tc netem, docs/reliability.md).
+void refuse_faults_over_dds(const io::Scenario& sc);
+
 /// ROS sensor-data QoS (KEEP_LAST 5, BEST_EFFORT) on the three sensor topics.
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics);
 

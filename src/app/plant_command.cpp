@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -52,6 +53,9 @@ class PlantProcess {
                                                           dds::parse_node_name(o_.schedule_node));
     }
     next_event_ = sc_.schedule.begin();
+    // Real time: the watchdog measures how long ago a command arrived on the wall clock, so a
+    // controller that dies is noticed within its limit however the ticks are paced.
+    if (!o_.lockstep) plant_.use_receipt_clock(steady_ns);
     announcer_.announce();  // `ros2 node list` shows /quadrotor_plant
     std::cerr << fmt::format("plant: domain {}, namespace {}, {} mode, {} ticks of {} s\n",
                              transport_.participant().domain_id(), sc_.simulation.ns,
@@ -75,9 +79,11 @@ class PlantProcess {
         pace_to_wall_clock();
       }
       plant_.latch_command(k);
+      log_watchdog(k);
       record(k);
       if (mcap_) mcap_->flush_settled(clock_.ns(k));
       if (k < sc_.simulation.duration_ticks) plant_.integrate(k);
+      ++ticks_run_;
     }
     finish(kExitOk);
     report();
@@ -167,20 +173,43 @@ class PlantProcess {
     return true;
   }
 
-  /// Real time: takes in messages until the wall clock reaches the next tick.
+  /// Real time: takes in messages until the wall clock reaches the next tick. Notes how late the
+  /// loop got there (a stalled loop, e.g. under a flood of messages, shows as lateness).
   void pace_to_wall_clock() {
-    next_wall_ns_ += static_cast<std::int64_t>(static_cast<double>(clock_.period_ns) / o_.rate_factor);
-    while (!stop_requested()) {
-      const std::int64_t left = next_wall_ns_ - steady_ns();
-      if (left <= 0) break;
-      transport_.spin_once(left);
+    const auto period = static_cast<std::int64_t>(static_cast<double>(clock_.period_ns) / o_.rate_factor);
+    next_wall_ns_ += period;
+    std::int64_t now = steady_ns();
+    while (!stop_requested() && now < next_wall_ns_) {
+      transport_.spin_once(next_wall_ns_ - now);
+      now = steady_ns();
+    }
+    const std::int64_t late = now - next_wall_ns_;
+    max_late_ns_ = std::max(max_late_ns_, late);
+    if (late > period) ++late_ticks_;
+  }
+
+  /// The watchdog's changes as events on stderr (simulated time, and the monotonic wall clock).
+  void log_watchdog(sim::Tick k) {
+    if (plant_.watchdog_active() == watchdog_logged_) return;
+    watchdog_logged_ = plant_.watchdog_active();
+    const double mono_s = static_cast<double>(steady_ns()) / 1e9;
+    if (watchdog_logged_) {
+      std::cerr << fmt::format("plant: watchdog: no valid motor command for {:.3f} s (limit {:g} s) at t = {:g} s "
+                               "(monotonic {:.6f} s); policy {}\n",
+                               static_cast<double>(plant_.command_age_ns()) / 1e9,
+                               clock_.seconds(plant_.options().watchdog_ticks), clock_.seconds(k), mono_s,
+                               sim::to_string(plant_.options().watchdog_policy));
+    } else {
+      std::cerr << fmt::format("plant: watchdog: valid motor commands again at t = {:g} s (monotonic {:.6f} s)\n",
+                               clock_.seconds(k), mono_s);
     }
   }
 
   void record(sim::Tick k) {
     if (!csv_) return;
     csv_->write(clock_.seconds(k), plant_.state(), plant_.applied_command(),
-                have_status_ ? io::ControlColumns::from(status_) : io::ControlColumns::none());
+                have_status_ ? io::ControlColumns::from(status_) : io::ControlColumns::none(),
+                plant_.watchdog_active());
   }
 
   /// Completes the recordings (also on the error paths, so what was recorded is readable).
@@ -213,6 +242,15 @@ class PlantProcess {
                              "rejected {}, stale {}\n",
                              sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
                              st.commands_stale);
+    std::cerr << fmt::format("plant: watchdog ({:g} s, policy {}) took over {} times for {} ticks\n",
+                             clock_.seconds(plant_.options().watchdog_ticks),
+                             sim::to_string(plant_.options().watchdog_policy), st.watchdog_trips, st.watchdog_ticks);
+    if (!o_.lockstep) {
+      std::cerr << fmt::format("plant: real-time pacing: {} ticks in {:.3f} s wall ({:.1f} ticks/s), max lateness "
+                               "{:.1f} ms, {} ticks more than one period late\n",
+                               ticks_run_, wall_s, static_cast<double>(ticks_run_) / wall_s,
+                               static_cast<double>(max_late_ns_) / 1e6, late_ticks_);
+    }
   }
 
   std::int64_t timeout_ns() const { return static_cast<std::int64_t>(o_.timeout_s * 1e9); }
@@ -234,6 +272,10 @@ class PlantProcess {
   bool waiting_ = true;  ///< lockstep: wait for each command (off after a timeout under hold)
   std::int64_t loop_start_ns_ = 0, next_wall_ns_ = 0;
   std::vector<std::int64_t> round_trip_ns_;  ///< lockstep: sensor publication -> command back
+  bool watchdog_logged_ = false;
+  std::int64_t ticks_run_ = 0;
+  std::int64_t max_late_ns_ = 0;  ///< real time: worst arrival of the loop after a tick's wall time
+  std::int64_t late_ticks_ = 0;   ///< real time: ticks reached more than one period late
 };
 
 }  // namespace
@@ -243,6 +285,20 @@ int plant_command(const PlantCommandOptions& o) {
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;
+    refuse_faults_over_dds(sc);
+    if (o.watchdog_s >= 0.0) {
+      const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
+      if (std::abs(ticks - std::round(ticks)) > 1e-6) {
+        std::cerr << fmt::format("error: --watchdog {:g}: expected a whole number of plant periods ({:g} s)\n",
+                                 o.watchdog_s, sc.simulation.plant.clock.period_s());
+        return 2;
+      }
+      sc.simulation.plant.watchdog_ticks = static_cast<sim::Tick>(std::round(ticks));
+    }
+    if (!o.watchdog_policy.empty()) {
+      sc.simulation.plant.watchdog_policy =
+          o.watchdog_policy == "hold" ? sim::WatchdogPolicy::kHold : sim::WatchdogPolicy::kStop;
+    }
     if (o.duration_s >= 0.0) {
       sc.simulation.duration_ticks =
           static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);

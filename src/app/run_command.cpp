@@ -124,6 +124,11 @@ int run_command(const RunOptions& opt) {
     fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
+      if (sc.simulation.faults.active()) {
+        std::cerr << "error: " << opt.scenario << ": faults: message loss and delay are injected by the "
+                     "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
+        return 2;
+      }
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
     } else {
       sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
@@ -132,10 +137,20 @@ int run_command(const RunOptions& opt) {
                             sim::Topics::for_namespace(sc.simulation.ns));
       install_stop_handlers();
       Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
+      bool watchdog = false;
       try {
         simulation.run([&](const sim::TickRecord& r) {
           const io::ControlColumns c = io::ControlColumns::from(r.status);
-          csv.write(r.t_s, r.state, r.applied_command, c);
+          const sim::PlantNode& plant = simulation.plant();
+          if (plant.watchdog_active() != watchdog) {
+            watchdog = plant.watchdog_active();
+            std::cerr << (watchdog ? fmt::format("run: plant watchdog: no valid motor command for {:g} s at t = {:g} s; "
+                                                 "policy {}\n",
+                                                 static_cast<double>(plant.command_age_ns()) / 1e9, r.t_s,
+                                                 sim::to_string(plant.options().watchdog_policy))
+                                   : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
+          }
+          csv.write(r.t_s, r.state, r.applied_command, c, watchdog);
           mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
           progress.update(r.t_s);
           if (stop_requested()) throw Interrupted{};
@@ -152,6 +167,17 @@ int run_command(const RunOptions& opt) {
       csv.close();
       mcap.close();
       mcap.write_bag_metadata(out.string(), "run.mcap");
+      const auto& st = simulation.plant().stats();
+      if (st.watchdog_trips > 0) {
+        std::cout << fmt::format("plant watchdog took over {} times, for {} ticks\n", st.watchdog_trips,
+                                 st.watchdog_ticks);
+      }
+      const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
+      if (sc.simulation.faults.active()) {
+        std::cout << fmt::format("injected faults dropped: {} motor commands, {} Pose, {} Velocity, {} Imu\n",
+                                 simulation.dropped(topics.motor_commands), simulation.dropped(topics.pose),
+                                 simulation.dropped(topics.velocity), simulation.dropped(topics.imu));
+      }
       if (simulation.plant().stats().commands_rejected > 0) {
         std::cout << fmt::format("plant rejected {} of {} motor commands\n",
                                  simulation.plant().stats().commands_rejected,

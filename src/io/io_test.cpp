@@ -513,7 +513,8 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
       ControlColumns c{a(1), a(2), a(3), a(4), a(5), a(6), Eigen::Vector4d(a(7), a(8), a(9), a(10)),
                        k % 2 == 1};
       const double t = static_cast<double>(k) * 1e7 / 1e9;
-      w.write(t, x, cmd, c);
+      const bool watchdog = k % 3 == 0;
+      w.write(t, x, cmd, c, watchdog);
       const model::Euler e = model::euler_from_quaternion(x.q_WB);
       expected.push_back({t,          x.p_W.x(),      x.p_W.y(),      x.p_W.z(),      x.v_W.x(),
                           x.v_W.y(),  x.v_W.z(),      x.q_WB.w(),     x.q_WB.x(),     x.q_WB.y(),
@@ -522,7 +523,7 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
                           x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3],
                           c.x_des,    c.y_des,        c.z_des,        c.roll_des,     c.pitch_des,
                           c.yaw_des,  c.U[0],         c.U[1],         c.U[2],         c.U[3],
-                          c.safety ? 1.0 : 0.0});
+                          c.safety ? 1.0 : 0.0, watchdog ? 1.0 : 0.0});
     }
     w.close();
   }

@@ -124,7 +124,43 @@ void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duratio
   cfg.duration_ticks = tick_at(s, "duration_s", duration_s, cfg.plant.clock.period_ns);
   cfg.ns = s.text("namespace", cfg.ns);
   if (std::string err = sim::validate_namespace(cfg.ns); !err.empty()) s.fail("namespace", err);
+  const double watchdog_s = s.number("watchdog_s", 0.5, 0.0, 1e6);
+  cfg.plant.watchdog_ticks = tick_at(s, "watchdog_s", watchdog_s, cfg.plant.clock.period_ns);
+  cfg.plant.watchdog_policy = s.choice("watchdog_policy", "stop", {"hold", "stop"}) == "hold"
+                                  ? sim::WatchdogPolicy::kHold
+                                  : sim::WatchdogPolicy::kStop;
   s.reject_unknown_keys();
+}
+
+// `faults:` message loss and delay injected by the in-process transport. Defaults apply to the
+// four topics between plant and controller (Pose, Velocity, Imu, motor_commands); `topics:` sets
+// any of the vehicle's topics by its name within the namespace.
+void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultConfig& out) {
+  out.seed = static_cast<std::uint64_t>(f.integer("seed", 1, 0, 9007199254740991LL));
+  sim::TopicFaults all;
+  all.drop_probability = f.number("drop_probability", 0.0, 0.0, 1.0);
+  all.delay_ticks = f.integer("delay_ticks", 0, 0, 100000);
+  const sim::Topics t = sim::Topics::for_namespace(cfg.ns);
+  const std::map<std::string, std::string> by_name = {
+      {"motor_commands", t.motor_commands}, {"Pose", t.pose},   {"Velocity", t.velocity},
+      {"Imu", t.imu},                       {"clock", t.clock}, {"controller_status", t.controller_status}};
+  for (const std::string* name : {&t.pose, &t.velocity, &t.imu, &t.motor_commands}) out.topics[*name] = all;
+  if (auto per = f.section("topics")) {
+    for (const std::string& key : per->keys()) {
+      const auto it = by_name.find(key);
+      if (it == by_name.end()) {
+        per->fail(key, "unknown topic; expected motor_commands, Pose, Velocity, Imu, clock or controller_status");
+      }
+      auto one = per->section(key);
+      if (!one) per->fail(key, "expected a mapping with drop_probability and/or delay_ticks");
+      sim::TopicFaults tf = out.topics.count(it->second) ? out.topics[it->second] : sim::TopicFaults{};
+      tf.drop_probability = one->number("drop_probability", tf.drop_probability, 0.0, 1.0);
+      tf.delay_ticks = one->integer("delay_ticks", tf.delay_ticks, 0, 100000);
+      one->reject_unknown_keys();
+      out.topics[it->second] = tf;
+    }
+  }
+  f.reject_unknown_keys();
 }
 
 void read_steps(YamlSection& analysis, std::vector<StepSpec>& steps, double duration_s) {
@@ -219,6 +255,8 @@ Scenario load_scenario(const std::string& path) {
       !err.empty()) {
     root.fail("simulation.substeps", err);
   }
+
+  if (auto f = root.section("faults")) read_faults(*f, sc.simulation, sc.simulation.faults);
 
   if (auto i = root.section("initial")) {
     const auto p = i->numbers("position_m", {0.0, 0.0, 0.0}, 3);

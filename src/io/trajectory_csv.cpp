@@ -27,7 +27,8 @@ const std::vector<std::string>& TrajectoryWriter::columns() {
       "t",     "x",      "y",       "z",       "vx",       "vy",       "vz",   "qw",  "qx",
       "qy",    "qz",     "roll",    "pitch",   "yaw",      "p",        "q",    "r",   "w1",
       "w2",    "w3",     "w4",      "cmd1",    "cmd2",     "cmd3",     "cmd4", "x_des", "y_des",
-      "z_des", "roll_des", "pitch_des", "yaw_des", "U1",   "U2",       "U3",   "U4",  "safety"};
+      "z_des", "roll_des", "pitch_des", "yaw_des", "U1",   "U2",       "U3",   "U4",  "safety",
+      "watchdog"};
   return c;
 }
 
@@ -48,7 +49,7 @@ TrajectoryWriter::~TrajectoryWriter() {
 }
 
 void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vector4d& cmd,
-                             const ControlColumns& c) {
+                             const ControlColumns& c, bool watchdog) {
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   auto out = std::back_inserter(buffer_);
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},", t, x.p_W.x(), x.p_W.y(),
@@ -56,8 +57,8 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
                  x.q_WB.z(), e.roll_rad, e.pitch_rad, e.yaw_rad, x.w_B.x(), x.w_B.y(), x.w_B.z());
   fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1],
                  x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
-  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{}\n", c.x_des, c.y_des, c.z_des, c.roll_des,
-                 c.pitch_des, c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0);
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{}\n", c.x_des, c.y_des, c.z_des, c.roll_des,
+                 c.pitch_des, c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
   if (buffer_.size() > (1 << 16)) {
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     buffer_.clear();

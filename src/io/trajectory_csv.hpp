@@ -32,8 +32,10 @@ class TrajectoryWriter {
 
   static const std::vector<std::string>& columns();
 
-  /// `command` is the rotor command acting over the next interval [rad/s].
-  void write(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c);
+  /// `command` is the rotor command acting over the next interval [rad/s]; `watchdog`: the plant's
+  /// watchdog set it (no valid command for its limit).
+  void write(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
+             bool watchdog = false);
   /// Flushes and closes; throws std::runtime_error on a write error.
   void close();
 

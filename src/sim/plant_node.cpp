@@ -1,5 +1,6 @@
 #include "sim/plant_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace quadcosim::sim {
@@ -8,6 +9,8 @@ namespace {
 msg::Vector3 to_msg(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 }  // namespace
+
+std::string to_string(WatchdogPolicy p) { return p == WatchdogPolicy::kHold ? "hold" : "stop"; }
 
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
@@ -34,6 +37,8 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     return;
   }
   last_command_stamp_ns_ = stamp;
+  last_valid_tick_ = current_tick_;
+  if (receipt_clock_) last_valid_receipt_ns_ = receipt_clock_();
   pending_.push_back({current_tick_ + options_.command_delay_ticks,
                       model::Vector4(m.data[0], m.data[1], m.data[2], m.data[3])});
 }
@@ -70,6 +75,22 @@ void PlantNode::latch_command(Tick k) {
   while (!pending_.empty() && pending_.front().effective_tick <= k) {
     applied_ = pending_.front().omega;
     pending_.pop_front();
+  }
+  if (options_.watchdog_ticks <= 0) return;
+  if (receipt_clock_) {
+    const std::int64_t now = receipt_clock_();
+    if (last_valid_receipt_ns_ < 0) last_valid_receipt_ns_ = now;  // the limit runs from the first tick
+    command_age_ns_ = now - last_valid_receipt_ns_;
+  } else {
+    command_age_ns_ = options_.clock.ns(k - std::min(last_valid_tick_, k));
+  }
+  const bool expired = command_age_ns_ >= options_.clock.ns(options_.watchdog_ticks);
+  if (expired && !watchdog_active_) ++stats_.watchdog_trips;
+  watchdog_active_ = expired;
+  if (!expired) return;
+  ++stats_.watchdog_ticks;
+  if (options_.watchdog_policy == WatchdogPolicy::kStop) {
+    applied_.setConstant(model_.params().motor.omega_min_rad_s);
   }
 }
 

@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <string>
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
@@ -13,6 +15,13 @@
 
 namespace quadcosim::sim {
 
+/// What the plant does with its motors when no valid command has arrived for the watchdog limit.
+enum class WatchdogPolicy {
+  kHold,  ///< keep the last valid command
+  kStop,  ///< all motors to the vehicle's omega_min_rad_s (0 by default: the motors stop)
+};
+std::string to_string(WatchdogPolicy p);
+
 struct PlantOptions {
   TickClock clock;
   int substeps = 1;              ///< RK4 steps per plant tick
@@ -21,12 +30,19 @@ struct PlantOptions {
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
   /// (a repeat) and is dropped instead of overriding the current one.
   bool drop_stale_commands = false;
+  /// Watchdog limit [ticks]: when no valid command has been received for this long, the policy
+  /// acts until one arrives. 0 switches the watchdog off. Measured in simulated ticks, or on the
+  /// receipt clock after use_receipt_clock().
+  Tick watchdog_ticks = 50;
+  WatchdogPolicy watchdog_policy = WatchdogPolicy::kStop;
 };
 
 struct PlantStats {
   std::uint64_t commands_received = 0;
   std::uint64_t commands_rejected = 0;  ///< wrong length or non-finite: ignored, last good one held
   std::uint64_t commands_stale = 0;     ///< lockstep repeats of an earlier tick's command, dropped
+  std::uint64_t watchdog_trips = 0;     ///< times the watchdog took over (no valid command for its limit)
+  std::uint64_t watchdog_ticks = 0;     ///< ticks latched under the watchdog's policy
 };
 
 class PlantNode {
@@ -38,6 +54,13 @@ class PlantNode {
   void publish_outputs(Tick k);
   /// Fixes the command that acts over [t_k, t_k+1): the newest one whose delay has elapsed.
   void latch_command(Tick k);
+  /// Real time: measure the watchdog on `clock` [ns] (when commands arrive) instead of in ticks, so a
+  /// controller that stops is noticed whatever the plant's simulated time does.
+  void use_receipt_clock(std::function<std::int64_t()> clock) { receipt_clock_ = std::move(clock); }
+  /// True while the watchdog's policy sets the latched command (since the last latch_command).
+  bool watchdog_active() const { return watchdog_active_; }
+  /// Time [ns] without a valid command at the last latch_command (ticks * period, or receipt clock).
+  std::int64_t command_age_ns() const { return command_age_ns_; }
   /// Integrates the state from t_k to t_k+1 under the latched command.
   void integrate(Tick k);
 
@@ -66,6 +89,11 @@ class PlantNode {
   };
   std::deque<Pending> pending_;
   PlantStats stats_;
+  std::function<std::int64_t()> receipt_clock_;
+  Tick last_valid_tick_ = 0;           ///< tick during which the newest valid command arrived
+  std::int64_t last_valid_receipt_ns_ = -1;  ///< receipt clock: its arrival (-1: none, from the first latch)
+  std::int64_t command_age_ns_ = 0;
+  bool watchdog_active_ = false;
   Publisher<msg::Clock> clock_pub_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;

@@ -12,6 +12,7 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
       plant_(transport_, Topics::for_namespace(config.ns), vehicle, config.plant, initial),
       controller_(transport_, Topics::for_namespace(config.ns), controller),
       schedule_(std::move(schedule)) {
+  transport_.set_faults(config.faults);
   transport_.subscribe<msg::ControllerStatus>(
       Topics::for_namespace(config.ns).controller_status,
       [this](const msg::ControllerStatus& m) { status_ = m; });
@@ -24,6 +25,7 @@ void Simulation::run(const std::function<void(const TickRecord&)>& on_tick) {
   const double control_dt_s = clock.period_s() * config_.controller_divider;
   auto next_event = schedule_.begin();
   for (Tick k = 0; k <= config_.duration_ticks; ++k) {
+    transport_.advance_to(k);
     for (; next_event != schedule_.end() && next_event->tick <= k; ++next_event) {
       if (std::string err = controller_.set_parameter(next_event->name, next_event->value); !err.empty()) {
         throw std::invalid_argument("scheduled parameter at t=" + std::to_string(clock.seconds(k)) +

@@ -2,6 +2,7 @@
 // transport, driven by the integer-tick multi-rate scheduler.
 //
 // Per plant tick k (time t_k = k * period):
+//   0. messages held back by injected delays (SimulationConfig::faults) and due by tick k arrive;
 //   1. scheduled parameter changes due at t_k are applied to the controller;
 //   2. the plant publishes /clock, Pose, Velocity, Imu for x(t_k);
 //   3. on every `controller_divider`-th tick the controller steps and publishes a command;
@@ -19,6 +20,7 @@
 #include "control/parameters.hpp"
 #include "sim/clock.hpp"
 #include "sim/controller_node.hpp"
+#include "sim/faults.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
 
@@ -35,6 +37,7 @@ struct SimulationConfig {
   int controller_divider = 2;  ///< controller period = divider * plant period
   Tick duration_ticks = 1500;  ///< last recorded tick
   std::string ns = "/drone";
+  FaultConfig faults;  ///< injected message loss and delay (in-process only; none by default)
 };
 
 /// One recorded tick.
@@ -59,6 +62,8 @@ class Simulation {
   const PlantNode& plant() const { return plant_; }
   /// The bus the nodes talk on, for observers such as recorders (subscribe before run()).
   Transport& transport() { return transport_; }
+  /// Messages lost to injected faults on `topic` so far.
+  std::uint64_t dropped(const std::string& topic) const { return transport_.dropped(topic); }
   const ControllerNode& controller() const { return controller_; }
 
  private:

@@ -10,15 +10,20 @@
 
 namespace quadcosim::sim {
 
-/// A message type as a transport sees it: its ROS 2 type name and its C++ identity.
+/// A message type as a transport sees it: its ROS 2 type name, its C++ identity, and how to copy
+/// one (for a transport that holds messages back, e.g. to delay them).
 struct TopicType {
   std::string_view ros_type;  ///< e.g. "geometry_msgs/msg/PoseStamped"
   std::type_index cpp_type;
+  std::shared_ptr<const void> (*clone)(const void* message);
 };
 
 template <class T>
 TopicType topic_type() {
-  return {T::kRosType, std::type_index(typeid(T))};
+  return {T::kRosType, std::type_index(typeid(T)),
+          [](const void* m) -> std::shared_ptr<const void> {
+            return std::make_shared<const T>(*static_cast<const T*>(m));
+          }};
 }
 
 class Transport;
