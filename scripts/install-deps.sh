@@ -9,6 +9,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
+  iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)
 )
 

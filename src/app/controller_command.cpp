@@ -68,16 +68,22 @@ int controller_command(const ControllerCommandOptions& o) {
       node.use_receipt_clock(steady_ns);
       const auto wall_period_ns =
           static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
-      // Until the first sensor sample arrives it commands nothing: a controller (re)started beside a
-      // flying plant must not send it the stale-data safety command before it has seen the vehicle.
-      // After that, Algorithm 1 as everywhere: stale data -> the safety command.
+      // Until the first complete sensor sample (Pose, Velocity and Imu of one tick) arrives it
+      // commands nothing: a controller (re)started beside a flying plant must not send it the
+      // stale-data safety command before it has seen the vehicle. After that, Algorithm 1 as
+      // everywhere: stale data -> the safety command.
       std::int64_t next = steady_ns();
-      bool safety = false;
+      bool seen_vehicle = false, safety = false;
       while (!stop_requested()) {
         next += wall_period_ns;
         for (std::int64_t left; !stop_requested() && (left = next - steady_ns()) > 0;) transport.spin_once(left);
+        if (!seen_vehicle) {
+          if (node.synchronized_stamp_ns() < 0) continue;
+          seen_vehicle = true;
+          std::cerr << fmt::format("controller: first complete sensor sample (t = {:g} s); controlling\n",
+                                   static_cast<double>(node.synchronized_stamp_ns()) / 1e9);
+        }
         const std::int64_t sim_now = node.newest_stamp_ns();
-        if (sim_now < 0) continue;
         apply_schedule(sim_now);
         const std::int64_t now = steady_ns();
         if (node.step(now, dt_s).safety != safety) {
