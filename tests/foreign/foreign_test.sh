@@ -16,7 +16,7 @@
 #    makes z'' = (kp (2 - z) - kd z')/m: wn = 1.43 rad/s, zeta = 0.48, overshoot 18 % (peak 2.36 m at
 #    2.5 s), |z - 2| < 0.08 m after 4 s. At >= 2.5 s of driving (the count bound) the last thrust
 #    error is <= 0.74 m/s^2 of specific force, and after the foreign node stops the plant holds its
-#    last command: simulating drive windows from 2 to 5.4 s with the rest held gives z(6 s) in
+#    last command (watchdog policy hold): simulating drive windows from 2 to 5.4 s with the rest held gives z(6 s) in
 #    [1.5, 2.13] m. Hence: final z in [1.0, 3.0], the highest z <= 3.0 (peak 2.36), and z is 0 up to
 #    the first applied foreign command (on the ground, rotors stopped: nobody else commands them).
 #  - Imu linear_acceleration.z at the last sample = thrust/m (level attitude, equal rotors):
@@ -60,7 +60,9 @@ wait_for() {
   return "$rc"
 }
 
-"$bin" plant --realtime --duration 6 --record "$tmp/plant.csv" > "$tmp/plant.log" 2>&1 &
+# --watchdog-policy hold: the plant keeps the foreign node's last command after it stops (the
+# default watchdog would stop the motors 0.5 s later; docs/reliability.md).
+"$bin" plant --realtime --duration 6 --watchdog-policy hold --record "$tmp/plant.csv" > "$tmp/plant.log" 2>&1 &
 plant_pid=$!; pids+=("$plant_pid")
 "$foreign" 5 > "$tmp/foreign.json" 2> "$tmp/foreign.log" &
 foreign_pid=$!; pids+=("$foreign_pid")
