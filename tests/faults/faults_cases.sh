@@ -289,6 +289,32 @@ assert wd == 0, wd
 PY
     ;;
 
+  bad_input)  # the new flags and keys refuse what they cannot do, naming it, with exit 2
+    expect_2() {  # expect_2 WHAT TEXT COMMAND...
+      local what="$1" text="$2"; shift 2
+      set +e
+      "$@" > "$tmp/bad.log" 2>&1
+      local rc=$?
+      set -e
+      [ "$rc" -eq 2 ] || fail "$what: expected exit 2, got $rc"
+      grep -q -- "$text" "$tmp/bad.log" || fail "$what: message lacks '$text': $(cat "$tmp/bad.log")"
+    }
+    expect_2 "--watchdog off the tick grid" "--watchdog 0.015: expected a whole number of plant periods" \
+      "$bin" plant --watchdog 0.015
+    printf 'simulation: {duration_s: 1}\nfaults: {drop_probability: 0.1}\n' > "$tmp/lossy.yaml"
+    expect_2 "faults over DDS (run)" "injected by the in-process transport only" \
+      "$bin" run "$tmp/lossy.yaml" --out "$tmp/r" --no-plots --transport dds
+    expect_2 "faults over DDS (plant)" "faults: message loss and delay are injected by the in-process" \
+      "$bin" plant --scenario "$tmp/lossy.yaml"
+    expect_2 "faults over DDS (controller)" "faults: message loss and delay are injected by the in-process" \
+      "$bin" controller --scenario "$tmp/lossy.yaml"
+    printf 'simulation: {watchdog_policy: land}\n' > "$tmp/policy.yaml"
+    expect_2 "unknown policy in a scenario" "simulation.watchdog_policy" "$bin" plant --scenario "$tmp/policy.yaml"
+    # In-process the same scenario runs, and says what the faults did.
+    "$bin" run "$tmp/lossy.yaml" --out "$tmp/r" --no-plots > "$tmp/run.log" 2>&1 || fail "in-process run with faults"
+    grep -q "injected faults dropped: [0-9]* motor commands" "$tmp/run.log" || fail "no fault counts printed"
+    ;;
+
   *) fail "unknown case" ;;
 esac
 echo "PASS [$case_name]"
