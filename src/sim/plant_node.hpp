@@ -59,7 +59,8 @@ class PlantNode {
 
   const model::State& state() const { return state_; }
   const model::Quadrotor& model() const { return model_; }
-  /// The command latched for the current interval, as received (before the model's clamping).
+  /// The command latched for the current interval, as received after validate_command (speeds within
+  /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& applied_command() const { return applied_; }
   const PlantStats& stats() const { return stats_; }
   /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet).
