@@ -12,98 +12,37 @@
 // the real traffic. After every record the loop advances one plant tick (the controller every
 // second). Checked after every tick: the plant state is finite, and every motor command the
 // controller sends is four finite speeds.
-#include <dds/dds.h>
-#include <dds/ddsi/ddsi_serdata.h>
-#include <dds/ddsi/ddsi_sertype.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
-#include <functional>
 #include <memory>
-#include <vector>
 
-#include "dds/participant.hpp"
 #include "dds/ros_types.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
+#include "cyclone_bytes.hpp"
 
 namespace {
 
 using namespace quadcosim;
 
-// One incoming type: a topic on a participant without discovery, and the sertype Cyclone uses to
-// read samples of it.
-struct IncomingType {
-  const dds::TypeOps* ops = nullptr;
-  const ddsi_sertype* sertype = nullptr;
-  ddsi_serdata* keep = nullptr;  // holds a reference on the sertype for the life of the process
-};
-
-template <class T>
-IncomingType incoming(const dds::Participant& p, const char* topic_name) {
-  IncomingType t;
-  t.ops = dds::type_ops(typeid(T));
-  const dds_entity_t topic =
-      dds::check(dds_create_topic(p.handle(), t.ops->descriptor, topic_name, nullptr, nullptr), "dds_create_topic");
-  dds_qos_t* qos = dds::ros_qos(10, true);
-  const dds_entity_t reader = dds::check(dds_create_reader(p.handle(), topic, qos, nullptr), "dds_create_reader");
-  const dds_entity_t writer = dds::check(dds_create_writer(p.handle(), topic, qos, nullptr), "dds_create_writer");
-  dds_delete_qos(qos);
-  // One sample written and taken as serialized data gives the sertype (the public way in 0.10).
-  const T sample{};
-  dds::check(t.ops->write(writer, &sample), "dds_write");
-  dds_sample_info_t info;
-  if (dds_takecdr(reader, &t.keep, 1, &info, DDS_ANY_STATE) != 1) {
-    std::fprintf(stderr, "fuzz_messages: no local sample on %s\n", topic_name);
-    std::abort();
-  }
-  t.sertype = t.keep->type;
-  return t;
-}
-
+// The four incoming types, each with the topic Cyclone reads it on and our type adapter.
 struct Setup {
-  std::unique_ptr<dds::Participant> participant;
-  IncomingType types[4];
-
-  Setup() {
-    dds::RosEnvironment env;
-    env.range = dds::DiscoveryRange::kOff;  // nothing leaves the process
-    if (const char* id = std::getenv("ROS_DOMAIN_ID")) env.domain_id = static_cast<std::uint32_t>(std::atoi(id));
-    participant = std::make_unique<dds::Participant>(env);
-    types[0] = incoming<msg::Float64MultiArray>(*participant, "rt/fuzz/motor_commands");
-    types[1] = incoming<msg::PoseStamped>(*participant, "rt/fuzz/Pose");
-    types[2] = incoming<msg::TwistStamped>(*participant, "rt/fuzz/Velocity");
-    types[3] = incoming<msg::Imu>(*participant, "rt/fuzz/Imu");
-  }
+  std::unique_ptr<dds::Participant> participant = fuzz::isolated_participant();
+  const dds::TypeOps* ops[4] = {dds::type_ops(typeid(msg::Float64MultiArray)), dds::type_ops(typeid(msg::PoseStamped)),
+                                dds::type_ops(typeid(msg::TwistStamped)), dds::type_ops(typeid(msg::Imu))};
+  fuzz::LocalTopic topics[4] = {{*participant, ops[0]->descriptor, "rt/fuzz/motor_commands"},
+                                {*participant, ops[1]->descriptor, "rt/fuzz/Pose"},
+                                {*participant, ops[2]->descriptor, "rt/fuzz/Velocity"},
+                                {*participant, ops[3]->descriptor, "rt/fuzz/Imu"}};
 };
 
 const Setup& setup() {
-  static const Setup s;  // process-wide, created on the first input
+  static const Setup s;  // process-wide, made on the first input
   return s;
-}
-
-// Decodes `bytes` as Cyclone would and hands the message (as a pointer to the C++ struct) to `to`;
-// false when Cyclone refuses the bytes.
-bool decode(const IncomingType& t, const std::uint8_t* bytes, std::size_t size,
-            const std::function<void(const void*)>& to) {
-  ddsrt_iovec_t iov;
-  iov.iov_base = const_cast<std::uint8_t*>(bytes);
-  iov.iov_len = static_cast<ddsrt_iov_len_t>(size);
-  ddsi_serdata* sd = ddsi_serdata_from_ser_iov(t.sertype, SDK_DATA, 1, &iov, size);
-  if (!sd) return false;
-  std::vector<std::max_align_t> storage(t.ops->descriptor->m_size / sizeof(std::max_align_t) + 1);
-  void* sample = storage.data();
-  ddsi_sertype_zero_sample(t.sertype, sample);
-  const bool ok = ddsi_serdata_to_sample(sd, sample, nullptr, nullptr);
-  if (ok) t.ops->deliver(sample, to);
-  ddsi_sertype_free_sample(t.sertype, sample, DDS_FREE_CONTENTS);
-  ddsi_serdata_unref(sd);
-  return ok;
 }
 
 bool finite(const model::State& x) {
@@ -133,7 +72,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   sim::PlantNode plant(bus, topics, config.params.vehicle, {}, x0);
   plant.set_log([](const std::string&) {});
 
-  bool bad_command = false;
   auto inject_command = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
   auto inject_pose = bus.advertise<msg::PoseStamped>(topics.pose);
   auto inject_velocity = bus.advertise<msg::TwistStamped>(topics.velocity);
@@ -141,34 +79,29 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   const double period_s = 0.01;
   sim::Tick k = 0;
-  std::size_t at = 0;
-  while (at < size && k < 256) {
-    const int kind = data[at] % 4;
-    std::size_t len = 0;
-    if (at + 3 <= size) len = data[at + 1] | (std::size_t{data[at + 2]} << 8);
-    at = std::min(size, at + 3);
-    len = std::min(len, size - at);
-    const std::uint8_t* bytes = data + at;
-    at += len;
-
+  fuzz::for_each_record(data, size, 256, [&](int record_kind, const std::uint8_t* bytes, std::size_t len) {
+    const int kind = record_kind % 4;
     plant.publish_outputs(k);  // the real sensor data of tick k
-    decode(s.types[kind], bytes, len, [&](const void* m) {
-      switch (kind) {
-        case 0: inject_command.publish(*static_cast<const msg::Float64MultiArray*>(m)); break;
-        case 1: inject_pose.publish(*static_cast<const msg::PoseStamped*>(m)); break;
-        case 2: inject_velocity.publish(*static_cast<const msg::TwistStamped*>(m)); break;
-        case 3: inject_imu.publish(*static_cast<const msg::Imu*>(m)); break;
-      }
+    s.topics[kind].with_sample(bytes, len, [&](const void* c_sample) {
+      s.ops[kind]->deliver(c_sample, [&](const void* m) {
+        switch (kind) {
+          case 0: inject_command.publish(*static_cast<const msg::Float64MultiArray*>(m)); break;
+          case 1: inject_pose.publish(*static_cast<const msg::PoseStamped*>(m)); break;
+          case 2: inject_velocity.publish(*static_cast<const msg::TwistStamped*>(m)); break;
+          case 3: inject_imu.publish(*static_cast<const msg::Imu*>(m)); break;
+        }
+      });
     });
     if (k % 2 == 0) {
       const control::Command& c = controller.step(k * 10'000'000, 2 * period_s);
-      for (int i = 0; i < 4; ++i) bad_command = bad_command || !std::isfinite(c.omega_rad_s[i]);
-      if (bad_command) fail("the controller sent a non-finite rotor speed", k);
+      for (int i = 0; i < 4; ++i) {
+        if (!std::isfinite(c.omega_rad_s[i])) fail("the controller sent a non-finite rotor speed", k);
+      }
     }
     plant.latch_command(k);
     plant.integrate(k);
     if (!finite(plant.state())) fail("the plant state is not finite", k);
     ++k;
-  }
+  });
   return 0;
 }

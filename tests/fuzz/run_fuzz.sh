@@ -2,19 +2,20 @@
 # Runs every libFuzzer target for a bounded time on its committed corpus (which replays every seed
 # and every regression input first), without changing the corpus. Exits 1 on the first crash, leak,
 # sanitizer report, timeout or failed check, and prints the reproducer.
-#   usage: run_fuzz.sh FUZZ_BIN_DIR SOURCE_DIR [SECONDS_PER_TARGET]   (default: $QUADCOSIM_FUZZ_SECONDS or 30)
+#   usage: run_fuzz.sh FUZZ_BIN_DIR SOURCE_DIR [SECONDS_PER_TARGET]   (default: $QUADCOSIM_FUZZ_SECONDS or 20)
 set -euo pipefail
-bin="$1"; src="$2"; seconds="${3:-${QUADCOSIM_FUZZ_SECONDS:-30}}"
+bin="$1"; src="$2"; seconds="${3:-${QUADCOSIM_FUZZ_SECONDS:-20}}"
 artifacts="$bin/artifacts"
 mkdir -p "$artifacts"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-# fuzz_messages opens a DDS participant without discovery; a domain id of the test range all the same.
+# fuzz_messages and fuzz_parameters open a DDS participant without discovery; a domain id of the
+# test range all the same.
 export ROS_DOMAIN_ID=$((165 + ${QUADCOSIM_TEST_DOMAIN_OFFSET:-0})) ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
 export ASAN_OPTIONS="${ASAN_OPTIONS:-abort_on_error=1}" UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
 
-for target in fuzz_config fuzz_messages; do
+for target in fuzz_config fuzz_messages fuzz_parameters; do
   corpus="$src/tests/fuzz/corpus/$target"
   mkdir -p "$work/$target"
   dict=()
