@@ -16,19 +16,19 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
   transport.subscribe<msg::PoseStamped>(topics.pose, [this, topic = topics.pose](const msg::PoseStamped& m) {
-    if (!accept(validate_pose(m, pose_stamp_ns_), topic)) return;
+    if (!accept(validate_pose(m, pose_stamp_ns_), topic, pose_backwards_)) return;
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
-    if (!accept(validate_velocity(m, velocity_stamp_ns_), topic)) return;
+    if (!accept(validate_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) return;
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
   });
   transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
-    if (!accept(validate_imu(m, imu_stamp_ns_), topic)) return;
+    if (!accept(validate_imu(m, imu_stamp_ns_), topic, imu_backwards_)) return;
     const Eigen::Quaterniond q(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
     const model::Euler e = model::euler_from_quaternion(q);
     estimate_.roll_rad = e.roll_rad;
@@ -40,8 +40,18 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   });
 }
 
-bool ControllerNode::accept(const SensorCheck& check, const std::string& topic) {
-  if (check.ok()) return true;
+bool ControllerNode::accept(const SensorCheck& check, const std::string& topic, int& backwards) {
+  if (check.ok()) {
+    backwards = 0;
+    return true;
+  }
+  if (check.fault == SensorFault::kStampBackwards && ++backwards > kStampRestartCount) {
+    log_("controller: " + topic + ": " + std::to_string(kStampRestartCount) +
+         " samples in a row older than the newest accepted; taking it that the sender's clock restarted (" +
+         check.reason + ")");
+    backwards = 0;
+    return true;
+  }
   LogThrottle& counter = fault_log_[static_cast<int>(check.fault)];
   if (counter.count()) {
     log_("controller: " + topic + " message rejected, " + to_string(check.fault) + " (" + check.reason + "); " +

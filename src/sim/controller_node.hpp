@@ -67,8 +67,10 @@ class ControllerNode {
  private:
   static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
 
-  /// Counts and logs a refused message on `topic`; false when `check` refused it.
-  bool accept(const SensorCheck& check, const std::string& topic);
+  /// Counts and logs a refused message on `topic`; false when `check` refused it. `backwards`: the
+  /// topic's run of well-formed samples refused as older than the newest (kStampRestartCount of them
+  /// in a row: the sender's clock restarted, and the sample is accepted).
+  bool accept(const SensorCheck& check, const std::string& topic, int& backwards);
 
   control::ControllerConfig config_;
   control::FlightController controller_;
@@ -84,6 +86,7 @@ class ControllerNode {
   msg::ControllerStatus status_;
   std::function<void(const std::string&)> log_;
   std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing
+  int pose_backwards_ = 0, velocity_backwards_ = 0, imu_backwards_ = 0;
   Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;
   msg::Float64MultiArray command_msg_;

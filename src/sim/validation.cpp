@@ -96,22 +96,22 @@ const char* to_string(SensorFault f) {
 }
 
 SensorCheck validate_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
-  return first_fault([&] { return check_stamp(m.header.stamp, last_stamp_ns); },
-                     [&] { return check_vector("position", m.position); },
-                     [&] { return check_orientation(m.orientation); });
+  return first_fault([&] { return check_vector("position", m.position); },
+                     [&] { return check_orientation(m.orientation); },
+                     [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
 }
 
 SensorCheck validate_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
-  return first_fault([&] { return check_stamp(m.header.stamp, last_stamp_ns); },
-                     [&] { return check_vector("linear", m.linear); },
-                     [&] { return check_vector("angular", m.angular); });
+  return first_fault([&] { return check_vector("linear", m.linear); },
+                     [&] { return check_vector("angular", m.angular); },
+                     [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
 }
 
 SensorCheck validate_imu(const msg::Imu& m, std::int64_t last_stamp_ns) {
-  return first_fault([&] { return check_stamp(m.header.stamp, last_stamp_ns); },
-                     [&] { return check_orientation(m.orientation); },
+  return first_fault([&] { return check_orientation(m.orientation); },
                      [&] { return check_vector("angular_velocity", m.angular_velocity); },
-                     [&] { return check_vector("linear_acceleration", m.linear_acceleration); });
+                     [&] { return check_vector("linear_acceleration", m.linear_acceleration); },
+                     [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
 }
 
 }  // namespace quadcosim::sim

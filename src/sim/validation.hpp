@@ -59,11 +59,19 @@ struct SensorCheck {
 
 /// `last_stamp_ns`: the newest stamp [ns] accepted on this topic, or INT64_MIN before any. A stamp
 /// equal to it is accepted (a lockstep peer may repeat a tick's sample); an older one is refused.
+/// The content is checked first: kStampBackwards means a well-formed sample that is only too old.
 /// Checked: stamp, position and orientation (Pose); stamp, linear and angular (Velocity); stamp,
 /// orientation, angular_velocity, linear_acceleration (Imu). Covariances and frame_id are not read.
 SensorCheck validate_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
 SensorCheck validate_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
 SensorCheck validate_imu(const msg::Imu& m, std::int64_t last_stamp_ns);
+
+/// A sender whose clock restarted (a plant process started again under a running controller) sends
+/// only well-formed samples older than the newest accepted. After this many such samples in a row
+/// on one topic, with none accepted in between, the next one is taken as a restart of the sender's
+/// clock and accepted (at 100 Hz: half a second, during which the stale-data safety holds). A single
+/// replayed or reordered old sample is still refused.
+constexpr int kStampRestartCount = 50;
 
 // ---------------------------------------------------------------------------------------------
 // Logging of rejections

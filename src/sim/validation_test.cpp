@@ -291,5 +291,30 @@ TEST(ControllerValidationTest, ValidDataRecoversAndBackwardStampsAreRefused) {
   }
 }
 
+TEST(ControllerValidationTest, ASenderWhoseClockRestartedIsFollowedAfterARunOfOldSamples) {
+  ControllerRig rig;
+  rig.send(50'000'000'000, 1.0, 5.0);  // t = 50 s
+  EXPECT_FALSE(rig.node->step(50'000'000'000, 0.02).safety);
+  // The sender starts again from t = 0: refused (and the data ages into the safety) until
+  // kStampRestartCount samples in a row were refused on each topic; the next is accepted.
+  for (int k = 0; k < kStampRestartCount; ++k) rig.send(k * 10'000'000LL, 1.0, 7.0);
+  EXPECT_EQ(rig.node->estimate().p_W.z(), 5.0);
+  EXPECT_TRUE(rig.node->step(50'500'000'000, 0.02).safety);
+  EXPECT_EQ(rig.node->status().rejected_stamp_backwards, 3u * kStampRestartCount);
+  rig.send(kStampRestartCount * 10'000'000LL, 1.0, 7.0);
+  EXPECT_EQ(rig.node->estimate().p_W.z(), 7.0);
+  // Time is measured by stamps here, so "now" follows the sender's new clock.
+  EXPECT_FALSE(rig.node->step(kStampRestartCount * 10'000'000LL, 0.02).safety);
+  // A single old sample after that is refused again.
+  rig.send(0, 1.0, 9.0);
+  EXPECT_EQ(rig.node->estimate().p_W.z(), 7.0);
+}
+
+TEST(ValidateSensorTest, ContentIsCheckedBeforeTheStamp) {
+  msg::PoseStamped p = pose_at(0);
+  p.position.x = kNaN;
+  EXPECT_EQ(validate_pose(p, 10).fault, SensorFault::kNonFinite);  // old and NaN: reported as NaN
+}
+
 }  // namespace
 }  // namespace quadcosim::sim
