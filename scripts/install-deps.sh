@@ -11,6 +11,8 @@ packages=(
   python3 python3-matplotlib python3-numpy
   iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)
+  clang libclang-rt-dev  # sanitizer build and libFuzzer targets (scripts/sanitize.sh); clang-14 and
+                         # libclang-rt-14-dev on Debian 12
 )
 
 missing=()

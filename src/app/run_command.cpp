@@ -178,10 +178,9 @@ int run_command(const RunOptions& opt) {
                                  simulation.dropped(topics.motor_commands), simulation.dropped(topics.pose),
                                  simulation.dropped(topics.velocity), simulation.dropped(topics.imu));
       }
-      if (simulation.plant().stats().commands_rejected > 0) {
-        std::cout << fmt::format("plant rejected {} of {} motor commands\n",
-                                 simulation.plant().stats().commands_rejected,
-                                 simulation.plant().stats().commands_received);
+      if (st.commands_rejected > 0 || st.commands_clamped > 0) {
+        std::cout << fmt::format("plant rejected {} and clamped {} of {} motor commands (last: {})\n",
+                                 st.commands_rejected, st.commands_clamped, st.commands_received, st.last_problem);
       }
     }
 

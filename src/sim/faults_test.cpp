@@ -223,6 +223,7 @@ struct HoverRun {
   std::vector<model::Vector4> applied;
   int safety_ticks = 0;
   std::uint64_t dropped_commands = 0, dropped_imu = 0, watchdog_trips = 0;
+  std::vector<msg::PlantStatus> plant_status;  ///< as published on /drone/plant_status
 };
 
 HoverRun hover(const FaultConfig& faults, Tick ticks) {
@@ -234,6 +235,8 @@ HoverRun hover(const FaultConfig& faults, Tick ticks) {
   const model::State x0 = model::Quadrotor(controller.params.vehicle).initial_state({0, 0, 1.0}, 0.0, true);
   Simulation s(cfg, controller.params.vehicle, x0, controller, {});
   HoverRun r;
+  s.transport().subscribe<msg::PlantStatus>(Topics::for_namespace(cfg.ns).plant_status,
+                                            [&](const msg::PlantStatus& m) { r.plant_status.push_back(m); });
   s.run([&](const TickRecord& rec) {
     r.states.push_back(rec.state);
     r.applied.push_back(rec.applied_command);
@@ -314,6 +317,19 @@ TEST(FaultInjectionTest, TotalCommandLossEngagesTheWatchdogWhichStopsTheMotors) 
   for (Tick k = 0; k < 50; ++k) EXPECT_GT(r.applied[k][0], 4000.0) << k;
   for (Tick k = 50; k <= 100; ++k) EXPECT_EQ(r.applied[k], model::Vector4::Zero()) << k;
   EXPECT_EQ(r.watchdog_trips, 1u);
+  // The plant's status shows it from the next tick on (published with the outputs, before the latch).
+  bool seen = false;
+  for (const auto& st : r.plant_status) {
+    const std::int64_t k = st.header.stamp.to_ns() / 10'000'000;
+    EXPECT_EQ(st.watchdog_active, k >= 51) << "tick " << k;
+    if (k == 51) {
+      seen = true;
+      EXPECT_EQ(st.watchdog_trips, 1u);
+      EXPECT_EQ(st.watchdog_ticks, 1u);
+    }
+  }
+  EXPECT_TRUE(seen) << "a status goes out on the tick the watchdog state changes";
+  EXPECT_EQ(r.plant_status.back().watchdog_ticks, 50u);  // ticks 50..99 latched before tick 100's status
 }
 
 }  // namespace
