@@ -68,8 +68,10 @@ make_namespaces() {
   if [ "$(id -u)" -ne 0 ]; then why="needs root (ip netns add), running as uid $(id -u)"
   elif ! command -v ip > /dev/null; then why="needs iproute2 (ip), not installed (scripts/install-deps.sh)"
   else
+    # Leftovers of an earlier run under the same names (namespaces are torn down asynchronously).
     ip netns del "$nsA" 2>/dev/null || true
     ip netns del "$nsB" 2>/dev/null || true
+    ip link del "$nsA" 2>/dev/null || true
     if ! { ip netns add "$nsA" && namespaces+=("$nsA") && ip netns add "$nsB" && namespaces+=("$nsB") &&
            ip link add "${nsA}" type veth peer name "${nsB}" &&
            ip link set "${nsA}" netns "$nsA" && ip link set "${nsB}" netns "$nsB" &&
