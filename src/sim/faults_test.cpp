@@ -141,6 +141,23 @@ TEST(PlantWatchdogTest, ReceiptClockStartsAtTheFirstTickWhenNothingArrives) {
   EXPECT_TRUE(rig.plant->watchdog_active());
 }
 
+TEST(PlantWatchdogTest, ALockstepRepeatOfTheCurrentTickIsNotANewCommand) {
+  PlantOptions opt;
+  opt.drop_stale_commands = true;
+  WatchdogRig rig(opt);
+  msg::Float64MultiArray m;
+  m.data = {4000, 4000, 4000, 4000};
+  m.dim = {{msg::command_label(40'000'000), 4, 4}};
+  rig.plant->publish_outputs(4);
+  rig.cmd.publish(m);
+  rig.plant->publish_outputs(4);  // the plant asks again; the controller answers again
+  rig.cmd.publish(m);
+  rig.plant->latch_command(4);
+  EXPECT_EQ(rig.plant->stats().commands_accepted, 1u);
+  EXPECT_EQ(rig.plant->stats().commands_stale, 1u);
+  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(4000.0));
+}
+
 // --- injected faults ----------------------------------------------------------------------------
 
 TEST(FaultInjectionTest, DropsAtTheConfiguredRateOnlyOnItsTopic) {

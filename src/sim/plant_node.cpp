@@ -40,7 +40,10 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     return;
   }
   const std::int64_t stamp = msg::command_stamp_ns(m);
-  if (options_.drop_stale_commands && stamp >= 0 && stamp < options_.clock.ns(current_tick_)) {
+  // A repeat answers an earlier tick, or the current one a second time (the controller answering the
+  // plant's republished outputs): either way it is not a new command and is not counted as one.
+  if (options_.drop_stale_commands && stamp >= 0 &&
+      (stamp < options_.clock.ns(current_tick_) || stamp == last_command_stamp_ns_)) {
     ++stats_.commands_stale;
     return;
   }

@@ -30,7 +30,7 @@ struct PlantOptions {
   std::string frame_id = "world";
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
   /// (a repeat) and is dropped instead of overriding the current one.
-  bool drop_stale_commands = false;
+  bool drop_stale_commands = false;  ///< (also a second command labelled with the current tick)
   /// Watchdog limit [ticks]: when no valid command has been received for this long, the policy
   /// acts until one arrives. 0 switches the watchdog off. Measured in simulated ticks, or on the
   /// receipt clock after use_receipt_clock().
