@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"inproc", "dds"}));
   run_cmd->add_option("--timeout", run.timeout_s, "dds: lockstep wait for a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
+  run_cmd->add_option("--keystore", run.keystore,
+                      "dds: run secured (SROS2 keystore, Enforce); created when missing, with enclaves "
+                      "/quadcosim/plant and /quadcosim/controller");
   run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
   run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
@@ -46,6 +49,8 @@ int main(int argc, char** argv) {
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
 
+  add_enclave_option(plant_cmd, plant.enclave);
+
   ControllerCommandOptions ctl;
   auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
   ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
@@ -62,6 +67,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 1e6));
   ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
       ->check(CLI::Validator(check_node_name, "NAME"));
+
+  add_enclave_option(ctl_cmd, ctl.enclave);
 
   OpenloopOptions ol;
   auto* ol_cmd = app.add_subcommand("openloop", "the plant alone under a rotor speed schedule");
@@ -114,7 +121,13 @@ int main(int argc, char** argv) {
   rec_cmd->add_option("--duration", rec.duration_s, "stop after this many seconds (default: Ctrl-C)")
       ->check(CLI::Range(0.0, 1e9));
 
+  add_enclave_option(rec_cmd, rec.enclave);
+
+  SecurityOptions sec;
+  auto* sec_cmd = add_security_subcommand(app, sec);
+
   CLI11_PARSE(app, argc, argv);
+  if (*sec_cmd) return security_command(sec);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);
