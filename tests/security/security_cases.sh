@@ -134,6 +134,11 @@ case "$case_name" in
     expect_refusal "key.pem: not an unencrypted PEM private key" "$bin" topic list --wait 0.1 --enclave /quadcosim/plant
     ROS_SECURITY_KEYSTORE= expect_refusal "ROS_SECURITY_KEYSTORE is not set" "$bin" topic list --wait 0.1
     expect_refusal "must not start with a digit" "$bin" topic list --wait 0.1 --enclave /4x
+    # Credentials for another domain: Cyclone refuses the participant and says why.
+    "$bin" security create-keystore "$tmp/other" --domain-id 3 > /dev/null 2>&1 || fail "create-keystore 3 failed"
+    "$bin" security create-enclave "$tmp/other" /tools --domain-id 3 > /dev/null 2>&1 || fail "create-enclave 3 failed"
+    ROS_SECURITY_KEYSTORE="$tmp/other" expect_refusal "Could not find domain $ROS_DOMAIN_ID in governance" \
+      "$bin" topic list --wait 0.1 --enclave /tools
     # Permissive: a warning naming the problem, then the command runs without security.
     ROS_SECURITY_STRATEGY=Permissive "$bin" topic list --wait 0.1 --enclave /quadcosim/plant > "$tmp/permissive.log" 2>&1 \
       || fail "Permissive did not run"
