@@ -96,7 +96,7 @@ case "$case_name" in
     "$bin" security create-enclave "$ks" /rogue --deny-publish /drone/motor_commands >> "$tmp/ks.log" 2>&1 \
       || fail "create-enclave --deny-publish failed"
     "$bin" security check "$ks" /rogue > "$tmp/check.log" 2>&1 || fail "the /rogue enclave is not usable"
-    start_secured_plant 3
+    start_secured_plant 4
     set +e
     timeout 20 bash -c "$(declare -f secure); ks='$ks'; secure /rogue '$bin' controller --scenario '$scenario' --realtime" \
       > "$tmp/rogue.log" 2>&1
@@ -106,9 +106,28 @@ case "$case_name" in
     grep -q "security (Enforce): enclave /rogue" "$tmp/rogue.log" || fail "the rogue did not authenticate"
     grep -q "rt/drone/motor_commands failed: Not Allowed By Security" "$tmp/rogue.log" \
       || fail "no access-control refusal naming rt/drone/motor_commands"
+    # A participant that skips that local check: its own governance (signed with the CA key, which a
+    # real intruder would not have) leaves the command topic unprotected, so it creates its writer;
+    # the plant, under the keystore's governance, refuses to match it.
+    sed 's|<topic_access_rules>|&<topic_rule><topic_expression>rt/drone/motor_commands</topic_expression><enable_discovery_protection>true</enable_discovery_protection><enable_liveliness_protection>true</enable_liveliness_protection><enable_read_access_control>false</enable_read_access_control><enable_write_access_control>false</enable_write_access_control><metadata_protection_kind>ENCRYPT</metadata_protection_kind><data_protection_kind>ENCRYPT</data_protection_kind></topic_rule>|' \
+      "$ks/enclaves/governance.xml" > "$tmp/bypass_governance.xml"
+    "$bin" security create-enclave "$ks" /bypass --deny-publish /drone/motor_commands >> "$tmp/ks.log" 2>&1 \
+      || fail "create-enclave /bypass failed"
+    rm "$ks/enclaves/bypass/governance.p7s"
+    openssl smime -sign -text -in "$tmp/bypass_governance.xml" -out "$ks/enclaves/bypass/governance.p7s" \
+      -signer "$ks/public/ca.cert.pem" -inkey "$ks/private/ca.key.pem" || fail "cannot sign the bypass governance"
+    set +e
+    timeout 1.5 bash -c "$(declare -f secure); ks='$ks'; secure /bypass '$bin' controller --scenario '$scenario' --realtime" \
+      > "$tmp/bypass.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 124 ] || fail "the bypassing controller did not run until stopped (exit $rc)"
+    ! grep -q "Not Allowed By Security" "$tmp/bypass.log" || fail "the bypass was refused locally"
     finish_plant
     grep -q "commands received 0," "$tmp/plant.log" || fail "a denied command reached the plant"
     [ "$(max_z "$tmp/plant.csv")" = "0.000000" ] || fail "the vehicle climbed"
+    grep -q "match_remote_writer .* security_attributes mismatch" "$tmp/plant.log" \
+      || fail "the plant did not refuse the bypassing writer"
     ;;
 
   enforce_missing)  # Enforce refuses unusable credentials by name; Permissive warns and runs unsecured
