@@ -4,10 +4,12 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
+#include "sim/realism.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
@@ -21,6 +23,8 @@ struct PlantOptions {
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
   /// (a repeat) and is dropped instead of overriding the current one.
   bool drop_stale_commands = false;
+  /// Sensor noise, rates and latency, wind, rotor faults (sim/realism.hpp); all off by default.
+  RealismConfig realism;
 };
 
 struct PlantStats {
@@ -66,6 +70,8 @@ class PlantNode {
   };
   std::deque<Pending> pending_;
   PlantStats stats_;
+  /// Present when options.realism or the vehicle's drag asks for it; null keeps the paper's plant.
+  std::unique_ptr<PlantRealism> realism_;
   Publisher<msg::Clock> clock_pub_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
