@@ -2,6 +2,7 @@
 // failed, 2 bad input (file, flag), 3 an output could not be produced.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -121,6 +122,22 @@ struct RecordOptions {
   double duration_s = -1.0;         ///< stop after this wall time [s] (default: Ctrl-C)
 };
 int record_command(const RecordOptions& options);
+
+/// `quadcosim sweep` (sweep_command.cpp): Monte Carlo over perturbed vehicle parameters and seeded
+/// noise. Exit 0 when at least min_pass_rate of the runs pass, 1 otherwise, 2 on bad input, 3 when an
+/// output cannot be written.
+struct SweepOptions {
+  std::string scenario;
+  int runs = 20;
+  std::uint64_t seed = 1;
+  std::vector<std::string> vary;   ///< KEY=P%
+  std::string out_dir;
+  int jobs = 2;                    ///< threads
+  double min_pass_rate = 1.0;
+  bool plots = true;
+};
+CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
+int sweep_command(const SweepOptions& options);
 
 /// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
 /// override); returns false (after printing why) when it fails.

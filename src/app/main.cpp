@@ -114,7 +114,11 @@ int main(int argc, char** argv) {
   rec_cmd->add_option("--duration", rec.duration_s, "stop after this many seconds (default: Ctrl-C)")
       ->check(CLI::Range(0.0, 1e9));
 
+  SweepOptions sweep;
+  auto* sweep_cmd = add_sweep_subcommand(app, sweep);
+
   CLI11_PARSE(app, argc, argv);
+  if (*sweep_cmd) return sweep_command(sweep);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);
