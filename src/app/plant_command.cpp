@@ -1,0 +1,261 @@
+// `quadcosim plant`: the plant node as a long-running process over DDS, in lockstep (deterministic,
+// as fast as plant and controller can go) or in real time (paced by the wall clock).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "app/node_common.hpp"
+#include "app/parameter_binding.hpp"
+#include "app/signals.hpp"
+#include "dds/dds_transport.hpp"
+#include "dds/node_announcer.hpp"
+#include "dds/parameter_client.hpp"
+#include "io/mcap_recorder.hpp"
+#include "io/scenario.hpp"
+#include "io/trajectory_csv.hpp"
+#include "sim/plant_node.hpp"
+
+namespace quadcosim::app {
+
+namespace {
+
+/// Exit codes of `plant` (docs/cosimulation.md).
+constexpr int kExitOk = 0, kExitRefused = 2, kExitNoController = 4, kExitInterrupted = 130;
+
+/// One plant process: the node on its DDS transport, what it records, and the per-tick steps of
+/// the two loop kinds. Construction does all the setup; run() drives the ticks.
+class PlantProcess {
+ public:
+  PlantProcess(const PlantCommandOptions& o, io::Scenario sc)
+      : o_(o),
+        sc_(std::move(sc)),
+        clock_(sc_.simulation.plant.clock),
+        divider_(sc_.simulation.controller_divider),
+        topics_(sim::Topics::for_namespace(sc_.simulation.ns)),
+        transport_(dds::read_ros_environment()),
+        plant_(make_plant()),
+        announcer_(transport_.participant().handle(), "quadrotor_plant") {
+    status_.header.stamp = msg::Time::from_ns(-1);
+    transport_.subscribe<msg::ControllerStatus>(topics_.controller_status, [this](const msg::ControllerStatus& m) {
+      status_ = m;
+      have_status_ = true;
+    });
+    if (!o_.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.record);
+    if (!o_.mcap.empty()) mcap_ = std::make_unique<io::McapRecorder>(o_.mcap, transport_, topics_);
+    if (!o_.schedule_node.empty()) {
+      scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
+                                                          dds::parse_node_name(o_.schedule_node));
+    }
+    next_event_ = sc_.schedule.begin();
+    announcer_.announce();  // `ros2 node list` shows /quadrotor_plant
+    std::cerr << fmt::format("plant: domain {}, namespace {}, {} mode, {} ticks of {} s\n",
+                             transport_.participant().domain_id(), sc_.simulation.ns,
+                             o_.lockstep ? "lockstep" : "real-time", sc_.simulation.duration_ticks,
+                             clock_.period_s());
+  }
+
+  /// Runs every tick; returns the process's exit code.
+  int run() {
+    if ((o_.lockstep || o_.wait_for_controller) && !wait_for_controller()) return kExitNoController;
+    loop_start_ns_ = steady_ns();
+    next_wall_ns_ = loop_start_ns_;
+    round_trip_ns_.reserve(static_cast<std::size_t>(sc_.simulation.duration_ticks / divider_ + 1));
+    for (sim::Tick k = 0; k <= sc_.simulation.duration_ticks && !stop_requested(); ++k) {
+      if (!apply_due_schedule(k)) return finish(kExitRefused);
+      const std::uint64_t received_before = plant_.stats().commands_received;
+      plant_.publish_outputs(k);
+      if (o_.lockstep) {
+        if (!await_command(k, received_before)) return finish(kExitNoController);
+      } else {
+        pace_to_wall_clock();
+      }
+      plant_.latch_command(k);
+      record(k);
+      if (mcap_) mcap_->flush_settled(clock_.ns(k));
+      if (k < sc_.simulation.duration_ticks) plant_.integrate(k);
+    }
+    finish(kExitOk);
+    report();
+    return stop_requested() ? kExitInterrupted : kExitOk;
+  }
+
+ private:
+  sim::PlantNode make_plant() {
+    if (o_.sensor_qos) use_sensor_qos(transport_, topics_);
+    sim::PlantOptions po = sc_.simulation.plant;
+    po.drop_stale_commands = o_.lockstep;
+    return sim::PlantNode(transport_, topics_, sc_.vehicle, po, io::initial_state(sc_));
+  }
+
+  /// Waits until a controller is there to answer, so tick 0 is not published into the void.
+  bool wait_for_controller() {
+    // The recorder's own readers (same participant) match too: look for one more.
+    const int own = mcap_ ? 1 : 0;
+    const bool found = transport_.spin_until(
+        [&] {
+          return stop_requested() || (transport_.matched_writers(topics_.motor_commands) > 0 &&
+                                      transport_.matched_readers(topics_.pose) > own &&
+                                      transport_.matched_readers(topics_.velocity) > own &&
+                                      transport_.matched_readers(topics_.imu) > own);
+        },
+        timeout_ns());
+    if (!found) {
+      std::cerr << fmt::format("plant: no controller on {} within {} s (matched command writers: {}, "
+                               "pose readers: {}); is it running on ROS_DOMAIN_ID {}?\n",
+                               topics_.motor_commands, o_.timeout_s, transport_.matched_writers(topics_.motor_commands),
+                               transport_.matched_readers(topics_.pose), transport_.participant().domain_id());
+    }
+    return found;
+  }
+
+  /// The schedule through the controller's parameter services: each change due by tick k is
+  /// acknowledged before tick k is published, so the run stays deterministic. False when refused.
+  bool apply_due_schedule(sim::Tick k) {
+    for (; scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k; ++next_event_) {
+      const auto r = scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns());
+      if (r.size() != 1 || !r[0].successful) {
+        std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event_->name,
+                                 clock_.seconds(k), o_.schedule_node, r.empty() ? "no result" : r[0].reason);
+        return false;
+      }
+    }
+    return true;
+  }
+
+  /// Lockstep, after tick k's outputs are out: on control ticks, waits for the command (and status)
+  /// answering tick k, publishing the outputs again every 50 ms. On timeout, false under the abort
+  /// policy; under hold, waiting switches off until commands arrive again, so a vanished controller
+  /// costs one timeout, not one per tick.
+  bool await_command(sim::Tick k, std::uint64_t received_before) {
+    const std::int64_t t_ns = clock_.ns(k);
+    if (!waiting_) {
+      transport_.spin_once(0);  // collect without waiting
+      if (plant_.stats().commands_received > received_before) {
+        std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
+        waiting_ = true;
+      }
+    }
+    if (!waiting_ || k % divider_ != 0) return true;
+    const bool status_expected = transport_.matched_writers(topics_.controller_status) > 0;
+    auto answered = [&] {
+      const bool command = plant_.last_command_stamp_ns() == t_ns ||
+                           (plant_.last_command_stamp_ns() < 0 && plant_.stats().commands_received > received_before);
+      return stop_requested() || (command && (!status_expected || status_.header.stamp.to_ns() == t_ns));
+    };
+    const std::int64_t asked = steady_ns();
+    const std::int64_t deadline = asked + timeout_ns();
+    // Ask again every 50 ms: a sample sent while discovery was still settling may not arrive.
+    while (!transport_.spin_until(answered, 50 * kMs)) {
+      if (steady_ns() >= deadline) {
+        std::cerr << fmt::format(
+            "plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
+            "matched command writers: {}; policy: {}\n",
+            topics_.motor_commands, k, clock_.seconds(k), o_.timeout_s,
+            transport_.matched_writers(topics_.motor_commands), o_.on_timeout);
+        if (o_.on_timeout == "abort") return false;
+        waiting_ = false;  // hold the last command and go on
+        break;
+      }
+      plant_.publish_outputs(k);
+    }
+    round_trip_ns_.push_back(steady_ns() - asked);
+    return true;
+  }
+
+  /// Real time: takes in messages until the wall clock reaches the next tick.
+  void pace_to_wall_clock() {
+    next_wall_ns_ += static_cast<std::int64_t>(static_cast<double>(clock_.period_ns) / o_.rate_factor);
+    while (!stop_requested()) {
+      const std::int64_t left = next_wall_ns_ - steady_ns();
+      if (left <= 0) break;
+      transport_.spin_once(left);
+    }
+  }
+
+  void record(sim::Tick k) {
+    if (!csv_) return;
+    csv_->write(clock_.seconds(k), plant_.state(), plant_.applied_command(),
+                have_status_ ? io::ControlColumns::from(status_) : io::ControlColumns::none());
+  }
+
+  /// Completes the recordings (also on the error paths, so what was recorded is readable).
+  int finish(int code) {
+    if (csv_) csv_->close();
+    if (mcap_ && code == kExitOk) {
+      while (transport_.spin_once(0) > 0) {  // what is still in the readers
+      }
+      mcap_->close();
+      const std::filesystem::path p(o_.mcap);
+      mcap_->write_bag_metadata(p.parent_path().empty() ? "." : p.parent_path().string(), p.filename().string());
+    }
+    return code;
+  }
+
+  void report() {
+    if (!round_trip_ns_.empty()) {
+      std::sort(round_trip_ns_.begin(), round_trip_ns_.end());
+      auto pct = [&](double q) {
+        return static_cast<double>(round_trip_ns_[static_cast<std::size_t>(q * (round_trip_ns_.size() - 1))]) / 1e3;
+      };
+      std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
+                               "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
+                               round_trip_ns_.size(), pct(0.5), pct(0.99), pct(1.0));
+    }
+    const auto& st = plant_.stats();
+    const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
+    const double sim_s = clock_.seconds(sc_.simulation.duration_ticks);
+    std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
+                             "rejected {}, stale {}\n",
+                             sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
+                             st.commands_stale);
+  }
+
+  std::int64_t timeout_ns() const { return static_cast<std::int64_t>(o_.timeout_s * 1e9); }
+
+  const PlantCommandOptions& o_;
+  io::Scenario sc_;
+  sim::TickClock clock_;
+  int divider_;
+  sim::Topics topics_;
+  dds::DdsTransport transport_;
+  sim::PlantNode plant_;
+  dds::NodeAnnouncer announcer_;
+  msg::ControllerStatus status_;
+  bool have_status_ = false;
+  std::unique_ptr<io::TrajectoryWriter> csv_;
+  std::unique_ptr<io::McapRecorder> mcap_;
+  std::unique_ptr<dds::ParameterClient> scheduler_;
+  std::vector<sim::ScheduledParameter>::const_iterator next_event_;
+  bool waiting_ = true;  ///< lockstep: wait for each command (off after a timeout under hold)
+  std::int64_t loop_start_ns_ = 0, next_wall_ns_ = 0;
+  std::vector<std::int64_t> round_trip_ns_;  ///< lockstep: sensor publication -> command back
+};
+
+}  // namespace
+
+int plant_command(const PlantCommandOptions& o) {
+  install_stop_handlers();
+  try {
+    io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
+    if (!o.ns.empty()) sc.simulation.ns = o.ns;
+    if (o.duration_s >= 0.0) {
+      sc.simulation.duration_ticks =
+          static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
+    }
+    PlantProcess process(o, std::move(sc));
+    return process.run();
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: plant: " << e.what() << '\n';
+    return 3;
+  }
+}
+
+}  // namespace quadcosim::app
