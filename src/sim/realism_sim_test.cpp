@@ -134,6 +134,31 @@ TEST(PlantRealismTest, ImuCovariancesCarryTheDiscreteNoiseVariance) {
   EXPECT_EQ(rig.got.pose.size(), 4u);  // the other sensors keep the plant rate
 }
 
+TEST(PlantRealismTest, PublishedImuReadingsHaveTheDatasheetStatistics) {
+  // At rest on the ground the true rate is 0 and the specific force (0, 0, g). Gyro density
+  // 0.001 rad/s/√Hz and accel density 0.02 m/s²/√Hz at 100 Hz: sigma 0.01 rad/s and 0.2 m/s².
+  RealismConfig r;
+  r.seed = 17;
+  r.imu.gyro_noise_density = 0.001;
+  r.imu.accel_noise_density = 0.02;
+  const model::State ground = model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 0}, 0.0, false);
+  Rig rig(r, ground);
+  const int n = 20000;
+  rig.run(n);
+  double sg = 0.0, sg2 = 0.0, sa = 0.0, sa2 = 0.0;
+  for (const msg::Imu& m : rig.got.imu) {
+    sg += m.angular_velocity.y;
+    sg2 += m.angular_velocity.y * m.angular_velocity.y;
+    sa += m.linear_acceleration.z;
+    sa2 += m.linear_acceleration.z * m.linear_acceleration.z;
+  }
+  const double mg = sg / n, ma = sa / n;
+  EXPECT_NEAR(mg, 0.0, 5 * 0.01 / std::sqrt(n));
+  EXPECT_NEAR(std::sqrt(sg2 / n - mg * mg), 0.01, 0.01 * 5 / std::sqrt(2.0 * n));
+  EXPECT_NEAR(ma, 9.81, 5 * 0.2 / std::sqrt(n));
+  EXPECT_NEAR(std::sqrt(sa2 / n - ma * ma), 0.2, 0.2 * 5 / std::sqrt(2.0 * n));
+}
+
 TEST(PlantRealismTest, LatencyPublishesTheStateOfEarlierTicks) {
   // Free fall from 20 m with rotors stopped: z(t) = 20 - g t^2 / 2 (RK4 is exact on it). With a
   // latency of 3 ticks the pose published at tick k shows z(t_{k-3}), stamped t_k.
