@@ -86,6 +86,9 @@ PYEOF
     [ $rc -eq 1 ] && grep -q "0 of 2 runs passed" "$TMP/o" || fail "expected exit 1 and 0 of 2 passed (rc $rc)"
     "$QC" sweep "$TMP/tight.yaml" --runs 2 --out "$TMP/t2" --no-plots --min-pass-rate 0 > "$TMP/o" 2>&1; rc=$?
     [ $rc -eq 0 ] || fail "--min-pass-rate 0 should exit 0 (rc $rc)"
+    # The plot tool on a directory without summary.json: exit 1, naming the file.
+    "$PY" "$SRC/tools/plot_sweep.py" "$TMP/nothing" > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 1 ] && grep -q "nothing/summary.json: file not found" "$TMP/o" || fail "plot_sweep.py on a missing summary (rc $rc)"
     set -e
     ;;
 
