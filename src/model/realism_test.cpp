@@ -7,6 +7,8 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <ostream>
+#include <string>
 #include <vector>
 
 #include "model/quadrotor.hpp"
@@ -189,6 +191,10 @@ struct DrydenCase {
   int order;
   double sigma, L, V;
 };
+// Printed in test names (instead of the raw bytes, padding included).
+void PrintTo(const DrydenCase& c, std::ostream* os) {
+  *os << (c.order == 1 ? "u" : "v") << " sigma " << c.sigma << " L " << c.L << " V " << c.V;
+}
 
 class DrydenSpectrumTest : public ::testing::TestWithParam<DrydenCase> {};
 
@@ -239,7 +245,10 @@ TEST_P(DrydenSpectrumTest, SeriesHasTheConfiguredMeanVarianceAndSpectrum) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Forms, DrydenSpectrumTest,
-                         ::testing::Values(DrydenCase{1, 1.5, 20.0, 10.0}, DrydenCase{2, 0.8, 20.0, 10.0}));
+                         ::testing::Values(DrydenCase{1, 1.5, 20.0, 10.0}, DrydenCase{2, 0.8, 20.0, 10.0}),
+                         [](const ::testing::TestParamInfo<DrydenCase>& i) {
+                           return std::string(i.param.order == 1 ? "longitudinal" : "lateral");
+                         });
 
 TEST(WindFieldTest, MeanWindWithoutGustsAndGustsAlongTheWindAxes) {
   WindParams p;
