@@ -1,7 +1,27 @@
 // quadcosim: one binary, one subcommand per job.
 #include <CLI/CLI.hpp>
 
+#include <iostream>
+#include <string>
+
 #include "app/commands.hpp"
+#include "sim/topics.hpp"
+
+namespace {
+
+// The first argument when it is neither a subcommand of `app` nor a flag `app` knows: CLI11 would
+// only say "A subcommand is required" without naming it.
+std::string unknown_first_argument(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return {};
+  const std::string first = argv[1];
+  if (first == "-h" || first == "--help" || first == "--version") return {};
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    if (sub->get_name() == first) return {};
+  }
+  return first;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace quadcosim::app;
@@ -29,7 +49,8 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
       ->check(CLI::ExistingFile);
-  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1");
+  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
+  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
   plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
   plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
@@ -53,7 +74,7 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
-  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
+  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
   ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
@@ -117,7 +138,20 @@ int main(int argc, char** argv) {
   SweepOptions sweep;
   auto* sweep_cmd = add_sweep_subcommand(app, sweep);
 
-  CLI11_PARSE(app, argc, argv);
+  // Bad flags and arguments: CLI11's message (it names the flag, the value and what was expected) and
+  // exit 2, as for every other bad input; --help and --version exit 0.
+  if (const std::string first = unknown_first_argument(app, argc, argv); !first.empty()) {
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
+    std::cerr << "error: " << (first[0] == '-' ? "unknown option '" : "unknown command '") << first
+              << "'; expected a command: " << names << "\nRun with --help for more information.\n";
+    return 2;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   if (*sweep_cmd) return sweep_command(sweep);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);

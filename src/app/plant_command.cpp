@@ -210,9 +210,9 @@ class PlantProcess {
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
     const double sim_s = clock_.seconds(sc_.simulation.duration_ticks);
     std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
-                             "rejected {}, stale {}\n",
+                             "rejected {}, clamped {}, stale {}\n",
                              sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
-                             st.commands_stale);
+                             st.commands_clamped, st.commands_stale);
   }
 
   std::int64_t timeout_ns() const { return static_cast<std::int64_t>(o_.timeout_s * 1e9); }

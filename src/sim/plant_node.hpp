@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <functional>
+#include <string>
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
@@ -12,6 +14,7 @@
 #include "sim/realism.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
+#include "sim/validation.hpp"
 
 namespace quadcosim::sim {
 
@@ -25,12 +28,21 @@ struct PlantOptions {
   bool drop_stale_commands = false;
   /// Sensor noise, rates and latency, wind, rotor faults (sim/realism.hpp); all off by default.
   RealismConfig realism;
+  /// /<ns>/plant_status goes out on every tick whose counters changed and at least every this many
+  /// ticks; 0: once per simulated second.
+  Tick status_period_ticks = 0;
 };
 
+/// What became of the motor commands (sim/validation.hpp validate_command).
 struct PlantStats {
   std::uint64_t commands_received = 0;
+  std::uint64_t commands_accepted = 0;  ///< used, clamped ones included (not repeats)
   std::uint64_t commands_rejected = 0;  ///< wrong length or non-finite: ignored, last good one held
+  std::uint64_t commands_rejected_length = 0;      ///< of those: not exactly 4 values
+  std::uint64_t commands_rejected_non_finite = 0;  ///< of those: a NaN/Inf speed
+  std::uint64_t commands_clamped = 0;   ///< a speed < 0 or > omega_max: used clamped to [0, omega_max]
   std::uint64_t commands_stale = 0;     ///< lockstep repeats of an earlier tick's command, dropped
+  std::string last_problem;             ///< the reason given for the newest rejected/clamped command
 };
 
 class PlantNode {
@@ -38,7 +50,11 @@ class PlantNode {
   PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
             const PlantOptions& options, const model::State& initial);
 
-  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k.
+  /// Where rejected and clamped commands are reported (rate-limited: the first of each kind, then
+  /// every 100th, each line with the count so far). Default: stderr.
+  void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
+
+  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k, and the plant status when due.
   void publish_outputs(Tick k);
   /// Fixes the command that acts over [t_k, t_k+1): the newest one whose delay has elapsed.
   void latch_command(Tick k);
@@ -47,7 +63,8 @@ class PlantNode {
 
   const model::State& state() const { return state_; }
   const model::Quadrotor& model() const { return model_; }
-  /// The command latched for the current interval, as received (before the model's clamping).
+  /// The command latched for the current interval, as received after validate_command (speeds within
+  /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& applied_command() const { return applied_; }
   const PlantStats& stats() const { return stats_; }
   /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet).
@@ -57,6 +74,7 @@ class PlantNode {
 
  private:
   void on_command(const msg::Float64MultiArray& m);
+  void publish_status(Tick k);
 
   model::Quadrotor model_;
   PlantOptions options_;
@@ -72,6 +90,11 @@ class PlantNode {
   PlantStats stats_;
   /// Present when options.realism or the vehicle's drag asks for it; null keeps the paper's plant.
   std::unique_ptr<PlantRealism> realism_;
+  std::function<void(const std::string&)> log_;
+  LogThrottle rejected_log_, clamped_log_;
+  msg::PlantStatus status_;
+  Tick last_status_tick_ = -1;
+  Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
