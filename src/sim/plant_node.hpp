@@ -4,12 +4,14 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <functional>
 #include <string>
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
+#include "sim/realism.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 #include "sim/validation.hpp"
@@ -36,6 +38,8 @@ struct PlantOptions {
   /// receipt clock after use_receipt_clock().
   Tick watchdog_ticks = 50;
   WatchdogPolicy watchdog_policy = WatchdogPolicy::kStop;
+  /// Sensor noise, rates and latency, wind, rotor faults (sim/realism.hpp); all off by default.
+  RealismConfig realism;
   /// /<ns>/plant_status goes out on every tick whose counters changed and at least every this many
   /// ticks; 0: once per simulated second.
   Tick status_period_ticks = 0;
@@ -110,6 +114,8 @@ class PlantNode {
   std::int64_t last_valid_receipt_ns_ = -1;  ///< receipt clock: its arrival (-1: none, from the first latch)
   std::int64_t command_age_ns_ = 0;
   bool watchdog_active_ = false;
+  /// Present when options.realism or the vehicle's drag asks for it; null keeps the paper's plant.
+  std::unique_ptr<PlantRealism> realism_;
   std::function<void(const std::string&)> log_;
   LogThrottle rejected_log_, clamped_log_;
   msg::PlantStatus status_;
