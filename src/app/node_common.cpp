@@ -17,7 +17,7 @@ io::Scenario scenario_or_defaults(const std::string& path, const std::string& ve
 void refuse_faults_over_dds(const io::Scenario& sc) {
   if (!sc.simulation.faults.active()) return;
   throw io::ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) +
-                        ": faults: message loss and delay are injected by the in-process transport only "
+                        ": message_faults: message loss and delay are injected by the in-process transport only "
                         "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
 }
 

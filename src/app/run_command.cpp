@@ -144,7 +144,7 @@ int run_command(const RunOptions& opt) {
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
       if (sc.simulation.faults.active()) {
-        std::cerr << "error: " << opt.scenario << ": faults: message loss and delay are injected by the "
+        std::cerr << "error: " << opt.scenario << ": message_faults: message loss and delay are injected by the "
                      "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
         return 2;
       }

@@ -1,4 +1,4 @@
-// Scenario keys of the reliability features: simulation.watchdog_s / watchdog_policy and faults:.
+// Scenario keys of the reliability features: simulation.watchdog_s / watchdog_policy and message_faults:.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -37,7 +37,7 @@ TEST(ReliabilityKeysTest, WatchdogAndFaultsAreRead) {
   watchdog_s: 0.25
   watchdog_policy: hold
   namespace: /uav1
-faults:
+message_faults:
   seed: 9
   drop_probability: 0.1
   delay_ticks: 1
@@ -65,15 +65,15 @@ TEST(ReliabilityKeysTest, BadValuesNameFileKeyAndValue) {
   e = error_of("policy", "simulation: {watchdog_policy: land}\n");
   EXPECT_NE(e.find("simulation.watchdog_policy"), std::string::npos) << e;
   EXPECT_NE(e.find("land"), std::string::npos) << e;
-  e = error_of("prob", "faults: {drop_probability: 1.5}\n");
-  EXPECT_NE(e.find("faults.drop_probability"), std::string::npos) << e;
-  e = error_of("topic", "faults: {topics: {Odom: {drop_probability: 0.1}}}\n");
-  EXPECT_NE(e.find("faults.topics.Odom"), std::string::npos) << e;
+  e = error_of("prob", "message_faults: {drop_probability: 1.5}\n");
+  EXPECT_NE(e.find("message_faults.drop_probability"), std::string::npos) << e;
+  e = error_of("topic", "message_faults: {topics: {Odom: {drop_probability: 0.1}}}\n");
+  EXPECT_NE(e.find("message_faults.topics.Odom"), std::string::npos) << e;
   EXPECT_NE(e.find("unknown topic"), std::string::npos) << e;
-  e = error_of("key", "faults: {loss: 0.1}\n");
-  EXPECT_NE(e.find("faults.loss"), std::string::npos) << e;
-  e = error_of("delay", "faults: {delay_ticks: -1}\n");
-  EXPECT_NE(e.find("faults.delay_ticks"), std::string::npos) << e;
+  e = error_of("key", "message_faults: {loss: 0.1}\n");
+  EXPECT_NE(e.find("message_faults.loss"), std::string::npos) << e;
+  e = error_of("delay", "message_faults: {delay_ticks: -1}\n");
+  EXPECT_NE(e.find("message_faults.delay_ticks"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -141,7 +141,7 @@ void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duratio
   s.reject_unknown_keys();
 }
 
-// `faults:` message loss and delay injected by the in-process transport. Defaults apply to the
+// `message_faults:` message loss and delay injected by the in-process transport. Defaults apply to the
 // four topics between plant and controller (Pose, Velocity, Imu, motor_commands); `topics:` sets
 // any of the vehicle's topics by its name within the namespace.
 void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultConfig& out) {
@@ -273,7 +273,7 @@ Scenario load_scenario(const std::string& path) {
     root.fail("simulation.substeps", err);
   }
 
-  if (auto f = root.section("faults")) read_faults(*f, sc.simulation, sc.simulation.faults);
+  if (auto f = root.section("message_faults")) read_faults(*f, sc.simulation, sc.simulation.faults);
 
   if (auto i = root.section("initial")) {
     const auto p = i->numbers("position_m", {0.0, 0.0, 0.0}, 3);

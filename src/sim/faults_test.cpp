@@ -271,7 +271,7 @@ FaultConfig lossy(std::uint64_t seed) {
   f.seed = seed;
   const Topics t = Topics::for_namespace("/drone");
   for (const std::string* name : {&t.pose, &t.velocity, &t.imu, &t.motor_commands}) {
-    f.topics[*name] = {0.10, 1};  // 10 % loss, one tick (10 ms, more than the 5 ms asked) late
+    f.topics[*name] = {0.10, 1};  // 10 % loss, one tick (10 ms, at least 5 ms) late
   }
   return f;
 }

@@ -307,12 +307,12 @@ PY
     }
     expect_2 "--watchdog off the tick grid" "--watchdog 0.015: expected a whole number of plant periods" \
       "$bin" plant --watchdog 0.015
-    printf 'simulation: {duration_s: 1}\nfaults: {drop_probability: 0.1}\n' > "$tmp/lossy.yaml"
+    printf 'simulation: {duration_s: 1}\nmessage_faults: {drop_probability: 0.1}\n' > "$tmp/lossy.yaml"
     expect_2 "faults over DDS (run)" "injected by the in-process transport only" \
       "$bin" run "$tmp/lossy.yaml" --out "$tmp/r" --no-plots --transport dds
-    expect_2 "faults over DDS (plant)" "faults: message loss and delay are injected by the in-process" \
+    expect_2 "faults over DDS (plant)" "message_faults: message loss and delay are injected by the in-process" \
       "$bin" plant --scenario "$tmp/lossy.yaml"
-    expect_2 "faults over DDS (controller)" "faults: message loss and delay are injected by the in-process" \
+    expect_2 "faults over DDS (controller)" "message_faults: message loss and delay are injected by the in-process" \
       "$bin" controller --scenario "$tmp/lossy.yaml"
     printf 'simulation: {watchdog_policy: land}\n' > "$tmp/policy.yaml"
     expect_2 "unknown policy in a scenario" "simulation.watchdog_policy" "$bin" plant --scenario "$tmp/policy.yaml"
