@@ -146,6 +146,8 @@ int main(int argc, char** argv) {
 
   SecurityOptions sec;
   auto* sec_cmd = add_security_subcommand(app, sec);
+  SweepOptions sweep;
+  auto* sweep_cmd = add_sweep_subcommand(app, sweep);
 
   // Bad flags and arguments: CLI11's message (it names the flag, the value and what was expected) and
   // exit 2, as for every other bad input; --help and --version exit 0.
@@ -162,6 +164,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (*sec_cmd) return security_command(sec);
+  if (*sweep_cmd) return sweep_command(sweep);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);
