@@ -19,6 +19,8 @@ struct RunOptions {
   bool realtime = false;             ///< dds: real time instead of lockstep
   double rate_factor = 1.0;          ///< dds real time: k times faster than the wall clock
   double timeout_s = 10.0;           ///< dds: lockstep wait for one command before the policy applies
+  int vehicles = 0;                  ///< > 0: a swarm of this many vehicles (overrides swarm.vehicles)
+  int threads = 0;                   ///< > 0: in-process swarm threads (overrides swarm.threads)
 };
 int run_command(const RunOptions& options);
 
@@ -64,6 +66,10 @@ struct PlantCommandOptions {
   /// Lockstep: apply the scenario's schedule through this node's ROS 2 parameter services, each
   /// change before the tick it is due at ("" = the plant leaves the schedule to the controller).
   std::string schedule_node;
+  int vehicles = 0;         ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...), lockstep
+  std::string ns_prefix;    ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
+  int threads = 2;          ///< vehicles > 0: threads (one DDS participant each)
+  std::string swarm_out;    ///< vehicles > 0: directory for summary.json, vehicles.csv, recorded vehicles
 };
 int plant_command(const PlantCommandOptions& options);
 
@@ -77,6 +83,9 @@ struct ControllerCommandOptions {
   double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
   std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
   bool apply_schedule = true;  ///< apply the scenario's schedule itself (off when the plant does it)
+  int vehicles = 0;            ///< > 0: host this many vehicles' controllers (lockstep)
+  std::string ns_prefix;       ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
+  int threads = 2;             ///< vehicles > 0: threads (one DDS participant each)
 };
 int controller_command(const ControllerCommandOptions& options);
 

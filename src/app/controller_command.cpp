@@ -8,6 +8,7 @@
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
+#include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
@@ -23,6 +24,7 @@ int controller_command(const ControllerCommandOptions& o) {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;
+    if (o.vehicles > 0) return swarm_controller_command(o, std::move(sc));
     const sim::TickClock clock = sc.simulation.plant.clock;
     const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
     const double dt_s = static_cast<double>(control_period_ns) / 1e9;

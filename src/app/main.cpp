@@ -22,6 +22,10 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
   run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
+  run_cmd->add_option("--vehicles", run.vehicles, "a swarm of N vehicles on a grid (default: the scenario's swarm section)")
+      ->check(CLI::Range(1, 10'000'000));
+  run_cmd->add_option("--threads", run.threads, "in-process swarm: worker threads (default: swarm.threads, 2)")
+      ->check(CLI::Range(1, 64));
 
   PlantCommandOptions plant;
   auto* plant_cmd = app.add_subcommand("plant", "the plant as a ROS 2 node over DDS (until done or Ctrl-C)");
@@ -30,6 +34,11 @@ int main(int argc, char** argv) {
   plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
       ->check(CLI::ExistingFile);
   plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1");
+  plant_cmd->add_option("--vehicles", plant.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  plant_cmd->add_option("--ns-prefix", plant.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  plant_cmd->add_option("--threads", plant.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
   plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
   plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
@@ -43,6 +52,7 @@ int main(int argc, char** argv) {
                         "lockstep: apply the scenario's schedule through this node's parameter services");
   plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
+  plant_cmd->add_option("--swarm-out", plant.swarm_out, "with --vehicles: write summary.json, vehicles.csv here");
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
 
@@ -54,6 +64,11 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
+  ctl_cmd->add_option("--vehicles", ctl.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  ctl_cmd->add_option("--ns-prefix", ctl.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  ctl_cmd->add_option("--threads", ctl.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
   ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,

@@ -12,6 +12,7 @@
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
+#include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_client.hpp"
@@ -247,6 +248,7 @@ int plant_command(const PlantCommandOptions& o) {
       sc.simulation.duration_ticks =
           static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
     }
+    if (o.vehicles > 0) return swarm_plant_command(o, std::move(sc));
     PlantProcess process(o, std::move(sc));
     return process.run();
   } catch (const io::ConfigError& e) {

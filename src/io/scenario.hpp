@@ -13,6 +13,7 @@
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
 
 namespace quadcosim::io {
 
@@ -44,6 +45,13 @@ struct StepSpec {
   std::map<std::string, double> reference;  ///< published figures to compare with
 };
 
+/// A scenario's `swarm:` section: many vehicles of the same scenario on a grid (sim/swarm.hpp).
+struct SwarmSpec {
+  sim::SwarmLayout layout;
+  int threads = 2;                   ///< in-process worker threads (1..64)
+  std::vector<int> record_vehicles;  ///< vehicles whose full trajectory is written (default none)
+};
+
 struct Scenario {
   std::string path;  ///< file it was read from ("" for built-in defaults)
   std::string name;
@@ -54,6 +62,7 @@ struct Scenario {
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
+  std::optional<SwarmSpec> swarm;  ///< present when the file has a `swarm:` section
 };
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).

@@ -17,11 +17,13 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
+    ++samples_received_;
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this](const msg::TwistStamped& m) {
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
+    ++samples_received_;
   });
   transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
     const Eigen::Quaterniond q(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -32,6 +34,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
+    ++samples_received_;
   });
 }
 

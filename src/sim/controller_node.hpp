@@ -53,6 +53,9 @@ class ControllerNode {
   /// same stamp (a complete sample of one plant tick); -1 otherwise.
   std::int64_t synchronized_stamp_ns() const;
 
+  /// Pose, Velocity and Imu messages taken in so far (a host of many nodes sees which one got data).
+  std::uint64_t samples_received() const { return samples_received_; }
+
   /// The status published by the last step.
   const msg::ControllerStatus& status() const { return status_; }
 
@@ -70,6 +73,7 @@ class ControllerNode {
   std::function<std::int64_t()> receipt_clock_;
   std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
   std::int64_t last_step_ns_ = kNever;
+  std::uint64_t samples_received_ = 0;
   msg::ControllerStatus status_;
   Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;

@@ -12,7 +12,7 @@ msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
     : model_(vehicle), options_(options), state_(initial), applied_(initial.omega_rad_s) {
-  clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
+  if (options.publish_clock) clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
   pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
   velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
   imu_pub_ = transport.advertise<msg::Imu>(topics.imu);
@@ -44,7 +44,7 @@ void PlantNode::publish_outputs(Tick k) {
   const msg::Header header{stamp, options_.frame_id};
   const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_);
 
-  clock_pub_.publish(msg::Clock{stamp});
+  if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
 
   msg::PoseStamped pose;
   pose.header = header;

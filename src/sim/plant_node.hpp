@@ -21,6 +21,9 @@ struct PlantOptions {
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
   /// (a repeat) and is dropped instead of overriding the current one.
   bool drop_stale_commands = false;
+  /// Publish /clock. It is global, not namespaced: when one process hosts many plants, one of them
+  /// publishes it.
+  bool publish_clock = true;
 };
 
 struct PlantStats {
