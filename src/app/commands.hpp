@@ -70,6 +70,7 @@ struct PlantCommandOptions {
   std::string ns_prefix;    ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
   int threads = 2;          ///< vehicles > 0: threads (one DDS participant each)
   std::string swarm_out;    ///< vehicles > 0: directory for summary.json, vehicles.csv, recorded vehicles
+  std::string stats;        ///< write run figures (real-time factor, round trip) as JSON here ("" none)
 };
 int plant_command(const PlantCommandOptions& options);
 
@@ -86,6 +87,7 @@ struct ControllerCommandOptions {
   int vehicles = 0;            ///< > 0: host this many vehicles' controllers (lockstep)
   std::string ns_prefix;       ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
   int threads = 2;             ///< vehicles > 0: threads (one DDS participant each)
+  std::string stats;           ///< real time: write the control period jitter as JSON here on exit
 };
 int controller_command(const ControllerCommandOptions& options);
 
@@ -140,6 +142,17 @@ int plot_command(const std::string& run_dir);
 
 /// `quadcosim compare RUN_A RUN_B [--out DIR]`: overlays two runs and tabulates their step figures.
 int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out);
+
+struct BenchOptions {
+  bool json = false;          ///< one JSON object on stdout (else the same, indented)
+  bool quick = false;         ///< short runs and small searches (a smoke test, not figures)
+  std::string only;           ///< one part: inproc, dds, realtime, swarm_inproc, swarm_dds ("" all)
+  double seconds = 0.0;       ///< > 0: simulated seconds of the inproc / dds part (e.g. for callgrind)
+  std::string scenario;       ///< single-vehicle scenario (default: scenarios/paper/altitude_step.yaml)
+  std::string swarm_scenario; ///< swarm scenario (default: scenarios/swarm/grid_takeoff.yaml)
+};
+/// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
+int bench_command(const BenchOptions& options);
 
 /// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py).
 bool make_plots(const std::string& run_dir);

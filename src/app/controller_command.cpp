@@ -70,13 +70,16 @@ int controller_command(const ControllerCommandOptions& o) {
       const auto wall_period_ns =
           static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
       std::int64_t next = steady_ns();
+      PeriodJitter jitter(wall_period_ns);
       while (!stop_requested()) {
         next += wall_period_ns;
-        for (std::int64_t left; !stop_requested() && (left = next - steady_ns()) > 0;) transport.spin_once(left);
+        wait_until(transport, next);
+        jitter.add(steady_ns());
         const std::int64_t sim_now = node.newest_stamp_ns();
         apply_schedule(sim_now < 0 ? 0 : sim_now);
         node.step(steady_ns(), dt_s);
       }
+      if (!o.stats.empty()) write_stats(o.stats, jitter.figures());
     }
     std::cerr << "controller: stopped\n";
     return 0;

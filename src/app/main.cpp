@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
                         "lockstep: apply the scenario's schedule through this node's parameter services");
   plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
+  plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
   plant_cmd->add_option("--swarm-out", plant.swarm_out, "with --vehicles: write summary.json, vehicles.csv here");
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
@@ -75,6 +76,7 @@ int main(int argc, char** argv) {
                     "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
+  ctl_cmd->add_option("--stats", ctl.stats, "real time: write the control period jitter as JSON here on exit");
   ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
@@ -129,7 +131,21 @@ int main(int argc, char** argv) {
   rec_cmd->add_option("--duration", rec.duration_s, "stop after this many seconds (default: Ctrl-C)")
       ->check(CLI::Range(0.0, 1e9));
 
+  BenchOptions bench;
+  bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
+  bench.swarm_scenario = QUADCOSIM_SCENARIOS_DIR "/swarm/grid_takeoff.yaml";
+  auto* bench_cmd = app.add_subcommand("bench", "measure speed: in-process, DDS lockstep, real-time jitter, swarms");
+  bench_cmd->add_flag("--json", bench.json, "print one JSON object");
+  bench_cmd->add_flag("--quick", bench.quick, "short runs (smoke test; the figures are not representative)");
+  bench_cmd->add_option("--only", bench.only, "run one part")
+      ->check(CLI::IsMember({"inproc", "dds", "realtime", "swarm_inproc", "swarm_dds"}));
+  bench_cmd->add_option("--seconds", bench.seconds, "simulated seconds of the inproc/dds part")
+      ->check(CLI::Range(0.0, 1e6));
+  bench_cmd->add_option("--scenario", bench.scenario, "single-vehicle scenario")->check(CLI::ExistingFile);
+  bench_cmd->add_option("--swarm-scenario", bench.swarm_scenario, "swarm scenario")->check(CLI::ExistingFile);
+
   CLI11_PARSE(app, argc, argv);
+  if (*bench_cmd) return bench_command(bench);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);

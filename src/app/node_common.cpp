@@ -1,5 +1,12 @@
 #include "app/node_common.hpp"
 
+#include <sys/prctl.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
 namespace quadcosim::app {
 
 io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file) {
@@ -12,6 +19,33 @@ io::Scenario scenario_or_defaults(const std::string& path, const std::string& ve
   if (!vehicle_file.empty()) sc.vehicle = io::load_vehicle(vehicle_file);
   sc.controller.params.vehicle = sc.vehicle;
   return sc;
+}
+
+void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
+  static const bool slack_set = prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0;
+  (void)slack_set;
+  for (std::int64_t left; (left = deadline_ns - steady_ns()) > 0;) transport.spin_once(left);
+}
+
+void PeriodJitter::add(std::int64_t now_ns) {
+  if (last_ns_ >= 0) jitter_ns_.push_back(std::llabs(now_ns - last_ns_ - period_ns_));
+  last_ns_ = now_ns;
+}
+
+nlohmann::json PeriodJitter::figures() const {
+  std::vector<std::int64_t> j = jitter_ns_;
+  std::sort(j.begin(), j.end());
+  auto pct = [&](double q) {
+    return j.empty() ? 0.0 : static_cast<double>(j[static_cast<std::size_t>(q * static_cast<double>(j.size() - 1))]) / 1e3;
+  };
+  return {{"period_jitter_us_p50", pct(0.5)}, {"period_jitter_us_p99", pct(0.99)},
+          {"period_jitter_us_max", pct(1.0)}, {"periods", j.size()}};
+}
+
+void write_stats(const std::string& path, const nlohmann::json& stats) {
+  std::ofstream f(path);
+  f << stats.dump() << '\n';
+  if (!f) std::cerr << "warning: cannot write statistics to " << path << '\n';
 }
 
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics) {

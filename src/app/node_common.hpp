@@ -5,6 +5,9 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "dds/dds_transport.hpp"
 #include "io/scenario.hpp"
@@ -24,6 +27,30 @@ inline std::int64_t steady_ns() {
 /// The scenario at `path` (the built-in defaults when empty), its vehicle replaced by the one in
 /// `vehicle_file` when given. Throws io::ConfigError.
 io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file);
+
+/// Real-time loops: lets the DDS transport deliver messages until the wall clock reaches
+/// `deadline_ns` (steady_ns), then returns. The first call also asks the kernel for 1 ns timer slack
+/// (default 50 us), so the wake-up lands on the deadline rather than up to 50 us after it.
+void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
+
+/// Period jitter of a periodic loop: |t_k - t_k-1 - period| over every period [us].
+class PeriodJitter {
+ public:
+  explicit PeriodJitter(std::int64_t period_ns) : period_ns_(period_ns) {}
+  /// The loop's k-th wake-up time [ns].
+  void add(std::int64_t now_ns);
+  /// {"period_jitter_us_p50", "_p99", "_max", "periods"} (zeros before two wake-ups).
+  nlohmann::json figures() const;
+
+ private:
+  std::int64_t period_ns_;
+  std::int64_t last_ns_ = -1;
+  std::vector<std::int64_t> jitter_ns_;
+};
+
+/// Writes `stats` as one JSON object to `path` (the --stats option of plant and controller, read by
+/// `quadcosim bench`); a failure is reported on stderr, not fatal.
+void write_stats(const std::string& path, const nlohmann::json& stats);
 
 /// ROS sensor-data QoS (KEEP_LAST 5, BEST_EFFORT) on the three sensor topics.
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics);

@@ -198,6 +198,7 @@ class PlantProcess {
   }
 
   void report() {
+    nlohmann::json stats;
     if (!round_trip_ns_.empty()) {
       std::sort(round_trip_ns_.begin(), round_trip_ns_.end());
       auto pct = [&](double q) {
@@ -206,6 +207,9 @@ class PlantProcess {
       std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
                                "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
                                round_trip_ns_.size(), pct(0.5), pct(0.99), pct(1.0));
+      stats["roundtrip_us_p50"] = pct(0.5);
+      stats["roundtrip_us_p99"] = pct(0.99);
+      stats["roundtrip_us_max"] = pct(1.0);
     }
     const auto& st = plant_.stats();
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
@@ -214,6 +218,10 @@ class PlantProcess {
                              "rejected {}, stale {}\n",
                              sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
                              st.commands_stale);
+    stats["simulated_s"] = sim_s;
+    stats["wall_s"] = wall_s;
+    stats["real_time_factor"] = sim_s / wall_s;
+    if (!o_.stats.empty()) write_stats(o_.stats, stats);
   }
 
   std::int64_t timeout_ns() const { return static_cast<std::int64_t>(o_.timeout_s * 1e9); }

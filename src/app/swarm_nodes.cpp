@@ -283,6 +283,9 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   const double sim_s = sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks);
   std::cerr << fmt::format("plant: done; {} vehicles, {:g} s simulated in {:.3f} s ({:.2f}x real time)\n", n, sim_s,
                            wall_s, sim_s / wall_s);
+  if (!o.stats.empty()) {
+    write_stats(o.stats, {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
+  }
   if (!o.swarm_out.empty()) {
     std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
     std::vector<std::string> namespaces(static_cast<std::size_t>(n));

@@ -66,7 +66,7 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   status_pub_.publish(status_);
 
   for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];
-  command_msg_.dim[0].label = msg::command_label(sim_now_ns);
+  msg::write_command_label(command_msg_.dim[0].label, sim_now_ns);
   command_pub_.publish(command_msg_);
   last_step_ns_ = now_ns;
   return command_;

@@ -67,9 +67,16 @@ void PlantNode::publish_outputs(Tick k) {
 }
 
 void PlantNode::latch_command(Tick k) {
-  while (!pending_.empty() && pending_.front().effective_tick <= k) {
-    applied_ = pending_.front().omega;
-    pending_.pop_front();
+  while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) {
+    applied_ = pending_[pending_head_].omega;
+    ++pending_head_;
+  }
+  if (pending_head_ == pending_.size()) {
+    pending_.clear();  // keeps the capacity
+    pending_head_ = 0;
+  } else if (pending_head_ > 64 && pending_head_ * 2 > pending_.size()) {
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
+    pending_head_ = 0;
   }
 }
 

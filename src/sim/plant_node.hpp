@@ -3,7 +3,7 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
+#include <vector>
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
@@ -67,7 +67,11 @@ class PlantNode {
     Tick effective_tick;
     model::Vector4 omega;
   };
-  std::deque<Pending> pending_;
+  // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
+  // dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a
+  // block every few commands).
+  std::vector<Pending> pending_;
+  std::size_t pending_head_ = 0;
   PlantStats stats_;
   Publisher<msg::Clock> clock_pub_;
   Publisher<msg::PoseStamped> pose_pub_;

@@ -57,6 +57,12 @@ Swarm::Swarm(const SimulationConfig& simulation, const model::VehicleParams& veh
 }
 
 void Swarm::run(int threads, Tick block_ticks, const std::vector<bool>& recorded, const Recorder& recorder) {
+  run_ticks(0, duration_ticks_, threads, block_ticks, recorded, recorder);
+}
+
+void Swarm::run_ticks(Tick first_tick, Tick last_tick, int threads, Tick block_ticks, const std::vector<bool>& recorded,
+                      const Recorder& recorder) {
+  last_tick = std::min(last_tick, duration_ticks_);
   threads = std::clamp(threads, 1, std::max(1, size()));
   block_ticks = std::max<Tick>(block_ticks, 1);
   std::exception_ptr failure;
@@ -65,8 +71,8 @@ void Swarm::run(int threads, Tick block_ticks, const std::vector<bool>& recorded
   // not interact, so threads need no synchronisation beyond the final join.
   auto work = [&](int first, int last) {
     try {
-      for (Tick start = 0; start <= duration_ticks_; start += block_ticks) {
-        const Tick end = std::min(start + block_ticks - 1, duration_ticks_);
+      for (Tick start = first_tick; start <= last_tick; start += block_ticks) {
+        const Tick end = std::min(start + block_ticks - 1, last_tick);
         for (int i = first; i < last; ++i) {
           Simulation& s = *vehicles_[static_cast<std::size_t>(i)];
           const bool rec = recorder && !recorded.empty() && recorded[static_cast<std::size_t>(i)];

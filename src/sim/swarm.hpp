@@ -65,6 +65,11 @@ class Swarm {
   /// Rethrows the first exception a vehicle raised (e.g. a refused scheduled parameter).
   void run(int threads, Tick block_ticks, const std::vector<bool>& recorded = {}, const Recorder& recorder = {});
 
+  /// The same for ticks first..last only (0 <= first, last <= duration_ticks); successive calls
+  /// continue where the last one stopped (run() is run_ticks(0, duration_ticks, ...)).
+  void run_ticks(Tick first, Tick last, int threads, Tick block_ticks, const std::vector<bool>& recorded = {},
+                 const Recorder& recorder = {});
+
   int size() const { return static_cast<int>(vehicles_.size()); }
   const Simulation& vehicle(int i) const { return *vehicles_[static_cast<std::size_t>(i)]; }
   const std::string& vehicle_ns(int i) const { return namespaces_[static_cast<std::size_t>(i)]; }
