@@ -68,7 +68,7 @@ int run_threads(int threads, F body) {
 class PlantShard {
  public:
   PlantShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, const std::vector<bool>& recorded,
-             const fs::path& out)
+             const fs::path& out, bool sensor_qos)
       : sc_(sc), clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment()), first_(first) {
     const model::State initial = io::initial_state(sc);
     for (int i = first; i < last; ++i) {
@@ -76,6 +76,7 @@ class PlantShard {
           sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto node = std::make_unique<Vehicle>();
       node->topics = sim::Topics::for_namespace(v.simulation.ns);
+      if (sensor_qos) use_sensor_qos(transport_, node->topics);
       sim::PlantOptions po = v.simulation.plant;
       po.drop_stale_commands = true;
       po.publish_clock = i == 0;  // one /clock for the whole swarm
@@ -194,14 +195,15 @@ class PlantShard {
 // One thread's share of the controllers.
 class ControllerShard {
  public:
-  ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last)
+  ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, bool sensor_qos)
       : clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment()) {
     const model::State initial = io::initial_state(sc);
     for (int i = first; i < last; ++i) {
       sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto c = std::make_unique<Vehicle>();
-      c->node = std::make_unique<sim::ControllerNode>(transport_, sim::Topics::for_namespace(v.simulation.ns),
-                                                      v.controller);
+      const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
+      if (sensor_qos) use_sensor_qos(transport_, topics);
+      c->node = std::make_unique<sim::ControllerNode>(transport_, topics, v.controller);
       c->schedule = std::move(v.schedule);
       std::stable_sort(c->schedule.begin(), c->schedule.end(),
                        [](const auto& a, const auto& b) { return a.tick < b.tick; });
@@ -267,7 +269,8 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   // Participants are created one after the other (Cyclone's domain setup is not worth racing).
   for (int t = 0; t < threads; ++t) {
     shards[static_cast<std::size_t>(t)] =
-        std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm_out));
+        std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm_out),
+                                     o.sensor_qos);
   }
   std::cerr << fmt::format("plant: {} vehicles ({}...), {} thread(s), lockstep, {} ticks of {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads, sc.simulation.duration_ticks,
@@ -317,7 +320,7 @@ int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc)
   const std::int64_t period_ns = sc.simulation.plant.clock.period_ns * sc.simulation.controller_divider;
   std::vector<std::unique_ptr<ControllerShard>> shards;
   for (int t = 0; t < threads; ++t) {
-    shards.push_back(std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads));
+    shards.push_back(std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads, o.sensor_qos));
   }
   std::cerr << fmt::format("controller: {} vehicles ({}...), {} thread(s), lockstep, period {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads,
