@@ -26,11 +26,10 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     ++samples_received_;
   });
   transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
-    const Eigen::Quaterniond q(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
-    const model::Euler e = model::euler_from_quaternion(q);
-    estimate_.roll_rad = e.roll_rad;
-    estimate_.pitch_rad = e.pitch_rad;
-    estimate_.yaw_rad = e.yaw_rad;
+    // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
+    // the control rate, so converting on arrival would do half the atan2s for nothing).
+    imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
+    imu_pending_ = true;
     estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
@@ -39,6 +38,13 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
 }
 
 const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
+  if (imu_pending_) {
+    const model::Euler e = model::euler_from_quaternion(imu_q_WB_);
+    estimate_.roll_rad = e.roll_rad;
+    estimate_.pitch_rad = e.pitch_rad;
+    estimate_.yaw_rad = e.yaw_rad;
+    imu_pending_ = false;
+  }
   const std::int64_t oldest = std::min({pose_ref_ns_, velocity_ref_ns_, imu_ref_ns_});
   estimate_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
                                      : static_cast<double>(now_ns - oldest) / 1e9;

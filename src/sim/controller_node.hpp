@@ -4,6 +4,7 @@
 // change between steps through the declared parameter table.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -74,6 +75,8 @@ class ControllerNode {
   std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
   std::int64_t last_step_ns_ = kNever;
   std::uint64_t samples_received_ = 0;
+  Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
+  bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
   Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;
