@@ -102,8 +102,14 @@ class PlantShard {
     std::size_t ready = 0;
     const bool found = transport_.spin_until(
         [&] {
-          while (ready < vehicles_.size() && transport_.matched_writers(vehicles_[ready]->topics.motor_commands) > 0 &&
-                 transport_.matched_readers(vehicles_[ready]->topics.imu) > 0) {
+          // As the single-vehicle plant: a command writer and all three sensor readers matched, so
+          // tick 0 is not published before the controller can hear it (that would cost a 50 ms retry).
+          while (ready < vehicles_.size()) {
+            const sim::Topics& t = vehicles_[ready]->topics;
+            if (transport_.matched_writers(t.motor_commands) == 0 || transport_.matched_readers(t.pose) == 0 ||
+                transport_.matched_readers(t.velocity) == 0 || transport_.matched_readers(t.imu) == 0) {
+              break;
+            }
             ++ready;
           }
           return stop_requested() || ready == vehicles_.size();
