@@ -10,6 +10,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
   chromium  # headless rendering check of report.html (tools/test_report.py)
+  clang libclang-rt-dev  # sanitizer build and libFuzzer targets (scripts/sanitize.sh); clang-14 and
+                         # libclang-rt-14-dev on Debian 12
 )
 
 missing=()

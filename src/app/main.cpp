@@ -1,7 +1,27 @@
 // quadcosim: one binary, one subcommand per job.
 #include <CLI/CLI.hpp>
 
+#include <iostream>
+#include <string>
+
 #include "app/commands.hpp"
+#include "sim/topics.hpp"
+
+namespace {
+
+// The first argument when it is neither a subcommand of `app` nor a flag `app` knows: CLI11 would
+// only say "A subcommand is required" without naming it.
+std::string unknown_first_argument(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return {};
+  const std::string first = argv[1];
+  if (first == "-h" || first == "--help" || first == "--version") return {};
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    if (sub->get_name() == first) return {};
+  }
+  return first;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace quadcosim::app;
@@ -33,7 +53,8 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
       ->check(CLI::ExistingFile);
-  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1");
+  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
+  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
   plant_cmd->add_option("--vehicles", plant.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
       ->check(CLI::Range(1, 1'000'000));
   plant_cmd->add_option("--ns-prefix", plant.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
@@ -64,7 +85,7 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
-  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1");
+  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
   ctl_cmd->add_option("--vehicles", ctl.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
       ->check(CLI::Range(1, 1'000'000));
   ctl_cmd->add_option("--ns-prefix", ctl.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
@@ -144,7 +165,20 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--scenario", bench.scenario, "single-vehicle scenario")->check(CLI::ExistingFile);
   bench_cmd->add_option("--swarm-scenario", bench.swarm_scenario, "swarm scenario")->check(CLI::ExistingFile);
 
-  CLI11_PARSE(app, argc, argv);
+  // Bad flags and arguments: CLI11's message (it names the flag, the value and what was expected) and
+  // exit 2, as for every other bad input; --help and --version exit 0.
+  if (const std::string first = unknown_first_argument(app, argc, argv); !first.empty()) {
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
+    std::cerr << "error: " << (first[0] == '-' ? "unknown option '" : "unknown command '") << first
+              << "'; expected a command: " << names << "\nRun with --help for more information.\n";
+    return 2;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   if (*bench_cmd) return bench_command(bench);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);

@@ -215,9 +215,9 @@ class PlantProcess {
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
     const double sim_s = clock_.seconds(sc_.simulation.duration_ticks);
     std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
-                             "rejected {}, stale {}\n",
+                             "rejected {}, clamped {}, stale {}\n",
                              sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
-                             st.commands_stale);
+                             st.commands_clamped, st.commands_stale);
     stats["simulated_s"] = sim_s;
     stats["wall_s"] = wall_s;
     stats["real_time_factor"] = sim_s / wall_s;

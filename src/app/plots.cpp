@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -49,9 +50,30 @@ bool make_plots(const std::string& run_dir) {
          run_tool("report.py", {run_dir, "--version-text", std::string("quadcosim ") + QUADCOSIM_VERSION});
 }
 
-int plot_command(const std::string& run_dir) { return make_plots(run_dir) ? 0 : 3; }
+namespace {
+// "" when `dir` holds a run's trajectory.csv, else the error to print (bad input: exit 2).
+std::string check_run_dir(const std::string& what, const std::string& dir) {
+  if (std::filesystem::is_regular_file(std::filesystem::path(dir) / "trajectory.csv")) return {};
+  return "error: " + what + ": " + dir + " is not a run directory (no trajectory.csv; expected the --out "
+         "directory of `quadcosim run`)";
+}
+}  // namespace
+
+int plot_command(const std::string& run_dir) {
+  if (std::string err = check_run_dir("run_dir", run_dir); !err.empty()) {
+    std::cerr << err << '\n';
+    return 2;
+  }
+  return make_plots(run_dir) ? 0 : 3;
+}
 
 int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out) {
+  for (const auto& [what, dir] : {std::pair{"run_a", run_a}, std::pair{"run_b", run_b}}) {
+    if (std::string err = check_run_dir(what, dir); !err.empty()) {
+      std::cerr << err << '\n';
+      return 2;
+    }
+  }
   std::vector<std::string> args = {run_a, run_b};
   if (!out.empty()) {
     args.push_back("--out");

@@ -154,10 +154,9 @@ int run_command(const RunOptions& opt) {
       csv.close();
       mcap.close();
       mcap.write_bag_metadata(out.string(), "run.mcap");
-      if (simulation.plant().stats().commands_rejected > 0) {
-        std::cout << fmt::format("plant rejected {} of {} motor commands\n",
-                                 simulation.plant().stats().commands_rejected,
-                                 simulation.plant().stats().commands_received);
+      if (const auto& st = simulation.plant().stats(); st.commands_rejected > 0 || st.commands_clamped > 0) {
+        std::cout << fmt::format("plant rejected {} and clamped {} of {} motor commands (last: {})\n",
+                                 st.commands_rejected, st.commands_clamped, st.commands_received, st.last_problem);
       }
     }
 

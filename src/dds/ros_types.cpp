@@ -170,6 +170,10 @@ struct Wire<msg::ControllerStatus> {
     for (int i = 0; i < 4; ++i) c.rotor_saturated[i] = m.rotor_saturated[i];
     c.tilt_saturated = m.tilt_saturated;
     c.safety = m.safety;
+    c.rejected_non_finite = m.rejected_non_finite;
+    c.rejected_bad_quaternion = m.rejected_bad_quaternion;
+    c.rejected_bad_stamp = m.rejected_bad_stamp;
+    c.rejected_stamp_backwards = m.rejected_stamp_backwards;
   }
   static void from(const C& c, msg::ControllerStatus& m) {
     from_c(c.header, m.header);
@@ -180,6 +184,32 @@ struct Wire<msg::ControllerStatus> {
     for (int i = 0; i < 4; ++i) m.rotor_saturated[i] = c.rotor_saturated[i];
     m.tilt_saturated = c.tilt_saturated;
     m.safety = c.safety;
+    m.rejected_non_finite = c.rejected_non_finite;
+    m.rejected_bad_quaternion = c.rejected_bad_quaternion;
+    m.rejected_bad_stamp = c.rejected_bad_stamp;
+    m.rejected_stamp_backwards = c.rejected_stamp_backwards;
+  }
+};
+
+template <>
+struct Wire<msg::PlantStatus> {
+  using C = quadcosim_msgs_msg_dds__PlantStatus_;
+  static const dds_topic_descriptor_t* desc() { return &quadcosim_msgs_msg_dds__PlantStatus__desc; }
+  static void to(const msg::PlantStatus& m, C& c) {
+    to_c(m.header, c.header);
+    c.commands_accepted = m.commands_accepted;
+    c.commands_clamped = m.commands_clamped;
+    c.commands_rejected_length = m.commands_rejected_length;
+    c.commands_rejected_non_finite = m.commands_rejected_non_finite;
+    c.last_problem = borrow(m.last_problem);
+  }
+  static void from(const C& c, msg::PlantStatus& m) {
+    from_c(c.header, m.header);
+    m.commands_accepted = c.commands_accepted;
+    m.commands_clamped = c.commands_clamped;
+    m.commands_rejected_length = c.commands_rejected_length;
+    m.commands_rejected_non_finite = c.commands_rejected_non_finite;
+    m.last_problem = own(c.last_problem);
   }
 };
 
@@ -215,6 +245,7 @@ const TypeOps* type_ops(std::type_index type) {
       {typeid(msg::Float64MultiArray), ops_for<msg::Float64MultiArray>()},
       {typeid(msg::Clock), ops_for<msg::Clock>()},
       {typeid(msg::ControllerStatus), ops_for<msg::ControllerStatus>()},
+      {typeid(msg::PlantStatus), ops_for<msg::PlantStatus>()},
   };
   const auto it = table.find(type);
   return it == table.end() ? nullptr : &it->second;

@@ -213,7 +213,22 @@ std::string to_yaml(const msg::ControllerStatus& m) {
       .list(0, "error", m.error)
       .list(0, "rotor_saturated", m.rotor_saturated)
       .value(0, "tilt_saturated", m.tilt_saturated)
-      .value(0, "safety", m.safety);
+      .value(0, "safety", m.safety)
+      .value(0, "rejected_non_finite", static_cast<std::int64_t>(m.rejected_non_finite))
+      .value(0, "rejected_bad_quaternion", static_cast<std::int64_t>(m.rejected_bad_quaternion))
+      .value(0, "rejected_bad_stamp", static_cast<std::int64_t>(m.rejected_bad_stamp))
+      .value(0, "rejected_stamp_backwards", static_cast<std::int64_t>(m.rejected_stamp_backwards));
+  return std::move(y).str();
+}
+
+std::string to_yaml(const msg::PlantStatus& m) {
+  Yaml y;
+  y.header(0, m.header)
+      .value(0, "commands_accepted", static_cast<std::int64_t>(m.commands_accepted))
+      .value(0, "commands_clamped", static_cast<std::int64_t>(m.commands_clamped))
+      .value(0, "commands_rejected_length", static_cast<std::int64_t>(m.commands_rejected_length))
+      .value(0, "commands_rejected_non_finite", static_cast<std::int64_t>(m.commands_rejected_non_finite))
+      .value(0, "last_problem", yaml_string(m.last_problem));
   return std::move(y).str();
 }
 

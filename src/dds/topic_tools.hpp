@@ -30,6 +30,7 @@ std::string to_yaml(const msg::Imu& m);
 std::string to_yaml(const msg::Float64MultiArray& m);
 std::string to_yaml(const msg::Clock& m);
 std::string to_yaml(const msg::ControllerStatus& m);
+std::string to_yaml(const msg::PlantStatus& m);
 
 /// Inter-arrival statistics over the last `window` intervals, as `ros2 topic hz` computes them.
 class RateWindow {

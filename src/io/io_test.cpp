@@ -379,6 +379,19 @@ INSTANTIATE_TEST_SUITE_P(
                     {"analysis.steps[0].criteria.t95_s: ", "min is above max"}},
         BadScenario{"top_level_not_a_mapping", "- 1\n- 2\n", {"mapping"}},
         BadScenario{"section_not_a_mapping", "simulation: 100\n", {"simulation: ", "'100'", "mapping"}},
+        // Found by fuzz_config (tests/fuzz/corpus/fuzz_config/regression_*): a list or a mapping as a
+        // key threw yaml-cpp's conversion error past the loader; an alias containing itself made the
+        // parameter walk recurse until the stack overflowed.
+        BadScenario{"list_as_key", "? [a, b]\n: 1\n", {"a list as a key", "expected a plain name"}},
+        BadScenario{"mapping_as_controller_key", "controller:\n  ? {a: 1}\n  : 2\n",
+                    {"controller: ", "a mapping as a key"}},
+        BadScenario{"alias_containing_itself", "controller: &c\n  lqr: *c\n",
+                    {"controller.lqr.lqr.lqr: ", "nested too deeply"}},
+        BadScenario{"criterion_bound_a_list",
+                    "analysis:\n  steps:\n    - channel: z\n      criteria: {overshoot_pct: [[1], 2]}\n",
+                    {"analysis.steps[0].criteria.overshoot_pct: ", "got a list, expected a number or null"}},
+        BadScenario{"parameter_a_list", "controller:\n  z_des: [1, 2]\n",
+                    {"controller.z_des: ", "got a list, expected a single value"}},
         BadScenario{"yaml_syntax_error",
                     "name: broken\nsimulation:\n  plant_rate_hz: 100\n  duration_s: 15: 3\n"
                     "controller:\n  mode: attitude\n",

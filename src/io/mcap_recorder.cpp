@@ -33,6 +33,7 @@ McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, c
   add<msg::TwistStamped>(transport, topics.velocity, only);
   add<msg::Imu>(transport, topics.imu, only);
   add<msg::ControllerStatus>(transport, topics.controller_status, only);
+  add<msg::PlantStatus>(transport, topics.plant_status, only);
   add<msg::Float64MultiArray>(transport, topics.motor_commands, only);
 }
 

@@ -17,7 +17,7 @@ namespace quadcosim::io {
 class McapRecorder {
  public:
   /// Opens `path` and subscribes, through `transport`, to the vehicle's topics: /clock, Pose,
-  /// Velocity, Imu, motor_commands and controller_status. Throws std::runtime_error naming the path.
+  /// Velocity, Imu, motor_commands, controller_status and plant_status. Throws std::runtime_error naming the path.
   /// `only`, when not empty, limits the recording to those topic names.
   McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics,
                const std::vector<std::string>& only = {});

@@ -63,7 +63,20 @@ json j(const msg::ControllerStatus& m) {
           {"error", m.error},
           {"rotor_saturated", m.rotor_saturated},
           {"tilt_saturated", m.tilt_saturated},
-          {"safety", m.safety}};
+          {"safety", m.safety},
+          {"rejected_non_finite", std::to_string(m.rejected_non_finite)},
+          {"rejected_bad_quaternion", std::to_string(m.rejected_bad_quaternion)},
+          {"rejected_bad_stamp", std::to_string(m.rejected_bad_stamp)},
+          {"rejected_stamp_backwards", std::to_string(m.rejected_stamp_backwards)}};
+}
+// uint64 fields as decimal strings: the reference reader decodes them as bigints, shown as strings.
+json j(const msg::PlantStatus& m) {
+  return {{"header", j(m.header)},
+          {"commands_accepted", std::to_string(m.commands_accepted)},
+          {"commands_clamped", std::to_string(m.commands_clamped)},
+          {"commands_rejected_length", std::to_string(m.commands_rejected_length)},
+          {"commands_rejected_non_finite", std::to_string(m.commands_rejected_non_finite)},
+          {"last_problem", m.last_problem}};
 }
 
 // One recorded topic: its channel and what has been written on it.
@@ -110,6 +123,7 @@ class Recorder {
       write(topics.pose, t::sample_pose(i), ns);
       write(topics.velocity, t::sample_twist(i), ns);
       write(topics.imu, t::sample_imu(i), ns);
+      if (i % 100 == 0 || i % 37 == 5) write(topics.plant_status, t::sample_plant_status(i), ns);
       if (i % 2 == 0) {  // the controller at 50 Hz
         write(topics.controller_status, t::sample_status(i), ns);
         write(topics.motor_commands, t::sample_command(i), ns);
@@ -161,6 +175,7 @@ int main(int argc, char** argv) {
     rec.add<msg::TwistStamped>(topics.velocity);
     rec.add<msg::Imu>(topics.imu);
     rec.add<msg::ControllerStatus>(topics.controller_status);
+    rec.add<msg::PlantStatus>(topics.plant_status);
     rec.add<msg::Float64MultiArray>(topics.motor_commands);
     if (mode == "killed") {
       rec.ticks(topics, 0, 100);

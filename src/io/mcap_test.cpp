@@ -86,8 +86,8 @@ std::string hex(const std::vector<std::uint8_t>& b) {
 
 // Compares ours with Cyclone's. Cyclone (0.10.2 here) pads the serialized sample to a multiple of 4
 // bytes with zeros and puts the pad count in the low two bits of the encapsulation options (XTypes
-// 1.3, 7.4.3.5.3): of our types only ControllerStatus, whose six trailing booleans leave it 2 bytes
-// short, comes out as 00 01 00 02 + payload + 00 00. to_cdr keeps the options 00 00 and adds no
+// 1.3, 7.4.3.5.3): e.g. a PlantStatus whose last_problem string leaves it 2 bytes short comes out
+// as 00 01 00 02 + payload + 00 00. to_cdr keeps the options 00 00 and adds no
 // padding (what the brief asks for; CDR readers ignore trailing bytes either way, and the options
 // carry no meaning for XCDR1 decoding). So: the representation identifier 00 01 (CDR_LE) must match;
 // Cyclone's options must be 00 0p with p exactly the padding a 4-byte multiple needs; the payloads
@@ -193,6 +193,16 @@ TEST_F(CdrTest, ControllerStatusMatchesCyclone) {
   }
 }
 
+TEST_F(CdrTest, PlantStatusMatchesCyclone) {
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::PlantStatus m = testing::sample_plant_status(static_cast<int>(k) * 11 + 1);
+    m.header.frame_id = kFrames[k];
+    check(m, "frame '" + kFrames[k] + "' problem '" + m.last_problem + "'");
+    m.last_problem = kFrames[k];  // strings of every length mod 4: Cyclone's trailing pad
+    check(m, "problem '" + m.last_problem + "'");
+  }
+}
+
 TEST(CdrLayoutTest, ClockIsTheHeaderAndTwoIntegers) {
   const std::vector<std::uint8_t> want = {0x00, 0x01, 0x00, 0x00, 0x02, 0, 0, 0, 0x03, 0, 0, 0};
   EXPECT_EQ(to_cdr(msg::Clock{{2, 3}}), want);
@@ -244,7 +254,13 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
   EXPECT_EQ(msg_blocks(status), (V{"std_msgs/Header", "builtin_interfaces/Time"}));
   EXPECT_EQ(status.substr(0, status.find("====")),
             "std_msgs/Header header\nstring mode\nfloat64[6] setpoint\nfloat64[4] u\nfloat64[4] error\n"
-            "bool[4] rotor_saturated\nbool tilt_saturated\nbool safety\n");
+            "bool[4] rotor_saturated\nbool tilt_saturated\nbool safety\nuint64 rejected_non_finite\n"
+            "uint64 rejected_bad_quaternion\nuint64 rejected_bad_stamp\nuint64 rejected_stamp_backwards\n");
+  const std::string& plant = ros2msg_definition(msg::PlantStatus::kRosType);
+  EXPECT_EQ(msg_blocks(plant), (V{"std_msgs/Header", "builtin_interfaces/Time"}));
+  EXPECT_EQ(plant.substr(0, plant.find("====")),
+            "std_msgs/Header header\nuint64 commands_accepted\nuint64 commands_clamped\n"
+            "uint64 commands_rejected_length\nuint64 commands_rejected_non_finite\nstring last_problem\n");
   EXPECT_THROW(ros2msg_definition("geometry_msgs/msg/PoseWithCovariance"), std::invalid_argument);
   EXPECT_THROW(ros2msg_definition("geometry_msgs/PoseStamped"), std::invalid_argument);
 }

@@ -66,6 +66,21 @@ inline msg::ControllerStatus sample_status(int i) {
   m.rotor_saturated = {i % 2 == 0, i % 3 == 0, false, true};
   m.tilt_saturated = i % 5 == 0;
   m.safety = i % 7 == 0;
+  m.rejected_non_finite = static_cast<std::uint64_t>(i) / 3;
+  m.rejected_bad_quaternion = static_cast<std::uint64_t>(i) / 5;
+  m.rejected_bad_stamp = i % 2;
+  m.rejected_stamp_backwards = 0x0102030405060708ull + static_cast<std::uint64_t>(i);  // all 8 bytes in use
+  return m;
+}
+
+inline msg::PlantStatus sample_plant_status(int i) {
+  msg::PlantStatus m;
+  m.header = sample_header(i, "world");
+  m.commands_accepted = static_cast<std::uint64_t>(i) / 2;
+  m.commands_clamped = static_cast<std::uint64_t>(i) / 7;
+  m.commands_rejected_length = static_cast<std::uint64_t>(i) % 3;
+  m.commands_rejected_non_finite = 0xfedcba9876543210ull - static_cast<std::uint64_t>(i);
+  m.last_problem = i % 4 == 0 ? "" : "rotor 2 speed " + std::to_string(-i) + " rad/s clamped to 0";
   return m;
 }
 

@@ -19,6 +19,7 @@ class CdrWriter {
   void u8(std::uint8_t v) { bytes_.push_back(v); }
   void boolean(bool v) { u8(v ? 1 : 0); }
   void u32(std::uint32_t v) { primitive(v); }
+  void u64(std::uint64_t v) { primitive(v); }
   void i32(std::int32_t v) { primitive(v); }
   void f64(double v) { primitive(v); }
   void str(const std::string& s) {
@@ -101,7 +102,18 @@ const std::map<std::string, std::string, std::less<>>& msg_files() {
        "float64[4] error\n"
        "bool[4] rotor_saturated\n"
        "bool tilt_saturated\n"
-       "bool safety\n"},
+       "bool safety\n"
+       "uint64 rejected_non_finite\n"
+       "uint64 rejected_bad_quaternion\n"
+       "uint64 rejected_bad_stamp\n"
+       "uint64 rejected_stamp_backwards\n"},
+      {"quadcosim_msgs/PlantStatus",
+       "std_msgs/Header header\n"
+       "uint64 commands_accepted\n"
+       "uint64 commands_clamped\n"
+       "uint64 commands_rejected_length\n"
+       "uint64 commands_rejected_non_finite\n"
+       "string last_problem\n"},
   };
   return files;
 }
@@ -205,6 +217,21 @@ std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m) {
   for (bool b : m.rotor_saturated) w.boolean(b);
   w.boolean(m.tilt_saturated);
   w.boolean(m.safety);
+  w.u64(m.rejected_non_finite);
+  w.u64(m.rejected_bad_quaternion);
+  w.u64(m.rejected_bad_stamp);
+  w.u64(m.rejected_stamp_backwards);
+  return w.take();
+}
+
+std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m) {
+  CdrWriter w;
+  put(w, m.header);
+  w.u64(m.commands_accepted);
+  w.u64(m.commands_clamped);
+  w.u64(m.commands_rejected_length);
+  w.u64(m.commands_rejected_non_finite);
+  w.str(m.last_problem);
   return w.take();
 }
 

@@ -25,12 +25,13 @@ std::vector<std::uint8_t> to_cdr(const msg::Imu& m);
 std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m);
 std::vector<std::uint8_t> to_cdr(const msg::Clock& m);
 std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m);
+std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m);
 
 /// The full `ros2msg` schema text of a ROS 2 message type named "pkg/msg/Type" (e.g.
 /// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType): the type's own .msg fields,
 /// then every type it depends on, depth first in field order, each once, as a line of 80 '=', a line
 /// "MSG: pkg/Type" and that type's fields (the ros1msg/ros2msg convention of the MCAP registry and
-/// rosbag2). Known: the six message types of sim/messages.hpp and the types they contain. Throws
+/// rosbag2). Known: the seven message types of sim/messages.hpp and the types they contain. Throws
 /// std::invalid_argument naming `ros_type` for any other.
 const std::string& ros2msg_definition(std::string_view ros_type);
 

@@ -62,7 +62,7 @@ void read_vehicle(YamlSection& s, model::VehicleParams& v) {
 
 control::ParameterValue parameter_value(YamlSection& s, const std::string& key,
                                         const control::ParameterSpec& spec, const YAML::Node& n) {
-  if (!n.IsScalar()) s.fail(key, "expected a single value");
+  if (!n.IsScalar()) s.fail(key, "got " + YamlSection::describe(n) + ", expected a single value");
   if (spec.is_choice()) return n.Scalar();
   try {
     return n.as<double>();
@@ -73,14 +73,21 @@ control::ParameterValue parameter_value(YamlSection& s, const std::string& key,
 
 // Applies every leaf of a (possibly nested) mapping as a controller parameter: `altitude: {kp: 4}`
 // and `altitude.kp: 4` are the same.
+// Parameter names have at most three parts (lqr.roll.q_angle); deeper nesting, as an alias that
+// contains itself (`a: &x {b: *x}`) makes, is refused instead of followed.
+constexpr int kMaxParameterDepth = 3;
+
 void read_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
-                     std::vector<std::pair<std::string, control::ParameterValue>>* out) {
+                     std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth = 1) {
   for (const std::string& key : s.keys()) {
     const YAML::Node n = s.raw(key);
     const std::string name = prefix.empty() ? key : prefix + "." + key;
     if (n.IsMap()) {
+      if (depth >= kMaxParameterDepth) {
+        s.fail(key, "unknown controller parameter '" + name + "' (nested too deeply; see `quadcosim params`)");
+      }
       YamlSection child(n, s.file(), s.key_path(key));
-      read_parameters(child, name, c, out);
+      read_parameters(child, name, c, out, depth + 1);
       continue;
     }
     const control::ParameterSpec* spec = control::find_parameter(name);
@@ -151,7 +158,7 @@ void read_steps(YamlSection& analysis, std::vector<StepSpec>& steps, double dura
           try {
             (i == 0 ? crit.min : crit.max) = b[i].as<double>();
           } catch (const YAML::Exception&) {
-            c->fail(fig, "got '" + b[i].Scalar() + "', expected a number or null");
+            c->fail(fig, "got " + YamlSection::describe(b[i]) + ", expected a number or null");
           }
         }
         if (crit.min && crit.max && *crit.min > *crit.max) c->fail(fig, "min is above max");

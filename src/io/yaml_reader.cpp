@@ -31,7 +31,9 @@ void YamlSection::fail(const std::string& key, const std::string& message) const
   throw ConfigError(file_ + ": " + (where.empty() ? "" : where + ": ") + message);
 }
 
-std::string YamlSection::shown(const YAML::Node& n) const {
+std::string YamlSection::shown(const YAML::Node& n) const { return describe(n); }
+
+std::string YamlSection::describe(const YAML::Node& n) {
   if (n.IsScalar()) return "'" + n.Scalar() + "'";
   if (n.IsSequence()) return "a list";
   if (n.IsMap()) return "a mapping";
@@ -146,10 +148,16 @@ std::vector<YAML::Node> YamlSection::sequence(const std::string& key) {
   return {n.begin(), n.end()};
 }
 
+std::string YamlSection::key_text(const YAML::Node& key) const {
+  // YAML allows a list or a mapping as a key (`? [a, b]: 1`); no key of ours is one.
+  if (!key.IsScalar()) fail("", "got " + shown(key) + " as a key, expected a plain name");
+  return key.Scalar();
+}
+
 std::vector<std::string> YamlSection::keys() {
   std::vector<std::string> out;
   for (const auto& kv : node_) {
-    out.push_back(kv.first.as<std::string>());
+    out.push_back(key_text(kv.first));
     used_.insert(out.back());
   }
   return out;
@@ -157,7 +165,7 @@ std::vector<std::string> YamlSection::keys() {
 
 void YamlSection::reject_unknown_keys() const {
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     if (!used_.count(key)) fail(key, "unknown key");
   }
 }

@@ -48,10 +48,13 @@ class YamlSection {
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
   std::string key_path(const std::string& key) const;
   const std::string& file() const { return file_; }
+  /// How a value appears in messages: 'text' for a scalar, else "a list", "a mapping", "nothing".
+  static std::string describe(const YAML::Node& n);
 
  private:
   YAML::Node get(const std::string& key);
   std::string shown(const YAML::Node& n) const;
+  std::string key_text(const YAML::Node& key) const;
 
   YAML::Node node_;
   std::string file_;

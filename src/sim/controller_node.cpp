@@ -1,6 +1,7 @@
 #include "sim/controller_node.hpp"
 
 #include <algorithm>
+#include <iostream>
 
 #include "model/attitude.hpp"
 
@@ -9,23 +10,27 @@ namespace quadcosim::sim {
 ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
                                const control::ControllerConfig& config)
     : config_(config), controller_(config.params) {
+  log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   status_pub_ = transport.advertise<msg::ControllerStatus>(topics.controller_status);
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
-  transport.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) {
+  transport.subscribe<msg::PoseStamped>(topics.pose, [this, topic = topics.pose](const msg::PoseStamped& m) {
+    if (!accept(validate_pose(m, pose_stamp_ns_), topic, pose_backwards_)) return;
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
     ++samples_received_;
   });
-  transport.subscribe<msg::TwistStamped>(topics.velocity, [this](const msg::TwistStamped& m) {
+  transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
+    if (!accept(validate_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) return;
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
     ++samples_received_;
   });
-  transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
+  transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
+    if (!accept(validate_imu(m, imu_stamp_ns_), topic, imu_backwards_)) return;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -35,6 +40,26 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     imu_ref_ns_ = reference(imu_stamp_ns_);
     ++samples_received_;
   });
+}
+
+bool ControllerNode::accept(const SensorCheck& check, const std::string& topic, int& backwards) {
+  if (check.ok()) {
+    backwards = 0;
+    return true;
+  }
+  if (check.fault == SensorFault::kStampBackwards && ++backwards > kStampRestartCount) {
+    log_("controller: " + topic + ": " + std::to_string(kStampRestartCount) +
+         " samples in a row older than the newest accepted; taking it that the sender's clock restarted (" +
+         check.reason + ")");
+    backwards = 0;
+    return true;
+  }
+  LogThrottle& counter = fault_log_[static_cast<int>(check.fault)];
+  if (counter.count()) {
+    log_("controller: " + topic + " message rejected, " + to_string(check.fault) + " (" + check.reason + "); " +
+         std::to_string(counter.total()) + " rejected for this reason so far (logged: 1st, then every 100th)");
+  }
+  return false;
 }
 
 const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
@@ -69,6 +94,10 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   }
   status_.tilt_saturated = command_.tilt_saturated;
   status_.safety = command_.safety;
+  status_.rejected_non_finite = fault_log_[static_cast<int>(SensorFault::kNonFinite)].total();
+  status_.rejected_bad_quaternion = fault_log_[static_cast<int>(SensorFault::kBadQuaternion)].total();
+  status_.rejected_bad_stamp = fault_log_[static_cast<int>(SensorFault::kBadStamp)].total();
+  status_.rejected_stamp_backwards = fault_log_[static_cast<int>(SensorFault::kStampBackwards)].total();
   status_pub_.publish(status_);
 
   for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];

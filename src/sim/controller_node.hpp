@@ -1,11 +1,15 @@
 // The flight controller as a node: keeps the latest Pose, Velocity and Imu (the IMU quaternion is
 // turned into Z-Y-X Euler angles, as the paper's imuCallback does), runs FlightController::step on
 // its period, and publishes the rotor speeds on /<ns>/motor_commands. Parameters (gains, setpoints)
-// change between steps through the declared parameter table.
+// change between steps through the declared parameter table. Sensor messages that fail the checks of
+// sim/validation.hpp (NaN/Inf, non-unit quaternion, malformed or backward stamp) are dropped, counted
+// in the status and logged (1st of each reason, then every 100th): the estimate keeps its last valid
+// values and ages, so the stale-data safety (Algorithm 1) takes over when nothing valid arrives.
 #pragma once
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <array>
 #include <functional>
 #include <limits>
 #include <string>
@@ -15,6 +19,7 @@
 #include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
+#include "sim/validation.hpp"
 
 namespace quadcosim::sim {
 
@@ -57,11 +62,19 @@ class ControllerNode {
   /// Pose, Velocity and Imu messages taken in so far (a host of many nodes sees which one got data).
   std::uint64_t samples_received() const { return samples_received_; }
 
+  /// Where refused sensor messages are reported (rate-limited per reason). Default: stderr.
+  void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
+
   /// The status published by the last step.
   const msg::ControllerStatus& status() const { return status_; }
 
  private:
   static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
+
+  /// Counts and logs a refused message on `topic`; false when `check` refused it. `backwards`: the
+  /// topic's run of well-formed samples refused as older than the newest (kStampRestartCount of them
+  /// in a row: the sender's clock restarted, and the sample is accepted).
+  bool accept(const SensorCheck& check, const std::string& topic, int& backwards);
 
   control::ControllerConfig config_;
   control::FlightController controller_;
@@ -78,6 +91,9 @@ class ControllerNode {
   Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
   bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
+  std::function<void(const std::string&)> log_;
+  std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing
+  int pose_backwards_ = 0, velocity_backwards_ = 0, imu_backwards_ = 0;
   Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;
   msg::Float64MultiArray command_msg_;

@@ -97,6 +97,26 @@ struct ControllerStatus {
   std::array<bool, 4> rotor_saturated{};
   bool tilt_saturated = false;
   bool safety = false;              ///< the stale-data safety command was sent
+  /// Sensor messages refused so far, by reason (sim/validation.hpp, docs/reliability.md); a refused
+  /// message leaves the estimate as it was, so its age grows until the safety command takes over.
+  std::uint64_t rejected_non_finite = 0;       ///< NaN/Inf in a field
+  std::uint64_t rejected_bad_quaternion = 0;   ///< orientation not a unit quaternion (zero included)
+  std::uint64_t rejected_bad_stamp = 0;        ///< sec < 0 or nanosec >= 1e9
+  std::uint64_t rejected_stamp_backwards = 0;  ///< older than the newest accepted on its topic
+};
+
+/// quadcosim_msgs/msg/PlantStatus: what the plant did with the motor commands it received (counters
+/// since start). Published by the plant with its sensor outputs on every tick whose counters changed
+/// and otherwise once per simulated second (tick 0 included). Lockstep repeats of an earlier tick's
+/// command are not counted here, so the status is the same in-process and over DDS.
+struct PlantStatus {
+  static constexpr std::string_view kRosType = "quadcosim_msgs/msg/PlantStatus";
+  Header header;                                   ///< stamp: the (simulated) time of the tick
+  std::uint64_t commands_accepted = 0;             ///< used (clamped ones included)
+  std::uint64_t commands_clamped = 0;              ///< a speed < 0 or > omega_max: used clamped
+  std::uint64_t commands_rejected_length = 0;      ///< not exactly 4 values (empty included): ignored
+  std::uint64_t commands_rejected_non_finite = 0;  ///< a NaN/Inf speed: ignored
+  std::string last_problem;  ///< why the newest rejected or clamped command was ("" for none yet)
 };
 
 /// rosgraph_msgs/msg/Clock

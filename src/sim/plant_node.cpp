@@ -1,6 +1,7 @@
 #include "sim/plant_node.hpp"
 
 #include <cmath>
+#include <iostream>
 
 namespace quadcosim::sim {
 
@@ -12,6 +13,8 @@ msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
     : model_(vehicle), options_(options), state_(initial), applied_(initial.omega_rad_s) {
+  log_ = [](const std::string& line) { std::cerr << line << '\n'; };
+  status_pub_ = transport.advertise<msg::PlantStatus>(topics.plant_status);
   if (options.publish_clock) clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
   pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
   velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
@@ -22,10 +25,15 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
 
 void PlantNode::on_command(const msg::Float64MultiArray& m) {
   ++stats_.commands_received;
-  bool ok = m.data.size() == 4;
-  for (std::size_t i = 0; ok && i < 4; ++i) ok = std::isfinite(m.data[i]);
-  if (!ok) {
+  const CommandCheck check = validate_command(m, model_.params().motor.omega_max_rad_s);
+  if (check.verdict == CommandVerdict::kRejected) {
+    stats_.last_problem = check.reason;
     ++stats_.commands_rejected;
+    ++(m.data.size() != 4 ? stats_.commands_rejected_length : stats_.commands_rejected_non_finite);
+    if (rejected_log_.count()) {
+      log_("plant: motor command rejected (" + check.reason + "), last good command held; " +
+           std::to_string(rejected_log_.total()) + " rejected so far (logged: 1st, then every 100th)");
+    }
     return;
   }
   const std::int64_t stamp = msg::command_stamp_ns(m);
@@ -33,9 +41,36 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     ++stats_.commands_stale;
     return;
   }
+  ++stats_.commands_accepted;
+  if (check.verdict == CommandVerdict::kClamped) {
+    stats_.last_problem = check.reason;
+    ++stats_.commands_clamped;
+    if (clamped_log_.count()) {
+      log_("plant: motor command clamped (" + check.reason + "); " + std::to_string(clamped_log_.total()) +
+           " clamped so far (logged: 1st, then every 100th)");
+    }
+  }
   last_command_stamp_ns_ = stamp;
-  pending_.push_back({current_tick_ + options_.command_delay_ticks,
-                      model::Vector4(m.data[0], m.data[1], m.data[2], m.data[3])});
+  pending_.push_back({current_tick_ + options_.command_delay_ticks, check.omega_rad_s});
+}
+
+void PlantNode::publish_status(Tick k) {
+  const Tick period = options_.status_period_ticks > 0
+                          ? options_.status_period_ticks
+                          : std::max<Tick>(1, 1'000'000'000 / options_.clock.period_ns);
+  const bool problem = stats_.commands_rejected_length != status_.commands_rejected_length ||
+                       stats_.commands_rejected_non_finite != status_.commands_rejected_non_finite ||
+                       stats_.commands_clamped != status_.commands_clamped;
+  if (!problem && k % period != 0) return;
+  if (k == last_status_tick_) return;  // one status per tick, also when a tick's outputs are repeated
+  last_status_tick_ = k;
+  status_.header = msg::Header{msg::Time::from_ns(options_.clock.ns(k)), options_.frame_id};
+  status_.commands_accepted = stats_.commands_accepted;
+  status_.commands_clamped = stats_.commands_clamped;
+  status_.commands_rejected_length = stats_.commands_rejected_length;
+  status_.commands_rejected_non_finite = stats_.commands_rejected_non_finite;
+  status_.last_problem = stats_.last_problem;
+  status_pub_.publish(status_);
 }
 
 void PlantNode::publish_outputs(Tick k) {
@@ -45,6 +80,7 @@ void PlantNode::publish_outputs(Tick k) {
   const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
+  publish_status(k);
 
   msg::PoseStamped pose;
   pose.header = header;

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "model/quadrotor.hpp"
@@ -10,6 +12,7 @@
 #include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
+#include "sim/validation.hpp"
 
 namespace quadcosim::sim {
 
@@ -21,15 +24,24 @@ struct PlantOptions {
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
   /// (a repeat) and is dropped instead of overriding the current one.
   bool drop_stale_commands = false;
+  /// /<ns>/plant_status goes out on every tick whose counters changed and at least every this many
+  /// ticks; 0: once per simulated second.
+  Tick status_period_ticks = 0;
   /// Publish /clock. It is global, not namespaced: when one process hosts many plants, one of them
   /// publishes it.
   bool publish_clock = true;
 };
 
+/// What became of the motor commands (sim/validation.hpp validate_command).
 struct PlantStats {
   std::uint64_t commands_received = 0;
+  std::uint64_t commands_accepted = 0;  ///< used, clamped ones included (not repeats)
   std::uint64_t commands_rejected = 0;  ///< wrong length or non-finite: ignored, last good one held
+  std::uint64_t commands_rejected_length = 0;      ///< of those: not exactly 4 values
+  std::uint64_t commands_rejected_non_finite = 0;  ///< of those: a NaN/Inf speed
+  std::uint64_t commands_clamped = 0;   ///< a speed < 0 or > omega_max: used clamped to [0, omega_max]
   std::uint64_t commands_stale = 0;     ///< lockstep repeats of an earlier tick's command, dropped
+  std::string last_problem;             ///< the reason given for the newest rejected/clamped command
 };
 
 class PlantNode {
@@ -37,7 +49,11 @@ class PlantNode {
   PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
             const PlantOptions& options, const model::State& initial);
 
-  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k.
+  /// Where rejected and clamped commands are reported (rate-limited: the first of each kind, then
+  /// every 100th, each line with the count so far). Default: stderr.
+  void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
+
+  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k, and the plant status when due.
   void publish_outputs(Tick k);
   /// Fixes the command that acts over [t_k, t_k+1): the newest one whose delay has elapsed.
   void latch_command(Tick k);
@@ -46,7 +62,8 @@ class PlantNode {
 
   const model::State& state() const { return state_; }
   const model::Quadrotor& model() const { return model_; }
-  /// The command latched for the current interval, as received (before the model's clamping).
+  /// The command latched for the current interval, as received after validate_command (speeds within
+  /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& applied_command() const { return applied_; }
   const PlantStats& stats() const { return stats_; }
   /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet).
@@ -56,6 +73,7 @@ class PlantNode {
 
  private:
   void on_command(const msg::Float64MultiArray& m);
+  void publish_status(Tick k);
 
   model::Quadrotor model_;
   PlantOptions options_;
@@ -73,6 +91,11 @@ class PlantNode {
   std::vector<Pending> pending_;
   std::size_t pending_head_ = 0;
   PlantStats stats_;
+  std::function<void(const std::string&)> log_;
+  LogThrottle rejected_log_, clamped_log_;
+  msg::PlantStatus status_;
+  Tick last_status_tick_ = -1;
+  Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;

@@ -12,6 +12,7 @@ struct Topics {
   std::string imu;             ///< plant ->, sensor_msgs/Imu
   std::string clock;           ///< plant ->, rosgraph_msgs/Clock (global, not namespaced)
   std::string controller_status;  ///< controller ->, quadcosim_msgs/ControllerStatus
+  std::string plant_status;       ///< plant ->, quadcosim_msgs/PlantStatus
 
   /// Topics under `ns` ("/drone" gives "/drone/Pose", ...). `ns` must start with '/'.
   static Topics for_namespace(const std::string& ns = "/drone");

@@ -1,0 +1,132 @@
+#!/usr/bin/env bash
+# Bad input to every command: a table of (expected exit code, fragments the error must contain,
+# command line). Each error must name what was wrong (file, key or flag, the value, what was
+# expected) and exit with the code the README gives: 2 for bad input (3 when an output cannot be
+# written). No case may reach the network or wait: flags and files are checked first.
+#   usage: bad_input.sh QUADCOSIM_BINARY SOURCE_DIR
+set -euo pipefail
+QC=$1
+SRC=$2
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+cd "$TMP"
+export ROS_DOMAIN_ID=$((166 + ${QUADCOSIM_TEST_DOMAIN_OFFSET:-0})) ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+ALT=$SRC/scenarios/paper/altitude_step.yaml
+
+# Inputs.
+printf 'vehicle: {mass_kg: heavy}\n' > wrong_type.yaml
+printf 'name: [\n  broken\n' > syntax.yaml
+printf 'simulaton: {duration_s: 1}\n' > unknown_key.yaml
+printf 'simulation: {plant_rate_hz: -5}\n' > out_of_range.yaml
+printf 'controller:\n  roll_des: 5\n' > param_range.yaml
+printf 'altitude: {kq: 3}\n' > params_unknown.yaml
+printf 'mass_kg: 1.0\nlayout: h\n' > vehicle_bad.yaml
+printf 'mass_kg: .nan\n' > vehicle_nan.yaml
+printf '? [a, b]\n: 1\n' > list_key.yaml
+printf 't,w1,w2,w3,w4\n0,1,2,3\n' > short.csv
+printf 't,w1,w2,w3,w4\n0,1,nan,3,4\n' > nan.csv
+printf 'time,a,b,c,d\n0,1,2,3,4\n' > header.csv
+printf 't,w1,w2,w3,w4\n0,1,2,3,4\n' > ok.csv
+mkdir -p not_a_run
+
+failures=0
+cases=0
+# expect RC "FRAGMENT;;FRAGMENT..." ARGS...
+expect() {
+  local want=$1 fragments=$2
+  shift 2
+  cases=$((cases + 1))
+  set +e
+  timeout 30 "$QC" "$@" > out.txt 2> err.txt
+  local rc=$?
+  set -e
+  local text
+  text="$(cat out.txt err.txt)"
+  local problem=""
+  [ "$rc" -eq "$want" ] || problem="exit $rc, expected $want"
+  local IFS_save=$IFS
+  IFS=$'\n'
+  for f in $(printf '%s' "$fragments" | sed 's/;;/\n/g'); do
+    [[ "$text" == *"$f"* ]] || problem="$problem${problem:+; }'$f' missing"
+  done
+  IFS=$IFS_save
+  if [ -n "$problem" ]; then
+    failures=$((failures + 1))
+    echo "FAIL: quadcosim $*: $problem"
+    echo "  output: $(head -c 600 <<< "$text")"
+  fi
+}
+
+# Command line
+expect 2 "unknown command 'frobnicate';;expected a command: run" frobnicate
+expect 2 "unknown option '--bogus'" --bogus
+expect 2 "A subcommand is required"
+
+# run
+expect 2 "scenario: File does not exist: missing.yaml" run missing.yaml --out o
+expect 2 "--out is required" run "$ALT"
+expect 2 "wrong_type.yaml: vehicle.mass_kg: got 'heavy', expected a number in [1e-06, 1e+12]" run wrong_type.yaml --out o --no-plots
+expect 2 "syntax.yaml: line 3: YAML syntax error" run syntax.yaml --out o --no-plots
+expect 2 "unknown_key.yaml: simulaton: unknown key" run unknown_key.yaml --out o --no-plots
+expect 2 "out_of_range.yaml: simulation.plant_rate_hz: got '-5', expected a number in [0.001, 1e+06]" run out_of_range.yaml --out o --no-plots
+expect 2 "param_range.yaml: controller.roll_des: roll_des must be in [-1.5, 1.5] rad, got 5" run param_range.yaml --out o --no-plots
+expect 2 "list_key.yaml: got a list as a key, expected a plain name" run list_key.yaml --out o --no-plots
+expect 2 "--transport: carrier not in {inproc,dds}" run "$ALT" --out o --transport carrier
+expect 2 "--timeout: Value abc not in range 0.01" run "$ALT" --out o --timeout abc
+expect 2 "--rate-factor: Value 0 not in range 0.001" run "$ALT" --out o --rate-factor 0
+expect 2 "The following argument was not expected: --fast" run "$ALT" --out o --fast
+expect 3 "cannot create output directory /proc/quadcosim_no" run "$ALT" --out /proc/quadcosim_no --no-plots
+
+# plant and controller (checked before any DDS entity is created)
+expect 2 "--scenario: File does not exist: missing.yaml" plant --scenario missing.yaml
+expect 2 "wrong_type.yaml: vehicle.mass_kg: got 'heavy'" plant --scenario wrong_type.yaml
+expect 2 "vehicle_bad.yaml: layout: got 'h', expected one of 'plus' 'x'" plant --vehicle vehicle_bad.yaml
+expect 2 "vehicle_nan.yaml: mass_kg: got '.nan', expected a number" plant --vehicle vehicle_nan.yaml
+expect 2 "--namespace: a namespace must start with '/', got 'drone'" plant --namespace drone
+expect 2 "--duration: Value -1 not in range 0" plant --duration -1
+expect 2 "--on-timeout: explode not in {abort,hold}" plant --on-timeout explode
+expect 2 "--params: File does not exist: missing.yaml" controller --params missing.yaml
+expect 2 "params_unknown.yaml: altitude.kq: unknown controller parameter 'altitude.kq'" controller --params params_unknown.yaml
+expect 2 "--namespace: a namespace may not contain '//', got '/a//b'" controller --namespace /a//b
+expect 2 "--node-name: invalid ROS node name '1ctl'" controller --node-name 1ctl
+expect 2 "--rate-factor: Value -2 not in range" controller --rate-factor -2
+
+# param and topic
+expect 2 "node is required" param get
+expect 2 "node: invalid ROS node name '9node'" param get 9node z_des
+expect 2 "value is required" param set /attitude_controller z_des
+expect 2 "--timeout: Value -1 not in range" param get /attitude_controller z_des --timeout -1
+expect 2 "topic is required" topic echo
+expect 2 "--count: Value -3 not in range 1" topic echo /drone/Pose --count -3
+expect 2 "--qos: fancy not in {default,sensor}" topic echo /drone/Pose --qos fancy
+expect 2 "--window: Value 0 not in range 1" topic hz /drone/Pose --window 0
+expect 2 "--wait: Value soon not in range" topic list --wait soon
+
+# record
+expect 2 "--out is required" record
+expect 2 "--namespace: a namespace must start with '/', got 'uav'" record --out r.mcap --namespace uav
+expect 2 "--topics: cannot record '/nope'" record --out r.mcap --topics /nope
+expect 2 "--duration: Value x not in range" record --out r.mcap --duration x
+
+# plot, compare, summary
+expect 2 "run_dir: Directory does not exist: missing_dir" plot missing_dir
+expect 2 "run_dir: not_a_run is not a run directory (no trajectory.csv" plot not_a_run
+expect 2 "run_b: Directory does not exist: missing_dir" compare not_a_run missing_dir
+expect 2 "run_a: not_a_run is not a run directory" compare not_a_run not_a_run
+expect 2 "not_a_run/metrics.json: cannot open" summary not_a_run
+expect 2 "run_dirs is required" summary
+
+# lqr, openloop, params
+expect 2 "param_range.yaml: controller.roll_des: unknown controller parameter 'controller.roll_des'" lqr --params param_range.yaml
+expect 2 "vehicle_bad.yaml: layout: got 'h'" lqr --vehicle vehicle_bad.yaml
+expect 2 "--commands: File does not exist: missing.csv" openloop --commands missing.csv --out t.csv
+expect 2 "short.csv:2: expected 5 values (t,w1,w2,w3,w4), got 4" openloop --commands short.csv --out t.csv
+expect 2 "nan.csv:2: values must be finite" openloop --commands nan.csv --out t.csv
+expect 2 "header.csv:1: header is 'time,a,b,c,d', expected t,w1,w2,w3,w4" openloop --commands header.csv --out t.csv
+expect 2 "--substeps: Value 0 not in range 1" openloop --commands ok.csv --out t.csv --substeps 0
+expect 2 "--rate-hz: Value fast not in range" openloop --commands ok.csv --out t.csv --rate-hz fast
+expect 3 "/proc/quadcosim_no.csv: cannot open for writing" openloop --commands ok.csv --out /proc/quadcosim_no.csv
+expect 2 "The following argument was not expected: extra" params extra
+
+echo "$((cases - failures)) passed, $failures failed"
+[ "$failures" -eq 0 ]
