@@ -98,7 +98,8 @@ nlohmann::json read_json(const fs::path& p) {
 struct NodeRun {
   nlohmann::json plant, controller;
 };
-NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s, int vehicles, bool realtime) {
+NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s, int vehicles, bool realtime,
+                  int rt_priority = 0) {
   const std::string self = self_executable();
   const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
   fs::remove(ps);
@@ -114,6 +115,10 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   }
   if (realtime) {
     c.push_back("--realtime");
+    if (rt_priority > 0) {
+      c.push_back("--rt-priority");
+      c.push_back(std::to_string(rt_priority));
+    }
     p.push_back("--realtime");
     p.push_back("--wait-for-controller");
   }
@@ -245,12 +250,27 @@ int bench_command(const BenchOptions& o) {
     }
   }
   if (want("realtime")) {
+    // The controller's 50 Hz loop under normal scheduling, then (the real-time setup) under
+    // SCHED_FIFO when the machine allows it.
     const double s = q ? 2.0 : 20.0;
-    note(fmt::format("real time, one vehicle, {} s", s));
-    const NodeRun r = run_nodes(tmp, o.scenario, s, 0, true);
-    j["realtime_period_jitter_us_p50"] = r.controller.is_object() ? r.controller.value("period_jitter_us_p50", 0.0) : 0.0;
-    j["realtime_period_jitter_us_p99"] = r.controller.is_object() ? r.controller.value("period_jitter_us_p99", 0.0) : 0.0;
-    j["realtime_period_jitter_us_max"] = r.controller.is_object() ? r.controller.value("period_jitter_us_max", 0.0) : 0.0;
+    auto measure = [&](int priority, const std::string& suffix) {
+      note(fmt::format("real time, one vehicle, {} s{}", s, priority > 0 ? fmt::format(", SCHED_FIFO {}", priority) : ""));
+      const NodeRun r = run_nodes(tmp, o.scenario, s, 0, true, priority);
+      for (const char* k : {"p50", "p99", "max"}) {
+        const std::string key = std::string("period_jitter_us_") + k;
+        j["realtime_" + key + suffix] = r.controller.is_object() ? r.controller.value(key, 0.0) : 0.0;
+      }
+    };
+    measure(0, "_normal");
+    if (o.rt_priority > 0) {
+      measure(o.rt_priority, "");
+      j["realtime_rt_priority"] = o.rt_priority;
+    } else {
+      for (const char* k : {"p50", "p99", "max"}) {
+        j[std::string("realtime_period_jitter_us_") + k] = j[std::string("realtime_period_jitter_us_") + k + "_normal"];
+      }
+      j["realtime_rt_priority"] = 0;
+    }
   }
   if (want("swarm_inproc")) {
     const double s = q ? 0.5 : 2.0;

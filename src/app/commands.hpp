@@ -88,6 +88,7 @@ struct ControllerCommandOptions {
   std::string ns_prefix;       ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
   int threads = 2;             ///< vehicles > 0: threads (one DDS participant each)
   std::string stats;           ///< real time: write the control period jitter as JSON here on exit
+  int rt_priority = 0;         ///< real time: run the control loop under SCHED_FIFO at this priority (0 off)
 };
 int controller_command(const ControllerCommandOptions& options);
 
@@ -150,6 +151,7 @@ struct BenchOptions {
   double seconds = 0.0;       ///< > 0: simulated seconds of the inproc / dds part (e.g. for callgrind)
   std::string scenario;       ///< single-vehicle scenario (default: scenarios/paper/altitude_step.yaml)
   std::string swarm_scenario; ///< swarm scenario (default: scenarios/swarm/grid_takeoff.yaml)
+  int rt_priority = 50;       ///< realtime part: also measure with the controller under SCHED_FIFO (0: not)
 };
 /// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
 int bench_command(const BenchOptions& options);

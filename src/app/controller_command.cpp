@@ -67,6 +67,9 @@ int controller_command(const ControllerCommandOptions& o) {
     } else {
       // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
       node.use_receipt_clock(steady_ns);
+      if (std::string err = use_realtime_priority(o.rt_priority); !err.empty()) {
+        std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
+      }
       const auto wall_period_ns =
           static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
       std::int64_t next = steady_ns();

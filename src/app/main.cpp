@@ -97,6 +97,9 @@ int main(int argc, char** argv) {
                     "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
+  ctl_cmd->add_option("--rt-priority", ctl.rt_priority,
+                      "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
+      ->check(CLI::Range(0, 99));
   ctl_cmd->add_option("--stats", ctl.stats, "real time: write the control period jitter as JSON here on exit");
   ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
       ->check(CLI::Validator(check_node_name, "NAME"));
@@ -162,6 +165,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"inproc", "dds", "realtime", "swarm_inproc", "swarm_dds"}));
   bench_cmd->add_option("--seconds", bench.seconds, "simulated seconds of the inproc/dds part")
       ->check(CLI::Range(0.0, 1e6));
+  bench_cmd->add_option("--rt-priority", bench.rt_priority, "realtime part: SCHED_FIFO priority of the controller (0: skip)")
+      ->check(CLI::Range(0, 99));
   bench_cmd->add_option("--scenario", bench.scenario, "single-vehicle scenario")->check(CLI::ExistingFile);
   bench_cmd->add_option("--swarm-scenario", bench.swarm_scenario, "swarm scenario")->check(CLI::ExistingFile);
 

@@ -28,10 +28,16 @@ inline std::int64_t steady_ns() {
 /// `vehicle_file` when given. Throws io::ConfigError.
 io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file);
 
-/// Real-time loops: lets the DDS transport deliver messages until the wall clock reaches
-/// `deadline_ns` (steady_ns), then returns. The first call also asks the kernel for 1 ns timer slack
-/// (default 50 us), so the wake-up lands on the deadline rather than up to 50 us after it.
+/// Real-time loops: lets the DDS transport deliver messages until 200 us before `deadline_ns`
+/// (steady_ns), then spins on the clock until the deadline (1 % of a 20 ms period), so the wake-up
+/// lands on the deadline instead of a scheduler wake-up later. The first call also asks the kernel
+/// for 1 ns timer slack (default 50 us) for the blocking part.
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
+
+/// Real time: runs the calling thread under SCHED_FIFO at `priority` (1..99) so other processes do
+/// not delay its wake-ups. Returns "" on success, else why not (e.g. no CAP_SYS_NICE): the caller
+/// warns and goes on with normal scheduling. priority 0: does nothing.
+std::string use_realtime_priority(int priority);
 
 /// Period jitter of a periodic loop: |t_k - t_k-1 - period| over every period [us].
 class PeriodJitter {
