@@ -21,6 +21,9 @@ struct RunOptions {
   double timeout_s = 10.0;           ///< dds: lockstep wait for one command before the policy applies
   int vehicles = 0;                  ///< > 0: a swarm of this many vehicles (overrides swarm.vehicles)
   int threads = 0;                   ///< > 0: in-process swarm threads (overrides swarm.threads)
+  /// dds: run secured (Enforce) with this SROS2 keystore; created when missing, as are the enclaves
+  /// /quadcosim/plant and /quadcosim/controller ("" = as the ROS_SECURITY_* environment says).
+  std::string keystore;
 };
 int run_command(const RunOptions& options);
 
@@ -71,6 +74,7 @@ struct PlantCommandOptions {
   int threads = 2;          ///< vehicles > 0: threads (one DDS participant each)
   std::string swarm_out;    ///< vehicles > 0: directory for summary.json, vehicles.csv, recorded vehicles
   std::string stats;        ///< write run figures (real-time factor, round trip) as JSON here ("" none)
+  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
 };
 int plant_command(const PlantCommandOptions& options);
 
@@ -89,6 +93,7 @@ struct ControllerCommandOptions {
   int threads = 2;             ///< vehicles > 0: threads (one DDS participant each)
   std::string stats;           ///< real time: write the control period jitter as JSON here on exit
   int rt_priority = 0;         ///< real time: run the control loop under SCHED_FIFO at this priority (0 off)
+  std::string enclave = "/";   ///< DDS Security enclave (rcl --enclave)
 };
 int controller_command(const ControllerCommandOptions& options);
 
@@ -103,6 +108,7 @@ struct ParamOptions {
   std::string value;       ///< set: read as `ros2 param set` reads it (10 integer, 10.0 double, ...)
   std::vector<std::string> prefixes;  ///< list: only names under these prefixes
   double timeout_s = 5.0;  ///< how long to look for the node and wait for its answer
+  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
 };
 /// Adds the `param` subcommand with get/set/list/describe under `app`, parsing into `options`.
 CLI::App* add_param_subcommand(CLI::App& app, ParamOptions& options);
@@ -121,6 +127,7 @@ struct TopicOptions {
   std::string qos;           ///< "default" (reliable) or "sensor" (best effort); "": the verb's default
   int window = 10000;        ///< hz: intervals the statistics cover
   double duration_s = 0.0;   ///< hz: stop after this long (0: until Ctrl-C)
+  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
 };
 /// Adds the `topic` subcommand with list/echo/hz under `app`, parsing into `options`.
 CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& options);
@@ -131,8 +138,26 @@ struct RecordOptions {
   std::string ns = "/drone";        ///< the vehicle's namespace
   std::vector<std::string> topics;  ///< subset of the vehicle's topics (default: all)
   double duration_s = -1.0;         ///< stop after this wall time [s] (default: Ctrl-C)
+  std::string enclave = "/";        ///< DDS Security enclave (rcl --enclave)
 };
 int record_command(const RecordOptions& options);
+
+/// `quadcosim security create-keystore|create-enclave|check` (security_command.cpp). Exit 0 on
+/// success, 1 when check finds problems, 2 on bad input (an existing keystore, a bad name or topic).
+struct SecurityOptions {
+  std::string verb;                       ///< set by the subcommand parsed
+  std::string dir;                        ///< the keystore
+  std::string name;                       ///< the enclave (create-enclave, check)
+  std::vector<std::string> deny_publish;  ///< create-enclave: ROS topics the enclave may not publish
+  int domain_id = -1;                     ///< < 0: ROS_DOMAIN_ID (or 0), as sros2 does
+};
+CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& options);
+int security_command(const SecurityOptions& options);
+/// Adds `--enclave NAME` (validated as rcl validates enclave names) to a DDS command.
+void add_enclave_option(CLI::App* command, std::string& enclave);
+/// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
+/// existing ones are used as they are. 0, or 2 after printing why not.
+int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);
 
 /// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
 /// override); returns false (after printing why) when it fails.

@@ -30,7 +30,7 @@ int controller_command(const ControllerCommandOptions& o) {
     const double dt_s = static_cast<double>(control_period_ns) / 1e9;
     const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
 
-    dds::DdsTransport transport(dds::read_ros_environment());
+    dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
     if (o.sensor_qos) use_sensor_qos(transport, topics);
     sim::ControllerNode node(transport, topics, sc.controller);
     const dds::NodeName ros_name = dds::parse_node_name(o.node_name);

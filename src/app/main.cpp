@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"inproc", "dds"}));
   run_cmd->add_option("--timeout", run.timeout_s, "dds: lockstep wait for a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
+  run_cmd->add_option("--keystore", run.keystore,
+                      "dds: run secured (SROS2 keystore, Enforce); created when missing, with enclaves "
+                      "/quadcosim/plant and /quadcosim/controller");
   run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
   run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
@@ -78,6 +81,8 @@ int main(int argc, char** argv) {
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
 
+  add_enclave_option(plant_cmd, plant.enclave);
+
   ControllerCommandOptions ctl;
   auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
   ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
@@ -103,6 +108,8 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--stats", ctl.stats, "real time: write the control period jitter as JSON here on exit");
   ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
       ->check(CLI::Validator(check_node_name, "NAME"));
+
+  add_enclave_option(ctl_cmd, ctl.enclave);
 
   OpenloopOptions ol;
   auto* ol_cmd = app.add_subcommand("openloop", "the plant alone under a rotor speed schedule");
@@ -155,6 +162,11 @@ int main(int argc, char** argv) {
   rec_cmd->add_option("--duration", rec.duration_s, "stop after this many seconds (default: Ctrl-C)")
       ->check(CLI::Range(0.0, 1e9));
 
+  add_enclave_option(rec_cmd, rec.enclave);
+
+  SecurityOptions sec;
+  auto* sec_cmd = add_security_subcommand(app, sec);
+
   BenchOptions bench;
   bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
   bench.swarm_scenario = QUADCOSIM_SCENARIOS_DIR "/swarm/grid_takeoff.yaml";
@@ -185,6 +197,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (*bench_cmd) return bench_command(bench);
+  if (*sec_cmd) return security_command(sec);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);

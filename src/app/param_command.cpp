@@ -28,6 +28,7 @@ CLI::App* add_param_subcommand(CLI::App& app, ParamOptions& o) {
         ->check(CLI::Validator(check_node_name, "NODE"));
     verb->add_option("--timeout", o.timeout_s, "how long to look for the node and wait for its answer [s]")
         ->check(CLI::Range(0.01, 3600.0));
+    add_enclave_option(verb, o.enclave);
   };
 
   auto* get = param->add_subcommand("get", "print a parameter's value, as `ros2 param get`");
@@ -89,7 +90,7 @@ int param_command(const ParamOptions& o) {
   try {
     const dds::NodeName node = dds::parse_node_name(o.node);
     const auto timeout_ns = static_cast<std::int64_t>(o.timeout_s * 1e9);
-    dds::ParameterClient client(dds::read_ros_environment(), node);
+    dds::ParameterClient client(dds::read_ros_environment(o.enclave), node);
     if (o.verb == "get") {
       const auto values = client.get({o.name}, timeout_ns);
       if (values.empty()) return not_set(node, o.name);

@@ -38,7 +38,7 @@ class PlantProcess {
         clock_(sc_.simulation.plant.clock),
         divider_(sc_.simulation.controller_divider),
         topics_(sim::Topics::for_namespace(sc_.simulation.ns)),
-        transport_(dds::read_ros_environment()),
+        transport_(dds::read_ros_environment(o.enclave)),
         plant_(make_plant()),
         announcer_(transport_.participant().handle(), "quadrotor_plant") {
     status_.header.stamp = msg::Time::from_ns(-1);

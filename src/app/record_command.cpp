@@ -34,7 +34,7 @@ int record_command(const RecordOptions& o) {
     }
     const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);  // a bag folder, as ros2 bag makes
-    dds::DdsTransport transport(dds::read_ros_environment());
+    dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
     io::McapRecorder recorder(o.out, transport, topics, o.topics);
     std::cerr << fmt::format("record: domain {}, writing {} (Ctrl-C to stop)\n",
                              transport.participant().domain_id(), o.out);

@@ -1,6 +1,7 @@
 // `quadcosim run SCENARIO --out DIR`
 #include <fmt/format.h>
 
+#include <stdlib.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -72,6 +73,19 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     controller_args.push_back("--no-schedule");
     for (std::string a : {"--schedule-via", "/attitude_controller"}) plant_args.push_back(a);
   }
+  if (!opt.keystore.empty()) {
+    // Secured: each node in its own enclave of the keystore, strategy Enforce (the children inherit
+    // the environment; an enclave override would put both in one enclave, so it is dropped).
+    const std::string keystore = fs::absolute(opt.keystore).string();
+    const std::string plant_enclave = "/quadcosim/plant", controller_enclave = "/quadcosim/controller";
+    if (int rc = prepare_keystore_for_run(keystore, {plant_enclave, controller_enclave}); rc != 0) return rc;
+    setenv("ROS_SECURITY_ENABLE", "true", 1);
+    setenv("ROS_SECURITY_STRATEGY", "Enforce", 1);
+    setenv("ROS_SECURITY_KEYSTORE", keystore.c_str(), 1);
+    unsetenv("ROS_SECURITY_ENCLAVE_OVERRIDE");
+    controller_args.insert(controller_args.end(), {"--enclave", controller_enclave});
+    plant_args.insert(plant_args.end(), {"--enclave", plant_enclave});
+  }
   if (opt.realtime) {
     for (std::string a : {"--realtime", "--rate-factor"}) controller_args.push_back(a);
     controller_args.push_back(fmt::format("{}", opt.rate_factor));
@@ -110,6 +124,11 @@ int run_command(const RunOptions& opt) {
     sc = io::load_scenario(opt.scenario);
   } catch (const io::ConfigError& e) {
     std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  }
+
+  if (!opt.keystore.empty() && opt.transport != "dds") {
+    std::cerr << "error: --keystore secures the DDS transport; add --transport dds\n";
     return 2;
   }
 

@@ -68,8 +68,8 @@ int run_threads(int threads, F body) {
 class PlantShard {
  public:
   PlantShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, const std::vector<bool>& recorded,
-             const fs::path& out, bool sensor_qos)
-      : sc_(sc), clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment()), first_(first) {
+             const fs::path& out, bool sensor_qos, const std::string& enclave)
+      : sc_(sc), clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment(enclave)), first_(first) {
     const model::State initial = io::initial_state(sc);
     for (int i = first; i < last; ++i) {
       const sim::SwarmVehicle v =
@@ -201,8 +201,9 @@ class PlantShard {
 // One thread's share of the controllers.
 class ControllerShard {
  public:
-  ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, bool sensor_qos)
-      : clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment()) {
+  ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, bool sensor_qos,
+                  const std::string& enclave)
+      : clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment(enclave)) {
     const model::State initial = io::initial_state(sc);
     for (int i = first; i < last; ++i) {
       sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
@@ -276,7 +277,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   for (int t = 0; t < threads; ++t) {
     shards[static_cast<std::size_t>(t)] =
         std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm_out),
-                                     o.sensor_qos);
+                                     o.sensor_qos, o.enclave);
   }
   std::cerr << fmt::format("plant: {} vehicles ({}...), {} thread(s), lockstep, {} ticks of {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads, sc.simulation.duration_ticks,
@@ -326,7 +327,8 @@ int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc)
   const std::int64_t period_ns = sc.simulation.plant.clock.period_ns * sc.simulation.controller_divider;
   std::vector<std::unique_ptr<ControllerShard>> shards;
   for (int t = 0; t < threads; ++t) {
-    shards.push_back(std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads, o.sensor_qos));
+    shards.push_back(std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads, o.sensor_qos,
+                                                       o.enclave));
   }
   std::cerr << fmt::format("controller: {} vehicles ({}...), {} thread(s), lockstep, period {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads,

@@ -98,7 +98,7 @@ std::string normalized(std::string topic) {
 }
 
 int topic_list(const TopicOptions& o) {
-  const dds::RosEnvironment env = dds::read_ros_environment();
+  const dds::RosEnvironment env = dds::read_ros_environment(o.enclave);
   dds::Participant participant(env);
   const auto topics = dds::ros_topics(dds::discover_endpoints(participant.handle(), to_ns(o.wait_s)));
   std::cout << dds::format_topic_list(topics, o.show_types, o.include_hidden) << std::flush;
@@ -107,7 +107,7 @@ int topic_list(const TopicOptions& o) {
 
 int topic_echo(const TopicOptions& o) {
   const std::string topic = normalized(o.topic);
-  dds::DdsTransport transport(dds::read_ros_environment());
+  dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   const dds::RosTopic found = find_topic(transport, topic, o.wait_s);
   const dds::QosProfile qos = qos_named(o.qos);
   if (qos.reliable && found.publishers > 0 && found.best_effort_publishers == found.publishers) {
@@ -127,7 +127,7 @@ int topic_echo(const TopicOptions& o) {
 
 int topic_hz(const TopicOptions& o) {
   const std::string topic = normalized(o.topic);
-  dds::DdsTransport transport(dds::read_ros_environment());
+  dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   const dds::RosTopic found = find_topic(transport, topic, o.wait_s);
   if (found.publishers == 0) {
     std::cerr << fmt::format("WARNING: topic [{}] does not appear to be published yet\n", topic);
@@ -180,6 +180,7 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
   list->add_flag("-t,--show-types", o.show_types, "also each topic's type");
   list->add_flag("-a,--include-hidden-topics", o.include_hidden, "also topics with a token starting with '_'");
   list->add_option("--wait", o.wait_s, "discovery time [s] (default 1)")->check(CLI::Range(0.0, 3600.0));
+  add_enclave_option(list, o.enclave);
   list->callback([&o] { o.verb = "list"; });
 
   auto* echo = topic->add_subcommand("echo", "print a topic's messages as `ros2 topic echo`");
@@ -189,6 +190,7 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
   echo->add_option("--qos", o.qos, "default: reliable (ROS default); sensor: best effort (matches any writer)")
       ->check(CLI::IsMember({"default", "sensor"}));
   echo->add_option("--wait", o.wait_s, "how long to look for the topic [s] (default 5)")->check(CLI::Range(0.0, 3600.0));
+  add_enclave_option(echo, o.enclave);
   echo->callback([&o] { o.verb = "echo"; });
 
   auto* hz = topic->add_subcommand("hz", "a topic's rate as `ros2 topic hz`, every second");
@@ -199,6 +201,7 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
   hz->add_option("--qos", o.qos, "sensor (default): best effort, matches any writer; default: reliable")
       ->check(CLI::IsMember({"default", "sensor"}));
   hz->add_option("--wait", o.wait_s, "how long to look for the topic [s] (default 5)")->check(CLI::Range(0.0, 3600.0));
+  add_enclave_option(hz, o.enclave);
   hz->callback([&o] { o.verb = "hz"; });
   return topic;
 }

@@ -1,7 +1,10 @@
 #include "dds/participant.hpp"
 
+#include "security/keystore.hpp"
+
 #include <cerrno>
 #include <cstdlib>
+#include <iostream>
 #include <sstream>
 
 namespace quadcosim::dds {
@@ -20,8 +23,13 @@ std::string env(const char* name) {
 }
 }  // namespace
 
-RosEnvironment read_ros_environment() {
+RosEnvironment read_ros_environment(const std::string& enclave) {
   RosEnvironment e;
+  if (const std::string why = security::enclave_name_error(enclave); !why.empty()) {
+    throw DdsError("enclave '" + enclave + "': " + why);
+  }
+  e.enclave = enclave;
+  e.security = read_security_environment();
   const std::string id = env("ROS_DOMAIN_ID");
   if (!id.empty()) {
     errno = 0;
@@ -76,17 +84,32 @@ std::string cyclone_config(const RosEnvironment& e) {
 }
 
 Participant::Participant(const RosEnvironment& env) : domain_id_(env.domain_id) {
+  const SecurityPlan security = plan_security(env.security, env.enclave);  // throws under Enforce
+  if (!security.note.empty()) std::cerr << security.note << '\n';
   const std::string config = cyclone_config(env);
   domain_ = dds_create_domain(env.domain_id, config.c_str());
   // A domain with this id may already exist in this process (e.g. two nodes in one test): then the
   // participant joins it with the configuration it already has.
   if (domain_ < 0 && domain_ != DDS_RETCODE_PRECONDITION_NOT_MET) check(domain_, "dds_create_domain");
   dds_qos_t* qos = dds_create_qos();
-  static const char kUserData[] = "enclave=/;";
-  dds_qset_userdata(qos, kUserData, sizeof(kUserData) - 1);
+  // As rmw: the enclave given to the node (not the override, which only selects the files).
+  const std::string user_data = "enclave=" + env.enclave + ";";
+  dds_qset_userdata(qos, user_data.data(), user_data.size());
+  if (security.secured) set_security_qos(qos, security.root);
   participant_ = dds_create_participant(env.domain_id, qos, nullptr);
   dds_delete_qos(qos);
+  if (participant_ < 0 && domain_ > 0) {
+    dds_delete(domain_);
+    domain_ = 0;
+  }
+  if (participant_ < 0 && security.secured) {
+    throw DdsError("dds_create_participant with security (enclave " + security.enclave_used + ", " +
+                   security.root.string() + ") failed: " + dds_strretcode(participant_) +
+                   "; Cyclone's reason is in its log above (a domain id the governance or permissions do "
+                   "not cover, or a plugin that cannot be loaded, are common causes)");
+  }
   check(participant_, "dds_create_participant");
+  secured_ = security.secured;
 }
 
 Participant::~Participant() {

@@ -1,7 +1,7 @@
 // A DDS domain participant that looks like a ROS 2 node's to other ROS 2 participants: domain id from
 // ROS_DOMAIN_ID, discovery range from ROS_AUTOMATIC_DISCOVERY_RANGE / ROS_LOCALHOST_ONLY /
 // ROS_STATIC_PEERS (as rmw_cyclonedds maps them onto Cyclone's configuration), USER_DATA
-// "enclave=/;".
+// "enclave=<enclave>;", and DDS Security from ROS_SECURITY_* (dds/security.hpp).
 #pragma once
 
 #include <dds/dds.h>
@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+
+#include "dds/security.hpp"
 
 namespace quadcosim::dds {
 
@@ -29,12 +31,16 @@ struct RosEnvironment {
   DiscoveryRange range = DiscoveryRange::kSubnet;
   std::string static_peers;  ///< ';'-separated addresses
   std::string cyclonedds_uri;
+  std::string enclave = "/";     ///< the node's enclave (rcl --enclave): USER_DATA and security files
+  SecurityEnvironment security;  ///< ROS_SECURITY_*
 };
 
 /// Reads ROS_DOMAIN_ID (base 0 like strtoul; unset or empty: 0), ROS_AUTOMATIC_DISCOVERY_RANGE,
-/// ROS_LOCALHOST_ONLY=1 (forces LOCALHOST), ROS_STATIC_PEERS and CYCLONEDDS_URI. Throws DdsError
-/// naming the variable and value when one is malformed (e.g. a domain id above 232).
-RosEnvironment read_ros_environment();
+/// ROS_LOCALHOST_ONLY=1 (forces LOCALHOST), ROS_STATIC_PEERS, CYCLONEDDS_URI and the ROS_SECURITY_*
+/// variables; `enclave` is the node's enclave name ("/" unless --enclave says otherwise). Throws
+/// DdsError naming the variable and value when one is malformed (e.g. a domain id above 232), or the
+/// enclave when it is not a valid enclave name.
+RosEnvironment read_ros_environment(const std::string& enclave = "/");
 
 /// The Cyclone configuration XML for the environment, as rmw_cyclonedds builds it.
 std::string cyclone_config(const RosEnvironment& env);
@@ -42,7 +48,10 @@ std::string cyclone_config(const RosEnvironment& env);
 /// RAII participant. Not copyable; deleting it deletes every entity it created.
 class Participant {
  public:
-  /// Creates the domain (with the configuration for `env`) and the participant.
+  /// Creates the domain (with the configuration for `env`) and the participant; with security on,
+  /// the participant carries the enclave's dds.sec.* properties (Enforce: throws DdsError naming
+  /// what is missing or unusable; Permissive: a warning on stderr and no security). A one-line note
+  /// on stderr says what was decided whenever security is on.
   explicit Participant(const RosEnvironment& env);
   ~Participant();
   Participant(const Participant&) = delete;
@@ -50,11 +59,14 @@ class Participant {
 
   dds_entity_t handle() const { return participant_; }
   std::uint32_t domain_id() const { return domain_id_; }
+  /// True when the participant runs with DDS Security (authenticated, access-controlled).
+  bool secured() const { return secured_; }
 
  private:
   dds_entity_t domain_ = 0;
   dds_entity_t participant_ = 0;
   std::uint32_t domain_id_ = 0;
+  bool secured_ = false;
 };
 
 /// The QoS rmw uses for `depth` KEEP_LAST, RELIABLE (or BEST_EFFORT), VOLATILE, XCDR1 only.
