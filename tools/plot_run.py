@@ -260,6 +260,8 @@ def load_metrics(path):
         "description": str(obj.get("description", "")),
         "passed": obj.get("passed") if isinstance(obj.get("passed"), bool) else None,
         "steps": clean,
+        # Position-hold figures (analysis.hold), passed through as written; None without one.
+        "hold": obj.get("hold") if isinstance(obj.get("hold"), dict) else None,
     }
 
 

@@ -209,6 +209,24 @@ def build_html(run_dir, metrics, version_text):
         if step["reference"].get("source"):
             w(f'<p class="source">reference source: {esc(step["reference"]["source"])}</p>')
 
+    hold = metrics.get("hold")
+    if hold:
+        hp = hold.get("passed")
+        w(f"<h2>Position hold from t = {esc(str(hold.get('after_s')))} s"
+          f"{esc('' if hp is None else (' — ok' if hp else ' — FAIL'))}</h2>")
+        crit = {c.get("figure"): c for c in hold.get("criteria", []) if isinstance(c, dict)}
+        w("<table>")
+        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
+        for key, value in (hold.get("figures") or {}).items():
+            c = crit.get(key)
+            band = _band(c) if c else "—"
+            status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
+            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+            ours = "—" if not plot_run._is_number(value) else f"{float(value):.3f} m"
+            w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
+              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
+        w("</table>")
+
     w("<h2>Figures</h2>")
     files = figure_files(run_dir)
     if not files:

@@ -122,6 +122,30 @@ class ReportTest(ToolTestBase):
         self.assertIn(">FAIL<", page)
         self.assertNotIn("data:image/png;base64,", page)  # no plots were made
 
+    def test_hold_section(self):
+        # A position-hold block (analysis.hold) is shown with its values, bands and verdict.
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
+        with open(os.path.join(run, "metrics.json")) as f:
+            m = json.load(f)
+        m["hold"] = {"after_s": 10.0,
+                     "figures": {"max_horizontal_error_m": 0.6125, "rms_horizontal_error_m": 0.25,
+                                 "max_vertical_error_m": None},
+                     "criteria": [{"figure": "max_horizontal_error_m", "min": None, "max": 0.5,
+                                   "value": 0.6125, "passed": False}],
+                     "passed": False}
+        m["passed"] = False
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            json.dump(m, f)
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
+            page = f.read()
+        self.assertIn("Position hold from t = 10.0 s — FAIL", page)
+        self.assertIn("0.613 m", page)
+        self.assertIn("≤ 0.5", page)
+        self.assertIn(">FAILED<", page)
+
     def test_missing_or_malformed_metrics_is_an_error(self):
         run = os.path.join(self.tmp, "run")
         make_run(run, [("z", 0.0, 0.0, 10.0)], n_rows=200, with_metrics=False)

@@ -2,6 +2,7 @@
 // failed, 2 bad input (file, flag), 3 an output could not be produced.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -158,6 +159,21 @@ void add_enclave_option(CLI::App* command, std::string& enclave);
 /// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
 /// existing ones are used as they are. 0, or 2 after printing why not.
 int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);
+/// `quadcosim sweep` (sweep_command.cpp): Monte Carlo over perturbed vehicle parameters and seeded
+/// noise. Exit 0 when at least min_pass_rate of the runs pass, 1 otherwise, 2 on bad input, 3 when an
+/// output cannot be written.
+struct SweepOptions {
+  std::string scenario;
+  int runs = 20;
+  std::uint64_t seed = 1;
+  std::vector<std::string> vary;   ///< KEY=P%
+  std::string out_dir;
+  int jobs = 2;                    ///< threads
+  double min_pass_rate = 1.0;
+  bool plots = true;
+};
+CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
+int sweep_command(const SweepOptions& options);
 
 /// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
 /// override); returns false (after printing why) when it fails.

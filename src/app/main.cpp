@@ -166,6 +166,8 @@ int main(int argc, char** argv) {
 
   SecurityOptions sec;
   auto* sec_cmd = add_security_subcommand(app, sec);
+  SweepOptions sweep;
+  auto* sweep_cmd = add_sweep_subcommand(app, sweep);
 
   BenchOptions bench;
   bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
@@ -198,6 +200,7 @@ int main(int argc, char** argv) {
   }
   if (*bench_cmd) return bench_command(bench);
   if (*sec_cmd) return security_command(sec);
+  if (*sweep_cmd) return sweep_command(sweep);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);

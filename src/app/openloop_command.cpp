@@ -34,6 +34,8 @@ int openloop_command(const OpenloopOptions& opt) {
   const auto last_tick = static_cast<sim::Tick>(std::floor(duration / clock.period_s() + 1e-9));
 
   const model::Quadrotor plant(vehicle);
+  const model::Environment idle;
+  const model::Environment* still_air = vehicle.aero.active() ? &idle : nullptr;
   model::State x = plant.initial_state({0.0, 0.0, opt.initial_z_m}, 0.0, false);
   try {
     io::TrajectoryWriter csv(opt.out);
@@ -43,7 +45,8 @@ int openloop_command(const OpenloopOptions& opt) {
       const double t = clock.seconds(k);
       while (next < rows.size() && rows[next].t_s <= t + 1e-12) cmd = rows[next++].omega_rad_s;
       csv.write(t, x, cmd, io::ControlColumns::none());
-      if (k < last_tick) plant.step(x, t, cmd, clock.period_s(), opt.substeps);
+      // Still air; the vehicle file's drag (vehicle.aero) acts on the motion through it.
+      if (k < last_tick) plant.step(x, t, cmd, clock.period_s(), opt.substeps, still_air);
     }
     csv.close();
   } catch (const std::exception& e) {

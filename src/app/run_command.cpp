@@ -180,14 +180,16 @@ int run_command(const RunOptions& opt) {
     }
 
     // Both transports are judged from what was recorded: the exact doubles of trajectory.csv.
-    const auto results = io::evaluate_steps(sc.steps, io::read_series(csv_path));
-    io::write_metrics_json((out / "metrics.json").string(), sc, results);
-    const std::string table = io::format_step_table(sc, results);
+    const io::Series series = io::read_series(csv_path);
+    const auto results = io::evaluate_steps(sc.steps, series);
+    const auto hold = sc.hold ? std::optional(io::evaluate_hold(*sc.hold, series)) : std::nullopt;
+    io::write_metrics_json((out / "metrics.json").string(), sc, results, hold);
+    const std::string table = io::format_step_table(sc, results, hold);
     std::ofstream((out / "metrics.txt").string()) << table;
     std::cout << table;
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir)) return 3;
-    return io::all_passed(results) ? 0 : 1;
+    return io::all_passed(results) && (!hold || hold->passed) ? 0 : 1;
   } catch (const control::CareError& e) {
     std::cerr << "error: " << opt.scenario << ": controller design failed: " << e.what() << '\n';
     return 2;

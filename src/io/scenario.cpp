@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "analysis/step_metrics.hpp"
+#include "io/realism_yaml.hpp"
 #include "io/yaml_reader.hpp"
 #include "sim/topics.hpp"
 
@@ -56,6 +57,7 @@ void read_vehicle(YamlSection& s, model::VehicleParams& v) {
     }
     m->reject_unknown_keys();
   }
+  if (auto a = s.section("aero")) read_aero(*a, v.aero);
   s.reject_unknown_keys();
   if (std::string err = model::validate(v); !err.empty()) s.fail("", err);
 }
@@ -134,7 +136,9 @@ void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duratio
   s.reject_unknown_keys();
 }
 
-void read_steps(YamlSection& analysis, std::vector<StepSpec>& steps, double duration_s) {
+void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
+  std::vector<StepSpec>& steps = sc.steps;
+  if (auto h = analysis.section("hold")) sc.hold = read_hold(*h, duration_s);
   const std::vector<std::string> channels = {"x", "y", "z", "roll", "pitch", "yaw"};
   int index = 0;
   for (const YAML::Node& n : analysis.sequence("steps")) {
@@ -231,6 +235,12 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
 
 }  // namespace
 
+const std::vector<std::string>& hold_figure_names() {
+  static const std::vector<std::string> names = {"max_horizontal_error_m", "rms_horizontal_error_m",
+                                                 "max_vertical_error_m"};
+  return names;
+}
+
 model::State initial_state(const Scenario& sc) {
   return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
 }
@@ -267,7 +277,8 @@ Scenario load_scenario(const std::string& path) {
   }
   if (auto c = root.section("controller")) read_parameters(*c, "", sc.controller, nullptr);
   read_schedule(root, sc, duration_s);
-  if (auto a = root.section("analysis")) read_steps(*a, sc.steps, duration_s);
+  read_realism(root, sc);
+  if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
   if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
   root.reject_unknown_keys();
   return sc;

@@ -52,6 +52,17 @@ struct SwarmSpec {
   std::vector<int> record_vehicles;  ///< vehicles whose full trajectory is written (default none)
 };
 
+/// Position hold (beyond the steps): from after_s on, how far the vehicle strays from its setpoint.
+/// Figures: max_horizontal_error_m (max of the horizontal distance to (x_des, y_des)),
+/// rms_horizontal_error_m, max_vertical_error_m (max |z - z_des|), all over t >= after_s.
+struct HoldSpec {
+  double after_s = 0.0;
+  std::vector<Criterion> criteria;
+};
+
+/// "max_horizontal_error_m", "rms_horizontal_error_m", "max_vertical_error_m".
+const std::vector<std::string>& hold_figure_names();
+
 struct Scenario {
   std::string path;  ///< file it was read from ("" for built-in defaults)
   std::string name;
@@ -63,6 +74,7 @@ struct Scenario {
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
   std::optional<SwarmSpec> swarm;  ///< present when the file has a `swarm:` section
+  std::optional<HoldSpec> hold;  ///< analysis.hold
 };
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).

@@ -86,12 +86,48 @@ bool all_passed(const std::vector<StepResult>& results) {
   return std::all_of(results.begin(), results.end(), [](const auto& r) { return r.passed; });
 }
 
+HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
+  HoldResult r;
+  r.spec = spec;
+  const auto& v = series.values;
+  const std::vector<std::string> need = {"x", "y", "z", "x_des", "y_des", "z_des"};
+  for (const auto& n : need) {
+    if (!v.count(n)) throw std::logic_error("no recorded series for " + n);
+  }
+  double max_h = 0.0, sum_h2 = 0.0, max_v = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < series.t_s.size(); ++i) {
+    if (series.t_s[i] < spec.after_s) continue;
+    const double dx = v.at("x")[i] - v.at("x_des")[i], dy = v.at("y")[i] - v.at("y_des")[i];
+    const double h = std::hypot(dx, dy);
+    const double dz = std::abs(v.at("z")[i] - v.at("z_des")[i]);
+    if (!std::isfinite(h) || !std::isfinite(dz)) continue;  // no setpoint recorded yet
+    max_h = std::max(max_h, h);
+    sum_h2 += h * h;
+    max_v = std::max(max_v, dz);
+    ++count;
+  }
+  if (count > 0) {
+    r.figures["max_horizontal_error_m"] = max_h;
+    r.figures["rms_horizontal_error_m"] = std::sqrt(sum_h2 / static_cast<double>(count));
+    r.figures["max_vertical_error_m"] = max_v;
+  }
+  for (const Criterion& c : spec.criteria) {
+    const auto it = r.figures.find(c.figure);
+    CriterionResult cr{c, it == r.figures.end() ? std::nullopt : std::optional<double>(it->second), false};
+    cr.passed = cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
+    r.passed = r.passed && cr.passed;
+    r.criteria.push_back(cr);
+  }
+  return r;
+}
+
 namespace {
 nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 }  // namespace
 
 void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results) {
+                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold) {
   nlohmann::json j;
   j["scenario"] = scenario.name;
   j["description"] = scenario.description;
@@ -122,13 +158,34 @@ void write_metrics_json(const std::string& path, const Scenario& scenario,
     s["passed"] = r.passed;
     j["steps"].push_back(s);
   }
-  j["passed"] = all_passed(results);
+  if (hold) {
+    nlohmann::json h;
+    h["after_s"] = hold->spec.after_s;
+    nlohmann::json figs = nlohmann::json::object();
+    for (const auto& name : hold_figure_names()) {
+      const auto it = hold->figures.find(name);
+      figs[name] = it == hold->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
+    }
+    h["figures"] = figs;
+    h["criteria"] = nlohmann::json::array();
+    for (const auto& c : hold->criteria) {
+      h["criteria"].push_back({{"figure", c.criterion.figure},
+                               {"min", opt(c.criterion.min)},
+                               {"max", opt(c.criterion.max)},
+                               {"value", opt(c.value)},
+                               {"passed", c.passed}});
+    }
+    h["passed"] = hold->passed;
+    j["hold"] = h;
+  }
+  j["passed"] = all_passed(results) && (!hold || hold->passed);
   std::ofstream out(path);
   out << j.dump(2) << '\n';
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
-std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results) {
+std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
+                              const std::optional<HoldResult>& hold) {
   std::string s = fmt::format("scenario {}\n", scenario.name);
   for (const StepResult& r : results) {
     s += fmt::format("step {} {:g} -> {:g} at t = {:g} s: {}\n", r.spec.channel, r.figures.initial,
@@ -146,6 +203,21 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
       const auto ref = r.spec.reference.find(name);
       s += fmt::format("  {:<24} {:>10} {:>22} {:>7} {:>10}\n", name, v ? fmt::format("{:.3f}", *v) : "-",
                        crit, verdict, ref != r.spec.reference.end() ? fmt::format("{:g}", ref->second) : "");
+    }
+  }
+  if (hold) {
+    s += fmt::format("hold from t = {:g} s: {}\n", hold->spec.after_s, hold->passed ? "PASS" : "FAIL");
+    for (const auto& name : hold_figure_names()) {
+      const auto it = hold->figures.find(name);
+      std::string crit, verdict;
+      for (const auto& c : hold->criteria) {
+        if (c.criterion.figure != name) continue;
+        crit = fmt::format("[{}, {}]", c.criterion.min ? fmt::format("{:g}", *c.criterion.min) : "-",
+                           c.criterion.max ? fmt::format("{:g}", *c.criterion.max) : "-");
+        verdict = c.passed ? "ok" : "FAIL";
+      }
+      s += fmt::format("  {:<24} {:>10} {:>22} {:>7}\n", name,
+                       it != hold->figures.end() ? fmt::format("{:.3f}", it->second) : "-", crit, verdict);
     }
   }
   return s;

@@ -33,6 +33,14 @@ struct StepResult {
   bool passed = true;
 };
 
+/// The position-hold figures (HoldSpec) of a run and their verdicts.
+struct HoldResult {
+  HoldSpec spec;
+  std::map<std::string, double> figures;  ///< by hold_figure_names(); absent when no sample follows after_s
+  std::vector<CriterionResult> criteria;
+  bool passed = true;
+};
+
 /// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des). Throws
 /// std::runtime_error naming the file and the missing column or bad line.
 Series read_series(const std::string& trajectory_csv);
@@ -42,11 +50,16 @@ std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const
 
 bool all_passed(const std::vector<StepResult>& results);
 
+/// Evaluates the hold criterion over the samples with t >= spec.after_s.
+HoldResult evaluate_hold(const HoldSpec& spec, const Series& series);
+
 /// Writes metrics.json (schema in docs/outputs.md). Throws std::runtime_error on I/O failure.
+/// `hold`, when given, is written under "hold" and counts in "passed".
 void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results);
+                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold = {});
 
 /// A fixed-width table: one line per figure with value, criterion, verdict and reference.
-std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results);
+std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
+                              const std::optional<HoldResult>& hold = {});
 
 }  // namespace quadcosim::io

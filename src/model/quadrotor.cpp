@@ -31,7 +31,8 @@ Wrench Quadrotor::wrench(const Vector4& omega) const {
 
 bool Quadrotor::on_ground(const State& x) const { return x.p_W.z() <= 0.0 && x.v_W.z() <= 0.0; }
 
-StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd) const {
+StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd,
+                                      const Environment* env) const {
   StateDerivative d;
   const bool ideal = params_.motor.model == MotorModel::kIdeal;
   const Vector4 omega = ideal ? cmd : x.omega_rad_s;
@@ -46,11 +47,12 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
     }
   }
 
-  const Wrench f = wrench(omega);
+  const Wrench f = env ? environment_wrench(omega, x, *env) : wrench(omega);
   const Eigen::Matrix3d R_WB = x.q_WB.toRotationMatrix();
   d.p_W = x.v_W;
   d.v_W = R_WB.col(2) * (f.thrust_N / params_.mass_kg);
   d.v_W.z() -= params_.gravity_m_s2;
+  if (env) d.v_W += aero_force_W(params_.aero, R_WB, x.v_W, env->wind_W, omega) / params_.mass_kg;
 
   const Eigen::Vector3d& w = x.w_B;
   Eigen::Vector3d tau = f.torque_B_Nm;
@@ -74,8 +76,13 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
   return d;
 }
 
-Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd) const {
-  const StateDerivative d = derivative(t_s, x, clamp_command(cmd));
+Wrench Quadrotor::environment_wrench(const Vector4& omega, const State& x, const Environment& env) const {
+  const Vector4 u = mixer_ * env.rotor_efficiency.cwiseProduct(omega.cwiseProduct(omega));
+  return {u[0] * ground_effect_factor(params_.aero, x.p_W.z()), u.tail<3>()};
+}
+
+Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const Environment* env) const {
+  const StateDerivative d = derivative(t_s, x, clamp_command(cmd), env);
   Eigen::Vector3d a_minus_g = d.v_W;
   a_minus_g.z() += params_.gravity_m_s2;
   return {x.p_W, x.q_WB, x.v_W, x.w_B, x.q_WB.conjugate() * a_minus_g};
@@ -111,16 +118,17 @@ StateDerivative weighted_sum(const StateDerivative& k1, const StateDerivative& k
 
 }  // namespace
 
-void Quadrotor::step(State& x, double t_s, const Vector4& cmd_in, double dt_s, int substeps) const {
+void Quadrotor::step(State& x, double t_s, const Vector4& cmd_in, double dt_s, int substeps,
+                     const Environment* env) const {
   assert(substeps >= 1);
   const Vector4 cmd = clamp_command(cmd_in);
   const double h = dt_s / substeps;
   for (int s = 0; s < substeps; ++s) {
     const double t = t_s + s * h;
-    const StateDerivative k1 = derivative(t, x, cmd);
-    const StateDerivative k2 = derivative(t + 0.5 * h, add_scaled(x, k1, 0.5 * h), cmd);
-    const StateDerivative k3 = derivative(t + 0.5 * h, add_scaled(x, k2, 0.5 * h), cmd);
-    const StateDerivative k4 = derivative(t + h, add_scaled(x, k3, h), cmd);
+    const StateDerivative k1 = derivative(t, x, cmd, env);
+    const StateDerivative k2 = derivative(t + 0.5 * h, add_scaled(x, k1, 0.5 * h), cmd, env);
+    const StateDerivative k3 = derivative(t + 0.5 * h, add_scaled(x, k2, 0.5 * h), cmd, env);
+    const StateDerivative k4 = derivative(t + h, add_scaled(x, k3, h), cmd, env);
     x = add_scaled(x, weighted_sum(k1, k2, k3, k4), h);
     x.q_WB.normalize();
     if (x.p_W.z() < 0.0) {  // touched down during the step: inelastic impact, held by friction

@@ -63,21 +63,30 @@ class Quadrotor {
   ///  - rotors: ideal (derivative 0, speeds = command) or first-order lag.
   /// Ground contact: while resting on z = 0 and the forces would push it down, the ground (with
   /// friction) holds the vehicle: all accelerations are zero.
-  StateDerivative derivative(double t_s, const State& x, const Vector4& omega_cmd_rad_s) const;
+  /// With an Environment (model/aero.hpp) the rotors' thrust and drag torque are scaled by their
+  /// efficiencies, the collective thrust by the ground effect, and the drag of the air moving at
+  /// env->wind_W enters the translation; without one (nullptr) the model is exactly the paper's.
+  StateDerivative derivative(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
+                             const Environment* env = nullptr) const;
 
   /// Sensor outputs at state x under the given command (the command sets the acceleration that the
   /// accelerometer measures).
-  Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s) const;
+  Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
+                  const Environment* env = nullptr) const;
 
   /// Advances x by dt_s with `substeps` classical RK4 steps, command held constant. After each step
   /// the quaternion is renormalised and ground contact is enforced (z >= 0; an impact is inelastic).
-  void step(State& x, double t_s, const Vector4& omega_cmd_rad_s, double dt_s, int substeps) const;
+  /// `env` (optional) is held constant over the step.
+  void step(State& x, double t_s, const Vector4& omega_cmd_rad_s, double dt_s, int substeps,
+            const Environment* env = nullptr) const;
 
   /// A state at rest at p_W with rotors stopped (or at hover speed when `hover` is true).
   State initial_state(const Eigen::Vector3d& p_W, double yaw_rad, bool hover) const;
 
  private:
   bool on_ground(const State& x) const;
+  /// Eq. (4) with each rotor's efficiency and the ground effect on U1.
+  Wrench environment_wrench(const Vector4& omega, const State& x, const Environment& env) const;
 
   VehicleParams params_;
   Matrix4 mixer_;

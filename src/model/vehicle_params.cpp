@@ -59,7 +59,7 @@ std::string validate(const VehicleParams& p) {
       << p.spin[0] << ", " << p.spin[1] << ", " << p.spin[2] << ", " << p.spin[3] << "]";
     return s.str();
   }
-  return {};
+  return validate(p.aero);
 }
 
 std::string validate_step(const VehicleParams& p, double period_s, int substeps) {

@@ -4,6 +4,8 @@
 #include <array>
 #include <string>
 
+#include "model/aero.hpp"
+
 namespace quadcosim::model {
 
 /// Arrangement of the four rotors in the body (FLU) frame.
@@ -53,6 +55,7 @@ struct VehicleParams {
   std::array<int, 4> spin = {+1, -1, +1, -1};
   MotorParams motor;
   GyroscopicModel gyroscopic = GyroscopicModel::kFull;
+  AeroParams aero;  ///< drag and ground effect (all zero: none, as in the paper)
 
   /// [rad/s] speed at which four equal rotors carry the weight: sqrt(m g / (4 k_t)).
   double hover_omega_rad_s() const;

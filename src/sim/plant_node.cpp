@@ -15,6 +15,11 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
     : model_(vehicle), options_(options), state_(initial), applied_(initial.omega_rad_s) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   status_pub_ = transport.advertise<msg::PlantStatus>(topics.plant_status);
+  if (options.realism.active() || vehicle.aero.active()) {
+    // The vehicle's namespace names its noise streams: /drone/Pose -> /drone.
+    const std::string ns = topics.pose.substr(0, topics.pose.rfind('/'));
+    realism_ = std::make_unique<PlantRealism>(options.realism, vehicle, ns, options.clock);
+  }
   if (options.publish_clock) clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
   pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
   velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
@@ -77,7 +82,8 @@ void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
   const msg::Header header{stamp, options_.frame_id};
-  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_);
+  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_,
+                                          realism_ ? &realism_->environment(k) : nullptr);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
   publish_status(k);
@@ -86,19 +92,26 @@ void PlantNode::publish_outputs(Tick k) {
   pose.header = header;
   pose.position = to_msg(y.p_W);
   pose.orientation = to_msg(y.q_WB);
-  pose_pub_.publish(pose);
 
   msg::TwistStamped twist;
   twist.header = header;
   twist.linear = to_msg(y.v_W);
   twist.angular = to_msg(y.w_B);
-  velocity_pub_.publish(twist);
 
   msg::Imu imu;
   imu.header = msg::Header{stamp, "base_link"};
   imu.orientation = to_msg(y.q_WB);
   imu.angular_velocity = to_msg(y.w_B);
   imu.linear_acceleration = to_msg(y.specific_force_B);
+  if (realism_) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
+    const PlantRealism::Due due = realism_->measure(k, y, pose, twist, imu);
+    if (due.pose) pose_pub_.publish(pose);
+    if (due.velocity) velocity_pub_.publish(twist);
+    if (due.imu) imu_pub_.publish(imu);
+    return;
+  }
+  pose_pub_.publish(pose);
+  velocity_pub_.publish(twist);
   imu_pub_.publish(imu);
 }
 
@@ -117,8 +130,8 @@ void PlantNode::latch_command(Tick k) {
 }
 
 void PlantNode::integrate(Tick k) {
-  model_.step(state_, options_.clock.seconds(k), applied_, options_.clock.period_s(),
-              options_.substeps);
+  model_.step(state_, options_.clock.seconds(k), applied_, options_.clock.period_s(), options_.substeps,
+              realism_ ? &realism_->environment(k) : nullptr);
 }
 
 }  // namespace quadcosim::sim

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <functional>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
+#include "sim/realism.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 #include "sim/validation.hpp"
@@ -24,6 +26,8 @@ struct PlantOptions {
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
   /// (a repeat) and is dropped instead of overriding the current one.
   bool drop_stale_commands = false;
+  /// Sensor noise, rates and latency, wind, rotor faults (sim/realism.hpp); all off by default.
+  RealismConfig realism;
   /// /<ns>/plant_status goes out on every tick whose counters changed and at least every this many
   /// ticks; 0: once per simulated second.
   Tick status_period_ticks = 0;
@@ -91,6 +95,8 @@ class PlantNode {
   std::vector<Pending> pending_;
   std::size_t pending_head_ = 0;
   PlantStats stats_;
+  /// Present when options.realism or the vehicle's drag asks for it; null keeps the paper's plant.
+  std::unique_ptr<PlantRealism> realism_;
   std::function<void(const std::string&)> log_;
   LogThrottle rejected_log_, clamped_log_;
   msg::PlantStatus status_;

@@ -9,7 +9,8 @@
 //   5. the tick is recorded (state at t_k, command over [t_k, t_k+1), the controller's latest status
 //      as received on its status topic);
 //   6. the plant integrates to t_k+1 (not after the last tick).
-// Same inputs, same bytes: nothing here reads a wall clock or a random source.
+// Same inputs, same bytes: nothing here reads a wall clock or an unseeded random source (the plant's
+// noise comes from the scenario's seed, sim/realism.hpp).
 #pragma once
 
 #include <functional>

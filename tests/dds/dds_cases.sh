@@ -37,6 +37,15 @@ case "$case_name" in
     paper="$src/tests/dds"
     identical midrun_schedule
     ;;
+  identical_realism)  # sensor noise, latency, rates, wind, gusts, drag, a rotor fault: the same bytes
+    paper="$src/tests/dds"
+    identical realism_lockstep
+    grep -q '"hold"' "$tmp/dds/metrics.json" || fail "no hold figures"
+    # The noise is really drawn from the seed: another seed flies another path.
+    sed 's/^seed: 2024$/seed: 2025/' "$paper/realism_lockstep.yaml" > "$tmp/seed2025.yaml"
+    "$bin" run "$tmp/seed2025.yaml" --out "$tmp/other" --no-plots > "$tmp/other.log" 2>&1 || fail "seed 2025 run failed"
+    if cmp -s "$tmp/in/trajectory.csv" "$tmp/other/trajectory.csv"; then fail "the seed changed nothing"; fi
+    ;;
 
   realtime_altitude|realtime_roll|realtime_pitch|realtime_yaw)  # the paper's setup: wall-clock paced
     # The accepted bands of the scenario must hold in real time too (exit 0 = every criterion met).

@@ -1,0 +1,149 @@
+#include "io/realism_yaml.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "model/wind.hpp"
+
+namespace quadcosim::io {
+
+namespace {
+
+constexpr double kBig = 1e6;
+
+Eigen::Vector3d vec3(YamlSection& s, const std::string& key, const Eigen::Vector3d& fallback, double min,
+                     double max) {
+  const auto v = s.numbers(key, {fallback.x(), fallback.y(), fallback.z()}, 3);
+  for (double e : v) {
+    if (e < min || e > max) s.fail(key, fmt::format("got an entry {:g}, expected numbers in [{:g}, {:g}]", e, min, max));
+  }
+  return {v[0], v[1], v[2]};
+}
+
+// rate_hz -> a whole divisor of the plant tick that is also a whole divisor of the controller
+// period (lockstep needs a complete Pose/Velocity/Imu sample at every control tick); latency_ticks.
+sim::SensorTiming read_timing(YamlSection& s, const sim::SimulationConfig& cfg) {
+  sim::SensorTiming t;
+  const double plant_hz = 1e9 / static_cast<double>(cfg.plant.clock.period_ns);
+  const double rate = s.number("rate_hz", plant_hz, 1e-6, plant_hz);
+  const double div = plant_hz / rate;
+  if (std::abs(div - std::round(div)) > 1e-9 || cfg.controller_divider % static_cast<int>(std::round(div)) != 0) {
+    s.fail("rate_hz", fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
+                                  "also divides the controller period ({} plant ticks), e.g. {:g} or {:g}",
+                                  rate, plant_hz, cfg.controller_divider, plant_hz,
+                                  plant_hz / cfg.controller_divider));
+  }
+  t.divider = static_cast<int>(std::round(div));
+  t.latency_ticks = static_cast<int>(s.integer("latency_ticks", 0, 0, 1000));
+  return t;
+}
+
+}  // namespace
+
+void read_aero(YamlSection& s, model::AeroParams& a) {
+  a.linear_drag_N_s_m = vec3(s, "linear_drag_N_s_m", a.linear_drag_N_s_m, 0.0, kBig);
+  a.quadratic_drag_N_s2_m2 = vec3(s, "quadratic_drag_N_s2_m2", a.quadratic_drag_N_s2_m2, 0.0, kBig);
+  a.rotor_drag_N_s_m_per_rad_s = s.number("rotor_drag_N_s_m_per_rad_s", a.rotor_drag_N_s_m_per_rad_s, 0.0, 1.0);
+  a.ground_effect_rotor_radius_m = s.number("ground_effect_rotor_radius_m", a.ground_effect_rotor_radius_m, 0.0, 100.0);
+  s.reject_unknown_keys();
+}
+
+void read_realism(YamlSection& root, Scenario& sc) {
+  sim::RealismConfig& r = sc.simulation.plant.realism;
+  const auto& cfg = sc.simulation;
+  r.seed = static_cast<std::uint64_t>(root.integer("seed", 0, 0, std::numeric_limits<long long>::max()));
+  if (auto s = root.section("sensors")) {
+    if (auto i = s->section("imu")) {
+      r.imu.timing = read_timing(*i, cfg);
+      r.imu.gyro_noise_density = i->number("gyro_noise_density_rad_s_sqrt_hz", 0.0, 0.0, 10.0);
+      r.imu.gyro_bias_random_walk = i->number("gyro_bias_random_walk_rad_s2_sqrt_hz", 0.0, 0.0, 10.0);
+      r.imu.gyro_bias_initial = i->number("gyro_bias_initial_rad_s", 0.0, 0.0, 10.0);
+      r.imu.accel_noise_density = i->number("accel_noise_density_m_s2_sqrt_hz", 0.0, 0.0, 100.0);
+      r.imu.accel_bias_random_walk = i->number("accel_bias_random_walk_m_s3_sqrt_hz", 0.0, 0.0, 100.0);
+      r.imu.accel_bias_initial = i->number("accel_bias_initial_m_s2", 0.0, 0.0, 100.0);
+      r.imu.orientation_sigma_rad = i->number("orientation_sigma_rad", 0.0, 0.0, 1.0);
+      i->reject_unknown_keys();
+    }
+    if (auto p = s->section("pose")) {
+      r.pose.timing = read_timing(*p, cfg);
+      r.pose.position_sigma_m = p->number("position_sigma_m", 0.0, 0.0, 1e3);
+      r.pose.orientation_sigma_rad = p->number("orientation_sigma_rad", 0.0, 0.0, 1.0);
+      p->reject_unknown_keys();
+    }
+    if (auto v = s->section("velocity")) {
+      r.velocity.timing = read_timing(*v, cfg);
+      r.velocity.linear_sigma_m_s = v->number("linear_sigma_m_s", 0.0, 0.0, 1e3);
+      r.velocity.angular_sigma_rad_s = v->number("angular_sigma_rad_s", 0.0, 0.0, 100.0);
+      v->reject_unknown_keys();
+    }
+    s->reject_unknown_keys();
+  }
+  if (auto e = root.section("environment")) {
+    r.wind.mean_W_m_s = vec3(*e, "wind_m_s", r.wind.mean_W_m_s, -200.0, 200.0);
+    if (auto g = e->section("gusts")) {
+      r.wind.gusts.enabled = true;
+      r.wind.gusts.w20_m_s = g->number("w20_m_s", r.wind.gusts.w20_m_s, 0.0, 100.0);
+      r.wind.gusts.altitude_m = g->number("altitude_m", r.wind.gusts.altitude_m, 1e-3, 1e4);
+      r.wind.gusts.airspeed_m_s = g->number("airspeed_m_s", r.wind.gusts.airspeed_m_s, 0.0, 200.0);
+      g->reject_unknown_keys();
+    }
+    e->reject_unknown_keys();
+  }
+  const double duration_s = cfg.plant.clock.seconds(cfg.duration_ticks);
+  int index = 0;
+  for (const YAML::Node& n : root.sequence("faults")) {
+    const std::string where = "faults[" + std::to_string(index++) + "]";
+    if (!n.IsMap()) root.fail(where, "expected a mapping with at_s, rotor, efficiency");
+    YamlSection s(n, root.file(), root.key_path(where));
+    sim::RotorFault f;
+    if (!s.has("rotor")) s.fail("rotor", "missing; expected the rotor number 1..4");
+    const double at = s.number("at_s", 0.0, 0.0, duration_s);
+    const double ticks = at / cfg.plant.clock.period_s();
+    if (std::abs(ticks - std::round(ticks)) > 1e-6) {
+      s.fail("at_s", fmt::format("got {:g} s, expected a whole number of plant periods ({:g} s)", at,
+                                 cfg.plant.clock.period_s()));
+    }
+    f.tick = static_cast<sim::Tick>(std::round(ticks));
+    f.rotor = static_cast<int>(s.integer("rotor", 1, 1, 4)) - 1;
+    f.efficiency = s.number("efficiency", 0.0, 0.0, 1.0);
+    s.reject_unknown_keys();
+    r.faults.push_back(f);
+  }
+  std::stable_sort(r.faults.begin(), r.faults.end(), [](const auto& a, const auto& b) { return a.tick < b.tick; });
+  if (std::string err = model::validate(r.wind); !err.empty()) root.fail("environment", err);
+}
+
+HoldSpec read_hold(YamlSection& s, double duration_s) {
+  HoldSpec h;
+  h.after_s = s.number("after_s", 0.0, 0.0, duration_s);
+  auto c = s.section("criteria");
+  if (!c) s.fail("criteria", "missing; expected e.g. {max_horizontal_error_m: [null, 0.5]}");
+  for (const std::string& fig : c->keys()) {
+    const auto& names = hold_figure_names();
+    if (std::find(names.begin(), names.end(), fig) == names.end()) {
+      c->fail(fig, "unknown hold figure (expected max_horizontal_error_m, rms_horizontal_error_m or "
+                   "max_vertical_error_m)");
+    }
+    const YAML::Node b = c->raw(fig);
+    if (!b.IsSequence() || b.size() != 2) c->fail(fig, "expected [min, max] (null for no bound)");
+    Criterion crit{fig, std::nullopt, std::nullopt};
+    for (int i = 0; i < 2; ++i) {
+      if (b[i].IsNull()) continue;
+      try {
+        (i == 0 ? crit.min : crit.max) = b[i].as<double>();
+      } catch (const YAML::Exception&) {
+        c->fail(fig, "got '" + b[i].Scalar() + "', expected a number or null");
+      }
+    }
+    if (crit.min && crit.max && *crit.min > *crit.max) c->fail(fig, "min is above max");
+    h.criteria.push_back(crit);
+  }
+  if (h.criteria.empty()) s.fail("criteria", "expected at least one figure");
+  s.reject_unknown_keys();
+  return h;
+}
+
+}  // namespace quadcosim::io

@@ -1,0 +1,21 @@
+// The scenario keys of the realism models (docs/scenarios.md, "Realism"): `seed`, `sensors`,
+// `environment`, `faults`, `vehicle.aero` and `analysis.hold`. Every reader throws ConfigError
+// naming file, key and value.
+#pragma once
+
+#include "io/scenario.hpp"
+#include "io/yaml_reader.hpp"
+
+namespace quadcosim::io {
+
+/// `vehicle.aero`: drag coefficients and ground effect.
+void read_aero(YamlSection& s, model::AeroParams& a);
+
+/// Top-level `seed`, `sensors`, `environment`, `faults` into sc.simulation.plant.realism. Needs the
+/// simulation section read first (rates and duration).
+void read_realism(YamlSection& root, Scenario& sc);
+
+/// `analysis.hold`: the position-hold criterion.
+HoldSpec read_hold(YamlSection& s, double duration_s);
+
+}  // namespace quadcosim::io
