@@ -30,6 +30,16 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
 
 void PlantNode::on_command(const msg::Float64MultiArray& m) {
   ++stats_.commands_received;
+  // Lockstep repeats first, whatever their content: an answer to an earlier tick, or a second copy
+  // of the answer to this one (the controller sends its last command again when the plant repeats a
+  // tick). Dropped and counted apart, so the other counters are those of a run without repeats.
+  const std::int64_t stamp = msg::command_stamp_ns(m);
+  if (options_.drop_stale_commands && stamp >= 0 &&
+      (stamp < options_.clock.ns(current_tick_) || stamp == last_label_seen_ns_)) {
+    ++stats_.commands_stale;
+    return;
+  }
+  if (stamp >= 0) last_label_seen_ns_ = stamp;
   const CommandCheck check = validate_command(m, model_.params().motor.omega_max_rad_s);
   if (check.verdict == CommandVerdict::kRejected) {
     stats_.last_problem = check.reason;
@@ -39,11 +49,6 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
       log_("plant: motor command rejected (" + check.reason + "), last good command held; " +
            std::to_string(rejected_log_.total()) + " rejected so far (logged: 1st, then every 100th)");
     }
-    return;
-  }
-  const std::int64_t stamp = msg::command_stamp_ns(m);
-  if (options_.drop_stale_commands && stamp >= 0 && stamp < options_.clock.ns(current_tick_)) {
-    ++stats_.commands_stale;
     return;
   }
   ++stats_.commands_accepted;

@@ -23,8 +23,9 @@ struct PlantOptions {
   int substeps = 1;              ///< RK4 steps per plant tick
   int command_delay_ticks = 0;   ///< a command received during tick k takes effect at tick k + delay
   std::string frame_id = "world";
-  /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick
-  /// (a repeat) and is dropped instead of overriding the current one.
+  /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick,
+  /// and a second command with the label already received is a copy of it (the controller answers
+  /// a repeated tick again): both are repeats, dropped and counted in commands_stale.
   bool drop_stale_commands = false;
   /// Sensor noise, rates and latency, wind, rotor faults (sim/realism.hpp); all off by default.
   RealismConfig realism;
@@ -44,7 +45,7 @@ struct PlantStats {
   std::uint64_t commands_rejected_length = 0;      ///< of those: not exactly 4 values
   std::uint64_t commands_rejected_non_finite = 0;  ///< of those: a NaN/Inf speed
   std::uint64_t commands_clamped = 0;   ///< a speed < 0 or > omega_max: used clamped to [0, omega_max]
-  std::uint64_t commands_stale = 0;     ///< lockstep repeats of an earlier tick's command, dropped
+  std::uint64_t commands_stale = 0;     ///< lockstep repeats (an earlier tick's command, or a second copy of this one), dropped
   std::string last_problem;             ///< the reason given for the newest rejected/clamped command
 };
 
@@ -84,6 +85,7 @@ class PlantNode {
   model::State state_;
   Tick current_tick_ = 0;
   std::int64_t last_command_stamp_ns_ = -1;
+  std::int64_t last_label_seen_ns_ = -1;  ///< newest command label received (accepted or not)
   model::Vector4 applied_ = model::Vector4::Zero();
   struct Pending {
     Tick effective_tick;

@@ -141,12 +141,12 @@ struct Rig {
   Publisher<msg::Float64MultiArray> cmd;
   std::unique_ptr<PlantNode> plant;
 
-  Rig() {
+  explicit Rig(PlantOptions options = {}) {
     bus.subscribe<msg::PlantStatus>(topics.plant_status, [this](const msg::PlantStatus& m) { statuses.push_back(m); });
     cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
     model::State x0;
     x0.p_W.z() = 10.0;
-    plant = std::make_unique<PlantNode>(bus, topics, vehicle, PlantOptions{}, x0);
+    plant = std::make_unique<PlantNode>(bus, topics, vehicle, options, x0);
     plant->set_log([this](const std::string& line) { log.push_back(line); });
   }
   void tick(Tick k) {
@@ -181,6 +181,35 @@ TEST(PlantValidationTest, StatusCountsRefusedAndClampedCommandsAndGoesOutOnTheNe
   rig.tick(100);
   EXPECT_EQ(rig.statuses.size(), 3u);  // once per simulated second
   EXPECT_EQ(rig.statuses.back().header.stamp.to_ns(), 1'000'000'000);
+}
+
+// Lockstep over DDS repeats ticks: the controller then answers the same tick twice. The copies are
+// counted apart, so the status counters match an in-process run, which has no repeats.
+TEST(PlantValidationTest, LockstepRepeatsOfACommandAreNotCountedTwice) {
+  PlantOptions options;
+  options.drop_stale_commands = true;
+  Rig rig(options);
+  auto labelled = [](std::vector<double> w, std::int64_t stamp_ns) {
+    msg::Float64MultiArray m = command(std::move(w));
+    m.dim.push_back({msg::command_label(stamp_ns), 4, 4});
+    return m;
+  };
+  rig.plant->publish_outputs(0);
+  rig.cmd.publish(labelled({100, 200, 300, 400}, 0));
+  rig.cmd.publish(labelled({100, 200, 300, 400}, 0));  // the same answer again
+  rig.plant->latch_command(0);
+  rig.plant->integrate(0);
+  rig.tick(1);
+  rig.plant->publish_outputs(2);
+  rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));  // a refused answer, and its copy
+  rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));
+  rig.cmd.publish(labelled({5, 6, 7, 8}, 0));  // an answer to an earlier tick
+  const PlantStats& st = rig.plant->stats();
+  EXPECT_EQ(st.commands_received, 5u);
+  EXPECT_EQ(st.commands_accepted, 1u);
+  EXPECT_EQ(st.commands_rejected_length, 1u);
+  EXPECT_EQ(st.commands_stale, 3u);
+  EXPECT_EQ(rig.plant->applied_command(), model::Vector4(100, 200, 300, 400));
 }
 
 TEST(PlantValidationTest, LogIsRateLimitedAndSaysHowMany) {
