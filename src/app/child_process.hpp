@@ -14,7 +14,8 @@ class ChildProcess {
  public:
   /// Starts `argv` (argv[0] is the program path) with the parent's environment and stdio.
   /// Throws std::runtime_error when it cannot.
-  explicit ChildProcess(const std::vector<std::string>& argv);
+  /// `output_path` (when not empty) receives the child's stdout and stderr instead.
+  explicit ChildProcess(const std::vector<std::string>& argv, const std::string& output_path = "");
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;

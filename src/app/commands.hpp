@@ -20,6 +20,8 @@ struct RunOptions {
   bool realtime = false;             ///< dds: real time instead of lockstep
   double rate_factor = 1.0;          ///< dds real time: k times faster than the wall clock
   double timeout_s = 10.0;           ///< dds: lockstep wait for one command before the policy applies
+  int vehicles = 0;                  ///< > 0: a swarm of this many vehicles (overrides swarm.vehicles)
+  int threads = 0;                   ///< > 0: in-process swarm threads (overrides swarm.threads)
   /// dds: run secured (Enforce) with this SROS2 keystore; created when missing, as are the enclaves
   /// /quadcosim/plant and /quadcosim/controller ("" = as the ROS_SECURITY_* environment says).
   std::string keystore;
@@ -70,6 +72,11 @@ struct PlantCommandOptions {
   std::string schedule_node;
   double watchdog_s = -1.0;     ///< overrides simulation.watchdog_s when >= 0 (0: off)
   std::string watchdog_policy;  ///< overrides simulation.watchdog_policy when set: "hold" or "stop"
+  int vehicles = 0;         ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...), lockstep
+  std::string ns_prefix;    ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
+  int threads = 2;          ///< vehicles > 0: threads (one DDS participant each)
+  std::string swarm_out;    ///< vehicles > 0: directory for summary.json, vehicles.csv, recorded vehicles
+  std::string stats;        ///< write run figures (real-time factor, round trip) as JSON here ("" none)
   std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
 };
 int plant_command(const PlantCommandOptions& options);
@@ -84,6 +91,11 @@ struct ControllerCommandOptions {
   double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
   std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
   bool apply_schedule = true;  ///< apply the scenario's schedule itself (off when the plant does it)
+  int vehicles = 0;            ///< > 0: host this many vehicles' controllers (lockstep)
+  std::string ns_prefix;       ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
+  int threads = 2;             ///< vehicles > 0: threads (one DDS participant each)
+  std::string stats;           ///< real time: write the control period jitter as JSON here on exit
+  int rt_priority = 0;         ///< real time: run the control loop under SCHED_FIFO at this priority (0 off)
   std::string enclave = "/";   ///< DDS Security enclave (rcl --enclave)
 };
 int controller_command(const ControllerCommandOptions& options);
@@ -174,6 +186,18 @@ int plot_command(const std::string& run_dir);
 
 /// `quadcosim compare RUN_A RUN_B [--out DIR]`: overlays two runs and tabulates their step figures.
 int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out);
+
+struct BenchOptions {
+  bool json = false;          ///< one JSON object on stdout (else the same, indented)
+  bool quick = false;         ///< short runs and small searches (a smoke test, not figures)
+  std::string only;           ///< one part: inproc, dds, realtime, swarm_inproc, swarm_dds ("" all)
+  double seconds = 0.0;       ///< > 0: simulated seconds of the inproc / dds part (e.g. for callgrind)
+  std::string scenario;       ///< single-vehicle scenario (default: scenarios/paper/altitude_step.yaml)
+  std::string swarm_scenario; ///< swarm scenario (default: scenarios/swarm/grid_takeoff.yaml)
+  int rt_priority = 50;       ///< realtime part: also measure with the controller under SCHED_FIFO (0: not)
+};
+/// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
+int bench_command(const BenchOptions& options);
 
 /// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py).
 bool make_plots(const std::string& run_dir);

@@ -8,6 +8,7 @@
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
+#include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
@@ -24,6 +25,7 @@ int controller_command(const ControllerCommandOptions& o) {
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;
     refuse_faults_over_dds(sc);
+    if (o.vehicles > 0) return swarm_controller_command(o, std::move(sc));
     const sim::TickClock clock = sc.simulation.plant.clock;
     const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
     const double dt_s = static_cast<double>(control_period_ns) / 1e9;
@@ -66,6 +68,9 @@ int controller_command(const ControllerCommandOptions& o) {
     } else {
       // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
       node.use_receipt_clock(steady_ns);
+      if (std::string err = use_realtime_priority(o.rt_priority); !err.empty()) {
+        std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
+      }
       const auto wall_period_ns =
           static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
       // Until the first complete sensor sample (Pose, Velocity and Imu of one tick) arrives it
@@ -73,10 +78,12 @@ int controller_command(const ControllerCommandOptions& o) {
       // stale-data safety command before it has seen the vehicle. After that, Algorithm 1 as
       // everywhere: stale data -> the safety command.
       std::int64_t next = steady_ns();
+      PeriodJitter jitter(wall_period_ns);
       bool seen_vehicle = false, safety = false;
       while (!stop_requested()) {
         next += wall_period_ns;
-        for (std::int64_t left; !stop_requested() && (left = next - steady_ns()) > 0;) transport.spin_once(left);
+        wait_until(transport, next);
+        jitter.add(steady_ns());
         if (!seen_vehicle) {
           if (node.synchronized_stamp_ns() < 0) continue;
           seen_vehicle = true;
@@ -94,6 +101,7 @@ int controller_command(const ControllerCommandOptions& o) {
                                    static_cast<double>(now) / 1e9);
         }
       }
+      if (!o.stats.empty()) write_stats(o.stats, jitter.figures());
     }
     std::cerr << "controller: stopped\n";
     return 0;

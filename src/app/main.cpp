@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
   run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
+  run_cmd->add_option("--vehicles", run.vehicles, "a swarm of N vehicles on a grid (default: the scenario's swarm section)")
+      ->check(CLI::Range(1, 10'000'000));
+  run_cmd->add_option("--threads", run.threads, "in-process swarm: worker threads (default: swarm.threads, 2)")
+      ->check(CLI::Range(1, 64));
 
   PlantCommandOptions plant;
   auto* plant_cmd = app.add_subcommand("plant", "the plant as a ROS 2 node over DDS (until done or Ctrl-C)");
@@ -54,6 +58,11 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
   plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
+  plant_cmd->add_option("--vehicles", plant.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  plant_cmd->add_option("--ns-prefix", plant.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  plant_cmd->add_option("--threads", plant.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
   plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
   plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
@@ -67,6 +76,8 @@ int main(int argc, char** argv) {
                         "lockstep: apply the scenario's schedule through this node's parameter services");
   plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
+  plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
+  plant_cmd->add_option("--swarm-out", plant.swarm_out, "with --vehicles: write summary.json, vehicles.csv here");
   plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
   plant_cmd->add_option("--watchdog", plant.watchdog_s,
@@ -87,12 +98,21 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
+  ctl_cmd->add_option("--vehicles", ctl.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  ctl_cmd->add_option("--ns-prefix", ctl.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  ctl_cmd->add_option("--threads", ctl.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
   ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
+  ctl_cmd->add_option("--rt-priority", ctl.rt_priority,
+                      "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
+      ->check(CLI::Range(0, 99));
+  ctl_cmd->add_option("--stats", ctl.stats, "real time: write the control period jitter as JSON here on exit");
   ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
@@ -156,6 +176,21 @@ int main(int argc, char** argv) {
   SweepOptions sweep;
   auto* sweep_cmd = add_sweep_subcommand(app, sweep);
 
+  BenchOptions bench;
+  bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
+  bench.swarm_scenario = QUADCOSIM_SCENARIOS_DIR "/swarm/grid_takeoff.yaml";
+  auto* bench_cmd = app.add_subcommand("bench", "measure speed: in-process, DDS lockstep, real-time jitter, swarms");
+  bench_cmd->add_flag("--json", bench.json, "print one JSON object");
+  bench_cmd->add_flag("--quick", bench.quick, "short runs (smoke test; the figures are not representative)");
+  bench_cmd->add_option("--only", bench.only, "run one part")
+      ->check(CLI::IsMember({"inproc", "dds", "realtime", "swarm_inproc", "swarm_dds"}));
+  bench_cmd->add_option("--seconds", bench.seconds, "simulated seconds of the inproc/dds part")
+      ->check(CLI::Range(0.0, 1e6));
+  bench_cmd->add_option("--rt-priority", bench.rt_priority, "realtime part: SCHED_FIFO priority of the controller (0: skip)")
+      ->check(CLI::Range(0, 99));
+  bench_cmd->add_option("--scenario", bench.scenario, "single-vehicle scenario")->check(CLI::ExistingFile);
+  bench_cmd->add_option("--swarm-scenario", bench.swarm_scenario, "swarm scenario")->check(CLI::ExistingFile);
+
   // Bad flags and arguments: CLI11's message (it names the flag, the value and what was expected) and
   // exit 2, as for every other bad input; --help and --version exit 0.
   if (const std::string first = unknown_first_argument(app, argc, argv); !first.empty()) {
@@ -170,6 +205,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  if (*bench_cmd) return bench_command(bench);
   if (*sec_cmd) return security_command(sec);
   if (*sweep_cmd) return sweep_command(sweep);
   if (*rec_cmd) return record_command(rec);

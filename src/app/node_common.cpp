@@ -1,5 +1,16 @@
 #include "app/node_common.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+#include <sys/prctl.h>
+
+#include <cstring>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
 namespace quadcosim::app {
 
 io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file) {
@@ -19,6 +30,50 @@ void refuse_faults_over_dds(const io::Scenario& sc) {
   throw io::ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) +
                         ": message_faults: message loss and delay are injected by the in-process transport only "
                         "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
+}
+
+void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
+  // (the timer slack matters for the blocking part)
+  static const bool slack_set = prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0;
+  (void)slack_set;
+  // Block on the waitset (delivering messages) until shortly before the deadline, then spin on the
+  // clock for the rest: a blocked thread's wake-up lands tens of microseconds late, more on a VM.
+  constexpr std::int64_t kSpinNs = 200'000;
+  for (std::int64_t left; (left = deadline_ns - steady_ns()) > kSpinNs;) transport.spin_once(left - kSpinNs);
+  transport.spin_once(0);
+  while (steady_ns() < deadline_ns) {
+  }
+}
+
+std::string use_realtime_priority(int priority) {
+  if (priority <= 0) return {};
+  sched_param p{};
+  p.sched_priority = priority;
+  if (const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p); rc != 0) {
+    return std::string("SCHED_FIFO priority ") + std::to_string(priority) + " refused: " + std::strerror(rc);
+  }
+  return {};
+}
+
+void PeriodJitter::add(std::int64_t now_ns) {
+  if (last_ns_ >= 0) jitter_ns_.push_back(std::llabs(now_ns - last_ns_ - period_ns_));
+  last_ns_ = now_ns;
+}
+
+nlohmann::json PeriodJitter::figures() const {
+  std::vector<std::int64_t> j = jitter_ns_;
+  std::sort(j.begin(), j.end());
+  auto pct = [&](double q) {
+    return j.empty() ? 0.0 : static_cast<double>(j[static_cast<std::size_t>(q * static_cast<double>(j.size() - 1))]) / 1e3;
+  };
+  return {{"period_jitter_us_p50", pct(0.5)}, {"period_jitter_us_p99", pct(0.99)},
+          {"period_jitter_us_max", pct(1.0)}, {"periods", j.size()}};
+}
+
+void write_stats(const std::string& path, const nlohmann::json& stats) {
+  std::ofstream f(path);
+  f << stats.dump() << '\n';
+  if (!f) std::cerr << "warning: cannot write statistics to " << path << '\n';
 }
 
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics) {

@@ -5,6 +5,9 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "dds/dds_transport.hpp"
 #include "io/scenario.hpp"
@@ -28,6 +31,35 @@ io::Scenario scenario_or_defaults(const std::string& path, const std::string& ve
 /// Throws io::ConfigError when the scenario asks for injected faults, which only the in-process
 /// transport can inject (over DDS, faults come from the network: tc netem, docs/reliability.md).
 void refuse_faults_over_dds(const io::Scenario& sc);
+/// Real-time loops: lets the DDS transport deliver messages until 200 us before `deadline_ns`
+/// (steady_ns), then spins on the clock until the deadline (1 % of a 20 ms period), so the wake-up
+/// lands on the deadline instead of a scheduler wake-up later. The first call also asks the kernel
+/// for 1 ns timer slack (default 50 us) for the blocking part.
+void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
+
+/// Real time: runs the calling thread under SCHED_FIFO at `priority` (1..99) so other processes do
+/// not delay its wake-ups. Returns "" on success, else why not (e.g. no CAP_SYS_NICE): the caller
+/// warns and goes on with normal scheduling. priority 0: does nothing.
+std::string use_realtime_priority(int priority);
+
+/// Period jitter of a periodic loop: |t_k - t_k-1 - period| over every period [us].
+class PeriodJitter {
+ public:
+  explicit PeriodJitter(std::int64_t period_ns) : period_ns_(period_ns) {}
+  /// The loop's k-th wake-up time [ns].
+  void add(std::int64_t now_ns);
+  /// {"period_jitter_us_p50", "_p99", "_max", "periods"} (zeros before two wake-ups).
+  nlohmann::json figures() const;
+
+ private:
+  std::int64_t period_ns_;
+  std::int64_t last_ns_ = -1;
+  std::vector<std::int64_t> jitter_ns_;
+};
+
+/// Writes `stats` as one JSON object to `path` (the --stats option of plant and controller, read by
+/// `quadcosim bench`); a failure is reported on stderr, not fatal.
+void write_stats(const std::string& path, const nlohmann::json& stats);
 
 /// ROS sensor-data QoS (KEEP_LAST 5, BEST_EFFORT) on the three sensor topics.
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics);

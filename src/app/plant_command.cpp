@@ -13,6 +13,7 @@
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
+#include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_client.hpp"
@@ -226,6 +227,7 @@ class PlantProcess {
   }
 
   void report() {
+    nlohmann::json stats;
     if (!round_trip_ns_.empty()) {
       std::sort(round_trip_ns_.begin(), round_trip_ns_.end());
       auto pct = [&](double q) {
@@ -234,6 +236,9 @@ class PlantProcess {
       std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
                                "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
                                round_trip_ns_.size(), pct(0.5), pct(0.99), pct(1.0));
+      stats["roundtrip_us_p50"] = pct(0.5);
+      stats["roundtrip_us_p99"] = pct(0.99);
+      stats["roundtrip_us_max"] = pct(1.0);
     }
     const auto& st = plant_.stats();
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
@@ -251,6 +256,10 @@ class PlantProcess {
                                ticks_run_, wall_s, static_cast<double>(ticks_run_) / wall_s,
                                static_cast<double>(max_late_ns_) / 1e6, late_ticks_);
     }
+    stats["simulated_s"] = sim_s;
+    stats["wall_s"] = wall_s;
+    stats["real_time_factor"] = sim_s / wall_s;
+    if (!o_.stats.empty()) write_stats(o_.stats, stats);
   }
 
   std::int64_t timeout_ns() const { return static_cast<std::int64_t>(o_.timeout_s * 1e9); }
@@ -303,6 +312,7 @@ int plant_command(const PlantCommandOptions& o) {
       sc.simulation.duration_ticks =
           static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
     }
+    if (o.vehicles > 0) return swarm_plant_command(o, std::move(sc));
     PlantProcess process(o, std::move(sc));
     return process.run();
   } catch (const io::ConfigError& e) {

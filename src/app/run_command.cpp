@@ -13,6 +13,7 @@
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/signals.hpp"
+#include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/scenario.hpp"
@@ -141,6 +142,7 @@ int run_command(const RunOptions& opt) {
 
   try {
     fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
+    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
       if (sc.simulation.faults.active()) {

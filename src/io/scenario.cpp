@@ -239,6 +239,36 @@ void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
   }
 }
 
+void read_swarm(YamlSection& s, SwarmSpec& spec) {
+  auto& l = spec.layout;
+  l.vehicles = static_cast<int>(s.integer("vehicles", l.vehicles, 1, 10'000'000));
+  l.spacing_m = s.number("spacing_m", l.spacing_m, 1e-3, 1e4);
+  l.altitude_layers = static_cast<int>(s.integer("altitude_layers", l.altitude_layers, 1, 1000));
+  l.layer_spacing_m = s.number("layer_spacing_m", l.layer_spacing_m, 0.0, 1e4);
+  l.ns_prefix = s.text("namespace_prefix", l.ns_prefix);
+  if (std::string err = sim::validate_namespace(l.ns_prefix + "0"); !err.empty()) {
+    s.fail("namespace_prefix", "got '" + l.ns_prefix + "': " + err);
+  }
+  spec.threads = static_cast<int>(s.integer("threads", spec.threads, 1, 64));
+  int index = 0;
+  for (const YAML::Node& n : s.sequence("record_vehicles")) {
+    const std::string where = "record_vehicles[" + std::to_string(index++) + "]";
+    long long v = -1;
+    try {
+      v = n.as<long long>();
+    } catch (const YAML::Exception&) {
+      s.fail(where, "got '" + (n.IsScalar() ? n.Scalar() : std::string("(not a scalar)")) +
+                        "', expected a vehicle index (an integer)");
+    }
+    if (v < 0 || v >= l.vehicles) {
+      s.fail(where, "got " + std::to_string(v) + ", expected a vehicle index in [0, " +
+                        std::to_string(l.vehicles - 1) + "]");
+    }
+    spec.record_vehicles.push_back(static_cast<int>(v));
+  }
+  s.reject_unknown_keys();
+}
+
 }  // namespace
 
 const std::vector<std::string>& hold_figure_names() {
@@ -287,6 +317,7 @@ Scenario load_scenario(const std::string& path) {
   read_schedule(root, sc, duration_s);
   read_realism(root, sc);
   if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
+  if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
   root.reject_unknown_keys();
   return sc;
 }

@@ -13,6 +13,7 @@
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
 
 namespace quadcosim::io {
 
@@ -44,6 +45,13 @@ struct StepSpec {
   std::map<std::string, double> reference;  ///< published figures to compare with
 };
 
+/// A scenario's `swarm:` section: many vehicles of the same scenario on a grid (sim/swarm.hpp).
+struct SwarmSpec {
+  sim::SwarmLayout layout;
+  int threads = 2;                   ///< in-process worker threads (1..64)
+  std::vector<int> record_vehicles;  ///< vehicles whose full trajectory is written (default none)
+};
+
 /// Position hold (beyond the steps): from after_s on, how far the vehicle strays from its setpoint.
 /// Figures: max_horizontal_error_m (max of the horizontal distance to (x_des, y_des)),
 /// rms_horizontal_error_m, max_vertical_error_m (max |z - z_des|), all over t >= after_s.
@@ -65,6 +73,7 @@ struct Scenario {
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
+  std::optional<SwarmSpec> swarm;  ///< present when the file has a `swarm:` section
   std::optional<HoldSpec> hold;  ///< analysis.hold
 };
 

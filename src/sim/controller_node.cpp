@@ -20,23 +20,25 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
+    ++samples_received_;
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
     if (!accept(validate_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) return;
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
+    ++samples_received_;
   });
   transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
     if (!accept(validate_imu(m, imu_stamp_ns_), topic, imu_backwards_)) return;
-    const Eigen::Quaterniond q(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
-    const model::Euler e = model::euler_from_quaternion(q);
-    estimate_.roll_rad = e.roll_rad;
-    estimate_.pitch_rad = e.pitch_rad;
-    estimate_.yaw_rad = e.yaw_rad;
+    // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
+    // the control rate, so converting on arrival would do half the atan2s for nothing).
+    imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
+    imu_pending_ = true;
     estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
+    ++samples_received_;
   });
 }
 
@@ -61,6 +63,13 @@ bool ControllerNode::accept(const SensorCheck& check, const std::string& topic, 
 }
 
 const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
+  if (imu_pending_) {
+    const model::Euler e = model::euler_from_quaternion(imu_q_WB_);
+    estimate_.roll_rad = e.roll_rad;
+    estimate_.pitch_rad = e.pitch_rad;
+    estimate_.yaw_rad = e.yaw_rad;
+    imu_pending_ = false;
+  }
   const std::int64_t oldest = std::min({pose_ref_ns_, velocity_ref_ns_, imu_ref_ns_});
   estimate_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
                                      : static_cast<double>(now_ns - oldest) / 1e9;
@@ -92,7 +101,7 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   status_pub_.publish(status_);
 
   for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];
-  command_msg_.dim[0].label = msg::command_label(sim_now_ns);
+  msg::write_command_label(command_msg_.dim[0].label, sim_now_ns);
   command_pub_.publish(command_msg_);
   last_step_ns_ = now_ns;
   return command_;

@@ -7,6 +7,7 @@
 // values and ages, so the stale-data safety (Algorithm 1) takes over when nothing valid arrives.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <array>
 #include <functional>
@@ -58,6 +59,9 @@ class ControllerNode {
   /// same stamp (a complete sample of one plant tick); -1 otherwise.
   std::int64_t synchronized_stamp_ns() const;
 
+  /// Pose, Velocity and Imu messages taken in so far (a host of many nodes sees which one got data).
+  std::uint64_t samples_received() const { return samples_received_; }
+
   /// Where refused sensor messages are reported (rate-limited per reason). Default: stderr.
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
@@ -83,6 +87,9 @@ class ControllerNode {
   std::function<std::int64_t()> receipt_clock_;
   std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
   std::int64_t last_step_ns_ = kNever;
+  std::uint64_t samples_received_ = 0;
+  Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
+  bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
   std::function<void(const std::string&)> log_;
   std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing

@@ -80,6 +80,8 @@ struct Float64MultiArray {
 /// simulated time [ns] of the sensor data the command answers. Lockstep uses it to match commands to
 /// ticks; commands without it (any other ROS 2 controller) are matched by arrival.
 std::string command_label(std::int64_t stamp_ns);
+/// The same label written into `label`, reusing its storage (no allocation once it has held one).
+void write_command_label(std::string& label, std::int64_t stamp_ns);
 /// The stamp of a command's label, or -1 when it has none.
 std::int64_t command_stamp_ns(const Float64MultiArray& m);
 

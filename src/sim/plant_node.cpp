@@ -23,7 +23,7 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
     const std::string ns = topics.pose.substr(0, topics.pose.rfind('/'));
     realism_ = std::make_unique<PlantRealism>(options.realism, vehicle, ns, options.clock);
   }
-  clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
+  if (options.publish_clock) clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
   pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
   velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
   imu_pub_ = transport.advertise<msg::Imu>(topics.imu);
@@ -99,7 +99,7 @@ void PlantNode::publish_outputs(Tick k) {
   const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_,
                                           realism_ ? &realism_->environment(k) : nullptr);
 
-  clock_pub_.publish(msg::Clock{stamp});
+  if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
   publish_status(k);
 
   msg::PoseStamped pose;
@@ -130,9 +130,16 @@ void PlantNode::publish_outputs(Tick k) {
 }
 
 void PlantNode::latch_command(Tick k) {
-  while (!pending_.empty() && pending_.front().effective_tick <= k) {
-    applied_ = pending_.front().omega;
-    pending_.pop_front();
+  while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) {
+    applied_ = pending_[pending_head_].omega;
+    ++pending_head_;
+  }
+  if (pending_head_ == pending_.size()) {
+    pending_.clear();  // keeps the capacity
+    pending_head_ = 0;
+  } else if (pending_head_ > 64 && pending_head_ * 2 > pending_.size()) {
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
+    pending_head_ = 0;
   }
   if (options_.watchdog_ticks <= 0) return;
   if (receipt_clock_) {

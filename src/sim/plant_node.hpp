@@ -3,10 +3,10 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
@@ -44,6 +44,9 @@ struct PlantOptions {
   /// /<ns>/plant_status goes out on every tick whose counters changed and at least every this many
   /// ticks; 0: once per simulated second.
   Tick status_period_ticks = 0;
+  /// Publish /clock. It is global, not namespaced: when one process hosts many plants, one of them
+  /// publishes it.
+  bool publish_clock = true;
 };
 
 /// What became of the motor commands (sim/validation.hpp validate_command).
@@ -109,7 +112,11 @@ class PlantNode {
     Tick effective_tick;
     model::Vector4 omega;
   };
-  std::deque<Pending> pending_;
+  // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
+  // dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a
+  // block every few commands).
+  std::vector<Pending> pending_;
+  std::size_t pending_head_ = 0;
   PlantStats stats_;
   std::function<std::int64_t()> receipt_clock_;
   Tick last_valid_tick_ = 0;           ///< tick during which the newest valid command arrived

@@ -279,3 +279,25 @@ TEST(SimulationTest, CommandDelayDelaysTheResponse) {
 
 }  // namespace
 }  // namespace quadcosim::sim
+
+namespace quadcosim::msg {
+namespace {
+TEST(CommandLabelTest, WritesAndReadsTheStamp) {
+  Float64MultiArray m;
+  m.dim = {{"", 4, 4}};
+  write_command_label(m.dim[0].label, 123'456'789'012);
+  EXPECT_EQ(m.dim[0].label, "rotors@123456789012");
+  EXPECT_EQ(command_stamp_ns(m), 123'456'789'012);
+  EXPECT_EQ(command_label(0), "rotors@0");
+  for (const char* bad : {"rotors@", "rotors@-5", "rotors@+5", "rotors@12x", "rotors@99999999999999999999",
+                          "rotor@5", "", "rotors@ 5"}) {
+    m.dim[0].label = bad;
+    EXPECT_EQ(command_stamp_ns(m), -1) << bad;
+  }
+  m.dim[0].label = "rotors@9223372036854775799";
+  EXPECT_EQ(command_stamp_ns(m), 9223372036854775799);
+  EXPECT_EQ(command_label(-20), "rotors@-20");
+  EXPECT_EQ(command_label(INT64_MIN), "rotors@-9223372036854775808");
+}
+}  // namespace
+}  // namespace quadcosim::msg

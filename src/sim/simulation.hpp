@@ -60,6 +60,22 @@ class Simulation {
   /// Runs ticks 0..duration_ticks, calling on_tick for each.
   void run(const std::function<void(const TickRecord&)>& on_tick);
 
+  /// Steps 1-6 above for tick k without recording: what run() does per tick. Call with k = 0, 1, ...
+  /// in order (a swarm advances many simulations tick by tick, or block by block).
+  void tick(Tick k) {
+    begin_tick(k);
+    end_tick(k);
+  }
+  /// Steps 1-4 of tick k (schedule, outputs, controller, latch).
+  void begin_tick(Tick k);
+  /// Step 6 of tick k (integrate to t_k+1; nothing after the last tick).
+  void end_tick(Tick k) {
+    if (k < config_.duration_ticks) plant_.integrate(k);
+  }
+  /// The current state, the command acting over [t_k, t_k+1) and the latest status, after
+  /// begin_tick(k) (for recorders that do not go through run()).
+  TickRecord record(Tick k) const;
+
   const PlantNode& plant() const { return plant_; }
   /// The bus the nodes talk on, for observers such as recorders (subscribe before run()).
   Transport& transport() { return transport_; }
@@ -73,6 +89,8 @@ class Simulation {
   PlantNode plant_;
   ControllerNode controller_;
   std::vector<ScheduledParameter> schedule_;
+  std::vector<ScheduledParameter>::const_iterator next_event_;
+  double control_dt_s_;
   msg::ControllerStatus status_;
 };
 

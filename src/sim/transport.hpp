@@ -53,8 +53,9 @@ class Transport {
 
   /// `callback` runs for every message on `topic`, in publication order. When it runs is up to the
   /// transport: in-process, during publish(); over a network, when the node polls.
-  template <class T>
-  void subscribe(const std::string& topic, std::function<void(const T&)> callback) {
+  /// `callback` is any callable taking const T& (stored as it is: one indirect call per delivery).
+  template <class T, class F>
+  void subscribe(const std::string& topic, F callback) {
     add_subscription(topic, topic_type<T>(), [cb = std::move(callback)](const void* m) {
       cb(*static_cast<const T*>(m));
     });

@@ -1,0 +1,303 @@
+// `quadcosim bench [--json] [--quick]`: the framework's speed on this machine, measured end to end
+// (docs/performance.md). Prints figures; asserts nothing.
+//   inproc_rtf                 one vehicle in-process (paper altitude scenario, recording off)
+//   baseline_rtf               the BASELINE minimal loop (bench/micro/baseline_loop.hpp) on the same
+//                              vehicle and gains: the machine's floor for this model
+//   dds_lockstep_rtf, dds_cmd_roundtrip_us_p50/p99
+//                              plant and controller as two processes over DDS, lockstep
+//   ddsperf_roundtrip_us_p50   Cyclone's own ddsperf ping/pong (when ddsperf is installed)
+//   realtime_period_jitter_us_p99
+//                              the controller's 50 Hz loop in real time (plant in real time too)
+//   swarm_inproc_vehicles_at_rt, swarm_dds_vehicles_at_rt
+//                              the largest swarm found at >= 1x real time (doubling, then bisection)
+#include <fmt/format.h>
+#include <sys/utsname.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "app/child_process.hpp"
+#include "app/commands.hpp"
+#include "app/node_common.hpp"
+#include "app/swarm.hpp"
+#include "bench/micro/baseline_setup.hpp"
+#include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
+
+namespace quadcosim::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void note(const std::string& s) { std::cerr << "bench: " << s << std::endl; }
+
+/// One vehicle in-process for sim_s simulated seconds, recording off; best of `reps` [x real time].
+double inproc_rtf(const io::Scenario& sc, double sim_s, int reps) {
+  sim::SimulationConfig cfg = sc.simulation;
+  cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
+  double best = 0.0;
+  for (int r = 0; r < reps; ++r) {
+    sim::Simulation s(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (sim::Tick k = 0; k <= cfg.duration_ticks; ++k) s.tick(k);
+    best = std::max(best, sim_s / seconds_since(t0));
+  }
+  return best;
+}
+
+double baseline_rtf(const io::Scenario& sc, double sim_s, int reps) {
+  const double dt = sc.simulation.plant.clock.period_s();
+  const long ticks = static_cast<long>(sim_s / dt + 0.5);
+  double best = 0.0, sink = 0.0;
+  for (int r = 0; r < reps; ++r) {
+    bench::BaselineLoop loop = bench::make_baseline(sc.controller.params, 10.0);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long k = 0; k <= ticks; ++k) loop.tick(k, dt);
+    best = std::max(best, sim_s / seconds_since(t0));
+    sink += loop.state().x[2];
+  }
+  if (!std::isfinite(sink)) note("baseline loop diverged");
+  return best;
+}
+
+/// In-process swarm of n vehicles for sim_s [x real time].
+double swarm_inproc_rtf(const io::Scenario& sc, int n, double sim_s) {
+  io::SwarmSpec spec = swarm_spec(sc, n, 2);
+  sim::SimulationConfig cfg = sc.simulation;
+  cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
+  sim::Swarm swarm(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
+  const auto t0 = std::chrono::steady_clock::now();
+  swarm.run(spec.threads, kSwarmBlockTicks);
+  return sim_s / seconds_since(t0);
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream f(p);
+  if (!f) return nullptr;
+  try {
+    return nlohmann::json::parse(f);
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+/// Plant and controller processes over DDS (lockstep, or real time); the plant's --stats (and the
+/// controller's, in real time) as JSON; null on failure.
+struct NodeRun {
+  nlohmann::json plant, controller;
+};
+NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s, int vehicles, bool realtime,
+                  int rt_priority = 0) {
+  const std::string self = self_executable();
+  const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
+  fs::remove(ps);
+  fs::remove(cs);
+  std::vector<std::string> c = {self, "controller", "--scenario", scenario, "--stats", cs};
+  std::vector<std::string> p = {self, "plant", "--scenario", scenario, "--duration", fmt::format("{}", sim_s),
+                                "--stats", ps, "--timeout", "60"};
+  if (vehicles > 0) {
+    for (auto* v : {&c, &p}) {
+      v->push_back("--vehicles");
+      v->push_back(std::to_string(vehicles));
+    }
+  }
+  if (realtime) {
+    c.push_back("--realtime");
+    if (rt_priority > 0) {
+      c.push_back("--rt-priority");
+      c.push_back(std::to_string(rt_priority));
+    }
+    p.push_back("--realtime");
+    p.push_back("--wait-for-controller");
+  }
+  NodeRun out;
+  {
+    ChildProcess controller(c, (tmp / "controller.log").string());
+    ChildProcess plant(p, (tmp / "plant.log").string());
+    const auto rc = plant.wait(600.0);
+    controller.stop();
+    if (!rc || *rc != 0) {
+      note(fmt::format("plant exited with {} (log: {})", rc ? *rc : -1, (tmp / "plant.log").string()));
+      return out;
+    }
+  }
+  out.plant = read_json(ps);
+  out.controller = read_json(cs);
+  return out;
+}
+
+/// Largest n with rate(n) >= 1: doubling from `start` (up to `cap`), then `bisections` halvings of
+/// the interval between the last good and the first bad n. 0 when even `start` is too slow.
+template <class Rate>
+int largest_at_real_time(int start, int cap, int bisections, Rate rate) {
+  int good = 0, bad = 0;
+  for (int n = start; n <= cap; n *= 2) {
+    const double r = rate(n);
+    note(fmt::format("  {} vehicles: {:.2f}x real time", n, r));
+    if (r >= 1.0) {
+      good = n;
+    } else {
+      bad = n;
+      break;
+    }
+  }
+  if (good == 0 || bad == 0) return good;
+  for (int i = 0; i < bisections && bad - good > 1; ++i) {
+    const int mid = good + (bad - good) / 2;
+    const double r = rate(mid);
+    note(fmt::format("  {} vehicles: {:.2f}x real time", mid, r));
+    (r >= 1.0 ? good : bad) = mid;
+  }
+  return good;
+}
+
+double ddsperf_roundtrip_us(const fs::path& tmp, double seconds) {
+  const char* domain = std::getenv("ROS_DOMAIN_ID");
+  const std::string d = domain && *domain ? domain : "0";
+  const std::string cmd = fmt::format(
+      "command -v ddsperf >/dev/null 2>&1 || exit 0; "
+      "timeout {0} ddsperf -D {1} -i {2} pong >/dev/null 2>&1 & pong=$!; "
+      "timeout {0} ddsperf -D {1} -i {2} ping > {3} 2>&1; kill $pong 2>/dev/null; wait $pong 2>/dev/null; true",
+      static_cast<int>(seconds) + 10, static_cast<int>(seconds), d, (tmp / "ping.log").string());
+  if (std::system(cmd.c_str()) != 0) return NAN;
+  // ddsperf prints lines like "... mean 25.1us min ... 50% 24.3us 90% ... 99% ..."; take the last.
+  std::ifstream f(tmp / "ping.log");
+  double v = NAN;
+  for (std::string line; std::getline(f, line);) {
+    const auto at = line.find(" 50% ");
+    if (at != std::string::npos) v = std::atof(line.c_str() + at + 5);
+  }
+  return v;
+}
+
+nlohmann::json machine() {
+  std::string cpu = "unknown";
+  std::ifstream f("/proc/cpuinfo");
+  for (std::string line; std::getline(f, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  utsname u{};
+  uname(&u);
+  return {{"cpu_model", cpu},
+          {"cores", std::thread::hardware_concurrency()},
+          {"kernel", fmt::format("{} {} {}", u.sysname, u.release, u.machine)},
+          {"compiler", fmt::format("{} {}", QUADCOSIM_COMPILER_ID, __VERSION__)},
+          {"build_type", QUADCOSIM_BUILD_TYPE},
+          {"load_average_1min", [] {
+             double l = NAN;
+             std::ifstream("/proc/loadavg") >> l;
+             return l;
+           }()}};
+}
+
+nlohmann::json number_or_null(double v) { return std::isfinite(v) && v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+int bench_command(const BenchOptions& o) {
+  io::Scenario paper, swarm;
+  try {
+    paper = io::load_scenario(o.scenario);
+    swarm = io::load_scenario(o.swarm_scenario);
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  }
+  const bool q = o.quick;
+  const auto all_start = std::chrono::steady_clock::now();
+  auto want = [&](const char* part) { return o.only.empty() || o.only == part; };
+  const fs::path tmp = fs::temp_directory_path() / fmt::format("quadcosim-bench-{}", ::getpid());
+  fs::create_directories(tmp);
+  nlohmann::json j;
+  j["quick"] = q;
+
+  if (want("inproc")) {
+    const double s = o.seconds > 0 ? o.seconds : (q ? 20.0 : 600.0);
+    note(fmt::format("in-process, one vehicle, {} s simulated", s));
+    const double r = inproc_rtf(paper, s, q || o.seconds > 0 ? 1 : 3);
+    j["inproc_rtf"] = r;
+    if (o.only.empty() || !o.seconds) {
+      const double b = baseline_rtf(paper, s, q ? 1 : 3);
+      j["baseline_rtf"] = b;
+      j["inproc_vs_baseline"] = r / b;
+    }
+  }
+  if (want("dds")) {
+    const double s = o.seconds > 0 ? o.seconds : (q ? 4.0 : 120.0);
+    note(fmt::format("DDS lockstep, one vehicle, {} s simulated", s));
+    const NodeRun r = run_nodes(tmp, o.scenario, s, 0, false);
+    j["dds_lockstep_rtf"] = r.plant.is_object() ? r.plant.value("real_time_factor", 0.0) : 0.0;
+    j["dds_cmd_roundtrip_us_p50"] = r.plant.is_object() ? r.plant.value("roundtrip_us_p50", 0.0) : 0.0;
+    j["dds_cmd_roundtrip_us_p99"] = r.plant.is_object() ? r.plant.value("roundtrip_us_p99", 0.0) : 0.0;
+    if (!q) {
+      note("ddsperf ping/pong, 5 s");
+      j["ddsperf_roundtrip_us_p50"] = number_or_null(ddsperf_roundtrip_us(tmp, 5.0));
+    }
+  }
+  if (want("realtime")) {
+    // The controller's 50 Hz loop under normal scheduling, then (the real-time setup) under
+    // SCHED_FIFO when the machine allows it.
+    const double s = q ? 2.0 : 20.0;
+    auto measure = [&](int priority, const std::string& suffix) {
+      note(fmt::format("real time, one vehicle, {} s{}", s, priority > 0 ? fmt::format(", SCHED_FIFO {}", priority) : ""));
+      const NodeRun r = run_nodes(tmp, o.scenario, s, 0, true, priority);
+      for (const char* k : {"p50", "p99", "max"}) {
+        const std::string key = std::string("period_jitter_us_") + k;
+        j["realtime_" + key + suffix] = r.controller.is_object() ? r.controller.value(key, 0.0) : 0.0;
+      }
+    };
+    measure(0, "_normal");
+    if (o.rt_priority > 0) {
+      measure(o.rt_priority, "");
+      j["realtime_rt_priority"] = o.rt_priority;
+    } else {
+      for (const char* k : {"p50", "p99", "max"}) {
+        j[std::string("realtime_period_jitter_us_") + k] = j[std::string("realtime_period_jitter_us_") + k + "_normal"];
+      }
+      j["realtime_rt_priority"] = 0;
+    }
+  }
+  if (want("swarm_inproc")) {
+    const double s = q ? 0.5 : 2.0;
+    note(fmt::format("in-process swarm, {} s simulated per trial", s));
+    j["swarm_inproc_vehicles_at_rt"] = largest_at_real_time(q ? 256 : 4096, q ? 1024 : 1 << 20, q ? 0 : 5,
+                                                            [&](int n) { return swarm_inproc_rtf(swarm, n, s); });
+    j["swarm_inproc_trial_s"] = s;
+  }
+  if (want("swarm_dds")) {
+    const double s = q ? 1.0 : 4.0;
+    note(fmt::format("DDS swarm, {} s simulated per trial", s));
+    j["swarm_dds_vehicles_at_rt"] = largest_at_real_time(q ? 4 : 32, q ? 8 : 8192, q ? 0 : 4, [&](int n) {
+      const NodeRun r = run_nodes(tmp, o.swarm_scenario, s, n, false);
+      return r.plant.is_object() ? r.plant.value("real_time_factor", 0.0) : 0.0;
+    });
+    j["swarm_dds_trial_s"] = s;
+  }
+  j["machine"] = machine();
+  j["bench_wall_s"] = seconds_since(all_start);
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  if (o.json) {
+    std::cout << j.dump() << std::endl;
+  } else {
+    std::cout << j.dump(2) << std::endl;
+  }
+  return 0;
+}
+
+}  // namespace quadcosim::app

@@ -1,0 +1,343 @@
+// `quadcosim plant --vehicles N` and `quadcosim controller --vehicles N`: N vehicles' nodes in one
+// process over DDS, each vehicle under its own namespace (<prefix>0000, ...), lockstep only. The
+// vehicles are split over `threads` threads; each thread has its own DDS participant and runs its
+// vehicles' PlantNodes (or ControllerNodes) exactly as the single-vehicle processes do, so every
+// vehicle's numbers equal those of the in-process swarm.
+#include <fmt/format.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "app/node_common.hpp"
+#include "app/signals.hpp"
+#include "app/swarm.hpp"
+#include "control/care.hpp"
+#include "dds/node_announcer.hpp"
+#include "io/trajectory_csv.hpp"
+#include "sim/controller_node.hpp"
+#include "sim/plant_node.hpp"
+
+namespace quadcosim::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kExitOk = 0, kExitRefused = 2, kExitNoPeer = 4, kExitInterrupted = 130;
+
+io::SwarmSpec node_spec(const io::Scenario& sc, int vehicles, const std::string& ns_prefix) {
+  io::SwarmSpec spec = swarm_spec(sc, vehicles, 0);
+  if (!ns_prefix.empty()) {
+    if (std::string err = sim::validate_namespace(ns_prefix + "0"); !err.empty()) {
+      throw io::ConfigError("--ns-prefix: got '" + ns_prefix + "': " + err);
+    }
+    spec.layout.ns_prefix = ns_prefix;
+  }
+  return spec;
+}
+
+/// Runs `body(t)` on `threads` threads (t = 0 on the caller's); returns the largest exit code.
+template <class F>
+int run_threads(int threads, F body) {
+  std::atomic<int> worst{0};
+  auto one = [&](int t) {
+    int rc;
+    try {
+      rc = body(t);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      rc = 3;
+    }
+    int cur = worst.load();
+    while (rc > cur && !worst.compare_exchange_weak(cur, rc)) {
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(one, t);
+  one(0);
+  for (auto& th : pool) th.join();
+  return worst.load();
+}
+
+// One thread's share of the plants: its participant, its vehicles, the lockstep loop.
+class PlantShard {
+ public:
+  PlantShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, const std::vector<bool>& recorded,
+             const fs::path& out, bool sensor_qos, const std::string& enclave)
+      : sc_(sc), clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment(enclave)), first_(first) {
+    const model::State initial = io::initial_state(sc);
+    for (int i = first; i < last; ++i) {
+      const sim::SwarmVehicle v =
+          sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
+      auto node = std::make_unique<Vehicle>();
+      node->topics = sim::Topics::for_namespace(v.simulation.ns);
+      if (sensor_qos) use_sensor_qos(transport_, node->topics);
+      sim::PlantOptions po = v.simulation.plant;
+      po.drop_stale_commands = true;
+      po.publish_clock = i == 0;  // one /clock for the whole swarm
+      node->plant = std::make_unique<sim::PlantNode>(transport_, node->topics, sc.vehicle, po, v.initial);
+      if (recorded[static_cast<std::size_t>(i)]) {
+        node->csv = std::make_unique<io::TrajectoryWriter>(
+            (out / v.simulation.ns.substr(1) / "trajectory.csv").string());
+        Vehicle* raw = node.get();
+        transport_.subscribe<msg::ControllerStatus>(node->topics.controller_status,
+                                                    [raw](const msg::ControllerStatus& m) { raw->status = m; });
+        node->status.header.stamp = msg::Time::from_ns(-1);
+      }
+      vehicles_.push_back(std::move(node));
+    }
+    announcer_ = std::make_unique<dds::NodeAnnouncer>(transport_.participant().handle(),
+                                                      fmt::format("quadrotor_plants_{}", first));
+    announcer_->announce();
+  }
+
+  /// Waits for every vehicle's controller, then runs all ticks. Returns an exit code.
+  int run(double timeout_s, int divider, sim::Tick duration_ticks) {
+    const auto timeout_ns = static_cast<std::int64_t>(timeout_s * 1e9);
+    std::size_t ready = 0;
+    const bool found = transport_.spin_until(
+        [&] {
+          // As the single-vehicle plant: a command writer and all three sensor readers matched, so
+          // tick 0 is not published before the controller can hear it (that would cost a 50 ms retry).
+          while (ready < vehicles_.size()) {
+            const sim::Topics& t = vehicles_[ready]->topics;
+            if (transport_.matched_writers(t.motor_commands) == 0 || transport_.matched_readers(t.pose) == 0 ||
+                transport_.matched_readers(t.velocity) == 0 || transport_.matched_readers(t.imu) == 0) {
+              break;
+            }
+            ++ready;
+          }
+          return stop_requested() || ready == vehicles_.size();
+        },
+        timeout_ns);
+    if (!found) {
+      std::cerr << fmt::format("plant: no controller for {} within {} s ({} of {} vehicles of this thread matched)\n",
+                               vehicles_[ready]->topics.motor_commands, timeout_s, ready, vehicles_.size());
+      return kExitNoPeer;
+    }
+    start_ns_ = steady_ns();
+    for (sim::Tick k = 0; k <= duration_ticks && !stop_requested(); ++k) {
+      for (auto& v : vehicles_) v->plant->publish_outputs(k);
+      if (k % divider == 0 && !await_commands(k, timeout_ns)) return kExitNoPeer;
+      for (auto& v : vehicles_) {
+        v->plant->latch_command(k);
+        if (v->csv) {
+          v->csv->write(clock_.seconds(k), v->plant->state(), v->plant->applied_command(),
+                        v->status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v->status)
+                                                             : io::ControlColumns::none());
+        }
+        if (k < duration_ticks) v->plant->integrate(k);
+      }
+    }
+    end_ns_ = steady_ns();
+    for (auto& v : vehicles_) {
+      if (v->csv) v->csv->close();
+    }
+    return stop_requested() ? kExitInterrupted : kExitOk;
+  }
+
+  SwarmFinal final_of(int i) const {
+    const auto& p = *vehicles_[static_cast<std::size_t>(i - first_)]->plant;
+    SwarmFinal f;
+    f.p_W = p.state().p_W;
+    f.rejected = p.stats().commands_rejected;
+    return f;
+  }
+  std::int64_t wall_ns() const { return end_ns_ - start_ns_; }
+
+ private:
+  struct Vehicle {
+    sim::Topics topics;
+    std::unique_ptr<sim::PlantNode> plant;
+    std::unique_ptr<io::TrajectoryWriter> csv;
+    msg::ControllerStatus status;
+  };
+
+  bool answered(const Vehicle& v, std::int64_t t_ns) const {
+    return v.plant->last_command_stamp_ns() == t_ns && (!v.csv || v.status.header.stamp.to_ns() == t_ns);
+  }
+
+  // Waits for every vehicle's command for tick k; asks again (publishes the outputs again) every
+  // 50 ms for the vehicles still missing.
+  bool await_commands(sim::Tick k, std::int64_t timeout_ns) {
+    const std::int64_t t_ns = clock_.ns(k);
+    std::size_t done = 0;
+    auto all = [&] {
+      // Vehicles answer in any order: skip the answered prefix, then check the rest once.
+      while (done < vehicles_.size() && answered(*vehicles_[done], t_ns)) ++done;
+      for (std::size_t i = done; i < vehicles_.size(); ++i) {
+        if (!answered(*vehicles_[i], t_ns)) return stop_requested();
+      }
+      return true;
+    };
+    const std::int64_t deadline = steady_ns() + timeout_ns;
+    while (!transport_.spin_until(all, 50 * kMs)) {
+      if (steady_ns() >= deadline) {
+        std::cerr << fmt::format("plant: lockstep timeout: no motor command on {} for tick {} after {} s\n",
+                                 vehicles_[done]->topics.motor_commands, k, static_cast<double>(timeout_ns) / 1e9);
+        return false;
+      }
+      for (std::size_t i = done; i < vehicles_.size(); ++i) {
+        if (!answered(*vehicles_[i], t_ns)) vehicles_[i]->plant->publish_outputs(k);
+      }
+    }
+    return true;
+  }
+
+  const io::Scenario& sc_;
+  sim::TickClock clock_;
+  dds::DdsTransport transport_;
+  int first_;
+  std::vector<std::unique_ptr<Vehicle>> vehicles_;
+  std::unique_ptr<dds::NodeAnnouncer> announcer_;
+  std::int64_t start_ns_ = 0, end_ns_ = 0;
+};
+
+// One thread's share of the controllers.
+class ControllerShard {
+ public:
+  ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, bool sensor_qos,
+                  const std::string& enclave)
+      : clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment(enclave)) {
+    const model::State initial = io::initial_state(sc);
+    for (int i = first; i < last; ++i) {
+      sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
+      auto c = std::make_unique<Vehicle>();
+      const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
+      if (sensor_qos) use_sensor_qos(transport_, topics);
+      c->node = std::make_unique<sim::ControllerNode>(transport_, topics, v.controller);
+      c->schedule = std::move(v.schedule);
+      std::stable_sort(c->schedule.begin(), c->schedule.end(),
+                       [](const auto& a, const auto& b) { return a.tick < b.tick; });
+      c->next = c->schedule.begin();
+      vehicles_.push_back(std::move(c));
+    }
+    announcer_ = std::make_unique<dds::NodeAnnouncer>(transport_.participant().handle(),
+                                                      fmt::format("attitude_controllers_{}", first));
+    announcer_->announce();
+  }
+
+  /// Steps each vehicle once per complete sample of a control tick, as `controller` does.
+  int run(std::int64_t control_period_ns, double dt_s) {
+    while (!stop_requested()) {
+      transport_.spin_once(100 * kMs);
+      for (auto& v : vehicles_) {
+        sim::ControllerNode& node = *v->node;
+        const std::uint64_t received = node.samples_received();
+        if (received == v->seen) continue;
+        v->seen = received;
+        const std::int64_t s = node.synchronized_stamp_ns();
+        if (s < 0 || s % control_period_ns != 0) continue;
+        if (s > node.last_step_ns()) {
+          for (; v->next != v->schedule.end() && clock_.ns(v->next->tick) <= s; ++v->next) {
+            if (std::string err = node.set_parameter(v->next->name, v->next->value); !err.empty()) {
+              std::cerr << "controller: scheduled parameter refused: " << err << '\n';
+              return kExitRefused;
+            }
+          }
+          node.step(s, dt_s);
+        } else if (s == node.last_step_ns()) {
+          node.republish();  // the plant asked again for a tick already answered
+        }
+      }
+    }
+    return kExitOk;
+  }
+
+ private:
+  struct Vehicle {
+    std::unique_ptr<sim::ControllerNode> node;
+    std::vector<sim::ScheduledParameter> schedule;
+    std::vector<sim::ScheduledParameter>::const_iterator next;
+    std::uint64_t seen = 0;
+  };
+  sim::TickClock clock_;
+  dds::DdsTransport transport_;
+  std::vector<std::unique_ptr<Vehicle>> vehicles_;
+  std::unique_ptr<dds::NodeAnnouncer> announcer_;
+};
+
+}  // namespace
+
+int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
+  const io::SwarmSpec spec = node_spec(sc, o.vehicles, o.ns_prefix);
+  const int n = spec.layout.vehicles;
+  const int threads = std::clamp(o.threads, 1, n);
+  std::vector<bool> recorded(static_cast<std::size_t>(n), false);
+  if (!o.swarm_out.empty()) {
+    for (int i : spec.record_vehicles) recorded[static_cast<std::size_t>(i)] = true;
+  }
+  std::vector<std::unique_ptr<PlantShard>> shards(static_cast<std::size_t>(threads));
+  // Participants are created one after the other (Cyclone's domain setup is not worth racing).
+  for (int t = 0; t < threads; ++t) {
+    shards[static_cast<std::size_t>(t)] =
+        std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm_out),
+                                     o.sensor_qos, o.enclave);
+  }
+  std::cerr << fmt::format("plant: {} vehicles ({}...), {} thread(s), lockstep, {} ticks of {} s\n", n,
+                           sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads, sc.simulation.duration_ticks,
+                           sc.simulation.plant.clock.period_s());
+  const int rc = run_threads(threads, [&](int t) {
+    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, sc.simulation.controller_divider,
+                                                    sc.simulation.duration_ticks);
+  });
+  if (rc != kExitOk) return rc;
+  std::int64_t wall_ns = 0;
+  for (const auto& s : shards) wall_ns = std::max(wall_ns, s->wall_ns());
+  const double wall_s = static_cast<double>(wall_ns) / 1e9;
+  const double sim_s = sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks);
+  std::cerr << fmt::format("plant: done; {} vehicles, {:g} s simulated in {:.3f} s ({:.2f}x real time)\n", n, sim_s,
+                           wall_s, sim_s / wall_s);
+  if (!o.stats.empty()) {
+    write_stats(o.stats, {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
+  }
+  if (!o.swarm_out.empty()) {
+    std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
+    std::vector<std::string> namespaces(static_cast<std::size_t>(n));
+    const model::State initial = io::initial_state(sc);
+    for (int t = 0; t < threads; ++t) {
+      for (int i = n * t / threads; i < n * (t + 1) / threads; ++i) {
+        const sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
+        SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
+        // The setpoint at the end: the vehicle's initial one with its whole schedule applied.
+        control::ControllerConfig c = v.controller;
+        for (const auto& e : v.schedule) control::set_parameter(c, e.name, e.value);
+        f.p_des_W = c.setpoint.p_des_W;
+        rows[static_cast<std::size_t>(i)] = f;
+        namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
+      }
+    }
+    write_swarm_summary(o.swarm_out, sc, spec, namespaces, rows,
+                        {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s},
+                         {"real_time_factor", sim_s / wall_s}});
+  }
+  return kExitOk;
+}
+
+int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc) {
+  const io::SwarmSpec spec = node_spec(sc, o.vehicles, o.ns_prefix);
+  const int n = spec.layout.vehicles;
+  const int threads = std::clamp(o.threads, 1, n);
+  if (!o.apply_schedule) sc.schedule.clear();
+  const std::int64_t period_ns = sc.simulation.plant.clock.period_ns * sc.simulation.controller_divider;
+  std::vector<std::unique_ptr<ControllerShard>> shards;
+  for (int t = 0; t < threads; ++t) {
+    shards.push_back(std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads, o.sensor_qos,
+                                                       o.enclave));
+  }
+  std::cerr << fmt::format("controller: {} vehicles ({}...), {} thread(s), lockstep, period {} s\n", n,
+                           sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads,
+                           static_cast<double>(period_ns) / 1e9);
+  const int rc = run_threads(threads, [&](int t) {
+    return shards[static_cast<std::size_t>(t)]->run(period_ns, static_cast<double>(period_ns) / 1e9);
+  });
+  std::cerr << "controller: stopped\n";
+  return rc;
+}
+
+}  // namespace quadcosim::app

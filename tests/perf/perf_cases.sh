@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Swarm runs and the bench smoke test. Usage: perf_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID
+# DDS cases run on their own ROS_DOMAIN_ID with localhost-only discovery and end every process they
+# started (trap), also on failure. Speed is never asserted here: bench prints figures.
+set -euo pipefail
+bin="$1"; src="$2"; case_name="$3"
+export ROS_DOMAIN_ID="$4" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
+tmp="$(mktemp -d)"
+cleanup() {
+  jobs -p | xargs -r kill -KILL 2>/dev/null || true
+  wait 2>/dev/null || true
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+fail() { echo "FAIL [$case_name]: $*"; for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done; exit 1; }
+py=/usr/bin/python3
+grid="$src/scenarios/swarm/grid_takeoff.yaml"
+
+case "$case_name" in
+  bench_quick)  # every key present, every figure positive and finite, the machine described
+    "$bin" bench --json --quick > "$tmp/bench.json" 2> "$tmp/bench.log" || fail "bench exited non-zero"
+    "$py" - "$tmp/bench.json" <<'PY' || fail "bench JSON incomplete"
+import json, math, sys
+j = json.loads(open(sys.argv[1]).read())
+for k in ["inproc_rtf", "baseline_rtf", "dds_lockstep_rtf", "dds_cmd_roundtrip_us_p50", "dds_cmd_roundtrip_us_p99",
+          "realtime_period_jitter_us_p99", "swarm_inproc_vehicles_at_rt", "swarm_dds_vehicles_at_rt"]:
+    v = j[k]
+    assert isinstance(v, (int, float)) and math.isfinite(v) and v > 0, (k, v)
+assert j["dds_cmd_roundtrip_us_p99"] >= j["dds_cmd_roundtrip_us_p50"], "p99 below p50"
+m = j["machine"]
+for k in ["cpu_model", "cores", "kernel", "compiler"]:
+    assert m[k], k
+assert m["cores"] >= 1
+PY
+    ;;
+  swarm_inproc)  # 100 vehicles: each at its own cell and height, recorded vehicles judged
+    "$bin" run "$grid" --vehicles 100 --out "$tmp/s" --no-plots > "$tmp/run.log" 2>&1 || fail "swarm run failed"
+    [ "$(wc -l < "$tmp/s/vehicles.csv")" -eq 101 ] || fail "vehicles.csv should have 100 rows"
+    [ -s "$tmp/s/uav0000/trajectory.csv" ] && [ -s "$tmp/s/uav0063/metrics.json" ] || fail "recorded vehicles missing"
+    "$py" - "$tmp/s" <<'PY' || fail "swarm outcome wrong"
+import csv, json, math, sys
+d = sys.argv[1]
+s = json.load(open(d + "/summary.json"))
+assert s["vehicles"] == 100 and s["vehicles_in_safety"] == 0 and s["vehicles_non_finite"] == 0, s
+rows = list(csv.DictReader(open(d + "/vehicles.csv")))
+assert [r["namespace"] for r in rows[:3]] == ["/uav0000", "/uav0001", "/uav0002"]
+for i, r in enumerate(rows):
+    # 10 columns (ceil(sqrt(100))), 2 m apart; heights 5, 6, 7 m by index mod 3.
+    want = ((i % 10) * 2.0, (i // 10) * 2.0, 5.0 + (i % 3))
+    got = tuple(float(r[k]) for k in ("x_m", "y_m", "z_m"))
+    assert all(abs(g - w) < 0.02 for g, w in zip(got, want)), (i, got, want)
+PY
+    # Bad input names the key and exits 2.
+    printf 'swarm:\n  vehicles: 4\n  record_vehicles: [7]\n' > "$tmp/bad.yaml"
+    set +e; "$bin" run "$tmp/bad.yaml" --out "$tmp/bad" --no-plots > "$tmp/bad.log" 2>&1; rc=$?; set -e
+    [ "$rc" -eq 2 ] || fail "bad swarm section: exit $rc, expected 2"
+    grep -q "swarm.record_vehicles\[0\]" "$tmp/bad.log" || fail "error does not name swarm.record_vehicles[0]"
+    ;;
+  swarm_dds_identical)  # 6 vehicles over DDS (one plant and one controller process, 2 threads each)
+    "$bin" run "$grid" --vehicles 6 --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process swarm failed"
+    "$bin" run "$grid" --vehicles 6 --out "$tmp/dds" --no-plots --transport dds > "$tmp/dds.log" 2>&1 \
+      || fail "DDS swarm failed"
+    cmp "$tmp/in/vehicles.csv" "$tmp/dds/vehicles.csv" || fail "final states differ"
+    cmp "$tmp/in/uav0000/trajectory.csv" "$tmp/dds/uav0000/trajectory.csv" || fail "recorded trajectory differs"
+    [ "$(wc -l < "$tmp/dds/uav0000/trajectory.csv")" -gt 1000 ] || fail "trajectory too short"
+    ;;
+  *) echo "unknown case $case_name"; exit 2 ;;
+esac
+echo "PASS [$case_name]"
