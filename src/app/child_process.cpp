@@ -1,5 +1,7 @@
 #include "app/child_process.hpp"
 
+#include "app/signals.hpp"
+
 #include <signal.h>
 #include <spawn.h>
 #include <fcntl.h>
@@ -9,6 +11,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <iostream>
 #include <stdexcept>
 #include <thread>
 
@@ -68,6 +71,32 @@ std::string self_executable() {
   const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
   if (n <= 0) throw std::runtime_error("cannot find the running executable (/proc/self/exe)");
   return std::string(buf, static_cast<std::size_t>(n));
+}
+
+int run_plant_and_controller(const std::vector<std::string>& plant_argv,
+                             const std::vector<std::string>& controller_argv) {
+  ChildProcess controller(controller_argv);
+  ChildProcess plant(plant_argv);
+  std::optional<int> plant_status;
+  while (!(plant_status = plant.wait(0.1))) {
+    if (stop_requested()) {
+      std::cerr << "run: interrupted; stopping plant and controller\n";
+      plant.stop();
+      controller.stop();
+      return 130;
+    }
+    if (auto c = controller.wait(0.0)) {
+      std::cerr << "run: the controller exited early (status " << *c << "); stopping the plant\n";
+      plant.stop();
+      return 4;
+    }
+  }
+  controller.stop();
+  if (*plant_status != 0) {
+    std::cerr << "run: the plant exited with status " << *plant_status << '\n';
+    return *plant_status == 2 ? 2 : 4;
+  }
+  return 0;
 }
 
 }  // namespace quadcosim::app

@@ -32,6 +32,12 @@ class ChildProcess {
   std::optional<int> status_;
 };
 
+/// Runs a plant and a controller process side by side until the plant ends (the controller is then
+/// stopped): 0 when the plant succeeded, 2 when it refused its input, 4 when it failed otherwise or
+/// the controller exited first, 130 on Ctrl-C (both stopped). Messages go to stderr prefixed "run:".
+int run_plant_and_controller(const std::vector<std::string>& plant_argv,
+                             const std::vector<std::string>& controller_argv);
+
 /// Path of the running executable (/proc/self/exe).
 std::string self_executable();
 

@@ -92,28 +92,7 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     for (std::string a : {"--realtime", "--wait-for-controller", "--rate-factor"}) plant_args.push_back(a);
     plant_args.push_back(fmt::format("{}", opt.rate_factor));
   }
-  ChildProcess controller(controller_args);
-  ChildProcess plant(plant_args);
-  std::optional<int> plant_status;
-  while (!(plant_status = plant.wait(0.1))) {
-    if (stop_requested()) {
-      std::cerr << "run: interrupted; stopping plant and controller\n";
-      plant.stop();
-      controller.stop();
-      return 130;
-    }
-    if (auto c = controller.wait(0.0)) {
-      std::cerr << "run: the controller exited early (status " << *c << "); stopping the plant\n";
-      plant.stop();
-      return 4;
-    }
-  }
-  controller.stop();
-  if (*plant_status != 0) {
-    std::cerr << "run: the plant exited with status " << *plant_status << '\n';
-    return 4;
-  }
-  return 0;
+  return run_plant_and_controller(plant_args, controller_args);
 }
 
 }  // namespace

@@ -110,26 +110,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario, "--vehicles",
                                                 std::to_string(n)};
     install_stop_handlers();
-    ChildProcess controller(controller_args);
-    ChildProcess plant(plant_args);
-    std::optional<int> plant_status;
-    while (!(plant_status = plant.wait(0.1))) {
-      if (stop_requested()) {
-        plant.stop();
-        controller.stop();
-        return 130;
-      }
-      if (auto c = controller.wait(0.0)) {
-        std::cerr << "run: the controller exited early (status " << *c << "); stopping the plant\n";
-        plant.stop();
-        return 4;
-      }
-    }
-    controller.stop();
-    if (*plant_status != 0) {
-      std::cerr << "run: the plant exited with status " << *plant_status << '\n';
-      return *plant_status == 2 ? 2 : 4;
-    }
+    if (const int rc = run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;
   } else {
     sim::Swarm swarm(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
     std::vector<bool> recorded(static_cast<std::size_t>(n), false);

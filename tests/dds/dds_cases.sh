@@ -2,19 +2,8 @@
 # Co-simulation over DDS with real processes. Usage: dds_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID
 # Every case runs on its own ROS_DOMAIN_ID with localhost-only discovery, and ends every process it
 # started (trap), also on failure.
-set -euo pipefail
-bin="$1"; src="$2"; case_name="$3"
-export ROS_DOMAIN_ID="$4" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
-tmp="$(mktemp -d)"
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-fail() { echo "FAIL [$case_name]: $*"; for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done; exit 1; }
+bin="$1"; src="$2"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 paper="$src/scenarios/paper"
 
 identical() {  # in-process and DDS lockstep give the same bytes

@@ -3,19 +3,8 @@
 # over DDS (lockstep, 1 s): the plant must refuse and clamp exactly what was sent, keep a finite
 # state, and publish the counts on /drone/plant_status (checked in its MCAP recording with the MCAP
 # reference reader when Node.js is there). Usage: hostile_commands.sh BINARY HOSTILE_CONTROLLER SOURCE_DIR DOMAIN_ID
-set -euo pipefail
 bin="$1"; hostile="$2"; src="$3"
-export ROS_DOMAIN_ID="$4" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
-tmp="$(mktemp -d)"
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-fail() { echo "FAIL [hostile_commands]: $*"; for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" hostile_commands "$4"
 
 mkdir -p "$tmp/bag"
 "$hostile" 2 > "$tmp/hostile.log" 2>&1 &

@@ -2,18 +2,8 @@
 # Swarm runs and the bench smoke test. Usage: perf_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID
 # DDS cases run on their own ROS_DOMAIN_ID with localhost-only discovery and end every process they
 # started (trap), also on failure. Speed is never asserted here: bench prints figures.
-set -euo pipefail
-bin="$1"; src="$2"; case_name="$3"
-export ROS_DOMAIN_ID="$4" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
-tmp="$(mktemp -d)"
-cleanup() {
-  jobs -p | xargs -r kill -KILL 2>/dev/null || true
-  wait 2>/dev/null || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-fail() { echo "FAIL [$case_name]: $*"; for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done; exit 1; }
+bin="$1"; src="$2"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 py=/usr/bin/python3
 grid="$src/scenarios/swarm/grid_takeoff.yaml"
 
