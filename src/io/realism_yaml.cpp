@@ -127,19 +127,8 @@ HoldSpec read_hold(YamlSection& s, double duration_s) {
       c->fail(fig, "unknown hold figure (expected max_horizontal_error_m, rms_horizontal_error_m or "
                    "max_vertical_error_m)");
     }
-    const YAML::Node b = c->raw(fig);
-    if (!b.IsSequence() || b.size() != 2) c->fail(fig, "expected [min, max] (null for no bound)");
-    Criterion crit{fig, std::nullopt, std::nullopt};
-    for (int i = 0; i < 2; ++i) {
-      if (b[i].IsNull()) continue;
-      try {
-        (i == 0 ? crit.min : crit.max) = b[i].as<double>();
-      } catch (const YAML::Exception&) {
-        c->fail(fig, "got '" + b[i].Scalar() + "', expected a number or null");
-      }
-    }
-    if (crit.min && crit.max && *crit.min > *crit.max) c->fail(fig, "min is above max");
-    h.criteria.push_back(crit);
+    const auto [min, max] = c->bounds(fig);
+    h.criteria.push_back(Criterion{fig, min, max});
   }
   if (h.criteria.empty()) s.fail("criteria", "expected at least one figure");
   s.reject_unknown_keys();

@@ -190,19 +190,8 @@ void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
         bool known = false;
         for (const auto& f : analysis::figure_names()) known = known || f == fig;
         if (!known) c->fail(fig, "unknown step figure (expected overshoot_pct, peak_time_s, rise_time_s, t95_s, settling_time_2pct_s or steady_state_error_pct)");
-        const YAML::Node b = c->raw(fig);
-        if (!b.IsSequence() || b.size() != 2) c->fail(fig, "expected [min, max] (null for no bound)");
-        Criterion crit{fig, std::nullopt, std::nullopt};
-        for (int i = 0; i < 2; ++i) {
-          if (b[i].IsNull()) continue;
-          try {
-            (i == 0 ? crit.min : crit.max) = b[i].as<double>();
-          } catch (const YAML::Exception&) {
-            c->fail(fig, "got " + YamlSection::describe(b[i]) + ", expected a number or null");
-          }
-        }
-        if (crit.min && crit.max && *crit.min > *crit.max) c->fail(fig, "min is above max");
-        step.criteria.push_back(crit);
+        const auto [min, max] = c->bounds(fig);
+        step.criteria.push_back(Criterion{fig, min, max});
       }
     }
     if (auto r = s.section("reference")) {

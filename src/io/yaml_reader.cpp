@@ -40,6 +40,22 @@ std::string YamlSection::describe(const YAML::Node& n) {
   return "nothing";
 }
 
+std::pair<std::optional<double>, std::optional<double>> YamlSection::bounds(const std::string& key) {
+  const YAML::Node b = get(key);
+  if (!b.IsSequence() || b.size() != 2) fail(key, "expected [min, max] (null for no bound)");
+  std::optional<double> bound[2];
+  for (int i = 0; i < 2; ++i) {
+    if (b[i].IsNull()) continue;
+    try {
+      bound[i] = b[i].as<double>();
+    } catch (const YAML::Exception&) {
+      fail(key, "got " + describe(b[i]) + ", expected a number or null");
+    }
+  }
+  if (bound[0] && bound[1] && *bound[0] > *bound[1]) fail(key, "min is above max");
+  return {bound[0], bound[1]};
+}
+
 bool YamlSection::has(const std::string& key) const { return node_[key].IsDefined(); }
 
 YAML::Node YamlSection::get(const std::string& key) {

@@ -7,6 +7,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/scenario.hpp"
@@ -32,6 +33,9 @@ class YamlSection {
                      const std::vector<std::string>& choices);
   /// A list of exactly n numbers; `fallback` when absent.
   std::vector<double> numbers(const std::string& key, std::vector<double> fallback, std::size_t n);
+  /// A pass band `[min, max]` under `key`, null for an absent bound; throws ConfigError when it is not
+  /// a two-element list of numbers or nulls, or when min is above max.
+  std::pair<std::optional<double>, std::optional<double>> bounds(const std::string& key);
   /// The mapping under `key`, or nothing when absent.
   std::optional<YamlSection> section(const std::string& key);
   /// The sequence under `key` as raw nodes (empty when absent); throws when not a sequence.
