@@ -71,6 +71,20 @@ class ReportTest(ToolTestBase):
             metrics = json.load(f)
         return run, path, page, metrics
 
+    def report_with_metrics(self, edit):
+        """report.html of an unplotted roll-step run whose metrics.json `edit(m)` changed in place."""
+        run = os.path.join(self.tmp, "run")
+        make_run(run, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
+        with open(os.path.join(run, "metrics.json")) as f:
+            m = json.load(f)
+        edit(m)
+        with open(os.path.join(run, "metrics.json"), "w") as f:
+            json.dump(m, f)
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
+            return f.read()
+
     def test_report_contents(self):
         run, path, page, metrics = self.make_report()
         step = metrics["steps"][0]
@@ -105,42 +119,26 @@ class ReportTest(ToolTestBase):
             self.assertEqual(f.read(), page)
 
     def test_failed_verdict(self):
-        run = os.path.join(self.tmp, "run")
-        make_run(run, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
-        with open(os.path.join(run, "metrics.json")) as f:
-            m = json.load(f)
-        m["steps"][0]["criteria"][0]["passed"] = False
-        m["steps"][0]["passed"] = False
-        m["passed"] = False
-        with open(os.path.join(run, "metrics.json"), "w") as f:
-            json.dump(m, f)
-        res = self.run_tool(REPORT, run)
-        self.assertEqual(res.returncode, 0, res.stderr)
-        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
-            page = f.read()
+        def fail_roll(m):
+            m["steps"][0]["criteria"][0]["passed"] = False
+            m["steps"][0]["passed"] = False
+            m["passed"] = False
+        page = self.report_with_metrics(fail_roll)
         self.assertIn(">FAILED<", page)
         self.assertIn(">FAIL<", page)
         self.assertNotIn("data:image/png;base64,", page)  # no plots were made
 
     def test_hold_section(self):
         # A position-hold block (analysis.hold) is shown with its values, bands and verdict.
-        run = os.path.join(self.tmp, "run")
-        make_run(run, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
-        with open(os.path.join(run, "metrics.json")) as f:
-            m = json.load(f)
-        m["hold"] = {"after_s": 10.0,
-                     "figures": {"max_horizontal_error_m": 0.6125, "rms_horizontal_error_m": 0.25,
-                                 "max_vertical_error_m": None},
-                     "criteria": [{"figure": "max_horizontal_error_m", "min": None, "max": 0.5,
-                                   "value": 0.6125, "passed": False}],
-                     "passed": False}
-        m["passed"] = False
-        with open(os.path.join(run, "metrics.json"), "w") as f:
-            json.dump(m, f)
-        res = self.run_tool(REPORT, run)
-        self.assertEqual(res.returncode, 0, res.stderr)
-        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
-            page = f.read()
+        def add_hold(m):
+            m["hold"] = {"after_s": 10.0,
+                         "figures": {"max_horizontal_error_m": 0.6125, "rms_horizontal_error_m": 0.25,
+                                     "max_vertical_error_m": None},
+                         "criteria": [{"figure": "max_horizontal_error_m", "min": None, "max": 0.5,
+                                       "value": 0.6125, "passed": False}],
+                         "passed": False}
+            m["passed"] = False
+        page = self.report_with_metrics(add_hold)
         self.assertIn("Position hold from t = 10.0 s — FAIL", page)
         self.assertIn("0.613 m", page)
         self.assertIn("≤ 0.5", page)
