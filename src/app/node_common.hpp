@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dds/dds_transport.hpp"
+#include "dds/steady_clock.hpp"
 #include "io/scenario.hpp"
 #include "sim/topics.hpp"
 
@@ -18,11 +19,7 @@ namespace quadcosim::app {
 constexpr std::int64_t kMs = 1'000'000;  ///< [ns]
 
 /// Monotonic wall clock [ns]; only the real-time loops and the latency figures read it.
-inline std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+using dds::steady_ns;
 
 /// The scenario at `path` (the built-in defaults when empty), its vehicle replaced by the one in
 /// `vehicle_file` when given. Throws io::ConfigError.

@@ -13,6 +13,7 @@
 #include "app/signals.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/graph.hpp"
+#include "dds/steady_clock.hpp"
 #include "dds/topic_tools.hpp"
 #include "sim/messages.hpp"
 
@@ -23,10 +24,7 @@ namespace {
 constexpr std::int64_t kMs = 1'000'000;
 constexpr std::int64_t kSecond = 1'000'000'000;
 
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+using dds::steady_ns;
 
 std::int64_t to_ns(double seconds) { return static_cast<std::int64_t>(seconds * 1e9); }
 

@@ -5,17 +5,11 @@
 #include <sstream>
 
 #include "dds/parameter_wire.hpp"
+#include "dds/steady_clock.hpp"
 
 namespace quadcosim::dds {
 
 namespace {
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-std::size_t index(ParamService s) { return static_cast<std::size_t>(s); }
 
 std::string seconds(std::int64_t ns) {
   std::ostringstream os;

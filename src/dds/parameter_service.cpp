@@ -5,18 +5,12 @@
 
 #include "dds/dds_transport.hpp"
 #include "dds/parameter_wire.hpp"
+#include "dds/steady_clock.hpp"
 #include "dds/participant.hpp"
 
 namespace quadcosim::dds {
 
 namespace {
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-std::size_t index(ParamService s) { return static_cast<std::size_t>(s); }
 
 std::vector<dds_instance_handle_t> matched_subscriptions(dds_entity_t writer) {
   std::vector<dds_instance_handle_t> h(8);

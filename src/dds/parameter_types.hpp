@@ -97,6 +97,8 @@ enum class ParamService { kGet, kGetTypes, kSet, kSetAtomically, kDescribe, kLis
 inline constexpr std::array<ParamService, 6> kParamServices = {
     ParamService::kGet,      ParamService::kGetTypes, ParamService::kSet,
     ParamService::kSetAtomically, ParamService::kDescribe, ParamService::kList};
+/// Position of `service` in kParamServices (and in per-service tables).
+inline constexpr std::size_t index(ParamService service) { return static_cast<std::size_t>(service); }
 /// "get_parameters", "get_parameter_types", "set_parameters", "set_parameters_atomically",
 /// "describe_parameters", "list_parameters".
 std::string_view service_suffix(ParamService service);
