@@ -29,7 +29,98 @@ Wrench Quadrotor::wrench(const Vector4& omega) const {
   return {u[0], u.tail<3>()};
 }
 
-bool Quadrotor::on_ground(const State& x) const { return x.p_W.z() <= 0.0 && x.v_W.z() <= 0.0; }
+namespace {
+
+// The rigid body's part of the state as plain doubles, for the hot path of step(): p_W (0-2), v_W
+// (3-5), q_WB as w, x, y, z (6-9), w_B (10-12).
+constexpr int kRigid = 13;
+using Rigid = double[kRigid];
+
+void pack(const State& x, Rigid r) {
+  for (int i = 0; i < 3; ++i) {
+    r[i] = x.p_W[i];
+    r[3 + i] = x.v_W[i];
+    r[10 + i] = x.w_B[i];
+  }
+  r[6] = x.q_WB.w();
+  r[7] = x.q_WB.x();
+  r[8] = x.q_WB.y();
+  r[9] = x.q_WB.z();
+}
+
+void unpack(const Rigid r, State& x) {
+  x.p_W = {r[0], r[1], r[2]};
+  x.v_W = {r[3], r[4], r[5]};
+  x.q_WB = Eigen::Quaterniond(r[6], r[7], r[8], r[9]);
+  x.w_B = {r[10], r[11], r[12]};
+}
+
+/// What the rigid body's derivative needs besides the state: the rotors' wrench (collective thrust per
+/// unit mass [m/s^2], body torque [N m]), an optional extra acceleration in the world frame [m/s^2]
+/// (air drag), and the vehicle's constants.
+struct RigidInputs {
+  double thrust_per_mass;
+  double torque_B[3];
+  const Eigen::Vector3d* accel_W;
+  double gravity;
+  double inertia[3];
+  bool gyroscopic;
+};
+
+/// The equations of Quadrotor::derivative() on 13 plain doubles (y -> d), so that step() can run RK4
+/// on them: translation, eq. (7), with R_WB's third column formed as Eigen's toRotationMatrix()
+/// forms it; rotation, eq. (8) (or (11)), the gyroscopic term as Eigen's cross() forms it; ground
+/// contact; dq/dt = 1/2 q (x) (0, w).
+inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, double* __restrict d) {
+  const double qw = y[6], qx = y[7], qy = y[8], qz = y[9];
+  const double tx = 2.0 * qx, ty = 2.0 * qy, tz = 2.0 * qz;
+  double ax = (tz * qx + ty * qw) * in.thrust_per_mass;
+  double ay = (tz * qy - tx * qw) * in.thrust_per_mass;
+  double az = (1.0 - (tx * qx + ty * qy)) * in.thrust_per_mass - in.gravity;
+  if (in.accel_W) {
+    ax += in.accel_W->x();
+    ay += in.accel_W->y();
+    az += in.accel_W->z();
+  }
+  const double wx = y[10], wy = y[11], wz = y[12];
+  double tau_x = in.torque_B[0], tau_y = in.torque_B[1], tau_z = in.torque_B[2];
+  if (in.gyroscopic) {
+    const double Iwx = in.inertia[0] * wx, Iwy = in.inertia[1] * wy, Iwz = in.inertia[2] * wz;
+    tau_x -= wy * Iwz - wz * Iwy;
+    tau_y -= wz * Iwx - wx * Iwz;
+    tau_z -= wx * Iwy - wy * Iwx;
+  }
+  double dwx = tau_x / in.inertia[0], dwy = tau_y / in.inertia[1], dwz = tau_z / in.inertia[2];
+  if (y[2] <= 0.0 && y[5] <= 0.0 && az <= 0.0) {
+    // Resting on the ground: the normal force and friction cancel the net force and torque.
+    ax = ay = az = 0.0;
+    dwx = dwy = dwz = 0.0;
+  }
+  d[0] = y[3];
+  d[1] = y[4];
+  d[2] = y[5];
+  d[3] = ax;
+  d[4] = ay;
+  d[5] = az;
+  d[6] = -0.5 * (qx * wx + qy * wy + qz * wz);
+  d[7] = 0.5 * (qw * wx + qy * wz - qz * wy);
+  d[8] = 0.5 * (qw * wy + qz * wx - qx * wz);
+  d[9] = 0.5 * (qw * wz + qx * wy - qy * wx);
+  d[10] = dwx;
+  d[11] = dwy;
+  d[12] = dwz;
+}
+
+RigidInputs rigid_inputs(const VehicleParams& p, const Wrench& f, const Eigen::Vector3d* accel_W) {
+  return {f.thrust_N / p.mass_kg,
+          {f.torque_B_Nm.x(), f.torque_B_Nm.y(), f.torque_B_Nm.z()},
+          accel_W,
+          p.gravity_m_s2,
+          {p.Ixx_kg_m2, p.Iyy_kg_m2, p.Izz_kg_m2},
+          p.gyroscopic == GyroscopicModel::kFull};
+}
+
+}  // namespace
 
 StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd,
                                       const Environment* env) const {
@@ -48,31 +139,18 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
   }
 
   const Wrench f = env ? environment_wrench(omega, x, *env) : wrench(omega);
-  const Eigen::Matrix3d R_WB = x.q_WB.toRotationMatrix();
-  d.p_W = x.v_W;
-  d.v_W = R_WB.col(2) * (f.thrust_N / params_.mass_kg);
-  d.v_W.z() -= params_.gravity_m_s2;
-  if (env) d.v_W += aero_force_W(params_.aero, R_WB, x.v_W, env->wind_W, omega) / params_.mass_kg;
-
-  const Eigen::Vector3d& w = x.w_B;
-  Eigen::Vector3d tau = f.torque_B_Nm;
-  if (params_.gyroscopic == GyroscopicModel::kFull) {
-    tau -= w.cross(inertia_diag_.cwiseProduct(w));
+  Eigen::Vector3d aero_accel_W;
+  if (env) {
+    aero_accel_W =
+        aero_force_W(params_.aero, x.q_WB.toRotationMatrix(), x.v_W, env->wind_W, omega) / params_.mass_kg;
   }
-  d.w_B = tau.cwiseQuotient(inertia_diag_);
-
-  if (on_ground(x) && d.v_W.z() <= 0.0) {
-    // Resting on the ground: the normal force and friction cancel the net force and torque.
-    d.v_W.setZero();
-    d.w_B.setZero();
-  }
-
-  // dq/dt = 1/2 q (x) (0, w)
-  const Eigen::Quaterniond& q = x.q_WB;
-  d.q_WB_wxyz << -0.5 * (q.x() * w.x() + q.y() * w.y() + q.z() * w.z()),
-      0.5 * (q.w() * w.x() + q.y() * w.z() - q.z() * w.y()),
-      0.5 * (q.w() * w.y() + q.z() * w.x() - q.x() * w.z()),
-      0.5 * (q.w() * w.z() + q.x() * w.y() - q.y() * w.x());
+  Rigid y, r;
+  pack(x, y);
+  rigid_derivative(y, rigid_inputs(params_, f, env ? &aero_accel_W : nullptr), r);
+  d.p_W = {r[0], r[1], r[2]};
+  d.v_W = {r[3], r[4], r[5]};
+  d.q_WB_wxyz = {r[6], r[7], r[8], r[9]};
+  d.w_B = {r[10], r[11], r[12]};
   return d;
 }
 
@@ -82,8 +160,16 @@ Wrench Quadrotor::environment_wrench(const Vector4& omega, const State& x, const
 }
 
 Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const Environment* env) const {
-  const StateDerivative d = derivative(t_s, x, clamp_command(cmd), env);
-  Eigen::Vector3d a_minus_g = d.v_W;
+  Eigen::Vector3d a_minus_g;
+  if (params_.motor.model == MotorModel::kIdeal && !env) {  // derivative()'s translation only
+    const Wrench f = wrench(clamp_command(cmd));
+    Rigid y, d;
+    pack(x, y);
+    rigid_derivative(y, rigid_inputs(params_, f, nullptr), d);
+    a_minus_g = {d[3], d[4], d[5]};
+  } else {
+    a_minus_g = derivative(t_s, x, clamp_command(cmd), env).v_W;
+  }
   a_minus_g.z() += params_.gravity_m_s2;
   return {x.p_W, x.q_WB, x.v_W, x.w_B, x.q_WB.conjugate() * a_minus_g};
 }
@@ -118,11 +204,47 @@ StateDerivative weighted_sum(const StateDerivative& k1, const StateDerivative& k
 
 }  // namespace
 
+
 void Quadrotor::step(State& x, double t_s, const Vector4& cmd_in, double dt_s, int substeps,
                      const Environment* env) const {
   assert(substeps >= 1);
   const Vector4 cmd = clamp_command(cmd_in);
   const double h = dt_s / substeps;
+  const bool ideal = params_.motor.model == MotorModel::kIdeal;
+  if (ideal && !env) {
+    // The rotors' wrench is the same in every stage: formed once, then RK4 on 13 plain doubles.
+    const Wrench f = wrench(cmd);
+    const RigidInputs in = rigid_inputs(params_, f, nullptr);
+    Rigid r, k1, k2, k3, k4, y;
+    pack(x, r);
+    for (int s = 0; s < substeps; ++s) {
+      rigid_derivative(r, in, k1);
+      for (int i = 0; i < kRigid; ++i) y[i] = r[i] + (0.5 * h) * k1[i];
+      rigid_derivative(y, in, k2);
+      for (int i = 0; i < kRigid; ++i) y[i] = r[i] + (0.5 * h) * k2[i];
+      rigid_derivative(y, in, k3);
+      for (int i = 0; i < kRigid; ++i) y[i] = r[i] + h * k3[i];
+      rigid_derivative(y, in, k4);
+      for (int i = 0; i < kRigid; ++i) {
+        r[i] = r[i] + h * ((k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
+      }
+      // Renormalised by Eigen, as the general path does (its sum of squares has its own order).
+      Eigen::Quaterniond q(r[6], r[7], r[8], r[9]);
+      q.normalize();
+      r[6] = q.w();
+      r[7] = q.x();
+      r[8] = q.y();
+      r[9] = q.z();
+      if (r[2] < 0.0) {  // touched down during the step: inelastic impact, held by friction
+        r[2] = 0.0;
+        r[3] = r[4] = r[5] = 0.0;
+        r[10] = r[11] = r[12] = 0.0;
+      }
+    }
+    unpack(r, x);
+    x.omega_rad_s = cmd;
+    return;
+  }
   for (int s = 0; s < substeps; ++s) {
     const double t = t_s + s * h;
     const StateDerivative k1 = derivative(t, x, cmd, env);
@@ -137,7 +259,7 @@ void Quadrotor::step(State& x, double t_s, const Vector4& cmd_in, double dt_s, i
       x.w_B.setZero();
     }
   }
-  if (params_.motor.model == MotorModel::kIdeal) {
+  if (ideal) {
     x.omega_rad_s = cmd;
   } else {
     x.omega_rad_s = clamp_command(x.omega_rad_s);

@@ -84,7 +84,6 @@ class Quadrotor {
   State initial_state(const Eigen::Vector3d& p_W, double yaw_rad, bool hover) const;
 
  private:
-  bool on_ground(const State& x) const;
   /// Eq. (4) with each rotor's efficiency and the ground effect on U1.
   Wrench environment_wrench(const Vector4& omega, const State& x, const Environment& env) const;
 
