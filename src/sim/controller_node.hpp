@@ -91,6 +91,7 @@ class ControllerNode {
   Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
   bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
+  control::Mode status_mode_{};  ///< the mode status_.mode names (when not empty)
   std::function<void(const std::string&)> log_;
   std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing
   int pose_backwards_ = 0, velocity_backwards_ = 0, imu_backwards_ = 0;

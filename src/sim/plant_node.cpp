@@ -27,6 +27,9 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
   velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
   imu_pub_ = transport.advertise<msg::Imu>(topics.imu);
+  pose_.header.frame_id = options.frame_id;
+  twist_.header.frame_id = options.frame_id;
+  imu_.header.frame_id = "base_link";
   transport.subscribe<msg::Float64MultiArray>(
       topics.motor_commands, [this](const msg::Float64MultiArray& m) { on_command(m); });
 }
@@ -95,38 +98,36 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const msg::Header header{stamp, options_.frame_id};
   const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_,
                                           realism_ ? &realism_->environment(k) : nullptr);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
   publish_status(k);
 
-  msg::PoseStamped pose;
-  pose.header = header;
-  pose.position = to_msg(y.p_W);
-  pose.orientation = to_msg(y.q_WB);
+  // The messages are kept between ticks (their frame ids are set once); every field that changes
+  // is written here or by the realism below.
+  pose_.header.stamp = stamp;
+  pose_.position = to_msg(y.p_W);
+  pose_.orientation = to_msg(y.q_WB);
 
-  msg::TwistStamped twist;
-  twist.header = header;
-  twist.linear = to_msg(y.v_W);
-  twist.angular = to_msg(y.w_B);
+  twist_.header.stamp = stamp;
+  twist_.linear = to_msg(y.v_W);
+  twist_.angular = to_msg(y.w_B);
 
-  msg::Imu imu;
-  imu.header = msg::Header{stamp, "base_link"};
-  imu.orientation = to_msg(y.q_WB);
-  imu.angular_velocity = to_msg(y.w_B);
-  imu.linear_acceleration = to_msg(y.specific_force_B);
+  imu_.header.stamp = stamp;
+  imu_.orientation = pose_.orientation;
+  imu_.angular_velocity = twist_.angular;
+  imu_.linear_acceleration = to_msg(y.specific_force_B);
   if (realism_) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
-    const PlantRealism::Due due = realism_->measure(k, y, pose, twist, imu);
-    if (due.pose) pose_pub_.publish(pose);
-    if (due.velocity) velocity_pub_.publish(twist);
-    if (due.imu) imu_pub_.publish(imu);
+    const PlantRealism::Due due = realism_->measure(k, y, pose_, twist_, imu_);
+    if (due.pose) pose_pub_.publish(pose_);
+    if (due.velocity) velocity_pub_.publish(twist_);
+    if (due.imu) imu_pub_.publish(imu_);
     return;
   }
-  pose_pub_.publish(pose);
-  velocity_pub_.publish(twist);
-  imu_pub_.publish(imu);
+  pose_pub_.publish(pose_);
+  velocity_pub_.publish(twist_);
+  imu_pub_.publish(imu_);
 }
 
 void PlantNode::latch_command(Tick k) {

@@ -128,6 +128,9 @@ class PlantNode {
   std::function<void(const std::string&)> log_;
   LogThrottle rejected_log_, clamped_log_;
   msg::PlantStatus status_;
+  msg::PoseStamped pose_;  ///< the outgoing sensor messages, reused from tick to tick
+  msg::TwistStamped twist_;
+  msg::Imu imu_;
   Tick last_status_tick_ = -1;
   Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;

@@ -299,5 +299,20 @@ TEST(CommandLabelTest, WritesAndReadsTheStamp) {
   EXPECT_EQ(command_label(-20), "rotors@-20");
   EXPECT_EQ(command_label(INT64_MIN), "rotors@-9223372036854775808");
 }
+
+TEST(CommandLabelTest, AgreesWithStdToStringAtEveryLength) {
+  // Every digit count and the edges between them, written and read back, against std::to_string.
+  std::vector<std::int64_t> values = {0, INT64_MAX, INT64_MIN, -1};
+  for (std::int64_t p = 1; p <= 1'000'000'000'000'000'000; p *= 10) {
+    for (std::int64_t v : {p - 1, p, p + 1, 7 * p + 3, -p}) values.push_back(v);
+  }
+  Float64MultiArray m;
+  m.dim = {{"", 4, 4}};
+  for (std::int64_t v : values) {
+    write_command_label(m.dim[0].label, v);
+    EXPECT_EQ(m.dim[0].label, "rotors@" + std::to_string(v));
+    EXPECT_EQ(command_stamp_ns(m), v >= 0 ? v : -1) << v;
+  }
+}
 }  // namespace
 }  // namespace quadcosim::msg

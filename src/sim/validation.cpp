@@ -107,25 +107,35 @@ const char* to_string(SensorFault f) {
   return "?";
 }
 
+bool pose_ok(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
+  return finite(m.position) && orientation_ok(m.orientation) && stamp_ok(m.header.stamp, last_stamp_ns);
+}
+
+bool velocity_ok(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
+  return finite(m.linear) && finite(m.angular) && stamp_ok(m.header.stamp, last_stamp_ns);
+}
+
+bool imu_ok(const msg::Imu& m, std::int64_t last_stamp_ns) {
+  return orientation_ok(m.orientation) && finite(m.angular_velocity) && finite(m.linear_acceleration) &&
+         stamp_ok(m.header.stamp, last_stamp_ns);
+}
+
 SensorCheck validate_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
-  if (finite(m.position) && orientation_ok(m.orientation) && stamp_ok(m.header.stamp, last_stamp_ns)) return {};
+  if (pose_ok(m, last_stamp_ns)) return {};
   return first_fault([&] { return check_vector("position", m.position); },
                      [&] { return check_orientation(m.orientation); },
                      [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
 }
 
 SensorCheck validate_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
-  if (finite(m.linear) && finite(m.angular) && stamp_ok(m.header.stamp, last_stamp_ns)) return {};
+  if (velocity_ok(m, last_stamp_ns)) return {};
   return first_fault([&] { return check_vector("linear", m.linear); },
                      [&] { return check_vector("angular", m.angular); },
                      [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
 }
 
 SensorCheck validate_imu(const msg::Imu& m, std::int64_t last_stamp_ns) {
-  if (orientation_ok(m.orientation) && finite(m.angular_velocity) && finite(m.linear_acceleration) &&
-      stamp_ok(m.header.stamp, last_stamp_ns)) {
-    return {};
-  }
+  if (imu_ok(m, last_stamp_ns)) return {};
   return first_fault([&] { return check_orientation(m.orientation); },
                      [&] { return check_vector("angular_velocity", m.angular_velocity); },
                      [&] { return check_vector("linear_acceleration", m.linear_acceleration); },

@@ -65,6 +65,11 @@ struct SensorCheck {
 SensorCheck validate_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
 SensorCheck validate_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
 SensorCheck validate_imu(const msg::Imu& m, std::int64_t last_stamp_ns);
+/// The same acceptance tests as plain booleans (true: the validate_* function would accept): asked
+/// first on every sample, so only a refused one builds a SensorCheck with its reason.
+bool pose_ok(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
+bool velocity_ok(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
+bool imu_ok(const msg::Imu& m, std::int64_t last_stamp_ns);
 
 /// A sender whose clock restarted (a plant process started again under a running controller) sends
 /// only well-formed samples older than the newest accepted. After this many such samples in a row
