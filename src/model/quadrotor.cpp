@@ -67,11 +67,11 @@ struct RigidInputs {
   bool gyroscopic;
 };
 
-/// The equations of Quadrotor::derivative() on 13 plain doubles (y -> d), so that step() can run RK4
-/// on them: translation, eq. (7), with R_WB's third column formed as Eigen's toRotationMatrix()
-/// forms it; rotation, eq. (8) (or (11)), the gyroscopic term as Eigen's cross() forms it; ground
-/// contact; dq/dt = 1/2 q (x) (0, w).
-inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, double* __restrict d) {
+/// dv_W/dt, eq. (7): the thrust along R_WB's third column (formed as Eigen's toRotationMatrix()
+/// forms it) per unit mass, gravity, and the extra acceleration if any, for the attitude q (w, x, y,
+/// z) in y[6..9]. `held` tells whether the ground holds the vehicle (resting on z = 0 with the net
+/// force pointing down), in which case the acceleration is zero.
+inline Eigen::Vector3d linear_acceleration(const double* y, const RigidInputs& in, bool& held) {
   const double qw = y[6], qx = y[7], qy = y[8], qz = y[9];
   const double tx = 2.0 * qx, ty = 2.0 * qy, tz = 2.0 * qz;
   double ax = (tz * qx + ty * qw) * in.thrust_per_mass;
@@ -82,6 +82,18 @@ inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, 
     ay += in.accel_W->y();
     az += in.accel_W->z();
   }
+  held = y[2] <= 0.0 && y[5] <= 0.0 && az <= 0.0;
+  if (held) return Eigen::Vector3d::Zero();
+  return {ax, ay, az};
+}
+
+/// The equations of Quadrotor::derivative() on 13 plain doubles (y -> d), so that step() can run RK4
+/// on them: translation (linear_acceleration); rotation, eq. (8) (or (11)), the gyroscopic term as
+/// Eigen's cross() forms it; ground contact; dq/dt = 1/2 q (x) (0, w).
+inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, double* __restrict d) {
+  bool held = false;
+  const Eigen::Vector3d a = linear_acceleration(y, in, held);
+  const double qw = y[6], qx = y[7], qy = y[8], qz = y[9];
   const double wx = y[10], wy = y[11], wz = y[12];
   double tau_x = in.torque_B[0], tau_y = in.torque_B[1], tau_z = in.torque_B[2];
   if (in.gyroscopic) {
@@ -91,17 +103,15 @@ inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, 
     tau_z -= wx * Iwy - wy * Iwx;
   }
   double dwx = tau_x / in.inertia[0], dwy = tau_y / in.inertia[1], dwz = tau_z / in.inertia[2];
-  if (y[2] <= 0.0 && y[5] <= 0.0 && az <= 0.0) {
-    // Resting on the ground: the normal force and friction cancel the net force and torque.
-    ax = ay = az = 0.0;
+  if (held) {  // resting on the ground: the normal force and friction cancel the net force and torque
     dwx = dwy = dwz = 0.0;
   }
   d[0] = y[3];
   d[1] = y[4];
   d[2] = y[5];
-  d[3] = ax;
-  d[4] = ay;
-  d[5] = az;
+  d[3] = a.x();
+  d[4] = a.y();
+  d[5] = a.z();
   d[6] = -0.5 * (qx * wx + qy * wy + qz * wz);
   d[7] = 0.5 * (qw * wx + qy * wz - qz * wy);
   d[8] = 0.5 * (qw * wy + qz * wx - qx * wz);
@@ -118,6 +128,19 @@ RigidInputs rigid_inputs(const VehicleParams& p, const Wrench& f, const Eigen::V
           p.gravity_m_s2,
           {p.Ixx_kg_m2, p.Iyy_kg_m2, p.Izz_kg_m2},
           p.gyroscopic == GyroscopicModel::kFull};
+}
+
+/// q.conjugate() * v as Eigen computes it (u = 2 (q_vec x v), v + w u + q_vec x u, with q_vec
+/// negated), on scalars read one by one: the state was just stored that way by step(), and Eigen's
+/// paired loads of it would wait for those stores.
+Eigen::Vector3d rotate_by_inverse(const Eigen::Quaterniond& q, const Eigen::Vector3d& v) {
+  const double qw = q.w(), qx = -q.x(), qy = -q.y(), qz = -q.z();
+  double ux = qy * v.z() - qz * v.y(), uy = qz * v.x() - qx * v.z(), uz = qx * v.y() - qy * v.x();
+  ux += ux;
+  uy += uy;
+  uz += uz;
+  return {v.x() + qw * ux + (qy * uz - qz * uy), v.y() + qw * uy + (qz * ux - qx * uz),
+          v.z() + qw * uz + (qx * uy - qy * ux)};
 }
 
 }  // namespace
@@ -162,16 +185,15 @@ Wrench Quadrotor::environment_wrench(const Vector4& omega, const State& x, const
 Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const Environment* env) const {
   Eigen::Vector3d a_minus_g;
   if (params_.motor.model == MotorModel::kIdeal && !env) {  // derivative()'s translation only
-    const Wrench f = wrench(clamp_command(cmd));
-    Rigid y, d;
-    pack(x, y);
-    rigid_derivative(y, rigid_inputs(params_, f, nullptr), d);
-    a_minus_g = {d[3], d[4], d[5]};
+    const double y[10] = {x.p_W.x(), x.p_W.y(), x.p_W.z(), x.v_W.x(), x.v_W.y(),
+                          x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
+    bool held = false;
+    a_minus_g = linear_acceleration(y, rigid_inputs(params_, wrench(clamp_command(cmd)), nullptr), held);
   } else {
     a_minus_g = derivative(t_s, x, clamp_command(cmd), env).v_W;
   }
   a_minus_g.z() += params_.gravity_m_s2;
-  return {x.p_W, x.q_WB, x.v_W, x.w_B, x.q_WB.conjugate() * a_minus_g};
+  return {x.p_W, x.q_WB, x.v_W, x.w_B, rotate_by_inverse(x.q_WB, a_minus_g)};
 }
 
 namespace {
@@ -228,13 +250,14 @@ void Quadrotor::step(State& x, double t_s, const Vector4& cmd_in, double dt_s, i
       for (int i = 0; i < kRigid; ++i) {
         r[i] = r[i] + h * ((k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
       }
-      // Renormalised by Eigen, as the general path does (its sum of squares has its own order).
-      Eigen::Quaterniond q(r[6], r[7], r[8], r[9]);
-      q.normalize();
-      r[6] = q.w();
-      r[7] = q.x();
-      r[8] = q.y();
-      r[9] = q.z();
+      // Renormalised as Eigen's normalize() does it on (x, y, z, w) in pairs: (x^2 + z^2) + (y^2 + w^2),
+      // then a division by the root (the general path's numbers; a test holds the two equal). In
+      // scalars: a Quaterniond here costs two failed store-to-load forwards per step.
+      const double n2 = (r[7] * r[7] + r[9] * r[9]) + (r[8] * r[8] + r[6] * r[6]);
+      if (n2 > 0.0) {
+        const double n = std::sqrt(n2);
+        for (int i = 6; i < 10; ++i) r[i] /= n;
+      }
       if (r[2] < 0.0) {  // touched down during the step: inelastic impact, held by friction
         r[2] = 0.0;
         r[3] = r[4] = r[5] = 0.0;

@@ -115,8 +115,8 @@ void PlantNode::publish_outputs(Tick k) {
   twist_.angular = to_msg(y.w_B);
 
   imu_.header.stamp = stamp;
-  imu_.orientation = pose_.orientation;
-  imu_.angular_velocity = twist_.angular;
+  imu_.orientation = to_msg(y.q_WB);  // from y, not from pose_: no reload of what was just stored
+  imu_.angular_velocity = to_msg(y.w_B);
   imu_.linear_acceleration = to_msg(y.specific_force_B);
   if (realism_) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
     const PlantRealism::Due due = realism_->measure(k, y, pose_, twist_, imu_);

@@ -46,9 +46,10 @@ enum class SensorFault {
 constexpr int kSensorFaultCount = 5;
 const char* to_string(SensorFault f);
 
-/// | |q| - 1 | above this refuses an orientation. The plant sends |q| = 1 to about 1e-15; a sender that
-/// normalises in single precision stays within about 1e-7. 1e-3 lets those through and refuses a
-/// zero, a default-constructed (0,0,0,0) or a garbled quaternion. Accepted ones are used as sent.
+/// | |q| - 1 | above this refuses an orientation (tested as |q|^2 within [(1 - tol)^2, (1 + tol)^2],
+/// without a square root). The plant sends |q| = 1 to about 1e-15; a sender that normalises in single
+/// precision stays within about 1e-7. 1e-3 lets those through and refuses a zero, a
+/// default-constructed (0,0,0,0) or a garbled quaternion. Accepted ones are used as sent.
 constexpr double kQuaternionNormTolerance = 1e-3;
 
 struct SensorCheck {
