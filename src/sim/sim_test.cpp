@@ -313,6 +313,15 @@ TEST(CommandLabelTest, AgreesWithStdToStringAtEveryLength) {
     EXPECT_EQ(m.dim[0].label, "rotors@" + std::to_string(v));
     EXPECT_EQ(command_stamp_ns(m), v >= 0 ? v : -1) << v;
   }
+  // A character just outside '0'..'9' at any position of a 17-digit label refuses it.
+  for (std::size_t i = 0; i < 17; ++i) {
+    for (const char bad : {'/', ':', 'x', ' ', '\0'}) {
+      std::string digits = "12345678901234567";
+      digits[i] = bad;
+      m.dim[0].label = "rotors@" + digits;
+      EXPECT_EQ(command_stamp_ns(m), -1) << i << " '" << bad << "'";
+    }
+  }
 }
 }  // namespace
 }  // namespace quadcosim::msg
