@@ -89,7 +89,7 @@ class Quadrotor {
 
   VehicleParams params_;
   Matrix4 mixer_;
-  Eigen::Vector3d inertia_diag_;
+  Eigen::Vector4d reciprocals_;  ///< 1/m, 1/Ixx, 1/Iyy, 1/Izz: the model multiplies by them
 };
 
 }  // namespace quadcosim::model

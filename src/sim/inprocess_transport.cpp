@@ -28,18 +28,23 @@ std::function<void(const void*)> InProcessTransport::make_sink(const std::string
   Channel* c = &channel(topic, type);
   return [this, c](const void* message) {
     if (!c->stream) return deliver(*c, message);
-    // One draw per message whatever happens to it, so a topic's faults do not depend on the others.
-    if (c->stream->uniform() < c->faults.drop_probability) {
-      ++c->dropped;
-      return;
-    }
-    if (c->faults.delay_ticks == 0) return deliver(*c, message);
-    const Tick due = tick_ + c->faults.delay_ticks;
-    // Keep due order across topics with different delays: insert after every message due no later.
-    auto at = delayed_.end();
-    while (at != delayed_.begin() && std::prev(at)->due > due) --at;
-    delayed_.insert(at, Delayed{due, c, c->clone(message)});
+    publish_with_faults(*c, message);
   };
+}
+
+// Out of line, so that the common path above (no faults) stays a test and a loop.
+[[gnu::noinline]] void InProcessTransport::publish_with_faults(Channel& c, const void* message) {
+  // One draw per message whatever happens to it, so a topic's faults do not depend on the others.
+  if (c.stream->uniform() < c.faults.drop_probability) {
+    ++c.dropped;
+    return;
+  }
+  if (c.faults.delay_ticks == 0) return deliver(c, message);
+  const Tick due = tick_ + c.faults.delay_ticks;
+  // Keep due order across topics with different delays: insert after every message due no later.
+  auto at = delayed_.end();
+  while (at != delayed_.begin() && std::prev(at)->due > due) --at;
+  delayed_.insert(at, Delayed{due, &c, c.clone(message)});
 }
 
 void InProcessTransport::deliver(Channel& c, const void* message) {

@@ -51,6 +51,7 @@ class InProcessTransport final : public Transport {
     std::shared_ptr<const void> message;
   };
   static void deliver(Channel& c, const void* message);
+  void publish_with_faults(Channel& c, const void* message);
   Channel& channel(const std::string& topic, const TopicType& type);
 
   // std::map: node-stable addresses, so sinks may keep a pointer to their channel.

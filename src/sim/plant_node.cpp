@@ -30,6 +30,9 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   pose_.header.frame_id = options.frame_id;
   twist_.header.frame_id = options.frame_id;
   imu_.header.frame_id = "base_link";
+  status_period_ticks_ = options.status_period_ticks > 0
+                             ? options.status_period_ticks
+                             : std::max<Tick>(1, 1'000'000'000 / options.clock.period_ns);
   transport.subscribe<msg::Float64MultiArray>(
       topics.motor_commands, [this](const msg::Float64MultiArray& m) { on_command(m); });
 }
@@ -73,14 +76,11 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
 }
 
 void PlantNode::publish_status(Tick k) {
-  const Tick period = options_.status_period_ticks > 0
-                          ? options_.status_period_ticks
-                          : std::max<Tick>(1, 1'000'000'000 / options_.clock.period_ns);
   const bool problem = stats_.commands_rejected_length != status_.commands_rejected_length ||
                        stats_.commands_rejected_non_finite != status_.commands_rejected_non_finite ||
                        stats_.commands_clamped != status_.commands_clamped ||
                        watchdog_active_ != status_.watchdog_active;
-  if (!problem && k % period != 0) return;
+  if (!problem && k % status_period_ticks_ != 0) return;
   if (k == last_status_tick_) return;  // one status per tick, also when a tick's outputs are repeated
   last_status_tick_ = k;
   status_.header = msg::Header{msg::Time::from_ns(options_.clock.ns(k)), options_.frame_id};

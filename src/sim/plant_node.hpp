@@ -128,6 +128,7 @@ class PlantNode {
   std::function<void(const std::string&)> log_;
   LogThrottle rejected_log_, clamped_log_;
   msg::PlantStatus status_;
+  Tick status_period_ticks_ = 1;  ///< ticks between periodic statuses (options or one simulated second)
   msg::PoseStamped pose_;  ///< the outgoing sensor messages, reused from tick to tick
   msg::TwistStamped twist_;
   msg::Imu imu_;

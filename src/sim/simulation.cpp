@@ -13,9 +13,16 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
       controller_(transport_, Topics::for_namespace(config.ns), controller),
       schedule_(std::move(schedule)) {
   transport_.set_faults(config.faults);
-  transport_.subscribe<msg::ControllerStatus>(
-      Topics::for_namespace(config.ns).controller_status,
-      [this](const msg::ControllerStatus& m) { status_ = m; });
+  const std::string status_topic = Topics::for_namespace(config.ns).controller_status;
+  if (const auto f = config.faults.topics.find(status_topic); f != config.faults.topics.end() && f->second.active()) {
+    // Statuses may be lost or late: record the last one delivered.
+    transport_.subscribe<msg::ControllerStatus>(status_topic, [this](const msg::ControllerStatus& m) { status_ = m; });
+    delivered_status_ = &status_;
+  } else {
+    // Every status is delivered as it is published: the last one delivered is the controller's own
+    // (no copy per control step).
+    delivered_status_ = &controller_.status();
+  }
   std::stable_sort(schedule_.begin(), schedule_.end(),
                    [](const auto& a, const auto& b) { return a.tick < b.tick; });
   next_event_ = schedule_.cbegin();
@@ -37,7 +44,7 @@ void Simulation::begin_tick(Tick k) {
 }
 
 TickRecord Simulation::record(Tick k) const {
-  return TickRecord{k, config_.plant.clock.seconds(k), plant_.state(), plant_.applied_command(), status_};
+  return TickRecord{k, config_.plant.clock.seconds(k), plant_.state(), plant_.applied_command(), *delivered_status_};
 }
 
 void Simulation::run(const std::function<void(const TickRecord&)>& on_tick) {

@@ -91,7 +91,8 @@ class Simulation {
   std::vector<ScheduledParameter> schedule_;
   std::vector<ScheduledParameter>::const_iterator next_event_;
   double control_dt_s_;
-  msg::ControllerStatus status_;
+  msg::ControllerStatus status_;  ///< the last status delivered, when faults may lose or delay statuses
+  const msg::ControllerStatus* delivered_status_ = nullptr;  ///< status_, or the controller's own
 };
 
 }  // namespace quadcosim::sim
