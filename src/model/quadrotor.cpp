@@ -198,15 +198,26 @@ Wrench Quadrotor::environment_wrench(const Vector4& omega, const State& x, const
   return {u[0] * ground_effect_factor(params_.aero, x.p_W.z()), u.tail<3>()};
 }
 
+AppliedCommand Quadrotor::apply(const Vector4& cmd) const {
+  AppliedCommand a;
+  a.omega_rad_s = clamp_command(cmd);
+  a.wrench = wrench(a.omega_rad_s);
+  return a;
+}
+
 Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const Environment* env) const {
+  return outputs(t_s, x, apply(cmd), env);
+}
+
+Outputs Quadrotor::outputs(double t_s, const State& x, const AppliedCommand& cmd, const Environment* env) const {
   Eigen::Vector3d a_minus_g;
   if (params_.motor.model == MotorModel::kIdeal && !env) {  // derivative()'s translation only
     const double y[10] = {x.p_W.x(), x.p_W.y(), x.p_W.z(), x.v_W.x(), x.v_W.y(),
                           x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
     bool held = false;
-    a_minus_g = linear_acceleration(y, rigid_inputs(params_, reciprocals_, wrench(clamp_command(cmd)), nullptr), held);
+    a_minus_g = linear_acceleration(y, rigid_inputs(params_, reciprocals_, cmd.wrench, nullptr), held);
   } else {
-    a_minus_g = derivative(t_s, x, clamp_command(cmd), env).v_W;
+    a_minus_g = derivative(t_s, x, cmd.omega_rad_s, env).v_W;
   }
   a_minus_g.z() += params_.gravity_m_s2;
   return {x.p_W, x.q_WB, x.v_W, x.w_B, rotate_by_inverse(x.q_WB, a_minus_g)};
@@ -243,16 +254,21 @@ StateDerivative weighted_sum(const StateDerivative& k1, const StateDerivative& k
 }  // namespace
 
 
-void Quadrotor::step(State& x, double t_s, const Vector4& cmd_in, double dt_s, int substeps,
+void Quadrotor::step(State& x, double t_s, const Vector4& cmd, double dt_s, int substeps,
+                     const Environment* env) const {
+  step(x, t_s, apply(cmd), dt_s, substeps, env);
+}
+
+void Quadrotor::step(State& x, double t_s, const AppliedCommand& applied, double dt_s, int substeps,
                      const Environment* env) const {
   assert(substeps >= 1);
-  const Vector4 cmd = clamp_command(cmd_in);
+  const Vector4& cmd = applied.omega_rad_s;
   const double h = dt_s / substeps;
   const bool ideal = params_.motor.model == MotorModel::kIdeal;
   if (ideal && !env) {
-    // The rotors' wrench is the same in every stage: formed once, then RK4 on 13 plain doubles.
-    const Wrench f = wrench(cmd);
-    const RigidInputs in = rigid_inputs(params_, reciprocals_, f, nullptr);
+    // The rotors' wrench is the same in every stage (and was formed with the command): RK4 on 13
+    // plain doubles.
+    const RigidInputs in = rigid_inputs(params_, reciprocals_, applied.wrench, nullptr);
     Rigid r, k1, k2, k3, k4, y;
     pack(x, r);
     for (int s = 0; s < substeps; ++s) {

@@ -43,6 +43,14 @@ struct Wrench {
   Eigen::Vector3d torque_B_Nm;
 };
 
+/// A motor command as the model applies it: clamped (Quadrotor::clamp_command), with the rotors'
+/// wrench for those speeds (eq. (4)). Formed once by Quadrotor::apply and reused while the command
+/// holds, so that neither step() nor outputs() forms it again on every tick.
+struct AppliedCommand {
+  Vector4 omega_rad_s = Vector4::Zero();
+  Wrench wrench{0.0, Eigen::Vector3d::Zero()};
+};
+
 class Quadrotor {
  public:
   explicit Quadrotor(const VehicleParams& params);
@@ -55,6 +63,9 @@ class Quadrotor {
 
   /// Eq. (4) for the given rotor speeds.
   Wrench wrench(const Vector4& omega_rad_s) const;
+
+  /// The command clamped and its wrench, for the step() and outputs() overloads that take it.
+  AppliedCommand apply(const Vector4& omega_cmd_rad_s) const;
 
   /// dx/dt at state x under the (already clamped) commanded rotor speeds:
   ///  - translation, eq. (7) in vector form: dv_W = R_WB (0, 0, U1) / m + (0, 0, -g);
@@ -73,11 +84,16 @@ class Quadrotor {
   /// accelerometer measures).
   Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
                   const Environment* env = nullptr) const;
+  /// The same for a command already applied (apply(omega_cmd_rad_s)): the same numbers.
+  Outputs outputs(double t_s, const State& x, const AppliedCommand& cmd, const Environment* env = nullptr) const;
 
   /// Advances x by dt_s with `substeps` classical RK4 steps, command held constant. After each step
   /// the quaternion is renormalised and ground contact is enforced (z >= 0; an impact is inelastic).
   /// `env` (optional) is held constant over the step.
   void step(State& x, double t_s, const Vector4& omega_cmd_rad_s, double dt_s, int substeps,
+            const Environment* env = nullptr) const;
+  /// The same for a command already applied (apply(omega_cmd_rad_s)): the same numbers.
+  void step(State& x, double t_s, const AppliedCommand& cmd, double dt_s, int substeps,
             const Environment* env = nullptr) const;
 
   /// A state at rest at p_W with rotors stopped (or at hover speed when `hover` is true).

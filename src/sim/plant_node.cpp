@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iostream>
 
 namespace quadcosim::sim {
@@ -98,7 +99,7 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, applied_,
+  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, model_command(),
                                           realism_ ? &realism_->environment(k) : nullptr);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
@@ -160,8 +161,20 @@ void PlantNode::latch_command(Tick k) {
   }
 }
 
+const model::AppliedCommand& PlantNode::model_command() {
+  // The latched command changes every control period at most: clamped and turned into a wrench once.
+  // Compared bit for bit (a -0.0 after a +0.0 is a new command: the model keeps the sign it is given).
+  if (!model_command_formed_ ||
+      std::memcmp(applied_.data(), model_command_from_.data(), sizeof(double) * 4) != 0) {
+    model_command_ = model_.apply(applied_);
+    model_command_from_ = applied_;
+    model_command_formed_ = true;
+  }
+  return model_command_;
+}
+
 void PlantNode::integrate(Tick k) {
-  model_.step(state_, options_.clock.seconds(k), applied_, options_.clock.period_s(), options_.substeps,
+  model_.step(state_, options_.clock.seconds(k), model_command(), options_.clock.period_s(), options_.substeps,
               realism_ ? &realism_->environment(k) : nullptr);
 }
 

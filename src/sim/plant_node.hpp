@@ -100,6 +100,8 @@ class PlantNode {
  private:
   void on_command(const msg::Float64MultiArray& m);
   void publish_status(Tick k);
+  /// applied_ as the model applies it (formed again only when applied_ changed).
+  const model::AppliedCommand& model_command();
 
   model::Quadrotor model_;
   PlantOptions options_;
@@ -108,6 +110,9 @@ class PlantNode {
   std::int64_t last_command_stamp_ns_ = -1;
   std::int64_t last_label_seen_ns_ = -1;  ///< newest command label received (accepted or not)
   model::Vector4 applied_ = model::Vector4::Zero();
+  model::AppliedCommand model_command_;
+  model::Vector4 model_command_from_ = model::Vector4::Zero();  ///< the applied_ it was formed from
+  bool model_command_formed_ = false;
   struct Pending {
     Tick effective_tick;
     model::Vector4 omega;
