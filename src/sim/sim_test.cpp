@@ -303,7 +303,9 @@ TEST(CommandLabelTest, WritesAndReadsTheStamp) {
 TEST(CommandLabelTest, AgreesWithStdToStringAtEveryLength) {
   // Every digit count and the edges between them, written and read back, against std::to_string.
   std::vector<std::int64_t> values = {0, INT64_MAX, INT64_MIN, -1};
-  for (std::int64_t p = 1; p <= 1'000'000'000'000'000'000; p *= 10) {
+  std::int64_t p = 1;
+  for (int e = 0; e <= 18; ++e) {  // p = 10^e
+    if (e > 0) p *= 10;
     for (std::int64_t v : {p - 1, p, p + 1, 7 * p + 3, -p}) values.push_back(v);
   }
   Float64MultiArray m;

@@ -19,11 +19,9 @@
 #include <cstdlib>
 #include <memory>
 
-#include "dds/ros_types.hpp"
-#include "sim/controller_node.hpp"
-#include "sim/inprocess_transport.hpp"
-#include "sim/plant_node.hpp"
+#include "closed_loop.hpp"
 #include "cyclone_bytes.hpp"
+#include "dds/ros_types.hpp"
 
 namespace {
 
@@ -45,43 +43,23 @@ const Setup& setup() {
   return s;
 }
 
-bool finite(const model::State& x) {
-  return x.p_W.allFinite() && x.v_W.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite() &&
-         x.omega_rad_s.allFinite();
-}
-
-[[noreturn]] void fail(const char* what, sim::Tick k) {
-  std::fprintf(stderr, "fuzz_messages: %s at tick %lld\n", what, static_cast<long long>(k));
-  std::abort();
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const Setup& s = setup();
 
-  sim::InProcessTransport bus;
-  const sim::Topics topics = sim::Topics::for_namespace("/drone");
-  control::ControllerConfig config;
-  config.setpoint.p_des_W.z() = 1.0;
-  sim::ControllerNode controller(bus, topics, config);
-  controller.set_log([](const std::string&) {});
-  model::State x0;
-  x0.p_W.z() = 1.0;
-  x0.omega_rad_s.setConstant(4830.0);
-  sim::PlantNode plant(bus, topics, config.params.vehicle, {}, x0);
-  plant.set_log([](const std::string&) {});
-
+  fuzz::ClosedLoop loop("fuzz_messages", 4830.0);  // rotors near hover speed
+  sim::InProcessTransport& bus = loop.bus();
+  const sim::Topics& topics = loop.topics();
   auto inject_command = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
   auto inject_pose = bus.advertise<msg::PoseStamped>(topics.pose);
   auto inject_velocity = bus.advertise<msg::TwistStamped>(topics.velocity);
   auto inject_imu = bus.advertise<msg::Imu>(topics.imu);
 
-  const double period_s = 0.01;
   sim::Tick k = 0;
   fuzz::for_each_record(data, size, 256, [&](int record_kind, const std::uint8_t* bytes, std::size_t len) {
     const int kind = record_kind % 4;
-    plant.publish_outputs(k);  // the real sensor data of tick k
+    loop.begin(k);  // the real sensor data of tick k, then the injected sample
     s.topics[kind].with_sample(bytes, len, [&](const void* c_sample) {
       s.ops[kind]->deliver(c_sample, [&](const void* m) {
         switch (kind) {
@@ -92,15 +70,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         }
       });
     });
-    if (k % 2 == 0) {
-      const control::Command& c = controller.step(k * 10'000'000, 2 * period_s);
-      for (int i = 0; i < 4; ++i) {
-        if (!std::isfinite(c.omega_rad_s[i])) fail("the controller sent a non-finite rotor speed", k);
-      }
-    }
-    plant.latch_command(k);
-    plant.integrate(k);
-    if (!finite(plant.state())) fail("the plant state is not finite", k);
+    loop.end(k);
     ++k;
   });
   return 0;

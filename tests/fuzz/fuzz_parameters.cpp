@@ -19,6 +19,7 @@
 #include <string>
 
 #include "app/parameter_binding.hpp"
+#include "closed_loop.hpp"
 #include "cyclone_bytes.hpp"
 #include "dds/parameter_service.hpp"
 #include "dds/parameter_wire.hpp"
@@ -76,17 +77,8 @@ Setup& setup() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Setup& s = setup();
-  sim::InProcessTransport bus;
-  const sim::Topics topics = sim::Topics::for_namespace("/drone");
-  control::ControllerConfig config;
-  config.setpoint.p_des_W.z() = 1.0;
-  sim::ControllerNode controller(bus, topics, config);
-  controller.set_log([](const std::string&) {});
-  model::State x0;
-  x0.p_W.z() = 1.0;
-  sim::PlantNode plant(bus, topics, config.params.vehicle, {}, x0);
-  plant.set_log([](const std::string&) {});
-  g_node = &controller;
+  fuzz::ClosedLoop loop("fuzz_parameters", 0.0);  // rotors stopped: the controller must lift it
+  g_node = &loop.controller();
 
   sim::Tick k = 0;
   fuzz::for_each_record(data, size, 64, [&](int kind, const std::uint8_t* bytes, std::size_t len) {
@@ -96,20 +88,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (s.server->serve() != 1) fail("a request Cyclone had read did not reach the server");
     }
     for (int i = 0; i < 2; ++i, ++k) {
-      plant.publish_outputs(k);
-      if (k % 2 == 0) {
-        const control::Command& c = controller.step(k * 10'000'000, 0.02);
-        for (int r = 0; r < 4; ++r) {
-          if (!std::isfinite(c.omega_rad_s[r])) fail("the controller sent a non-finite rotor speed");
-        }
-      }
-      plant.latch_command(k);
-      plant.integrate(k);
-      const model::State& x = plant.state();
-      if (!(x.p_W.allFinite() && x.v_W.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite() &&
-            x.omega_rad_s.allFinite())) {
-        fail("the plant state is not finite");
-      }
+      loop.begin(k);
+      loop.end(k);
     }
   });
   g_node = nullptr;
