@@ -43,14 +43,21 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
   // Lockstep repeats first, whatever their content: an answer to an earlier tick, or a second copy
   // of the answer to this one (the controller sends its last command again when the plant repeats a
   // tick). Dropped and counted apart, so the other counters are those of a run without repeats.
-  const std::int64_t stamp = msg::command_stamp_ns(m);
-  if (options_.drop_stale_commands && stamp >= 0 &&
-      (stamp < options_.clock.ns(current_tick_) || stamp == last_label_seen_ns_)) {
+  // The label is read only in lockstep, where commands cross a network and may come twice or late;
+  // delivered in-process, every command answers the tick it arrives in.
+  const std::int64_t stamp = options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1;
+  if (stamp >= 0 && (stamp < options_.clock.ns(current_tick_) || stamp == last_label_seen_ns_)) {
     ++stats_.commands_stale;
     return;
   }
   if (stamp >= 0) last_label_seen_ns_ = stamp;
-  const CommandCheck check = validate_command(m, model_.params().motor.omega_max_rad_s);
+  const double omega_max = model_.params().motor.omega_max_rad_s;
+  if (command_ok(m, omega_max)) {
+    ++stats_.commands_accepted;
+    accept_command(stamp, model::Vector4(m.data[0], m.data[1], m.data[2], m.data[3]));
+    return;
+  }
+  const CommandCheck check = validate_command(m, omega_max);
   if (check.verdict == CommandVerdict::kRejected) {
     stats_.last_problem = check.reason;
     ++stats_.commands_rejected;
@@ -70,10 +77,14 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
            " clamped so far (logged: 1st, then every 100th)");
     }
   }
-  last_command_stamp_ns_ = stamp;
+  accept_command(stamp, check.omega_rad_s);
+}
+
+void PlantNode::accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s) {
+  last_command_stamp_ns_ = stamp_ns;
   last_valid_tick_ = current_tick_;
   if (receipt_clock_) last_valid_receipt_ns_ = receipt_clock_();
-  pending_.push_back({current_tick_ + options_.command_delay_ticks, check.omega_rad_s});
+  pending_.push_back({current_tick_ + options_.command_delay_ticks, omega_rad_s});
 }
 
 void PlantNode::publish_status(Tick k) {

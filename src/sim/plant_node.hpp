@@ -33,6 +33,7 @@ struct PlantOptions {
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick,
   /// and a second command with the label already received is a copy of it (the controller answers
   /// a repeated tick again): both are repeats, dropped and counted in commands_stale.
+  /// Commands' labels are read only with this set (msg::command_stamp_ns).
   bool drop_stale_commands = false;
   /// Watchdog limit [ticks]: when no valid command has been received for this long, the policy
   /// acts until one arrives. 0 switches the watchdog off. Measured in simulated ticks, or on the
@@ -92,13 +93,16 @@ class PlantNode {
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& applied_command() const { return applied_; }
   const PlantStats& stats() const { return stats_; }
-  /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet).
+  /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet). Labels are read
+  /// with drop_stale_commands (lockstep) only; otherwise this stays -1.
   std::int64_t last_command_stamp_ns() const { return last_command_stamp_ns_; }
   const PlantOptions& options() const { return options_; }
   Tick current_tick() const { return current_tick_; }
 
  private:
   void on_command(const msg::Float64MultiArray& m);
+  /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
+  void accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
   /// applied_ as the model applies it (formed again only when applied_ changed).
   const model::AppliedCommand& model_command();

@@ -70,6 +70,13 @@ SensorCheck first_fault(Checks&&... checks) {
 
 }  // namespace
 
+bool command_ok(const msg::Float64MultiArray& m, double omega_max_rad_s) {
+  if (m.data.size() != 4) return false;
+  bool ok = true;
+  for (int i = 0; i < 4; ++i) ok &= m.data[i] >= 0.0 && m.data[i] <= omega_max_rad_s;  // NaN: false
+  return ok;
+}
+
 CommandCheck validate_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
   CommandCheck out;
   if (m.data.size() != 4) {

@@ -31,6 +31,9 @@ struct CommandCheck {
 /// Finite speeds below 0 become 0 and above `omega_max_rad_s` become omega_max (kClamped). The layout
 /// (dim, data_offset) is not checked: it only carries the lockstep label (msg::command_stamp_ns).
 CommandCheck validate_command(const msg::Float64MultiArray& m, double omega_max_rad_s);
+/// True when validate_command would accept `m` as sent (four finite speeds in [0, omega_max]):
+/// asked first on every command, so only a clamped or rejected one builds a CommandCheck.
+bool command_ok(const msg::Float64MultiArray& m, double omega_max_rad_s);
 
 // ---------------------------------------------------------------------------------------------
 // Sensor messages into the controller

@@ -32,6 +32,26 @@ TEST(ValidateCommandTest, FourFiniteSpeedsInRangeAreUsedAsSent) {
   EXPECT_EQ(c.reason, "");
 }
 
+TEST(ValidateCommandTest, TheQuickCheckAcceptsExactlyWhatTheFullCheckAcceptsAsSent) {
+  const double kInfinity = std::numeric_limits<double>::infinity();
+  const double kNotANumber = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> speeds = {0.0, -0.0, 1e-300, -1e-300, 4830.6, 12000.0, std::nextafter(12000.0, 1e9),
+                                      -5.0, 1e9, kInfinity, -kInfinity, kNotANumber};
+  int accepted = 0;
+  for (const double a : speeds) {
+    for (const double b : speeds) {
+      for (const std::vector<double>& d : {std::vector<double>{a, 100.0, b, 200.0}, std::vector<double>{b, a, 3.0, 4.0},
+                                           std::vector<double>{a, b, 1.0}, std::vector<double>{a, b, 1.0, 2.0, 3.0}}) {
+        const CommandCheck full = validate_command(command(d), 12000.0);
+        const bool quick = command_ok(command(d), 12000.0);
+        EXPECT_EQ(quick, full.verdict == CommandVerdict::kAccepted) << d.size() << " values, " << a << ", " << b;
+        accepted += quick;
+      }
+    }
+  }
+  EXPECT_EQ(accepted, 2 * 5 * 5);  // 0, -0, 1e-300, 4830.6, 12000 paired, in the two four-value layouts
+}
+
 TEST(ValidateCommandTest, WrongLengthAndNonFiniteAreRejectedWithTheReason) {
   struct Case {
     std::vector<double> data;
