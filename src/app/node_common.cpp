@@ -37,8 +37,10 @@ void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
   static const bool slack_set = prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0;
   (void)slack_set;
   // Block on the waitset (delivering messages) until shortly before the deadline, then spin on the
-  // clock for the rest: a blocked thread's wake-up lands tens of microseconds late, more on a VM.
-  constexpr std::int64_t kSpinNs = 200'000;
+  // clock for the rest: a blocked thread's wake-up lands tens of microseconds late, and on this VM the
+  // waitset's timed wait and the spin's DDS work sometimes overran a 200 us margin by up to 2 ms
+  // (controller alone, idle machine: period jitter p99 462 us with 200 us, 14 us with 1 ms).
+  constexpr std::int64_t kSpinNs = 1'000'000;
   for (std::int64_t left; (left = deadline_ns - steady_ns()) > kSpinNs;) transport.spin_once(left - kSpinNs);
   transport.spin_once(0);
   while (steady_ns() < deadline_ns) {

@@ -28,10 +28,10 @@ io::Scenario scenario_or_defaults(const std::string& path, const std::string& ve
 /// Throws io::ConfigError when the scenario asks for injected faults, which only the in-process
 /// transport can inject (over DDS, faults come from the network: tc netem, docs/reliability.md).
 void refuse_faults_over_dds(const io::Scenario& sc);
-/// Real-time loops: lets the DDS transport deliver messages until 200 us before `deadline_ns`
-/// (steady_ns), then spins on the clock until the deadline (1 % of a 20 ms period), so the wake-up
-/// lands on the deadline instead of a scheduler wake-up later. The first call also asks the kernel
-/// for 1 ns timer slack (default 50 us) for the blocking part.
+/// Real-time loops: lets the DDS transport deliver messages until 1 ms before `deadline_ns`
+/// (steady_ns), then spins on the clock until the deadline (5 % of a core for a 20 ms period), so
+/// the wake-up lands on the deadline instead of a scheduler wake-up later. The first call also asks
+/// the kernel for 1 ns timer slack (default 50 us) for the blocking part.
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
 
 /// Real time: runs the calling thread under SCHED_FIFO at `priority` (1..99) so other processes do
