@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <iostream>
 
 namespace quadcosim::sim {
@@ -16,7 +15,11 @@ std::string to_string(WatchdogPolicy p) { return p == WatchdogPolicy::kHold ? "h
 
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
-    : model_(vehicle), options_(options), state_(initial), applied_(initial.omega_rad_s) {
+    : model_(vehicle),
+      options_(options),
+      state_(initial),
+      applied_(initial.omega_rad_s),
+      model_command_(model_.apply(applied_)) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   status_pub_ = transport.advertise<msg::PlantStatus>(topics.plant_status);
   if (options.realism.active() || vehicle.aero.active()) {
@@ -110,7 +113,7 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, model_command(),
+  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, model_command_,
                                           realism_ ? &realism_->environment(k) : nullptr);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
@@ -143,10 +146,9 @@ void PlantNode::publish_outputs(Tick k) {
 }
 
 void PlantNode::latch_command(Tick k) {
-  while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) {
-    applied_ = pending_[pending_head_].omega;
-    ++pending_head_;
-  }
+  const std::size_t first = pending_head_;
+  while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
+  if (pending_head_ > first) set_applied(pending_[pending_head_ - 1].omega);  // the newest one due
   if (pending_head_ == pending_.size()) {
     pending_.clear();  // keeps the capacity
     pending_head_ = 0;
@@ -168,24 +170,17 @@ void PlantNode::latch_command(Tick k) {
   if (!expired) return;
   ++stats_.watchdog_ticks;
   if (options_.watchdog_policy == WatchdogPolicy::kStop) {
-    applied_.setConstant(model_.params().motor.omega_min_rad_s);
+    set_applied(model::Vector4::Constant(model_.params().motor.omega_min_rad_s));
   }
 }
 
-const model::AppliedCommand& PlantNode::model_command() {
-  // The latched command changes every control period at most: clamped and turned into a wrench once.
-  // Compared bit for bit (a -0.0 after a +0.0 is a new command: the model keeps the sign it is given).
-  if (!model_command_formed_ ||
-      std::memcmp(applied_.data(), model_command_from_.data(), sizeof(double) * 4) != 0) {
-    model_command_ = model_.apply(applied_);
-    model_command_from_ = applied_;
-    model_command_formed_ = true;
-  }
-  return model_command_;
+void PlantNode::set_applied(const model::Vector4& omega_rad_s) {
+  applied_ = omega_rad_s;
+  model_command_ = model_.apply(omega_rad_s);  // clamped and turned into a wrench once per latch
 }
 
 void PlantNode::integrate(Tick k) {
-  model_.step(state_, options_.clock.seconds(k), model_command(), options_.clock.period_s(), options_.substeps,
+  model_.step(state_, options_.clock.seconds(k), model_command_, options_.clock.period_s(), options_.substeps,
               realism_ ? &realism_->environment(k) : nullptr);
 }
 

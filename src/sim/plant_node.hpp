@@ -104,8 +104,8 @@ class PlantNode {
   /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
   void accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
-  /// applied_ as the model applies it (formed again only when applied_ changed).
-  const model::AppliedCommand& model_command();
+  /// Latches a command: applied_ and, formed once here, model_command_.
+  void set_applied(const model::Vector4& omega_rad_s);
 
   model::Quadrotor model_;
   PlantOptions options_;
@@ -114,9 +114,7 @@ class PlantNode {
   std::int64_t last_command_stamp_ns_ = -1;
   std::int64_t last_label_seen_ns_ = -1;  ///< newest command label received (accepted or not)
   model::Vector4 applied_ = model::Vector4::Zero();
-  model::AppliedCommand model_command_;
-  model::Vector4 model_command_from_ = model::Vector4::Zero();  ///< the applied_ it was formed from
-  bool model_command_formed_ = false;
+  model::AppliedCommand model_command_;  ///< applied_ as the model applies it (model_.apply(applied_))
   struct Pending {
     Tick effective_tick;
     model::Vector4 omega;
