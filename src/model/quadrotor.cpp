@@ -212,8 +212,8 @@ Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const
 Outputs Quadrotor::outputs(double t_s, const State& x, const AppliedCommand& cmd, const Environment* env) const {
   Eigen::Vector3d a_minus_g;
   if (params_.motor.model == MotorModel::kIdeal && !env) {  // derivative()'s translation only
-    const double y[10] = {x.p_W.x(), x.p_W.y(), x.p_W.z(), x.v_W.x(), x.v_W.y(),
-                          x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
+    Rigid y;
+    pack(x, y);
     bool held = false;
     a_minus_g = linear_acceleration(y, rigid_inputs(params_, reciprocals_, cmd.wrench, nullptr), held);
   } else {
@@ -252,7 +252,6 @@ StateDerivative weighted_sum(const StateDerivative& k1, const StateDerivative& k
 }
 
 }  // namespace
-
 
 void Quadrotor::step(State& x, double t_s, const Vector4& cmd, double dt_s, int substeps,
                      const Environment* env) const {
