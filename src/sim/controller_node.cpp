@@ -16,33 +16,21 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
   transport.subscribe<msg::PoseStamped>(topics.pose, [this, topic = topics.pose](const msg::PoseStamped& m) {
-    if (pose_ok(m, pose_stamp_ns_)) {
-      pose_backwards_ = 0;
-    } else if (!accept(validate_pose(m, pose_stamp_ns_), topic, pose_backwards_)) {
-      return;
-    }
+    if (!accept(pose_ok(m, pose_stamp_ns_), [&] { return validate_pose(m, pose_stamp_ns_); }, topic, pose_backwards_)) return;
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
     ++samples_received_;
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
-    if (velocity_ok(m, velocity_stamp_ns_)) {
-      velocity_backwards_ = 0;
-    } else if (!accept(validate_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) {
-      return;
-    }
+    if (!accept(velocity_ok(m, velocity_stamp_ns_), [&] { return validate_velocity(m, velocity_stamp_ns_); }, topic, velocity_backwards_)) return;
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
     ++samples_received_;
   });
   transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
-    if (imu_ok(m, imu_stamp_ns_)) {
-      imu_backwards_ = 0;
-    } else if (!accept(validate_imu(m, imu_stamp_ns_), topic, imu_backwards_)) {
-      return;
-    }
+    if (!accept(imu_ok(m, imu_stamp_ns_), [&] { return validate_imu(m, imu_stamp_ns_); }, topic, imu_backwards_)) return;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -54,11 +42,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   });
 }
 
-bool ControllerNode::accept(const SensorCheck& check, const std::string& topic, int& backwards) {
-  if (check.ok()) {
-    backwards = 0;
-    return true;
-  }
+bool ControllerNode::accept_refused(const SensorCheck& check, const std::string& topic, int& backwards) {
   if (check.fault == SensorFault::kStampBackwards && ++backwards > kStampRestartCount) {
     log_("controller: " + topic + ": " + std::to_string(kStampRestartCount) +
          " samples in a row older than the newest accepted; taking it that the sender's clock restarted (" +
@@ -92,10 +76,7 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   // The status is stamped with simulated time: the step's time, or the newest sample's in real time.
   const std::int64_t sim_now_ns = receipt_clock_ ? std::max<std::int64_t>(newest_stamp_ns(), 0) : now_ns;
   status_.header.stamp = msg::Time::from_ns(sim_now_ns);
-  if (status_.mode.empty() || sp.mode != status_mode_) {  // a string assignment only when it changes
-    status_.mode = control::to_string(sp.mode);
-    status_mode_ = sp.mode;
-  }
+  if (const char* mode = control::to_string(sp.mode); status_.mode != mode) status_.mode = mode;
   status_.setpoint = {sp.p_des_W.x(),
                       sp.p_des_W.y(),
                       sp.p_des_W.z(),

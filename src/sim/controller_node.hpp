@@ -71,10 +71,19 @@ class ControllerNode {
  private:
   static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
 
-  /// Counts and logs a refused message on `topic`; false when `check` refused it. `backwards`: the
+  /// True when a message on `topic` is to be used: `ok` (the plain check, *_ok), or else the
+  /// SensorCheck that `validate` returns, counted and logged by accept_refused. `backwards`: the
   /// topic's run of well-formed samples refused as older than the newest (kStampRestartCount of them
   /// in a row: the sender's clock restarted, and the sample is accepted).
-  bool accept(const SensorCheck& check, const std::string& topic, int& backwards);
+  template <class Validate>
+  bool accept(bool ok, const Validate& validate, const std::string& topic, int& backwards) {
+    if (ok) {
+      backwards = 0;
+      return true;
+    }
+    return accept_refused(validate(), topic, backwards);
+  }
+  bool accept_refused(const SensorCheck& check, const std::string& topic, int& backwards);
 
   control::ControllerConfig config_;
   control::FlightController controller_;
@@ -91,7 +100,6 @@ class ControllerNode {
   Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
   bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
-  control::Mode status_mode_{};  ///< the mode status_.mode names (when not empty)
   std::function<void(const std::string&)> log_;
   std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing
   int pose_backwards_ = 0, velocity_backwards_ = 0, imu_backwards_ = 0;
