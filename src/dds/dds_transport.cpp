@@ -1,5 +1,6 @@
 #include "dds/dds_transport.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 namespace quadcosim::dds {
@@ -43,10 +44,16 @@ dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const s
   dds_delete_qos(qos);
   check(e, ((writer ? "dds_create_writer " : "dds_create_reader ") + ros_topic).c_str());
   // Matching changes wake spin_once, so waits for a peer need no polling.
-  check(dds_set_status_mask(e, writer ? DDS_PUBLICATION_MATCHED_STATUS : DDS_SUBSCRIPTION_MATCHED_STATUS),
-        "dds_set_status_mask");
-  check(dds_waitset_attach(waitset_, e, 0), "dds_waitset_attach");
+  const std::uint32_t matched = writer ? DDS_PUBLICATION_MATCHED_STATUS : DDS_SUBSCRIPTION_MATCHED_STATUS;
+  check(dds_set_status_mask(e, matched), "dds_set_status_mask");
+  attach(e, -1 - static_cast<dds_attach_t>(matched_.size()));
+  matched_.push_back({e, matched});
   return e;
+}
+
+void DdsTransport::attach(dds_entity_t e, dds_attach_t arg) {
+  check(dds_waitset_attach(waitset_, e, arg), "dds_waitset_attach");
+  triggered_.push_back(0);
 }
 
 std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic,
@@ -55,7 +62,8 @@ std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_
   const dds_entity_t writer = create_endpoint(ros_topic, type, true, ops);
   writers_[ros_topic].push_back(writer);
   return [writer, ops, ros_topic](const void* message) {
-    check(ops->write(writer, message), ("dds_write " + ros_topic).c_str());
+    // The error's text is formed only on an error: a write is on every tick's path.
+    if (const dds_return_t rc = ops->write(writer, message); rc < 0) check(rc, ("dds_write " + ros_topic).c_str());
   };
 }
 
@@ -69,8 +77,7 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
   r->condition = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
   r->ops = ops;
   r->deliver = std::move(deliver);
-  check(dds_waitset_attach(waitset_, r->condition, static_cast<dds_attach_t>(readers_.size())),
-        "dds_waitset_attach");
+  attach(r->condition, static_cast<dds_attach_t>(readers_.size()));
   readers_.push_back(std::move(r));
 }
 
@@ -81,7 +88,7 @@ int DdsTransport::drain(Reader& r) {
     void* samples[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
     const dds_return_t n = dds_take(r.reader, samples, infos, kBatch, kBatch);
-    check(n, ("dds_take " + r.topic).c_str());
+    if (n < 0) check(n, ("dds_take " + r.topic).c_str());
     if (n == 0) break;
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;
@@ -96,26 +103,40 @@ int DdsTransport::drain(Reader& r) {
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
   if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
-  const dds_return_t rc = dds_waitset_wait(waitset_, nullptr, 0, timeout_ns);
+  const dds_return_t rc =
+      dds_waitset_wait(waitset_, triggered_.data(), triggered_.size(), timeout_ns);
   check(rc, "dds_waitset_wait");
-  // Clear the matched-status triggers (the counts stay readable).
+  ready_.clear();
   std::uint32_t status = 0;
-  for (const auto& [topic, ws] : writers_) {
-    for (dds_entity_t w : ws) dds_take_status(w, &status, DDS_PUBLICATION_MATCHED_STATUS);
+  if (static_cast<std::size_t>(rc) <= triggered_.size()) {
+    for (dds_return_t i = 0; i < rc; ++i) {
+      const dds_attach_t a = triggered_[static_cast<std::size_t>(i)];
+      if (a >= 0) {
+        ready_.push_back(static_cast<std::size_t>(a));
+      } else if (a != kExtra) {  // clear the matched-status trigger (the counts stay readable)
+        const Matched& m = matched_[static_cast<std::size_t>(-1 - a)];
+        dds_take_status(m.entity, &status, m.status);
+      }
+    }
+    std::sort(ready_.begin(), ready_.end());
+  } else {  // more triggered than attached (cannot happen: one slot per attachment); look at all
+    for (const Matched& m : matched_) dds_take_status(m.entity, &status, m.status);
+    for (std::size_t i = 0; i < readers_.size(); ++i) ready_.push_back(i);
   }
-  for (const auto& r : readers_) dds_take_status(r->reader, &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
   int delivered = 0;
-  for (auto& r : readers_) delivered += drain(*r);
-  // Copy the callbacks first: one may add or remove extra work.
-  std::vector<std::function<void()>> serve;
-  for (const auto& [id, w] : extra_) serve.push_back(w.serve);
-  for (const auto& f : serve) f();
+  for (std::size_t i : ready_) delivered += drain(*readers_[i]);
+  if (!extra_.empty()) {
+    // Copied first (into a kept vector): a callback may add or remove extra work.
+    serving_.clear();
+    for (const auto& [id, w] : extra_) serving_.push_back(w.serve);
+    for (const auto& f : serving_) f();
+  }
   return delivered;
 }
 
 int DdsTransport::add_extra_work(const std::vector<dds_entity_t>& wake_on, std::function<void()> serve) {
   const int id = next_extra_id_++;
-  for (dds_entity_t e : wake_on) check(dds_waitset_attach(waitset_, e, 0), "dds_waitset_attach");
+  for (dds_entity_t e : wake_on) attach(e, kExtra);
   extra_[id] = ExtraWork{wake_on, std::move(serve)};
   return id;
 }
@@ -123,7 +144,9 @@ int DdsTransport::add_extra_work(const std::vector<dds_entity_t>& wake_on, std::
 void DdsTransport::remove_extra_work(int id) {
   const auto it = extra_.find(id);
   if (it == extra_.end()) return;
-  for (dds_entity_t e : it->second.wake_on) dds_waitset_detach(waitset_, e);
+  for (dds_entity_t e : it->second.wake_on) {
+    if (dds_waitset_detach(waitset_, e) == DDS_RETCODE_OK) triggered_.pop_back();
+  }
   extra_.erase(it);
 }
 

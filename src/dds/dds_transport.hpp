@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -35,8 +36,10 @@ class DdsTransport final : public sim::Transport {
   /// QoS for endpoints created later on `ros_topic` (default: ROS default QoS).
   void set_qos(const std::string& ros_topic, QosProfile qos) { qos_[ros_topic] = qos; }
 
-  /// Waits up to timeout_ns for data on any subscription, then delivers every sample that has
-  /// arrived, reader by reader in subscription order. Returns how many messages were delivered.
+  /// Waits up to timeout_ns for data on any subscription, then delivers the samples of every
+  /// subscription the wait found with data, reader by reader in subscription order (the waitset
+  /// names them, so a wake costs what arrived, not the number of subscriptions). Returns how many
+  /// messages were delivered.
   int spin_once(std::int64_t timeout_ns);
 
   /// Spins until `done()` holds or timeout_ns passes; returns done().
@@ -74,12 +77,24 @@ class DdsTransport final : public sim::Transport {
   /// A writer or reader on `ros_topic` with its QoS, attached to the waitset for matching changes.
   dds_entity_t create_endpoint(const std::string& ros_topic, const sim::TopicType& type, bool writer,
                                const TypeOps*& ops);
+  /// Attaches `e` to the waitset with `arg`, keeping room in triggered_ for every attachment.
+  void attach(dds_entity_t e, dds_attach_t arg);
   dds_entity_t topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops);
   QosProfile qos_for(const std::string& ros_topic) const;
   int drain(Reader& r);
 
   Participant participant_;
   dds_entity_t waitset_ = 0;
+  // Waitset attachment arguments: a reader's read condition has its index in readers_ (>= 0); a
+  // writer or reader woken by matching changes has -1 - its index in matched_; extra work has kExtra.
+  static constexpr dds_attach_t kExtra = std::numeric_limits<dds_attach_t>::min();
+  struct Matched {
+    dds_entity_t entity;
+    std::uint32_t status;  ///< DDS_PUBLICATION_MATCHED_STATUS or DDS_SUBSCRIPTION_MATCHED_STATUS
+  };
+  std::vector<Matched> matched_;
+  std::vector<dds_attach_t> triggered_;  ///< what one wait found, one slot per attachment
+  std::vector<std::size_t> ready_;       ///< readers with data, in subscription order
   std::map<std::string, dds_entity_t> topics_;
   std::vector<std::unique_ptr<Reader>> readers_;
   std::map<std::string, std::vector<dds_entity_t>> writers_;
@@ -89,6 +104,7 @@ class DdsTransport final : public sim::Transport {
     std::function<void()> serve;
   };
   std::map<int, ExtraWork> extra_;
+  std::vector<std::function<void()>> serving_;  ///< spin_once's copy of the extra work's callbacks
   int next_extra_id_ = 1;
 };
 
