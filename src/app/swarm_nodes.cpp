@@ -82,8 +82,10 @@ class PlantShard {
       po.publish_clock = i == 0;  // one /clock for the whole swarm
       node->plant = std::make_unique<sim::PlantNode>(transport_, node->topics, sc.vehicle, po, v.initial);
       if (recorded[static_cast<std::size_t>(i)]) {
-        node->csv = std::make_unique<io::TrajectoryWriter>(
-            (out / v.simulation.ns.substr(1) / "trajectory.csv").string());
+        const fs::path dir = out / v.simulation.ns.substr(1);
+        std::error_code ec;  // a failure shows as the writer's "cannot open" naming the file
+        fs::create_directories(dir, ec);
+        node->csv = std::make_unique<io::TrajectoryWriter>((dir / "trajectory.csv").string());
         Vehicle* raw = node.get();
         transport_.subscribe<msg::ControllerStatus>(node->topics.controller_status,
                                                     [raw](const msg::ControllerStatus& m) { raw->status = m; });

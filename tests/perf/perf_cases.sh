@@ -54,6 +54,14 @@ PY
     cmp "$tmp/in/vehicles.csv" "$tmp/dds/vehicles.csv" || fail "final states differ"
     cmp "$tmp/in/uav0000/trajectory.csv" "$tmp/dds/uav0000/trajectory.csv" || fail "recorded trajectory differs"
     [ "$(wc -l < "$tmp/dds/uav0000/trajectory.csv")" -gt 1000 ] || fail "trajectory too short"
+    # Best-effort sensor topics (ROS sensor data QoS), the plant writing the swarm's files itself
+    # into a folder it makes: the same numbers.
+    "$bin" controller --scenario "$grid" --vehicles 6 --sensor-qos > "$tmp/be_c.log" 2>&1 &
+    pids+=($!)
+    "$bin" plant --scenario "$grid" --vehicles 6 --sensor-qos --swarm-out "$tmp/be" > "$tmp/be_p.log" 2>&1 \
+      || fail "DDS swarm with --sensor-qos failed"
+    cmp "$tmp/in/vehicles.csv" "$tmp/be/vehicles.csv" || fail "final states differ with --sensor-qos"
+    cmp "$tmp/in/uav0000/trajectory.csv" "$tmp/be/uav0000/trajectory.csv" || fail "trajectory differs with --sensor-qos"
     ;;
   *) echo "unknown case $case_name"; exit 2 ;;
 esac
