@@ -135,7 +135,7 @@ RigidInputs rigid_inputs(const VehicleParams& p, const Eigen::Vector4d& reciproc
 }
 
 /// Scales q (w, x, y, z) to unit norm: |q|^2 summed as Eigen sums (x, y, z, w) in pairs, then one
-/// division and four products (the state's quaternion after every RK4 step, in both drivers).
+/// division and four products (end_substep: the state's quaternion after every RK4 step).
 void normalize_quaternion(double& w, double& x, double& y, double& z) {
   const double n2 = (x * x + z * z) + (y * y + w * w);
   if (!(n2 > 0.0)) return;
@@ -144,6 +144,18 @@ void normalize_quaternion(double& w, double& x, double& y, double& z) {
   x *= inv_n;
   y *= inv_n;
   z *= inv_n;
+}
+
+/// The end of an RK4 step, in both drivers: the quaternion back to unit norm; a vehicle that went
+/// below z = 0 during the step touched down (inelastic impact, held by friction).
+void end_substep(Rigid r) {
+  // On scalars: an Eigen quaternion here costs two failed store-to-load forwards per step.
+  normalize_quaternion(r[6], r[7], r[8], r[9]);
+  if (r[2] < 0.0) {
+    r[2] = 0.0;
+    r[3] = r[4] = r[5] = 0.0;
+    r[10] = r[11] = r[12] = 0.0;
+  }
 }
 
 /// q.conjugate() * v as Eigen computes it (u = 2 (q_vec x v), v + w u + q_vec x u, with q_vec
@@ -281,13 +293,7 @@ void Quadrotor::step(State& x, double t_s, const AppliedCommand& applied, double
       for (int i = 0; i < kRigid; ++i) {
         r[i] = r[i] + h * ((k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) * (1.0 / 6.0));
       }
-      // On scalars: an Eigen quaternion here costs two failed store-to-load forwards per step.
-      normalize_quaternion(r[6], r[7], r[8], r[9]);
-      if (r[2] < 0.0) {  // touched down during the step: inelastic impact, held by friction
-        r[2] = 0.0;
-        r[3] = r[4] = r[5] = 0.0;
-        r[10] = r[11] = r[12] = 0.0;
-      }
+      end_substep(r);
     }
     unpack(r, x);
     x.omega_rad_s = cmd;
@@ -300,12 +306,10 @@ void Quadrotor::step(State& x, double t_s, const AppliedCommand& applied, double
     const StateDerivative k3 = derivative(t + 0.5 * h, add_scaled(x, k2, 0.5 * h), cmd, env);
     const StateDerivative k4 = derivative(t + h, add_scaled(x, k3, h), cmd, env);
     x = add_scaled(x, weighted_sum(k1, k2, k3, k4), h);
-    normalize_quaternion(x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z());
-    if (x.p_W.z() < 0.0) {  // touched down during the step: inelastic impact, held by friction
-      x.p_W.z() = 0.0;
-      x.v_W.setZero();
-      x.w_B.setZero();
-    }
+    Rigid r;
+    pack(x, r);
+    end_substep(r);
+    unpack(r, x);
   }
   if (ideal) {
     x.omega_rad_s = cmd;
