@@ -59,6 +59,7 @@ struct PlantCommandOptions {
   std::string vehicle;      ///< vehicle file, replaces the scenario's vehicle when set
   std::string ns;           ///< overrides the scenario's namespace when set
   bool sensor_qos = false;  ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
+  std::string cpus;         ///< run on these CPUs only ("0", "0-1"; "" for any)
   bool lockstep = true;     ///< false: real time
   double rate_factor = 1.0; ///< real time: run k times faster than the wall clock
   double duration_s = -1.0; ///< overrides the scenario's duration when >= 0
@@ -87,6 +88,7 @@ struct ControllerCommandOptions {
   std::string vehicle;   ///< vehicle file (the controller's model of the vehicle)
   std::string ns;
   bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
+  std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)
   bool lockstep = true;
   double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
   std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
@@ -158,6 +160,8 @@ CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& options);
 int security_command(const SecurityOptions& options);
 /// Adds `--enclave NAME` (validated as rcl validates enclave names) to a DDS command.
 void add_enclave_option(CLI::App* command, std::string& enclave);
+/// `--cpus LIST` (plant, controller): the CPUs the process runs on, checked as a CPU list.
+void add_cpus_option(CLI::App* command, std::string& cpus);
 /// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
 /// existing ones are used as they are. 0, or 2 after printing why not.
 int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);

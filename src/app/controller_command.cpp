@@ -20,6 +20,11 @@ namespace quadcosim::app {
 
 int controller_command(const ControllerCommandOptions& o) {
   install_stop_handlers();
+  // Before any DDS participant: Cyclone's threads inherit the affinity.
+  if (std::string err = use_cpus(o.cpus); !err.empty()) {
+    std::cerr << "error: controller: --cpus: " << err << '\n';
+    return 2;
+  }
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);

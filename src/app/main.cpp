@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
   plant_cmd->add_option("--threads", plant.threads, "with --vehicles: threads, one DDS participant each")
       ->check(CLI::Range(1, 64));
   plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
+  add_cpus_option(plant_cmd, plant.cpus);
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
   plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
@@ -104,6 +105,7 @@ int main(int argc, char** argv) {
   ctl_cmd->add_option("--threads", ctl.threads, "with --vehicles: threads, one DDS participant each")
       ->check(CLI::Range(1, 64));
   ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
+  add_cpus_option(ctl_cmd, ctl.cpus);
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");

@@ -1,15 +1,20 @@
 #include "app/node_common.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/prctl.h>
 
+#include <cerrno>
 #include <cstring>
 
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+
+#include "app/commands.hpp"
 
 namespace quadcosim::app {
 
@@ -53,6 +58,63 @@ std::string use_realtime_priority(int priority) {
   p.sched_priority = priority;
   if (const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p); rc != 0) {
     return std::string("SCHED_FIFO priority ") + std::to_string(priority) + " refused: " + std::strerror(rc);
+  }
+  return {};
+}
+
+std::string parse_cpu_list(const std::string& text, std::vector<int>& cpus) {
+  cpus.clear();
+  // CPU numbers up to CPU_SETSIZE - 1 (1023): what a cpu_set_t holds.
+  auto number = [](const std::string& t, int& v) {
+    if (t.empty() || t.size() > 4 || t.find_first_not_of("0123456789") != std::string::npos) return false;
+    v = std::stoi(t);
+    return v < CPU_SETSIZE;
+  };
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const std::size_t dash = item.find('-');
+    int lo = 0, hi = 0;
+    const bool ok = dash == std::string::npos ? number(item, lo) && number(item, hi)
+                                              : number(item.substr(0, dash), lo) && number(item.substr(dash + 1), hi);
+    if (!ok || lo > hi) {
+      return "'" + text + "' is not a CPU list (e.g. 0, 0,2 or 0-3; CPUs 0.." + std::to_string(CPU_SETSIZE - 1) +
+             "): bad item '" + item + "'";
+    }
+    for (int c = lo; c <= hi; ++c) cpus.push_back(c);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  std::sort(cpus.begin(), cpus.end());
+  cpus.erase(std::unique(cpus.begin(), cpus.end()), cpus.end());
+  return {};
+}
+
+void add_cpus_option(CLI::App* command, std::string& cpus) {
+  command
+      ->add_option("--cpus", cpus,
+                   "run this process on these CPUs only, e.g. 0 or 0-1 (as taskset -c; on 2 cores, plant and "
+                   "controller each on its own CPU run lockstep faster)")
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            std::vector<int> cpus;
+            return parse_cpu_list(text, cpus);
+          },
+          "LIST"));
+}
+
+std::string use_cpus(const std::string& list) {
+  if (list.empty()) return {};
+  std::vector<int> cpus;
+  if (std::string err = parse_cpu_list(list, cpus); !err.empty()) return err;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int c : cpus) CPU_SET(c, &set);
+  if (sched_setaffinity(0, sizeof(set), &set) != 0) {
+    const int err = errno;
+    return "CPUs " + list + " refused: " + std::strerror(err) +
+           (err == EINVAL ? " (none of them is online and allowed here; see nproc / taskset -p $$)" : "");
   }
   return {};
 }

@@ -39,6 +39,16 @@ void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
 /// warns and goes on with normal scheduling. priority 0: does nothing.
 std::string use_realtime_priority(int priority);
 
+/// A CPU list as taskset and /proc write it: "1", "0,2", "0-3", "0-1,4". Fills `cpus` (sorted, no
+/// repeats); returns "" or what is wrong with `text`.
+std::string parse_cpu_list(const std::string& text, std::vector<int>& cpus);
+
+/// `--cpus LIST`: runs this process on the CPUs of `list` only (sched_setaffinity on the calling
+/// thread; every thread it starts afterwards, Cyclone's included, inherits it), so call it before
+/// any DDS participant exists. Returns "" or what is wrong: the list, or why the kernel refused
+/// (e.g. no such CPU). An empty list does nothing.
+std::string use_cpus(const std::string& list);
+
 /// Period jitter of a periodic loop: |t_k - t_k-1 - period| over every period [us].
 class PeriodJitter {
  public:

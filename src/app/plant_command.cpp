@@ -291,6 +291,11 @@ class PlantProcess {
 
 int plant_command(const PlantCommandOptions& o) {
   install_stop_handlers();
+  // Before any DDS participant: Cyclone's threads inherit the affinity.
+  if (std::string err = use_cpus(o.cpus); !err.empty()) {
+    std::cerr << "error: plant: --cpus: " << err << '\n';
+    return 2;
+  }
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;

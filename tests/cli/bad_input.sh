@@ -79,6 +79,9 @@ expect 3 "cannot create output directory /proc/quadcosim_no" run "$ALT" --out /p
 
 # plant and controller (checked before any DDS entity is created)
 expect 2 "--scenario: File does not exist: missing.yaml" plant --scenario missing.yaml
+expect 2 "--cpus: 'x' is not a CPU list;;bad item 'x'" plant --cpus x
+expect 2 "--cpus: '0,2-1' is not a CPU list;;bad item '2-1'" controller --cpus 0,2-1
+expect 2 "error: controller: --cpus: CPUs 1000 refused" controller --cpus 1000
 expect 2 "wrong_type.yaml: vehicle.mass_kg: got 'heavy'" plant --scenario wrong_type.yaml
 expect 2 "vehicle_bad.yaml: layout: got 'h', expected one of 'plus' 'x'" plant --vehicle vehicle_bad.yaml
 expect 2 "vehicle_nan.yaml: mass_kg: got '.nan', expected a number" plant --vehicle vehicle_nan.yaml

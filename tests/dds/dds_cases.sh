@@ -84,6 +84,25 @@ case "$case_name" in
     fi
     ;;
 
+  pinned)  # plant and controller each on its own CPU (--cpus): every thread there, the same bytes
+    # The first two CPUs this test may use (one, twice, on a single-CPU machine).
+    read -r want_p want_c < <(/usr/bin/python3 -c '
+import os
+c = sorted(os.sched_getaffinity(0))
+print(c[0], c[1] if len(c) > 1 else c[0])')
+    "$bin" run "$paper/roll_step.yaml" --out "$tmp/in" --no-plots > /dev/null
+    "$bin" controller --scenario "$paper/roll_step.yaml" --cpus "$want_c" > "$tmp/c.log" 2>&1 &
+    pids+=($!)
+    "$bin" plant --scenario "$paper/roll_step.yaml" --cpus "$want_p" --record "$tmp/p.csv" > "$tmp/p.log" 2>&1 \
+      || fail "plant failed"
+    cmp "$tmp/in/trajectory.csv" "$tmp/p.csv" || fail "differs from the in-process run"
+    # Every thread of the controller (its own and Cyclone's) is on its CPU only.
+    for status in /proc/"${pids[-1]}"/task/*/status; do
+      allowed=$(sed -n 's/^Cpus_allowed_list:[[:space:]]*//p' "$status")
+      [ "$allowed" = "$want_c" ] || fail "controller thread $status allowed on '$allowed', expected '$want_c'"
+    done
+    ;;
+
   sensor_qos)  # best-effort sensor topics (ROS sensor-data QoS) on both sides: still the same bytes
     "$bin" run "$paper/roll_step.yaml" --out "$tmp/in" --no-plots > /dev/null
     "$bin" controller --scenario "$paper/roll_step.yaml" --sensor-qos > "$tmp/c.log" 2>&1 &

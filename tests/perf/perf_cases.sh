@@ -18,6 +18,12 @@ for k in ["inproc_rtf", "baseline_rtf", "dds_lockstep_rtf", "dds_cmd_roundtrip_u
     v = j[k]
     assert isinstance(v, (int, float)) and math.isfinite(v) and v > 0, (k, v)
 assert j["dds_cmd_roundtrip_us_p99"] >= j["dds_cmd_roundtrip_us_p50"], "p99 below p50"
+# Two CPUs or more: the DDS figures again with plant and controller pinned apart.
+if j["pinned_cpus"] is not None:
+    assert len(j["pinned_cpus"]) == 2 and j["pinned_cpus"][0] != j["pinned_cpus"][1], j["pinned_cpus"]
+    for k in ["dds_lockstep_rtf_pinned", "swarm_dds_vehicles_at_rt_pinned"]:
+        v = j[k]
+        assert isinstance(v, (int, float)) and math.isfinite(v) and v > 0, (k, v)
 m = j["machine"]
 for k in ["cpu_model", "cores", "kernel", "compiler"]:
     assert m[k], k
