@@ -13,7 +13,6 @@
 //   *_pinned                   the DDS figures again with the plant and the controller each on its
 //                              own CPU (--cpus; pinned_cpus names them, null with fewer than 2 CPUs)
 #include <fmt/format.h>
-#include <sched.h>
 #include <sys/utsname.h>
 
 #include <chrono>
@@ -102,7 +101,7 @@ struct NodeRun {
   nlohmann::json plant, controller;
 };
 NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s, int vehicles, bool realtime,
-                  int rt_priority = 0, const std::vector<int>& pin = {}) {
+                  int rt_priority = 0, bool pinned = false) {
   const std::string self = self_executable();
   const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
   fs::remove(ps);
@@ -116,10 +115,7 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
       v->push_back(std::to_string(vehicles));
     }
   }
-  if (pin.size() == 2) {  // --cpus: the plant on the first CPU, the controller on the second
-    p.insert(p.end(), {"--cpus", std::to_string(pin[0])});
-    c.insert(c.end(), {"--cpus", std::to_string(pin[1])});
-  }
+  if (pinned) pin_apart(p, c);
   if (realtime) {
     c.push_back("--realtime");
     if (rt_priority > 0) {
@@ -143,19 +139,6 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   out.plant = read_json(ps);
   out.controller = read_json(cs);
   return out;
-}
-
-/// The first two CPUs this process may run on, for the pinned DDS figures; empty with fewer.
-std::vector<int> two_cpus() {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  std::vector<int> cpus;
-  if (sched_getaffinity(0, sizeof(set), &set) != 0) return cpus;
-  for (int c = 0; c < CPU_SETSIZE && cpus.size() < 2; ++c) {
-    if (CPU_ISSET(c, &set)) cpus.push_back(c);
-  }
-  if (cpus.size() < 2) cpus.clear();
-  return cpus;
 }
 
 /// Largest n with rate(n) >= 1: doubling from `start` (up to `cap`), then `bisections` halvings of
@@ -267,7 +250,7 @@ int bench_command(const BenchOptions& o) {
       const std::string suffix = pinned ? "_pinned" : "";
       note(fmt::format("DDS lockstep, one vehicle, {} s simulated{}", s,
                        pinned ? fmt::format(", plant on CPU {}, controller on CPU {}", pin[0], pin[1]) : ""));
-      const NodeRun r = run_nodes(tmp, o.scenario, s, 0, false, 0, pinned ? pin : std::vector<int>{});
+      const NodeRun r = run_nodes(tmp, o.scenario, s, 0, false, 0, pinned);
       j["dds_lockstep_rtf" + suffix] = r.plant.is_object() ? r.plant.value("real_time_factor", 0.0) : 0.0;
       j["dds_cmd_roundtrip_us_p50" + suffix] = r.plant.is_object() ? r.plant.value("roundtrip_us_p50", 0.0) : 0.0;
       j["dds_cmd_roundtrip_us_p99" + suffix] = r.plant.is_object() ? r.plant.value("roundtrip_us_p99", 0.0) : 0.0;
@@ -314,7 +297,7 @@ int bench_command(const BenchOptions& o) {
       note(fmt::format("DDS swarm, {} s simulated per trial{}", s, pinned ? ", plant and controller pinned" : ""));
       j[pinned ? "swarm_dds_vehicles_at_rt_pinned" : "swarm_dds_vehicles_at_rt"] =
           largest_at_real_time(q ? 4 : 32, q ? 8 : 8192, q ? 0 : 4, [&](int n) {
-            const NodeRun r = run_nodes(tmp, o.swarm_scenario, s, n, false, 0, pinned ? pin : std::vector<int>{});
+            const NodeRun r = run_nodes(tmp, o.swarm_scenario, s, n, false, 0, pinned);
             return r.plant.is_object() ? r.plant.value("real_time_factor", 0.0) : 0.0;
           });
     }

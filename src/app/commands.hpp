@@ -22,6 +22,7 @@ struct RunOptions {
   double timeout_s = 10.0;           ///< dds: lockstep wait for one command before the policy applies
   int vehicles = 0;                  ///< > 0: a swarm of this many vehicles (overrides swarm.vehicles)
   int threads = 0;                   ///< > 0: in-process swarm threads (overrides swarm.threads)
+  bool pin = false;                  ///< dds: plant and controller each on its own CPU (--cpus)
   /// dds: run secured (Enforce) with this SROS2 keystore; created when missing, as are the enclaves
   /// /quadcosim/plant and /quadcosim/controller ("" = as the ROS_SECURITY_* environment says).
   std::string keystore;

@@ -25,6 +25,7 @@ int controller_command(const ControllerCommandOptions& o) {
     std::cerr << "error: controller: --cpus: " << err << '\n';
     return 2;
   }
+  if (!o.cpus.empty()) std::cerr << "controller: on CPU(s) " << o.cpus << " only\n";
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);

@@ -42,6 +42,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--keystore", run.keystore,
                       "dds: run secured (SROS2 keystore, Enforce); created when missing, with enclaves "
                       "/quadcosim/plant and /quadcosim/controller");
+  run_cmd->add_flag("--pin", run.pin,
+                    "dds: plant on one CPU, controller on another (the first two this process may use)");
   run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
   run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));

@@ -119,6 +119,28 @@ std::string use_cpus(const std::string& list) {
   return {};
 }
 
+std::vector<int> two_cpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  std::vector<int> cpus;
+  if (sched_getaffinity(0, sizeof(set), &set) != 0) return cpus;
+  for (int c = 0; c < CPU_SETSIZE && cpus.size() < 2; ++c) {
+    if (CPU_ISSET(c, &set)) cpus.push_back(c);
+  }
+  if (cpus.size() < 2) cpus.clear();
+  return cpus;
+}
+
+void pin_apart(std::vector<std::string>& plant_args, std::vector<std::string>& controller_args) {
+  const std::vector<int> cpus = two_cpus();
+  if (cpus.empty()) {
+    std::cerr << "run: --pin: fewer than two CPUs available here; plant and controller not pinned\n";
+    return;
+  }
+  plant_args.insert(plant_args.end(), {"--cpus", std::to_string(cpus[0])});
+  controller_args.insert(controller_args.end(), {"--cpus", std::to_string(cpus[1])});
+}
+
 void PeriodJitter::add(std::int64_t now_ns) {
   if (last_ns_ >= 0) jitter_ns_.push_back(std::llabs(now_ns - last_ns_ - period_ns_));
   last_ns_ = now_ns;

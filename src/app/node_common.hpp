@@ -49,6 +49,13 @@ std::string parse_cpu_list(const std::string& text, std::vector<int>& cpus);
 /// (e.g. no such CPU). An empty list does nothing.
 std::string use_cpus(const std::string& list);
 
+/// The first two CPUs this process may run on (its affinity mask); empty with fewer.
+std::vector<int> two_cpus();
+
+/// `run --pin`: adds `--cpus` to the plant's (first CPU) and the controller's (second CPU) command
+/// lines; with fewer than two CPUs it says so on stderr and leaves them unpinned.
+void pin_apart(std::vector<std::string>& plant_args, std::vector<std::string>& controller_args);
+
 /// Period jitter of a periodic loop: |t_k - t_k-1 - period| over every period [us].
 class PeriodJitter {
  public:

@@ -296,6 +296,7 @@ int plant_command(const PlantCommandOptions& o) {
     std::cerr << "error: plant: --cpus: " << err << '\n';
     return 2;
   }
+  if (!o.cpus.empty()) std::cerr << "plant: on CPU(s) " << o.cpus << " only\n";
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;

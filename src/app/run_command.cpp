@@ -12,6 +12,7 @@
 
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
+#include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
@@ -92,6 +93,7 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     for (std::string a : {"--realtime", "--wait-for-controller", "--rate-factor"}) plant_args.push_back(a);
     plant_args.push_back(fmt::format("{}", opt.rate_factor));
   }
+  if (opt.pin) pin_apart(plant_args, controller_args);
   return run_plant_and_controller(plant_args, controller_args);
 }
 

@@ -101,6 +101,14 @@ print(c[0], c[1] if len(c) > 1 else c[0])')
       allowed=$(sed -n 's/^Cpus_allowed_list:[[:space:]]*//p' "$status")
       [ "$allowed" = "$want_c" ] || fail "controller thread $status allowed on '$allowed', expected '$want_c'"
     done
+    # `run --pin` does the same for its two child processes.
+    "$bin" run "$paper/roll_step.yaml" --transport dds --pin --out "$tmp/r" --no-plots > "$tmp/run.log" 2>&1 \
+      || fail "run --transport dds --pin failed"
+    cmp "$tmp/in/trajectory.csv" "$tmp/r/trajectory.csv" || fail "run --pin differs from the in-process run"
+    if [ "$want_p" != "$want_c" ]; then
+      grep -q "^plant: on CPU(s) $want_p only" "$tmp/run.log" || fail "run --pin: plant not on CPU $want_p"
+      grep -q "^controller: on CPU(s) $want_c only" "$tmp/run.log" || fail "run --pin: controller not on CPU $want_c"
+    fi
     ;;
 
   sensor_qos)  # best-effort sensor topics (ROS sensor-data QoS) on both sides: still the same bytes
