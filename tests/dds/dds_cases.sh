@@ -101,6 +101,7 @@ print(c[0], c[1] if len(c) > 1 else c[0])')
       allowed=$(sed -n 's/^Cpus_allowed_list:[[:space:]]*//p' "$status")
       [ "$allowed" = "$want_c" ] || fail "controller thread $status allowed on '$allowed', expected '$want_c'"
     done
+    kill -TERM "${pids[-1]}"; wait "${pids[-1]}" 2>/dev/null || true  # one controller on the domain
     # `run --pin` does the same for its two child processes.
     "$bin" run "$paper/roll_step.yaml" --transport dds --pin --out "$tmp/r" --no-plots > "$tmp/run.log" 2>&1 \
       || fail "run --transport dds --pin failed"
