@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "sim/lockstep_stepper.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
@@ -44,14 +45,6 @@ int controller_command(const ControllerCommandOptions& o) {
     // The ROS 2 parameter services, answered inside transport.spin_once (both loops below).
     dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
     if (!o.apply_schedule) sc.schedule.clear();
-    auto next_event = sc.schedule.begin();
-    auto apply_schedule = [&](std::int64_t now_ns) {
-      for (; next_event != sc.schedule.end() && clock.ns(next_event->tick) <= now_ns; ++next_event) {
-        if (std::string err = node.set_parameter(next_event->name, next_event->value); !err.empty()) {
-          throw std::invalid_argument("scheduled parameter refused: " + err);
-        }
-      }
-    };
     dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
     announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
     std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
@@ -59,18 +52,11 @@ int controller_command(const ControllerCommandOptions& o) {
                              o.lockstep ? "lockstep" : "real-time", dt_s);
 
     if (o.lockstep) {
-      // Step once per complete sample of a control tick, on the sample's own time.
-      while (!stop_requested()) {
-        const int delivered = transport.spin_once(100 * kMs);
-        const std::int64_t s = node.synchronized_stamp_ns();
-        if (s < 0 || s % control_period_ns != 0) continue;
-        if (s > node.last_step_ns()) {
-          apply_schedule(s);
-          node.step(s, dt_s);
-        } else if (s == node.last_step_ns() && delivered > 0) {
-          node.republish();  // the plant asked again for a tick we answered
-        }
-      }
+      // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
+      // arrival, so answering a tick wakes no other thread; spin_once serves the parameter services.
+      sim::LockstepStepper stepper(node, std::move(sc.schedule), clock, sc.simulation.controller_divider);
+      const dds::ArrivalDelivery arrival(transport);
+      while (!stop_requested()) transport.spin_once(100 * kMs);
     } else {
       // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
       node.use_receipt_clock(steady_ns);
@@ -86,6 +72,7 @@ int controller_command(const ControllerCommandOptions& o) {
       std::int64_t next = steady_ns();
       PeriodJitter jitter(wall_period_ns);
       bool seen_vehicle = false, safety = false;
+      sim::ParameterSchedule schedule(std::move(sc.schedule), clock);
       while (!stop_requested()) {
         next += wall_period_ns;
         wait_until(transport, next);
@@ -97,7 +84,7 @@ int controller_command(const ControllerCommandOptions& o) {
                                    static_cast<double>(node.synchronized_stamp_ns()) / 1e9);
         }
         const std::int64_t sim_now = node.newest_stamp_ns();
-        apply_schedule(sim_now);
+        schedule.apply(node, sim_now);
         const std::int64_t now = steady_ns();
         if (node.step(now, dt_s).safety != safety) {
           safety = !safety;

@@ -13,6 +13,7 @@
 #include <mutex>
 #include <thread>
 
+#include "sim/lockstep_stepper.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
@@ -200,12 +201,13 @@ class PlantShard {
   std::int64_t start_ns_ = 0, end_ns_ = 0;
 };
 
-// One thread's share of the controllers.
+// One thread's share of the controllers: each steps where its samples are delivered (on
+// Cyclone's receive thread, delivery on arrival), the thread serves only discovery meanwhile.
 class ControllerShard {
  public:
   ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, bool sensor_qos,
                   const std::string& enclave)
-      : clock_(sc.simulation.plant.clock), transport_(dds::read_ros_environment(enclave)) {
+      : transport_(dds::read_ros_environment(enclave)) {
     const model::State initial = io::initial_state(sc);
     for (int i = first; i < last; ++i) {
       sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
@@ -213,10 +215,8 @@ class ControllerShard {
       const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
       if (sensor_qos) use_sensor_qos(transport_, topics);
       c->node = std::make_unique<sim::ControllerNode>(transport_, topics, v.controller);
-      c->schedule = std::move(v.schedule);
-      std::stable_sort(c->schedule.begin(), c->schedule.end(),
-                       [](const auto& a, const auto& b) { return a.tick < b.tick; });
-      c->next = c->schedule.begin();
+      c->stepper = std::make_unique<sim::LockstepStepper>(*c->node, std::move(v.schedule), sc.simulation.plant.clock,
+                                                     sc.simulation.controller_divider);
       vehicles_.push_back(std::move(c));
     }
     announcer_ = std::make_unique<dds::NodeAnnouncer>(transport_.participant().handle(),
@@ -225,28 +225,13 @@ class ControllerShard {
   }
 
   /// Steps each vehicle once per complete sample of a control tick, as `controller` does.
-  int run(std::int64_t control_period_ns, double dt_s) {
-    while (!stop_requested()) {
-      transport_.spin_once(100 * kMs);
-      for (auto& v : vehicles_) {
-        sim::ControllerNode& node = *v->node;
-        const std::uint64_t received = node.samples_received();
-        if (received == v->seen) continue;
-        v->seen = received;
-        const std::int64_t s = node.synchronized_stamp_ns();
-        if (s < 0 || s % control_period_ns != 0) continue;
-        if (s > node.last_step_ns()) {
-          for (; v->next != v->schedule.end() && clock_.ns(v->next->tick) <= s; ++v->next) {
-            if (std::string err = node.set_parameter(v->next->name, v->next->value); !err.empty()) {
-              std::cerr << "controller: scheduled parameter refused: " << err << '\n';
-              return kExitRefused;
-            }
-          }
-          node.step(s, dt_s);
-        } else if (s == node.last_step_ns()) {
-          node.republish();  // the plant asked again for a tick already answered
-        }
-      }
+  int run() {
+    try {
+      const dds::ArrivalDelivery arrival(transport_);
+      while (!stop_requested()) transport_.spin_once(100 * kMs);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "controller: " << e.what() << '\n';
+      return kExitRefused;
     }
     return kExitOk;
   }
@@ -254,11 +239,8 @@ class ControllerShard {
  private:
   struct Vehicle {
     std::unique_ptr<sim::ControllerNode> node;
-    std::vector<sim::ScheduledParameter> schedule;
-    std::vector<sim::ScheduledParameter>::const_iterator next;
-    std::uint64_t seen = 0;
+    std::unique_ptr<sim::LockstepStepper> stepper;
   };
-  sim::TickClock clock_;
   dds::DdsTransport transport_;
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
@@ -336,7 +318,7 @@ int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc)
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads,
                            static_cast<double>(period_ns) / 1e9);
   const int rc = run_threads(threads, [&](int t) {
-    return shards[static_cast<std::size_t>(t)]->run(period_ns, static_cast<double>(period_ns) / 1e9);
+    return shards[static_cast<std::size_t>(t)]->run();
   });
   std::cerr << "controller: stopped\n";
   return rc;

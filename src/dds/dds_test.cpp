@@ -6,6 +6,12 @@
 #include <cstring>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
 #include "dds/dds_transport.hpp"
 #include "sim/messages.hpp"
 
@@ -78,6 +84,127 @@ TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
   EXPECT_EQ(status_in.setpoint, s.setpoint);
   EXPECT_EQ(status_in.rotor_saturated, s.rotor_saturated);
   EXPECT_TRUE(status_in.safety);
+}
+
+// Waits (without spinning `t`) until `done()`, up to 5 s.
+template <class F>
+bool eventually(F done) {
+  for (int i = 0; i < 5000 && !done(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return done();
+}
+
+msg::Clock clock_at(std::int64_t ns) {
+  msg::Clock c;
+  c.clock = msg::Time::from_ns(ns);
+  return c;
+}
+
+// Two transports on one domain: `a` publishes /t/in, `b` subscribes (matched before returning).
+struct ArrivalRig {
+  DdsTransport a{test_env()}, b{test_env()};
+  sim::Publisher<msg::Clock> in;
+  std::vector<std::int64_t> got;
+  std::vector<std::thread::id> threads;
+  std::atomic<int> count{0};
+
+  explicit ArrivalRig(std::function<void(const msg::Clock&)> extra = {}) {
+    b.subscribe<msg::Clock>("/t/in", [this, extra](const msg::Clock& m) {
+      got.push_back(m.clock.to_ns());
+      threads.push_back(std::this_thread::get_id());
+      if (extra) extra(m);
+      ++count;
+    });
+    in = a.advertise<msg::Clock>("/t/in");
+  }
+  bool matched() {
+    return b.spin_until([&] { return b.matched_writers("/t/in") == 1; }, 5'000'000'000) &&
+           a.spin_until([&] { return a.matched_readers("/t/in") == 1; }, 5'000'000'000);
+  }
+};
+
+// In one process Cyclone delivers to a local reader on the publishing thread, so a publisher on a
+// thread of its own stands for the receive thread of a remote one.
+TEST(DdsTransportTest, OnArrivalDeliversInOrderOnlyWhileTheOwnerWaits) {
+  ArrivalRig rig;
+  ASSERT_TRUE(rig.matched());
+  rig.b.deliver_on_arrival(true);
+  std::thread first([&] {
+    for (int i = 1; i <= 50; ++i) rig.in.publish(clock_at(i));
+  });
+  int counted = 0;  // what spin_once reports as delivered since its last call
+  const auto t0 = std::chrono::steady_clock::now();
+  while (rig.count < 50 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
+    counted += rig.b.spin_once(10'000'000);
+  }
+  first.join();
+  counted += rig.b.spin_once(0);
+  EXPECT_EQ(counted, 50);
+  for (int i = 0; i < 50; ++i) EXPECT_EQ(rig.got[static_cast<std::size_t>(i)], i + 1);
+  for (const auto& id : rig.threads) EXPECT_NE(id, std::this_thread::get_id());
+  // Between spin_once calls the owner holds the deliveries: the other thread's sample waits.
+  std::thread second([&] { rig.in.publish(clock_at(51)); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(rig.count, 50);
+  ASSERT_TRUE(rig.b.spin_until([&] { return rig.count == 51; }, 5'000'000'000));
+  second.join();
+
+  rig.b.deliver_on_arrival(false);  // back to delivery by spin_once, on the caller's thread
+  std::thread third([&] { rig.in.publish(clock_at(52)); });
+  third.join();
+  EXPECT_EQ(rig.count, 51);
+  ASSERT_TRUE(rig.b.spin_until([&] { return rig.count == 52; }, 5'000'000'000));
+  EXPECT_EQ(rig.threads.back(), std::this_thread::get_id());
+  EXPECT_EQ(rig.got.back(), 52);
+}
+
+TEST(DdsTransportTest, OnArrivalADeliveryMayPublishToItsOwnTransport) {
+  // b answers every /t/in on /t/echo, which b itself also reads: a delivery inside a delivery.
+  std::atomic<int> echoes{0};
+  sim::Publisher<msg::Clock> echo;
+  ArrivalRig rig([&](const msg::Clock& m) { echo.publish(m); });
+  echo = rig.b.advertise<msg::Clock>("/t/echo");
+  rig.b.subscribe<msg::Clock>("/t/echo", [&](const msg::Clock&) { ++echoes; });
+  ASSERT_TRUE(rig.matched());
+  ASSERT_TRUE(rig.b.spin_until([&] { return rig.b.matched_readers("/t/echo") >= 1; }, 5'000'000'000));
+  const ArrivalDelivery arrival(rig.b);
+  std::thread publisher([&] {
+    for (int i = 1; i <= 20; ++i) rig.in.publish(clock_at(i));
+  });
+  EXPECT_TRUE(rig.b.spin_until([&] { return echoes == 20; }, 5'000'000'000)) << echoes << " echoes";
+  publisher.join();
+}
+
+TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesSpinOnceAndIsRethrown) {
+  ArrivalRig rig([](const msg::Clock& m) {
+    if (m.clock.to_ns() == 3) throw std::invalid_argument("sample 3 refused");
+  });
+  ASSERT_TRUE(rig.matched());
+  const ArrivalDelivery arrival(rig.b);
+  for (int i = 1; i <= 5; ++i) rig.in.publish(clock_at(i));
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    for (int i = 0; i < 100; ++i) rig.b.spin_once(10'000'000'000);
+    FAIL() << "not rethrown";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "sample 3 refused");
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));  // woken, not timed out
+  EXPECT_EQ(rig.count, 2);  // 1 and 2; nothing after the failure
+}
+
+TEST(DdsTransportTest, OnArrivalTheWakeConditionEndsTheWait) {
+  ArrivalRig rig;
+  ASSERT_TRUE(rig.matched());
+  const ArrivalDelivery arrival(rig.b);
+  rig.b.wake_on_arrival([&] { return !rig.got.empty() && rig.got.back() == 7; });
+  for (int i = 1; i <= 7; ++i) rig.in.publish(clock_at(i));
+  const auto t0 = std::chrono::steady_clock::now();
+  // One long wait returns once sample 7 is in (every earlier one delivered before it).
+  while (rig.count < 7 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
+    rig.b.spin_once(30'000'000'000);
+  }
+  EXPECT_EQ(rig.count, 7);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
 }
 
 TEST(DdsTransportTest, TopicAndTypeNamesFollowRos2) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
+#include <utility>
 
 namespace quadcosim::dds {
 
@@ -9,9 +11,16 @@ std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_top
 
 DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
   waitset_ = check(dds_create_waitset(participant_.handle()), "dds_create_waitset");
+  wake_ = check(dds_create_guardcondition(participant_.handle()), "dds_create_guardcondition");
+  attach(wake_, kExtra);
 }
 
 DdsTransport::~DdsTransport() {
+  try {
+    deliver_on_arrival(false);  // no delivery runs past this point; the lock is released
+  } catch (const DdsError&) {
+    // The participant's deletion below detaches the listeners all the same.
+  }
   // Entities go with the participant (Participant's destructor).
 }
 
@@ -72,13 +81,80 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
   const TypeOps* ops = nullptr;
   const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
   auto r = std::make_unique<Reader>();
+  r->owner = this;
+  r->index = readers_.size();
   r->topic = ros_topic;
   r->reader = reader;
   r->condition = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
   r->ops = ops;
   r->deliver = std::move(deliver);
-  attach(r->condition, static_cast<dds_attach_t>(readers_.size()));
+  if (arrival_) {
+    // Delivered by the listener from the start (none on the waitset); what came before the
+    // listener was set is taken now.
+    listen(*r, true);
+    const std::lock_guard<std::recursive_mutex> g(mutex_);
+    delivered_on_arrival_ += drain(*r);
+  } else {
+    attach(r->condition, static_cast<dds_attach_t>(r->index));
+  }
   readers_.push_back(std::move(r));
+}
+
+void DdsTransport::listen(Reader& r, bool on) {
+  if (on) {
+    dds_listener_t* l = dds_create_listener(&r);
+    dds_lset_data_available(l, &DdsTransport::on_data_available);
+    const dds_return_t rc = dds_set_listener(r.reader, l);
+    dds_delete_listener(l);
+    check(rc, ("dds_set_listener " + r.topic).c_str());
+  } else {
+    check(dds_set_listener(r.reader, nullptr), ("dds_set_listener " + r.topic).c_str());  // waits for a callback
+  }
+}
+
+void DdsTransport::on_data_available(dds_entity_t, void* arg) {
+  Reader& r = *static_cast<Reader*>(arg);
+  DdsTransport& t = *r.owner;
+  const std::lock_guard<std::recursive_mutex> g(t.mutex_);
+  if (t.failure_) return;  // delivery stopped; spin_once rethrows
+  try {
+    t.delivered_on_arrival_ += t.drain(r);
+  } catch (...) {
+    t.failure_ = std::current_exception();
+  }
+  t.after_arrival();
+}
+
+void DdsTransport::after_arrival() {
+  bool wake = static_cast<bool>(failure_);
+  if (!wake && wake_when_) {
+    try {
+      wake = wake_when_();
+    } catch (...) {
+      failure_ = std::current_exception();
+      wake = true;
+    }
+  }
+  if (wake) dds_set_guardcondition(wake_, true);
+}
+
+void DdsTransport::deliver_on_arrival(bool on) {
+  if (on == arrival_) return;
+  if (!on) mutex_.unlock();  // first: removing a listener waits for its delivery, which needs the lock
+  for (auto& r : readers_) {
+    if (on) {
+      if (dds_waitset_detach(waitset_, r->condition) == DDS_RETCODE_OK) triggered_.pop_back();
+      listen(*r, true);
+    } else {
+      listen(*r, false);
+      attach(r->condition, static_cast<dds_attach_t>(r->index));
+    }
+  }
+  arrival_ = on;
+  if (on) {
+    mutex_.lock();  // held by this thread but in spin_once's wait
+    for (auto& r : readers_) delivered_on_arrival_ += drain(*r);  // what came before the listeners
+  }
 }
 
 int DdsTransport::drain(Reader& r) {
@@ -90,10 +166,15 @@ int DdsTransport::drain(Reader& r) {
     const dds_return_t n = dds_take(r.reader, samples, infos, kBatch, kBatch);
     if (n < 0) check(n, ("dds_take " + r.topic).c_str());
     if (n == 0) break;
-    for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data) continue;
-      r.ops->deliver(samples[i], r.deliver);
-      ++delivered;
+    try {
+      for (int i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        r.ops->deliver(samples[i], r.deliver);
+        ++delivered;
+      }
+    } catch (...) {
+      dds_return_loan(r.reader, samples, n);  // the loan goes back whatever a delivery throws
+      throw;
     }
     dds_return_loan(r.reader, samples, n);
     if (n < kBatch) break;
@@ -103,8 +184,15 @@ int DdsTransport::drain(Reader& r) {
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
   if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
+  // On arrival, deliveries run while this thread waits, and only then.
+  if (arrival_) mutex_.unlock();
   const dds_return_t rc =
       dds_waitset_wait(waitset_, triggered_.data(), triggered_.size(), timeout_ns);
+  if (arrival_) {
+    mutex_.lock();
+    dds_set_guardcondition(wake_, false);
+    if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
+  }
   check(rc, "dds_waitset_wait");
   ready_.clear();
   std::uint32_t status = 0;
@@ -123,7 +211,7 @@ int DdsTransport::spin_once(std::int64_t timeout_ns) {
     for (const Matched& m : matched_) dds_take_status(m.entity, &status, m.status);
     for (std::size_t i = 0; i < readers_.size(); ++i) ready_.push_back(i);
   }
-  int delivered = 0;
+  int delivered = std::exchange(delivered_on_arrival_, 0);
   for (std::size_t i : ready_) delivered += drain(*readers_[i]);
   if (!extra_.empty()) {
     // Copied first (into a kept vector): a callback may add or remove extra work.
@@ -151,6 +239,18 @@ void DdsTransport::remove_extra_work(int id) {
 }
 
 bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t timeout_ns) {
+  // On arrival, a delivery that makes `done` hold ends the wait (the caller's own condition is
+  // back afterwards). Under the lock: no delivery runs while this thread is out of spin_once.
+  struct WakeScope {
+    std::function<bool()>& slot;
+    std::function<bool()> saved;
+    ~WakeScope() { slot = std::move(saved); }
+  };
+  std::optional<WakeScope> wake;
+  if (arrival_) {
+    wake.emplace(WakeScope{wake_when_, std::move(wake_when_)});
+    wake_when_ = [&done, &saved = wake->saved] { return done() || (saved && saved()); };
+  }
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::nanoseconds(timeout_ns);
   while (!done()) {

@@ -1,14 +1,17 @@
 // Transport over Cyclone DDS speaking the ROS 2 wire format: topic "/drone/Pose" travels as DDS
 // topic "rt/drone/Pose" with type "geometry_msgs::msg::dds_::PoseStamped_", XCDR1, and the ROS QoS
-// set explicitly. Subscriptions are delivered by spin_once() on the caller's thread, so a node never
-// sees a callback while it is in the middle of a step.
+// set explicitly. Subscriptions are delivered by spin_once() on the caller's thread, or on arrival on
+// Cyclone's receive thread while the caller waits in spin_once; either way a node never sees a
+// callback while it is in the middle of a step.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <exception>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -39,10 +42,34 @@ class DdsTransport final : public sim::Transport {
   /// Waits up to timeout_ns for data on any subscription, then delivers the samples of every
   /// subscription the wait found with data, reader by reader in subscription order (the waitset
   /// names them, so a wake costs what arrived, not the number of subscriptions). Returns how many
-  /// messages were delivered.
+  /// messages were delivered. With delivery on arrival (below), waits for matching changes, extra
+  /// work or the wake condition only, serves the extra work, and returns the messages delivered on
+  /// arrival since the last call; it rethrows what a delivery on arrival threw.
   int spin_once(std::int64_t timeout_ns);
 
-  /// Spins until `done()` holds or timeout_ns passes; returns done().
+  /// Delivery on arrival (on) or by spin_once (off, the default). On arrival, each subscription's
+  /// samples are taken and delivered on the Cyclone thread that received them (a DATA_AVAILABLE
+  /// listener), so a node that reacts to data where it is delivered (a lockstep controller stepping
+  /// on a complete sample) answers without waking another thread. A node still never sees a
+  /// callback while its own thread is busy with it: the thread that turns delivery on arrival on
+  /// holds the deliveries' (recursive) lock from then on, except while spin_once waits, so a
+  /// delivery runs only while that thread waits in spin_once, and never beside another delivery.
+  /// Call it, spin_once and the switch off from that one thread, never from inside a delivery. A
+  /// delivery may publish (also to this transport's own readers). An exception a delivery throws is
+  /// kept (later deliveries are dropped), wakes spin_once and is rethrown by it. Turning it off
+  /// waits for a delivery in progress; do so (or let ArrivalDelivery do it) before anything a
+  /// delivery uses is destroyed.
+  void deliver_on_arrival(bool on);
+  bool delivers_on_arrival() const { return arrival_; }
+
+  /// With delivery on arrival: after each delivery, spin_once is woken when `when()` holds
+  /// (evaluated under the deliveries' lock; e.g. "the command I wait for is here"). Without one,
+  /// deliveries on arrival do not wake spin_once. Empty to clear.
+  void wake_on_arrival(std::function<bool()> when) { wake_when_ = std::move(when); }
+
+  /// Spins until `done()` holds or timeout_ns passes; returns done(). `done` runs on the caller's
+  /// thread between waits; with delivery on arrival also after each delivery (under the
+  /// deliveries' lock), so a delivery that makes it hold ends the wait.
   bool spin_until(const std::function<bool()>& done, std::int64_t timeout_ns);
 
   /// Writers matched by our readers of `ros_topic` / readers matched by our writers of it.
@@ -68,12 +95,17 @@ class DdsTransport final : public sim::Transport {
 
  private:
   struct Reader {
+    DdsTransport* owner;
+    std::size_t index;  ///< in readers_ (its waitset attachment argument)
     std::string topic;
     dds_entity_t reader;
     dds_entity_t condition;
     const TypeOps* ops;
     std::function<void(const void*)> deliver;
   };
+  static void on_data_available(dds_entity_t reader, void* arg);
+  /// Delivery on arrival for one reader: its listener set, its read condition off the waitset.
+  void listen(Reader& r, bool on);
   /// A writer or reader on `ros_topic` with its QoS, attached to the waitset for matching changes.
   dds_entity_t create_endpoint(const std::string& ros_topic, const sim::TopicType& type, bool writer,
                                const TypeOps*& ops);
@@ -106,6 +138,28 @@ class DdsTransport final : public sim::Transport {
   std::map<int, ExtraWork> extra_;
   std::vector<std::function<void()>> serving_;  ///< spin_once's copy of the extra work's callbacks
   int next_extra_id_ = 1;
+  bool arrival_ = false;
+  /// Deliveries on arrival take it; the thread that switched arrival on holds it but in spin_once's wait.
+  std::recursive_mutex mutex_;
+  int delivered_on_arrival_ = 0;    ///< since the last spin_once (under mutex_)
+  std::exception_ptr failure_;      ///< the first exception of a delivery on arrival (under mutex_)
+  std::function<bool()> wake_when_;  ///< wake_on_arrival's condition (under mutex_)
+  dds_entity_t wake_ = 0;            ///< guard condition on the waitset: a delivery on arrival wakes spin_once
+  /// After a delivery on arrival (under mutex_): wakes spin_once on a failure or when wake_when_ holds.
+  void after_arrival();
+};
+
+/// Delivery on arrival for a scope, on the thread that creates it: on in the constructor, off
+/// (waiting for a delivery in progress) in the destructor. Declare it after what the deliveries use.
+class ArrivalDelivery {
+ public:
+  explicit ArrivalDelivery(DdsTransport& t, bool on = true) : t_(t) { t_.deliver_on_arrival(on); }
+  ~ArrivalDelivery() { t_.deliver_on_arrival(false); }
+  ArrivalDelivery(const ArrivalDelivery&) = delete;
+  ArrivalDelivery& operator=(const ArrivalDelivery&) = delete;
+
+ private:
+  DdsTransport& t_;
 };
 
 }  // namespace quadcosim::dds

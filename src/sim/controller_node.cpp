@@ -21,6 +21,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
     ++samples_received_;
+    if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
     if (!accept(velocity_ok(m, velocity_stamp_ns_), [&] { return validate_velocity(m, velocity_stamp_ns_); }, topic, velocity_backwards_)) return;
@@ -28,6 +29,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
     ++samples_received_;
+    if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
     if (!accept(imu_ok(m, imu_stamp_ns_), [&] { return validate_imu(m, imu_stamp_ns_); }, topic, imu_backwards_)) return;
@@ -39,6 +41,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
     ++samples_received_;
+    if (on_sample_) on_sample_();
   });
 }
 

@@ -62,6 +62,10 @@ class ControllerNode {
   /// Pose, Velocity and Imu messages taken in so far (a host of many nodes sees which one got data).
   std::uint64_t samples_received() const { return samples_received_; }
 
+  /// Called after each Pose, Velocity or Imu message taken in, where the transport delivers it: a
+  /// lockstep host steps from here (LockstepStepper) instead of polling after every wait.
+  void on_sample(std::function<void()> f) { on_sample_ = std::move(f); }
+
   /// Where refused sensor messages are reported (rate-limited per reason). Default: stderr.
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
@@ -101,6 +105,7 @@ class ControllerNode {
   bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
   std::function<void(const std::string&)> log_;
+  std::function<void()> on_sample_;
   std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing
   int pose_backwards_ = 0, velocity_backwards_ = 0, imu_backwards_ = 0;
   Publisher<msg::ControllerStatus> status_pub_;
