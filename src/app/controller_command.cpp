@@ -26,7 +26,8 @@ int controller_command(const ControllerCommandOptions& o) {
     std::cerr << "error: controller: --cpus: " << err << '\n';
     return 2;
   }
-  if (!o.cpus.empty()) std::cerr << "controller: on CPU(s) " << o.cpus << " only\n";
+  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
+  if (!o.cpus.empty()) std::cerr << fmt::format("controller: on CPU(s) {} only\n", o.cpus);
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "app/commands.hpp"
@@ -70,23 +71,9 @@ class PlantProcess {
     loop_start_ns_ = steady_ns();
     next_wall_ns_ = loop_start_ns_;
     round_trip_ns_.reserve(static_cast<std::size_t>(sc_.simulation.duration_ticks / divider_ + 1));
-    for (sim::Tick k = 0; k <= sc_.simulation.duration_ticks && !stop_requested(); ++k) {
-      if (!apply_due_schedule(k)) return finish(kExitRefused);
-      const std::uint64_t received_before = plant_.stats().commands_received;
-      plant_.publish_outputs(k);
-      if (o_.lockstep) {
-        if (!await_command(k, received_before)) return finish(kExitNoController);
-      } else {
-        pace_to_wall_clock();
-      }
-      plant_.latch_command(k);
-      log_watchdog(k);
-      record(k);
-      if (mcap_) mcap_->flush_settled(clock_.ns(k));
-      if (k < sc_.simulation.duration_ticks) plant_.integrate(k);
-      ++ticks_run_;
-    }
-    finish(kExitOk);
+    const int rc = o_.lockstep ? run_lockstep() : run_realtime();
+    finish(rc);
+    if (rc != kExitOk) return rc;
     report();
     return stop_requested() ? kExitInterrupted : kExitOk;
   }
@@ -124,7 +111,9 @@ class PlantProcess {
   /// acknowledged before tick k is published, so the run stays deterministic. False when refused.
   bool apply_due_schedule(sim::Tick k) {
     for (; scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k; ++next_event_) {
-      const auto r = scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns());
+      // The reply comes through Cyclone's receive thread: let deliveries on arrival through meanwhile.
+      const auto r = transport_.with_deliveries(
+          [&] { return scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns()); });
       if (r.size() != 1 || !r[0].successful) {
         std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event_->name,
                                  clock_.seconds(k), o_.schedule_node, r.empty() ? "no result" : r[0].reason);
@@ -134,43 +123,140 @@ class PlantProcess {
     return true;
   }
 
-  /// Lockstep, after tick k's outputs are out: on control ticks, waits for the command (and status)
-  /// answering tick k, publishing the outputs again every 50 ms. On timeout, false under the abort
-  /// policy; under hold, waiting switches off until commands arrive again, so a vanished controller
-  /// costs one timeout, not one per tick.
-  bool await_command(sim::Tick k, std::uint64_t received_before) {
-    const std::int64_t t_ns = clock_.ns(k);
-    if (!waiting_) {
-      transport_.spin_once(0);  // collect without waiting
-      if (plant_.stats().commands_received > received_before) {
-        std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
-        waiting_ = true;
-      }
+  /// Real time: each tick published, paced by the wall clock, then completed.
+  int run_realtime() {
+    for (sim::Tick k = 0; k <= sc_.simulation.duration_ticks && !stop_requested(); ++k) {
+      if (!apply_due_schedule(k)) return kExitRefused;
+      plant_.publish_outputs(k);
+      pace_to_wall_clock();
+      end_tick(k);
     }
-    if (!waiting_ || k % divider_ != 0) return true;
-    const bool status_expected = transport_.matched_writers(topics_.controller_status) > 0;
-    auto answered = [&] {
-      const bool command = plant_.last_command_stamp_ns() == t_ns ||
-                           (plant_.last_command_stamp_ns() < 0 && plant_.stats().commands_received > received_before);
-      return stop_requested() || (command && (!status_expected || status_.header.stamp.to_ns() == t_ns));
-    };
-    const std::int64_t asked = steady_ns();
-    const std::int64_t deadline = asked + timeout_ns();
-    // Ask again every 50 ms: a sample sent while discovery was still settling may not arrive.
-    while (!transport_.spin_until(answered, 50 * kMs)) {
-      if (steady_ns() >= deadline) {
+    return kExitOk;
+  }
+
+  /// What follows tick k's wait: latch the command, log, record, integrate to t_k+1.
+  void end_tick(sim::Tick k) {
+    plant_.latch_command(k);
+    log_watchdog(k);
+    record(k);
+    if (mcap_) mcap_->flush_settled(clock_.ns(k));
+    if (k < sc_.simulation.duration_ticks) plant_.integrate(k);
+    ++ticks_run_;
+  }
+
+  // Lockstep. Commands and statuses are delivered on arrival (on Cyclone's receive thread), and
+  // the delivery that completes the awaited tick's answer runs the ticks that follow right there,
+  // up to the next control tick's publication: a control period wakes no thread of this process
+  // but the receive thread. The main thread sleeps meanwhile; it is woken to ask again (every
+  // 50 ms without progress), at the timeout, at the end, and for what needs it: a scheduled change
+  // through the parameter services (a blocking request) and the hold policy's unpaced ticks (with
+  // delivery by spin_once again).
+  enum class Phase { kAwaiting, kMainThread, kDone };
+
+  int run_lockstep() {
+    arrival_.emplace(transport_);
+    transport_.on_arrival([this] {
+      // Not inside advance: our own publications reach our own readers (the recorder's) at once.
+      if (advancing_ || phase_ != Phase::kAwaiting || !answered(k_)) return false;
+      phase_ = advance(true);
+      return phase_ != Phase::kAwaiting;  // wake the main thread only when it has work
+    });
+    for (;;) {
+      phase_ = advance(false);
+      if (refused_) return kExitRefused;
+      if (phase_ == Phase::kDone || stop_requested()) return kExitOk;
+      if (!await_progress()) return kExitNoController;
+    }
+  }
+
+  /// Runs ticks from k_ on until one waits for its answer (kAwaiting) or the run ends (kDone); on
+  /// the receive thread (`on_arrival`) it stops before a tick that needs the main thread
+  /// (kMainThread). A refused scheduled change ends the run with refused_ set.
+  Phase advance(bool on_arrival) {
+    advancing_ = true;
+    const Phase p = advance_ticks(on_arrival);
+    advancing_ = false;
+    return p;
+  }
+  Phase advance_ticks(bool on_arrival) {
+    for (;;) {
+      const sim::Tick k = k_;
+      if (!published_) {
+        if (k > sc_.simulation.duration_ticks || stop_requested()) return Phase::kDone;
+        if (on_arrival && (!waiting_ || schedule_due(k))) return Phase::kMainThread;
+        if (!apply_due_schedule(k)) {
+          refused_ = true;
+          return Phase::kDone;
+        }
+        received_before_ = plant_.stats().commands_received;
+        plant_.publish_outputs(k);
+        asked_ns_ = last_ask_ns_ = steady_ns();
+        published_ = true;
+        if (!waiting_) collect_while_holding(k);
+        if (waiting_ && k % divider_ == 0) {
+          status_expected_ = transport_.matched_writers(topics_.controller_status) > 0;
+        }
+      }
+      if (waiting_ && k % divider_ == 0) {
+        if (!answered(k)) return Phase::kAwaiting;
+        round_trip_ns_.push_back(steady_ns() - asked_ns_);
+      }
+      end_tick(k);
+      ++k_;
+      published_ = false;
+    }
+  }
+
+  /// The command (and status, when a status writer is matched) answering control tick k is in.
+  bool answered(sim::Tick k) const {
+    const std::int64_t t_ns = clock_.ns(k);
+    const bool command = plant_.last_command_stamp_ns() == t_ns ||
+                         (plant_.last_command_stamp_ns() < 0 && plant_.stats().commands_received > received_before_);
+    return command && (!status_expected_ || status_.header.stamp.to_ns() == t_ns);
+  }
+
+  bool schedule_due(sim::Tick k) const {
+    return scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k;
+  }
+
+  /// Under hold, after a timeout: takes in what has arrived; when commands are back, lockstep
+  /// (and delivery on arrival) resumes.
+  void collect_while_holding(sim::Tick k) {
+    transport_.spin_once(0);
+    if (plant_.stats().commands_received > received_before_) {
+      std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
+      waiting_ = true;
+      arrival_.emplace(transport_);
+    }
+  }
+
+  /// Main thread, while tick k_ waits for its answer (the receive thread runs the ticks whose
+  /// answers arrive): publishes the awaited tick again after 50 ms without progress (a sample sent
+  /// while discovery was settling may not arrive). At --timeout, false under the abort policy;
+  /// under hold, waiting switches off until commands arrive again, so a vanished controller costs
+  /// one timeout, not one per tick.
+  bool await_progress() {
+    while (phase_ == Phase::kAwaiting && !stop_requested() && !answered(k_)) {
+      const std::int64_t now = steady_ns();
+      if (now - asked_ns_ >= timeout_ns()) {
         std::cerr << fmt::format(
             "plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
             "matched command writers: {}; policy: {}\n",
-            topics_.motor_commands, k, clock_.seconds(k), o_.timeout_s,
+            topics_.motor_commands, k_, clock_.seconds(k_), o_.timeout_s,
             transport_.matched_writers(topics_.motor_commands), o_.on_timeout);
         if (o_.on_timeout == "abort") return false;
-        waiting_ = false;  // hold the last command and go on
-        break;
+        waiting_ = false;  // hold the last command and go on, taking in commands by spin_once
+        arrival_.reset();
+        return true;
       }
-      plant_.publish_outputs(k);
+      if (now - last_ask_ns_ >= 50 * kMs) {
+        plant_.publish_outputs(k_);
+        last_ask_ns_ = now;
+      }
+      // Not woken per tick the receive thread runs: this thread looks again at the latest k_.
+      transport_.spin_until([&] { return phase_ != Phase::kAwaiting || stop_requested(); },
+                            last_ask_ns_ + 50 * kMs - now);
     }
-    round_trip_ns_.push_back(steady_ns() - asked);
     return true;
   }
 
@@ -215,6 +301,8 @@ class PlantProcess {
 
   /// Completes the recordings (also on the error paths, so what was recorded is readable).
   int finish(int code) {
+    arrival_.reset();  // what is still in the readers is taken by spin_once below
+    transport_.on_arrival(nullptr);
     if (csv_) csv_->close();
     if (mcap_ && code == kExitOk) {
       while (transport_.spin_once(0) > 0) {  // what is still in the readers
@@ -279,12 +367,22 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool waiting_ = true;  ///< lockstep: wait for each command (off after a timeout under hold)
+  // Lockstep state, shared by the main thread and the receive thread (under the deliveries' lock).
+  Phase phase_ = Phase::kAwaiting;
+  sim::Tick k_ = 0;             ///< the tick in progress
+  bool published_ = false;      ///< k_'s outputs are out
+  bool refused_ = false;        ///< a scheduled change was refused
+  bool advancing_ = false;      ///< inside advance (on either thread)
+  bool status_expected_ = false;  ///< a status writer was matched when k_ was published
+  std::uint64_t received_before_ = 0;  ///< commands received before k_ was published
+  std::int64_t asked_ns_ = 0, last_ask_ns_ = 0;  ///< k_ first published / last published [steady ns]
   std::int64_t loop_start_ns_ = 0, next_wall_ns_ = 0;
   std::vector<std::int64_t> round_trip_ns_;  ///< lockstep: sensor publication -> command back
   bool watchdog_logged_ = false;
   std::int64_t ticks_run_ = 0;
   std::int64_t max_late_ns_ = 0;  ///< real time: worst arrival of the loop after a tick's wall time
   std::int64_t late_ticks_ = 0;   ///< real time: ticks reached more than one period late
+  std::optional<dds::ArrivalDelivery> arrival_;  ///< lockstep: delivery on arrival (last: off first)
 };
 
 }  // namespace
@@ -296,7 +394,8 @@ int plant_command(const PlantCommandOptions& o) {
     std::cerr << "error: plant: --cpus: " << err << '\n';
     return 2;
   }
-  if (!o.cpus.empty()) std::cerr << "plant: on CPU(s) " << o.cpus << " only\n";
+  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
+  if (!o.cpus.empty()) std::cerr << fmt::format("plant: on CPU(s) {} only\n", o.cpus);
   try {
     io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
     if (!o.ns.empty()) sc.simulation.ns = o.ns;

@@ -192,19 +192,32 @@ TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesSpinOnceAndIsRethrown) {
   EXPECT_EQ(rig.count, 2);  // 1 and 2; nothing after the failure
 }
 
-TEST(DdsTransportTest, OnArrivalTheWakeConditionEndsTheWait) {
+TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) {
   ArrivalRig rig;
   ASSERT_TRUE(rig.matched());
   const ArrivalDelivery arrival(rig.b);
-  rig.b.wake_on_arrival([&] { return !rig.got.empty() && rig.got.back() == 7; });
-  for (int i = 1; i <= 7; ++i) rig.in.publish(clock_at(i));
+  int runs = 0;
+  rig.b.on_arrival([&] {
+    ++runs;
+    return !rig.got.empty() && rig.got.back() == 7;
+  });
+  std::thread publisher([&] {
+    for (int i = 1; i <= 7; ++i) rig.in.publish(clock_at(i));
+  });
   const auto t0 = std::chrono::steady_clock::now();
-  // One long wait returns once sample 7 is in (every earlier one delivered before it).
+  // Long waits return once sample 7 is in (every earlier one delivered before it).
   while (rig.count < 7 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
     rig.b.spin_once(30'000'000'000);
   }
+  publisher.join();
   EXPECT_EQ(rig.count, 7);
+  EXPECT_EQ(runs, 7);
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+  // spin_until runs the hook too, beside its own condition.
+  std::thread more([&] { rig.in.publish(clock_at(8)); });
+  EXPECT_TRUE(rig.b.spin_until([&] { return rig.count == 8; }, 5'000'000'000));
+  more.join();
+  EXPECT_EQ(runs, 8);
 }
 
 TEST(DdsTransportTest, TopicAndTypeNamesFollowRos2) {

@@ -127,9 +127,9 @@ void DdsTransport::on_data_available(dds_entity_t, void* arg) {
 
 void DdsTransport::after_arrival() {
   bool wake = static_cast<bool>(failure_);
-  if (!wake && wake_when_) {
+  if (!wake && after_arrival_) {
     try {
-      wake = wake_when_();
+      wake = after_arrival_();
     } catch (...) {
       failure_ = std::current_exception();
       wake = true;
@@ -248,8 +248,11 @@ bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t ti
   };
   std::optional<WakeScope> wake;
   if (arrival_) {
-    wake.emplace(WakeScope{wake_when_, std::move(wake_when_)});
-    wake_when_ = [&done, &saved = wake->saved] { return done() || (saved && saved()); };
+    wake.emplace(WakeScope{after_arrival_, std::move(after_arrival_)});
+    after_arrival_ = [&done, &saved = wake->saved] {
+      const bool own = saved && saved();  // the caller's hook runs whatever done() says
+      return done() || own;
+    };
   }
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::nanoseconds(timeout_ns);

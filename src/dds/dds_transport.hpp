@@ -62,10 +62,28 @@ class DdsTransport final : public sim::Transport {
   void deliver_on_arrival(bool on);
   bool delivers_on_arrival() const { return arrival_; }
 
-  /// With delivery on arrival: after each delivery, spin_once is woken when `when()` holds
-  /// (evaluated under the deliveries' lock; e.g. "the command I wait for is here"). Without one,
-  /// deliveries on arrival do not wake spin_once. Empty to clear.
-  void wake_on_arrival(std::function<bool()> when) { wake_when_ = std::move(when); }
+  /// Runs `blocking()` on the owning thread with deliveries let through, as in spin_once's wait:
+  /// for a blocking call that needs Cyclone's receive thread (e.g. waiting for a service reply on
+  /// another reader), which a delivery waiting for the lock would otherwise hold up. `blocking`
+  /// must not touch what deliveries touch. Without delivery on arrival it just runs `blocking`.
+  template <class F>
+  auto with_deliveries(F blocking) {
+    if (!arrival_) return blocking();
+    struct Relock {
+      std::recursive_mutex& m;
+      ~Relock() { m.lock(); }
+    };
+    mutex_.unlock();
+    const Relock relock{mutex_};
+    return blocking();
+  }
+
+  /// With delivery on arrival: `after()` runs after each delivery, on the delivering thread under
+  /// the deliveries' lock, and spin_once is woken when it returns true. A node may react there (a
+  /// lockstep plant runs its next ticks once the command it waits for is in) and wake its own
+  /// thread only when that thread has work. Without one, deliveries on arrival do not wake
+  /// spin_once. Empty to clear.
+  void on_arrival(std::function<bool()> after) { after_arrival_ = std::move(after); }
 
   /// Spins until `done()` holds or timeout_ns passes; returns done(). `done` runs on the caller's
   /// thread between waits; with delivery on arrival also after each delivery (under the
@@ -143,9 +161,10 @@ class DdsTransport final : public sim::Transport {
   std::recursive_mutex mutex_;
   int delivered_on_arrival_ = 0;    ///< since the last spin_once (under mutex_)
   std::exception_ptr failure_;      ///< the first exception of a delivery on arrival (under mutex_)
-  std::function<bool()> wake_when_;  ///< wake_on_arrival's condition (under mutex_)
+  std::function<bool()> after_arrival_;  ///< on_arrival's hook (under mutex_)
   dds_entity_t wake_ = 0;            ///< guard condition on the waitset: a delivery on arrival wakes spin_once
-  /// After a delivery on arrival (under mutex_): wakes spin_once on a failure or when wake_when_ holds.
+  /// After a delivery on arrival (under mutex_): runs after_arrival_; wakes spin_once on a failure
+  /// or when it returns true.
   void after_arrival();
 };
 

@@ -180,6 +180,43 @@ assert abs(z[-1] - 1.0) <= 0.02, z[-1]
 PY
     ;;
 
+  lockstep_hold)  # lockstep: the controller stops answering (SIGSTOP), the plant holds, then resumes
+    "$bin" controller --scenario "$hover" > "$tmp/c.log" 2>&1 &
+    ctl=$!; pids+=("$ctl")
+    # 600 s simulated: a few seconds in lockstep, and longer than the pause below unpaced.
+    "$bin" plant --scenario "$hover" --duration 600 --timeout 1 --on-timeout hold --record "$tmp/t.csv" \
+      > "$tmp/plant.log" 2>&1 &
+    plant=$!; pids+=("$plant")
+    wait_for 15 grep -q "lockstep mode" "$tmp/plant.log" || fail "plant did not start"
+    sleep 0.3
+    kill -STOP "$ctl"
+    wait_for 10 grep -q "lockstep timeout" "$tmp/plant.log" || { kill -CONT "$ctl"; fail "no lockstep timeout"; }
+    kill -CONT "$ctl"
+    set +e
+    timeout 60 tail --pid="$plant" -f /dev/null
+    wait "$plant"; rc=$?
+    set -e
+    [ "$rc" -eq 0 ] || fail "plant exited with $rc"
+    grep -q "policy: hold" "$tmp/plant.log" || fail "the timeout did not name the hold policy"
+    back=$(grep -o "commands are back at tick [0-9]*" "$tmp/plant.log" | grep -o "[0-9]*$") ||
+      fail "lockstep did not resume"
+    received=$(grep -o "commands received [0-9]*" "$tmp/plant.log" | grep -o "[0-9]*$")
+    "$py" - "$tmp/t.csv" "$back" "$received" <<'PY' || fail "after the resume (see above)"
+import csv, sys
+path, back, received = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+rows = list(csv.DictReader(open(path)))
+last = len(rows) - 1  # ticks 0..60000
+assert last == 60000, last
+# After the resume every control tick is answered again: at least that many commands came in.
+after = (last - back) // 2
+print(f"resumed at tick {back}; {received} commands received, {after} control ticks after the resume")
+assert back < last and received >= after, (back, received, after)
+# And the controller flies the vehicle again: back at its 1 m hover at the end.
+z = float(rows[-1]["z"])
+assert abs(z - 1.0) < 0.05, z
+PY
+    ;;
+
   plant_killed)  # real time: kill -9 the plant; the controller's safety within its staleness limit
     limit=0.1  # the controller's stale_limit_s (default)
     "$bin" controller --realtime --scenario "$hover" > "$tmp/controller.log" 2>&1 &
