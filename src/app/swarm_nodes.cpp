@@ -123,6 +123,9 @@ class PlantShard {
                                vehicles_[ready]->topics.motor_commands, timeout_s, ready, vehicles_.size());
       return kExitNoPeer;
     }
+    // Commands and statuses are taken in on Cyclone's receive thread as they arrive; this thread
+    // wakes once every vehicle's answer is in (spin_until's condition), not once per batch.
+    const dds::ArrivalDelivery arrival(transport_);
     start_ns_ = steady_ns();
     for (sim::Tick k = 0; k <= duration_ticks && !stop_requested(); ++k) {
       for (auto& v : vehicles_) v->plant->publish_outputs(k);
