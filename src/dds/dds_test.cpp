@@ -122,6 +122,22 @@ struct ArrivalRig {
   }
 };
 
+TEST(DdsTransportTest, OnArrivalOnlyTheOwningThreadMaySpin) {
+  ArrivalRig rig;
+  const ArrivalDelivery arrival(rig.b);
+  std::string error;
+  std::thread other([&] {
+    try {
+      rig.b.spin_once(0);
+    } catch (const std::logic_error& e) {
+      error = e.what();
+    }
+  });
+  other.join();
+  EXPECT_NE(error.find("spin_once"), std::string::npos) << error;
+  EXPECT_EQ(rig.b.spin_once(0), 0);  // the owner may
+}
+
 // In one process Cyclone delivers to a local reader on the publishing thread, so a publisher on a
 // thread of its own stands for the receive thread of a remote one.
 TEST(DdsTransportTest, OnArrivalDeliversInOrderOnlyWhileTheOwnerWaits) {

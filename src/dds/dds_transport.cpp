@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <optional>
+#include <stdexcept>
+#include <thread>
 #include <utility>
 
 namespace quadcosim::dds {
@@ -18,7 +20,7 @@ DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
 DdsTransport::~DdsTransport() {
   try {
     deliver_on_arrival(false);  // no delivery runs past this point; the lock is released
-  } catch (const DdsError&) {
+  } catch (const std::exception&) {  // DdsError, or logic_error from another thread
     // The participant's deletion below detaches the listeners all the same.
   }
   // Entities go with the participant (Participant's destructor).
@@ -138,8 +140,17 @@ void DdsTransport::after_arrival() {
   if (wake) dds_set_guardcondition(wake_, true);
 }
 
+void DdsTransport::check_owner(const char* what) const {
+  if (arrival_ && std::this_thread::get_id() != owner_) {
+    throw std::logic_error(std::string("DdsTransport::") + what +
+                           " called from a thread other than the one that turned delivery on arrival on");
+  }
+}
+
 void DdsTransport::deliver_on_arrival(bool on) {
   if (on == arrival_) return;
+  check_owner("deliver_on_arrival");
+  if (on) owner_ = std::this_thread::get_id();
   if (!on) mutex_.unlock();  // first: removing a listener waits for its delivery, which needs the lock
   for (auto& r : readers_) {
     if (on) {
@@ -185,6 +196,7 @@ int DdsTransport::drain(Reader& r) {
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
   if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
   // On arrival, deliveries run while this thread waits, and only then.
+  check_owner("spin_once");
   if (arrival_) mutex_.unlock();
   const dds_return_t rc =
       dds_waitset_wait(waitset_, triggered_.data(), triggered_.size(), timeout_ns);

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "dds/participant.hpp"
@@ -54,11 +55,11 @@ class DdsTransport final : public sim::Transport {
   /// callback while its own thread is busy with it: the thread that turns delivery on arrival on
   /// holds the deliveries' (recursive) lock from then on, except while spin_once waits, so a
   /// delivery runs only while that thread waits in spin_once, and never beside another delivery.
-  /// Call it, spin_once and the switch off from that one thread, never from inside a delivery. A
-  /// delivery may publish (also to this transport's own readers). An exception a delivery throws is
-  /// kept (later deliveries are dropped), wakes spin_once and is rethrown by it. Turning it off
-  /// waits for a delivery in progress; do so (or let ArrivalDelivery do it) before anything a
-  /// delivery uses is destroyed.
+  /// Call it, spin_once and the switch off from that one thread (another gets std::logic_error),
+  /// never from inside a delivery. A delivery may publish (also to this transport's own readers).
+  /// An exception a delivery throws is kept (later deliveries are dropped), wakes spin_once and is
+  /// rethrown by it. Turning it off waits for a delivery in progress; do so (or let
+  /// ArrivalDelivery do it) before anything a delivery uses is destroyed.
   void deliver_on_arrival(bool on);
   bool delivers_on_arrival() const { return arrival_; }
 
@@ -69,6 +70,7 @@ class DdsTransport final : public sim::Transport {
   template <class F>
   auto with_deliveries(F blocking) {
     if (!arrival_) return blocking();
+    check_owner("with_deliveries");
     struct Relock {
       std::recursive_mutex& m;
       ~Relock() { m.lock(); }
@@ -157,6 +159,9 @@ class DdsTransport final : public sim::Transport {
   std::vector<std::function<void()>> serving_;  ///< spin_once's copy of the extra work's callbacks
   int next_extra_id_ = 1;
   bool arrival_ = false;
+  std::thread::id owner_;  ///< the thread that turned delivery on arrival on
+  /// Throws std::logic_error naming `what` when delivery is on arrival and this is not owner_'s thread.
+  void check_owner(const char* what) const;
   /// Deliveries on arrival take it; the thread that switched arrival on holds it but in spin_once's wait.
   std::recursive_mutex mutex_;
   int delivered_on_arrival_ = 0;    ///< since the last spin_once (under mutex_)
