@@ -86,6 +86,95 @@ TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
   EXPECT_TRUE(status_in.safety);
 }
 
+// The types the test above leaves out, and every field of the two status types, each with a value
+// of its own so a field read from or written to its neighbour shows.
+TEST(DdsTransportTest, RoundTripsTheRestFieldForField) {
+  DdsTransport a(test_env()), b(test_env());
+  msg::TwistStamped twist_in;
+  msg::Clock clock_in;
+  msg::ControllerStatus cs_in;
+  msg::PlantStatus ps_in;
+  int got = 0;
+  b.subscribe<msg::TwistStamped>("/r/Velocity", [&](const msg::TwistStamped& m) { twist_in = m; ++got; });
+  b.subscribe<msg::Clock>("/r/clock", [&](const msg::Clock& m) { clock_in = m; ++got; });
+  b.subscribe<msg::ControllerStatus>("/r/cs", [&](const msg::ControllerStatus& m) { cs_in = m; ++got; });
+  b.subscribe<msg::PlantStatus>("/r/ps", [&](const msg::PlantStatus& m) { ps_in = m; ++got; });
+  auto twist = a.advertise<msg::TwistStamped>("/r/Velocity");
+  auto clock = a.advertise<msg::Clock>("/r/clock");
+  auto cs = a.advertise<msg::ControllerStatus>("/r/cs");
+  auto ps = a.advertise<msg::PlantStatus>("/r/ps");
+  ASSERT_TRUE(b.spin_until([&] { return b.matched_writers("/r/Velocity") == 1 && b.matched_writers("/r/clock") == 1 &&
+                                        b.matched_writers("/r/cs") == 1 && b.matched_writers("/r/ps") == 1; },
+                           5'000'000'000));
+  ASSERT_TRUE(a.spin_until([&] { return a.matched_readers("/r/ps") == 1; }, 5'000'000'000));
+
+  msg::TwistStamped t;
+  t.header = {{7, 8}, "world"};
+  t.linear = {1, 2, 3};
+  t.angular = {4, 5, 6};
+  msg::Clock k;
+  k.clock = {2147483647, 999999999};
+  msg::ControllerStatus c;
+  c.header = {{9, 10}, "base_link"};
+  c.mode = "attitude";
+  c.setpoint = {1, 2, 3, 4, 5, 6};
+  c.u = {7, 8, 9, 10};
+  c.error = {11, 12, 13, 14};
+  c.rotor_saturated = {false, true, false, true};
+  c.tilt_saturated = true;
+  c.safety = false;
+  c.rejected_non_finite = 101;
+  c.rejected_bad_quaternion = 102;
+  c.rejected_bad_stamp = 103;
+  c.rejected_stamp_backwards = 18446744073709551615u;
+  msg::PlantStatus p;
+  p.header = {{11, 12}, ""};
+  p.commands_accepted = 201;
+  p.commands_clamped = 202;
+  p.commands_rejected_length = 203;
+  p.commands_rejected_non_finite = 204;
+  p.last_problem = "speed 1e+09 rad/s above omega_max";
+  p.watchdog_active = true;
+  p.watchdog_trips = 205;
+  p.watchdog_ticks = 206;
+  twist.publish(t);
+  clock.publish(k);
+  cs.publish(c);
+  ps.publish(p);
+  ASSERT_TRUE(b.spin_until([&] { return got == 4; }, 5'000'000'000));
+
+  EXPECT_EQ(twist_in.header.stamp.to_ns(), t.header.stamp.to_ns());
+  EXPECT_EQ(twist_in.header.frame_id, "world");
+  EXPECT_EQ(twist_in.linear.x, 1);
+  EXPECT_EQ(twist_in.linear.z, 3);
+  EXPECT_EQ(twist_in.angular.x, 4);
+  EXPECT_EQ(twist_in.angular.z, 6);
+  EXPECT_EQ(clock_in.clock.sec, 2147483647);
+  EXPECT_EQ(clock_in.clock.nanosec, 999999999u);
+  EXPECT_EQ(cs_in.header.frame_id, "base_link");
+  EXPECT_EQ(cs_in.header.stamp.to_ns(), c.header.stamp.to_ns());
+  EXPECT_EQ(cs_in.mode, "attitude");
+  EXPECT_EQ(cs_in.setpoint, c.setpoint);
+  EXPECT_EQ(cs_in.u, c.u);
+  EXPECT_EQ(cs_in.error, c.error);
+  EXPECT_EQ(cs_in.rotor_saturated, c.rotor_saturated);
+  EXPECT_TRUE(cs_in.tilt_saturated);
+  EXPECT_FALSE(cs_in.safety);
+  EXPECT_EQ(cs_in.rejected_non_finite, 101u);
+  EXPECT_EQ(cs_in.rejected_bad_quaternion, 102u);
+  EXPECT_EQ(cs_in.rejected_bad_stamp, 103u);
+  EXPECT_EQ(cs_in.rejected_stamp_backwards, 18446744073709551615u);
+  EXPECT_EQ(ps_in.header.stamp.to_ns(), p.header.stamp.to_ns());
+  EXPECT_EQ(ps_in.commands_accepted, 201u);
+  EXPECT_EQ(ps_in.commands_clamped, 202u);
+  EXPECT_EQ(ps_in.commands_rejected_length, 203u);
+  EXPECT_EQ(ps_in.commands_rejected_non_finite, 204u);
+  EXPECT_EQ(ps_in.last_problem, p.last_problem);
+  EXPECT_TRUE(ps_in.watchdog_active);
+  EXPECT_EQ(ps_in.watchdog_trips, 205u);
+  EXPECT_EQ(ps_in.watchdog_ticks, 206u);
+}
+
 // Waits (without spinning `t`) until `done()`, up to 5 s.
 template <class F>
 bool eventually(F done) {

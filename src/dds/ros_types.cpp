@@ -1,6 +1,8 @@
 #include "dds/ros_types.hpp"
 
+#include <array>
 #include <map>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -20,49 +22,61 @@ namespace {
 char* borrow(const std::string& s) { return const_cast<char*>(s.c_str()); }
 std::string own(const char* s) { return s ? std::string(s) : std::string(); }
 
-void to_c(const msg::Time& m, builtin_interfaces_msg_dds__Time_& c) {
-  c.sec = m.sec;
-  c.nanosec = m.nanosec;
-}
-void from_c(const builtin_interfaces_msg_dds__Time_& c, msg::Time& m) {
-  m.sec = c.sec;
-  m.nanosec = c.nanosec;
-}
-void to_c(const msg::Header& m, std_msgs_msg_dds__Header_& c) {
-  to_c(m.stamp, c.stamp);
-  c.frame_id = borrow(m.frame_id);
-}
-void from_c(const std_msgs_msg_dds__Header_& c, msg::Header& m) {
-  from_c(c.stamp, m.stamp);
-  m.frame_id = own(c.frame_id);
-}
-template <class C>
-void to_c3(const msg::Vector3& m, C& c) {
-  c.x = m.x;
-  c.y = m.y;
-  c.z = m.z;
-}
-template <class C>
-void from_c3(const C& c, msg::Vector3& m) {
-  m = {c.x, c.y, c.z};
-}
-void to_c(const msg::Quaternion& m, geometry_msgs_msg_dds__Quaternion_& c) {
-  c.x = m.x;
-  c.y = m.y;
-  c.z = m.z;
-  c.w = m.w;
-}
-void from_c(const geometry_msgs_msg_dds__Quaternion_& c, msg::Quaternion& m) { m = {c.x, c.y, c.z, c.w}; }
-template <std::size_t N>
-void copy(const double (&from)[N], std::array<double, N>& to) {
-  for (std::size_t i = 0; i < N; ++i) to[i] = from[i];
-}
-template <std::size_t N>
-void copy(const std::array<double, N>& from, double (&to)[N]) {
-  for (std::size_t i = 0; i < N; ++i) to[i] = from[i];
+// Each message type lists its fields once, as (C++ field, C field) pairs handed to a visitor:
+// ToC copies each pair into the C struct, FromC back into the C++ message.
+template <class M, class C, class F>
+void fields(M& m, C& c, F f) {  // builtin_interfaces/Time
+  f(m.sec, c.sec);
+  f(m.nanosec, c.nanosec);
 }
 
-// One specialisation per message type: its C type, descriptor and conversions.
+struct ToC {
+  template <class A, class B, std::enable_if_t<std::is_arithmetic_v<A>, int> = 0>
+  void operator()(const A& m, B& c) const { c = m; }
+  void operator()(const std::string& m, char*& c) const { c = borrow(m); }
+  template <class T, std::size_t N>
+  void operator()(const std::array<T, N>& m, T (&c)[N]) const {
+    for (std::size_t i = 0; i < N; ++i) c[i] = m[i];
+  }
+  void operator()(const msg::Time& m, builtin_interfaces_msg_dds__Time_& c) const { fields(m, c, *this); }
+  void operator()(const msg::Header& m, std_msgs_msg_dds__Header_& c) const {
+    (*this)(m.stamp, c.stamp);
+    (*this)(m.frame_id, c.frame_id);
+  }
+  template <class V>  // geometry_msgs Vector3 or Point
+  void operator()(const msg::Vector3& m, V& c) const {
+    c.x = m.x;
+    c.y = m.y;
+    c.z = m.z;
+  }
+  void operator()(const msg::Quaternion& m, geometry_msgs_msg_dds__Quaternion_& c) const {
+    c.x = m.x;
+    c.y = m.y;
+    c.z = m.z;
+    c.w = m.w;
+  }
+};
+
+struct FromC {
+  template <class A, class B, std::enable_if_t<std::is_arithmetic_v<A>, int> = 0>
+  void operator()(A& m, const B& c) const { m = c; }
+  void operator()(std::string& m, const char* c) const { m = own(c); }
+  template <class T, std::size_t N>
+  void operator()(std::array<T, N>& m, const T (&c)[N]) const {
+    for (std::size_t i = 0; i < N; ++i) m[i] = c[i];
+  }
+  void operator()(msg::Time& m, const builtin_interfaces_msg_dds__Time_& c) const { fields(m, c, *this); }
+  void operator()(msg::Header& m, const std_msgs_msg_dds__Header_& c) const {
+    (*this)(m.stamp, c.stamp);
+    (*this)(m.frame_id, c.frame_id);
+  }
+  template <class V>
+  void operator()(msg::Vector3& m, const V& c) const { m = {c.x, c.y, c.z}; }
+  void operator()(msg::Quaternion& m, const geometry_msgs_msg_dds__Quaternion_& c) const { m = {c.x, c.y, c.z, c.w}; }
+};
+
+// One specialisation per message type: its C type, descriptor and fields (ops_for below turns them
+// into both conversions), or for Float64MultiArray, whose sequences need storage, to and from.
 template <class T>
 struct Wire;
 
@@ -70,15 +84,11 @@ template <>
 struct Wire<msg::PoseStamped> {
   using C = geometry_msgs_msg_dds__PoseStamped_;
   static const dds_topic_descriptor_t* desc() { return &geometry_msgs_msg_dds__PoseStamped__desc; }
-  static void to(const msg::PoseStamped& m, C& c) {
-    to_c(m.header, c.header);
-    to_c3(m.position, c.pose.position);
-    to_c(m.orientation, c.pose.orientation);
-  }
-  static void from(const C& c, msg::PoseStamped& m) {
-    from_c(c.header, m.header);
-    from_c3(c.pose.position, m.position);
-    from_c(c.pose.orientation, m.orientation);
+  template <class M, class CC, class F>
+  static void fields(M& m, CC& c, F f) {
+    f(m.header, c.header);
+    f(m.position, c.pose.position);
+    f(m.orientation, c.pose.orientation);
   }
 };
 
@@ -86,15 +96,11 @@ template <>
 struct Wire<msg::TwistStamped> {
   using C = geometry_msgs_msg_dds__TwistStamped_;
   static const dds_topic_descriptor_t* desc() { return &geometry_msgs_msg_dds__TwistStamped__desc; }
-  static void to(const msg::TwistStamped& m, C& c) {
-    to_c(m.header, c.header);
-    to_c3(m.linear, c.twist.linear);
-    to_c3(m.angular, c.twist.angular);
-  }
-  static void from(const C& c, msg::TwistStamped& m) {
-    from_c(c.header, m.header);
-    from_c3(c.twist.linear, m.linear);
-    from_c3(c.twist.angular, m.angular);
+  template <class M, class CC, class F>
+  static void fields(M& m, CC& c, F f) {
+    f(m.header, c.header);
+    f(m.linear, c.twist.linear);
+    f(m.angular, c.twist.angular);
   }
 };
 
@@ -102,23 +108,15 @@ template <>
 struct Wire<msg::Imu> {
   using C = sensor_msgs_msg_dds__Imu_;
   static const dds_topic_descriptor_t* desc() { return &sensor_msgs_msg_dds__Imu__desc; }
-  static void to(const msg::Imu& m, C& c) {
-    to_c(m.header, c.header);
-    to_c(m.orientation, c.orientation);
-    copy(m.orientation_covariance, c.orientation_covariance);
-    to_c3(m.angular_velocity, c.angular_velocity);
-    copy(m.angular_velocity_covariance, c.angular_velocity_covariance);
-    to_c3(m.linear_acceleration, c.linear_acceleration);
-    copy(m.linear_acceleration_covariance, c.linear_acceleration_covariance);
-  }
-  static void from(const C& c, msg::Imu& m) {
-    from_c(c.header, m.header);
-    from_c(c.orientation, m.orientation);
-    copy(c.orientation_covariance, m.orientation_covariance);
-    from_c3(c.angular_velocity, m.angular_velocity);
-    copy(c.angular_velocity_covariance, m.angular_velocity_covariance);
-    from_c3(c.linear_acceleration, m.linear_acceleration);
-    copy(c.linear_acceleration_covariance, m.linear_acceleration_covariance);
+  template <class M, class CC, class F>
+  static void fields(M& m, CC& c, F f) {
+    f(m.header, c.header);
+    f(m.orientation, c.orientation);
+    f(m.orientation_covariance, c.orientation_covariance);
+    f(m.angular_velocity, c.angular_velocity);
+    f(m.angular_velocity_covariance, c.angular_velocity_covariance);
+    f(m.linear_acceleration, c.linear_acceleration);
+    f(m.linear_acceleration_covariance, c.linear_acceleration_covariance);
   }
 };
 
@@ -153,41 +151,30 @@ template <>
 struct Wire<msg::Clock> {
   using C = rosgraph_msgs_msg_dds__Clock_;
   static const dds_topic_descriptor_t* desc() { return &rosgraph_msgs_msg_dds__Clock__desc; }
-  static void to(const msg::Clock& m, C& c) { to_c(m.clock, c.clock); }
-  static void from(const C& c, msg::Clock& m) { from_c(c.clock, m.clock); }
+  template <class M, class CC, class F>
+  static void fields(M& m, CC& c, F f) {
+    f(m.clock, c.clock);
+  }
 };
 
 template <>
 struct Wire<msg::ControllerStatus> {
   using C = quadcosim_msgs_msg_dds__ControllerStatus_;
   static const dds_topic_descriptor_t* desc() { return &quadcosim_msgs_msg_dds__ControllerStatus__desc; }
-  static void to(const msg::ControllerStatus& m, C& c) {
-    to_c(m.header, c.header);
-    c.mode = borrow(m.mode);
-    copy(m.setpoint, c.setpoint);
-    copy(m.u, c.u);
-    copy(m.error, c.error);
-    for (int i = 0; i < 4; ++i) c.rotor_saturated[i] = m.rotor_saturated[i];
-    c.tilt_saturated = m.tilt_saturated;
-    c.safety = m.safety;
-    c.rejected_non_finite = m.rejected_non_finite;
-    c.rejected_bad_quaternion = m.rejected_bad_quaternion;
-    c.rejected_bad_stamp = m.rejected_bad_stamp;
-    c.rejected_stamp_backwards = m.rejected_stamp_backwards;
-  }
-  static void from(const C& c, msg::ControllerStatus& m) {
-    from_c(c.header, m.header);
-    m.mode = own(c.mode);
-    copy(c.setpoint, m.setpoint);
-    copy(c.u, m.u);
-    copy(c.error, m.error);
-    for (int i = 0; i < 4; ++i) m.rotor_saturated[i] = c.rotor_saturated[i];
-    m.tilt_saturated = c.tilt_saturated;
-    m.safety = c.safety;
-    m.rejected_non_finite = c.rejected_non_finite;
-    m.rejected_bad_quaternion = c.rejected_bad_quaternion;
-    m.rejected_bad_stamp = c.rejected_bad_stamp;
-    m.rejected_stamp_backwards = c.rejected_stamp_backwards;
+  template <class M, class CC, class F>
+  static void fields(M& m, CC& c, F f) {
+    f(m.header, c.header);
+    f(m.mode, c.mode);
+    f(m.setpoint, c.setpoint);
+    f(m.u, c.u);
+    f(m.error, c.error);
+    f(m.rotor_saturated, c.rotor_saturated);
+    f(m.tilt_saturated, c.tilt_saturated);
+    f(m.safety, c.safety);
+    f(m.rejected_non_finite, c.rejected_non_finite);
+    f(m.rejected_bad_quaternion, c.rejected_bad_quaternion);
+    f(m.rejected_bad_stamp, c.rejected_bad_stamp);
+    f(m.rejected_stamp_backwards, c.rejected_stamp_backwards);
   }
 };
 
@@ -195,27 +182,17 @@ template <>
 struct Wire<msg::PlantStatus> {
   using C = quadcosim_msgs_msg_dds__PlantStatus_;
   static const dds_topic_descriptor_t* desc() { return &quadcosim_msgs_msg_dds__PlantStatus__desc; }
-  static void to(const msg::PlantStatus& m, C& c) {
-    to_c(m.header, c.header);
-    c.commands_accepted = m.commands_accepted;
-    c.commands_clamped = m.commands_clamped;
-    c.commands_rejected_length = m.commands_rejected_length;
-    c.commands_rejected_non_finite = m.commands_rejected_non_finite;
-    c.last_problem = borrow(m.last_problem);
-    c.watchdog_active = m.watchdog_active;
-    c.watchdog_trips = m.watchdog_trips;
-    c.watchdog_ticks = m.watchdog_ticks;
-  }
-  static void from(const C& c, msg::PlantStatus& m) {
-    from_c(c.header, m.header);
-    m.commands_accepted = c.commands_accepted;
-    m.commands_clamped = c.commands_clamped;
-    m.commands_rejected_length = c.commands_rejected_length;
-    m.commands_rejected_non_finite = c.commands_rejected_non_finite;
-    m.last_problem = own(c.last_problem);
-    m.watchdog_active = c.watchdog_active;
-    m.watchdog_trips = c.watchdog_trips;
-    m.watchdog_ticks = c.watchdog_ticks;
+  template <class M, class CC, class F>
+  static void fields(M& m, CC& c, F f) {
+    f(m.header, c.header);
+    f(m.commands_accepted, c.commands_accepted);
+    f(m.commands_clamped, c.commands_clamped);
+    f(m.commands_rejected_length, c.commands_rejected_length);
+    f(m.commands_rejected_non_finite, c.commands_rejected_non_finite);
+    f(m.last_problem, c.last_problem);
+    f(m.watchdog_active, c.watchdog_active);
+    f(m.watchdog_trips, c.watchdog_trips);
+    f(m.watchdog_ticks, c.watchdog_ticks);
   }
 };
 
@@ -230,13 +207,18 @@ TypeOps ops_for() {
           Wire<T>::to(*static_cast<const T*>(message), c, dims);
           return dds_write(writer, &c);
         } else {
-          Wire<T>::to(*static_cast<const T*>(message), c);
+          Wire<T>::fields(*static_cast<const T*>(message), c, ToC{});
           return dds_write(writer, &c);
         }
       },
       [](const void* sample, const std::function<void(const void*)>& to) {
         T m;
-        Wire<T>::from(*static_cast<const typename Wire<T>::C*>(sample), m);
+        const auto& c = *static_cast<const typename Wire<T>::C*>(sample);
+        if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
+          Wire<T>::from(c, m);
+        } else {
+          Wire<T>::fields(m, c, FromC{});
+        }
         to(&m);
       }};
 }
