@@ -183,8 +183,8 @@ PY
   lockstep_hold)  # lockstep: the controller stops answering (SIGSTOP), the plant holds, then resumes
     "$bin" controller --scenario "$hover" > "$tmp/c.log" 2>&1 &
     ctl=$!; pids+=("$ctl")
-    # 600 s simulated: a few seconds in lockstep, and longer than the pause below unpaced.
-    "$bin" plant --scenario "$hover" --duration 600 --timeout 1 --on-timeout hold --record "$tmp/t.csv" \
+    # 1200 s simulated: several seconds in lockstep, and seconds more than the pause below unpaced.
+    "$bin" plant --scenario "$hover" --duration 1200 --timeout 1 --on-timeout hold --record "$tmp/t.csv" \
       > "$tmp/plant.log" 2>&1 &
     plant=$!; pids+=("$plant")
     wait_for 15 grep -q "lockstep mode" "$tmp/plant.log" || fail "plant did not start"
@@ -205,8 +205,8 @@ PY
 import csv, sys
 path, back, received = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 rows = list(csv.DictReader(open(path)))
-last = len(rows) - 1  # ticks 0..60000
-assert last == 60000, last
+last = len(rows) - 1  # ticks 0..120000
+assert last == 120000, last
 # After the resume every control tick is answered again: at least that many commands came in.
 after = (last - back) // 2
 print(f"resumed at tick {back}; {received} commands received, {after} control ticks after the resume")
