@@ -1,23 +1,7 @@
 #include "sim/lockstep_stepper.hpp"
 
-#include <algorithm>
-#include <stdexcept>
 
 namespace quadcosim::sim {
-
-ParameterSchedule::ParameterSchedule(std::vector<ScheduledParameter> schedule, const TickClock& clock)
-    : schedule_(std::move(schedule)), clock_(clock) {
-  std::stable_sort(schedule_.begin(), schedule_.end(), [](const auto& a, const auto& b) { return a.tick < b.tick; });
-  next_ = schedule_.begin();
-}
-
-void ParameterSchedule::apply(ControllerNode& node, std::int64_t now_ns) {
-  for (; next_ != schedule_.end() && clock_.ns(next_->tick) <= now_ns; ++next_) {
-    if (std::string err = node.set_parameter(next_->name, next_->value); !err.empty()) {
-      throw std::invalid_argument("scheduled parameter refused: " + err);
-    }
-  }
-}
 
 LockstepStepper::LockstepStepper(ControllerNode& node, std::vector<ScheduledParameter> schedule,
                                  const TickClock& clock, int controller_divider)

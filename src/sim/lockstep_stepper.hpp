@@ -10,25 +10,9 @@
 
 #include "sim/clock.hpp"
 #include "sim/controller_node.hpp"
-#include "sim/simulation.hpp"
+#include "sim/parameter_schedule.hpp"
 
 namespace quadcosim::sim {
-
-/// A controller's parameter schedule, applied in tick order as simulated time passes.
-class ParameterSchedule {
- public:
-  ParameterSchedule(std::vector<ScheduledParameter> schedule, const TickClock& clock);
-  ParameterSchedule(const ParameterSchedule&) = delete;
-  ParameterSchedule& operator=(const ParameterSchedule&) = delete;
-  /// Sets on `node` every change due by `now_ns` not set yet. Throws std::invalid_argument naming a
-  /// change the node refused.
-  void apply(ControllerNode& node, std::int64_t now_ns);
-
- private:
-  std::vector<ScheduledParameter> schedule_;  ///< by tick
-  std::vector<ScheduledParameter>::const_iterator next_;
-  TickClock clock_;
-};
 
 class LockstepStepper {
  public:

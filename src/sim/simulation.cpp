@@ -1,8 +1,5 @@
 #include "sim/simulation.hpp"
 
-#include <algorithm>
-#include <stdexcept>
-
 namespace quadcosim::sim {
 
 Simulation::Simulation(const SimulationConfig& config, const model::VehicleParams& vehicle,
@@ -11,7 +8,7 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
     : config_(config),
       plant_(transport_, Topics::for_namespace(config.ns), vehicle, config.plant, initial),
       controller_(transport_, Topics::for_namespace(config.ns), controller),
-      schedule_(std::move(schedule)) {
+      schedule_(std::move(schedule), config.plant.clock) {
   transport_.set_faults(config.faults);
   const std::string status_topic = Topics::for_namespace(config.ns).controller_status;
   if (const auto f = config.faults.topics.find(status_topic); f != config.faults.topics.end() && f->second.active()) {
@@ -23,21 +20,13 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
     // (no copy per control step).
     delivered_status_ = &controller_.status();
   }
-  std::stable_sort(schedule_.begin(), schedule_.end(),
-                   [](const auto& a, const auto& b) { return a.tick < b.tick; });
-  next_event_ = schedule_.cbegin();
   control_dt_s_ = config_.plant.clock.period_s() * config_.controller_divider;
 }
 
 void Simulation::begin_tick(Tick k) {
   const TickClock& clock = config_.plant.clock;
   transport_.advance_to(k);  // messages held back by injected delay are delivered now
-  for (; next_event_ != schedule_.cend() && next_event_->tick <= k; ++next_event_) {
-    if (std::string err = controller_.set_parameter(next_event_->name, next_event_->value); !err.empty()) {
-      throw std::invalid_argument("scheduled parameter at t=" + std::to_string(clock.seconds(k)) +
-                                  " s refused: " + err);
-    }
-  }
+  schedule_.apply(controller_, clock.ns(k));
   plant_.publish_outputs(k);
   if (k % config_.controller_divider == 0) controller_.step(clock.ns(k), control_dt_s_);
   plant_.latch_command(k);

@@ -23,15 +23,10 @@
 #include "sim/controller_node.hpp"
 #include "sim/faults.hpp"
 #include "sim/inprocess_transport.hpp"
+#include "sim/parameter_schedule.hpp"
 #include "sim/plant_node.hpp"
 
 namespace quadcosim::sim {
-
-struct ScheduledParameter {
-  Tick tick = 0;
-  std::string name;
-  control::ParameterValue value;
-};
 
 struct SimulationConfig {
   PlantOptions plant;
@@ -88,8 +83,7 @@ class Simulation {
   InProcessTransport transport_;
   PlantNode plant_;
   ControllerNode controller_;
-  std::vector<ScheduledParameter> schedule_;
-  std::vector<ScheduledParameter>::const_iterator next_event_;
+  ParameterSchedule schedule_;
   double control_dt_s_;
   msg::ControllerStatus status_;  ///< the last status delivered, when faults may lose or delay statuses
   const msg::ControllerStatus* delivered_status_ = nullptr;  ///< status_, or the controller's own
