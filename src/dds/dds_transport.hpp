@@ -61,7 +61,6 @@ class DdsTransport final : public sim::Transport {
   /// rethrown by it. Turning it off waits for a delivery in progress; do so (or let
   /// ArrivalDelivery do it) before anything a delivery uses is destroyed.
   void deliver_on_arrival(bool on);
-  bool delivers_on_arrival() const { return arrival_; }
 
   /// Runs `blocking()` on the owning thread with deliveries let through, as in spin_once's wait:
   /// for a blocking call that needs Cyclone's receive thread (e.g. waiting for a service reply on
@@ -177,7 +176,7 @@ class DdsTransport final : public sim::Transport {
 /// (waiting for a delivery in progress) in the destructor. Declare it after what the deliveries use.
 class ArrivalDelivery {
  public:
-  explicit ArrivalDelivery(DdsTransport& t, bool on = true) : t_(t) { t_.deliver_on_arrival(on); }
+  explicit ArrivalDelivery(DdsTransport& t) : t_(t) { t_.deliver_on_arrival(true); }
   ~ArrivalDelivery() { t_.deliver_on_arrival(false); }
   ArrivalDelivery(const ArrivalDelivery&) = delete;
   ArrivalDelivery& operator=(const ArrivalDelivery&) = delete;

@@ -20,7 +20,6 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
-    ++samples_received_;
     if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
@@ -28,7 +27,6 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
-    ++samples_received_;
     if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
@@ -40,7 +38,6 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
-    ++samples_received_;
     if (on_sample_) on_sample_();
   });
 }

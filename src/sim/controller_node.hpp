@@ -59,9 +59,6 @@ class ControllerNode {
   /// same stamp (a complete sample of one plant tick); -1 otherwise.
   std::int64_t synchronized_stamp_ns() const;
 
-  /// Pose, Velocity and Imu messages taken in so far (a host of many nodes sees which one got data).
-  std::uint64_t samples_received() const { return samples_received_; }
-
   /// Called after each Pose, Velocity or Imu message taken in, where the transport delivers it: a
   /// lockstep host steps from here (LockstepStepper) instead of polling after every wait.
   void on_sample(std::function<void()> f) { on_sample_ = std::move(f); }
@@ -100,7 +97,6 @@ class ControllerNode {
   std::function<std::int64_t()> receipt_clock_;
   std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
   std::int64_t last_step_ns_ = kNever;
-  std::uint64_t samples_received_ = 0;
   Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
   bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
   msg::ControllerStatus status_;
