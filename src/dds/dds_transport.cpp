@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -129,9 +128,10 @@ void DdsTransport::on_data_available(dds_entity_t, void* arg) {
 
 void DdsTransport::after_arrival() {
   bool wake = static_cast<bool>(failure_);
-  if (!wake && after_arrival_) {
+  if (!wake) {
     try {
-      wake = after_arrival_();
+      if (after_arrival_) wake = after_arrival_();  // the node's hook runs whatever until_ says
+      if (until_ && (*until_)()) wake = true;
     } catch (...) {
       failure_ = std::current_exception();
       wake = true;
@@ -251,21 +251,12 @@ void DdsTransport::remove_extra_work(int id) {
 }
 
 bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t timeout_ns) {
-  // On arrival, a delivery that makes `done` hold ends the wait (the caller's own condition is
-  // back afterwards). Under the lock: no delivery runs while this thread is out of spin_once.
-  struct WakeScope {
-    std::function<bool()>& slot;
-    std::function<bool()> saved;
-    ~WakeScope() { slot = std::move(saved); }
-  };
-  std::optional<WakeScope> wake;
-  if (arrival_) {
-    wake.emplace(WakeScope{after_arrival_, std::move(after_arrival_)});
-    after_arrival_ = [&done, &saved = wake->saved] {
-      const bool own = saved && saved();  // the caller's hook runs whatever done() says
-      return done() || own;
-    };
-  }
+  // On arrival, a delivery that makes `done` hold ends the wait (after_arrival asks it).
+  struct Until {
+    const std::function<bool()>*& slot;
+    const std::function<bool()>* saved;
+    ~Until() { slot = saved; }
+  } until{until_, std::exchange(until_, &done)};
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::nanoseconds(timeout_ns);
   while (!done()) {

@@ -166,9 +166,10 @@ class DdsTransport final : public sim::Transport {
   int delivered_on_arrival_ = 0;    ///< since the last spin_once (under mutex_)
   std::exception_ptr failure_;      ///< the first exception of a delivery on arrival (under mutex_)
   std::function<bool()> after_arrival_;  ///< on_arrival's hook (under mutex_)
+  const std::function<bool()>* until_ = nullptr;  ///< spin_until's condition while it runs (under mutex_)
   dds_entity_t wake_ = 0;            ///< guard condition on the waitset: a delivery on arrival wakes spin_once
-  /// After a delivery on arrival (under mutex_): runs after_arrival_; wakes spin_once on a failure
-  /// or when it returns true.
+  /// After a delivery on arrival (under mutex_): runs after_arrival_, then spin_until's condition;
+  /// wakes spin_once on a failure or when either holds.
   void after_arrival();
 };
 
