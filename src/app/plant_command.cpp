@@ -151,7 +151,7 @@ class PlantProcess {
   // 50 ms without progress), at the timeout, at the end, and for what needs it: a scheduled change
   // through the parameter services (a blocking request) and the hold policy's unpaced ticks (with
   // delivery by spin_once again).
-  enum class Phase { kAwaiting, kMainThread, kDone };
+  enum class Phase { kAwaiting, kMainThread, kDone, kRefused };
 
   int run_lockstep() {
     arrival_.emplace(transport_);
@@ -163,7 +163,7 @@ class PlantProcess {
     });
     for (;;) {
       phase_ = advance(false);
-      if (refused_) return kExitRefused;
+      if (phase_ == Phase::kRefused) return kExitRefused;
       if (phase_ == Phase::kDone || stop_requested()) return kExitOk;
       if (!await_progress()) return kExitNoController;
     }
@@ -171,7 +171,7 @@ class PlantProcess {
 
   /// Runs ticks from k_ on until one waits for its answer (kAwaiting) or the run ends (kDone); on
   /// the receive thread (`on_arrival`) it stops before a tick that needs the main thread
-  /// (kMainThread). A refused scheduled change ends the run with refused_ set.
+  /// (kMainThread). A refused scheduled change ends the run (kRefused).
   Phase advance(bool on_arrival) {
     advancing_ = true;
     const Phase p = advance_ticks(on_arrival);
@@ -184,10 +184,7 @@ class PlantProcess {
       if (!published_) {
         if (k > sc_.simulation.duration_ticks || stop_requested()) return Phase::kDone;
         if (on_arrival && (!waiting_ || schedule_due(k))) return Phase::kMainThread;
-        if (!apply_due_schedule(k)) {
-          refused_ = true;
-          return Phase::kDone;
-        }
+        if (!apply_due_schedule(k)) return Phase::kRefused;
         received_before_ = plant_.stats().commands_received;
         plant_.publish_outputs(k);
         asked_ns_ = last_ask_ns_ = steady_ns();
@@ -371,7 +368,6 @@ class PlantProcess {
   Phase phase_ = Phase::kAwaiting;
   sim::Tick k_ = 0;             ///< the tick in progress
   bool published_ = false;      ///< k_'s outputs are out
-  bool refused_ = false;        ///< a scheduled change was refused
   bool advancing_ = false;      ///< inside advance (on either thread)
   bool status_expected_ = false;  ///< a status writer was matched when k_ was published
   std::uint64_t received_before_ = 0;  ///< commands received before k_ was published
