@@ -5,7 +5,6 @@
 #include <iostream>
 
 #include "app/commands.hpp"
-#include "sim/lockstep_stepper.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
@@ -16,6 +15,7 @@
 #include "dds/parameter_service.hpp"
 #include "io/scenario.hpp"
 #include "sim/controller_node.hpp"
+#include "sim/lockstep_stepper.hpp"
 
 namespace quadcosim::app {
 

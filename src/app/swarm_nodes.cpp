@@ -13,7 +13,6 @@
 #include <mutex>
 #include <thread>
 
-#include "sim/lockstep_stepper.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
@@ -21,6 +20,7 @@
 #include "dds/node_announcer.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
+#include "sim/lockstep_stepper.hpp"
 #include "sim/plant_node.hpp"
 
 namespace quadcosim::app {
