@@ -12,6 +12,7 @@
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
 #include "sim/realism.hpp"
+#include "sim/steppable_plant.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 #include "sim/validation.hpp"
@@ -64,7 +65,8 @@ struct PlantStats {
   std::string last_problem;             ///< the reason given for the newest rejected/clamped command
 };
 
-class PlantNode {
+/// The native plant behind the steppable-plant seam (sim/steppable_plant.hpp).
+class PlantNode final : public SteppablePlant {
  public:
   PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
             const PlantOptions& options, const model::State& initial);
@@ -74,9 +76,9 @@ class PlantNode {
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
   /// Publishes /clock, Pose, Velocity and Imu for the state at tick k, and the plant status when due.
-  void publish_outputs(Tick k);
+  void publish_outputs(Tick k) override;
   /// Fixes the command that acts over [t_k, t_k+1): the newest one whose delay has elapsed.
-  void latch_command(Tick k);
+  void latch_command(Tick k) override;
   /// Real time: measure the watchdog on `clock` [ns] (when commands arrive) instead of in ticks, so a
   /// controller that stops is noticed whatever the plant's simulated time does.
   void use_receipt_clock(std::function<std::int64_t()> clock) { receipt_clock_ = std::move(clock); }
@@ -85,7 +87,7 @@ class PlantNode {
   /// Time [ns] without a valid command at the last latch_command (ticks * period, or receipt clock).
   std::int64_t command_age_ns() const { return command_age_ns_; }
   /// Integrates the state from t_k to t_k+1 under the latched command.
-  void integrate(Tick k);
+  void integrate(Tick k) override;
 
   const model::State& state() const { return state_; }
   const model::Quadrotor& model() const { return model_; }
@@ -96,6 +98,7 @@ class PlantNode {
   /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet). Labels are read
   /// with drop_stale_commands (lockstep) only; otherwise this stays -1.
   std::int64_t last_command_stamp_ns() const { return last_command_stamp_ns_; }
+  CommandReceipt command_receipt() const override { return {stats_.commands_received, last_command_stamp_ns_}; }
   const PlantOptions& options() const { return options_; }
   Tick current_tick() const { return current_tick_; }
 
