@@ -14,8 +14,8 @@
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_service.hpp"
 #include "io/scenario.hpp"
+#include "drivers/controller_drivers.hpp"
 #include "sim/controller_node.hpp"
-#include "sim/lockstep_stepper.hpp"
 
 namespace quadcosim::app {
 
@@ -43,7 +43,7 @@ int controller_command(const ControllerCommandOptions& o) {
     if (o.sensor_qos) use_sensor_qos(transport, topics);
     sim::ControllerNode node(transport, topics, sc.controller);
     const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
-    // The ROS 2 parameter services, answered inside transport.spin_once (both loops below).
+    // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
     dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
     if (!o.apply_schedule) sc.schedule.clear();
     dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
@@ -54,10 +54,12 @@ int controller_command(const ControllerCommandOptions& o) {
 
     if (o.lockstep) {
       // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
-      // arrival, so answering a tick wakes no other thread; spin_once serves the parameter services.
-      sim::LockstepStepper stepper(node, std::move(sc.schedule), clock, sc.simulation.controller_divider);
-      const dds::ArrivalDelivery arrival(transport);
-      while (!stop_requested()) transport.spin_once(100 * kMs);
+      // arrival, so answering a tick wakes no other thread; the host's waits serve the parameter
+      // services.
+      DdsDriverHost host(transport);
+      drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
+                                               sc.simulation.controller_divider, host);
+      driver.run();
     } else {
       // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
       node.use_receipt_clock(steady_ns);
@@ -66,35 +68,23 @@ int controller_command(const ControllerCommandOptions& o) {
       }
       const auto wall_period_ns =
           static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
-      // Until the first complete sensor sample (Pose, Velocity and Imu of one tick) arrives it
-      // commands nothing: a controller (re)started beside a flying plant must not send it the
-      // stale-data safety command before it has seen the vehicle. After that, Algorithm 1 as
-      // everywhere: stale data -> the safety command.
-      std::int64_t next = steady_ns();
       PeriodJitter jitter(wall_period_ns);
-      bool seen_vehicle = false, safety = false;
-      sim::ParameterSchedule schedule(std::move(sc.schedule), clock);
-      while (!stop_requested()) {
-        next += wall_period_ns;
-        wait_until(transport, next);
-        jitter.add(steady_ns());
-        if (!seen_vehicle) {
-          if (node.synchronized_stamp_ns() < 0) continue;
-          seen_vehicle = true;
-          std::cerr << fmt::format("controller: first complete sensor sample (t = {:g} s); controlling\n",
-                                   static_cast<double>(node.synchronized_stamp_ns()) / 1e9);
-        }
-        const std::int64_t sim_now = node.newest_stamp_ns();
-        schedule.apply(node, sim_now);
-        const std::int64_t now = steady_ns();
-        if (node.step(now, dt_s).safety != safety) {
-          safety = !safety;
-          std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
-                                   safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
-                                   node.estimate().age_s, node.config().params.stale_limit_s,
-                                   static_cast<double>(now) / 1e9);
-        }
-      }
+      drivers::RealtimeControllerHooks h;
+      h.on_wake = [&](std::int64_t now) { jitter.add(now); };
+      h.on_first_sample = [](std::size_t, std::int64_t stamp_ns) {
+        std::cerr << fmt::format("controller: first complete sensor sample (t = {:g} s); controlling\n",
+                                 static_cast<double>(stamp_ns) / 1e9);
+      };
+      h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
+        std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
+                                 safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
+                                 node.estimate().age_s, node.config().params.stale_limit_s,
+                                 static_cast<double>(now) / 1e9);
+      };
+      DdsDriverHost host(transport, /*precise_deadlines=*/true);
+      drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
+                                               sc.simulation.controller_divider, o.rate_factor, std::move(h), host);
+      driver.run();
       if (!o.stats.empty()) write_stats(o.stats, jitter.figures());
     }
     std::cerr << "controller: stopped\n";

@@ -1,5 +1,7 @@
 #include "app/node_common.hpp"
 
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
 
 #include <pthread.h>
@@ -15,6 +17,7 @@
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "app/signals.hpp"
 
 namespace quadcosim::app {
 
@@ -50,6 +53,49 @@ void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
   transport.spin_once(0);
   while (steady_ns() < deadline_ns) {
   }
+}
+
+void DdsDriverHost::wait(std::int64_t timeout_ns, const std::function<bool()>& woken) {
+  if (arrival_) {
+    if (woken) {
+      arrival_->wait_until(woken, timeout_ns);
+    } else {
+      arrival_->wait(timeout_ns);
+    }
+  } else if (woken) {
+    transport_.spin_until(woken, timeout_ns);
+  } else {
+    transport_.spin_once(timeout_ns);
+  }
+}
+
+void DdsDriverHost::wait_until(std::int64_t deadline_ns) {
+  if (precise_ && !arrival_) {
+    app::wait_until(transport_, deadline_ns);
+  } else {
+    DriverHost::wait_until(deadline_ns);
+  }
+}
+
+std::string lockstep_timeout_message(const dds::DdsTransport& transport, const sim::Topics& topics,
+                                     const sim::TickClock& clock, sim::Tick k, double timeout_s,
+                                     const std::string& policy) {
+  return fmt::format("plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
+                     "matched command writers: {}; policy: {}\n",
+                     topics.motor_commands, k, clock.seconds(k), timeout_s,
+                     transport.matched_writers(topics.motor_commands), policy);
+}
+
+bool DdsDriverHost::stop_requested() { return app::stop_requested(); }
+
+void DdsDriverHost::deliver_on_arrival(bool on) {
+  if (!on) {
+    arrival_.reset();
+    return;
+  }
+  if (arrival_) return;
+  arrival_.emplace(transport_);
+  if (on_delivery_) arrival_->after_each(on_delivery_);
 }
 
 std::string use_realtime_priority(int priority) {

@@ -4,12 +4,16 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "dds/arrival_executor.hpp"
 #include "dds/dds_transport.hpp"
+#include "drivers/driver_host.hpp"
 #include "dds/steady_clock.hpp"
 #include "io/scenario.hpp"
 #include "sim/topics.hpp"
@@ -33,6 +37,44 @@ void refuse_faults_over_dds(const io::Scenario& sc);
 /// the wake-up lands on the deadline instead of a scheduler wake-up later. The first call also asks
 /// the kernel for 1 ns timer slack (default 50 us) for the blocking part.
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
+
+/// A driver's host on a DdsTransport (drivers/driver_host.hpp): the monotonic wall clock, Ctrl-C,
+/// waits by spin_once, and, while a driver awaits answers, delivery on arrival through a
+/// dds::ArrivalExecutor (its threading rule) that runs `on_delivery` after each delivery.
+class DdsDriverHost final : public drivers::DriverHost {
+ public:
+  /// `precise_deadlines`: wait_until spins its last millisecond (app::wait_until), for the
+  /// real-time controller's timer.
+  explicit DdsDriverHost(dds::DdsTransport& transport, bool precise_deadlines = false)
+      : transport_(transport), precise_(precise_deadlines) {}
+  /// What runs after each delivery on arrival (e.g. LockstepPlantDriver::on_delivery); true wakes
+  /// the waiting thread. Set it before the driver runs.
+  void on_delivery(std::function<bool()> f) { on_delivery_ = std::move(f); }
+  std::int64_t now_ns() override { return steady_ns(); }
+  void wait(std::int64_t timeout_ns, const std::function<bool()>& woken) override;
+  void wait_until(std::int64_t deadline_ns) override;
+  bool stop_requested() override;
+  void deliver_on_arrival(bool on) override;
+  /// Runs `blocking()` with deliveries on arrival let through (a blocking service call), or just
+  /// runs it.
+  template <class F>
+  auto unlocked(F blocking) {
+    return arrival_ ? arrival_->unlocked(std::move(blocking)) : blocking();
+  }
+
+ private:
+  dds::DdsTransport& transport_;
+  bool precise_;
+  std::function<bool()> on_delivery_;
+  std::optional<dds::ArrivalExecutor> arrival_;
+};
+
+/// The lockstep plant's diagnostic when the answer to tick k did not come within timeout_s (one
+/// line, for one vehicle and a swarm's alike): the topic, the tick and its time, the matched command
+/// writers, the policy.
+std::string lockstep_timeout_message(const dds::DdsTransport& transport, const sim::Topics& topics,
+                                     const sim::TickClock& clock, sim::Tick k, double timeout_s,
+                                     const std::string& policy);
 
 /// Real time: runs the calling thread under SCHED_FIFO at `priority` (1..99) so other processes do
 /// not delay its wake-ups. Returns "" on success, else why not (e.g. no CAP_SYS_NICE): the caller

@@ -18,6 +18,8 @@
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_client.hpp"
+#include "drivers/lockstep_plant_driver.hpp"
+#include "drivers/realtime_plant_driver.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
@@ -69,8 +71,6 @@ class PlantProcess {
   int run() {
     if ((o_.lockstep || o_.wait_for_controller) && !wait_for_controller()) return kExitNoController;
     loop_start_ns_ = steady_ns();
-    next_wall_ns_ = loop_start_ns_;
-    round_trip_ns_.reserve(static_cast<std::size_t>(sc_.simulation.duration_ticks / divider_ + 1));
     const int rc = o_.lockstep ? run_lockstep() : run_realtime();
     finish(rc);
     if (rc != kExitOk) return rc;
@@ -112,7 +112,7 @@ class PlantProcess {
   bool apply_due_schedule(sim::Tick k) {
     for (; scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k; ++next_event_) {
       // The reply comes through Cyclone's receive thread: let deliveries on arrival through meanwhile.
-      const auto r = transport_.with_deliveries(
+      const auto r = host_.unlocked(
           [&] { return scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns()); });
       if (r.size() != 1 || !r[0].successful) {
         std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event_->name,
@@ -123,153 +123,63 @@ class PlantProcess {
     return true;
   }
 
-  /// Real time: each tick published, paced by the wall clock, then completed.
+  /// Real time: each tick published, paced by the wall clock, then completed
+  /// (drivers::RealtimePlantDriver).
   int run_realtime() {
-    for (sim::Tick k = 0; k <= sc_.simulation.duration_ticks && !stop_requested(); ++k) {
-      if (!apply_due_schedule(k)) return kExitRefused;
-      plant_.publish_outputs(k);
-      pace_to_wall_clock();
-      end_tick(k);
-    }
+    drivers::RealtimeOptions ro;
+    ro.clock = clock_;
+    ro.duration_ticks = sc_.simulation.duration_ticks;
+    ro.rate_factor = o_.rate_factor;
+    drivers::RealtimeHooks h;
+    h.before_outputs = [this](sim::Tick k) { return apply_due_schedule(k); };
+    h.after_latch = [this](std::size_t, sim::Tick k) { after_latch(k); };
+    realtime_.emplace(std::vector<sim::SteppablePlant*>{&plant_}, ro, std::move(h), host_);
+    return realtime_->run() == drivers::RealtimeResult::kRefused ? kExitRefused : kExitOk;
+  }
+
+  /// Lockstep (drivers::LockstepPlantDriver): commands and statuses are delivered on arrival (on
+  /// Cyclone's receive thread), and the delivery that completes the awaited tick's answer runs the
+  /// ticks that follow right there, up to the next control tick's publication: a control period
+  /// wakes no thread of this process but the receive thread. The main thread is woken for what
+  /// needs it: a scheduled change through the parameter services (a blocking request), a timeout,
+  /// the hold policy's unpaced ticks, the end.
+  int run_lockstep() {
+    drivers::LockstepOptions lo;
+    lo.clock = clock_;
+    lo.duration_ticks = sc_.simulation.duration_ticks;
+    lo.controller_divider = divider_;
+    lo.timeout_ns = timeout_ns();
+    lo.on_timeout = o_.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
+    drivers::DrivenPlant p{&plant_, [this] { return transport_.matched_writers(topics_.controller_status) > 0; },
+                           [this] { return status_.header.stamp.to_ns(); }};
+    drivers::LockstepHooks h;
+    h.main_thread_due = [this](sim::Tick k) { return schedule_due(k); };
+    h.before_outputs = [this](sim::Tick k) { return apply_due_schedule(k); };
+    h.after_latch = [this](std::size_t, sim::Tick k) { after_latch(k); };
+    h.on_timeout = [this](std::size_t, sim::Tick k) {
+      std::cerr << lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s, o_.on_timeout);
+    };
+    h.on_resume = [](sim::Tick k) {
+      std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
+    };
+    lockstep_.emplace(std::vector<drivers::DrivenPlant>{std::move(p)}, lo, std::move(h), host_);
+    host_.on_delivery([this] { return lockstep_->on_delivery(); });
+    const drivers::LockstepResult r = lockstep_->run();
+    host_.on_delivery(nullptr);
+    if (r == drivers::LockstepResult::kRefused) return kExitRefused;
+    if (r == drivers::LockstepResult::kTimedOut) return kExitNoController;
     return kExitOk;
   }
 
-  /// What follows tick k's wait: latch the command, log, record, integrate to t_k+1.
-  void end_tick(sim::Tick k) {
-    plant_.latch_command(k);
+  /// What follows tick k's latch, before the plant integrates: log, record.
+  void after_latch(sim::Tick k) {
     log_watchdog(k);
     record(k);
     if (mcap_) mcap_->flush_settled(clock_.ns(k));
-    if (k < sc_.simulation.duration_ticks) plant_.integrate(k);
-    ++ticks_run_;
-  }
-
-  // Lockstep. Commands and statuses are delivered on arrival (on Cyclone's receive thread), and
-  // the delivery that completes the awaited tick's answer runs the ticks that follow right there,
-  // up to the next control tick's publication: a control period wakes no thread of this process
-  // but the receive thread. The main thread sleeps meanwhile; it is woken to ask again (every
-  // 50 ms without progress), at the timeout, at the end, and for what needs it: a scheduled change
-  // through the parameter services (a blocking request) and the hold policy's unpaced ticks (with
-  // delivery by spin_once again).
-  enum class Phase { kAwaiting, kMainThread, kDone, kRefused };
-
-  int run_lockstep() {
-    arrival_.emplace(transport_);
-    transport_.on_arrival([this] {
-      // Not inside advance: our own publications reach our own readers (the recorder's) at once.
-      if (advancing_ || phase_ != Phase::kAwaiting || !answered(k_)) return false;
-      phase_ = advance(true);
-      return phase_ != Phase::kAwaiting;  // wake the main thread only when it has work
-    });
-    for (;;) {
-      phase_ = advance(false);
-      if (phase_ == Phase::kRefused) return kExitRefused;
-      if (phase_ == Phase::kDone || stop_requested()) return kExitOk;
-      if (!await_progress()) return kExitNoController;
-    }
-  }
-
-  /// Runs ticks from k_ on until one waits for its answer (kAwaiting) or the run ends (kDone); on
-  /// the receive thread (`on_arrival`) it stops before a tick that needs the main thread
-  /// (kMainThread). A refused scheduled change ends the run (kRefused).
-  Phase advance(bool on_arrival) {
-    advancing_ = true;
-    const Phase p = advance_ticks(on_arrival);
-    advancing_ = false;
-    return p;
-  }
-  Phase advance_ticks(bool on_arrival) {
-    for (;;) {
-      const sim::Tick k = k_;
-      if (!published_) {
-        if (k > sc_.simulation.duration_ticks || stop_requested()) return Phase::kDone;
-        if (on_arrival && (!waiting_ || schedule_due(k))) return Phase::kMainThread;
-        if (!apply_due_schedule(k)) return Phase::kRefused;
-        received_before_ = plant_.stats().commands_received;
-        plant_.publish_outputs(k);
-        asked_ns_ = last_ask_ns_ = steady_ns();
-        published_ = true;
-        if (!waiting_) collect_while_holding(k);
-        if (waiting_ && k % divider_ == 0) {
-          status_expected_ = transport_.matched_writers(topics_.controller_status) > 0;
-        }
-      }
-      if (waiting_ && k % divider_ == 0) {
-        if (!answered(k)) return Phase::kAwaiting;
-        round_trip_ns_.push_back(steady_ns() - asked_ns_);
-      }
-      end_tick(k);
-      ++k_;
-      published_ = false;
-    }
-  }
-
-  /// The command (and status, when a status writer is matched) answering control tick k is in.
-  bool answered(sim::Tick k) const {
-    const std::int64_t t_ns = clock_.ns(k);
-    const bool command = plant_.last_command_stamp_ns() == t_ns ||
-                         (plant_.last_command_stamp_ns() < 0 && plant_.stats().commands_received > received_before_);
-    return command && (!status_expected_ || status_.header.stamp.to_ns() == t_ns);
   }
 
   bool schedule_due(sim::Tick k) const {
     return scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k;
-  }
-
-  /// Under hold, after a timeout: takes in what has arrived; when commands are back, lockstep
-  /// (and delivery on arrival) resumes.
-  void collect_while_holding(sim::Tick k) {
-    transport_.spin_once(0);
-    if (plant_.stats().commands_received > received_before_) {
-      std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
-      waiting_ = true;
-      arrival_.emplace(transport_);
-    }
-  }
-
-  /// Main thread, while tick k_ waits for its answer (the receive thread runs the ticks whose
-  /// answers arrive): publishes the awaited tick again after 50 ms without progress (a sample sent
-  /// while discovery was settling may not arrive). At --timeout, false under the abort policy;
-  /// under hold, waiting switches off until commands arrive again, so a vanished controller costs
-  /// one timeout, not one per tick.
-  bool await_progress() {
-    while (phase_ == Phase::kAwaiting && !stop_requested() && !answered(k_)) {
-      const std::int64_t now = steady_ns();
-      if (now - asked_ns_ >= timeout_ns()) {
-        std::cerr << fmt::format(
-            "plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
-            "matched command writers: {}; policy: {}\n",
-            topics_.motor_commands, k_, clock_.seconds(k_), o_.timeout_s,
-            transport_.matched_writers(topics_.motor_commands), o_.on_timeout);
-        if (o_.on_timeout == "abort") return false;
-        waiting_ = false;  // hold the last command and go on, taking in commands by spin_once
-        arrival_.reset();
-        return true;
-      }
-      if (now - last_ask_ns_ >= 50 * kMs) {
-        plant_.publish_outputs(k_);
-        last_ask_ns_ = now;
-      }
-      // Not woken per tick the receive thread runs: this thread looks again at the latest k_.
-      transport_.spin_until([&] { return phase_ != Phase::kAwaiting || stop_requested(); },
-                            last_ask_ns_ + 50 * kMs - now);
-    }
-    return true;
-  }
-
-  /// Real time: takes in messages until the wall clock reaches the next tick. Notes how late the
-  /// loop got there (a stalled loop, e.g. under a flood of messages, shows as lateness).
-  void pace_to_wall_clock() {
-    const auto period = static_cast<std::int64_t>(static_cast<double>(clock_.period_ns) / o_.rate_factor);
-    next_wall_ns_ += period;
-    std::int64_t now = steady_ns();
-    while (!stop_requested() && now < next_wall_ns_) {
-      transport_.spin_once(next_wall_ns_ - now);
-      now = steady_ns();
-    }
-    const std::int64_t late = now - next_wall_ns_;
-    max_late_ns_ = std::max(max_late_ns_, late);
-    if (late > period) ++late_ticks_;
   }
 
   /// The watchdog's changes as events on stderr (simulated time, and the monotonic wall clock).
@@ -298,8 +208,7 @@ class PlantProcess {
 
   /// Completes the recordings (also on the error paths, so what was recorded is readable).
   int finish(int code) {
-    arrival_.reset();  // what is still in the readers is taken by spin_once below
-    transport_.on_arrival(nullptr);
+    // Delivery on arrival ended with the driver's run: what is still in the readers is taken below.
     if (csv_) csv_->close();
     if (mcap_ && code == kExitOk) {
       while (transport_.spin_once(0) > 0) {  // what is still in the readers
@@ -313,14 +222,16 @@ class PlantProcess {
 
   void report() {
     nlohmann::json stats;
-    if (!round_trip_ns_.empty()) {
-      std::sort(round_trip_ns_.begin(), round_trip_ns_.end());
+    std::vector<std::int64_t> round_trip_ns;  // lockstep: sensor publication -> command back
+    if (lockstep_) round_trip_ns = lockstep_->round_trips_ns();
+    if (!round_trip_ns.empty()) {
+      std::sort(round_trip_ns.begin(), round_trip_ns.end());
       auto pct = [&](double q) {
-        return static_cast<double>(round_trip_ns_[static_cast<std::size_t>(q * (round_trip_ns_.size() - 1))]) / 1e3;
+        return static_cast<double>(round_trip_ns[static_cast<std::size_t>(q * (round_trip_ns.size() - 1))]) / 1e3;
       };
       std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
                                "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
-                               round_trip_ns_.size(), pct(0.5), pct(0.99), pct(1.0));
+                               round_trip_ns.size(), pct(0.5), pct(0.99), pct(1.0));
       stats["roundtrip_us_p50"] = pct(0.5);
       stats["roundtrip_us_p99"] = pct(0.99);
       stats["roundtrip_us_max"] = pct(1.0);
@@ -335,11 +246,11 @@ class PlantProcess {
     std::cerr << fmt::format("plant: watchdog ({:g} s, policy {}) took over {} times for {} ticks\n",
                              clock_.seconds(plant_.options().watchdog_ticks),
                              sim::to_string(plant_.options().watchdog_policy), st.watchdog_trips, st.watchdog_ticks);
-    if (!o_.lockstep) {
+    if (realtime_) {
       std::cerr << fmt::format("plant: real-time pacing: {} ticks in {:.3f} s wall ({:.1f} ticks/s), max lateness "
                                "{:.1f} ms, {} ticks more than one period late\n",
-                               ticks_run_, wall_s, static_cast<double>(ticks_run_) / wall_s,
-                               static_cast<double>(max_late_ns_) / 1e6, late_ticks_);
+                               realtime_->ticks_run(), wall_s, static_cast<double>(realtime_->ticks_run()) / wall_s,
+                               static_cast<double>(realtime_->max_late_ns()) / 1e6, realtime_->late_ticks());
     }
     stats["simulated_s"] = sim_s;
     stats["wall_s"] = wall_s;
@@ -363,22 +274,12 @@ class PlantProcess {
   std::unique_ptr<io::McapRecorder> mcap_;
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
-  bool waiting_ = true;  ///< lockstep: wait for each command (off after a timeout under hold)
-  // Lockstep state, shared by the main thread and the receive thread (under the deliveries' lock).
-  Phase phase_ = Phase::kAwaiting;
-  sim::Tick k_ = 0;             ///< the tick in progress
-  bool published_ = false;      ///< k_'s outputs are out
-  bool advancing_ = false;      ///< inside advance (on either thread)
-  bool status_expected_ = false;  ///< a status writer was matched when k_ was published
-  std::uint64_t received_before_ = 0;  ///< commands received before k_ was published
-  std::int64_t asked_ns_ = 0, last_ask_ns_ = 0;  ///< k_ first published / last published [steady ns]
-  std::int64_t loop_start_ns_ = 0, next_wall_ns_ = 0;
-  std::vector<std::int64_t> round_trip_ns_;  ///< lockstep: sensor publication -> command back
   bool watchdog_logged_ = false;
-  std::int64_t ticks_run_ = 0;
-  std::int64_t max_late_ns_ = 0;  ///< real time: worst arrival of the loop after a tick's wall time
-  std::int64_t late_ticks_ = 0;   ///< real time: ticks reached more than one period late
-  std::optional<dds::ArrivalDelivery> arrival_;  ///< lockstep: delivery on arrival (last: off first)
+  std::int64_t loop_start_ns_ = 0;
+  // Last: the drivers and their host (with delivery on arrival) go first.
+  DdsDriverHost host_{transport_};
+  std::optional<drivers::LockstepPlantDriver> lockstep_;
+  std::optional<drivers::RealtimePlantDriver> realtime_;
 };
 
 }  // namespace

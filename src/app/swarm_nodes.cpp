@@ -19,8 +19,9 @@
 #include "control/care.hpp"
 #include "dds/node_announcer.hpp"
 #include "io/trajectory_csv.hpp"
+#include "drivers/controller_drivers.hpp"
+#include "drivers/lockstep_plant_driver.hpp"
 #include "sim/controller_node.hpp"
-#include "sim/lockstep_stepper.hpp"
 #include "sim/plant_node.hpp"
 
 namespace quadcosim::app {
@@ -65,7 +66,7 @@ int run_threads(int threads, F body) {
   return worst.load();
 }
 
-// One thread's share of the plants: its participant, its vehicles, the lockstep loop.
+// One thread's share of the plants: its participant, its vehicles, their lockstep driver.
 class PlantShard {
  public:
   PlantShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, const std::vector<bool>& recorded,
@@ -99,8 +100,9 @@ class PlantShard {
     announcer_->announce();
   }
 
-  /// Waits for every vehicle's controller, then runs all ticks. Returns an exit code.
-  int run(double timeout_s, int divider, sim::Tick duration_ticks) {
+  /// Waits for every vehicle's controller, then runs all ticks (drivers::LockstepPlantDriver over
+  /// this thread's vehicles). Returns an exit code.
+  int run(double timeout_s, const std::string& on_timeout, int divider, sim::Tick duration_ticks) {
     const auto timeout_ns = static_cast<std::int64_t>(timeout_s * 1e9);
     std::size_t ready = 0;
     const bool found = transport_.spin_until(
@@ -123,28 +125,51 @@ class PlantShard {
                                vehicles_[ready]->topics.motor_commands, timeout_s, ready, vehicles_.size());
       return kExitNoPeer;
     }
-    // Commands and statuses are taken in on Cyclone's receive thread as they arrive; this thread
-    // wakes once every vehicle's answer is in (spin_until's condition), not once per batch.
-    const dds::ArrivalDelivery arrival(transport_);
-    start_ns_ = steady_ns();
-    for (sim::Tick k = 0; k <= duration_ticks && !stop_requested(); ++k) {
-      for (auto& v : vehicles_) v->plant->publish_outputs(k);
-      if (k % divider == 0 && !await_commands(k, timeout_ns)) return kExitNoPeer;
-      for (auto& v : vehicles_) {
-        v->plant->latch_command(k);
-        if (v->csv) {
-          v->csv->write(clock_.seconds(k), v->plant->state(), v->plant->applied_command(),
-                        v->status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v->status)
-                                                             : io::ControlColumns::none());
-        }
-        if (k < duration_ticks) v->plant->integrate(k);
+    drivers::LockstepOptions lo;
+    lo.clock = clock_;
+    lo.duration_ticks = duration_ticks;
+    lo.controller_divider = divider;
+    lo.timeout_ns = timeout_ns;
+    lo.on_timeout = on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
+    // Commands and statuses are taken in on Cyclone's receive thread as they arrive, and this thread
+    // runs the ticks, woken once every vehicle's answer is in: the shards' participants share one
+    // receive thread, which must not run every shard's ticks.
+    lo.ticks_on_delivery = false;
+    std::vector<drivers::DrivenPlant> plants;
+    for (auto& v : vehicles_) {
+      drivers::DrivenPlant p{v->plant.get(), {}, {}};
+      if (v->csv) {  // a recorded vehicle's status is awaited, as the single-vehicle plant's
+        Vehicle* raw = v.get();
+        p.status_awaited = [this, raw] { return transport_.matched_writers(raw->topics.controller_status) > 0; };
+        p.status_stamp_ns = [raw] { return raw->status.header.stamp.to_ns(); };
       }
+      plants.push_back(std::move(p));
     }
+    drivers::LockstepHooks h;
+    h.after_latch = [this](std::size_t i, sim::Tick k) {
+      Vehicle& v = *vehicles_[i];
+      if (!v.csv) return;
+      v.csv->write(clock_.seconds(k), v.plant->state(), v.plant->applied_command(),
+                   v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status)
+                                                      : io::ControlColumns::none());
+    };
+    h.on_timeout = [&](std::size_t i, sim::Tick k) {
+      std::cerr << lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
+    };
+    h.on_resume = [](sim::Tick k) {
+      std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
+    };
+    drivers::LockstepPlantDriver driver(std::move(plants), lo, std::move(h), host_);
+    host_.on_delivery([&driver] { return driver.on_delivery(); });
+    start_ns_ = steady_ns();
+    const drivers::LockstepResult r = driver.run();
     end_ns_ = steady_ns();
+    host_.on_delivery(nullptr);
     for (auto& v : vehicles_) {
       if (v->csv) v->csv->close();
     }
-    return stop_requested() ? kExitInterrupted : kExitOk;
+    if (r == drivers::LockstepResult::kTimedOut) return kExitNoPeer;
+    return r == drivers::LockstepResult::kStopped ? kExitInterrupted : kExitOk;
   }
 
   SwarmFinal final_of(int i) const {
@@ -164,37 +189,6 @@ class PlantShard {
     msg::ControllerStatus status;
   };
 
-  bool answered(const Vehicle& v, std::int64_t t_ns) const {
-    return v.plant->last_command_stamp_ns() == t_ns && (!v.csv || v.status.header.stamp.to_ns() == t_ns);
-  }
-
-  // Waits for every vehicle's command for tick k; asks again (publishes the outputs again) every
-  // 50 ms for the vehicles still missing.
-  bool await_commands(sim::Tick k, std::int64_t timeout_ns) {
-    const std::int64_t t_ns = clock_.ns(k);
-    std::size_t done = 0;
-    auto all = [&] {
-      // Vehicles answer in any order: skip the answered prefix, then check the rest once.
-      while (done < vehicles_.size() && answered(*vehicles_[done], t_ns)) ++done;
-      for (std::size_t i = done; i < vehicles_.size(); ++i) {
-        if (!answered(*vehicles_[i], t_ns)) return stop_requested();
-      }
-      return true;
-    };
-    const std::int64_t deadline = steady_ns() + timeout_ns;
-    while (!transport_.spin_until(all, 50 * kMs)) {
-      if (steady_ns() >= deadline) {
-        std::cerr << fmt::format("plant: lockstep timeout: no motor command on {} for tick {} after {} s\n",
-                                 vehicles_[done]->topics.motor_commands, k, static_cast<double>(timeout_ns) / 1e9);
-        return false;
-      }
-      for (std::size_t i = done; i < vehicles_.size(); ++i) {
-        if (!answered(*vehicles_[i], t_ns)) vehicles_[i]->plant->publish_outputs(k);
-      }
-    }
-    return true;
-  }
-
   const io::Scenario& sc_;
   sim::TickClock clock_;
   dds::DdsTransport transport_;
@@ -202,26 +196,30 @@ class PlantShard {
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
   std::int64_t start_ns_ = 0, end_ns_ = 0;
+  DdsDriverHost host_{transport_};
 };
 
-// One thread's share of the controllers: each steps where its samples are delivered (on
-// Cyclone's receive thread, delivery on arrival), the thread serves only discovery meanwhile.
+// One thread's share of the controllers (drivers::LockstepControllerDriver): each steps where its
+// samples are delivered (on Cyclone's receive thread, delivery on arrival), the thread serves only
+// discovery meanwhile.
 class ControllerShard {
  public:
   ControllerShard(const io::Scenario& sc, const io::SwarmSpec& spec, int first, int last, bool sensor_qos,
                   const std::string& enclave)
       : transport_(dds::read_ros_environment(enclave)) {
     const model::State initial = io::initial_state(sc);
+    std::vector<drivers::DrivenController> driven;
     for (int i = first; i < last; ++i) {
       sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto c = std::make_unique<Vehicle>();
       const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
       if (sensor_qos) use_sensor_qos(transport_, topics);
       c->node = std::make_unique<sim::ControllerNode>(transport_, topics, v.controller);
-      c->stepper = std::make_unique<sim::LockstepStepper>(*c->node, std::move(v.schedule), sc.simulation.plant.clock,
-                                                     sc.simulation.controller_divider);
+      driven.push_back({c->node.get(), std::move(v.schedule)});
       vehicles_.push_back(std::move(c));
     }
+    driver_ = std::make_unique<drivers::LockstepControllerDriver>(std::move(driven), sc.simulation.plant.clock,
+                                                                  sc.simulation.controller_divider, host_);
     announcer_ = std::make_unique<dds::NodeAnnouncer>(transport_.participant().handle(),
                                                       fmt::format("attitude_controllers_{}", first));
     announcer_->announce();
@@ -230,8 +228,7 @@ class ControllerShard {
   /// Steps each vehicle once per complete sample of a control tick, as `controller` does.
   int run() {
     try {
-      const dds::ArrivalDelivery arrival(transport_);
-      while (!stop_requested()) transport_.spin_once(100 * kMs);
+      driver_->run();
     } catch (const std::invalid_argument& e) {
       std::cerr << "controller: " << e.what() << '\n';
       return kExitRefused;
@@ -242,10 +239,11 @@ class ControllerShard {
  private:
   struct Vehicle {
     std::unique_ptr<sim::ControllerNode> node;
-    std::unique_ptr<sim::LockstepStepper> stepper;
   };
   dds::DdsTransport transport_;
+  DdsDriverHost host_{transport_};
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
+  std::unique_ptr<drivers::LockstepControllerDriver> driver_;  ///< after the nodes: unhooks first
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
 };
 
@@ -270,7 +268,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads, sc.simulation.duration_ticks,
                            sc.simulation.plant.clock.period_s());
   const int rc = run_threads(threads, [&](int t) {
-    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, sc.simulation.controller_divider,
+    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, o.on_timeout, sc.simulation.controller_divider,
                                                     sc.simulation.duration_ticks);
   });
   if (rc != kExitOk) return rc;

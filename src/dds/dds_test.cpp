@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "dds/arrival_executor.hpp"
 #include "dds/dds_transport.hpp"
 #include "sim/messages.hpp"
 
@@ -211,20 +212,22 @@ struct ArrivalRig {
   }
 };
 
-TEST(DdsTransportTest, OnArrivalOnlyTheOwningThreadMaySpin) {
+TEST(DdsTransportTest, OnArrivalOnlyTheOwningThreadMayWaitAndTheTransportItselfNotSpin) {
   ArrivalRig rig;
-  const ArrivalDelivery arrival(rig.b);
+  ArrivalExecutor arrival(rig.b);
   std::string error;
   std::thread other([&] {
     try {
-      rig.b.spin_once(0);
+      arrival.wait(0);
     } catch (const std::logic_error& e) {
       error = e.what();
     }
   });
   other.join();
-  EXPECT_NE(error.find("spin_once"), std::string::npos) << error;
-  EXPECT_EQ(rig.b.spin_once(0), 0);  // the owner may
+  EXPECT_NE(error.find("ArrivalExecutor::wait"), std::string::npos) << error;
+  EXPECT_EQ(arrival.wait(0), 0);  // the owner may
+  EXPECT_THROW(rig.b.spin_once(0), std::logic_error);  // not past the executor
+  EXPECT_THROW(ArrivalExecutor second(rig.b), std::logic_error);
 }
 
 // In one process Cyclone delivers to a local reader on the publishing thread, so a publisher on a
@@ -232,28 +235,28 @@ TEST(DdsTransportTest, OnArrivalOnlyTheOwningThreadMaySpin) {
 TEST(DdsTransportTest, OnArrivalDeliversInOrderOnlyWhileTheOwnerWaits) {
   ArrivalRig rig;
   ASSERT_TRUE(rig.matched());
-  rig.b.deliver_on_arrival(true);
+  auto arrival = std::make_unique<ArrivalExecutor>(rig.b);
   std::thread first([&] {
     for (int i = 1; i <= 50; ++i) rig.in.publish(clock_at(i));
   });
-  int counted = 0;  // what spin_once reports as delivered since its last call
+  int counted = 0;  // what wait reports as delivered since its last call
   const auto t0 = std::chrono::steady_clock::now();
   while (rig.count < 50 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
-    counted += rig.b.spin_once(10'000'000);
+    counted += arrival->wait(10'000'000);
   }
   first.join();
-  counted += rig.b.spin_once(0);
+  counted += arrival->wait(0);
   EXPECT_EQ(counted, 50);
   for (int i = 0; i < 50; ++i) EXPECT_EQ(rig.got[static_cast<std::size_t>(i)], i + 1);
   for (const auto& id : rig.threads) EXPECT_NE(id, std::this_thread::get_id());
-  // Between spin_once calls the owner holds the deliveries: the other thread's sample waits.
+  // Between waits the owner holds the deliveries: the other thread's sample waits.
   std::thread second([&] { rig.in.publish(clock_at(51)); });
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(rig.count, 50);
-  ASSERT_TRUE(rig.b.spin_until([&] { return rig.count == 51; }, 5'000'000'000));
+  ASSERT_TRUE(arrival->wait_until([&] { return rig.count == 51; }, 5'000'000'000));
   second.join();
 
-  rig.b.deliver_on_arrival(false);  // back to delivery by spin_once, on the caller's thread
+  arrival.reset();  // back to delivery by spin_once, on the caller's thread
   std::thread third([&] { rig.in.publish(clock_at(52)); });
   third.join();
   EXPECT_EQ(rig.count, 51);
@@ -271,24 +274,24 @@ TEST(DdsTransportTest, OnArrivalADeliveryMayPublishToItsOwnTransport) {
   rig.b.subscribe<msg::Clock>("/t/echo", [&](const msg::Clock&) { ++echoes; });
   ASSERT_TRUE(rig.matched());
   ASSERT_TRUE(rig.b.spin_until([&] { return rig.b.matched_readers("/t/echo") >= 1; }, 5'000'000'000));
-  const ArrivalDelivery arrival(rig.b);
+  ArrivalExecutor arrival(rig.b);
   std::thread publisher([&] {
     for (int i = 1; i <= 20; ++i) rig.in.publish(clock_at(i));
   });
-  EXPECT_TRUE(rig.b.spin_until([&] { return echoes == 20; }, 5'000'000'000)) << echoes << " echoes";
+  EXPECT_TRUE(arrival.wait_until([&] { return echoes == 20; }, 5'000'000'000)) << echoes << " echoes";
   publisher.join();
 }
 
-TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesSpinOnceAndIsRethrown) {
+TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesTheWaitAndIsRethrown) {
   ArrivalRig rig([](const msg::Clock& m) {
     if (m.clock.to_ns() == 3) throw std::invalid_argument("sample 3 refused");
   });
   ASSERT_TRUE(rig.matched());
-  const ArrivalDelivery arrival(rig.b);
+  ArrivalExecutor arrival(rig.b);
   for (int i = 1; i <= 5; ++i) rig.in.publish(clock_at(i));
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    for (int i = 0; i < 100; ++i) rig.b.spin_once(10'000'000'000);
+    for (int i = 0; i < 100; ++i) arrival.wait(10'000'000'000);
     FAIL() << "not rethrown";
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "sample 3 refused");
@@ -300,9 +303,9 @@ TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesSpinOnceAndIsRethrown) {
 TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) {
   ArrivalRig rig;
   ASSERT_TRUE(rig.matched());
-  const ArrivalDelivery arrival(rig.b);
+  ArrivalExecutor arrival(rig.b);
   int runs = 0;
-  rig.b.on_arrival([&] {
+  arrival.after_each([&] {
     ++runs;
     return !rig.got.empty() && rig.got.back() == 7;
   });
@@ -312,15 +315,15 @@ TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) 
   const auto t0 = std::chrono::steady_clock::now();
   // Long waits return once sample 7 is in (every earlier one delivered before it).
   while (rig.count < 7 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
-    rig.b.spin_once(30'000'000'000);
+    arrival.wait(30'000'000'000);
   }
   publisher.join();
   EXPECT_EQ(rig.count, 7);
   EXPECT_EQ(runs, 7);
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
-  // spin_until runs the hook too, beside its own condition.
+  // wait_until runs the hook too, beside its own condition.
   std::thread more([&] { rig.in.publish(clock_at(8)); });
-  EXPECT_TRUE(rig.b.spin_until([&] { return rig.count == 8; }, 5'000'000'000));
+  EXPECT_TRUE(arrival.wait_until([&] { return rig.count == 8; }, 5'000'000'000));
   more.join();
   EXPECT_EQ(runs, 8);
 }

@@ -12,17 +12,10 @@ std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_top
 
 DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
   waitset_ = check(dds_create_waitset(participant_.handle()), "dds_create_waitset");
-  wake_ = check(dds_create_guardcondition(participant_.handle()), "dds_create_guardcondition");
-  attach(wake_, kExtra);
 }
 
 DdsTransport::~DdsTransport() {
-  try {
-    deliver_on_arrival(false);  // no delivery runs past this point; the lock is released
-  } catch (const std::exception&) {  // DdsError, or logic_error from another thread
-    // The participant's deletion below detaches the listeners all the same.
-  }
-  // Entities go with the participant (Participant's destructor).
+  // Entities go with the participant (Participant's destructor), listeners with their readers.
 }
 
 QosProfile DdsTransport::qos_for(const std::string& ros_topic) const {
@@ -89,16 +82,16 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
   r->condition = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
   r->ops = ops;
   r->deliver = std::move(deliver);
-  if (arrival_) {
-    // Delivered by the listener from the start (none on the waitset); what came before the
-    // listener was set is taken now.
-    listen(*r, true);
-    const std::lock_guard<std::recursive_mutex> g(mutex_);
-    delivered_on_arrival_ += drain(*r);
-  } else {
-    attach(r->condition, static_cast<dds_attach_t>(r->index));
-  }
+  Reader& added = *r;
   readers_.push_back(std::move(r));
+  if (arrival_sink_) {
+    // Announced by the listener from the start (none on the waitset); what came before the
+    // listener was set is announced now.
+    listen(added, true);
+    arrival_sink_(added.index);
+  } else {
+    attach(added.condition, static_cast<dds_attach_t>(added.index));
+  }
 }
 
 void DdsTransport::listen(Reader& r, bool on) {
@@ -114,58 +107,25 @@ void DdsTransport::listen(Reader& r, bool on) {
 }
 
 void DdsTransport::on_data_available(dds_entity_t, void* arg) {
-  Reader& r = *static_cast<Reader*>(arg);
-  DdsTransport& t = *r.owner;
-  const std::lock_guard<std::recursive_mutex> g(t.mutex_);
-  if (t.failure_) return;  // delivery stopped; spin_once rethrows
-  try {
-    t.delivered_on_arrival_ += t.drain(r);
-  } catch (...) {
-    t.failure_ = std::current_exception();
-  }
-  t.after_arrival();
+  const Reader& r = *static_cast<const Reader*>(arg);
+  r.owner->arrival_sink_(r.index);
 }
 
-void DdsTransport::after_arrival() {
-  bool wake = static_cast<bool>(failure_);
-  if (!wake) {
-    try {
-      if (after_arrival_) wake = after_arrival_();  // the node's hook runs whatever until_ says
-      if (until_ && (*until_)()) wake = true;
-    } catch (...) {
-      failure_ = std::current_exception();
-      wake = true;
-    }
-  }
-  if (wake) dds_set_guardcondition(wake_, true);
-}
-
-void DdsTransport::check_owner(const char* what) const {
-  if (arrival_ && std::this_thread::get_id() != owner_) {
-    throw std::logic_error(std::string("DdsTransport::") + what +
-                           " called from a thread other than the one that turned delivery on arrival on");
-  }
-}
-
-void DdsTransport::deliver_on_arrival(bool on) {
-  if (on == arrival_) return;
-  check_owner("deliver_on_arrival");
-  if (on) owner_ = std::this_thread::get_id();
-  if (!on) mutex_.unlock();  // first: removing a listener waits for its delivery, which needs the lock
+void DdsTransport::set_arrival_sink(std::function<void(std::size_t)> sink) {
+  if (!sink && !arrival_sink_) return;
+  if (sink && arrival_sink_) throw std::logic_error("DdsTransport: a second ArrivalExecutor on one transport");
+  const bool on = static_cast<bool>(sink);
+  if (on) arrival_sink_ = std::move(sink);  // before the first listener can call it
   for (auto& r : readers_) {
     if (on) {
       if (dds_waitset_detach(waitset_, r->condition) == DDS_RETCODE_OK) triggered_.pop_back();
       listen(*r, true);
     } else {
-      listen(*r, false);
+      listen(*r, false);  // waits for a listener call in progress
       attach(r->condition, static_cast<dds_attach_t>(r->index));
     }
   }
-  arrival_ = on;
-  if (on) {
-    mutex_.lock();  // held by this thread but in spin_once's wait
-    for (auto& r : readers_) delivered_on_arrival_ += drain(*r);  // what came before the listeners
-  }
+  if (!on) arrival_sink_ = nullptr;
 }
 
 int DdsTransport::drain(Reader& r) {
@@ -194,17 +154,19 @@ int DdsTransport::drain(Reader& r) {
 }
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
-  if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
-  // On arrival, deliveries run while this thread waits, and only then.
-  check_owner("spin_once");
-  if (arrival_) mutex_.unlock();
-  const dds_return_t rc =
-      dds_waitset_wait(waitset_, triggered_.data(), triggered_.size(), timeout_ns);
-  if (arrival_) {
-    mutex_.lock();
-    dds_set_guardcondition(wake_, false);
-    if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
+  if (arrival_sink_) {
+    throw std::logic_error("DdsTransport::spin_once called while an ArrivalExecutor delivers on arrival "
+                           "(wait through the executor)");
   }
+  if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
+  return serve_wait(wait_waitset(timeout_ns));
+}
+
+dds_return_t DdsTransport::wait_waitset(std::int64_t timeout_ns) {
+  return dds_waitset_wait(waitset_, triggered_.data(), triggered_.size(), timeout_ns);
+}
+
+int DdsTransport::serve_wait(dds_return_t rc) {
   check(rc, "dds_waitset_wait");
   ready_.clear();
   std::uint32_t status = 0;
@@ -221,9 +183,11 @@ int DdsTransport::spin_once(std::int64_t timeout_ns) {
     std::sort(ready_.begin(), ready_.end());
   } else {  // more triggered than attached (cannot happen: one slot per attachment); look at all
     for (const Matched& m : matched_) dds_take_status(m.entity, &status, m.status);
-    for (std::size_t i = 0; i < readers_.size(); ++i) ready_.push_back(i);
+    if (!arrival_sink_) {
+      for (std::size_t i = 0; i < readers_.size(); ++i) ready_.push_back(i);
+    }
   }
-  int delivered = std::exchange(delivered_on_arrival_, 0);
+  int delivered = 0;
   for (std::size_t i : ready_) delivered += drain(*readers_[i]);
   if (!extra_.empty()) {
     // Copied first (into a kept vector): a callback may add or remove extra work.
@@ -251,12 +215,6 @@ void DdsTransport::remove_extra_work(int id) {
 }
 
 bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t timeout_ns) {
-  // On arrival, a delivery that makes `done` hold ends the wait (after_arrival asks it).
-  struct Until {
-    const std::function<bool()>*& slot;
-    const std::function<bool()>* saved;
-    ~Until() { slot = saved; }
-  } until{until_, std::exchange(until_, &done)};
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::nanoseconds(timeout_ns);
   while (!done()) {

@@ -1,19 +1,16 @@
 // Transport over Cyclone DDS speaking the ROS 2 wire format: topic "/drone/Pose" travels as DDS
 // topic "rt/drone/Pose" with type "geometry_msgs::msg::dds_::PoseStamped_", XCDR1, and the ROS QoS
-// set explicitly. Subscriptions are delivered by spin_once() on the caller's thread, or on arrival on
-// Cyclone's receive thread while the caller waits in spin_once; either way a node never sees a
-// callback while it is in the middle of a step.
+// set explicitly. A plain waitset transport: subscriptions are delivered by spin_once() on the
+// caller's thread. Delivery on arrival, on Cyclone's receive thread, is dds::ArrivalExecutor's
+// (dds/arrival_executor.hpp), which states its threading rule.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <exception>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "dds/participant.hpp"
@@ -42,53 +39,12 @@ class DdsTransport final : public sim::Transport {
 
   /// Waits up to timeout_ns for data on any subscription, then delivers the samples of every
   /// subscription the wait found with data, reader by reader in subscription order (the waitset
-  /// names them, so a wake costs what arrived, not the number of subscriptions). Returns how many
-  /// messages were delivered. With delivery on arrival (below), waits for matching changes, extra
-  /// work or the wake condition only, serves the extra work, and returns the messages delivered on
-  /// arrival since the last call; it rethrows what a delivery on arrival threw.
+  /// names them, so a wake costs what arrived, not the number of subscriptions), on the caller's
+  /// thread, then serves the extra work. Returns how many messages were delivered. While an
+  /// ArrivalExecutor delivers this transport's samples, use its wait() instead (std::logic_error).
   int spin_once(std::int64_t timeout_ns);
 
-  /// Delivery on arrival (on) or by spin_once (off, the default). On arrival, each subscription's
-  /// samples are taken and delivered on the Cyclone thread that received them (a DATA_AVAILABLE
-  /// listener), so a node that reacts to data where it is delivered (a lockstep controller stepping
-  /// on a complete sample) answers without waking another thread. A node still never sees a
-  /// callback while its own thread is busy with it: the thread that turns delivery on arrival on
-  /// holds the deliveries' (recursive) lock from then on, except while spin_once waits, so a
-  /// delivery runs only while that thread waits in spin_once, and never beside another delivery.
-  /// Call it, spin_once and the switch off from that one thread (another gets std::logic_error),
-  /// never from inside a delivery. A delivery may publish (also to this transport's own readers).
-  /// An exception a delivery throws is kept (later deliveries are dropped), wakes spin_once and is
-  /// rethrown by it. Turning it off waits for a delivery in progress; do so (or let
-  /// ArrivalDelivery do it) before anything a delivery uses is destroyed.
-  void deliver_on_arrival(bool on);
-
-  /// Runs `blocking()` on the owning thread with deliveries let through, as in spin_once's wait:
-  /// for a blocking call that needs Cyclone's receive thread (e.g. waiting for a service reply on
-  /// another reader), which a delivery waiting for the lock would otherwise hold up. `blocking`
-  /// must not touch what deliveries touch. Without delivery on arrival it just runs `blocking`.
-  template <class F>
-  auto with_deliveries(F blocking) {
-    if (!arrival_) return blocking();
-    check_owner("with_deliveries");
-    struct Relock {
-      std::recursive_mutex& m;
-      ~Relock() { m.lock(); }
-    };
-    mutex_.unlock();
-    const Relock relock{mutex_};
-    return blocking();
-  }
-
-  /// With delivery on arrival: `after()` runs after each delivery, on the delivering thread under
-  /// the deliveries' lock, and spin_once is woken when it returns true. A node may react there (a
-  /// lockstep plant runs its next ticks once the command it waits for is in) and wake its own
-  /// thread only when that thread has work. Without one, deliveries on arrival do not wake
-  /// spin_once. Empty to clear.
-  void on_arrival(std::function<bool()> after) { after_arrival_ = std::move(after); }
-
-  /// Spins until `done()` holds or timeout_ns passes; returns done(). `done` runs on the caller's
-  /// thread between waits; with delivery on arrival also after each delivery (under the
-  /// deliveries' lock), so a delivery that makes it hold ends the wait.
+  /// Spins until `done()` holds or timeout_ns passes; returns done(). `done` runs between waits.
   bool spin_until(const std::function<bool()>& done, std::int64_t timeout_ns);
 
   /// Writers matched by our readers of `ros_topic` / readers matched by our writers of it.
@@ -113,6 +69,20 @@ class DdsTransport final : public sim::Transport {
                         std::function<void(const void*)> deliver) override;
 
  private:
+  friend class ArrivalExecutor;  // delivery on arrival (dds/arrival_executor.hpp): the calls below
+  /// With `sink`, every subscription's samples (also of later subscriptions) are announced to
+  /// sink(subscription index) on the Cyclone thread that received them (a DATA_AVAILABLE listener)
+  /// and no longer delivered by spin_once; empty: back to spin_once (waits for a listener call in
+  /// progress). A later subscription's sink is called at once for what came before its listener.
+  void set_arrival_sink(std::function<void(std::size_t)> sink);
+  /// Delivers what subscription `index` holds on the calling thread; returns how many.
+  int take(std::size_t index) { return drain(*readers_[index]); }
+  std::size_t subscription_count() const { return readers_.size(); }
+  /// spin_once in two halves: the wait (its result kept for serve_wait), then the deliveries and
+  /// the extra work.
+  dds_return_t wait_waitset(std::int64_t timeout_ns);
+  int serve_wait(dds_return_t rc);
+
   struct Reader {
     DdsTransport* owner;
     std::size_t index;  ///< in readers_ (its waitset attachment argument)
@@ -157,33 +127,7 @@ class DdsTransport final : public sim::Transport {
   std::map<int, ExtraWork> extra_;
   std::vector<std::function<void()>> serving_;  ///< spin_once's copy of the extra work's callbacks
   int next_extra_id_ = 1;
-  bool arrival_ = false;
-  std::thread::id owner_;  ///< the thread that turned delivery on arrival on
-  /// Throws std::logic_error naming `what` when delivery is on arrival and this is not owner_'s thread.
-  void check_owner(const char* what) const;
-  /// Deliveries on arrival take it; the thread that switched arrival on holds it but in spin_once's wait.
-  std::recursive_mutex mutex_;
-  int delivered_on_arrival_ = 0;    ///< since the last spin_once (under mutex_)
-  std::exception_ptr failure_;      ///< the first exception of a delivery on arrival (under mutex_)
-  std::function<bool()> after_arrival_;  ///< on_arrival's hook (under mutex_)
-  const std::function<bool()>* until_ = nullptr;  ///< spin_until's condition while it runs (under mutex_)
-  dds_entity_t wake_ = 0;            ///< guard condition on the waitset: a delivery on arrival wakes spin_once
-  /// After a delivery on arrival (under mutex_): runs after_arrival_, then spin_until's condition;
-  /// wakes spin_once on a failure or when either holds.
-  void after_arrival();
-};
-
-/// Delivery on arrival for a scope, on the thread that creates it: on in the constructor, off
-/// (waiting for a delivery in progress) in the destructor. Declare it after what the deliveries use.
-class ArrivalDelivery {
- public:
-  explicit ArrivalDelivery(DdsTransport& t) : t_(t) { t_.deliver_on_arrival(true); }
-  ~ArrivalDelivery() { t_.deliver_on_arrival(false); }
-  ArrivalDelivery(const ArrivalDelivery&) = delete;
-  ArrivalDelivery& operator=(const ArrivalDelivery&) = delete;
-
- private:
-  DdsTransport& t_;
+  std::function<void(std::size_t)> arrival_sink_;  ///< set_arrival_sink's (empty: delivery by spin_once)
 };
 
 }  // namespace quadcosim::dds

@@ -17,7 +17,38 @@ identical() {  # in-process and DDS lockstep give the same bytes
   [ "$(wc -l < "$tmp/dds/trajectory.csv")" -gt 500 ] || fail "trajectory too short"
 }
 
+# Every scenario in scenarios/, in-process and over DDS lockstep: the same bytes (single vehicles:
+# trajectory, metrics, MCAP; swarms: every recorded vehicle's trajectory and metrics and the final
+# states). With QUADCOSIM_REFERENCE_DIR set (REF/<scenario name>/ from an earlier build's
+# `run --no-plots`), the in-process outputs are compared with it too: before/after a change.
+identical_all() {
+  local files=("trajectory.csv" "metrics.json" "run.mcap" "vehicles.csv") n=0
+  for s in "$src"/scenarios/*/*.yaml; do
+    local name; name="$(basename "$s" .yaml)"
+    s="${s#"$src/"}"  # run from the source folder: metrics.json names the scenario as given
+    cd "$src"
+    "$bin" run "$s" --out "$tmp/in/$name" --no-plots > "$tmp/in_$name.log" 2>&1 || fail "$name: in-process run failed"
+    "$bin" run "$s" --out "$tmp/dds/$name" --no-plots --transport dds > "$tmp/dds_$name.log" 2>&1 \
+      || fail "$name: DDS run failed"
+    local compared=0
+    while IFS= read -r f; do
+      local rel="${f#"$tmp/in/$name/"}"
+      case " ${files[*]} " in *" $(basename "$rel") "*) ;; *) continue ;; esac
+      cmp "$f" "$tmp/dds/$name/$rel" || fail "$name: $rel differs over DDS"
+      if [ -n "${QUADCOSIM_REFERENCE_DIR:-}" ]; then
+        cmp "$f" "$QUADCOSIM_REFERENCE_DIR/$name/$rel" || fail "$name: $rel differs from the reference"
+      fi
+      compared=$((compared + 1))
+    done < <(find "$tmp/in/$name" -type f | sort)
+    [ "$compared" -ge 2 ] || fail "$name: only $compared files compared"
+    n=$((n + 1))
+  done
+  [ "$n" -ge 9 ] || fail "only $n scenarios found"
+  echo "$n scenarios identical in-process and over DDS${QUADCOSIM_REFERENCE_DIR:+ and to the reference}"
+}
+
 case "$case_name" in
+  identical_all_scenarios) identical_all ;;
   identical_altitude) identical altitude_step ;;
   identical_roll) identical roll_step ;;
   identical_pitch) identical pitch_step ;;
