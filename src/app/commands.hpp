@@ -182,6 +182,19 @@ struct SweepOptions {
 CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
 int sweep_command(const SweepOptions& options);
 
+/// `quadcosim margins [SCENARIO]` (margins_command.cpp, docs/margins.md): gain, phase and delay margins
+/// of each loop about hover. Exit 0 when every loop is stable closed-loop, 1 when one is not (its
+/// margins are undefined), 2 on bad input (file, flag, a vehicle that cannot hover, an LQR design
+/// that fails), 3 when an output cannot be written.
+struct MarginsOptions {
+  std::string scenario;  ///< "" for the defaults
+  std::string out_dir;   ///< "" for stdout only
+  bool json = false;     ///< print JSON instead of the table
+  bool plots = true;     ///< with out_dir: Bode and Nyquist PNGs (tools/plot_margins.py)
+};
+CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& options);
+int margins_command(const MarginsOptions& options);
+
 /// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
 /// override); returns false (after printing why) when it fails.
 bool run_tool(const std::string& script, const std::vector<std::string>& args);

@@ -179,6 +179,8 @@ int main(int argc, char** argv) {
   auto* sec_cmd = add_security_subcommand(app, sec);
   SweepOptions sweep;
   auto* sweep_cmd = add_sweep_subcommand(app, sweep);
+  MarginsOptions margins;
+  auto* margins_cmd = add_margins_subcommand(app, margins);
 
   BenchOptions bench;
   bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
@@ -212,6 +214,7 @@ int main(int argc, char** argv) {
   if (*bench_cmd) return bench_command(bench);
   if (*sec_cmd) return security_command(sec);
   if (*sweep_cmd) return sweep_command(sweep);
+  if (*margins_cmd) return margins_command(margins);
   if (*rec_cmd) return record_command(rec);
   if (*plot_cmd) return plot_command(plot_dir);
   if (*cmp_cmd) return compare_command(cmp_a, cmp_b, cmp_out);
