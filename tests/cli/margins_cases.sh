@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# `quadcosim margins`, one case per CTest test.
+#   usage: margins_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE
+set -euo pipefail
+QC=$1
+SRC=$2
+CASE=$3
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+fail() { echo "FAIL [$CASE]: $*" >&2; exit 1; }
+PY=${QUADCOSIM_PYTHON:-/usr/bin/python3}
+P="$SRC/scenarios/paper"
+
+# A copy of the paper's roll scenario with one `simulation:` key set: with_simulation NAME KEY VALUE
+# writes $TMP/NAME.yaml.
+with_simulation() {
+  "$PY" - "$P/roll_step.yaml" "$TMP/$1.yaml" "$2" "$3" <<'PYEOF'
+import re, sys
+text = open(sys.argv[1]).read()
+key, value = sys.argv[3], sys.argv[4]
+text, n = re.subn(rf"^  {key}: .*$", f"  {key}: {value}", text, flags=re.M)
+if n == 0:
+    text = text.replace("simulation:\n", f"simulation:\n  {key}: {value}\n", 1)
+open(sys.argv[2], "w").write(text)
+PYEOF
+}
+
+case "$CASE" in
+  paper_closed_form)  # the paper's loops against the ZOH transfer functions of the gains `lqr` prints
+    "$QC" lqr > "$TMP/lqr.txt"
+    for s in altitude_step roll_step; do
+      "$QC" margins "$P/$s.yaml" --json > "$TMP/$s.json" || fail "margins $s exited $?"
+    done
+    cmp -s "$TMP/altitude_step.json" "$TMP/roll_step.json" && fail "the JSON does not name its scenario"
+    "$QC" margins "$P/roll_step.yaml" > "$TMP/table.txt"
+    for loop in roll pitch yaw altitude; do grep -q "^$loop " "$TMP/table.txt" || fail "no $loop row"; done
+    grep -qi nan "$TMP/table.txt" && fail "NaN in the table"
+    "$PY" - "$TMP/lqr.txt" "$TMP/roll_step.json" <<'PYEOF' || fail "margins differ from the closed form"
+import cmath, json, math, re, sys
+lqr = open(sys.argv[1]).read()
+doc = json.load(open(sys.argv[2]))
+T = doc["controller_period_s"]
+assert T == 0.02, T
+# The gains are read as `lqr` prints them (6 significant digits): hence the tolerances below.
+# x/u = T^2 (z + 1) / (2 J (z - 1)^2) and v/u = T / (J (z - 1)) for 1/(J s^2) under a ZOH; the
+# controller feeds back k1 x + k2 v on the measured angle (height) and rate (speed).
+plants = {}
+for name, inertia, k1, k2 in re.findall(r"(\w+) axis \(I = ([\d.e-]+) kg m\^2\).*?k1 = ([\d.e-]+), k2 = ([\d.e-]+)", lqr, re.S):
+    plants[name] = (float(inertia), float(k1), float(k2))
+plants["altitude"] = (1.96, 4.0, 2.7)  # m, K_p,z, K_d,z (docs/controller.md defaults)
+def L(w, J, k1, k2):
+    z = cmath.exp(1j * w * T)
+    return k1 * T * T * (z + 1) / (2 * J * (z - 1) ** 2) + k2 * T / (J * (z - 1))
+for loop in doc["loops"]:
+    J, k1, k2 = plants[loop["name"]]
+    lo, hi = 1e-3, math.pi / T
+    for _ in range(200):  # |L| falls monotonically here: bisect |L| = 1
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if abs(L(mid, J, k1, k2)) > 1 else (lo, mid)
+    wgc = lo
+    pm = math.degrees(cmath.phase(L(wgc, J, k1, k2))) + 180.0
+    gm_db = -20 * math.log10(abs(L(math.pi / T, J, k1, k2)))  # phase -180 at Nyquist
+    got = loop["phase_margin"]
+    assert abs(got["frequency_rad_s"] - wgc) < 2e-5 * wgc, (loop["name"], got, wgc)
+    assert abs(got["deg"] - pm) < 2e-3, (loop["name"], got, pm)
+    assert abs(loop["gain_margin"]["db"] - gm_db) < 1e-3, (loop["name"], loop["gain_margin"], gm_db)
+    assert abs(loop["delay_margin"]["s"] - math.radians(pm) / wgc) < 2e-5 * loop["delay_margin"]["s"], loop["name"]
+    assert loop["gain_reduction_margin"]["status"] == "infinite"
+    print(f"{loop['name']}: PM {pm:.3f} deg at {wgc:.4f} rad/s, GM {gm_db:.3f} dB: as the closed form")
+PYEOF
+    ;;
+
+  delay_and_rate)  # one sample of command delay costs w_gc T of phase; a slower controller loses phase
+    "$QC" margins "$P/roll_step.yaml" --json > "$TMP/base.json"
+    with_simulation delay command_delay_ticks 2
+    "$QC" margins "$TMP/delay.yaml" --json > "$TMP/delay.json"
+    with_simulation slow controller_rate_hz 25
+    "$QC" margins "$TMP/slow.yaml" --json > "$TMP/slow.json"
+    "$PY" - "$TMP/base.json" "$TMP/delay.json" "$TMP/slow.json" <<'PYEOF' || fail "margins did not move as expected"
+import json, math, sys
+base, delay, slow = (json.load(open(p)) for p in sys.argv[1:4])
+assert delay["command_delay_ticks"] == 2 and slow["controller_period_s"] == 0.04
+for b, d, s in zip(base["loops"], delay["loops"], slow["loops"]):
+    w = b["phase_margin"]["frequency_rad_s"]
+    assert abs(d["phase_margin"]["frequency_rad_s"] - w) < 1e-6 * w, b["name"]
+    drop = b["phase_margin"]["deg"] - d["phase_margin"]["deg"]
+    assert abs(drop - math.degrees(w * 0.02)) < 1e-5, (b["name"], drop, math.degrees(w * 0.02))
+    assert abs(b["delay_margin"]["s"] - d["delay_margin"]["s"] - 0.02) < 1e-8, b["name"]
+    assert s["phase_margin"]["deg"] < b["phase_margin"]["deg"], b["name"]
+    assert s["gain_margin"]["db"] < b["gain_margin"]["db"], b["name"]
+    print(f"{b['name']}: PM {b['phase_margin']['deg']:.2f} -> {d['phase_margin']['deg']:.2f} deg with one "
+          f"sample of delay, {s['phase_margin']['deg']:.2f} deg at 25 Hz")
+PYEOF
+    ;;
+
+  out_and_plots)  # --out writes the JSON, the table, the response and a Bode and Nyquist PNG per loop
+    "$QC" margins "$SRC/scenarios/examples/position_step.yaml" --out "$TMP/m" > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "exit $?"; }
+    for loop in roll pitch yaw altitude position_x position_y; do
+      for kind in bode nyquist; do
+        [ -s "$TMP/m/${kind}_$loop.png" ] || fail "no ${kind}_$loop.png"
+      done
+      grep -q "^$loop," "$TMP/m/frequency_response.csv" || fail "no response rows for $loop"
+    done
+    "$PY" -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['mode']=='position' and len(d['loops'])==6" "$TMP/m/margins.json" \
+      || fail "margins.json lacks the position loops"
+    cmp <(sed -n '1,20p' "$TMP/m/margins.txt") <(sed -n '1,20p' "$TMP/log" | grep -v '\.png$') || fail "margins.txt is not the table printed"
+    "$QC" margins --out "$TMP/np" --no-plots > /dev/null || fail "--no-plots failed"
+    ls "$TMP/np"/*.png > /dev/null 2>&1 && fail "--no-plots wrote PNGs"
+    [ -s "$TMP/np/margins.json" ] || fail "no margins.json with --no-plots"
+    ;;
+
+  unstable)  # a loop the delay destabilises: exit 1, margins stated undefined, no NaN anywhere
+    with_simulation late command_delay_ticks 40
+    set +e
+    "$QC" margins "$TMP/late.yaml" > "$TMP/table.txt" 2>&1; rc=$?
+    "$QC" margins "$TMP/late.yaml" --json > "$TMP/late.json" 2>/dev/null
+    set -e
+    [ "$rc" = 1 ] || { cat "$TMP/table.txt"; fail "exit $rc, expected 1"; }
+    grep -q "^roll .*undefined.*UNSTABLE" "$TMP/table.txt" || { cat "$TMP/table.txt"; fail "roll not reported unstable"; }
+    grep -qi nan "$TMP/table.txt" "$TMP/late.json" && fail "NaN printed"
+    "$PY" - "$TMP/late.json" <<'PYEOF' || fail "JSON does not state the undefined margins"
+import json, sys
+d = json.load(open(sys.argv[1]))
+roll = d["loops"][0]
+assert roll["closed_loop_stable"] is False
+for k in ("gain_margin", "phase_margin", "delay_margin"):
+    assert roll[k]["status"] == "undefined" and roll[k][{"gain_margin": "db", "phase_margin": "deg", "delay_margin": "s"}[k]] is None, k
+PYEOF
+    ;;
+
+  bad_input)  # a vehicle that cannot hover, a bad file, a flag without its partner: exit 2, named
+    sed 's/^simulation:/vehicle:\n  motor: {omega_max_rad_s: 4000}\nsimulation:/' "$P/roll_step.yaml" > "$TMP/weak.yaml"
+    set +e
+    "$QC" margins "$TMP/weak.yaml" > "$TMP/out" 2> "$TMP/err"; rc=$?
+    set -e
+    [ "$rc" = 2 ] || { cat "$TMP/out" "$TMP/err"; fail "weak motors: exit $rc, expected 2"; }
+    grep -q "cannot hover" "$TMP/err" && grep -q "omega_max" "$TMP/err" || { cat "$TMP/err"; fail "message does not say why"; }
+    printf 'name: [\n' > "$TMP/broken.yaml"
+    set +e
+    "$QC" margins "$TMP/broken.yaml" > /dev/null 2> "$TMP/err2"; rc=$?
+    "$QC" margins --no-plots > /dev/null 2> "$TMP/err3"; rc3=$?
+    "$QC" margins "$TMP/missing.yaml" > /dev/null 2>&1; rc4=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q "broken.yaml" "$TMP/err2" || fail "broken YAML: exit $rc: $(cat "$TMP/err2")"
+    [ "$rc3" = 2 ] && grep -q -- "--no-plots needs --out" "$TMP/err3" || fail "--no-plots alone: exit $rc3"
+    [ "$rc4" = 2 ] || fail "missing file: exit $rc4"
+    ;;
+
+  *) fail "unknown case" ;;
+esac
+echo "ok [$CASE]"
