@@ -32,8 +32,8 @@ namespace {
 /// Exit codes of `plant` (docs/cosimulation.md).
 constexpr int kExitOk = 0, kExitRefused = 2, kExitNoController = 4, kExitInterrupted = 130;
 
-/// One plant process: the node on its DDS transport, what it records, and the per-tick steps of
-/// the two loop kinds. Construction does all the setup; run() drives the ticks.
+/// One plant process: the node on its DDS transport, what it records, and the driver that advances
+/// it (lockstep or real time). Construction does all the setup; run() runs the driver.
 class PlantProcess {
  public:
   PlantProcess(const PlantCommandOptions& o, io::Scenario sc)
