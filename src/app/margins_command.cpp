@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -135,6 +136,36 @@ analysis::Margin gain_db(analysis::Margin m) {
   return m;
 }
 
+// The files `margins --out` writes: margins.json, margins.txt, frequency_response.csv and a Bode and
+// a Nyquist plot per loop.
+bool is_margins_output(const std::string& name) {
+  if (name == "margins.json" || name == "margins.txt" || name == "frequency_response.csv") return true;
+  for (const char* loop : {"roll", "pitch", "yaw", "altitude", "position_x", "position_y"}) {
+    if (name == fmt::format("bode_{}.png", loop) || name == fmt::format("nyquist_{}.png", loop)) return true;
+  }
+  return false;
+}
+
+// An output folder holds nothing but a previous analysis's files, which are removed so that none
+// of them outlives this one (a position-mode run's position plots, say). "" or why not.
+std::string prepare_out_dir(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return {};
+  if (!fs::is_directory(dir, ec)) return dir.string() + " exists and is not a directory";
+  std::vector<fs::path> ours;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!is_margins_output(name))
+      return dir.string() + " holds files `margins` does not write (" + name +
+             "); give an empty folder or one a previous `margins --out` wrote";
+    ours.push_back(e.path());
+  }
+  if (ec) return "cannot read " + dir.string() + ": " + ec.message();
+  for (const fs::path& p : ours) fs::remove(p, ec);
+  return {};
+}
+
 bool write_file(const std::filesystem::path& p, const std::string& text) {
   std::ofstream f(p);
   f << text;
@@ -163,6 +194,12 @@ int margins_command(const MarginsOptions& o) {
   if (!o.plots && o.out_dir.empty()) {
     std::cerr << "error: --no-plots needs --out (plots are only written into an output directory)\n";
     return 2;
+  }
+  if (!o.out_dir.empty()) {
+    if (std::string why = prepare_out_dir(o.out_dir); !why.empty()) {
+      std::cerr << "error: --out: " << why << '\n';
+      return 2;
+    }
   }
   Setup s;
   std::vector<analysis::HoverLoop> loops;
