@@ -283,6 +283,54 @@ TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {
   EXPECT_EQ(sc.controller.params.vehicle.mass_kg, 2.5);
 }
 
+// Every key of the vehicle parameter table, at its place in the file, reaches its member.
+TEST(ScenarioTest, VehicleFileReadsEveryKey) {
+  TempDir dir;
+  const model::VehicleParams v = load_vehicle(dir.write("all.yaml", R"(mass_kg: 1.5
+gravity_m_s2: 3.7
+Ixx_kg_m2: 0.011
+Iyy_kg_m2: 0.012
+Izz_kg_m2: 0.021
+arm_length_m: 0.25
+kt_N_per_rad2_s2: 3.0e-7
+km_Nm_per_rad2_s2: 2.0e-9
+layout: x
+spin: [-1, 1, -1, 1]
+gyroscopic: simplified
+motor:
+  model: first_order
+  tau_up_s: 0.015
+  tau_down_s: 0.025
+  omega_min_rad_s: 100
+  omega_max_rad_s: 9000
+aero:
+  linear_drag_N_s_m: [0.1, 0.2, 0.3]
+  quadratic_drag_N_s2_m2: [0.01, 0.02, 0.03]
+  rotor_drag_N_s_m_per_rad_s: 1.0e-5
+  ground_effect_rotor_radius_m: 0.12
+)"));
+  EXPECT_EQ(v.mass_kg, 1.5);
+  EXPECT_EQ(v.gravity_m_s2, 3.7);
+  EXPECT_EQ(v.Ixx_kg_m2, 0.011);
+  EXPECT_EQ(v.Iyy_kg_m2, 0.012);
+  EXPECT_EQ(v.Izz_kg_m2, 0.021);
+  EXPECT_EQ(v.arm_length_m, 0.25);
+  EXPECT_EQ(v.kt_N_per_rad2_s2, 3.0e-7);
+  EXPECT_EQ(v.km_Nm_per_rad2_s2, 2.0e-9);
+  EXPECT_EQ(v.layout, model::RotorLayout::kX);
+  EXPECT_EQ(v.spin, (std::array<int, 4>{-1, 1, -1, 1}));
+  EXPECT_EQ(v.gyroscopic, model::GyroscopicModel::kSimplified);
+  EXPECT_EQ(v.motor.model, model::MotorModel::kFirstOrder);
+  EXPECT_EQ(v.motor.tau_up_s, 0.015);
+  EXPECT_EQ(v.motor.tau_down_s, 0.025);
+  EXPECT_EQ(v.motor.omega_min_rad_s, 100.0);
+  EXPECT_EQ(v.motor.omega_max_rad_s, 9000.0);
+  EXPECT_EQ(v.aero.linear_drag_N_s_m, Eigen::Vector3d(0.1, 0.2, 0.3));
+  EXPECT_EQ(v.aero.quadratic_drag_N_s2_m2, Eigen::Vector3d(0.01, 0.02, 0.03));
+  EXPECT_EQ(v.aero.rotor_drag_N_s_m_per_rad_s, 1.0e-5);
+  EXPECT_EQ(v.aero.ground_effect_rotor_radius_m, 0.12);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Malformed scenarios: each error names the file, the key path and the bad value.
 
@@ -359,6 +407,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadScenario{"spin_not_unit", "vehicle:\n  spin: [1, -1, 2, -1]\n", {"vehicle.spin: ", "2"}},
         BadScenario{"spin_unbalanced", "vehicle:\n  spin: [1, 1, 1, -1]\n",
                     {"vehicle.spin: ", "[1, 1, 1, -1]"}},
+        BadScenario{"gravity_zero", "vehicle: {gravity_m_s2: 0}\n",
+                    {"vehicle.gravity_m_s2: ", "got '0'", "(0, 1000]"}},
+        BadScenario{"mass_below_range", "vehicle: {mass_kg: 1e-9}\n", {"vehicle.mass_kg: ", "[1e-06, 1e+12]"}},
+        BadScenario{"drag_entry_negative", "vehicle:\n  aero: {linear_drag_N_s_m: [0, -0.5, 0]}\n",
+                    {"vehicle.aero.linear_drag_N_s_m: ", "-0.5", "[0, 1e+06]"}},
+        BadScenario{"omega_min_above_max", "vehicle:\n  motor: {omega_min_rad_s: 500, omega_max_rad_s: 400}\n",
+                    {"vehicle.motor.omega_min_rad_s: ", "below motor.omega_max_rad_s", "500"}},
+        BadScenario{"unknown_aero_key", "vehicle:\n  aero: {sideways_drag: 1}\n",
+                    {"vehicle.aero.sideways_drag: unknown key"}},
         BadScenario{"spin_too_short", "vehicle:\n  spin: [1, -1]\n", {"vehicle.spin: ", "a list", "4"}},
         BadScenario{"initial_below_ground", "initial: {position_m: [0, 0, -1]}\n",
                     {"initial.position_m: ", "z must be >= 0"}},

@@ -43,14 +43,6 @@ sim::SensorTiming read_timing(YamlSection& s, const sim::SimulationConfig& cfg) 
 
 }  // namespace
 
-void read_aero(YamlSection& s, model::AeroParams& a) {
-  a.linear_drag_N_s_m = vec3(s, "linear_drag_N_s_m", a.linear_drag_N_s_m, 0.0, kBig);
-  a.quadratic_drag_N_s2_m2 = vec3(s, "quadratic_drag_N_s2_m2", a.quadratic_drag_N_s2_m2, 0.0, kBig);
-  a.rotor_drag_N_s_m_per_rad_s = s.number("rotor_drag_N_s_m_per_rad_s", a.rotor_drag_N_s_m_per_rad_s, 0.0, 1.0);
-  a.ground_effect_rotor_radius_m = s.number("ground_effect_rotor_radius_m", a.ground_effect_rotor_radius_m, 0.0, 100.0);
-  s.reject_unknown_keys();
-}
-
 void read_realism(YamlSection& root, Scenario& sc) {
   sim::RealismConfig& r = sc.simulation.plant.realism;
   const auto& cfg = sc.simulation;

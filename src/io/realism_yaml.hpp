@@ -8,9 +8,6 @@
 
 namespace quadcosim::io {
 
-/// `vehicle.aero`: drag coefficients and ground effect.
-void read_aero(YamlSection& s, model::AeroParams& a);
-
 /// Top-level `seed`, `sensors`, `environment`, `faults` into sc.simulation.plant.realism. Needs the
 /// simulation section read first (rates and duration).
 void read_realism(YamlSection& root, Scenario& sc);

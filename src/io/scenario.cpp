@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
+#include <string_view>
 
 #include "analysis/step_metrics.hpp"
 #include "io/realism_yaml.hpp"
@@ -16,50 +18,72 @@ namespace {
 
 constexpr double kHuge = 1e12;
 
-void read_vehicle(YamlSection& s, model::VehicleParams& v) {
-  v.mass_kg = s.number("mass_kg", v.mass_kg, 1e-6, kHuge);
-  v.gravity_m_s2 = s.number("gravity_m_s2", v.gravity_m_s2, 0.0, 1e3);
-  v.Ixx_kg_m2 = s.number("Ixx_kg_m2", v.Ixx_kg_m2, 1e-12, kHuge);
-  v.Iyy_kg_m2 = s.number("Iyy_kg_m2", v.Iyy_kg_m2, 1e-12, kHuge);
-  v.Izz_kg_m2 = s.number("Izz_kg_m2", v.Izz_kg_m2, 1e-12, kHuge);
-  v.arm_length_m = s.number("arm_length_m", v.arm_length_m, 1e-6, 1e3);
-  v.kt_N_per_rad2_s2 = s.number("kt_N_per_rad2_s2", v.kt_N_per_rad2_s2, 1e-20, 1.0);
-  v.km_Nm_per_rad2_s2 = s.number("km_Nm_per_rad2_s2", v.km_Nm_per_rad2_s2, 1e-20, 1.0);
-  v.layout = s.choice("layout", model::to_string(v.layout), {"plus", "x"}) == "plus"
-                 ? model::RotorLayout::kPlus
-                 : model::RotorLayout::kX;
-  v.gyroscopic = s.choice("gyroscopic", model::to_string(v.gyroscopic), {"full", "simplified"}) == "full"
-                     ? model::GyroscopicModel::kFull
-                     : model::GyroscopicModel::kSimplified;
-  if (s.has("spin")) {
-    const auto spin = s.numbers("spin", {}, 4);
-    const std::string got = fmt::format("got [{:g}, {:g}, {:g}, {:g}], ", spin[0], spin[1], spin[2], spin[3]);
-    for (int i = 0; i < 4; ++i) {
-      if (spin[i] != 1.0 && spin[i] != -1.0) s.fail("spin", got + "expected four entries, each 1 or -1");
-      v.spin[i] = static_cast<int>(spin[i]);
-    }
-    if (v.spin[0] + v.spin[1] + v.spin[2] + v.spin[3] != 0) {
-      s.fail("spin", got + "expected two rotors of each direction (two 1 and two -1)");
+// Reads every entry of the vehicle parameter table from its place in `root` (top level, or the
+// `motor:` / `aero:` sections; a 3-vector's .x/.y/.z entries are one list of three), each checked
+// against its declared range, then the rules between fields (model::validate).
+void read_vehicle(YamlSection& root, model::VehicleParams& v) {
+  std::map<std::string, std::optional<YamlSection>, std::less<>> sections;
+  auto section = [&](std::string_view name) -> YamlSection* {
+    if (name.empty()) return &root;
+    auto it = sections.find(name);
+    if (it == sections.end()) it = sections.emplace(std::string(name), root.section(std::string(name))).first;
+    return it->second ? &*it->second : nullptr;
+  };
+  const auto& table = model::vehicle_parameters();
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const model::VehicleParameter& p = table[i];
+    YamlSection* s = section(p.section());
+    if (!s) continue;
+    const std::string key(p.key());
+    switch (p.kind) {
+      case model::VehicleParameter::Kind::kNumber:
+        if (p.component() < 0) {
+          p.ref(v) = s->number(key, p.get(v), p.range);
+        } else if (p.component() == 0) {
+          // Entries i, i+1, i+2 are the vector's x, y, z.
+          const auto got = s->numbers(key, {p.get(v), table[i + 1].get(v), table[i + 2].get(v)}, 3);
+          for (int c = 0; c < 3; ++c) {
+            const model::VehicleParameter& e = table[i + static_cast<std::size_t>(c)];
+            if (!e.range.contains(got[static_cast<std::size_t>(c)])) {
+              s->fail(key, fmt::format("got an entry {:g}, expected numbers in {}", got[static_cast<std::size_t>(c)],
+                                       e.range.text()));
+            }
+            e.ref(v) = got[static_cast<std::size_t>(c)];
+          }
+        }
+        break;
+      case model::VehicleParameter::Kind::kChoice: {
+        const std::vector<std::string> choices(p.choices.begin(), p.choices.end());
+        p.set_choice(v, s->choice(key, std::string(p.choice_of(v)), choices));
+        break;
+      }
+      case model::VehicleParameter::Kind::kSigns:
+        if (s->has(key)) {
+          const auto got = s->numbers(key, {}, 4);
+          for (int r = 0; r < 4; ++r) {
+            const double g = got[static_cast<std::size_t>(r)];
+            if (g != 1.0 && g != -1.0) {
+              s->fail(key, fmt::format("got [{:g}, {:g}, {:g}, {:g}], expected four entries, each 1 or -1", got[0],
+                                       got[1], got[2], got[3]));
+            }
+            p.signs(v)[static_cast<std::size_t>(r)] = static_cast<int>(g);
+          }
+        }
+        break;
     }
   }
-  if (auto m = s.section("motor")) {
-    v.motor.model = m->choice("model", model::to_string(v.motor.model), {"ideal", "first_order"}) == "ideal"
-                        ? model::MotorModel::kIdeal
-                        : model::MotorModel::kFirstOrder;
-    v.motor.tau_up_s = m->number("tau_up_s", v.motor.tau_up_s, 1e-6, 1e3);
-    v.motor.tau_down_s = m->number("tau_down_s", v.motor.tau_down_s, 1e-6, 1e3);
-    v.motor.omega_min_rad_s = m->number("omega_min_rad_s", v.motor.omega_min_rad_s, 0.0, 1e7);
-    v.motor.omega_max_rad_s = m->number("omega_max_rad_s", v.motor.omega_max_rad_s, 1e-3, 1e7);
-    if (v.motor.omega_min_rad_s >= v.motor.omega_max_rad_s) {
-      m->fail("omega_min_rad_s", "got " + fmt::format("{:g}", v.motor.omega_min_rad_s) +
-                                     ", expected less than omega_max_rad_s (" +
-                                     fmt::format("{:g}", v.motor.omega_max_rad_s) + ")");
-    }
-    m->reject_unknown_keys();
+  for (auto& [name, s] : sections) {
+    if (s) s->reject_unknown_keys();
   }
-  if (auto a = s.section("aero")) read_aero(*a, v.aero);
-  s.reject_unknown_keys();
-  if (std::string err = model::validate(v); !err.empty()) s.fail("", err);
+  root.reject_unknown_keys();
+  if (std::string err = model::validate(v); !err.empty()) {
+    // validate() names the field first ("spin must ..."): report it at that key.
+    const std::string field = err.substr(0, err.find(' '));
+    if (model::find_vehicle_parameter(field) && field.size() < err.size()) {
+      root.fail(field, err.substr(field.size() + 1));
+    }
+    root.fail("", err);
+  }
 }
 
 control::ParameterValue parameter_value(YamlSection& s, const std::string& key,

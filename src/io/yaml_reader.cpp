@@ -66,18 +66,21 @@ YAML::Node YamlSection::get(const std::string& key) {
 YAML::Node YamlSection::raw(const std::string& key) { return get(key); }
 
 double YamlSection::number(const std::string& key, double fallback, double min, double max) {
+  return number(key, fallback, model::Range{min, max});
+}
+
+double YamlSection::number(const std::string& key, double fallback, const model::Range& range) {
   const YAML::Node n = get(key);
   if (!n.IsDefined()) return fallback;
-  std::ostringstream expected;
-  expected << "expected a number in [" << min << ", " << max << "]";
+  const std::string expected = "expected a number in " + range.text();
   double v = 0.0;
   try {
     if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
     v = n.as<double>();
   } catch (const YAML::Exception&) {
-    fail(key, "got " + shown(n) + ", " + expected.str());
+    fail(key, "got " + shown(n) + ", " + expected);
   }
-  if (!std::isfinite(v) || v < min || v > max) fail(key, "got " + shown(n) + ", " + expected.str());
+  if (!range.contains(v)) fail(key, "got " + shown(n) + ", " + expected);
   return v;
 }
 

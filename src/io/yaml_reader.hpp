@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "io/scenario.hpp"
+#include "model/vehicle_params.hpp"
 
 namespace quadcosim::io {
 
@@ -24,6 +25,8 @@ class YamlSection {
   bool has(const std::string& key) const;
   /// A number in [min, max] (NaN/inf refused); `fallback` when the key is absent.
   double number(const std::string& key, double fallback, double min, double max);
+  /// A number inside `range` (its ends open or closed; NaN/inf refused); `fallback` when absent.
+  double number(const std::string& key, double fallback, const model::Range& range);
   /// An integer in [min, max]; `fallback` when absent.
   long long integer(const std::string& key, long long fallback, long long min, long long max);
   bool boolean(const std::string& key, bool fallback);

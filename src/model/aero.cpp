@@ -32,25 +32,4 @@ double ground_effect_factor(const AeroParams& a, double z_m) {
   return 1.0 / (1.0 - r * r);
 }
 
-std::string validate(const AeroParams& a) {
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(a.linear_drag_N_s_m[i]) || a.linear_drag_N_s_m[i] < 0.0) {
-      return "aero.linear_drag_N_s_m must be finite and >= 0, got " + std::to_string(a.linear_drag_N_s_m[i]);
-    }
-    if (!std::isfinite(a.quadratic_drag_N_s2_m2[i]) || a.quadratic_drag_N_s2_m2[i] < 0.0) {
-      return "aero.quadratic_drag_N_s2_m2 must be finite and >= 0, got " +
-             std::to_string(a.quadratic_drag_N_s2_m2[i]);
-    }
-  }
-  if (!std::isfinite(a.rotor_drag_N_s_m_per_rad_s) || a.rotor_drag_N_s_m_per_rad_s < 0.0) {
-    return "aero.rotor_drag_N_s_m_per_rad_s must be finite and >= 0, got " +
-           std::to_string(a.rotor_drag_N_s_m_per_rad_s);
-  }
-  if (!std::isfinite(a.ground_effect_rotor_radius_m) || a.ground_effect_rotor_radius_m < 0.0) {
-    return "aero.ground_effect_rotor_radius_m must be finite and >= 0, got " +
-           std::to_string(a.ground_effect_rotor_radius_m);
-  }
-  return {};
-}
-
 }  // namespace quadcosim::model

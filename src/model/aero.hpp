@@ -40,7 +40,7 @@ Eigen::Vector3d aero_force_W(const AeroParams& a, const Eigen::Matrix3d& R_WB, c
 /// Ground-effect thrust factor at height z_m [m] (1 when off).
 double ground_effect_factor(const AeroParams& a, double z_m);
 
-/// Empty when `a` is meaningful (coefficients finite and >= 0), else a message naming the field.
-std::string validate(const AeroParams& a);
+// The coefficients' accepted ranges are declared in the vehicle parameter table
+// (vehicle_params.hpp, `aero.*`) and checked by validate(const VehicleParams&).
 
 }  // namespace quadcosim::model

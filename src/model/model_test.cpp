@@ -207,6 +207,147 @@ TEST(Validate, RejectsBadSpinSigns) {
 }
 
 // -------------------------------------------------------------------------------------------------
+// The vehicle parameter table
+
+using quadcosim::model::find_vehicle_parameter;
+using quadcosim::model::Range;
+using quadcosim::model::VehicleParameter;
+using quadcosim::model::vehicle_parameters;
+
+TEST(VehicleParameterTable, DefaultsReadThroughTheTableAreTable1) {
+  const VehicleParams p;
+  const auto value = [&](const char* name) {
+    const VehicleParameter* e = find_vehicle_parameter(name);
+    EXPECT_NE(e, nullptr) << name;
+    return e ? e->text(p) : std::string("(missing)");
+  };
+  EXPECT_EQ(value("mass_kg"), "1.96");
+  EXPECT_EQ(value("gravity_m_s2"), "9.81");
+  EXPECT_EQ(value("Ixx_kg_m2"), "0.0149");
+  EXPECT_EQ(value("Iyy_kg_m2"), "0.0153");
+  EXPECT_EQ(value("Izz_kg_m2"), "0.0532");
+  EXPECT_EQ(value("arm_length_m"), "0.59");
+  EXPECT_EQ(value("kt_N_per_rad2_s2"), "2.06e-07");
+  EXPECT_EQ(value("km_Nm_per_rad2_s2"), "1.01e-10");
+  EXPECT_EQ(value("layout"), "plus");
+  EXPECT_EQ(value("spin"), "[1, -1, 1, -1]");
+  EXPECT_EQ(value("gyroscopic"), "full");
+  EXPECT_EQ(value("motor.model"), "ideal");
+  EXPECT_EQ(value("aero.linear_drag_N_s_m.z"), "0");
+  EXPECT_EQ(find_vehicle_parameter("mass"), nullptr);
+  EXPECT_EQ(find_vehicle_parameter("aero.linear_drag_N_s_m"), nullptr);  // a vector is three entries
+}
+
+// Each entry binds the member its name says: write a distinct value through every numeric entry and
+// read the struct back field by field (the list below is written out independently of the table).
+TEST(VehicleParameterTable, EveryEntryBindsTheMemberItNames) {
+  VehicleParams p;
+  double next = 1.0;
+  int numbers = 0;
+  for (const VehicleParameter& e : vehicle_parameters()) {
+    if (e.kind != VehicleParameter::Kind::kNumber) continue;
+    e.ref(p) = next;
+    next += 1.0;
+    ++numbers;
+  }
+  ASSERT_EQ(numbers, 20);
+  EXPECT_EQ(p.mass_kg, 1.0);
+  EXPECT_EQ(p.gravity_m_s2, 2.0);
+  EXPECT_EQ(p.Ixx_kg_m2, 3.0);
+  EXPECT_EQ(p.Iyy_kg_m2, 4.0);
+  EXPECT_EQ(p.Izz_kg_m2, 5.0);
+  EXPECT_EQ(p.arm_length_m, 6.0);
+  EXPECT_EQ(p.kt_N_per_rad2_s2, 7.0);
+  EXPECT_EQ(p.km_Nm_per_rad2_s2, 8.0);
+  EXPECT_EQ(p.motor.tau_up_s, 9.0);
+  EXPECT_EQ(p.motor.tau_down_s, 10.0);
+  EXPECT_EQ(p.motor.omega_min_rad_s, 11.0);
+  EXPECT_EQ(p.motor.omega_max_rad_s, 12.0);
+  EXPECT_EQ(p.aero.linear_drag_N_s_m, Eigen::Vector3d(13, 14, 15));
+  EXPECT_EQ(p.aero.quadratic_drag_N_s2_m2, Eigen::Vector3d(16, 17, 18));
+  EXPECT_EQ(p.aero.rotor_drag_N_s_m_per_rad_s, 19.0);
+  EXPECT_EQ(p.aero.ground_effect_rotor_radius_m, 20.0);
+
+  VehicleParams q;
+  find_vehicle_parameter("layout")->set_choice(q, "x");
+  find_vehicle_parameter("gyroscopic")->set_choice(q, "simplified");
+  find_vehicle_parameter("motor.model")->set_choice(q, "first_order");
+  EXPECT_EQ(q.layout, RotorLayout::kX);
+  EXPECT_EQ(q.gyroscopic, GyroscopicModel::kSimplified);
+  EXPECT_EQ(q.motor.model, MotorModel::kFirstOrder);
+  find_vehicle_parameter("spin")->signs(q)[0] = -1;
+  EXPECT_EQ(q.spin[0], -1);
+}
+
+TEST(VehicleParameterTable, YamlLayoutOfNames) {
+  const VehicleParameter* m = find_vehicle_parameter("mass_kg");
+  EXPECT_EQ(m->section(), "");
+  EXPECT_EQ(m->key(), "mass_kg");
+  EXPECT_EQ(m->component(), -1);
+  const VehicleParameter* t = find_vehicle_parameter("motor.tau_up_s");
+  EXPECT_EQ(t->section(), "motor");
+  EXPECT_EQ(t->key(), "tau_up_s");
+  EXPECT_EQ(t->component(), -1);
+  const VehicleParameter* d = find_vehicle_parameter("aero.quadratic_drag_N_s2_m2.y");
+  EXPECT_EQ(d->section(), "aero");
+  EXPECT_EQ(d->key(), "quadratic_drag_N_s2_m2");
+  EXPECT_EQ(d->component(), 1);
+}
+
+TEST(VehicleParameterTable, RangeEndsAreOpenOrClosed) {
+  const Range half_open{0.0, 1.0, Range::End::kOpen, Range::End::kClosed};
+  EXPECT_FALSE(half_open.contains(0.0));
+  EXPECT_TRUE(half_open.contains(1e-300));
+  EXPECT_TRUE(half_open.contains(1.0));
+  EXPECT_FALSE(half_open.contains(std::nextafter(1.0, 2.0)));
+  EXPECT_FALSE(half_open.contains(std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_EQ(half_open.text(), "(0, 1]");
+  const Range closed_open{-2.0, 1e12, Range::End::kClosed, Range::End::kOpen};
+  EXPECT_TRUE(closed_open.contains(-2.0));
+  EXPECT_FALSE(closed_open.contains(1e12));
+  EXPECT_EQ(closed_open.text(), "[-2, 1e+12)");
+}
+
+// Gravity was >= 0 in the YAML loader and > 0 in validate(): one range now, open at 0.
+TEST(VehicleParameterTable, GravityMustBeAboveZero) {
+  VehicleParams p;
+  p.gravity_m_s2 = 0.0;
+  expect_rejected(p, "gravity_m_s2");
+  EXPECT_NE(quadcosim::model::validate(p).find("(0, 1000]"), std::string::npos) << quadcosim::model::validate(p);
+  p.gravity_m_s2 = 1.62;  // the Moon
+  EXPECT_EQ(quadcosim::model::validate(p), "");
+}
+
+// validate() checks every numeric entry against its declared range: just outside each end is refused,
+// naming the field; the ends themselves follow their open/closed kind.
+TEST(VehicleParameterTable, ValidateChecksEveryDeclaredRange) {
+  for (const VehicleParameter& e : vehicle_parameters()) {
+    if (e.kind != VehicleParameter::Kind::kNumber) continue;
+    SCOPED_TRACE(std::string(e.name));
+    for (const bool low : {true, false}) {
+      const double end = low ? e.range.min : e.range.max;
+      const bool open = (low ? e.range.min_end : e.range.max_end) == Range::End::kOpen;
+      const double outside = std::nextafter(end, low ? -1e300 : 1e300);
+      VehicleParams p;
+      if (e.name == "motor.omega_max_rad_s" && low) p.motor.omega_min_rad_s = 0.0;
+      e.ref(p) = outside;
+      expect_rejected(p, std::string(e.name));
+      e.ref(p) = end;
+      // omega_min at its upper end would pass omega_max: that is the cross-field rule, not the range.
+      if (e.name == "motor.omega_min_rad_s" && !low) continue;
+      if (open) {
+        expect_rejected(p, std::string(e.name));
+      } else {
+        EXPECT_EQ(quadcosim::model::validate(p), "") << "end " << end;
+      }
+    }
+    VehicleParams p;
+    e.ref(p) = std::numeric_limits<double>::infinity();
+    expect_rejected(p, std::string(e.name));
+  }
+}
+
+// -------------------------------------------------------------------------------------------------
 // Mixer
 
 TEST(Mixer, PlusLayoutIsEq4ElementByElement) {

@@ -1,6 +1,8 @@
 #include "model/vehicle_params.hpp"
 
 #include <algorithm>
+#include <cassert>
+#include <charconv>
 #include <cmath>
 #include <sstream>
 
@@ -11,8 +13,154 @@ double VehicleParams::hover_omega_rad_s() const {
 }
 
 namespace {
-bool positive_finite(double v) { return std::isfinite(v) && v > 0.0; }
 
+using End = Range::End;
+constexpr double kHuge = 1e12;
+
+constexpr Range closed(double min, double max) { return {min, max, End::kClosed, End::kClosed}; }
+constexpr Range above(double min, double max) { return {min, max, End::kOpen, End::kClosed}; }
+
+std::string number_text(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round trip
+  return std::string(buf, r.ptr);
+}
+
+// One numeric parameter bound to a double inside VehicleParams.
+#define QC_NUMBER(NAME, UNIT, RANGE, MEMBER, MEANING)                                        \
+  VehicleParameter {                                                                        \
+    NAME, UNIT, MEANING, VehicleParameter::Kind::kNumber, RANGE, {},                        \
+        [](VehicleParams& v) -> double& { return v.MEMBER; }, nullptr, nullptr, nullptr       \
+  }
+
+// One named option bound to an enum member; `to_string` names its values.
+#define QC_CHOICE(NAME, MEMBER, TYPE, FIRST, SECOND, MEANING)                                  \
+  VehicleParameter {                                                                        \
+    NAME, "", MEANING, VehicleParameter::Kind::kChoice, {}, {to_string(FIRST), to_string(SECOND)}, \
+        nullptr, [](const VehicleParams& v) -> std::string_view { return to_string(v.MEMBER); }, \
+        [](VehicleParams& v, std::string_view c) { v.MEMBER = c == to_string(FIRST) ? FIRST : SECOND; }, \
+        nullptr                                                                             \
+  }
+
+std::vector<VehicleParameter> make_table() {
+  const Range drag = closed(0.0, 1e6);
+  return {
+      QC_NUMBER("mass_kg", "kg", closed(1e-6, kHuge), mass_kg, "vehicle mass m"),
+      QC_NUMBER("gravity_m_s2", "m/s^2", above(0.0, 1e3), gravity_m_s2, "gravitational acceleration g (along -z_W)"),
+      QC_NUMBER("Ixx_kg_m2", "kg m^2", closed(1e-12, kHuge), Ixx_kg_m2, "moment of inertia about x_B"),
+      QC_NUMBER("Iyy_kg_m2", "kg m^2", closed(1e-12, kHuge), Iyy_kg_m2, "moment of inertia about y_B"),
+      QC_NUMBER("Izz_kg_m2", "kg m^2", closed(1e-12, kHuge), Izz_kg_m2, "moment of inertia about z_B"),
+      QC_NUMBER("arm_length_m", "m", closed(1e-6, 1e3), arm_length_m, "rotor axis to centre of mass, L"),
+      QC_NUMBER("kt_N_per_rad2_s2", "N/(rad/s)^2", closed(1e-20, 1.0), kt_N_per_rad2_s2,
+                "thrust coefficient k_t, eq. (1)"),
+      QC_NUMBER("km_Nm_per_rad2_s2", "N m/(rad/s)^2", closed(1e-20, 1.0), km_Nm_per_rad2_s2,
+                "drag-torque coefficient k_m, eq. (2)"),
+      QC_CHOICE("layout", layout, RotorLayout, RotorLayout::kPlus, RotorLayout::kX,
+                "rotor arrangement: plus (rotor 1 on the nose, eq. (4)) or x (turned 45 deg)"),
+      VehicleParameter{"spin", "", "reaction-torque sign of rotors 1..4 (+1: clockwise from above); two of each, alternating",
+                       VehicleParameter::Kind::kSigns, {}, {}, nullptr, nullptr, nullptr,
+                       [](VehicleParams& v) -> std::array<int, 4>& { return v.spin; }},
+      QC_CHOICE("gyroscopic", gyroscopic, GyroscopicModel, GyroscopicModel::kFull, GyroscopicModel::kSimplified,
+                "rotational dynamics: full (eq. (10), with w x I w) or simplified (eq. (11))"),
+      QC_CHOICE("motor.model", motor.model, MotorModel, MotorModel::kIdeal, MotorModel::kFirstOrder,
+                "motor speed response: ideal (instant) or first_order (lag)"),
+      QC_NUMBER("motor.tau_up_s", "s", closed(1e-6, 1e3), motor.tau_up_s, "first-order lag time constant when spinning up"),
+      QC_NUMBER("motor.tau_down_s", "s", closed(1e-6, 1e3), motor.tau_down_s,
+                "first-order lag time constant when spinning down"),
+      QC_NUMBER("motor.omega_min_rad_s", "rad/s", closed(0.0, 1e7), motor.omega_min_rad_s,
+                "lowest rotor speed (0: may stop); below omega_max_rad_s"),
+      QC_NUMBER("motor.omega_max_rad_s", "rad/s", closed(1e-3, 1e7), motor.omega_max_rad_s, "highest rotor speed"),
+      QC_NUMBER("aero.linear_drag_N_s_m.x", "N/(m/s)", drag, aero.linear_drag_N_s_m.x(), "linear body drag along x_B"),
+      QC_NUMBER("aero.linear_drag_N_s_m.y", "N/(m/s)", drag, aero.linear_drag_N_s_m.y(), "linear body drag along y_B"),
+      QC_NUMBER("aero.linear_drag_N_s_m.z", "N/(m/s)", drag, aero.linear_drag_N_s_m.z(), "linear body drag along z_B"),
+      QC_NUMBER("aero.quadratic_drag_N_s2_m2.x", "N/(m/s)^2", drag, aero.quadratic_drag_N_s2_m2.x(),
+                "quadratic body drag along x_B"),
+      QC_NUMBER("aero.quadratic_drag_N_s2_m2.y", "N/(m/s)^2", drag, aero.quadratic_drag_N_s2_m2.y(),
+                "quadratic body drag along y_B"),
+      QC_NUMBER("aero.quadratic_drag_N_s2_m2.z", "N/(m/s)^2", drag, aero.quadratic_drag_N_s2_m2.z(),
+                "quadratic body drag along z_B"),
+      QC_NUMBER("aero.rotor_drag_N_s_m_per_rad_s", "N/((m/s) (rad/s))", closed(0.0, 1.0),
+                aero.rotor_drag_N_s_m_per_rad_s, "rotor (induced) drag k_rd, summed over the rotors"),
+      QC_NUMBER("aero.ground_effect_rotor_radius_m", "m", closed(0.0, 100.0), aero.ground_effect_rotor_radius_m,
+                "rotor radius R for ground effect (0: off)"),
+  };
+}
+#undef QC_NUMBER
+#undef QC_CHOICE
+
+std::string signs_text(const std::array<int, 4>& s) {
+  return "[" + std::to_string(s[0]) + ", " + std::to_string(s[1]) + ", " + std::to_string(s[2]) + ", " +
+         std::to_string(s[3]) + "]";
+}
+
+}  // namespace
+
+bool Range::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  const bool low_ok = min_end == End::kOpen ? v > min : v >= min;
+  const bool high_ok = max_end == End::kOpen ? v < max : v <= max;
+  return low_ok && high_ok;
+}
+
+std::string Range::text() const {
+  std::ostringstream s;
+  s << (min_end == End::kOpen ? '(' : '[') << min << ", " << max << (max_end == End::kOpen ? ')' : ']');
+  return s.str();
+}
+
+double VehicleParameter::get(const VehicleParams& v) const {
+  assert(kind == Kind::kNumber);
+  // `ref` only names the member; reading through it does not modify `v`.
+  return ref(const_cast<VehicleParams&>(v));
+}
+
+std::string VehicleParameter::text(const VehicleParams& v) const {
+  switch (kind) {
+    case Kind::kNumber:
+      return number_text(get(v));
+    case Kind::kChoice:
+      return std::string(choice_of(v));
+    case Kind::kSigns:
+      return signs_text(signs(const_cast<VehicleParams&>(v)));
+  }
+  return {};
+}
+
+std::string_view VehicleParameter::section() const {
+  const auto dot = name.find('.');
+  return dot == std::string_view::npos ? std::string_view{} : name.substr(0, dot);
+}
+
+std::string_view VehicleParameter::key() const {
+  std::string_view rest = name;
+  if (const auto dot = rest.find('.'); dot != std::string_view::npos) rest = rest.substr(dot + 1);
+  if (const auto dot = rest.find('.'); dot != std::string_view::npos) rest = rest.substr(0, dot);
+  return rest;
+}
+
+int VehicleParameter::component() const {
+  const std::string_view s = section();
+  if (s.empty()) return -1;
+  const std::string_view rest = name.substr(s.size() + 1);
+  const auto dot = rest.find('.');
+  if (dot == std::string_view::npos) return -1;
+  const std::string_view axis = rest.substr(dot + 1);
+  return axis == "x" ? 0 : axis == "y" ? 1 : 2;
+}
+
+const std::vector<VehicleParameter>& vehicle_parameters() {
+  static const std::vector<VehicleParameter> table = make_table();
+  return table;
+}
+
+const VehicleParameter* find_vehicle_parameter(std::string_view name) {
+  for (const auto& p : vehicle_parameters()) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+namespace {
 std::string must(const char* name, const char* what, double got) {
   std::ostringstream s;
   s << name << " must be " << what << ", got " << got;
@@ -21,45 +169,32 @@ std::string must(const char* name, const char* what, double got) {
 }  // namespace
 
 std::string validate(const VehicleParams& p) {
-  const struct {
-    const char* name;
-    double value;
-  } positives[] = {
-      {"mass_kg", p.mass_kg},
-      {"gravity_m_s2", p.gravity_m_s2},
-      {"Ixx_kg_m2", p.Ixx_kg_m2},
-      {"Iyy_kg_m2", p.Iyy_kg_m2},
-      {"Izz_kg_m2", p.Izz_kg_m2},
-      {"arm_length_m", p.arm_length_m},
-      {"kt_N_per_rad2_s2", p.kt_N_per_rad2_s2},
-      {"km_Nm_per_rad2_s2", p.km_Nm_per_rad2_s2},
-      {"motor.tau_up_s", p.motor.tau_up_s},
-      {"motor.tau_down_s", p.motor.tau_down_s},
-      {"motor.omega_max_rad_s", p.motor.omega_max_rad_s},
-  };
-  for (const auto& f : positives) {
-    if (!positive_finite(f.value)) return must(f.name, "a finite number > 0", f.value);
-  }
-  if (!std::isfinite(p.motor.omega_min_rad_s) || p.motor.omega_min_rad_s < 0.0) {
-    return must("motor.omega_min_rad_s", "a finite number >= 0", p.motor.omega_min_rad_s);
+  for (const VehicleParameter& f : vehicle_parameters()) {
+    if (f.kind != VehicleParameter::Kind::kNumber) continue;
+    const double v = f.get(p);
+    if (!f.range.contains(v)) {
+      std::ostringstream s;
+      s << f.name << " must be in " << f.range.text();
+      if (!f.unit.empty()) s << " " << f.unit;
+      s << ", got " << v;
+      return s.str();
+    }
   }
   if (p.motor.omega_min_rad_s >= p.motor.omega_max_rad_s) {
     return must("motor.omega_min_rad_s", "below motor.omega_max_rad_s", p.motor.omega_min_rad_s);
   }
   for (int s : p.spin) {
-    if (s != 1 && s != -1) return must("spin", "a list of four values, each +1 or -1", s);
+    if (s != 1 && s != -1) return "spin must be four values, each +1 or -1, got " + signs_text(p.spin);
   }
   int sum = p.spin[0] + p.spin[1] + p.spin[2] + p.spin[3];
-  if (sum != 0) return must("spin", "two +1 and two -1 entries (sum 0)", sum);
+  if (sum != 0) return "spin must have two +1 and two -1 entries (sum 0), got " + signs_text(p.spin);
   // Adjacent rotors turning the same way make the yaw row of eq. (4) a combination of the other
   // rows (for either layout): the mixer is singular and yaw cannot be allocated.
   if (p.spin[0] != p.spin[2]) {
-    std::ostringstream s;
-    s << "spin must alternate around the frame (rotors 1 and 3 one way, 2 and 4 the other), got ["
-      << p.spin[0] << ", " << p.spin[1] << ", " << p.spin[2] << ", " << p.spin[3] << "]";
-    return s.str();
+    return "spin must alternate around the frame (rotors 1 and 3 one way, 2 and 4 the other), got " +
+           signs_text(p.spin);
   }
-  return validate(p.aero);
+  return {};
 }
 
 std::string validate_step(const VehicleParams& p, double period_s, int substeps) {

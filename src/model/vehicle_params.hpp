@@ -3,6 +3,8 @@
 
 #include <array>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "model/aero.hpp"
 
@@ -61,8 +63,62 @@ struct VehicleParams {
   double hover_omega_rad_s() const;
 };
 
+/// An interval of accepted values; each end either includes its value (closed) or not (open).
+struct Range {
+  enum class End { kClosed, kOpen };
+  double min = 0.0, max = 0.0;
+  End min_end = End::kClosed, max_end = End::kClosed;
+
+  /// True when `v` is finite and inside.
+  bool contains(double v) const;
+  /// "[1e-06, 1e+12]", "(0, 1000]": the form errors and tables print.
+  std::string text() const;
+};
+
+/// One vehicle parameter, declared once: its YAML path, unit, accepted values, meaning and the member
+/// of VehicleParams it binds to. The YAML loader (scenario `vehicle:` sections and vehicle files),
+/// validate(), `quadcosim params --vehicle`, sweeps and docs/model.md all read this one table.
+struct VehicleParameter {
+  enum class Kind {
+    kNumber,  ///< a double: `range`, `ref`
+    kChoice,  ///< a named option: `choices`, `choice_of`, `set_choice`
+    kSigns,   ///< the four rotor spin signs (+1 or -1 each): `signs`
+  };
+
+  /// YAML path: "mass_kg", "motor.tau_up_s"; one component of a 3-vector is "aero.linear_drag_N_s_m.x".
+  std::string_view name;
+  std::string_view unit;  ///< SI unit; "" when dimensionless or not a number
+  std::string_view meaning;
+  Kind kind = Kind::kNumber;
+  Range range;                            ///< kNumber: the values accepted
+  std::vector<std::string_view> choices;  ///< kChoice: the values accepted
+  double& (*ref)(VehicleParams&) = nullptr;                          ///< kNumber: the member
+  std::string_view (*choice_of)(const VehicleParams&) = nullptr;     ///< kChoice: current value
+  void (*set_choice)(VehicleParams&, std::string_view) = nullptr;    ///< kChoice: one of `choices`
+  std::array<int, 4>& (*signs)(VehicleParams&) = nullptr;            ///< kSigns: the member
+
+  /// kNumber: the value in `v`.
+  double get(const VehicleParams& v) const;
+  /// The value in `v` as text: "1.96", "plus", "[1, -1, 1, -1]".
+  std::string text(const VehicleParams& v) const;
+  /// YAML layout of `name`: the section ("" at the top, "motor", "aero"), the key within it, and the
+  /// vector component (0, 1, 2 for .x/.y/.z; -1 for a scalar).
+  std::string_view section() const;
+  std::string_view key() const;
+  int component() const;
+};
+
+/// Every vehicle parameter, in the order files and tables list them (a 3-vector as three
+/// consecutive entries .x, .y, .z).
+const std::vector<VehicleParameter>& vehicle_parameters();
+
+/// The entry whose YAML path is `name` ("mass_kg", "motor.tau_up_s", "aero.linear_drag_N_s_m.x"), or
+/// nullptr.
+const VehicleParameter* find_vehicle_parameter(std::string_view name);
+
 /// Returns an empty string when `p` is physically meaningful, else a message naming the first bad field
-/// (e.g. "mass_kg must be > 0, got -1").
+/// (e.g. "mass_kg must be in [1e-06, 1e+12] kg, got -1"): every number within its declared range, then
+/// the rules between fields (omega_min below omega_max, spin signs balanced and alternating).
 std::string validate(const VehicleParams& p);
 
 /// Empty when RK4 with step `step_s` [s] is stable for the motor lag (step <= 2 tau; RK4's limit on a
