@@ -46,8 +46,13 @@ struct LqrOptions {
 };
 int lqr_command(const LqrOptions& options);
 
-/// Lists the controller parameters (name, unit, range, default, meaning).
-int params_command();
+struct ParamsOptions {
+  bool vehicle = false;   ///< the vehicle's parameters instead of the controller's
+  bool markdown = false;  ///< the vehicle table as Markdown (docs/model.md)
+};
+/// Lists the controller's (or with `vehicle`, the vehicle's) parameters: name, unit, range, default,
+/// meaning.
+int params_command(const ParamsOptions& options);
 
 struct SummaryOptions {
   std::vector<std::string> run_dirs;

@@ -1,4 +1,4 @@
-// `quadcosim lqr` and `quadcosim params`.
+// `quadcosim lqr` and `quadcosim params [--vehicle]`.
 #include <fmt/format.h>
 
 #include <iostream>
@@ -48,7 +48,49 @@ int lqr_command(const LqrOptions& opt) {
   }
 }
 
-int params_command() {
+namespace {
+
+// The vehicle parameter table (model::vehicle_parameters()): as aligned text, or as the Markdown
+// table docs/model.md carries (tests/cli checks the two agree).
+int vehicle_params_table(bool markdown) {
+  const model::VehicleParams defaults;
+  constexpr const char* text_row = "{:<34} {:<18} {:<18} {:<14} {}\n";
+  constexpr const char* md_row = "| {} | {} | {} | {} | {} |\n";
+  if (markdown) {
+    std::cout << fmt::format(md_row, "key", "unit", "range", "default", "meaning");
+    std::cout << "|---|---|---|---|---|\n";
+  } else {
+    std::cout << fmt::format(text_row, "name", "unit", "range", "default", "meaning");
+  }
+  for (const auto& p : model::vehicle_parameters()) {
+    std::string range;
+    switch (p.kind) {
+      case model::VehicleParameter::Kind::kNumber:
+        range = p.range.text();
+        break;
+      case model::VehicleParameter::Kind::kChoice:
+        for (auto c : p.choices) {
+          if (!range.empty()) range += markdown ? " \\| " : "|";
+          range.append(c);
+        }
+        break;
+      case model::VehicleParameter::Kind::kSigns:
+        range = "+1 or -1 each";
+        break;
+    }
+    if (markdown) {
+      std::cout << fmt::format(md_row, fmt::format("`{}`", p.name), p.unit, range, p.text(defaults), p.meaning);
+    } else {
+      std::cout << fmt::format(text_row, p.name, p.unit, range, p.text(defaults), p.meaning);
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int params_command(const ParamsOptions& options) {
+  if (options.vehicle) return vehicle_params_table(options.markdown);
   const control::ControllerConfig defaults;
   std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", "name", "unit", "range", "default", "meaning");
   for (const auto& p : control::controller_parameters()) {

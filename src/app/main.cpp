@@ -141,7 +141,11 @@ int main(int argc, char** argv) {
   lqr_cmd->add_option("--params", lqr.params, "controller parameter YAML")->check(CLI::ExistingFile);
   lqr_cmd->add_option("--vehicle", lqr.vehicle, "vehicle YAML")->check(CLI::ExistingFile);
 
-  auto* params_cmd = app.add_subcommand("params", "list the controller's parameters");
+  ParamsOptions params;
+  auto* params_cmd = app.add_subcommand("params", "list the controller's (or the vehicle's) parameters");
+  params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
+  params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
+      ->needs(params_cmd->get_option("--vehicle"));
 
   SummaryOptions sum;
   auto* sum_cmd = app.add_subcommand("summary", "table of step figures of several runs (ours beside the paper's)");
@@ -223,7 +227,7 @@ int main(int argc, char** argv) {
   if (*ctl_cmd) return controller_command(ctl);
   if (*ol_cmd) return openloop_command(ol);
   if (*lqr_cmd) return lqr_command(lqr);
-  if (*params_cmd) return params_command();
+  if (*params_cmd) return params_command(params);
   if (*sum_cmd) return summary_command(sum);
   if (*topic_cmd) return topic_command(topic);
   if (*param_cmd) return param_command(param);

@@ -164,6 +164,22 @@ case $CASE in
     grep -qE '^z_des[[:space:]]' "$TMP/out" || { cat "$TMP/out" >&2; fail "z_des not listed by 'params'"; }
     ;;
 
+  params_vehicle)
+    # The vehicle table: Table 1's mass as its default, gravity's range open at 0, and docs/model.md
+    # carrying exactly the table the binary prints (between its two marker lines).
+    expect_rc 0 "$QC" params --vehicle
+    grep -qE '^mass_kg[[:space:]]+kg[[:space:]]+\[1e-06, 1e\+12\][[:space:]]+1\.96[[:space:]]' "$TMP/out" ||
+      { cat "$TMP/out" >&2; fail "mass_kg row of 'params --vehicle'"; }
+    grep -qE '^gravity_m_s2[[:space:]]+m/s\^2[[:space:]]+\(0, 1000\][[:space:]]+9\.81[[:space:]]' "$TMP/out" ||
+      { cat "$TMP/out" >&2; fail "gravity_m_s2 row of 'params --vehicle'"; }
+    expect_rc 0 "$QC" params --vehicle --markdown
+    sed -n '/<!-- vehicle-parameters:begin/,/<!-- vehicle-parameters:end/p' "$SRC/docs/model.md" | sed '1d;$d' \
+      > "$TMP/doc_table"
+    [ -s "$TMP/doc_table" ] || fail "docs/model.md has no vehicle-parameters block"
+    diff -u "$TMP/doc_table" "$TMP/out" >&2 ||
+      fail "docs/model.md's vehicle table differs from 'quadcosim params --vehicle --markdown' (paste its output)"
+    ;;
+
   *)
     echo "unknown case '$CASE'" >&2
     exit 2
