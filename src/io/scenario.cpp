@@ -282,6 +282,8 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
   s.reject_unknown_keys();
 }
 
+Scenario read_scenario(YamlSection root, const std::string& path);
+
 }  // namespace
 
 const std::vector<std::string>& hold_figure_names() {
@@ -295,7 +297,16 @@ model::State initial_state(const Scenario& sc) {
 }
 
 Scenario load_scenario(const std::string& path) {
-  YamlSection root = YamlSection::load_file(path);
+  return read_scenario(YamlSection::load_file(path), path);
+}
+
+Scenario load_scenario(const YAML::Node& node, const std::string& path) {
+  if (!node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
+  return read_scenario(YamlSection(node, path, ""), path);
+}
+
+namespace {
+Scenario read_scenario(YamlSection root, const std::string& path) {
   Scenario sc;
   sc.path = path;
   sc.name = root.text("name", std::filesystem::path(path).stem().string());
@@ -334,6 +345,7 @@ Scenario load_scenario(const std::string& path) {
   root.reject_unknown_keys();
   return sc;
 }
+}  // namespace
 
 model::VehicleParams load_vehicle(const std::string& path) {
   YamlSection root = YamlSection::load_file(path);

@@ -15,6 +15,10 @@
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
 
+namespace YAML {
+class Node;
+}
+
 namespace quadcosim::io {
 
 /// Bad file content. what() names the file, the key path, the value and what was expected, e.g.
@@ -83,6 +87,11 @@ model::State initial_state(const Scenario& scenario);
 /// Loads and validates a scenario. Throws ConfigError (file unreadable, YAML syntax, unknown key,
 /// wrong type, value out of range, a rate that is not a whole divisor, ...).
 Scenario load_scenario(const std::string& path);
+
+/// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file
+/// and `path` is recorded as the scenario's path. A sweep sets keys in the parsed file and loads each
+/// run's scenario with this, so a run's value is checked exactly as the same value written in the file.
+Scenario load_scenario(const YAML::Node& root, const std::string& source);
 
 /// Loads a vehicle file: the keys of a scenario's `vehicle:` section at top level. Throws ConfigError.
 model::VehicleParams load_vehicle(const std::string& path);

@@ -126,8 +126,8 @@ namespace {
 nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 }  // namespace
 
-void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold) {
+nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
+                            const std::optional<HoldResult>& hold) {
   nlohmann::json j;
   j["scenario"] = scenario.name;
   j["description"] = scenario.description;
@@ -179,8 +179,13 @@ void write_metrics_json(const std::string& path, const Scenario& scenario,
     j["hold"] = h;
   }
   j["passed"] = all_passed(results) && (!hold || hold->passed);
+  return j;
+}
+
+void write_metrics_json(const std::string& path, const Scenario& scenario,
+                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold) {
   std::ofstream out(path);
-  out << j.dump(2) << '\n';
+  out << metrics_json(scenario, results, hold).dump(2) << '\n';
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 

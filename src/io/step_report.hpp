@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,6 +53,11 @@ bool all_passed(const std::vector<StepResult>& results);
 
 /// Evaluates the hold criterion over the samples with t >= spec.after_s.
 HoldResult evaluate_hold(const HoldSpec& spec, const Series& series);
+
+/// The content of metrics.json (schema in docs/outputs.md), for callers that add to it (a sweep adds
+/// the run's seed and varied values).
+nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
+                            const std::optional<HoldResult>& hold = {});
 
 /// Writes metrics.json (schema in docs/outputs.md). Throws std::runtime_error on I/O failure.
 /// `hold`, when given, is written under "hold" and counts in "passed".
