@@ -171,18 +171,28 @@ void add_cpus_option(CLI::App* command, std::string& cpus);
 /// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
 /// existing ones are used as they are. 0, or 2 after printing why not.
 int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);
-/// `quadcosim sweep` (sweep_command.cpp): Monte Carlo over perturbed vehicle parameters and seeded
-/// noise. Exit 0 when at least min_pass_rate of the runs pass, 1 otherwise, 2 on bad input, 3 when an
-/// output cannot be written.
+/// `quadcosim sweep` (sweep_command.cpp, on the sweep library src/sweep/, docs/sweeps.md): runs of a
+/// scenario with varied keys and seeded noise; `sweep rerun DIR I --out RUN` flies run I again with
+/// the outputs of `run`; `sweep merge OUT DIR...` joins shards. Exit 0 when at least min_pass_rate of
+/// the runs pass (a shard: when it ran), 1 otherwise, 2 on bad input, 3 when an output cannot be written.
 struct SweepOptions {
+  std::string mode = "sweep";      ///< "sweep", "rerun" or "merge"
   std::string scenario;
-  int runs = 20;
+  int runs = 20;                   ///< runs, or runs per grid point with a grid (default 1 then)
+  bool runs_given = false;
   std::uint64_t seed = 1;
-  std::vector<std::string> vary;   ///< KEY=P%
+  std::vector<std::string> vary;   ///< KEY=P%, KEY=uniform(a,b), ... (sweep/plan.hpp)
+  std::string sampler = "random";  ///< random or lhs
+  std::string keep = "none";       ///< trajectories kept: none, failing, all
+  std::string shard;               ///< "K/N" or ""
+  bool force = false;
   std::string out_dir;
   int jobs = 2;                    ///< threads
   double min_pass_rate = 1.0;
   bool plots = true;
+  std::string sweep_dir;           ///< rerun: the sweep
+  int rerun_index = 0;
+  std::vector<std::string> shard_dirs;  ///< merge: the shards
 };
 CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
 int sweep_command(const SweepOptions& options);

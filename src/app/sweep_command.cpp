@@ -1,33 +1,20 @@
-// `quadcosim sweep SCENARIO --runs N --seed S --vary mass=10% ... --out DIR`: Monte Carlo over
-// model uncertainty and the scenario's noise. Run i gets its own seed (stream_seed(S, "sweep",
-// "run/<i>")); from it each varied vehicle parameter draws its factor from its own stream, uniform in
-// [1 - P, 1 + P], and the scenario's noise and gusts are seeded with it. The plant flies the perturbed
-// vehicle; the controller keeps the nominal one (it was designed for it). Runs are in-process
-// simulations on a pool of --jobs threads; results are kept by run index, so summary.json is the same
-// bytes whatever the scheduling.
+// `quadcosim sweep SCENARIO --runs N --seed S --vary KEY=DIST ... --out DIR` and its `rerun` and
+// `merge` subcommands: flags and console text only; drawing, running and summarising the runs is the
+// sweep library's (src/sweep/, docs/sweeps.md).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <nlohmann/json.hpp>
-#include <optional>
-#include <set>
-#include <thread>
 
 #include "app/commands.hpp"
 #include "control/care.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
-#include "io/trajectory_csv.hpp"
-#include "model/attitude.hpp"
-#include "model/random.hpp"
-#include "sim/simulation.hpp"
+#include "sweep/sweep.hpp"
 
 namespace quadcosim::app {
 
@@ -35,271 +22,237 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A vehicle field that --vary may scale: its name (the stream it draws from) and where it lives.
-struct Field {
-  const char* name;
-  double* (*get)(model::VehicleParams&);
-};
-
-#define QUADCOSIM_FIELD(NAME, EXPR) \
-  Field { NAME, [](model::VehicleParams& v) -> double* { return &(EXPR); } }
-
-const std::vector<Field>& all_fields() {
-  static const std::vector<Field> fields = {
-      QUADCOSIM_FIELD("mass_kg", v.mass_kg),
-      QUADCOSIM_FIELD("gravity_m_s2", v.gravity_m_s2),
-      QUADCOSIM_FIELD("Ixx_kg_m2", v.Ixx_kg_m2),
-      QUADCOSIM_FIELD("Iyy_kg_m2", v.Iyy_kg_m2),
-      QUADCOSIM_FIELD("Izz_kg_m2", v.Izz_kg_m2),
-      QUADCOSIM_FIELD("arm_length_m", v.arm_length_m),
-      QUADCOSIM_FIELD("kt_N_per_rad2_s2", v.kt_N_per_rad2_s2),
-      QUADCOSIM_FIELD("km_Nm_per_rad2_s2", v.km_Nm_per_rad2_s2),
-      QUADCOSIM_FIELD("motor.tau_up_s", v.motor.tau_up_s),
-      QUADCOSIM_FIELD("motor.tau_down_s", v.motor.tau_down_s),
-      QUADCOSIM_FIELD("motor.omega_max_rad_s", v.motor.omega_max_rad_s),
-      QUADCOSIM_FIELD("aero.linear_drag_N_s_m.x", v.aero.linear_drag_N_s_m.x()),
-      QUADCOSIM_FIELD("aero.linear_drag_N_s_m.y", v.aero.linear_drag_N_s_m.y()),
-      QUADCOSIM_FIELD("aero.linear_drag_N_s_m.z", v.aero.linear_drag_N_s_m.z()),
-      QUADCOSIM_FIELD("aero.quadratic_drag_N_s2_m2.x", v.aero.quadratic_drag_N_s2_m2.x()),
-      QUADCOSIM_FIELD("aero.quadratic_drag_N_s2_m2.y", v.aero.quadratic_drag_N_s2_m2.y()),
-      QUADCOSIM_FIELD("aero.quadratic_drag_N_s2_m2.z", v.aero.quadratic_drag_N_s2_m2.z()),
-      QUADCOSIM_FIELD("aero.rotor_drag_N_s_m_per_rad_s", v.aero.rotor_drag_N_s_m_per_rad_s),
-      QUADCOSIM_FIELD("aero.ground_effect_rotor_radius_m", v.aero.ground_effect_rotor_radius_m),
-  };
-  return fields;
-}
-#undef QUADCOSIM_FIELD
-
-// Short names users type, each standing for one or more fields (each field draws independently).
-const std::map<std::string, std::vector<std::string>>& aliases() {
-  static const std::map<std::string, std::vector<std::string>> a = {
-      {"mass", {"mass_kg"}},
-      {"gravity", {"gravity_m_s2"}},
-      {"inertia", {"Ixx_kg_m2", "Iyy_kg_m2", "Izz_kg_m2"}},
-      {"Ixx", {"Ixx_kg_m2"}},
-      {"Iyy", {"Iyy_kg_m2"}},
-      {"Izz", {"Izz_kg_m2"}},
-      {"arm", {"arm_length_m"}},
-      {"kt", {"kt_N_per_rad2_s2"}},
-      {"km", {"km_Nm_per_rad2_s2"}},
-      {"motor_tau", {"motor.tau_up_s", "motor.tau_down_s"}},
-      {"omega_max", {"motor.omega_max_rad_s"}},
-      {"linear_drag", {"aero.linear_drag_N_s_m.x", "aero.linear_drag_N_s_m.y", "aero.linear_drag_N_s_m.z"}},
-      {"quadratic_drag",
-       {"aero.quadratic_drag_N_s2_m2.x", "aero.quadratic_drag_N_s2_m2.y", "aero.quadratic_drag_N_s2_m2.z"}},
-      {"rotor_drag", {"aero.rotor_drag_N_s_m_per_rad_s"}},
-      {"ground_effect_radius", {"aero.ground_effect_rotor_radius_m"}},
-  };
-  return a;
+// Refuses (false, after printing why) an output folder that holds another sweep's outputs, unless
+// `force`, which removes exactly those files first. A folder holding a run's outputs is refused.
+// The files a sweep writes are the sweep library's list (sweep::sweep_outputs).
+bool prepare_out(const fs::path& out, bool force) {
+  std::error_code ec;
+  if (fs::exists(out / "trajectory.csv", ec) || fs::exists(out / "metrics.json", ec)) {
+    std::cerr << "error: " << out.string() << " holds a run's outputs (metrics.json or trajectory.csv); "
+              << "give the sweep a folder of its own\n";
+    return false;
+  }
+  const auto old = sweep::sweep_outputs(out);
+  if (old.empty()) return true;
+  if (!force) {
+    std::cerr << "error: " << out.string() << " holds another sweep's outputs (" << old.size()
+              << " files, e.g. " << old.front().filename().string()
+              << "); add --force to remove them first, or choose another --out\n";
+    return false;
+  }
+  sweep::remove_sweep_outputs(out);
+  return true;
 }
 
-struct Vary {
-  std::string key;     ///< as typed
-  double fraction;     ///< P / 100
-  std::vector<const Field*> fields;
-};
-
-std::string known_keys() {
-  std::string s;
-  for (const auto& [k, _] : aliases()) s += (s.empty() ? "" : ", ") + k;
-  s += " or a field name such as mass_kg, motor.tau_up_s, aero.linear_drag_N_s_m.x";
-  return s;
+bool write_json(const fs::path& path, const nlohmann::json& j) {
+  std::ofstream f(path);
+  f << j.dump(2) << '\n';
+  if (!f) {
+    std::cerr << "error: " << path.string() << ": write failed\n";
+    return false;
+  }
+  return true;
 }
 
-// "mass=10%" -> Vary; throws std::invalid_argument naming the spec.
-Vary parse_vary(const std::string& spec) {
-  const auto eq = spec.find('=');
-  if (eq == std::string::npos || spec.back() != '%') {
-    throw std::invalid_argument("--vary " + spec + ": expected KEY=P% (e.g. mass=10%)");
-  }
-  Vary v;
-  v.key = spec.substr(0, eq);
-  const std::string number = spec.substr(eq + 1, spec.size() - eq - 2);
-  char* end = nullptr;
-  const double p = std::strtod(number.c_str(), &end);
-  if (number.empty() || end != number.c_str() + number.size() || !std::isfinite(p) || p < 0.0 || p >= 100.0) {
-    throw std::invalid_argument("--vary " + spec + ": got '" + number + "%', expected a percentage in [0, 100)");
-  }
-  v.fraction = p / 100.0;
-  std::vector<std::string> names;
-  if (auto a = aliases().find(v.key); a != aliases().end()) {
-    names = a->second;
-  } else {
-    names = {v.key};
-  }
-  for (const auto& n : names) {
-    const auto f = std::find_if(all_fields().begin(), all_fields().end(), [&](const Field& x) { return n == x.name; });
-    if (f == all_fields().end()) {
-      throw std::invalid_argument("--vary " + spec + ": unknown parameter '" + v.key + "' (expected " + known_keys() + ")");
+// Console summary: pass count, then per figure the runs that have it and the missing ones, and the
+// statistics of those that have it.
+void print_summary(const nlohmann::json& j, std::ostream& os) {
+  const int runs = j["runs"].get<int>();
+  const int passed = j["passed"].get<int>();
+  os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", j["scenario"].get<std::string>(), passed,
+                    runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
+  int failed_runs = 0;
+  for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
+  if (failed_runs > 0) os << fmt::format("  {} runs could not be flown (their error is in summary.json)\n", failed_runs);
+  os << fmt::format("  {:<36} {:>6} {:>7}  {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "figure", "count", "missing",
+                    "mean", "std", "min", "p50", "p95", "max");
+  for (const auto& [name, d] : j["figures"].items()) {
+    const auto count = d["count"].get<int>(), missing = d["missing"].get<int>();
+    if (count == 0) {
+      os << fmt::format("  {:<36} {:>6} {:>7}  (no run has this figure)\n", name, count, missing);
+      continue;
     }
-    v.fields.push_back(&*f);
+    os << fmt::format("  {:<36} {:>6} {:>7}  {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g}\n", name, count,
+                      missing, d["mean"].get<double>(), d["std"].get<double>(), d["min"].get<double>(),
+                      d["p50"].get<double>(), d["p95"].get<double>(), d["max"].get<double>());
   }
-  return v;
 }
 
-struct RunResult {
-  std::uint64_t seed = 0;
-  std::map<std::string, double> factors;   ///< field -> factor applied
-  std::vector<io::StepResult> steps;
-  std::optional<io::HoldResult> hold;
-  bool passed = false;
-  std::string error;  ///< non-empty when the run could not be done
-};
-
-io::Series simulate(const io::Scenario& sc, const model::VehicleParams& plant_vehicle) {
-  sim::Simulation simulation(sc.simulation, plant_vehicle,
-                             model::Quadrotor(plant_vehicle)
-                                 .initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover),
-                             sc.controller, sc.schedule);
-  io::Series s;
-  const std::size_t n = static_cast<std::size_t>(sc.simulation.duration_ticks + 1);
-  s.t_s.reserve(n);
-  const char* names[] = {"x", "y", "z", "roll", "pitch", "yaw", "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des"};
-  for (const char* name : names) s.values[name].reserve(n);
-  auto& v = s.values;
-  simulation.run([&](const sim::TickRecord& r) {
-    // The same numbers trajectory.csv holds (TrajectoryWriter, ControlColumns).
-    const model::Euler e = model::euler_from_quaternion(r.state.q_WB);
-    const io::ControlColumns c = io::ControlColumns::from(r.status);
-    s.t_s.push_back(r.t_s);
-    v["x"].push_back(r.state.p_W.x());
-    v["y"].push_back(r.state.p_W.y());
-    v["z"].push_back(r.state.p_W.z());
-    v["roll"].push_back(e.roll_rad);
-    v["pitch"].push_back(e.pitch_rad);
-    v["yaw"].push_back(e.yaw_rad);
-    v["x_des"].push_back(c.x_des);
-    v["y_des"].push_back(c.y_des);
-    v["z_des"].push_back(c.z_des);
-    v["roll_des"].push_back(c.roll_des);
-    v["pitch_des"].push_back(c.pitch_des);
-    v["yaw_des"].push_back(c.yaw_des);
-  });
-  return s;
+int verdict(const nlohmann::json& j, double min_pass_rate) {
+  return static_cast<double>(j["passed"].get<int>()) >= min_pass_rate * j["runs"].get<int>() ? 0 : 1;
 }
 
-RunResult one_run(const io::Scenario& nominal, const std::vector<Vary>& vary, std::uint64_t sweep_seed, int index,
-                  const fs::path& run_dir) {
-  RunResult r;
-  r.seed = model::stream_seed(sweep_seed, "sweep", "run/" + std::to_string(index));
-  io::Scenario sc = nominal;
-  sc.simulation.plant.realism.seed = r.seed;
-  model::VehicleParams plant = nominal.vehicle;
-  for (const Vary& v : vary) {
-    for (const Field* f : v.fields) {
-      model::Rng rng(model::stream_seed(r.seed, "vary", f->name));
-      const double factor = 1.0 + v.fraction * (2.0 * rng.uniform() - 1.0);
-      *f->get(plant) *= factor;
-      r.factors[f->name] = factor;
-    }
+bool parse_shard(const std::string& text, int& k, int& n) {
+  const auto slash = text.find('/');
+  if (slash == std::string::npos) return false;
+  try {
+    std::size_t a = 0, b = 0;
+    k = std::stoi(text.substr(0, slash), &a);
+    n = std::stoi(text.substr(slash + 1), &b);
+    return a == slash && b == text.size() - slash - 1 && n >= 1 && k >= 1 && k <= n;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+int rerun_command(const SweepOptions& o) {
+  const fs::path out(o.out_dir);
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_empty(out, ec) && !o.force) {
+    std::cerr << "error: " << o.out_dir << " is not empty; add --force to write the run into it anyway\n";
+    return 2;
+  }
+  sweep::Plan plan;
+  try {
+    plan = sweep::plan_of(o.sweep_dir);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  }
+  if (o.rerun_index < 0 || o.rerun_index >= plan.runs) {
+    std::cerr << fmt::format("error: sweep rerun: run {} is not in {} (runs 0..{})\n", o.rerun_index, o.sweep_dir,
+                             plan.runs - 1);
+    return 2;
   }
   try {
-    if (std::string err = model::validate(plant); !err.empty()) throw std::invalid_argument(err);
-    if (std::string err = model::validate_step(plant, sc.simulation.plant.clock.period_s(), sc.simulation.plant.substeps);
-        !err.empty()) {
-      throw std::invalid_argument(err);
-    }
-    const io::Series series = simulate(sc, plant);
-    r.steps = io::evaluate_steps(sc.steps, series);
-    if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
-    r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed);
-    sc.vehicle = plant;  // metrics.json of the run describes what flew
-    fs::create_directories(run_dir);
-    io::write_metrics_json((run_dir / "metrics.json").string(), sc, r.steps, r.hold);
+    fs::create_directories(out);
+    fs::copy_file(fs::path(o.sweep_dir) / "scenario.yaml", out / "scenario.yaml", fs::copy_options::overwrite_existing);
+    const sweep::RunResult r = sweep::rerun(plan, o.rerun_index, out);
+    std::ifstream txt(out / "metrics.txt");
+    std::cout << fmt::format("sweep run {} (seed {}):", o.rerun_index, r.sample.seed);
+    for (const auto& [k, v] : r.sample.values) std::cout << fmt::format(" {}={}", k, v);
+    std::cout << '\n' << txt.rdbuf();
+    std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
+    if (o.plots && !make_plots(o.out_dir)) return 3;
+    return r.passed ? 0 : 1;
+  } catch (const control::CareError& e) {
+    std::cerr << "error: sweep run " << o.rerun_index << ": controller design failed: " << e.what() << '\n';
+    return 2;
+  } catch (const io::ConfigError& e) {
+    std::cerr << "error: sweep run " << o.rerun_index << ": " << e.what() << '\n';
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: sweep run " << o.rerun_index << ": " << e.what() << '\n';
+    return 2;
   } catch (const std::exception& e) {
-    r.error = e.what();
-    r.passed = false;
+    std::cerr << "error: " << e.what() << '\n';
+    return 3;
   }
-  return r;
 }
 
-// Percentile by linear interpolation between closest ranks (numpy's default, "linear").
-double percentile(const std::vector<double>& sorted, double q) {
-  const double pos = q * static_cast<double>(sorted.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
-}
-
-nlohmann::json distribution(std::vector<double> values, int runs) {
-  nlohmann::json j;
-  j["count"] = values.size();
-  j["missing"] = runs - static_cast<int>(values.size());
-  if (values.empty()) return j;
-  double sum = 0.0;
-  for (double v : values) sum += v;
-  const double mean = sum / static_cast<double>(values.size());
-  double ss = 0.0;
-  for (double v : values) ss += (v - mean) * (v - mean);
-  std::sort(values.begin(), values.end());
-  j["min"] = values.front();
-  j["max"] = values.back();
-  j["mean"] = mean;
-  j["std"] = values.size() > 1 ? std::sqrt(ss / static_cast<double>(values.size() - 1)) : 0.0;
-  for (const auto& [name, q] : std::vector<std::pair<const char*, double>>{
-           {"p5", 0.05}, {"p25", 0.25}, {"p50", 0.5}, {"p75", 0.75}, {"p95", 0.95}}) {
-    j[name] = percentile(values, q);
-  }
-  return j;
-}
-
-// Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step
-// of the same channel gets "roll#2.overshoot_pct"), "hold.<figure>" for the hold.
-std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunResult& r,
-                                                                        const io::Scenario& sc) {
-  std::vector<std::pair<std::string, std::optional<double>>> out;
-  std::map<std::string, int> seen;
-  for (std::size_t i = 0; i < sc.steps.size(); ++i) {
-    const std::string& ch = sc.steps[i].channel;
-    const int n = ++seen[ch];
-    const std::string prefix = n == 1 ? ch : fmt::format("{}#{}", ch, n);
-    for (const auto& name : analysis::figure_names()) {
-      out.emplace_back(prefix + "." + name,
-                       i < r.steps.size() ? analysis::figure(r.steps[i].figures, name) : std::nullopt);
-    }
-  }
-  if (sc.hold) {
-    for (const auto& name : io::hold_figure_names()) {
-      std::optional<double> v;
-      if (r.hold) {
-        if (auto it = r.hold->figures.find(name); it != r.hold->figures.end()) v = it->second;
+int merge_command(const SweepOptions& o) {
+  nlohmann::json header;
+  std::vector<nlohmann::json> per_run;
+  for (const std::string& dir : o.shard_dirs) {
+    const fs::path file = fs::path(dir) / "shard.json";
+    nlohmann::json j;
+    try {
+      std::ifstream in(file);
+      if (!in) {
+        std::cerr << "error: " << file.string() << ": not found (not a shard folder)\n";
+        return 2;
       }
-      out.emplace_back("hold." + name, v);
+      in >> j;
+      if (header.is_null()) {
+        header = j.at("header");
+      } else if (j.at("header") != header) {
+        std::cerr << "error: " << file.string() << ": a shard of another sweep (scenario, seed, runs or --vary differ "
+                  << "from " << o.shard_dirs.front() << ")\n";
+        return 2;
+      }
+      for (auto& r : j.at("per_run")) per_run.push_back(std::move(r));
+    } catch (const nlohmann::json::exception& e) {
+      std::cerr << "error: " << file.string() << ": not a shard's results (" << e.what() << ")\n";
+      return 2;
     }
   }
-  return out;
+  nlohmann::json summary;
+  try {
+    summary = sweep::summary_json(header, std::move(per_run));
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: sweep merge: " << e.what() << " in the shards given\n";
+    return 2;
+  }
+  const fs::path out(o.out_dir);
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) {
+    std::cerr << "error: cannot create output directory " << o.out_dir << ": " << ec.message() << '\n';
+    return 3;
+  }
+  if (!prepare_out(out, o.force)) return 2;
+  fs::copy_file(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml",
+                fs::copy_options::overwrite_existing, ec);
+  if (ec || !write_json(out / "summary.json", summary)) return 3;
+  print_summary(summary, std::cout);
+  std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
+  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return 3;
+  return verdict(summary, o.min_pass_rate);
 }
 
 }  // namespace
 
 CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
-  auto* c = app.add_subcommand("sweep", "Monte Carlo: N runs with perturbed vehicle parameters and seeded noise");
-  c->add_option("scenario", o.scenario, "scenario YAML file")->required()->check(CLI::ExistingFile);
-  c->add_option("--runs", o.runs, "number of runs")->check(CLI::Range(1, 1000000));
-  c->add_option("--seed", o.seed, "sweep seed (run i's seed derives from it)");
-  c->add_option("--vary", o.vary, "KEY=P%: scale a vehicle parameter by a factor uniform in [1-P, 1+P] per run (repeatable)");
-  c->add_option("--out", o.out_dir, "output directory (created)")->required();
+  auto* c = app.add_subcommand("sweep", "Runs of a scenario with varied keys and seeded noise (docs/sweeps.md)");
+  c->add_option("scenario", o.scenario, "scenario YAML file")->check(CLI::ExistingFile);
+  c->add_option("--runs", o.runs, "number of runs; with a grid, runs per grid point (default 1 then)")
+      ->check(CLI::Range(1, 10000000))
+      ->each([&o](const std::string&) { o.runs_given = true; });
+  c->add_option("--seed", o.seed, "sweep seed (run i's seed and values derive from it)");
+  c->add_option("--vary", o.vary,
+                "KEY=P% | KEY=uniform(a,b) | KEY=normal(mu,sigma) | KEY=grid(v1,...) | KEY=linspace(a,b,n); KEY "
+                "is a scenario key by its YAML path (controller.altitude.kp, vehicle.mass_kg, ...) or an alias "
+                "(mass, inertia, kt, ...) (repeatable)");
+  c->add_option("--sampler", o.sampler, "random, or lhs: Latin hypercube over the random keys")
+      ->check(CLI::IsMember({"random", "lhs"}));
+  c->add_option("--keep", o.keep, "keep trajectory.csv of none, failing or all runs")
+      ->check(CLI::IsMember({"none", "failing", "all"}));
+  c->add_option("--shard", o.shard, "K/N: run the runs i with i % N == K-1 and write shard.json for `sweep merge`");
+  c->add_flag("--force", o.force, "replace another sweep's outputs in --out (exactly the files a sweep writes)");
+  c->add_option("--out", o.out_dir, "output directory (created)");
   c->add_option("--jobs", o.jobs, "parallel runs (threads)")->check(CLI::Range(1, 64));
   c->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
-  c->add_flag("!--no-plots", o.plots, "skip the histograms and box plots");
+  c->add_flag("!--no-plots", o.plots, "skip the plots");
+
+  auto* r = c->add_subcommand("rerun", "fly run I of a sweep again with the outputs of `run`");
+  r->add_option("dir", o.sweep_dir, "sweep folder (summary.json or shard.json, scenario.yaml)")->required();
+  r->add_option("index", o.rerun_index, "run index")->required();
+  r->add_option("--out", o.out_dir, "run folder (created)")->required();
+  r->add_flag("--force", o.force, "write into a folder that is not empty");
+  r->add_flag("!--no-plots", o.plots, "skip the plots and report");
+  r->callback([&o] { o.mode = "rerun"; });
+
+  auto* m = c->add_subcommand("merge", "join the shards of a sweep into one summary.json");
+  m->add_option("out", o.out_dir, "output folder (created)")->required();
+  m->add_option("dirs", o.shard_dirs, "shard folders (each with shard.json)")->required();
+  m->add_flag("--force", o.force, "replace another sweep's outputs in OUT");
+  m->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
+      ->check(CLI::Range(0.0, 1.0));
+  m->add_flag("!--no-plots", o.plots, "skip the plots");
+  m->callback([&o] { o.mode = "merge"; });
   return c;
 }
 
 int sweep_command(const SweepOptions& o) {
-  io::Scenario sc;
-  std::vector<Vary> vary;
+  if (o.mode == "rerun") return rerun_command(o);
+  if (o.mode == "merge") return merge_command(o);
+  if (o.scenario.empty() || o.out_dir.empty()) {
+    std::cerr << "error: sweep: give a SCENARIO and --out DIR (or `sweep rerun`, `sweep merge`; see --help)\n";
+    return 2;
+  }
+  int shard = 1, shards = 1;
+  if (!o.shard.empty() && !parse_shard(o.shard, shard, shards)) {
+    std::cerr << "error: --shard " << o.shard << ": expected K/N with 1 <= K <= N (e.g. 2/8)\n";
+    return 2;
+  }
+  sweep::Plan plan;
   try {
-    sc = io::load_scenario(o.scenario);
-    std::set<std::string> used;
-    for (const auto& spec : o.vary) {
-      vary.push_back(parse_vary(spec));
-      for (const Field* f : vary.back().fields) {
-        if (!used.insert(f->name).second) {
-          throw std::invalid_argument("--vary " + spec + ": " + f->name + " is already varied by an earlier --vary");
-        }
-      }
-    }
+    bool grid = false;
+    for (const auto& spec : o.vary) grid = grid || sweep::parse_vary(spec).distribution == sweep::Distribution::kGrid;
+    const int per_point = grid && !o.runs_given ? 1 : o.runs;
+    plan = sweep::make_plan(o.scenario, o.vary, o.seed, per_point,
+                            o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
   } catch (const io::ConfigError& e) {
     std::cerr << "error: " << e.what() << '\n';
     return 2;
@@ -307,92 +260,55 @@ int sweep_command(const SweepOptions& o) {
     std::cerr << "error: " << e.what() << '\n';
     return 2;
   }
-  if (sc.steps.empty() && !sc.hold) {
+  if (plan.nominal.steps.empty() && !plan.nominal.hold) {
     std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps and no hold criterion; "
               << "a sweep needs something to judge\n";
     return 2;
   }
   const fs::path out(o.out_dir);
   std::error_code ec;
-  fs::create_directories(out / "runs", ec);
+  fs::create_directories(out, ec);
   if (ec) {
     std::cerr << "error: cannot create output directory " << o.out_dir << ": " << ec.message() << '\n';
     return 3;
   }
+  if (!prepare_out(out, o.force)) return 2;
+  fs::create_directories(out / "runs", ec);
+  fs::copy_file(o.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing, ec);
+  if (ec) {
+    std::cerr << "error: cannot write " << (out / "scenario.yaml").string() << ": " << ec.message() << '\n';
+    return 3;
+  }
+  const sweep::Keep keep = o.keep == "all" ? sweep::Keep::kAll : o.keep == "failing" ? sweep::Keep::kFailing : sweep::Keep::kNone;
+  const std::vector<int> indices = sweep::shard_indices(plan.runs, shard, shards);
+  const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep);
 
-  std::vector<RunResult> results(static_cast<std::size_t>(o.runs));
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int i; (i = next.fetch_add(1)) < o.runs;) {
-      results[static_cast<std::size_t>(i)] = one_run(sc, vary, o.seed, i, out / "runs" / fmt::format("{:04d}", i));
+  std::vector<nlohmann::json> per_run;
+  per_run.reserve(results.size());
+  for (const auto& r : results) {
+    if (!r.error.empty()) {
+      std::cerr << fmt::format("sweep: run {} (seed {}) failed: {}\n", r.sample.index, r.sample.seed, r.error);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 0; t < std::min(o.jobs, o.runs); ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-
-  for (std::size_t i = 0; i < results.size(); ++i) {
-    if (!results[i].error.empty()) {
-      std::cerr << fmt::format("sweep: run {} (seed {}) failed: {}\n", i, results[i].seed, results[i].error);
-    }
+    per_run.push_back(sweep::per_run_json(plan, r));
   }
-
-  nlohmann::json j;
-  j["scenario"] = sc.name;
-  j["scenario_file"] = o.scenario;
-  j["seed"] = o.seed;
-  j["runs"] = o.runs;
-  const int passed = static_cast<int>(std::count_if(results.begin(), results.end(), [](const auto& r) { return r.passed; }));
-  j["passed"] = passed;
-  j["pass_rate"] = static_cast<double>(passed) / o.runs;
-  j["distribution"] = "uniform";
-  j["vary"] = nlohmann::json::array();
-  for (const Vary& v : vary) {
-    nlohmann::json fields = nlohmann::json::array();
-    for (const Field* f : v.fields) fields.push_back(f->name);
-    j["vary"].push_back({{"key", v.key}, {"percent", v.fraction * 100.0}, {"fields", fields}});
+  const nlohmann::json header = sweep::header_json(plan);
+  if (!o.shard.empty()) {
+    int passed = 0;
+    for (const auto& r : results) passed += r.passed ? 1 : 0;
+    nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
+    if (!write_json(out / "shard.json", j)) return 3;
+    std::cout << fmt::format("sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
+                             "join the shards with `quadcosim sweep merge OUT DIR...`\n",
+                             plan.nominal.name, o.shard, results.size(), plan.runs, passed,
+                             (out / "shard.json").string());
+    return 0;
   }
-  std::map<std::string, std::vector<double>> values;
-  std::vector<std::string> order;
-  j["per_run"] = nlohmann::json::array();
-  for (std::size_t i = 0; i < results.size(); ++i) {
-    const RunResult& r = results[i];
-    nlohmann::json run = {{"index", i}, {"seed", r.seed}, {"passed", r.passed}};
-    run["factors"] = r.factors;
-    nlohmann::json figs = nlohmann::json::object();
-    for (const auto& [name, v] : figures_of(r, sc)) {
-      if (!values.count(name)) order.push_back(name);
-      auto& list = values[name];
-      if (v && r.error.empty()) list.push_back(*v);
-      figs[name] = v && r.error.empty() ? nlohmann::json(*v) : nlohmann::json();
-    }
-    run["figures"] = figs;
-    if (!r.error.empty()) run["error"] = r.error;
-    j["per_run"].push_back(run);
-  }
-  nlohmann::json dist = nlohmann::json::object();
-  for (const auto& name : order) dist[name] = distribution(values[name], o.runs);
-  j["figures"] = dist;
-  {
-    std::ofstream f(out / "summary.json");
-    f << j.dump(2) << '\n';
-    if (!f) {
-      std::cerr << "error: " << (out / "summary.json").string() << ": write failed\n";
-      return 3;
-    }
-  }
-  std::cout << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", sc.name, passed, o.runs,
-                           100.0 * passed / o.runs, o.seed);
-  for (const auto& name : order) {
-    const auto& d = dist[name];
-    if (d["count"].get<int>() == 0) continue;
-    std::cout << fmt::format("  {:<36} mean {:>10.4g}  std {:>10.4g}  min {:>10.4g}  p50 {:>10.4g}  p95 {:>10.4g}  max {:>10.4g}\n",
-                             name, d["mean"].get<double>(), d["std"].get<double>(), d["min"].get<double>(),
-                             d["p50"].get<double>(), d["p95"].get<double>(), d["max"].get<double>());
-  }
+  const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
+  if (!write_json(out / "summary.json", summary)) return 3;
+  print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
   if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return 3;
-  return static_cast<double>(passed) >= o.min_pass_rate * o.runs ? 0 : 1;
+  return verdict(summary, o.min_pass_rate);
 }
 
 }  // namespace quadcosim::app

@@ -1,0 +1,350 @@
+#include "sweep/sweep.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <fstream>
+#include <map>
+#include <thread>
+
+#include "analysis/step_metrics.hpp"
+#include "control/care.hpp"
+#include "io/mcap_recorder.hpp"
+#include "io/trajectory_csv.hpp"
+#include "model/attitude.hpp"
+#include "sim/simulation.hpp"
+#include "sim/topics.hpp"
+#include "sweep/statistics.hpp"
+
+namespace quadcosim::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Simulates `sc` (plant: sc.vehicle; controller: sc.controller) and returns the signals judged, the
+// same numbers trajectory.csv holds. With `csv` it writes trajectory.csv there, with `mcap_dir` also
+// run.mcap and metadata.yaml.
+io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path* mcap_dir) {
+  sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+  std::optional<io::TrajectoryWriter> writer;
+  if (csv) writer.emplace(csv->string());
+  std::optional<io::McapRecorder> mcap;
+  if (mcap_dir) {
+    mcap.emplace((*mcap_dir / "run.mcap").string(), simulation.transport(),
+                 sim::Topics::for_namespace(sc.simulation.ns));
+  }
+  io::Series s;
+  const std::size_t n = static_cast<std::size_t>(sc.simulation.duration_ticks + 1);
+  s.t_s.reserve(n);
+  static const char* names[] = {"x", "y", "z", "roll", "pitch", "yaw",
+                                "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des"};
+  std::vector<double>* col[12];
+  for (int i = 0; i < 12; ++i) {
+    col[i] = &s.values[names[i]];
+    col[i]->reserve(n);
+  }
+  bool watchdog = false;
+  simulation.run([&](const sim::TickRecord& r) {
+    // The same numbers trajectory.csv holds (TrajectoryWriter, ControlColumns).
+    const model::Euler e = model::euler_from_quaternion(r.state.q_WB);
+    const io::ControlColumns c = io::ControlColumns::from(r.status);
+    s.t_s.push_back(r.t_s);
+    const double row[12] = {r.state.p_W.x(), r.state.p_W.y(), r.state.p_W.z(), e.roll_rad, e.pitch_rad, e.yaw_rad,
+                            c.x_des,         c.y_des,         c.z_des,         c.roll_des, c.pitch_des, c.yaw_des};
+    for (int i = 0; i < 12; ++i) col[i]->push_back(row[i]);
+    if (writer) {
+      watchdog = simulation.plant().watchdog_active();
+      writer->write(r.t_s, r.state, r.applied_command, c, watchdog);
+    }
+    if (mcap) mcap->flush_settled(sc.simulation.plant.clock.ns(r.tick));
+  });
+  if (writer) writer->close();
+  if (mcap) {
+    mcap->close();
+    mcap->write_bag_metadata(mcap_dir->string(), "run.mcap");
+  }
+  return s;
+}
+
+void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
+  r.steps = io::evaluate_steps(sc.steps, series);
+  if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
+  r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed);
+}
+
+void write_json(const fs::path& path, const nlohmann::json& j) {
+  std::ofstream f(path);
+  f << j.dump(2) << '\n';
+  if (!f) throw std::runtime_error(path.string() + ": write failed");
+}
+
+// Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step
+// of the same channel gets "roll#2.overshoot_pct"), "hold.<figure>" for the hold.
+std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunResult& r, const io::Scenario& sc) {
+  std::vector<std::pair<std::string, std::optional<double>>> out;
+  std::map<std::string, int> seen;
+  const bool ok = r.error.empty();
+  for (std::size_t i = 0; i < sc.steps.size(); ++i) {
+    const std::string& ch = sc.steps[i].channel;
+    const int n = ++seen[ch];
+    const std::string prefix = n == 1 ? ch : fmt::format("{}#{}", ch, n);
+    for (const auto& name : analysis::figure_names()) {
+      out.emplace_back(prefix + "." + name, ok && i < r.steps.size() ? analysis::figure(r.steps[i].figures, name)
+                                                                     : std::nullopt);
+    }
+  }
+  if (sc.hold) {
+    for (const auto& name : io::hold_figure_names()) {
+      std::optional<double> v;
+      if (ok && r.hold) {
+        if (auto it = r.hold->figures.find(name); it != r.hold->figures.end()) v = it->second;
+      }
+      out.emplace_back("hold." + name, v);
+    }
+  }
+  return out;
+}
+
+nlohmann::json values_json(const Sample& s) {
+  nlohmann::json v = nlohmann::json::object();
+  for (const auto& [k, x] : s.values) v[k] = x;
+  return v;
+}
+
+}  // namespace
+
+nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r) {
+  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold);
+  nlohmann::json s;
+  s["index"] = r.sample.index;
+  s["seed"] = r.sample.seed;
+  s["sweep_seed"] = plan.seed;
+  s["values"] = values_json(r.sample);
+  s["factors"] = r.sample.factors;
+  // What the controller was designed for against what flew, for every varied vehicle key (other keys
+  // reach the controller and the plant alike: the controller flies its varied gains).
+  nlohmann::json vehicle = nlohmann::json::object();
+  for (const Vary& v : plan.vary) {
+    for (const Key& k : v.keys) {
+      if (!k.is_vehicle) continue;
+      const auto it = std::find_if(r.sample.values.begin(), r.sample.values.end(),
+                                   [&](const auto& p) { return p.first == k.path; });
+      vehicle[k.path] = {{"controller_designed_for", *k.nominal}, {"flown", it->second}};
+    }
+  }
+  s["vehicle"] = vehicle;
+  j["sweep"] = s;
+  return j;
+}
+
+RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep keep) {
+  RunResult r;
+  r.sample = sample(plan, index);
+  io::Scenario sc;
+  try {
+    sc = scenario_for(plan, r.sample);
+    if (!run_dir.empty()) fs::create_directories(run_dir);
+    const fs::path csv = run_dir / "trajectory.csv";
+    const bool record_now = keep == Keep::kAll && !run_dir.empty();
+    judge(sc, simulate(sc, record_now ? &csv : nullptr, nullptr), r);
+    if (keep == Keep::kFailing && !r.passed && !run_dir.empty()) (void)simulate(sc, &csv, nullptr);
+    if (!run_dir.empty()) write_json(run_dir / "metrics.json", run_metrics_json(plan, sc, r));
+  } catch (const control::CareError& e) {
+    r.error = std::string("controller design failed: ") + e.what();
+  } catch (const std::exception& e) {
+    r.error = e.what();
+  }
+  if (!r.error.empty()) r.passed = false;
+  return r;
+}
+
+std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs, const fs::path& runs_dir,
+                                Keep keep) {
+  std::vector<RunResult> results(indices.size());
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i; (i = next.fetch_add(1)) < indices.size();) {
+      const int index = indices[i];
+      results[i] = run_one(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep);
+    }
+  };
+  std::vector<std::thread> pool;
+  const int threads = std::max(1, std::min<int>(jobs, static_cast<int>(indices.size())));
+  for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  return results;
+}
+
+std::vector<int> shard_indices(int runs, int shard, int count) {
+  std::vector<int> out;
+  for (int i = shard - 1; i < runs; i += count) out.push_back(i);
+  return out;
+}
+
+RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
+  if (index < 0 || index >= plan.runs) {
+    throw std::invalid_argument(fmt::format("run {} is not in the sweep (runs 0..{})", index, plan.runs - 1));
+  }
+  RunResult r;
+  r.sample = sample(plan, index);
+  const io::Scenario sc = scenario_for(plan, r.sample);
+  fs::create_directories(dir);
+  const fs::path csv = dir / "trajectory.csv";
+  (void)simulate(sc, &csv, &dir);
+  judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
+  write_json(dir / "metrics.json", run_metrics_json(plan, sc, r));
+  std::ofstream txt(dir / "metrics.txt");
+  txt << io::format_step_table(sc, r.steps, r.hold);
+  if (!txt) throw std::runtime_error((dir / "metrics.txt").string() + ": write failed");
+  return r;
+}
+
+nlohmann::json header_json(const Plan& plan) {
+  nlohmann::json j;
+  j["scenario"] = plan.nominal.name;
+  j["scenario_file"] = plan.scenario_file;
+  j["seed"] = plan.seed;
+  j["runs"] = plan.runs;
+  j["runs_per_point"] = plan.repeats;
+  j["sampler"] = to_string(plan.sampler);
+  j["vary"] = nlohmann::json::array();
+  for (const Vary& v : plan.vary) {
+    nlohmann::json keys = nlohmann::json::array();
+    nlohmann::json fields = nlohmann::json::array();
+    for (const Key& k : v.keys) {
+      nlohmann::json kj = {{"path", k.path}, {"stream", k.stream}, {"applies_to", k.is_vehicle ? "plant" : "scenario"}};
+      kj["nominal"] = k.nominal ? nlohmann::json(*k.nominal) : nlohmann::json();
+      kj["declared_range"] = k.declared ? nlohmann::json::array({k.declared->min, k.declared->max}) : nlohmann::json();
+      keys.push_back(kj);
+      fields.push_back(k.stream);
+    }
+    nlohmann::json vj = {{"spec", v.spec}, {"key", v.name}, {"distribution", to_string(v.distribution)},
+                         {"keys", keys}, {"fields", fields}};
+    switch (v.distribution) {
+      case Distribution::kPercent: vj["percent"] = v.a * 100.0; break;
+      case Distribution::kUniform: vj["min"] = v.a; vj["max"] = v.b; break;
+      case Distribution::kNormal: vj["mean"] = v.a; vj["sigma"] = v.b; break;
+      case Distribution::kGrid: vj["values"] = v.values; break;
+    }
+    j["vary"].push_back(vj);
+  }
+  return j;
+}
+
+nlohmann::json per_run_json(const Plan& plan, const RunResult& r) {
+  nlohmann::json run = {{"index", r.sample.index}, {"seed", r.sample.seed}, {"passed", r.passed}};
+  run["values"] = values_json(r.sample);
+  run["factors"] = r.sample.factors;
+  nlohmann::json figs = nlohmann::json::object();
+  for (const auto& [name, v] : figures_of(r, plan.nominal)) figs[name] = v ? nlohmann::json(*v) : nlohmann::json();
+  run["figures"] = figs;
+  if (!r.error.empty()) run["error"] = r.error;
+  return run;
+}
+
+nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run) {
+  const int runs = header.at("runs").get<int>();
+  std::sort(per_run.begin(), per_run.end(),
+            [](const auto& a, const auto& b) { return a.at("index").template get<int>() < b.at("index").template get<int>(); });
+  for (std::size_t i = 0; i < per_run.size(); ++i) {
+    const int index = per_run[i].at("index").get<int>();
+    if (index != static_cast<int>(i)) {
+      throw std::invalid_argument(index < static_cast<int>(i) ? fmt::format("run {} appears twice", index)
+                                                              : fmt::format("run {} is missing", i));
+    }
+  }
+  if (static_cast<int>(per_run.size()) != runs) {
+    throw std::invalid_argument(per_run.size() < static_cast<std::size_t>(runs)
+                                    ? fmt::format("run {} is missing", per_run.size())
+                                    : fmt::format("{} runs for a sweep of {}", per_run.size(), runs));
+  }
+  nlohmann::json j = header;
+  const auto passed = std::count_if(per_run.begin(), per_run.end(), [](const auto& r) { return r.at("passed").template get<bool>(); });
+  j["passed"] = passed;
+  j["pass_rate"] = runs > 0 ? static_cast<double>(passed) / runs : 0.0;
+  std::map<std::string, std::vector<std::optional<double>>> values;
+  for (const auto& r : per_run) {
+    for (const auto& [name, v] : r.at("figures").items()) {
+      values[name].push_back(v.is_null() ? std::nullopt : std::optional<double>(v.get<double>()));
+    }
+  }
+  nlohmann::json dist = nlohmann::json::object();
+  for (const auto& [name, list] : values) {
+    const FigureStats d = figure_stats(list);
+    nlohmann::json f = {{"count", d.count}, {"missing", d.missing}};
+    if (d.count > 0) {
+      f.update({{"min", d.min}, {"max", d.max}, {"mean", d.mean}, {"std", d.std}, {"p5", d.p5}, {"p25", d.p25},
+                {"p50", d.p50}, {"p75", d.p75}, {"p95", d.p95}});
+    }
+    dist[name] = f;
+  }
+  j["per_run"] = std::move(per_run);
+  j["figures"] = dist;
+  return j;
+}
+
+Plan plan_of(const fs::path& dir) {
+  nlohmann::json h;
+  fs::path file = dir / "summary.json";
+  if (!fs::exists(file)) file = dir / "shard.json";
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error((dir / "summary.json").string() + ": not found (nor shard.json): not a sweep folder");
+  try {
+    in >> h;
+    if (h.contains("header")) h = h.at("header");
+    std::vector<std::string> specs;
+    for (const auto& v : h.at("vary")) specs.push_back(v.at("spec").get<std::string>());
+    const fs::path scenario = dir / "scenario.yaml";
+    if (!fs::exists(scenario)) throw std::runtime_error(scenario.string() + ": not found");
+    Plan p = make_plan(scenario.string(), specs, h.at("seed").get<std::uint64_t>(), h.at("runs_per_point").get<int>(),
+                       h.at("sampler").get<std::string>() == "lhs" ? Sampler::kLhs : Sampler::kRandom);
+    if (p.runs != h.at("runs").get<int>()) throw std::runtime_error("the plan gives another number of runs");
+    return p;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(file.string() + ": not a sweep's summary (" + e.what() + ")");
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(file.string() + ": " + e.what());
+  } catch (const io::ConfigError& e) {
+    throw std::runtime_error(e.what());
+  }
+}
+
+std::vector<fs::path> sweep_outputs(const fs::path& dir) {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return out;
+  for (const char* name : {"summary.json", "shard.json", "scenario.yaml", "box.png"}) {
+    if (fs::exists(dir / name)) out.push_back(dir / name);
+  }
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string n = e.path().filename().string();
+    const bool png = n.size() > 4 && n.ends_with(".png");
+    if (png && (n.starts_with("hist_") || n.starts_with("scatter_") || n.starts_with("map_"))) out.push_back(e.path());
+  }
+  if (fs::is_directory(dir / "runs", ec)) {
+    for (const auto& e : fs::directory_iterator(dir / "runs", ec)) {
+      const std::string n = e.path().filename().string();
+      if (!e.is_directory() || n.empty() || !std::all_of(n.begin(), n.end(), ::isdigit)) continue;
+      for (const char* f : {"metrics.json", "trajectory.csv"}) {
+        if (fs::exists(e.path() / f)) out.push_back(e.path() / f);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void remove_sweep_outputs(const fs::path& dir) {
+  for (const fs::path& p : sweep_outputs(dir)) fs::remove(p);
+  std::error_code ec;
+  if (fs::is_directory(dir / "runs", ec)) {
+    for (const auto& e : fs::directory_iterator(dir / "runs", ec)) {
+      if (e.is_directory() && fs::is_empty(e.path())) fs::remove(e.path());
+    }
+    if (fs::is_empty(dir / "runs")) fs::remove(dir / "runs");
+  }
+}
+
+}  // namespace quadcosim::sweep

@@ -1,0 +1,72 @@
+// Running a sweep's runs and summarising them (docs/sweeps.md). No console output: callers (the
+// CLI, later Python) print what they want from the returned results and JSON.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/step_report.hpp"
+#include "sweep/plan.hpp"
+
+namespace quadcosim::sweep {
+
+/// Which runs keep their trajectory.csv in runs/NNNN/.
+enum class Keep { kNone, kFailing, kAll };
+
+struct RunResult {
+  Sample sample;
+  std::vector<io::StepResult> steps;
+  std::optional<io::HoldResult> hold;
+  bool passed = false;
+  std::string error;  ///< non-empty when the run could not be done (a refused value, a failed design)
+};
+
+/// Simulates run `index` in-process and judges it. With `run_dir` non-empty writes its metrics.json
+/// there (and trajectory.csv when `keep` asks for it). Never throws for a bad sample: the reason is
+/// in RunResult::error.
+RunResult run_one(const Plan& plan, int index, const std::filesystem::path& run_dir, Keep keep = Keep::kNone);
+
+/// Runs `indices` on `jobs` threads, each into runs_dir/NNNN (no files when runs_dir is empty);
+/// results in the order of `indices`, whatever the scheduling.
+std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs,
+                                const std::filesystem::path& runs_dir, Keep keep = Keep::kNone);
+
+/// Runs i with i % count == shard - 1 (shard in 1..count), ascending.
+std::vector<int> shard_indices(int runs, int shard, int count);
+
+/// Flies run `index` again into `dir` with the outputs of `quadcosim run` in-process: trajectory.csv,
+/// run.mcap, metadata.yaml, metrics.json (with the "sweep" section), metrics.txt; judged from the
+/// recorded CSV as `run` is. Throws io::ConfigError / std::invalid_argument for a refused value,
+/// std::runtime_error when a file cannot be written.
+RunResult rerun(const Plan& plan, int index, const std::filesystem::path& dir);
+
+/// metrics.json of a sweep run: `quadcosim run`'s, plus "sweep": {index, seed, sweep_seed, values,
+/// factors, vehicle: designed vs flown}.
+nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r);
+
+/// What identifies a sweep: scenario, scenario_file, seed, runs, sampler, runs_per_point, vary.
+/// Shards of one sweep have equal headers.
+nlohmann::json header_json(const Plan& plan);
+
+/// A run's entry of summary.json's per_run: index, seed, passed, values, factors, figures, error.
+nlohmann::json per_run_json(const Plan& plan, const RunResult& r);
+
+/// summary.json from the header and every run's per_run entry (any order; sorted by index here).
+/// Throws std::invalid_argument when an index is missing, repeated or out of range.
+nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run);
+
+/// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it).
+/// Throws std::runtime_error naming the file.
+Plan plan_of(const std::filesystem::path& sweep_dir);
+
+/// Files a sweep writes in `dir` that are there now (summary.json, shard.json, scenario.yaml,
+/// runs/NNNN/{metrics.json,trajectory.csv}, the plots of tools/plot_sweep.py): what --force removes.
+std::vector<std::filesystem::path> sweep_outputs(const std::filesystem::path& dir);
+
+/// Removes sweep_outputs(dir) and the run folders left empty.
+void remove_sweep_outputs(const std::filesystem::path& dir);
+
+}  // namespace quadcosim::sweep

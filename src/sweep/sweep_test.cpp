@@ -1,0 +1,316 @@
+// The sweep library: statistics against hand-computed values, the --vary forms, keys set in the
+// parsed scenario, draws (pure in (seed, run, key), grid factorial, Latin hypercube strata, the
+// truncated normal against its closed-form mean), the scenario a run flies, and summaries that do not
+// depend on threads or on the order runs come in.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <unistd.h>
+#include <fmt/format.h>
+
+#include "control/parameters.hpp"
+#include "model/random.hpp"
+#include "sweep/statistics.hpp"
+#include "sweep/sweep.hpp"
+
+namespace quadcosim::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+// A 2 s altitude step (fast runs) with a dotted controller key and a vehicle section.
+fs::path scenario_file() {
+  const fs::path dir = fs::temp_directory_path() / ("sweep_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path p = dir / "step.yaml";
+  std::ofstream(p) << R"(name: step
+simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 2}
+vehicle:
+  mass_kg: 1.2
+controller:
+  mode: attitude
+  altitude.kp: 4
+  z_des: 0
+schedule:
+  - at_s: 0
+    set: {z_des: 1.0}
+analysis:
+  steps:
+    - channel: z
+      at_s: 0
+      criteria:
+        overshoot_pct: [null, 25]
+)";
+  return p;
+}
+
+TEST(Statistics, PercentilesAndMomentsAgainstHandComputedValues) {
+  // 1, 2, 3, 4, 10: mean 4, sample variance (9+4+1+0+36)/4 = 12.5; p25 at rank 1 -> 2; p95 at rank
+  // 3.8 -> 4 + 0.8 * 6 = 8.8; p5 at rank 0.2 -> 1.2.
+  const FigureStats d = figure_stats({10.0, 2.0, std::nullopt, 1.0, 4.0, 3.0, std::nullopt});
+  EXPECT_EQ(d.count, 5u);
+  EXPECT_EQ(d.missing, 2u);
+  EXPECT_DOUBLE_EQ(d.mean, 4.0);
+  EXPECT_DOUBLE_EQ(d.std, std::sqrt(12.5));
+  EXPECT_DOUBLE_EQ(d.min, 1.0);
+  EXPECT_DOUBLE_EQ(d.max, 10.0);
+  EXPECT_DOUBLE_EQ(d.p25, 2.0);
+  EXPECT_DOUBLE_EQ(d.p50, 3.0);
+  EXPECT_DOUBLE_EQ(d.p95, 8.8);
+  EXPECT_DOUBLE_EQ(d.p5, 1.2);
+  const FigureStats none = figure_stats({std::nullopt, std::nullopt});
+  EXPECT_EQ(none.count, 0u);
+  EXPECT_EQ(none.missing, 2u);
+  EXPECT_EQ(figure_stats({7.0}).std, 0.0);
+}
+
+TEST(ParseVary, EveryForm) {
+  Vary v = parse_vary("mass=10%");
+  EXPECT_EQ(v.name, "mass");
+  EXPECT_EQ(v.distribution, Distribution::kPercent);
+  EXPECT_DOUBLE_EQ(v.a, 0.1);
+  v = parse_vary("controller.altitude.kp=uniform(2, 6)");
+  EXPECT_EQ(v.distribution, Distribution::kUniform);
+  EXPECT_EQ(v.a, 2.0);
+  EXPECT_EQ(v.b, 6.0);
+  v = parse_vary("x=normal(1,0.5)");
+  EXPECT_EQ(v.distribution, Distribution::kNormal);
+  v = parse_vary("x=grid(1,2.5,-3)");
+  EXPECT_EQ(v.values, (std::vector<double>{1.0, 2.5, -3.0}));
+  v = parse_vary("x=linspace(0,1,5)");
+  EXPECT_EQ(v.values, (std::vector<double>{0.0, 0.25, 0.5, 0.75, 1.0}));
+  v = parse_vary("x=linspace(0.1,0.7,3)");
+  EXPECT_EQ(v.values.front(), 0.1);
+  EXPECT_EQ(v.values.back(), 0.7);  // the ends exactly as typed
+}
+
+TEST(ParseVary, BadSpecsNameWhatIsWrong) {
+  const auto error_of = [](const std::string& spec) {
+    try {
+      parse_vary(spec);
+    } catch (const PlanError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_THAT(error_of("mass=10"), HasSubstr("expected KEY=P%"));
+  EXPECT_THAT(error_of("mass=150%"), HasSubstr("percentage in [0, 100)"));
+  EXPECT_THAT(error_of("k=uniform(3,1)"), HasSubstr("a < b"));
+  EXPECT_THAT(error_of("k=uniform(1)"), HasSubstr("takes 2 numbers"));
+  EXPECT_THAT(error_of("k=normal(1,0)"), HasSubstr("sigma > 0"));
+  EXPECT_THAT(error_of("k=grid(1,x)"), HasSubstr("got 'x', expected a finite number"));
+  EXPECT_THAT(error_of("k=linspace(0,1,2.5)"), HasSubstr("whole n"));
+  EXPECT_THAT(error_of("k=beta(1,2)"), HasSubstr("unknown distribution 'beta'"));
+}
+
+TEST(SetKey, DottedNestedListsAndErrors) {
+  YAML::Node root = YAML::Load("controller: {altitude.kp: 4, lqr: {roll: {r: 100}}}\ninitial: {position_m: [0, 0, 1]}");
+  set_key(root, "controller.altitude.kp", 7.5);
+  set_key(root, "controller.lqr.roll.r", 50);
+  set_key(root, "initial.position_m[2]", 3.25);
+  set_key(root, "initial.position_m.x", -1);
+  set_key(root, "vehicle.motor.tau_up_s", 0.03);  // absent mappings are created
+  EXPECT_EQ(root["controller"]["altitude.kp"].as<double>(), 7.5);
+  EXPECT_FALSE(root["controller"]["altitude"]);  // the dotted key was set, not a second one added
+  EXPECT_EQ(root["controller"]["lqr"]["roll"]["r"].as<double>(), 50.0);
+  EXPECT_EQ(root["initial"]["position_m"][2].as<double>(), 3.25);
+  EXPECT_EQ(root["initial"]["position_m"][0].as<double>(), -1.0);
+  EXPECT_EQ(root["vehicle"]["motor"]["tau_up_s"].as<double>(), 0.03);
+  // A value round-trips exactly through the node (17 significant digits).
+  set_key(root, "vehicle.mass_kg", 0.1 + 0.2);
+  EXPECT_EQ(root["vehicle"]["mass_kg"].as<double>(), 0.1 + 0.2);
+  EXPECT_THROW(set_key(root, "initial.position_m[3]", 1), PlanError);
+  EXPECT_THROW(set_key(root, "controller.altitude.kp.x", 1), PlanError);
+  EXPECT_THROW(set_key(root, "environment.list[0]", 1), PlanError);  // no list to index
+  // A default list is written whole when the file has none.
+  YAML::Node empty = YAML::Load("{}");
+  set_key(empty, "initial.position_m.z", 2, {{"initial.position_m", {0.5, 0.25, 0}}});
+  EXPECT_EQ(empty["initial"]["position_m"][0].as<double>(), 0.5);
+  EXPECT_EQ(empty["initial"]["position_m"][2].as<double>(), 2.0);
+}
+
+TEST(Plan, RefusesUnknownKeysDoubleVariationAndValuesTheLoaderRefuses) {
+  const std::string f = scenario_file().string();
+  const auto error_of = [&](const std::vector<std::string>& specs) {
+    try {
+      make_plan(f, specs, 1, 4, Sampler::kRandom);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_THAT(error_of({"wingspan=5%"}), HasSubstr("unknown parameter 'wingspan'"));
+  EXPECT_THAT(error_of({"controller.altitude.kpp=uniform(1,2)"}), HasSubstr("unknown controller parameter 'altitude.kpp'"));
+  EXPECT_THAT(error_of({"controller.mode=grid(1)"}), HasSubstr("is a choice"));
+  EXPECT_THAT(error_of({"inertia=5%", "Ixx=5%"}), HasSubstr("already varied"));
+  EXPECT_THAT(error_of({"vehicle.mass_kg=5%", "mass=1%"}), HasSubstr("already varied"));
+  EXPECT_THAT(error_of({"vehicle.mass_kg=grid(1, -2)"}), AllOf(HasSubstr("grid value -2"), HasSubstr("vehicle.mass_kg")));
+  EXPECT_THAT(error_of({"simulation.wobble=uniform(1,2)"}), HasSubstr("wobble"));
+  EXPECT_THAT(error_of({"environment.gusts.w20_m_s=10%"}), HasSubstr("has no value in"));
+  // Outside the controller table's declared range: refused before any run.
+  EXPECT_THAT(error_of({"controller.altitude.min_cos_tilt=uniform(0.01,0.5)"}), HasSubstr("declared range [0.05, 1]"));
+  EXPECT_EQ(error_of({"controller.altitude.kp=uniform(1,2)", "environment.gusts.w20_m_s=uniform(0,2)"}), "accepted");
+}
+
+TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
+  const std::string f = scenario_file().string();
+  const Plan a = make_plan(f, {"mass=10%", "controller.altitude.kp=uniform(2,6)"}, 42, 100, Sampler::kRandom);
+  const Plan b = make_plan(f, {"controller.altitude.kp=uniform(2,6)", "mass=10%"}, 42, 100, Sampler::kRandom);
+  for (int i : {0, 57, 99}) {
+    const Sample s = sample(a, i);
+    EXPECT_EQ(sample(a, i).values, s.values);  // same call, same numbers
+    // A key's draw depends on (seed, run, key) only, not on the other keys or their order.
+    std::map<std::string, double> other(b.vary.empty() ? std::map<std::string, double>{} : std::map<std::string, double>{});
+    for (const auto& [k, v] : sample(b, i).values) other[k] = v;
+    for (const auto& [k, v] : s.values) EXPECT_EQ(other.at(k), v) << k;
+    // KEY=P%: factor 1 + P (2u - 1) with u the run's "vary"/field stream, as sweeps always drew.
+    model::Rng rng(model::stream_seed(model::stream_seed(42, "sweep", "run/" + std::to_string(i)), "vary", "mass_kg"));
+    const double factor = 1.0 + 0.1 * (2.0 * rng.uniform() - 1.0);
+    EXPECT_EQ(s.factors.at("mass_kg"), factor);
+    EXPECT_EQ(s.values[0].first, "vehicle.mass_kg");
+    EXPECT_EQ(s.values[0].second, 1.2 * factor);
+    EXPECT_GE(s.values[1].second, 2.0);
+    EXPECT_LE(s.values[1].second, 6.0);
+  }
+  EXPECT_NE(sample(a, 1).values, sample(a, 2).values);
+}
+
+TEST(Sample, GridIsFullFactorialWithTheFirstKeySlowest) {
+  const Plan p = make_plan(scenario_file().string(),
+                           {"controller.altitude.kp=grid(2,4)", "controller.altitude.kd=linspace(1,3,3)"}, 1, 2,
+                           Sampler::kRandom);
+  ASSERT_EQ(p.runs, 2 * 3 * 2);  // two repeats per point
+  std::multiset<std::pair<double, double>> points;
+  for (int i = 0; i < p.runs; ++i) {
+    const Sample s = sample(p, i);
+    points.insert({s.values[0].second, s.values[1].second});
+  }
+  for (double kp : {2.0, 4.0}) {
+    for (double kd : {1.0, 2.0, 3.0}) EXPECT_EQ(points.count({kp, kd}), 2u) << kp << " " << kd;
+  }
+  EXPECT_EQ(sample(p, 0).values[1].second, 1.0);
+  EXPECT_EQ(sample(p, 2).values[1].second, 2.0);  // runs 0, 1 repeat point 0; run 2 is the next kd
+  EXPECT_EQ(sample(p, 6).values[0].second, 4.0);
+  EXPECT_NE(sample(p, 0).seed, sample(p, 1).seed);  // repeats differ in their noise seed
+}
+
+TEST(Sample, LatinHypercubePutsOneRunInEveryStratumOfEveryKey) {
+  const int n = 50;
+  const Plan p = make_plan(scenario_file().string(),
+                           {"controller.altitude.kp=uniform(0,1)", "controller.altitude.kd=uniform(10,20)"}, 3, n,
+                           Sampler::kLhs);
+  std::set<int> kp_strata, kd_strata;
+  for (int i = 0; i < n; ++i) {
+    const Sample s = sample(p, i);
+    kp_strata.insert(static_cast<int>(std::floor(s.values[0].second * n)));
+    kd_strata.insert(static_cast<int>(std::floor((s.values[1].second - 10.0) / 10.0 * n)));
+  }
+  EXPECT_EQ(kp_strata.size(), static_cast<std::size_t>(n));
+  EXPECT_EQ(kd_strata.size(), static_cast<std::size_t>(n));
+  // Plain random draws leave strata empty (50 draws into 50 bins: about 18 stay empty).
+  const Plan r = make_plan(scenario_file().string(), {"controller.altitude.kp=uniform(0,1)"}, 3, n, Sampler::kRandom);
+  std::set<int> random_strata;
+  for (int i = 0; i < n; ++i) random_strata.insert(static_cast<int>(std::floor(sample(r, i).values[0].second * n)));
+  EXPECT_LT(random_strata.size(), static_cast<std::size_t>(n));
+}
+
+// Mean of N(mu, sigma) truncated to [a, b]: mu + sigma (phi(alpha) - phi(beta)) / (Phi(beta) - Phi(alpha)).
+double truncated_mean(double mu, double sigma, double a, double b) {
+  const auto pdf = [](double z) { return std::exp(-0.5 * z * z) / std::sqrt(2.0 * std::numbers::pi); };
+  const auto cdf = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  const double al = (a - mu) / sigma, be = (b - mu) / sigma;
+  return mu + sigma * (pdf(al) - pdf(be)) / (cdf(be) - cdf(al));
+}
+
+TEST(Sample, NormalTruncatedToTheDeclaredRangeHasTheClosedFormMean) {
+  const int n = 4000;
+  // altitude.min_cos_tilt is declared in [0.05, 1]: normal(0.1, 0.3) is cut hard at 0.05.
+  const Plan p = make_plan(scenario_file().string(), {"controller.altitude.min_cos_tilt=normal(0.1,0.3)",
+                                                      "controller.altitude.kd=normal(3,0.5)"},
+                           9, n, Sampler::kLhs);
+  double sum = 0.0, sum_kd = 0.0, ss_kd = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const Sample s = sample(p, i);
+    const double x = s.values[0].second;
+    ASSERT_GE(x, 0.05);
+    ASSERT_LE(x, 1.0);
+    sum += x;
+    sum_kd += s.values[1].second;
+    ss_kd += (s.values[1].second - 3.0) * (s.values[1].second - 3.0);
+  }
+  EXPECT_NEAR(sum / n, truncated_mean(0.1, 0.3, 0.05, 1.0), 0.005);  // 0.3066; untruncated it would be 0.1
+  EXPECT_NEAR(sum_kd / n, 3.0, 0.01);  // kd's range [0, 1e9] cuts nothing
+  EXPECT_NEAR(std::sqrt(ss_kd / n), 0.5, 0.01);
+}
+
+TEST(ScenarioFor, PlantFliesTheDrawTheControllerKeepsTheNominalVehicle) {
+  const Plan p = make_plan(scenario_file().string(), {"vehicle.mass_kg=grid(1.5)", "controller.altitude.kp=grid(7)"},
+                           1, 1, Sampler::kRandom);
+  const Sample s = sample(p, 0);
+  const io::Scenario sc = scenario_for(p, s);
+  EXPECT_EQ(sc.vehicle.mass_kg, 1.5);
+  EXPECT_EQ(sc.controller.params.vehicle.mass_kg, 1.2);
+  EXPECT_EQ(std::get<double>(*control::get_parameter(sc.controller, "altitude.kp")), 7.0);
+  EXPECT_EQ(sc.simulation.plant.realism.seed, s.seed);
+}
+
+TEST(RunOne, ARefusedDrawFailsThatRunNamingKeyAndValue) {
+  // normal(0.3, 1) on the mass: about 40 % of draws are negative, which the loader refuses.
+  const Plan p = make_plan(scenario_file().string(), {"vehicle.mass_kg=normal(0.3,1)"}, 5, 20, Sampler::kRandom);
+  int refused = 0;
+  for (int i = 0; i < p.runs; ++i) {
+    const Sample s = sample(p, i);
+    if (s.values[0].second > 0.0) continue;
+    const RunResult r = run_one(p, i, {});
+    EXPECT_FALSE(r.passed);
+    EXPECT_THAT(r.error, HasSubstr("vehicle.mass_kg"));
+    const auto q = r.error.find("got '");
+    ASSERT_NE(q, std::string::npos) << r.error;
+    EXPECT_EQ(std::stod(r.error.substr(q + 5)), s.values[0].second);  // the very value drawn
+    ++refused;
+  }
+  EXPECT_GT(refused, 0);
+}
+
+TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {
+  const Plan p = make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 7, 6,
+                           Sampler::kRandom);
+  std::vector<int> all = shard_indices(p.runs, 1, 1);
+  ASSERT_EQ(all, (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  const auto one = run_many(p, all, 1, {});
+  const auto two = run_many(p, all, 2, {});
+  std::vector<nlohmann::json> a, b;
+  for (const auto& r : one) a.push_back(per_run_json(p, r));
+  for (const auto& r : two) b.push_back(per_run_json(p, r));
+  const std::string dump = summary_json(header_json(p), a).dump(2);
+  EXPECT_EQ(summary_json(header_json(p), b).dump(2), dump);
+  // Shards 1/2 and 2/2 (even, odd runs), joined in the other order, through their JSON text.
+  EXPECT_EQ(shard_indices(6, 2, 2), (std::vector<int>{1, 3, 5}));
+  std::vector<nlohmann::json> joined;
+  for (int k : {2, 1}) {
+    for (const auto& r : run_many(p, shard_indices(p.runs, k, 2), 2, {})) {
+      joined.push_back(nlohmann::json::parse(per_run_json(p, r).dump()));
+    }
+  }
+  EXPECT_EQ(summary_json(header_json(p), joined).dump(2), dump);
+  // The distribution is that of the per-run figures.
+  const nlohmann::json s = summary_json(header_json(p), a);
+  double mx = -1e300;
+  for (const auto& r : s["per_run"]) mx = std::max(mx, r["figures"]["z.steady_state_error_pct"].get<double>());
+  EXPECT_EQ(s["figures"]["z.steady_state_error_pct"]["max"].get<double>(), mx);
+  EXPECT_EQ(s["figures"]["z.steady_state_error_pct"]["count"].get<int>(), 6);
+  // A run missing or given twice is refused.
+  a.pop_back();
+  EXPECT_THROW(summary_json(header_json(p), a), std::invalid_argument);
+  a.push_back(a.front());
+  EXPECT_THROW(summary_json(header_json(p), a), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace quadcosim::sweep
