@@ -10,6 +10,7 @@ packages=(
   libssl-dev openssl  # DDS Security keystores (libcrypto); openssl checks them in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
+  slurm-wlm munge  # a private single-node Slurm cluster for the sweep job array test (tests/sweep/slurm_test.sh)
   iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)
   clang libclang-rt-dev  # sanitizer build and libFuzzer targets (scripts/sanitize.sh); clang-14 and
