@@ -15,48 +15,11 @@ namespace quadcosim::sweep {
 
 namespace {
 
-// A vehicle field: its name (as in the scenario's `vehicle:` section, lists with .x/.y/.z) and where
-// it lives, for its nominal value.
-struct Field {
-  const char* name;
-  double (*get)(const model::VehicleParams&);
-};
-
-#define QUADCOSIM_FIELD(NAME, EXPR) \
-  Field { NAME, [](const model::VehicleParams& v) -> double { return EXPR; } }
-
-const std::vector<Field>& vehicle_fields() {
-  static const std::vector<Field> fields = {
-      QUADCOSIM_FIELD("mass_kg", v.mass_kg),
-      QUADCOSIM_FIELD("gravity_m_s2", v.gravity_m_s2),
-      QUADCOSIM_FIELD("Ixx_kg_m2", v.Ixx_kg_m2),
-      QUADCOSIM_FIELD("Iyy_kg_m2", v.Iyy_kg_m2),
-      QUADCOSIM_FIELD("Izz_kg_m2", v.Izz_kg_m2),
-      QUADCOSIM_FIELD("arm_length_m", v.arm_length_m),
-      QUADCOSIM_FIELD("kt_N_per_rad2_s2", v.kt_N_per_rad2_s2),
-      QUADCOSIM_FIELD("km_Nm_per_rad2_s2", v.km_Nm_per_rad2_s2),
-      QUADCOSIM_FIELD("motor.tau_up_s", v.motor.tau_up_s),
-      QUADCOSIM_FIELD("motor.tau_down_s", v.motor.tau_down_s),
-      QUADCOSIM_FIELD("motor.omega_min_rad_s", v.motor.omega_min_rad_s),
-      QUADCOSIM_FIELD("motor.omega_max_rad_s", v.motor.omega_max_rad_s),
-      QUADCOSIM_FIELD("aero.linear_drag_N_s_m.x", v.aero.linear_drag_N_s_m.x()),
-      QUADCOSIM_FIELD("aero.linear_drag_N_s_m.y", v.aero.linear_drag_N_s_m.y()),
-      QUADCOSIM_FIELD("aero.linear_drag_N_s_m.z", v.aero.linear_drag_N_s_m.z()),
-      QUADCOSIM_FIELD("aero.quadratic_drag_N_s2_m2.x", v.aero.quadratic_drag_N_s2_m2.x()),
-      QUADCOSIM_FIELD("aero.quadratic_drag_N_s2_m2.y", v.aero.quadratic_drag_N_s2_m2.y()),
-      QUADCOSIM_FIELD("aero.quadratic_drag_N_s2_m2.z", v.aero.quadratic_drag_N_s2_m2.z()),
-      QUADCOSIM_FIELD("aero.rotor_drag_N_s_m_per_rad_s", v.aero.rotor_drag_N_s_m_per_rad_s),
-      QUADCOSIM_FIELD("aero.ground_effect_rotor_radius_m", v.aero.ground_effect_rotor_radius_m),
-  };
-  return fields;
-}
-#undef QUADCOSIM_FIELD
-
-const Field* find_field(const std::string& name) {
-  for (const Field& f : vehicle_fields()) {
-    if (name == f.name) return &f;
-  }
-  return nullptr;
+// A vehicle field: a number of the vehicle parameter table (model/vehicle_params.hpp), by its YAML
+// path within `vehicle:` ("mass_kg", "motor.tau_up_s", "aero.linear_drag_N_s_m.x").
+const model::VehicleParameter* find_field(const std::string& name) {
+  const model::VehicleParameter* p = model::find_vehicle_parameter(name);
+  return p && p->kind == model::VehicleParameter::Kind::kNumber ? p : nullptr;
 }
 
 std::string known_aliases() {
@@ -201,11 +164,12 @@ std::optional<double> get_at(const YAML::Node& node, const std::vector<std::stri
 // Resolves the KEY of a spec into the scenario keys it sets.
 std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML::Node& root) {
   std::vector<Key> keys;
-  const auto vehicle_key = [&](const Field& f) {
+  const auto vehicle_key = [&](const model::VehicleParameter& f) {
     Key k;
-    k.path = std::string("vehicle.") + f.name;
-    k.stream = f.name;
+    k.path = "vehicle." + std::string(f.name);
+    k.stream = std::string(f.name);
     k.nominal = f.get(nominal.vehicle);
+    k.declared = DeclaredRange{f.range.min, f.range.max, "the vehicle parameter table (`quadcosim params --vehicle`)"};
     k.is_vehicle = true;
     return k;
   };
@@ -213,9 +177,9 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
     for (const auto& n : a->second) keys.push_back(vehicle_key(*find_field(n)));
     return keys;
   }
-  if (const Field* f = find_field(v.name)) return {vehicle_key(*f)};
+  if (const auto* f = find_field(v.name)) return {vehicle_key(*f)};
   if (v.name.rfind("vehicle.", 0) == 0) {
-    if (const Field* f = find_field(v.name.substr(8))) return {vehicle_key(*f)};
+    if (const auto* f = find_field(v.name.substr(8))) return {vehicle_key(*f)};
   }
   if (v.name.find('.') == std::string::npos) {
     throw PlanError("--vary " + v.spec + ": unknown parameter '" + v.name + "' (expected an alias (" + known_aliases() +

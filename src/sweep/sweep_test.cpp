@@ -150,7 +150,9 @@ TEST(Plan, RefusesUnknownKeysDoubleVariationAndValuesTheLoaderRefuses) {
   EXPECT_THAT(error_of({"controller.mode=grid(1)"}), HasSubstr("is a choice"));
   EXPECT_THAT(error_of({"inertia=5%", "Ixx=5%"}), HasSubstr("already varied"));
   EXPECT_THAT(error_of({"vehicle.mass_kg=5%", "mass=1%"}), HasSubstr("already varied"));
-  EXPECT_THAT(error_of({"vehicle.mass_kg=grid(1, -2)"}), AllOf(HasSubstr("grid value -2"), HasSubstr("vehicle.mass_kg")));
+  EXPECT_THAT(error_of({"vehicle.mass_kg=grid(1, -2)"}),
+              AllOf(HasSubstr("vehicle.mass_kg = -2"), HasSubstr("declared range [1e-06, 1e+12]")));
+  EXPECT_THAT(error_of({"initial.yaw_rad=grid(0, 12)"}), AllOf(HasSubstr("grid value 12"), HasSubstr("initial.yaw_rad")));
   EXPECT_THAT(error_of({"simulation.wobble=uniform(1,2)"}), HasSubstr("wobble"));
   EXPECT_THAT(error_of({"environment.gusts.w20_m_s=10%"}), HasSubstr("has no value in"));
   // Outside the controller table's declared range: refused before any run.
@@ -261,15 +263,18 @@ TEST(ScenarioFor, PlantFliesTheDrawTheControllerKeepsTheNominalVehicle) {
 }
 
 TEST(RunOne, ARefusedDrawFailsThatRunNamingKeyAndValue) {
-  // normal(0.3, 1) on the mass: about 40 % of draws are negative, which the loader refuses.
-  const Plan p = make_plan(scenario_file().string(), {"vehicle.mass_kg=normal(0.3,1)"}, 5, 20, Sampler::kRandom);
+  // initial.yaw_rad declares no range; the loader takes [-10, 10]: normal(0, 20) draws outside it in
+  // about 62 % of runs. The mass, declared in [1e-06, 1e12], is truncated there: never refused.
+  const Plan p = make_plan(scenario_file().string(), {"initial.yaw_rad=normal(0,20)", "vehicle.mass_kg=normal(0.3,1)"},
+                           5, 20, Sampler::kRandom);
   int refused = 0;
   for (int i = 0; i < p.runs; ++i) {
     const Sample s = sample(p, i);
-    if (s.values[0].second > 0.0) continue;
+    EXPECT_GE(s.values[1].second, 1e-6);
+    if (std::abs(s.values[0].second) <= 10.0) continue;
     const RunResult r = run_one(p, i, {});
     EXPECT_FALSE(r.passed);
-    EXPECT_THAT(r.error, HasSubstr("vehicle.mass_kg"));
+    EXPECT_THAT(r.error, HasSubstr("initial.yaw_rad"));
     const auto q = r.error.find("got '");
     ASSERT_NE(q, std::string::npos) << r.error;
     EXPECT_EQ(std::stod(r.error.substr(q + 5)), s.values[0].second);  // the very value drawn
