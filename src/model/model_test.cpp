@@ -940,29 +940,134 @@ TEST(SpecificForce, RestingOnGroundReadsGravityReactionInBody) {
 
 }  // namespace
 
-// step() takes a plain-double RK4 for ideal motors without an Environment (the paper's plant, the hot
-// path) and the general Eigen one otherwise. A neutral Environment (no wind, full efficiency, no
-// drag or ground effect) changes no number, so both drivers must give the same doubles through a
-// take-off from the ground, manoeuvres and a drop back onto it, with one and three sub-steps.
-TEST(QuadrotorStep, PlainPathEqualsGeneralPathUnderANeutralEnvironment) {
-  for (const int substeps : {1, 3}) {
-    const Quadrotor m{VehicleParams{}};
-    const quadcosim::model::Environment neutral;
-    State a = m.initial_state({0.0, 0.0, 0.0}, 0.3, false);
-    State b = a;
-    const double hover = m.params().hover_omega_rad_s();
-    for (int k = 0; k < 600; ++k) {
-      // Rest, climb with a roll and yaw doublet, then rotors cut (falls back to the ground).
-      const double s = k < 50 ? 0.5 : (k < 400 ? 1.08 : 0.0);
-      const double d = k < 200 ? 40.0 * std::sin(0.05 * k) : 25.0 * std::cos(0.03 * k);
-      const Vector4 u = Vector4(hover * s + d, hover * s - 0.5 * d, hover * s - d, hover * s + 0.7 * d);
-      m.step(a, 0.01 * k, u, 0.01, substeps);
-      m.step(b, 0.01 * k, u, 0.01, substeps, &neutral);
-      ASSERT_TRUE(a.p_W == b.p_W && a.v_W == b.v_W && a.q_WB.coeffs() == b.q_WB.coeffs() && a.w_B == b.w_B &&
-                  a.omega_rad_s == b.omega_rad_s)
-          << "tick " << k << " substeps " << substeps << ": " << a.p_W.transpose() << " vs " << b.p_W.transpose();
+namespace {
+
+// The plant written out independently of model/quadrotor.cpp, as a textbook would: an Eigen state
+// vector (p, v, q as w x y z, w_B, rotor speeds), each rotor's thrust k_t w^2 at its arm position
+// r_i = L (cos a_i, sin a_i, 0) and reaction torque spin_i k_m w^2, R(q) from Eigen's quaternion,
+// q' = 1/2 q (x) (0, w), classical RK4 with the quaternion normalised after each step. No ground
+// (the flight below stays high above it).
+using Vec17 = Eigen::Matrix<double, 17, 1>;
+
+Vec17 textbook_derivative(const VehicleParams& p, const Vec17& x, const Vector4& cmd) {
+  const bool lag = p.motor.model == MotorModel::kFirstOrder;
+  const Vector4 w = lag ? Vector4(x.segment<4>(13)) : cmd;
+  double thrust = 0.0;
+  Eigen::Vector3d tau = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 4; ++i) {
+    const double a = (p.layout == RotorLayout::kPlus ? 0.0 : std::numbers::pi / 4.0) - i * std::numbers::pi / 2.0;
+    const Eigen::Vector3d r(p.arm_length_m * std::cos(a), p.arm_length_m * std::sin(a), 0.0);
+    const double f = p.kt_N_per_rad2_s2 * w[i] * w[i];
+    thrust += f;
+    tau += r.cross(Eigen::Vector3d(0.0, 0.0, f)) + Eigen::Vector3d(0.0, 0.0, p.spin[i] * p.km_Nm_per_rad2_s2 * w[i] * w[i]);
+  }
+  const Eigen::Quaterniond q(x[6], x[7], x[8], x[9]);
+  const Eigen::Vector3d w_B = x.segment<3>(10);
+  const Eigen::Vector3d I(p.Ixx_kg_m2, p.Iyy_kg_m2, p.Izz_kg_m2);
+  Vec17 d = Vec17::Zero();
+  d.segment<3>(0) = x.segment<3>(3);
+  d.segment<3>(3) = q.toRotationMatrix() * Eigen::Vector3d(0.0, 0.0, thrust / p.mass_kg) -
+                    Eigen::Vector3d(0.0, 0.0, p.gravity_m_s2);
+  const Eigen::Quaterniond dq = q * Eigen::Quaterniond(0.0, w_B.x(), w_B.y(), w_B.z());
+  d.segment<4>(6) = 0.5 * Eigen::Vector4d(dq.w(), dq.x(), dq.y(), dq.z());
+  d.segment<3>(10) = (tau - w_B.cross(I.cwiseProduct(w_B))).cwiseQuotient(I);
+  if (lag) {
+    for (int i = 0; i < 4; ++i) {
+      const double e = cmd[i] - x[13 + i];
+      d[13 + i] = e / (e > 0.0 ? p.motor.tau_up_s : p.motor.tau_down_s);
     }
-    EXPECT_EQ(a.p_W.z(), 0.0);   // back on the ground
-    EXPECT_GT(a.q_WB.coeffs().head<3>().norm(), 0.01);  // and it did turn on the way
+  }
+  return d;
+}
+
+void textbook_step(const VehicleParams& p, Vec17& x, const Vector4& cmd, double dt, int substeps) {
+  const double h = dt / substeps;
+  for (int s = 0; s < substeps; ++s) {
+    const Vec17 k1 = textbook_derivative(p, x, cmd);
+    const Vec17 k2 = textbook_derivative(p, x + 0.5 * h * k1, cmd);
+    const Vec17 k3 = textbook_derivative(p, x + 0.5 * h * k2, cmd);
+    const Vec17 k4 = textbook_derivative(p, x + h * k3, cmd);
+    x += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    x.segment<4>(6).normalize();
+  }
+  if (p.motor.model == MotorModel::kIdeal) x.segment<4>(13) = cmd;
+}
+
+// Rest, climb with a roll and yaw doublet, then (from tick 400) rotors cut.
+Vector4 doublet_command(const Quadrotor& m, int k) {
+  const double hover = m.params().hover_omega_rad_s();
+  const double s = k < 50 ? 0.5 : (k < 400 ? 1.08 : 0.0);
+  const double d = k < 200 ? 40.0 * std::sin(0.05 * k) : 25.0 * std::cos(0.03 * k);
+  return Vector4(hover * s + d, hover * s - 0.5 * d, hover * s - d, hover * s + 0.7 * d);
+}
+
+}  // namespace
+
+// A neutral Environment (no wind, full efficiency, no drag or ground effect) changes no number: the
+// integrator then forms the rotors' wrench at every stage, with the efficiencies, the ground-effect
+// factor 1 and a zero drag, instead of once per step, and must give the same doubles through a
+// take-off from the ground, manoeuvres and a drop back onto it, for both motor models, with one and
+// three sub-steps.
+TEST(QuadrotorStep, ANeutralEnvironmentChangesNoNumber) {
+  for (const MotorModel motor : {MotorModel::kIdeal, MotorModel::kFirstOrder}) {
+    for (const int substeps : {1, 3}) {
+      VehicleParams params;
+      params.motor.model = motor;
+      const Quadrotor m{params};
+      const quadcosim::model::Environment neutral;
+      State a = m.initial_state({0.0, 0.0, 0.0}, 0.3, false);
+      State b = a;
+      for (int k = 0; k < 600; ++k) {
+        const Vector4 u = doublet_command(m, k);
+        const Outputs ya = m.outputs(0.01 * k, a, u), yb = m.outputs(0.01 * k, b, u, &neutral);
+        ASSERT_TRUE(ya.specific_force_B == yb.specific_force_B) << "tick " << k;
+        m.step(a, 0.01 * k, u, 0.01, substeps);
+        m.step(b, 0.01 * k, u, 0.01, substeps, &neutral);
+        ASSERT_TRUE(a.p_W == b.p_W && a.v_W == b.v_W && a.q_WB.coeffs() == b.q_WB.coeffs() && a.w_B == b.w_B &&
+                    a.omega_rad_s == b.omega_rad_s)
+            << "tick " << k << " substeps " << substeps << ": " << a.p_W.transpose() << " vs " << b.p_W.transpose();
+      }
+      EXPECT_EQ(a.p_W.z(), 0.0);                          // back on the ground
+      EXPECT_GT(a.q_WB.coeffs().head<3>().norm(), 0.01);  // and it did turn on the way
+    }
+  }
+}
+
+// The same flight high above the ground, with and without a neutral Environment, against the
+// textbook formulation above (a different association of the same sums: equal to rounding).
+TEST(QuadrotorStep, FollowsAnIndependentTextbookFormulation) {
+  for (const MotorModel motor : {MotorModel::kIdeal, MotorModel::kFirstOrder}) {
+    for (const RotorLayout layout : {RotorLayout::kPlus, RotorLayout::kX}) {
+      for (const int substeps : {1, 3}) {
+        VehicleParams params;
+        params.motor.model = motor;
+        params.layout = layout;
+        const Quadrotor m{params};
+        const quadcosim::model::Environment neutral;
+        State a = m.initial_state({1.0, -2.0, 50.0}, 0.3, true);
+        State b = a;
+        Vec17 t;
+        t << a.p_W, a.v_W, a.q_WB.w(), a.q_WB.x(), a.q_WB.y(), a.q_WB.z(), a.w_B, a.omega_rad_s;
+        double worst = 0.0;
+        for (int k = 50; k < 400; ++k) {
+          const Vector4 u = doublet_command(m, k);
+          m.step(a, 0.01 * k, u, 0.01, substeps);
+          m.step(b, 0.01 * k, u, 0.01, substeps, &neutral);
+          textbook_step(params, t, u, 0.01, substeps);
+          for (const State* x : {&a, &b}) {
+            Vec17 s;
+            s << x->p_W, x->v_W, x->q_WB.w(), x->q_WB.x(), x->q_WB.y(), x->q_WB.z(), x->w_B, x->omega_rad_s;
+            Vec17 scale = Vec17::Ones();
+            scale.segment<4>(13).setConstant(1e4);  // rotor speeds are ~1e4 rad/s
+            worst = std::max(worst, (s - t).cwiseQuotient(scale).cwiseAbs().maxCoeff());
+          }
+        }
+        EXPECT_LT(worst, 1e-9) << "motor " << static_cast<int>(motor) << " layout " << static_cast<int>(layout)
+                               << " substeps " << substeps;
+        EXPECT_GT((a.p_W - Eigen::Vector3d(1.0, -2.0, 50.0)).norm(), 5.0);  // it flew (open loop: off and down)
+        EXPECT_GT(a.p_W.z(), 10.0);                                          // far from the ground
+        EXPECT_GT(a.q_WB.coeffs().head<3>().norm(), 0.01);  // and turned
+      }
+    }
   }
 }

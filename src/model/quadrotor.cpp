@@ -31,12 +31,13 @@ Wrench Quadrotor::wrench(const Vector4& omega) const {
 
 namespace {
 
-// The rigid body's part of the state as plain doubles, for the hot path of step(): p_W (0-2), v_W
-// (3-5), q_WB as w, x, y, z (6-9), w_B (10-12).
+// The state as plain doubles for the integrator: the rigid body, p_W (0-2), v_W (3-5), q_WB as w, x,
+// y, z (6-9), w_B (10-12), then the rotor speeds (13-16), which only a lagging motor integrates.
 constexpr int kRigid = 13;
-using Rigid = double[kRigid];
+constexpr int kWithRotors = 17;
+using Packed = double[kWithRotors];
 
-void pack(const State& x, Rigid r) {
+inline void pack_rigid(const State& x, Packed r) {
   for (int i = 0; i < 3; ++i) {
     r[i] = x.p_W[i];
     r[3 + i] = x.v_W[i];
@@ -48,25 +49,41 @@ void pack(const State& x, Rigid r) {
   r[9] = x.q_WB.z();
 }
 
-void unpack(const Rigid r, State& x) {
+/// The rotor speeds as well, where they are read: a lagging motor's state (an ideal one turns at the
+/// command).
+inline void pack(const State& x, bool rotor_lag, Packed r) {
+  pack_rigid(x, r);
+  if (rotor_lag) {
+    for (int i = 0; i < 4; ++i) r[13 + i] = x.omega_rad_s[i];
+  }
+}
+
+inline void unpack(const Packed r, State& x) {
   x.p_W = {r[0], r[1], r[2]};
   x.v_W = {r[3], r[4], r[5]};
   x.q_WB = Eigen::Quaterniond(r[6], r[7], r[8], r[9]);
   x.w_B = {r[10], r[11], r[12]};
 }
 
+}  // namespace
+
 /// What the rigid body's derivative needs besides the state: the rotors' wrench (collective thrust per
 /// unit mass [m/s^2], body torque [N m]), an optional extra acceleration in the world frame [m/s^2]
 /// (air drag), and the vehicle's constants.
-struct RigidInputs {
+struct Quadrotor::RigidInputs {
   double thrust_per_mass;
   double torque_B[3];
-  const Eigen::Vector3d* accel_W;
+  bool has_accel_W;
+  double accel_W[3];
   double gravity;
   double inertia[3];
   double inv_inertia[3];
   bool gyroscopic;
 };
+
+namespace {
+
+using RigidInputs = Quadrotor::RigidInputs;
 
 /// dv_W/dt, eq. (7): the thrust along R_WB's third column (formed as Eigen's toRotationMatrix()
 /// forms it) per unit mass, gravity, and the extra acceleration if any, for the attitude q (w, x, y,
@@ -78,20 +95,20 @@ inline Eigen::Vector3d linear_acceleration(const double* y, const RigidInputs& i
   double ax = (tz * qx + ty * qw) * in.thrust_per_mass;
   double ay = (tz * qy - tx * qw) * in.thrust_per_mass;
   double az = (1.0 - (tx * qx + ty * qy)) * in.thrust_per_mass - in.gravity;
-  if (in.accel_W) {
-    ax += in.accel_W->x();
-    ay += in.accel_W->y();
-    az += in.accel_W->z();
+  if (in.has_accel_W) {  // not "+ 0.0" when there is none: that would turn a -0 into +0
+    ax += in.accel_W[0];
+    ay += in.accel_W[1];
+    az += in.accel_W[2];
   }
   held = y[2] <= 0.0 && y[5] <= 0.0 && az <= 0.0;
   if (held) return Eigen::Vector3d::Zero();
   return {ax, ay, az};
 }
 
-/// The equations of Quadrotor::derivative() on 13 plain doubles (y -> d), so that step() can run RK4
-/// on them: translation (linear_acceleration); rotation, eq. (8) (or (11)), the gyroscopic term as
-/// Eigen's cross() forms it, times 1/I (a product, not a division: shorter latency on every RK4
-/// stage); ground contact; dq/dt = 1/2 q (x) (0, w).
+/// The equations of Quadrotor::derivative() on the rigid body's 13 plain doubles (y -> d):
+/// translation (linear_acceleration); rotation, eq. (8) (or (11)), the gyroscopic term as Eigen's
+/// cross() forms it, times 1/I (a product, not a division: shorter latency on every RK4 stage);
+/// ground contact; dq/dt = 1/2 q (x) (0, w).
 inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, double* __restrict d) {
   bool held = false;
   const Eigen::Vector3d a = linear_acceleration(y, in, held);
@@ -123,17 +140,6 @@ inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, 
   d[12] = dwz;
 }
 
-RigidInputs rigid_inputs(const VehicleParams& p, const Eigen::Vector4d& reciprocals, const Wrench& f,
-                         const Eigen::Vector3d* accel_W) {
-  return {f.thrust_N * reciprocals[0],
-          {f.torque_B_Nm.x(), f.torque_B_Nm.y(), f.torque_B_Nm.z()},
-          accel_W,
-          p.gravity_m_s2,
-          {p.Ixx_kg_m2, p.Iyy_kg_m2, p.Izz_kg_m2},
-          {reciprocals[1], reciprocals[2], reciprocals[3]},
-          p.gyroscopic == GyroscopicModel::kFull};
-}
-
 /// Scales q (w, x, y, z) to unit norm: |q|^2 summed as Eigen sums (x, y, z, w) in pairs, then one
 /// division and four products (end_substep: the state's quaternion after every RK4 step).
 void normalize_quaternion(double& w, double& x, double& y, double& z) {
@@ -146,9 +152,9 @@ void normalize_quaternion(double& w, double& x, double& y, double& z) {
   z *= inv_n;
 }
 
-/// The end of an RK4 step, in both drivers: the quaternion back to unit norm; a vehicle that went
-/// below z = 0 during the step touched down (inelastic impact, held by friction).
-void end_substep(Rigid r) {
+/// The end of an RK4 step: the quaternion back to unit norm; a vehicle that went below z = 0 during
+/// the step touched down (inelastic impact, held by friction).
+void end_substep(double* r) {
   // On scalars: an Eigen quaternion here costs two failed store-to-load forwards per step.
   normalize_quaternion(r[6], r[7], r[8], r[9]);
   if (r[2] < 0.0) {
@@ -173,41 +179,101 @@ Eigen::Vector3d rotate_by_inverse(const Eigen::Quaterniond& q, const Eigen::Vect
 
 }  // namespace
 
-StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd,
-                                      const Environment* env) const {
-  StateDerivative d;
-  const bool ideal = params_.motor.model == MotorModel::kIdeal;
-  const Vector4 omega = ideal ? cmd : x.omega_rad_s;
+Quadrotor::RigidInputs Quadrotor::rigid_inputs(const Wrench& f) const {
+  return {f.thrust_N * reciprocals_[0],
+          {f.torque_B_Nm.x(), f.torque_B_Nm.y(), f.torque_B_Nm.z()},
+          false,
+          {0.0, 0.0, 0.0},
+          params_.gravity_m_s2,
+          {params_.Ixx_kg_m2, params_.Iyy_kg_m2, params_.Izz_kg_m2},
+          {reciprocals_[1], reciprocals_[2], reciprocals_[3]},
+          params_.gyroscopic == GyroscopicModel::kFull};
+}
 
-  if (ideal) {
-    d.omega_rad_s.setZero();
+Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const AppliedCommand& cmd,
+                                                 const Environment* env) const {
+  const bool ideal = params_.motor.model == MotorModel::kIdeal;
+  if (!env) return rigid_inputs(ideal ? cmd.wrench : wrench(Vector4(y[13], y[14], y[15], y[16])));
+  // The rotors turn at the command (ideal) or at the state's speeds (lag); the air's drag acts on the
+  // velocity relative to the wind in the body frame.
+  const Vector4 omega = ideal ? cmd.omega_rad_s : Vector4(y[13], y[14], y[15], y[16]);
+  const Vector4 u = mixer_ * env->rotor_efficiency.cwiseProduct(omega.cwiseProduct(omega));
+  RigidInputs in = rigid_inputs({u[0] * ground_effect_factor(params_.aero, y[2]), u.tail<3>()});
+  const Eigen::Quaterniond q_WB(y[6], y[7], y[8], y[9]);
+  const Eigen::Vector3d accel_W =
+      aero_force_W(params_.aero, q_WB.toRotationMatrix(), Eigen::Vector3d(y[3], y[4], y[5]), env->wind_W, omega) *
+      reciprocals_[0];
+  in.has_accel_W = true;
+  for (int i = 0; i < 3; ++i) in.accel_W[i] = accel_W[i];
+  return in;
+}
+
+template <bool kVaryingInputs, bool kRotorLag>
+void Quadrotor::stage_derivative(const double* __restrict y, const AppliedCommand& cmd, const Environment* env,
+                                 const RigidInputs& held_inputs, double* __restrict d) const {
+  if constexpr (kVaryingInputs) {
+    rigid_derivative(y, varying_inputs(y, cmd, env), d);
   } else {
+    rigid_derivative(y, held_inputs, d);
+  }
+  if constexpr (kRotorLag) {  // first-order lag towards the command, its own time constant each way
     for (int i = 0; i < 4; ++i) {
-      const double err = cmd[i] - x.omega_rad_s[i];
+      const double err = cmd.omega_rad_s[i] - y[13 + i];
       const double tau = err > 0.0 ? params_.motor.tau_up_s : params_.motor.tau_down_s;
-      d.omega_rad_s[i] = err / tau;
+      d[13 + i] = err / tau;
     }
   }
+}
 
-  const Wrench f = env ? environment_wrench(omega, x, *env) : wrench(omega);
-  Eigen::Vector3d aero_accel_W;
-  if (env) {
-    aero_accel_W =
-        aero_force_W(params_.aero, x.q_WB.toRotationMatrix(), x.v_W, env->wind_W, omega) * reciprocals_[0];
+template <bool kVaryingInputs, bool kRotorLag>
+[[gnu::always_inline]] inline void Quadrotor::integrate(State& x, const AppliedCommand& cmd, double h, int substeps,
+                          const Environment* env) const {
+  constexpr int n = kRotorLag ? kWithRotors : kRigid;  // ideal rotors: their speeds are the command
+  Packed r;
+  pack(x, kRotorLag, r);
+  // Formed once when it is the same in every stage (ideal motors, no Environment: the paper's plant).
+  const RigidInputs held_inputs = kVaryingInputs ? RigidInputs{} : rigid_inputs(cmd.wrench);
+  double k1[n], k2[n], k3[n], k4[n], y[n];
+  for (int s = 0; s < substeps; ++s) {
+    stage_derivative<kVaryingInputs, kRotorLag>(r, cmd, env, held_inputs, k1);
+    for (int i = 0; i < n; ++i) y[i] = r[i] + (0.5 * h) * k1[i];
+    stage_derivative<kVaryingInputs, kRotorLag>(y, cmd, env, held_inputs, k2);
+    for (int i = 0; i < n; ++i) y[i] = r[i] + (0.5 * h) * k2[i];
+    stage_derivative<kVaryingInputs, kRotorLag>(y, cmd, env, held_inputs, k3);
+    for (int i = 0; i < n; ++i) y[i] = r[i] + h * k3[i];
+    stage_derivative<kVaryingInputs, kRotorLag>(y, cmd, env, held_inputs, k4);
+    for (int i = 0; i < n; ++i) r[i] = r[i] + h * ((k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) * (1.0 / 6.0));
+    end_substep(r);
   }
-  Rigid y, r;
-  pack(x, y);
-  rigid_derivative(y, rigid_inputs(params_, reciprocals_, f, env ? &aero_accel_W : nullptr), r);
+  unpack(r, x);
+  if constexpr (kRotorLag) {
+    x.omega_rad_s = clamp_command(Vector4(r[13], r[14], r[15], r[16]));
+  } else {
+    x.omega_rad_s = cmd.omega_rad_s;
+  }
+}
+
+StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd,
+                                      const Environment* env) const {
+  AppliedCommand applied;
+  applied.omega_rad_s = cmd;  // already clamped, as the caller promises
+  const bool lag = params_.motor.model == MotorModel::kFirstOrder;
+  Packed y, r;
+  pack(x, lag, y);
+  if (!lag) {
+    applied.wrench = wrench(cmd);
+    stage_derivative<true, false>(y, applied, env, RigidInputs{}, r);
+    for (int i = 0; i < 4; ++i) r[13 + i] = 0.0;
+  } else {
+    stage_derivative<true, true>(y, applied, env, RigidInputs{}, r);
+  }
+  StateDerivative d;
   d.p_W = {r[0], r[1], r[2]};
   d.v_W = {r[3], r[4], r[5]};
   d.q_WB_wxyz = {r[6], r[7], r[8], r[9]};
   d.w_B = {r[10], r[11], r[12]};
+  d.omega_rad_s = {r[13], r[14], r[15], r[16]};
   return d;
-}
-
-Wrench Quadrotor::environment_wrench(const Vector4& omega, const State& x, const Environment& env) const {
-  const Vector4 u = mixer_ * env.rotor_efficiency.cwiseProduct(omega.cwiseProduct(omega));
-  return {u[0] * ground_effect_factor(params_.aero, x.p_W.z()), u.tail<3>()};
 }
 
 AppliedCommand Quadrotor::apply(const Vector4& cmd) const {
@@ -221,100 +287,43 @@ Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const
   return outputs(t_s, x, apply(cmd), env);
 }
 
-Outputs Quadrotor::outputs(double t_s, const State& x, const AppliedCommand& cmd, const Environment* env) const {
-  Eigen::Vector3d a_minus_g;
-  if (params_.motor.model == MotorModel::kIdeal && !env) {  // derivative()'s translation only
-    Rigid y;
-    pack(x, y);
-    bool held = false;
-    a_minus_g = linear_acceleration(y, rigid_inputs(params_, reciprocals_, cmd.wrench, nullptr), held);
-  } else {
-    a_minus_g = derivative(t_s, x, cmd.omega_rad_s, env).v_W;
-  }
+template <bool kVaryingInputs>
+[[gnu::always_inline]] inline Eigen::Vector3d Quadrotor::specific_force_W(const State& x, const AppliedCommand& cmd, const Environment* env) const {
+  Packed y;
+  pack(x, params_.motor.model == MotorModel::kFirstOrder, y);
+  bool held = false;
+  // derivative()'s translation only, with the inputs of a step's first stage.
+  Eigen::Vector3d a_minus_g =
+      linear_acceleration(y, kVaryingInputs ? varying_inputs(y, cmd, env) : rigid_inputs(cmd.wrench), held);
   a_minus_g.z() += params_.gravity_m_s2;
-  return {x.p_W, x.q_WB, x.v_W, x.w_B, rotate_by_inverse(x.q_WB, a_minus_g)};
+  return a_minus_g;
 }
 
-namespace {
-
-State add_scaled(const State& x, const StateDerivative& d, double h) {
-  State y;
-  y.p_W = x.p_W + h * d.p_W;
-  y.v_W = x.v_W + h * d.v_W;
-  y.q_WB.coeffs() = x.q_WB.coeffs();  // Eigen stores (x, y, z, w)
-  y.q_WB.w() += h * d.q_WB_wxyz[0];
-  y.q_WB.x() += h * d.q_WB_wxyz[1];
-  y.q_WB.y() += h * d.q_WB_wxyz[2];
-  y.q_WB.z() += h * d.q_WB_wxyz[3];
-  y.w_B = x.w_B + h * d.w_B;
-  y.omega_rad_s = x.omega_rad_s + h * d.omega_rad_s;
-  return y;
+Outputs Quadrotor::outputs(double /*t_s*/, const State& x, const AppliedCommand& cmd, const Environment* env) const {
+  // As step(), compiled for what varies: nothing but the state for ideal motors without an Environment.
+  const bool varying = env || params_.motor.model == MotorModel::kFirstOrder;
+  const Eigen::Vector3d a_minus_g_W = varying ? specific_force_W<true>(x, cmd, env) : specific_force_W<false>(x, cmd, env);
+  return {x.p_W, x.q_WB, x.v_W, x.w_B, rotate_by_inverse(x.q_WB, a_minus_g_W)};
 }
-
-StateDerivative weighted_sum(const StateDerivative& k1, const StateDerivative& k2,
-                             const StateDerivative& k3, const StateDerivative& k4) {
-  // (k1 + 2 k2 + 2 k3 + k4) / 6, the RK4 slope.
-  auto mix = [](const auto& a, const auto& b, const auto& c, const auto& e) {
-    return ((a + 2.0 * b + 2.0 * c + e) * (1.0 / 6.0)).eval();
-  };
-  return {mix(k1.p_W, k2.p_W, k3.p_W, k4.p_W), mix(k1.v_W, k2.v_W, k3.v_W, k4.v_W),
-          mix(k1.q_WB_wxyz, k2.q_WB_wxyz, k3.q_WB_wxyz, k4.q_WB_wxyz),
-          mix(k1.w_B, k2.w_B, k3.w_B, k4.w_B),
-          mix(k1.omega_rad_s, k2.omega_rad_s, k3.omega_rad_s, k4.omega_rad_s)};
-}
-
-}  // namespace
 
 void Quadrotor::step(State& x, double t_s, const Vector4& cmd, double dt_s, int substeps,
                      const Environment* env) const {
   step(x, t_s, apply(cmd), dt_s, substeps, env);
 }
 
-void Quadrotor::step(State& x, double t_s, const AppliedCommand& applied, double dt_s, int substeps,
+void Quadrotor::step(State& x, double /*t_s*/, const AppliedCommand& applied, double dt_s, int substeps,
                      const Environment* env) const {
   assert(substeps >= 1);
-  const Vector4& cmd = applied.omega_rad_s;
   const double h = dt_s / substeps;
-  const bool ideal = params_.motor.model == MotorModel::kIdeal;
-  if (ideal && !env) {
-    // The rotors' wrench is the same in every stage (and was formed with the command): RK4 on 13
-    // plain doubles.
-    const RigidInputs in = rigid_inputs(params_, reciprocals_, applied.wrench, nullptr);
-    Rigid r, k1, k2, k3, k4, y;
-    pack(x, r);
-    for (int s = 0; s < substeps; ++s) {
-      rigid_derivative(r, in, k1);
-      for (int i = 0; i < kRigid; ++i) y[i] = r[i] + (0.5 * h) * k1[i];
-      rigid_derivative(y, in, k2);
-      for (int i = 0; i < kRigid; ++i) y[i] = r[i] + (0.5 * h) * k2[i];
-      rigid_derivative(y, in, k3);
-      for (int i = 0; i < kRigid; ++i) y[i] = r[i] + h * k3[i];
-      rigid_derivative(y, in, k4);
-      for (int i = 0; i < kRigid; ++i) {
-        r[i] = r[i] + h * ((k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) * (1.0 / 6.0));
-      }
-      end_substep(r);
-    }
-    unpack(r, x);
-    x.omega_rad_s = cmd;
-    return;
-  }
-  for (int s = 0; s < substeps; ++s) {
-    const double t = t_s + s * h;
-    const StateDerivative k1 = derivative(t, x, cmd, env);
-    const StateDerivative k2 = derivative(t + 0.5 * h, add_scaled(x, k1, 0.5 * h), cmd, env);
-    const StateDerivative k3 = derivative(t + 0.5 * h, add_scaled(x, k2, 0.5 * h), cmd, env);
-    const StateDerivative k4 = derivative(t + h, add_scaled(x, k3, h), cmd, env);
-    x = add_scaled(x, weighted_sum(k1, k2, k3, k4), h);
-    Rigid r;
-    pack(x, r);
-    end_substep(r);
-    unpack(r, x);
-  }
-  if (ideal) {
-    x.omega_rad_s = cmd;
+  // One integrator, compiled for what varies over a step's stages: nothing for ideal motors without
+  // an Environment (the rotors' wrench was formed with the command), the wrench and drag at each
+  // stage's state otherwise, and the rotor speeds too for a lagging motor.
+  if (params_.motor.model == MotorModel::kFirstOrder) {
+    integrate<true, true>(x, applied, h, substeps, env);
+  } else if (env) {
+    integrate<true, false>(x, applied, h, substeps, env);
   } else {
-    x.omega_rad_s = clamp_command(x.omega_rad_s);
+    integrate<false, false>(x, applied, h, substeps, nullptr);
   }
 }
 

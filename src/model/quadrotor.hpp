@@ -99,9 +99,27 @@ class Quadrotor {
   /// A state at rest at p_W with rotors stopped (or at hover speed when `hover` is true).
   State initial_state(const Eigen::Vector3d& p_W, double yaw_rad, bool hover) const;
 
+ /// What one RK4 stage's rigid-body derivative takes besides the state (defined in quadrotor.cpp).
+  struct RigidInputs;
+
  private:
-  /// Eq. (4) with each rotor's efficiency and the ground effect on U1.
-  Wrench environment_wrench(const Vector4& omega, const State& x, const Environment& env) const;
+  /// RigidInputs for the rotors' wrench f, without an extra acceleration.
+  RigidInputs rigid_inputs(const Wrench& f) const;
+  /// The inputs at the packed state y where they vary from stage to stage (quadrotor.cpp): the
+  /// rotors' wrench, eq. (4), at the command (ideal motors) or at y's rotor speeds (lag); with an
+  /// Environment, each rotor's efficiency, the ground effect on U1 and the air's drag as an extra
+  /// acceleration. Without either, the command's own wrench (AppliedCommand) is used instead.
+  RigidInputs varying_inputs(const double* y, const AppliedCommand& cmd, const Environment* env) const;
+  /// dy/dt at the packed state y; `held_inputs` are used when kVaryingInputs is false.
+  template <bool kVaryingInputs, bool kRotorLag>
+  void stage_derivative(const double* y, const AppliedCommand& cmd, const Environment* env,
+                        const RigidInputs& held_inputs, double* d) const;
+  /// The RK4 integrator of step(): `substeps` steps of h on x packed into plain doubles.
+  template <bool kVaryingInputs, bool kRotorLag>
+  void integrate(State& x, const AppliedCommand& cmd, double h, int substeps, const Environment* env) const;
+  /// The specific force at x in the world frame, a_W - g_W (Outputs::specific_force_B rotated).
+  template <bool kVaryingInputs>
+  Eigen::Vector3d specific_force_W(const State& x, const AppliedCommand& cmd, const Environment* env) const;
 
   VehicleParams params_;
   Matrix4 mixer_;
