@@ -12,6 +12,7 @@
 //                              the largest swarm found at >= 1x real time (doubling, then bisection)
 //   *_pinned                   the DDS figures again with the plant and the controller each on its
 //                              own CPU (--cpus; pinned_cpus names them, null with fewer than 2 CPUs)
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/utsname.h>
 
@@ -27,6 +28,7 @@
 
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/swarm.hpp"
 #include "bench/micro/baseline_setup.hpp"
@@ -204,15 +206,26 @@ nlohmann::json number_or_null(double v) { return std::isfinite(v) && v > 0 ? nlo
 
 }  // namespace
 
+CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& bench) {
+  bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
+  bench.swarm_scenario = QUADCOSIM_SCENARIOS_DIR "/swarm/grid_takeoff.yaml";
+  auto* bench_cmd = app.add_subcommand("bench", "measure speed: in-process, DDS lockstep, real-time jitter, swarms");
+  bench_cmd->add_flag("--json", bench.json, "print one JSON object");
+  bench_cmd->add_flag("--quick", bench.quick, "short runs (smoke test; the figures are not representative)");
+  bench_cmd->add_option("--only", bench.only, "run one part")
+      ->check(CLI::IsMember({"inproc", "dds", "realtime", "swarm_inproc", "swarm_dds"}));
+  bench_cmd->add_option("--seconds", bench.seconds, "simulated seconds of the inproc/dds part")
+      ->check(CLI::Range(0.0, 1e6));
+  bench_cmd->add_option("--rt-priority", bench.rt_priority, "realtime part: SCHED_FIFO priority of the controller (0: skip)")
+      ->check(CLI::Range(0, 99));
+  bench_cmd->add_option("--scenario", bench.scenario, "single-vehicle scenario")->check(CLI::ExistingFile);
+  bench_cmd->add_option("--swarm-scenario", bench.swarm_scenario, "swarm scenario")->check(CLI::ExistingFile);
+  return bench_cmd;
+}
+
 int bench_command(const BenchOptions& o) {
-  io::Scenario paper, swarm;
-  try {
-    paper = io::load_scenario(o.scenario);
-    swarm = io::load_scenario(o.swarm_scenario);
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  }
+  const io::Scenario paper = io::load_scenario(o.scenario);
+  const io::Scenario swarm = io::load_scenario(o.swarm_scenario);
   const bool q = o.quick;
   const auto all_start = std::chrono::steady_clock::now();
   auto want = [&](const char* part) { return o.only.empty() || o.only == part; };
@@ -311,7 +324,7 @@ int bench_command(const BenchOptions& o) {
   } else {
     std::cout << j.dump(2) << std::endl;
   }
-  return 0;
+  return exit_code::kOk;
 }
 
 }  // namespace quadcosim::app

@@ -1,5 +1,7 @@
-// The quadcosim subcommands. Each returns the process exit code: 0 success, 1 a step criterion
-// failed, 2 bad input (file, flag), 3 an output could not be produced.
+// The quadcosim subcommands. Each command file registers its subcommand with
+// add_<name>_subcommand(app, options) (the options it parses into) and runs it with
+// <name>_command(options), which returns the process exit code (app/exit_codes.hpp: the values
+// and, per command, what they mean); main.cpp runs it under run_guarded, which maps what it throws.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +30,7 @@ struct RunOptions {
   std::string keystore;
 };
 int run_command(const RunOptions& options);
+CLI::App* add_run_subcommand(CLI::App& app, RunOptions& options);
 
 struct OpenloopOptions {
   std::string commands;
@@ -39,12 +42,14 @@ struct OpenloopOptions {
   double initial_z_m = 0.0;
 };
 int openloop_command(const OpenloopOptions& options);
+CLI::App* add_openloop_subcommand(CLI::App& app, OpenloopOptions& options);
 
 struct LqrOptions {
   std::string params;   ///< controller parameter file, "" for defaults
   std::string vehicle;  ///< vehicle file, "" for the paper's vehicle
 };
 int lqr_command(const LqrOptions& options);
+CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& options);
 
 struct ParamsOptions {
   bool vehicle = false;   ///< the vehicle's parameters instead of the controller's
@@ -53,12 +58,14 @@ struct ParamsOptions {
 /// Lists the controller's (or with `vehicle`, the vehicle's) parameters: name, unit, range, default,
 /// meaning.
 int params_command(const ParamsOptions& options);
+CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& options);
 
 struct SummaryOptions {
   std::vector<std::string> run_dirs;
   std::string out;  ///< markdown file, "" for stdout only
 };
 int summary_command(const SummaryOptions& options);
+CLI::App* add_summary_subcommand(CLI::App& app, SummaryOptions& options);
 
 struct PlantCommandOptions {
   std::string scenario;     ///< vehicle, rates, duration, initial state ("" for defaults)
@@ -87,6 +94,7 @@ struct PlantCommandOptions {
   std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
 };
 int plant_command(const PlantCommandOptions& options);
+CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& options);
 
 struct ControllerCommandOptions {
   std::string scenario;  ///< controller parameters, rates, schedule ("" for defaults)
@@ -107,6 +115,7 @@ struct ControllerCommandOptions {
   std::string enclave = "/";   ///< DDS Security enclave (rcl --enclave)
 };
 int controller_command(const ControllerCommandOptions& options);
+CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& options);
 
 /// `quadcosim param get|set|list|describe NODE [NAME [VALUE]]` (param_command.cpp): the ROS 2
 /// parameter services of a node over DDS, printed as `ros2 param` prints them. Exit 0 on success,
@@ -152,6 +161,7 @@ struct RecordOptions {
   std::string enclave = "/";        ///< DDS Security enclave (rcl --enclave)
 };
 int record_command(const RecordOptions& options);
+CLI::App* add_record_subcommand(CLI::App& app, RecordOptions& options);
 
 /// `quadcosim security create-keystore|create-enclave|check` (security_command.cpp). Exit 0 on
 /// success, 1 when check finds problems, 2 on bad input (an existing keystore, a bad name or topic).
@@ -215,10 +225,19 @@ int margins_command(const MarginsOptions& options);
 bool run_tool(const std::string& script, const std::vector<std::string>& args);
 
 /// `quadcosim plot RUN_DIR`: regenerates the figures and report.html of a run.
-int plot_command(const std::string& run_dir);
+struct PlotOptions {
+  std::string run_dir;
+};
+CLI::App* add_plot_subcommand(CLI::App& app, PlotOptions& options);
+int plot_command(const PlotOptions& options);
 
 /// `quadcosim compare RUN_A RUN_B [--out DIR]`: overlays two runs and tabulates their step figures.
-int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out);
+struct CompareOptions {
+  std::string run_a, run_b;
+  std::string out;  ///< "" for RUN_B/compare_with_<RUN_A>
+};
+CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& options);
+int compare_command(const CompareOptions& options);
 
 struct BenchOptions {
   bool json = false;          ///< one JSON object on stdout (else the same, indented)
@@ -231,6 +250,7 @@ struct BenchOptions {
 };
 /// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
 int bench_command(const BenchOptions& options);
+CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& options);
 
 /// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py).
 bool make_plots(const std::string& run_dir);

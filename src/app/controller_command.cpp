@@ -1,104 +1,127 @@
 // `quadcosim controller`: the flight controller node as a long-running process over DDS, stepping
 // once per complete sensor sample in lockstep, or on a wall-clock timer in real time.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
-#include "control/care.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_service.hpp"
 #include "io/scenario.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "sim/controller_node.hpp"
+#include "sim/topics.hpp"
 
 namespace quadcosim::app {
+
+CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl) {
+  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
+  auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
+  ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
+      ->check(CLI::ExistingFile);
+  ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
+  ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
+      ->check(CLI::ExistingFile);
+  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
+  ctl_cmd->add_option("--vehicles", ctl.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  ctl_cmd->add_option("--ns-prefix", ctl.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  ctl_cmd->add_option("--threads", ctl.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
+  ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
+  add_cpus_option(ctl_cmd, ctl.cpus);
+  ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
+  ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
+                    "ignore the scenario's schedule (someone else sets the parameters)");
+  ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
+      ->check(CLI::Range(1e-3, 1e6));
+  ctl_cmd->add_option("--rt-priority", ctl.rt_priority,
+                      "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
+      ->check(CLI::Range(0, 99));
+  ctl_cmd->add_option("--stats", ctl.stats, "real time: write the control period jitter as JSON here on exit");
+  ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
+      ->check(CLI::Validator(check_node_name, "NAME"));
+
+  add_enclave_option(ctl_cmd, ctl.enclave);
+  return ctl_cmd;
+}
 
 int controller_command(const ControllerCommandOptions& o) {
   install_stop_handlers();
   // Before any DDS participant: Cyclone's threads inherit the affinity.
   if (std::string err = use_cpus(o.cpus); !err.empty()) {
     std::cerr << "error: controller: --cpus: " << err << '\n';
-    return 2;
+    return exit_code::kBadInput;
   }
   // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
   if (!o.cpus.empty()) std::cerr << fmt::format("controller: on CPU(s) {} only\n", o.cpus);
-  try {
-    io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
-    if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
-    if (!o.ns.empty()) sc.simulation.ns = o.ns;
-    refuse_faults_over_dds(sc);
-    if (o.vehicles > 0) return swarm_controller_command(o, std::move(sc));
-    const sim::TickClock clock = sc.simulation.plant.clock;
-    const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
-    const double dt_s = static_cast<double>(control_period_ns) / 1e9;
-    const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
+  io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
+  if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
+  if (!o.ns.empty()) sc.simulation.ns = o.ns;
+  refuse_faults_over_dds(sc);
+  if (o.vehicles > 0) return swarm_controller_command(o, std::move(sc));
+  const sim::TickClock clock = sc.simulation.plant.clock;
+  const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
+  const double dt_s = static_cast<double>(control_period_ns) / 1e9;
+  const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
 
-    dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
-    if (o.sensor_qos) use_sensor_qos(transport, topics);
-    sim::ControllerNode node(transport, topics, sc.controller);
-    const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
-    // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
-    dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
-    if (!o.apply_schedule) sc.schedule.clear();
-    dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
-    announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
-    std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
-                             transport.participant().domain_id(), sc.simulation.ns,
-                             o.lockstep ? "lockstep" : "real-time", dt_s);
+  dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
+  if (o.sensor_qos) use_sensor_qos(transport, topics);
+  sim::ControllerNode node(transport, topics, sc.controller);
+  const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
+  // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
+  dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
+  if (!o.apply_schedule) sc.schedule.clear();
+  dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
+  announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
+  std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
+                           transport.participant().domain_id(), sc.simulation.ns,
+                           o.lockstep ? "lockstep" : "real-time", dt_s);
 
-    if (o.lockstep) {
-      // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
-      // arrival, so answering a tick wakes no other thread; the host's waits serve the parameter
-      // services.
-      DdsDriverHost host(transport);
-      drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
-                                               sc.simulation.controller_divider, host);
-      driver.run();
-    } else {
-      // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
-      node.use_receipt_clock(steady_ns);
-      if (std::string err = use_realtime_priority(o.rt_priority); !err.empty()) {
-        std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
-      }
-      const auto wall_period_ns =
-          static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
-      PeriodJitter jitter(wall_period_ns);
-      drivers::RealtimeControllerHooks h;
-      h.on_wake = [&](std::int64_t now) { jitter.add(now); };
-      h.on_first_sample = [](std::size_t, std::int64_t stamp_ns) {
-        std::cerr << fmt::format("controller: first complete sensor sample (t = {:g} s); controlling\n",
-                                 static_cast<double>(stamp_ns) / 1e9);
-      };
-      h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
-        std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
-                                 safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
-                                 node.estimate().age_s, node.config().params.stale_limit_s,
-                                 static_cast<double>(now) / 1e9);
-      };
-      DdsDriverHost host(transport, /*precise_deadlines=*/true);
-      drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
-                                               sc.simulation.controller_divider, o.rate_factor, std::move(h), host);
-      driver.run();
-      if (!o.stats.empty()) write_stats(o.stats, jitter.figures());
+  if (o.lockstep) {
+    // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
+    // arrival, so answering a tick wakes no other thread; the host's waits serve the parameter
+    // services.
+    DdsDriverHost host(transport);
+    drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
+                                             sc.simulation.controller_divider, host);
+    driver.run();
+  } else {
+    // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
+    node.use_receipt_clock(steady_ns);
+    if (std::string err = use_realtime_priority(o.rt_priority); !err.empty()) {
+      std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
     }
-    std::cerr << "controller: stopped\n";
-    return 0;
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const control::CareError& e) {
-    std::cerr << "error: controller design failed: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: controller: " << e.what() << '\n';
-    return 3;
+    const auto wall_period_ns =
+        static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
+    PeriodJitter jitter(wall_period_ns);
+    drivers::RealtimeControllerHooks h;
+    h.on_wake = [&](std::int64_t now) { jitter.add(now); };
+    h.on_first_sample = [](std::size_t, std::int64_t stamp_ns) {
+      std::cerr << fmt::format("controller: first complete sensor sample (t = {:g} s); controlling\n",
+                               static_cast<double>(stamp_ns) / 1e9);
+    };
+    h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
+      std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
+                               safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
+                               node.estimate().age_s, node.config().params.stale_limit_s,
+                               static_cast<double>(now) / 1e9);
+    };
+    DdsDriverHost host(transport, /*precise_deadlines=*/true);
+    drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
+                                             sc.simulation.controller_divider, o.rate_factor, std::move(h), host);
+    driver.run();
+    if (!o.stats.empty()) write_stats(o.stats, jitter.figures());
   }
+  std::cerr << "controller: stopped\n";
+  return exit_code::kOk;
 }
 
 }  // namespace quadcosim::app

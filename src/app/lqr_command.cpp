@@ -1,10 +1,11 @@
 // `quadcosim lqr` and `quadcosim params [--vehicle]`.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <iostream>
 
 #include "app/commands.hpp"
-#include "control/care.hpp"
+#include "app/exit_codes.hpp"
 #include "control/parameters.hpp"
 #include "io/scenario.hpp"
 
@@ -17,35 +18,42 @@ std::string complex_str(const std::complex<double>& c) {
 }
 }  // namespace
 
+CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& lqr) {
+  auto* lqr_cmd = app.add_subcommand("lqr", "each attitude axis's A, B, Q, R, gain K and closed-loop poles");
+  lqr_cmd->add_option("--params", lqr.params, "controller parameter YAML")->check(CLI::ExistingFile);
+  lqr_cmd->add_option("--vehicle", lqr.vehicle, "vehicle YAML")->check(CLI::ExistingFile);
+  return lqr_cmd;
+}
+
+CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
+  auto* params_cmd = app.add_subcommand("params", "list the controller's (or the vehicle's) parameters");
+  params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
+  params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
+      ->needs(params_cmd->get_option("--vehicle"));
+  return params_cmd;
+}
+
 int lqr_command(const LqrOptions& opt) {
-  try {
-    model::VehicleParams vehicle;
-    if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
-    control::ControllerConfig cfg;
-    cfg.params.vehicle = vehicle;
-    if (!opt.params.empty()) cfg = io::load_controller(opt.params, vehicle);
-    const control::FlightController fc(cfg.params);
-    const char* names[3] = {"roll", "pitch", "yaw"};
-    const double inertia[3] = {vehicle.Ixx_kg_m2, vehicle.Iyy_kg_m2, vehicle.Izz_kg_m2};
-    for (int i = 0; i < 3; ++i) {
-      const control::AxisLqr& a = fc.axis(i);
-      std::cout << fmt::format("{} axis (I = {:g} kg m^2), state [e, rate], U = -K x\n", names[i], inertia[i]);
-      std::cout << fmt::format("  A = [[{:g}, {:g}], [{:g}, {:g}]]\n", a.A(0, 0), a.A(0, 1), a.A(1, 0), a.A(1, 1));
-      std::cout << fmt::format("  B = [{:g}, {:.6g}]\n", a.B(0), a.B(1));
-      std::cout << fmt::format("  Q = diag({:g}, {:g})   R = {:g}\n", a.Q(0, 0), a.Q(1, 1), a.R);
-      std::cout << fmt::format("  K = [{:.6g}, {:.6g}]   (Algorithm 1: k1 = {:.6g}, k2 = {:.6g})\n", a.K(0),
-                               a.K(1), -a.K(0), a.K(1));
-      std::cout << fmt::format("  closed-loop poles: {}, {}\n", complex_str(a.closed_loop_poles(0)),
-                               complex_str(a.closed_loop_poles(1)));
-    }
-    return 0;
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const control::CareError& e) {
-    std::cerr << "error: LQR design failed: " << e.what() << '\n';
-    return 2;
+  model::VehicleParams vehicle;
+  if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
+  control::ControllerConfig cfg;
+  cfg.params.vehicle = vehicle;
+  if (!opt.params.empty()) cfg = io::load_controller(opt.params, vehicle);
+  const control::FlightController fc(cfg.params);
+  const char* names[3] = {"roll", "pitch", "yaw"};
+  const double inertia[3] = {vehicle.Ixx_kg_m2, vehicle.Iyy_kg_m2, vehicle.Izz_kg_m2};
+  for (int i = 0; i < 3; ++i) {
+    const control::AxisLqr& a = fc.axis(i);
+    std::cout << fmt::format("{} axis (I = {:g} kg m^2), state [e, rate], U = -K x\n", names[i], inertia[i]);
+    std::cout << fmt::format("  A = [[{:g}, {:g}], [{:g}, {:g}]]\n", a.A(0, 0), a.A(0, 1), a.A(1, 0), a.A(1, 1));
+    std::cout << fmt::format("  B = [{:g}, {:.6g}]\n", a.B(0), a.B(1));
+    std::cout << fmt::format("  Q = diag({:g}, {:g})   R = {:g}\n", a.Q(0, 0), a.Q(1, 1), a.R);
+    std::cout << fmt::format("  K = [{:.6g}, {:.6g}]   (Algorithm 1: k1 = {:.6g}, k2 = {:.6g})\n", a.K(0),
+                             a.K(1), -a.K(0), a.K(1));
+    std::cout << fmt::format("  closed-loop poles: {}, {}\n", complex_str(a.closed_loop_poles(0)),
+                             complex_str(a.closed_loop_poles(1)));
   }
+  return exit_code::kOk;
 }
 
 namespace {
@@ -84,7 +92,7 @@ int vehicle_params_table(bool markdown) {
       std::cout << fmt::format(text_row, p.name, p.unit, range, p.text(defaults), p.meaning);
     }
   }
-  return 0;
+  return exit_code::kOk;
 }
 
 }  // namespace
@@ -106,7 +114,7 @@ int params_command(const ParamsOptions& options) {
     std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", p.name, p.is_choice() ? "" : p.unit,
                              range, control::to_string(p.get(defaults)), p.description);
   }
-  return 0;
+  return exit_code::kOk;
 }
 
 }  // namespace quadcosim::app

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "dds/parameter_client.hpp"
 
 namespace quadcosim::app {
@@ -59,7 +60,7 @@ namespace {
 
 int not_set(const dds::NodeName& node, const std::string& name) {
   std::cerr << "Parameter not set: node " << node.fully_qualified() << " has no parameter '" << name << "'\n";
-  return 1;
+  return exit_code::kFailed;
 }
 
 void print_descriptor(const dds::ParamDescriptor& d) {
@@ -87,56 +88,45 @@ void print_descriptor(const dds::ParamDescriptor& d) {
 }  // namespace
 
 int param_command(const ParamOptions& o) {
-  try {
-    const dds::NodeName node = dds::parse_node_name(o.node);
-    const auto timeout_ns = static_cast<std::int64_t>(o.timeout_s * 1e9);
-    dds::ParameterClient client(dds::read_ros_environment(o.enclave), node);
-    if (o.verb == "get") {
-      const auto values = client.get({o.name}, timeout_ns);
-      if (values.empty()) return not_set(node, o.name);
-      std::cout << dds::ros2_get_line(values.front()) << '\n';
-      return 0;
-    }
-    if (o.verb == "set") {
-      const auto results = client.set({{o.name, dds::parse_param_value(o.value)}}, timeout_ns);
-      if (results.size() != 1) {
-        std::cerr << "error: node " << node.fully_qualified() << " answered set_parameters with " << results.size()
-                  << " results for 1 parameter\n";
-        return 3;
-      }
-      if (!results.front().successful) {
-        std::cerr << "Setting parameter failed" << (results.front().reason.empty() ? "" : ": ")
-                  << results.front().reason << '\n';
-        return 1;
-      }
-      std::cout << "Set parameter successful" << (results.front().reason.empty() ? "" : ": ")
-                << results.front().reason << '\n';
-      return 0;
-    }
-    if (o.verb == "list") {
-      auto names = client.list(o.prefixes, dds::kDepthRecursive, timeout_ns).names;
-      std::sort(names.begin(), names.end());
-      for (const auto& n : names) std::cout << "  " << n << '\n';
-      return 0;
-    }
-    if (o.verb == "describe") {
-      const auto descriptors = client.describe({o.name}, timeout_ns);
-      if (descriptors.empty()) return not_set(node, o.name);
-      print_descriptor(descriptors.front());
-      return 0;
-    }
-    std::cerr << "error: param: unknown verb '" << o.verb << "'\n";
-    return 2;
-  } catch (const dds::ParameterCallError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 4;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: param: " << e.what() << '\n';
-    return 3;
+  const dds::NodeName node = dds::parse_node_name(o.node);
+  const auto timeout_ns = static_cast<std::int64_t>(o.timeout_s * 1e9);
+  dds::ParameterClient client(dds::read_ros_environment(o.enclave), node);
+  if (o.verb == "get") {
+    const auto values = client.get({o.name}, timeout_ns);
+    if (values.empty()) return not_set(node, o.name);
+    std::cout << dds::ros2_get_line(values.front()) << '\n';
+    return exit_code::kOk;
   }
+  if (o.verb == "set") {
+    const auto results = client.set({{o.name, dds::parse_param_value(o.value)}}, timeout_ns);
+    if (results.size() != 1) {
+      std::cerr << "error: node " << node.fully_qualified() << " answered set_parameters with " << results.size()
+                << " results for 1 parameter\n";
+      return exit_code::kOutput;
+    }
+    if (!results.front().successful) {
+      std::cerr << "Setting parameter failed" << (results.front().reason.empty() ? "" : ": ")
+                << results.front().reason << '\n';
+      return exit_code::kFailed;
+    }
+    std::cout << "Set parameter successful" << (results.front().reason.empty() ? "" : ": ")
+              << results.front().reason << '\n';
+    return exit_code::kOk;
+  }
+  if (o.verb == "list") {
+    auto names = client.list(o.prefixes, dds::kDepthRecursive, timeout_ns).names;
+    std::sort(names.begin(), names.end());
+    for (const auto& n : names) std::cout << "  " << n << '\n';
+    return exit_code::kOk;
+  }
+  if (o.verb == "describe") {
+    const auto descriptors = client.describe({o.name}, timeout_ns);
+    if (descriptors.empty()) return not_set(node, o.name);
+    print_descriptor(descriptors.front());
+    return exit_code::kOk;
+  }
+  std::cerr << "error: param: unknown verb '" << o.verb << "'\n";
+  return exit_code::kBadInput;
 }
 
 }  // namespace quadcosim::app

@@ -1,5 +1,6 @@
 // `quadcosim plant`: the plant node as a long-running process over DDS, in lockstep (deterministic,
 // as fast as plant and controller can go) or in real time (paced by the wall clock).
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
@@ -24,13 +26,15 @@
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/plant_node.hpp"
+#include "sim/topics.hpp"
 
 namespace quadcosim::app {
 
 namespace {
 
 /// Exit codes of `plant` (docs/cosimulation.md).
-constexpr int kExitOk = 0, kExitRefused = 2, kExitNoController = 4, kExitInterrupted = 130;
+constexpr int kExitOk = exit_code::kOk, kExitRefused = exit_code::kBadInput, kExitNoController = exit_code::kNoPeer,
+              kExitInterrupted = exit_code::kInterrupted;
 
 /// One plant process: the node on its DDS transport, what it records, and the driver that advances
 /// it (lockstep or real time). Construction does all the setup; run() runs the driver.
@@ -284,46 +288,81 @@ class PlantProcess {
 
 }  // namespace
 
+CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
+  auto* plant_cmd = app.add_subcommand("plant", "the plant as a ROS 2 node over DDS (until done or Ctrl-C)");
+  plant_cmd->add_option("--scenario", plant.scenario, "scenario YAML (vehicle, rates, duration, initial state)")
+      ->check(CLI::ExistingFile);
+  plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
+      ->check(CLI::ExistingFile);
+  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
+  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
+  plant_cmd->add_option("--vehicles", plant.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  plant_cmd->add_option("--ns-prefix", plant.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  plant_cmd->add_option("--threads", plant.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
+  plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
+  add_cpus_option(plant_cmd, plant.cpus);
+  plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
+  plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
+      ->check(CLI::Range(1e-3, 1e6));
+  plant_cmd->add_option("--duration", plant.duration_s, "simulated time [s]")->check(CLI::Range(0.0, 1e9));
+  plant_cmd->add_option("--record", plant.record, "write the trajectory CSV here");
+  plant_cmd->add_option("--mcap", plant.mcap, "record the topics as MCAP here (metadata.yaml beside it)");
+  plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
+      ->check(CLI::Range(0.01, 3600.0));
+  plant_cmd->add_option("--schedule-via", plant.schedule_node,
+                        "lockstep: apply the scenario's schedule through this node's parameter services");
+  plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
+                      "real time: start only once a controller is matched (up to --timeout)");
+  plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
+  plant_cmd->add_option("--swarm-out", plant.swarm_out, "with --vehicles: write summary.json, vehicles.csv here");
+  plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
+      ->check(CLI::IsMember({"abort", "hold"}));
+  plant_cmd->add_option("--watchdog", plant.watchdog_s,
+                        "no valid motor command for this long [s] -> the watchdog policy (0: off; "
+                        "default: the scenario's simulation.watchdog_s, 0.5)")
+      ->check(CLI::Range(0.0, 1e6));
+  plant_cmd->add_option("--watchdog-policy", plant.watchdog_policy,
+                        "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
+      ->check(CLI::IsMember({"hold", "stop"}));
+
+  add_enclave_option(plant_cmd, plant.enclave);
+  return plant_cmd;
+}
+
 int plant_command(const PlantCommandOptions& o) {
   install_stop_handlers();
   // Before any DDS participant: Cyclone's threads inherit the affinity.
   if (std::string err = use_cpus(o.cpus); !err.empty()) {
     std::cerr << "error: plant: --cpus: " << err << '\n';
-    return 2;
+    return exit_code::kBadInput;
   }
   // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
   if (!o.cpus.empty()) std::cerr << fmt::format("plant: on CPU(s) {} only\n", o.cpus);
-  try {
-    io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
-    if (!o.ns.empty()) sc.simulation.ns = o.ns;
-    refuse_faults_over_dds(sc);
-    if (o.watchdog_s >= 0.0) {
-      const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
-      if (std::abs(ticks - std::round(ticks)) > 1e-6) {
-        std::cerr << fmt::format("error: --watchdog {:g}: expected a whole number of plant periods ({:g} s)\n",
-                                 o.watchdog_s, sc.simulation.plant.clock.period_s());
-        return 2;
-      }
-      sc.simulation.plant.watchdog_ticks = static_cast<sim::Tick>(std::round(ticks));
+  io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
+  if (!o.ns.empty()) sc.simulation.ns = o.ns;
+  refuse_faults_over_dds(sc);
+  if (o.watchdog_s >= 0.0) {
+    const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
+    if (std::abs(ticks - std::round(ticks)) > 1e-6) {
+      std::cerr << fmt::format("error: --watchdog {:g}: expected a whole number of plant periods ({:g} s)\n",
+                               o.watchdog_s, sc.simulation.plant.clock.period_s());
+      return exit_code::kBadInput;
     }
-    if (!o.watchdog_policy.empty()) {
-      sc.simulation.plant.watchdog_policy =
-          o.watchdog_policy == "hold" ? sim::WatchdogPolicy::kHold : sim::WatchdogPolicy::kStop;
-    }
-    if (o.duration_s >= 0.0) {
-      sc.simulation.duration_ticks =
-          static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
-    }
-    if (o.vehicles > 0) return swarm_plant_command(o, std::move(sc));
-    PlantProcess process(o, std::move(sc));
-    return process.run();
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: plant: " << e.what() << '\n';
-    return 3;
+    sc.simulation.plant.watchdog_ticks = static_cast<sim::Tick>(std::round(ticks));
   }
+  if (!o.watchdog_policy.empty()) {
+    sc.simulation.plant.watchdog_policy =
+        o.watchdog_policy == "hold" ? sim::WatchdogPolicy::kHold : sim::WatchdogPolicy::kStop;
+  }
+  if (o.duration_s >= 0.0) {
+    sc.simulation.duration_ticks =
+        static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
+  }
+  if (o.vehicles > 0) return swarm_plant_command(o, std::move(sc));
+  PlantProcess process(o, std::move(sc));
+  return process.run();
 }
 
 }  // namespace quadcosim::app

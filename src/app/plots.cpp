@@ -1,5 +1,6 @@
 // The Python tools (tools/*.py: plots, report, comparison) run with Debian's /usr/bin/python3,
 // where python3-matplotlib lives.
+#include <CLI/CLI.hpp>
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -8,6 +9,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 
 namespace quadcosim::app {
 
@@ -59,27 +61,42 @@ std::string check_run_dir(const std::string& what, const std::string& dir) {
 }
 }  // namespace
 
-int plot_command(const std::string& run_dir) {
-  if (std::string err = check_run_dir("run_dir", run_dir); !err.empty()) {
-    std::cerr << err << '\n';
-    return 2;
-  }
-  return make_plots(run_dir) ? 0 : 3;
+CLI::App* add_plot_subcommand(CLI::App& app, PlotOptions& plot) {
+  auto* plot_cmd = app.add_subcommand("plot", "regenerate a run directory's figures");
+  plot_cmd->add_option("run_dir", plot.run_dir, "run directory (trajectory.csv, metrics.json)")
+      ->required()->check(CLI::ExistingDirectory);
+  return plot_cmd;
 }
 
-int compare_command(const std::string& run_a, const std::string& run_b, const std::string& out) {
-  for (const auto& [what, dir] : {std::pair{"run_a", run_a}, std::pair{"run_b", run_b}}) {
+CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& compare) {
+  auto* cmp_cmd = app.add_subcommand("compare", "overlay two runs (e.g. two gain sets) and tabulate their step figures");
+  cmp_cmd->add_option("run_a", compare.run_a, "first run directory")->required()->check(CLI::ExistingDirectory);
+  cmp_cmd->add_option("run_b", compare.run_b, "second run directory")->required()->check(CLI::ExistingDirectory);
+  cmp_cmd->add_option("--out", compare.out, "output directory (default: RUN_B/compare_with_<RUN_A>)");
+  return cmp_cmd;
+}
+
+int plot_command(const PlotOptions& o) {
+  if (std::string err = check_run_dir("run_dir", o.run_dir); !err.empty()) {
+    std::cerr << err << '\n';
+    return exit_code::kBadInput;
+  }
+  return make_plots(o.run_dir) ? exit_code::kOk : exit_code::kOutput;
+}
+
+int compare_command(const CompareOptions& o) {
+  for (const auto& [what, dir] : {std::pair{"run_a", o.run_a}, std::pair{"run_b", o.run_b}}) {
     if (std::string err = check_run_dir(what, dir); !err.empty()) {
       std::cerr << err << '\n';
-      return 2;
+      return exit_code::kBadInput;
     }
   }
-  std::vector<std::string> args = {run_a, run_b};
-  if (!out.empty()) {
+  std::vector<std::string> args = {o.run_a, o.run_b};
+  if (!o.out.empty()) {
     args.push_back("--out");
-    args.push_back(out);
+    args.push_back(o.out);
   }
-  return run_tool("compare_runs.py", args) ? 0 : 3;
+  return run_tool("compare_runs.py", args) ? exit_code::kOk : exit_code::kOutput;
 }
 
 }  // namespace quadcosim::app

@@ -1,4 +1,5 @@
 // `quadcosim run SCENARIO --out DIR`
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <stdlib.h>
@@ -12,6 +13,7 @@
 
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
@@ -99,29 +101,48 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
 
 }  // namespace
 
+CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
+  auto* run_cmd = app.add_subcommand("run", "run a scenario: trajectory.csv, metrics.json, plots");
+  run_cmd->add_option("scenario", run.scenario, "scenario YAML file")->required()->check(CLI::ExistingFile);
+  run_cmd->add_option("--out", run.out_dir, "output directory (created)")->required();
+  run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots and report.html");
+  run_cmd->add_option("--transport", run.transport,
+                      "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
+      ->check(CLI::IsMember({"inproc", "dds"}));
+  run_cmd->add_option("--timeout", run.timeout_s, "dds: lockstep wait for a command [s]")
+      ->check(CLI::Range(0.01, 3600.0));
+  run_cmd->add_option("--keystore", run.keystore,
+                      "dds: run secured (SROS2 keystore, Enforce); created when missing, with enclaves "
+                      "/quadcosim/plant and /quadcosim/controller");
+  run_cmd->add_flag("--pin", run.pin,
+                    "dds: plant on one CPU, controller on another (the first two this process may use)");
+  run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
+  run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
+      ->check(CLI::Range(1e-3, 1e6));
+  run_cmd->add_option("--vehicles", run.vehicles, "a swarm of N vehicles on a grid (default: the scenario's swarm section)")
+      ->check(CLI::Range(1, 10'000'000));
+  run_cmd->add_option("--threads", run.threads, "in-process swarm: worker threads (default: swarm.threads, 2)")
+      ->check(CLI::Range(1, 64));
+  return run_cmd;
+}
+
 int run_command(const RunOptions& opt) {
-  io::Scenario sc;
-  try {
-    sc = io::load_scenario(opt.scenario);
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  }
+  const io::Scenario sc = io::load_scenario(opt.scenario);
 
   if (!opt.keystore.empty() && opt.transport != "dds") {
     std::cerr << "error: --keystore secures the DDS transport; add --transport dds\n";
-    return 2;
+    return exit_code::kBadInput;
   }
 
   std::error_code ec;
   fs::create_directories(opt.out_dir, ec);
   if (ec) {
     std::cerr << "error: cannot create output directory " << opt.out_dir << ": " << ec.message() << '\n';
-    return 3;
+    return exit_code::kOutput;
   }
   const fs::path out(opt.out_dir);
 
-  try {
+  try {  // the model's and the controller's checks of the scenario name no file: say which
     fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
     if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out);
     const std::string csv_path = (out / "trajectory.csv").string();
@@ -129,7 +150,7 @@ int run_command(const RunOptions& opt) {
       if (sc.simulation.faults.active()) {
         std::cerr << "error: " << opt.scenario << ": message_faults: message loss and delay are injected by the "
                      "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
-        return 2;
+        return exit_code::kBadInput;
       }
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
     } else {
@@ -163,7 +184,7 @@ int run_command(const RunOptions& opt) {
         mcap.close();
         mcap.write_bag_metadata(out.string(), "run.mcap");
         std::cerr << "\nrun: interrupted; " << csv_path << " and run.mcap hold what ran\n";
-        return 130;
+        return exit_code::kInterrupted;
       }
       progress.done();
       csv.close();
@@ -195,17 +216,12 @@ int run_command(const RunOptions& opt) {
     std::ofstream((out / "metrics.txt").string()) << table;
     std::cout << table;
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
-    if (opt.plots && !make_plots(opt.out_dir)) return 3;
-    return io::all_passed(results) && (!hold || hold->passed) ? 0 : 1;
+    if (opt.plots && !make_plots(opt.out_dir)) return exit_code::kOutput;
+    return io::all_passed(results) && (!hold || hold->passed) ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {
-    std::cerr << "error: " << opt.scenario << ": controller design failed: " << e.what() << '\n';
-    return 2;
+    throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());
   } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << opt.scenario << ": " << e.what() << '\n';
-    return 2;
-  } catch (const std::runtime_error& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 3;
+    throw io::ConfigError(opt.scenario + ": " + e.what());
   }
 }
 

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "dds/participant.hpp"
 #include "security/keystore.hpp"
 
@@ -64,38 +65,30 @@ CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& o) {
 }
 
 int security_command(const SecurityOptions& o) {
-  try {
-    if (o.verb == "create-keystore") {
-      const std::uint32_t domain = domain_or_env(o.domain_id);
-      security::create_keystore(o.dir, domain);
-      std::cout << fmt::format("created keystore {} (CA sros2CA, governance for domain {})\n", o.dir, domain);
-      return 0;
-    }
-    if (o.verb == "create-enclave") {
-      security::EnclavePolicy policy;
-      policy.deny_publish = o.deny_publish;
-      policy.domain_id = domain_or_env(o.domain_id);
-      const fs::path dir = security::create_enclave(o.dir, o.name, policy);
-      std::cout << fmt::format("created enclave {} in {} (domain {}{})\n", o.name, dir.string(), policy.domain_id,
-                               o.deny_publish.empty() ? "" : fmt::format(", may not publish {}", fmt::join(o.deny_publish, " ")));
-      return 0;
-    }
-    if (o.verb == "check") {
-      const fs::path dir = security::enclave_dir(o.dir, o.name);
-      const auto problems = security::check_enclave(dir);
-      for (const auto& p : problems) std::cout << "problem: " << p << '\n';
-      if (problems.empty()) std::cout << "enclave " << o.name << " in " << dir.string() << " is usable\n";
-      return problems.empty() ? 0 : 1;
-    }
-    std::cerr << "error: security: expected create-keystore, create-enclave or check\n";
-    return 2;
-  } catch (const security::KeystoreError& e) {
-    std::cerr << "error: security " << o.verb << ": " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: security " << o.verb << ": " << e.what() << '\n';
-    return 3;
+  if (o.verb == "create-keystore") {
+    const std::uint32_t domain = domain_or_env(o.domain_id);
+    security::create_keystore(o.dir, domain);
+    std::cout << fmt::format("created keystore {} (CA sros2CA, governance for domain {})\n", o.dir, domain);
+    return exit_code::kOk;
   }
+  if (o.verb == "create-enclave") {
+    security::EnclavePolicy policy;
+    policy.deny_publish = o.deny_publish;
+    policy.domain_id = domain_or_env(o.domain_id);
+    const fs::path dir = security::create_enclave(o.dir, o.name, policy);
+    std::cout << fmt::format("created enclave {} in {} (domain {}{})\n", o.name, dir.string(), policy.domain_id,
+                             o.deny_publish.empty() ? "" : fmt::format(", may not publish {}", fmt::join(o.deny_publish, " ")));
+    return exit_code::kOk;
+  }
+  if (o.verb == "check") {
+    const fs::path dir = security::enclave_dir(o.dir, o.name);
+    const auto problems = security::check_enclave(dir);
+    for (const auto& p : problems) std::cout << "problem: " << p << '\n';
+    if (problems.empty()) std::cout << "enclave " << o.name << " in " << dir.string() << " is usable\n";
+    return problems.empty() ? exit_code::kOk : exit_code::kFailed;
+  }
+  std::cerr << "error: security: expected create-keystore, create-enclave or check\n";
+  return exit_code::kBadInput;
 }
 
 int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves) {
@@ -116,7 +109,7 @@ int prepare_keystore_for_run(const std::string& keystore, const std::vector<std:
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "error: run --keystore " << keystore << ": " << e.what() << '\n';
-    return 2;
+    return exit_code::kBadInput;
   }
 }
 

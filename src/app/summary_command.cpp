@@ -1,4 +1,5 @@
 // `quadcosim summary RUN_DIR... [--out FILE.md]`: our step figures beside the reference ones.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 
 namespace quadcosim::app {
 
@@ -27,6 +29,13 @@ std::string band(const nlohmann::json& criteria, const std::string& fig) {
 }
 }  // namespace
 
+CLI::App* add_summary_subcommand(CLI::App& app, SummaryOptions& sum) {
+  auto* sum_cmd = app.add_subcommand("summary", "table of step figures of several runs (ours beside the paper's)");
+  sum_cmd->add_option("run_dirs", sum.run_dirs, "run directories (with metrics.json)")->required();
+  sum_cmd->add_option("--out", sum.out, "also write the table to this Markdown file");
+  return sum_cmd;
+}
+
 int summary_command(const SummaryOptions& opt) {
   const std::vector<std::pair<std::string, std::string>> figs = {
       {"overshoot_pct", "overshoot %"},     {"peak_time_s", "peak s"},
@@ -43,7 +52,7 @@ int summary_command(const SummaryOptions& opt) {
       in >> j;
     } catch (const std::exception& e) {
       std::cerr << "error: " << path.string() << ": " << e.what() << '\n';
-      return 2;
+      return exit_code::kBadInput;
     }
     for (const auto& s : j.value("steps", nlohmann::json::array())) {
       const std::string step = fmt::format("{} {:g} → {:g}", s.value("channel", "?"),
@@ -70,10 +79,10 @@ int summary_command(const SummaryOptions& opt) {
         << md;
     if (!out) {
       std::cerr << "error: cannot write " << opt.out << '\n';
-      return 3;
+      return exit_code::kOutput;
     }
   }
-  return all_ok ? 0 : 1;
+  return all_ok ? exit_code::kOk : exit_code::kFailed;
 }
 
 }  // namespace quadcosim::app

@@ -10,6 +10,7 @@
 #include <map>
 
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "app/signals.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/graph.hpp"
@@ -54,9 +55,9 @@ std::string known_type_list() {
   return s;
 }
 
-/// Thrown for a topic that cannot be subscribed (not found, unknown type): exit 2.
-struct TopicError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+/// Thrown for a topic that cannot be subscribed (not found, unknown type): bad input, exit 2.
+struct TopicError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
 };
 
 /// Waits (up to wait_s, less once it appears) for `topic` in discovery and checks that quadcosim
@@ -100,7 +101,7 @@ int topic_list(const TopicOptions& o) {
   dds::Participant participant(env);
   const auto topics = dds::ros_topics(dds::discover_endpoints(participant.handle(), to_ns(o.wait_s)));
   std::cout << dds::format_topic_list(topics, o.show_types, o.include_hidden) << std::flush;
-  return 0;
+  return exit_code::kOk;
 }
 
 int topic_echo(const TopicOptions& o) {
@@ -120,7 +121,7 @@ int topic_echo(const TopicOptions& o) {
     ++printed;
   });
   while (!stop_requested() && (o.count <= 0 || printed < o.count)) transport.spin_once(100 * kMs);
-  return 0;
+  return exit_code::kOk;
 }
 
 int topic_hz(const TopicOptions& o) {
@@ -163,9 +164,9 @@ int topic_hz(const TopicOptions& o) {
   if (window.messages() > reported && window.stats()) report();  // what came in since the last report
   if (window.messages() == 0) {
     std::cerr << fmt::format("no message on {} (QoS {})\n", topic, o.qos);
-    return 1;
+    return exit_code::kFailed;
   }
-  return 0;
+  return exit_code::kOk;
 }
 
 }  // namespace
@@ -206,29 +207,21 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
 
 int topic_command(TopicOptions o) {
   install_stop_handlers();
-  try {
-    if (o.verb == "list") {
-      if (o.wait_s < 0) o.wait_s = 1.0;
-      return topic_list(o);
-    }
-    if (o.wait_s < 0) o.wait_s = 5.0;
-    if (o.verb == "echo") {
-      if (o.qos.empty()) o.qos = "default";
-      return topic_echo(o);
-    }
-    if (o.verb == "hz") {
-      if (o.qos.empty()) o.qos = "sensor";
-      return topic_hz(o);
-    }
-    std::cerr << "error: topic: expected list, echo or hz\n";
-    return 2;
-  } catch (const TopicError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: topic " << o.verb << ": " << e.what() << '\n';
-    return 3;
+  if (o.verb == "list") {
+    if (o.wait_s < 0) o.wait_s = 1.0;
+    return topic_list(o);
   }
+  if (o.wait_s < 0) o.wait_s = 5.0;
+  if (o.verb == "echo") {
+    if (o.qos.empty()) o.qos = "default";
+    return topic_echo(o);
+  }
+  if (o.verb == "hz") {
+    if (o.qos.empty()) o.qos = "sensor";
+    return topic_hz(o);
+  }
+  std::cerr << "error: topic: expected list, echo or hz\n";
+  return exit_code::kBadInput;
 }
 
 }  // namespace quadcosim::app
