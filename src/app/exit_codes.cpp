@@ -21,6 +21,7 @@ const std::vector<ExitCodeRow>& exit_code_table() {
       {kOk, "success", "*"},
       {kFailed, "a step or hold criterion failed", "run summary"},
       {kFailed, "fewer runs passed than --min-pass-rate asks", "sweep"},
+      {kFailed, "a loop is unstable closed-loop (its margins are undefined)", "margins"},
       {kFailed, "the enclave has problems (listed)", "security"},
       {kFailed, "the node refused the value, or has no such parameter", "param"},
       {kFailed, "no message arrived on the topic", "topic"},
