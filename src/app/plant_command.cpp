@@ -242,7 +242,11 @@ class PlantProcess {
     }
     const auto& st = plant_.stats();
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
-    const double sim_s = clock_.seconds(sc_.simulation.duration_ticks);
+    // The simulated time reached, not the time asked for: a run stopped early (Ctrl-C) integrated
+    // only the ticks it completed.
+    const sim::Tick asked = sc_.simulation.duration_ticks;
+    const sim::Tick completed = realtime_ ? realtime_->ticks_run() : lockstep_ ? lockstep_->ticks_run() : asked;
+    const double sim_s = clock_.seconds(std::min(completed, asked));
     std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
                              "rejected {}, clamped {}, stale {}\n",
                              sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
