@@ -55,9 +55,14 @@ bool make_plots(const std::string& run_dir) {
 namespace {
 // "" when `dir` holds a run's trajectory.csv, else the error to print (bad input: exit 2).
 std::string check_run_dir(const std::string& what, const std::string& dir) {
-  if (std::filesystem::is_regular_file(std::filesystem::path(dir) / "trajectory.csv")) return {};
-  return "error: " + what + ": " + dir + " is not a run directory (no trajectory.csv; expected the --out "
-         "directory of `quadcosim run`)";
+  // plot_run.py and report.py read both; name the missing one here rather than let Python fail.
+  for (const char* file : {"trajectory.csv", "metrics.json"}) {
+    if (!std::filesystem::is_regular_file(std::filesystem::path(dir) / file)) {
+      return "error: " + what + ": " + dir + " is not a run directory (no " + file +
+             "; expected the --out directory of `quadcosim run`)";
+    }
+  }
+  return {};
 }
 }  // namespace
 

@@ -27,7 +27,8 @@ printf 't,w1,w2,w3,w4\n0,1,2,3\n' > short.csv
 printf 't,w1,w2,w3,w4\n0,1,nan,3,4\n' > nan.csv
 printf 'time,a,b,c,d\n0,1,2,3,4\n' > header.csv
 printf 't,w1,w2,w3,w4\n0,1,2,3,4\n' > ok.csv
-mkdir -p not_a_run
+mkdir -p not_a_run no_metrics
+printf 't\n0\n' > no_metrics/trajectory.csv
 
 failures=0
 cases=0
@@ -114,6 +115,7 @@ expect 2 "--duration: Value x not in range" record --out r.mcap --duration x
 # plot, compare, summary
 expect 2 "run_dir: Directory does not exist: missing_dir" plot missing_dir
 expect 2 "run_dir: not_a_run is not a run directory (no trajectory.csv" plot not_a_run
+expect 2 "run_dir: no_metrics is not a run directory (no metrics.json" plot no_metrics
 expect 2 "run_b: Directory does not exist: missing_dir" compare not_a_run missing_dir
 expect 2 "run_a: not_a_run is not a run directory" compare not_a_run not_a_run
 expect 2 "not_a_run/metrics.json: cannot open" summary not_a_run
