@@ -6,6 +6,8 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <tuple>
+#include <type_traits>
 
 namespace quadcosim::io {
 
@@ -27,10 +29,6 @@ class CdrWriter {
     bytes_.insert(bytes_.end(), s.begin(), s.end());
     bytes_.push_back(0);
   }
-  template <std::size_t N>
-  void f64s(const std::array<double, N>& a) {
-    for (double v : a) f64(v);
-  }
 
   std::vector<std::uint8_t> take() { return std::move(bytes_); }
 
@@ -49,112 +47,170 @@ class CdrWriter {
   std::vector<std::uint8_t> bytes_;
 };
 
-void put(CdrWriter& w, const msg::Time& t) {
-  w.i32(t.sec);
-  w.u32(t.nanosec);
-}
-void put(CdrWriter& w, const msg::Header& h) {
-  put(w, h.stamp);
-  w.str(h.frame_id);
-}
-void put(CdrWriter& w, const msg::Vector3& v) {
-  w.f64(v.x);
-  w.f64(v.y);
-  w.f64(v.z);
-}
-void put(CdrWriter& w, const msg::Quaternion& q) {
-  w.f64(q.x);
-  w.f64(q.y);
-  w.f64(q.z);
-  w.f64(q.w);
-}
+template <class T>
+struct IsArray : std::false_type {};
+template <class T, std::size_t N>
+struct IsArray<std::array<T, N>> : std::true_type {};
+template <class T>
+struct IsVector : std::false_type {};
+template <class T>
+struct IsVector<std::vector<T>> : std::true_type {};
 
-// The .msg definitions (fields only, as in the ROS 2 packages; Jazzy and Humble agree), keyed
-// "pkg/Type". Field types without a package refer to the same package.
-const std::map<std::string, std::string, std::less<>>& msg_files() {
-  static const std::map<std::string, std::string, std::less<>> files = {
-      {"builtin_interfaces/Time", "int32 sec\nuint32 nanosec\n"},
-      {"std_msgs/Header", "builtin_interfaces/Time stamp\nstring frame_id\n"},
-      {"std_msgs/MultiArrayDimension", "string label\nuint32 size\nuint32 stride\n"},
-      {"std_msgs/MultiArrayLayout", "MultiArrayDimension[] dim\nuint32 data_offset\n"},
-      {"std_msgs/Float64MultiArray", "MultiArrayLayout layout\nfloat64[] data\n"},
-      {"geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z\n"},
-      {"geometry_msgs/Quaternion", "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n"},
-      {"geometry_msgs/Pose", "Point position\nQuaternion orientation\n"},
-      {"geometry_msgs/PoseStamped", "std_msgs/Header header\nPose pose\n"},
-      {"geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"},
-      {"geometry_msgs/Twist", "Vector3 linear\nVector3 angular\n"},
-      {"geometry_msgs/TwistStamped", "std_msgs/Header header\nTwist twist\n"},
-      {"sensor_msgs/Imu",
-       "std_msgs/Header header\n"
-       "geometry_msgs/Quaternion orientation\n"
-       "float64[9] orientation_covariance\n"
-       "geometry_msgs/Vector3 angular_velocity\n"
-       "float64[9] angular_velocity_covariance\n"
-       "geometry_msgs/Vector3 linear_acceleration\n"
-       "float64[9] linear_acceleration_covariance\n"},
-      {"rosgraph_msgs/Clock", "builtin_interfaces/Time clock\n"},
-      {"quadcosim_msgs/ControllerStatus",
-       "std_msgs/Header header\n"
-       "string mode\n"
-       "float64[6] setpoint\n"
-       "float64[4] u\n"
-       "float64[4] error\n"
-       "bool[4] rotor_saturated\n"
-       "bool tilt_saturated\n"
-       "bool safety\n"
-       "uint64 rejected_non_finite\n"
-       "uint64 rejected_bad_quaternion\n"
-       "uint64 rejected_bad_stamp\n"
-       "uint64 rejected_stamp_backwards\n"},
-      {"quadcosim_msgs/PlantStatus",
-       "std_msgs/Header header\n"
-       "uint64 commands_accepted\n"
-       "uint64 commands_clamped\n"
-       "uint64 commands_rejected_length\n"
-       "uint64 commands_rejected_non_finite\n"
-       "string last_problem\n"
-       "bool watchdog_active\n"
-       "uint64 watchdog_trips\n"
-       "uint64 watchdog_ticks\n"},
-  };
-  return files;
-}
+// Writes the fields of a message in the order its fields() lists them (sim/messages.hpp).
+struct CdrFields {
+  CdrWriter& w;
 
-bool is_primitive(std::string_view type) {
-  static const std::set<std::string_view> primitives = {"bool",   "byte",  "char",   "float32", "float64",
-                                                        "int8",   "uint8", "int16",  "uint16",  "int32",
-                                                        "uint32", "int64", "uint64", "string",  "wstring"};
-  return primitives.count(type) > 0;
-}
-
-// The "pkg/Type" keys of the non-primitive field types of `key`'s definition, in field order.
-std::vector<std::string> dependencies(const std::string& key) {
-  const std::string pkg = key.substr(0, key.find('/'));
-  std::vector<std::string> deps;
-  const std::string& text = msg_files().at(key);
-  std::size_t line = 0;
-  while (line < text.size()) {
-    const std::size_t end = text.find('\n', line);
-    std::string type = text.substr(line, text.find(' ', line) - line);
-    line = end + 1;
-    type = type.substr(0, type.find_first_of("[<"));  // T[], T[N], T[<=N], string<=N
-    if (is_primitive(type)) continue;
-    deps.push_back(type.find('/') == std::string::npos ? pkg + "/" + type : type);
+  template <class T>
+  void field(std::string_view /*name*/, const T& v, msg::FieldNote = {}) {
+    put(v);
   }
-  return deps;
+  template <class F>
+  void group(std::string_view /*name*/, std::string_view /*ros_type*/, F&& visit) {
+    visit(*this);
+  }
+
+  template <class T>
+  void put(const T& v) {
+    if constexpr (std::is_same_v<T, bool>) {
+      w.boolean(v);
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      w.str(v);
+    } else if constexpr (std::is_same_v<T, double>) {
+      w.f64(v);
+    } else if constexpr (std::is_same_v<T, std::int32_t>) {
+      w.i32(v);
+    } else if constexpr (std::is_same_v<T, std::uint32_t>) {
+      w.u32(v);
+    } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+      w.u64(v);
+    } else if constexpr (IsArray<T>::value) {
+      for (const auto& e : v) put(e);  // fixed array: the elements only
+    } else if constexpr (IsVector<T>::value) {
+      w.u32(static_cast<std::uint32_t>(v.size()));  // sequence: count, then the elements
+      for (const auto& e : v) put(e);
+    } else {
+      T::fields(v, *this);  // a nested message
+    }
+  }
+};
+
+template <class M>
+std::vector<std::uint8_t> cdr_of(const M& m) {
+  CdrWriter w;
+  CdrFields f{w};
+  M::fields(m, f);
+  return w.take();
+}
+
+// "pkg/msg/Type" -> "pkg/Type", as .msg files and MCAP's "MSG:" lines name types.
+std::string short_name(std::string_view ros_type) {
+  const auto slash = ros_type.find('/');
+  return std::string(ros_type.substr(0, slash)) + std::string(ros_type.substr(ros_type.find('/', slash + 1)));
+}
+std::string package_of(std::string_view name) { return std::string(name.substr(0, name.find('/'))); }
+
+// One .msg definition: its field lines and the types it uses, in field order.
+struct MsgType {
+  std::string text;
+  std::vector<std::string> deps;  ///< "pkg/Type" of each non-primitive field type, in order
+};
+using MsgTypes = std::map<std::string, MsgType, std::less<>>;
+
+// Builds a message's .msg text from its fields() list, and (into `types`) that of every type it uses.
+struct MsgFields {
+  std::string name;  ///< "pkg/Type" being written
+  MsgTypes& types;
+  MsgType out;
+
+  template <class T>
+  void field(std::string_view field_name, const T& v, msg::FieldNote note = {}) {
+    out.text += type_text(v, note.ros_type) + " " + std::string(field_name);
+    if (!note.default_value.empty()) out.text += " " + std::string(note.default_value);
+    out.text += "\n";
+  }
+  template <class F>
+  void group(std::string_view field_name, std::string_view ros_type, F&& visit) {
+    const std::string dep = short_name(ros_type);
+    out.text += local(dep) + " " + std::string(field_name) + "\n";
+    out.deps.push_back(dep);
+    if (types.count(dep) == 0) {
+      MsgFields sub{dep, types, {}};
+      visit(sub);
+      types[dep] = sub.out;
+    }
+  }
+
+  // A type as a field of `name` names it: bare within the same package, "pkg/Type" across packages.
+  std::string local(const std::string& dep) const {
+    return package_of(dep) == package_of(name) ? dep.substr(dep.find('/') + 1) : dep;
+  }
+
+  template <class T>
+  std::string type_text(const T& v, std::string_view ros_type) {
+    if constexpr (std::is_same_v<T, bool>) {
+      return "bool";
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      return "string";
+    } else if constexpr (std::is_same_v<T, double>) {
+      return "float64";
+    } else if constexpr (std::is_same_v<T, std::int32_t>) {
+      return "int32";
+    } else if constexpr (std::is_same_v<T, std::uint32_t>) {
+      return "uint32";
+    } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+      return "uint64";
+    } else if constexpr (IsArray<T>::value) {
+      return type_text(typename T::value_type{}, ros_type) + "[" + std::to_string(std::tuple_size_v<T>) + "]";
+    } else if constexpr (IsVector<T>::value) {
+      return type_text(typename T::value_type{}, ros_type) + "[]";
+    } else {
+      const std::string dep = short_name(ros_type.empty() ? T::kRosType : ros_type);
+      out.deps.push_back(dep);
+      if (types.count(dep) == 0) {
+        MsgFields sub{dep, types, {}};
+        T::fields(v, sub);
+        types[dep] = sub.out;
+      }
+      return local(dep);
+    }
+  }
+};
+
+template <class M>
+void add_type(MsgTypes& types) {
+  const std::string name = short_name(M::kRosType);
+  MsgFields f{name, types, {}};
+  const M m{};
+  M::fields(m, f);
+  types[name] = f.out;
+}
+
+// Every .msg definition the recorded message types need, keyed "pkg/Type".
+const MsgTypes& msg_types() {
+  static const MsgTypes types = [] {
+    MsgTypes t;
+    add_type<msg::PoseStamped>(t);
+    add_type<msg::TwistStamped>(t);
+    add_type<msg::Imu>(t);
+    add_type<msg::Float64MultiArray>(t);
+    add_type<msg::Clock>(t);
+    add_type<msg::ControllerStatus>(t);
+    add_type<msg::PlantStatus>(t);
+    return t;
+  }();
+  return types;
 }
 
 void append_dependencies(const std::string& key, std::set<std::string>& seen, std::string& out) {
-  for (const std::string& dep : dependencies(key)) {
+  for (const std::string& dep : msg_types().at(key).deps) {
     if (!seen.insert(dep).second) continue;
-    out += std::string(80, '=') + "\nMSG: " + dep + "\n" + msg_files().at(dep);
+    out += std::string(80, '=') + "\nMSG: " + dep + "\n" + msg_types().at(dep).text;
     append_dependencies(dep, seen, out);
   }
 }
 
 std::string full_definition(const std::string& key) {
-  std::string out = msg_files().at(key);
+  std::string out = msg_types().at(key).text;
   std::set<std::string> seen{key};
   append_dependencies(key, seen, out);
   return out;
@@ -162,90 +218,19 @@ std::string full_definition(const std::string& key) {
 
 }  // namespace
 
-std::vector<std::uint8_t> to_cdr(const msg::PoseStamped& m) {
-  CdrWriter w;
-  put(w, m.header);
-  put(w, m.position);
-  put(w, m.orientation);
-  return w.take();
-}
-
-std::vector<std::uint8_t> to_cdr(const msg::TwistStamped& m) {
-  CdrWriter w;
-  put(w, m.header);
-  put(w, m.linear);
-  put(w, m.angular);
-  return w.take();
-}
-
-std::vector<std::uint8_t> to_cdr(const msg::Imu& m) {
-  CdrWriter w;
-  put(w, m.header);
-  put(w, m.orientation);
-  w.f64s(m.orientation_covariance);
-  put(w, m.angular_velocity);
-  w.f64s(m.angular_velocity_covariance);
-  put(w, m.linear_acceleration);
-  w.f64s(m.linear_acceleration_covariance);
-  return w.take();
-}
-
-std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m) {
-  CdrWriter w;
-  w.u32(static_cast<std::uint32_t>(m.dim.size()));  // layout.dim
-  for (const auto& d : m.dim) {
-    w.str(d.label);
-    w.u32(d.size);
-    w.u32(d.stride);
-  }
-  w.u32(m.data_offset);  // layout.data_offset
-  w.u32(static_cast<std::uint32_t>(m.data.size()));
-  for (double v : m.data) w.f64(v);
-  return w.take();
-}
-
-std::vector<std::uint8_t> to_cdr(const msg::Clock& m) {
-  CdrWriter w;
-  put(w, m.clock);
-  return w.take();
-}
-
-std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m) {
-  CdrWriter w;
-  put(w, m.header);
-  w.str(m.mode);
-  w.f64s(m.setpoint);
-  w.f64s(m.u);
-  w.f64s(m.error);
-  for (bool b : m.rotor_saturated) w.boolean(b);
-  w.boolean(m.tilt_saturated);
-  w.boolean(m.safety);
-  w.u64(m.rejected_non_finite);
-  w.u64(m.rejected_bad_quaternion);
-  w.u64(m.rejected_bad_stamp);
-  w.u64(m.rejected_stamp_backwards);
-  return w.take();
-}
-
-std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m) {
-  CdrWriter w;
-  put(w, m.header);
-  w.u64(m.commands_accepted);
-  w.u64(m.commands_clamped);
-  w.u64(m.commands_rejected_length);
-  w.u64(m.commands_rejected_non_finite);
-  w.str(m.last_problem);
-  w.boolean(m.watchdog_active);
-  w.u64(m.watchdog_trips);
-  w.u64(m.watchdog_ticks);
-  return w.take();
-}
+std::vector<std::uint8_t> to_cdr(const msg::PoseStamped& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::TwistStamped& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::Imu& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::Clock& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m) { return cdr_of(m); }
 
 const std::string& ros2msg_definition(std::string_view ros_type) {
   // "pkg/msg/Type" -> the full text, built once from the .msg table (immutable afterwards).
   static const std::map<std::string, std::string, std::less<>> definitions = [] {
     std::map<std::string, std::string, std::less<>> d;
-    for (const auto& [key, text] : msg_files()) {
+    for (const auto& [key, type] : msg_types()) {
       const auto slash = key.find('/');
       d[key.substr(0, slash) + "/msg" + key.substr(slash)] = full_definition(key);
     }

@@ -1,6 +1,14 @@
 // The messages the nodes exchange, shaped field for field like their ROS 2 types (see
 // docs/ros2-wire.md in the shared docs), so a DDS transport maps them one to one and the in-process
 // transport carries exactly the numbers the wire would.
+//
+// Each message states its fields once, here, in wire order: `fields(m, v)` hands every field to a
+// visitor as v.field("name", member) (v.field("name", member, note) where the ROS type or a .msg
+// default differs from what the C++ type says), and a ROS sub-message that has no C++ struct of its
+// own (Pose, Twist, MultiArrayLayout) as v.group("name", "pkg/msg/Type", [&](auto& g) { ... }).
+// The CDR writer and the `.msg` schema text MCAP stores (io/ros2_cdr.cpp) follow from these lists;
+// the idlc conversions (dds/ros_types.cpp) pair each listed field with its C member, and the
+// byte-for-byte tests against Cyclone (io/mcap_test.cpp) fail when the two disagree.
 #pragma once
 
 #include <array>
@@ -11,10 +19,23 @@
 
 namespace quadcosim::msg {
 
+/// What a field's C++ type does not say: its ROS type when another message shares the C++ struct
+/// (geometry_msgs/Point is a Vector3 here), and its default in the .msg file.
+struct FieldNote {
+  std::string_view ros_type;       ///< "pkg/msg/Type", "" for the C++ type's own
+  std::string_view default_value;  ///< .msg default ("0"), "" for none
+};
+
 /// builtin_interfaces/msg/Time
 struct Time {
+  static constexpr std::string_view kRosType = "builtin_interfaces/msg/Time";
   std::int32_t sec = 0;
   std::uint32_t nanosec = 0;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("sec", m.sec);
+    v.field("nanosec", m.nanosec);
+  }
 
   static Time from_ns(std::int64_t ns);
   std::int64_t to_ns() const { return std::int64_t{sec} * 1'000'000'000 + nanosec; }
@@ -22,15 +43,40 @@ struct Time {
 
 /// std_msgs/msg/Header
 struct Header {
+  static constexpr std::string_view kRosType = "std_msgs/msg/Header";
   Time stamp;
   std::string frame_id;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("stamp", m.stamp);
+    v.field("frame_id", m.frame_id);
+  }
 };
 
+/// geometry_msgs/msg/Vector3 (and, by FieldNote, geometry_msgs/msg/Point)
 struct Vector3 {
+  static constexpr std::string_view kRosType = "geometry_msgs/msg/Vector3";
   double x = 0, y = 0, z = 0;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("x", m.x);
+    v.field("y", m.y);
+    v.field("z", m.z);
+  }
 };
+inline constexpr FieldNote kPoint{"geometry_msgs/msg/Point", ""};
+
+/// geometry_msgs/msg/Quaternion
 struct Quaternion {
+  static constexpr std::string_view kRosType = "geometry_msgs/msg/Quaternion";
   double x = 0, y = 0, z = 0, w = 1;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("x", m.x, FieldNote{"", "0"});
+    v.field("y", m.y, FieldNote{"", "0"});
+    v.field("z", m.z, FieldNote{"", "0"});
+    v.field("w", m.w, FieldNote{"", "1"});
+  }
 };
 
 /// geometry_msgs/msg/PoseStamped: position in the world frame, orientation q_WB.
@@ -39,6 +85,14 @@ struct PoseStamped {
   Header header;
   Vector3 position;  // geometry_msgs/Point
   Quaternion orientation;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.group("pose", "geometry_msgs/msg/Pose", [&](auto& g) {
+      g.field("position", m.position, kPoint);
+      g.field("orientation", m.orientation);
+    });
+  }
 };
 
 /// geometry_msgs/msg/TwistStamped: linear velocity in the world frame, angular velocity in body.
@@ -47,6 +101,14 @@ struct TwistStamped {
   Header header;
   Vector3 linear;
   Vector3 angular;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.group("twist", "geometry_msgs/msg/Twist", [&](auto& g) {
+      g.field("linear", m.linear);
+      g.field("angular", m.angular);
+    });
+  }
 };
 
 /// sensor_msgs/msg/Imu: orientation q_WB, body rates, specific force in body.
@@ -59,13 +121,30 @@ struct Imu {
   std::array<double, 9> angular_velocity_covariance{};
   Vector3 linear_acceleration;
   std::array<double, 9> linear_acceleration_covariance{};
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("orientation", m.orientation);
+    v.field("orientation_covariance", m.orientation_covariance);
+    v.field("angular_velocity", m.angular_velocity);
+    v.field("angular_velocity_covariance", m.angular_velocity_covariance);
+    v.field("linear_acceleration", m.linear_acceleration);
+    v.field("linear_acceleration_covariance", m.linear_acceleration_covariance);
+  }
 };
 
 /// std_msgs/msg/MultiArrayDimension
 struct MultiArrayDimension {
+  static constexpr std::string_view kRosType = "std_msgs/msg/MultiArrayDimension";
   std::string label;
   std::uint32_t size = 0;
   std::uint32_t stride = 0;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("label", m.label);
+    v.field("size", m.size);
+    v.field("stride", m.stride);
+  }
 };
 
 /// std_msgs/msg/Float64MultiArray
@@ -74,6 +153,14 @@ struct Float64MultiArray {
   std::vector<double> data;
   std::vector<MultiArrayDimension> dim;  ///< layout.dim
   std::uint32_t data_offset = 0;         ///< layout.data_offset
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.group("layout", "std_msgs/msg/MultiArrayLayout", [&](auto& g) {
+      g.field("dim", m.dim);
+      g.field("data_offset", m.data_offset);
+    });
+    v.field("data", m.data);
+  }
 };
 
 /// Motor commands from quadcosim's controller carry one dimension labelled "rotors@<ns>": the
@@ -103,6 +190,21 @@ struct ControllerStatus {
   std::uint64_t rejected_bad_quaternion = 0;   ///< orientation not a unit quaternion (zero included)
   std::uint64_t rejected_bad_stamp = 0;        ///< sec < 0 or nanosec >= 1e9
   std::uint64_t rejected_stamp_backwards = 0;  ///< older than the newest accepted on its topic
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("mode", m.mode);
+    v.field("setpoint", m.setpoint);
+    v.field("u", m.u);
+    v.field("error", m.error);
+    v.field("rotor_saturated", m.rotor_saturated);
+    v.field("tilt_saturated", m.tilt_saturated);
+    v.field("safety", m.safety);
+    v.field("rejected_non_finite", m.rejected_non_finite);
+    v.field("rejected_bad_quaternion", m.rejected_bad_quaternion);
+    v.field("rejected_bad_stamp", m.rejected_bad_stamp);
+    v.field("rejected_stamp_backwards", m.rejected_stamp_backwards);
+  }
 };
 
 /// quadcosim_msgs/msg/PlantStatus: what the plant did with the motor commands it received (counters
@@ -120,12 +222,28 @@ struct PlantStatus {
   bool watchdog_active = false;      ///< the watchdog's policy sets the motors (no valid command for its limit)
   std::uint64_t watchdog_trips = 0;  ///< times the watchdog took over
   std::uint64_t watchdog_ticks = 0;  ///< ticks latched under the watchdog's policy
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("commands_accepted", m.commands_accepted);
+    v.field("commands_clamped", m.commands_clamped);
+    v.field("commands_rejected_length", m.commands_rejected_length);
+    v.field("commands_rejected_non_finite", m.commands_rejected_non_finite);
+    v.field("last_problem", m.last_problem);
+    v.field("watchdog_active", m.watchdog_active);
+    v.field("watchdog_trips", m.watchdog_trips);
+    v.field("watchdog_ticks", m.watchdog_ticks);
+  }
 };
 
 /// rosgraph_msgs/msg/Clock
 struct Clock {
   static constexpr std::string_view kRosType = "rosgraph_msgs/msg/Clock";
   Time clock;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("clock", m.clock);
+  }
 };
 
 }  // namespace quadcosim::msg
