@@ -1,5 +1,5 @@
 // The messages the nodes exchange, shaped field for field like their ROS 2 types (see
-// docs/ros2-wire.md in the shared docs), so a DDS transport maps them one to one and the in-process
+// docs/ros2.md, "What is on the wire"), so a DDS transport maps them one to one and the in-process
 // transport carries exactly the numbers the wire would.
 //
 // Each message states its fields once, here, in wire order: `fields(m, v)` hands every field to a

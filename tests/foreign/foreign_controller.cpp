@@ -1,5 +1,5 @@
 // A "foreign" ROS 2 participant: plays the part of an rclcpp node on rmw_cyclonedds_cpp, written only
-// from the wire facts in docs/ros2-wire.md (topic names rt/..., type names pkg::msg::dds_::Name_,
+// from the wire facts in docs/ros2.md, "What is on the wire" (topic names rt/..., type names pkg::msg::dds_::Name_,
 // final XCDR1 types without type information, ROS QoS, USER_DATA "enclave=/;", the LOCALHOST
 // discovery configuration). It includes and links nothing of quadcosim: its types come from its own
 // IDL (tests/foreign/idl) through idlc, and it talks through the plain Cyclone DDS C API.
