@@ -77,6 +77,12 @@ expect 2 "--timeout: Value abc not in range 0.01" run "$ALT" --out o --timeout a
 expect 2 "--rate-factor: Value 0 not in range 0.001" run "$ALT" --out o --rate-factor 0
 expect 2 "The following argument was not expected: --fast" run "$ALT" --out o --fast
 expect 3 "cannot create output directory /proc/quadcosim_no" run "$ALT" --out /proc/quadcosim_no --no-plots
+for f in --realtime --pin "--timeout 5" "--keystore ks"; do
+  # shellcheck disable=SC2086
+  expect 2 "${f%% *}: does nothing with --transport inproc" run "$ALT" --out o $f
+done
+expect 2 "--rate-factor: does nothing with lockstep" run "$ALT" --out o --transport dds --rate-factor 2
+expect 2 "--threads: does nothing with --transport dds" run "$ALT" --out o --transport dds --threads 2
 
 # plant and controller (checked before any DDS entity is created)
 expect 2 "--scenario: File does not exist: missing.yaml" plant --scenario missing.yaml
