@@ -67,36 +67,75 @@ struct SummaryOptions {
 int summary_command(const SummaryOptions& options);
 CLI::App* add_summary_subcommand(CLI::App& app, SummaryOptions& options);
 
+/// `quadcosim plant`: what every mode takes, then what one mode alone takes (its own struct).
 struct PlantCommandOptions {
+  /// Lockstep only (one vehicle or --vehicles N).
+  struct Lockstep {
+    std::string on_timeout = "abort";  ///< "abort" (exit 4) or "hold" (last commands, go on unpaced)
+  };
+  /// Real time only (--realtime).
+  struct Realtime {
+    double rate_factor = 1.0;          ///< run k times faster than the wall clock
+    bool wait_for_controller = false;  ///< start the clock only once a controller is matched
+  };
+  /// One vehicle only (lockstep or real time).
+  struct OneVehicle {
+    std::string record;  ///< trajectory CSV to write ("" for none)
+    std::string mcap;    ///< MCAP file to record the topics into, metadata.yaml beside it ("" for none)
+    /// Apply the scenario's schedule through this node's ROS 2 parameter services, each change
+    /// before the tick it is due at ("" = the plant leaves the schedule to the controller).
+    std::string schedule_node;
+  };
+  /// --vehicles N (lockstep).
+  struct Swarm {
+    int vehicles = 0;       ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...)
+    std::string ns_prefix;  ///< overrides the scenario's swarm.namespace_prefix
+    int threads = 2;        ///< threads (one DDS participant each)
+    std::string out;        ///< directory for summary.json, vehicles.csv, recorded vehicles
+  };
+
+  // Every mode.
   std::string scenario;     ///< vehicle, rates, duration, initial state ("" for defaults)
   std::string vehicle;      ///< vehicle file, replaces the scenario's vehicle when set
   std::string ns;           ///< overrides the scenario's namespace when set
   bool sensor_qos = false;  ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
   std::string cpus;         ///< run on these CPUs only ("0", "0-1"; "" for any)
   bool lockstep = true;     ///< false: real time
-  double rate_factor = 1.0; ///< real time: run k times faster than the wall clock
   double duration_s = -1.0; ///< overrides the scenario's duration when >= 0
-  std::string record;       ///< trajectory CSV to write ("" for none)
-  std::string mcap;         ///< MCAP file to record the topics into, metadata.yaml beside it ("" for none)
-  double timeout_s = 10.0;  ///< lockstep: how long to wait for a controller / for one command
-  std::string on_timeout = "abort";  ///< lockstep: "abort" (exit 4) or "hold" (last command, go on)
-  bool wait_for_controller = false;  ///< real time: start the clock only once a controller is matched
-  /// Lockstep: apply the scenario's schedule through this node's ROS 2 parameter services, each
-  /// change before the tick it is due at ("" = the plant leaves the schedule to the controller).
-  std::string schedule_node;
+  double timeout_s = 10.0;  ///< how long to wait for a controller (and, in lockstep, for one command)
   double watchdog_s = -1.0;     ///< overrides simulation.watchdog_s when >= 0 (0: off)
   std::string watchdog_policy;  ///< overrides simulation.watchdog_policy when set: "hold" or "stop"
-  int vehicles = 0;         ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...), lockstep
-  std::string ns_prefix;    ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
-  int threads = 2;          ///< vehicles > 0: threads (one DDS participant each)
-  std::string swarm_out;    ///< vehicles > 0: directory for summary.json, vehicles.csv, recorded vehicles
   std::string stats;        ///< write run figures (real-time factor, round trip) as JSON here ("" none)
   std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
+
+  Lockstep lockstep_only;
+  Realtime realtime;
+  OneVehicle one_vehicle;
+  Swarm swarm;
 };
 int plant_command(const PlantCommandOptions& options);
 CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& options);
 
+/// `quadcosim controller`: what every mode takes, then what one mode alone takes (its own struct).
 struct ControllerCommandOptions {
+  /// Real time only (--realtime).
+  struct Realtime {
+    double rate_factor = 1.0;  ///< the timer runs k times faster (to match a faster plant)
+    std::string stats;         ///< write the control period jitter as JSON here on exit
+    int rt_priority = 0;       ///< run the control loop under SCHED_FIFO at this priority (0 off)
+  };
+  /// One vehicle only.
+  struct OneVehicle {
+    std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
+  };
+  /// --vehicles N (lockstep).
+  struct Swarm {
+    int vehicles = 0;       ///< > 0: host this many vehicles' controllers
+    std::string ns_prefix;  ///< overrides the scenario's swarm.namespace_prefix
+    int threads = 2;        ///< threads (one DDS participant each)
+  };
+
+  // Every mode.
   std::string scenario;  ///< controller parameters, rates, schedule ("" for defaults)
   std::string params;    ///< controller parameter file, applied over the scenario's
   std::string vehicle;   ///< vehicle file (the controller's model of the vehicle)
@@ -104,15 +143,12 @@ struct ControllerCommandOptions {
   bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
   std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)
   bool lockstep = true;
-  double rate_factor = 1.0;  ///< real time: the timer runs k times faster (to match a faster plant)
-  std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
   bool apply_schedule = true;  ///< apply the scenario's schedule itself (off when the plant does it)
-  int vehicles = 0;            ///< > 0: host this many vehicles' controllers (lockstep)
-  std::string ns_prefix;       ///< vehicles > 0: overrides the scenario's swarm.namespace_prefix
-  int threads = 2;             ///< vehicles > 0: threads (one DDS participant each)
-  std::string stats;           ///< real time: write the control period jitter as JSON here on exit
-  int rt_priority = 0;         ///< real time: run the control loop under SCHED_FIFO at this priority (0 off)
   std::string enclave = "/";   ///< DDS Security enclave (rcl --enclave)
+
+  Realtime realtime;
+  OneVehicle one_vehicle;
+  Swarm swarm;
 };
 int controller_command(const ControllerCommandOptions& options);
 CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& options);

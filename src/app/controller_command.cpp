@@ -30,23 +30,23 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
-  ctl_cmd->add_option("--vehicles", ctl.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+  ctl_cmd->add_option("--vehicles", ctl.swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
       ->check(CLI::Range(1, 1'000'000));
-  ctl_cmd->add_option("--ns-prefix", ctl.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  ctl_cmd->add_option("--threads", ctl.threads, "with --vehicles: threads, one DDS participant each")
+  ctl_cmd->add_option("--ns-prefix", ctl.swarm.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  ctl_cmd->add_option("--threads", ctl.swarm.threads, "with --vehicles: threads, one DDS participant each")
       ->check(CLI::Range(1, 64));
   ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   add_cpus_option(ctl_cmd, ctl.cpus);
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");
-  ctl_cmd->add_option("--rate-factor", ctl.rate_factor, "real time: run the timer k times faster")
+  ctl_cmd->add_option("--rate-factor", ctl.realtime.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
-  ctl_cmd->add_option("--rt-priority", ctl.rt_priority,
+  ctl_cmd->add_option("--rt-priority", ctl.realtime.rt_priority,
                       "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
       ->check(CLI::Range(0, 99));
-  ctl_cmd->add_option("--stats", ctl.stats, "real time: write the control period jitter as JSON here on exit");
-  ctl_cmd->add_option("--node-name", ctl.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
+  ctl_cmd->add_option("--stats", ctl.realtime.stats, "real time: write the control period jitter as JSON here on exit");
+  ctl_cmd->add_option("--node-name", ctl.one_vehicle.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
   add_enclave_option(ctl_cmd, ctl.enclave);
@@ -66,7 +66,7 @@ int controller_command(const ControllerCommandOptions& o) {
   if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
   if (!o.ns.empty()) sc.simulation.ns = o.ns;
   refuse_faults_over_dds(sc);
-  if (o.vehicles > 0) return swarm_controller_command(o, std::move(sc));
+  if (o.swarm.vehicles > 0) return swarm_controller_command(o, std::move(sc));
   const sim::TickClock clock = sc.simulation.plant.clock;
   const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
   const double dt_s = static_cast<double>(control_period_ns) / 1e9;
@@ -75,7 +75,7 @@ int controller_command(const ControllerCommandOptions& o) {
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   if (o.sensor_qos) use_sensor_qos(transport, topics);
   sim::ControllerNode node(transport, topics, sc.controller);
-  const dds::NodeName ros_name = dds::parse_node_name(o.node_name);
+  const dds::NodeName ros_name = dds::parse_node_name(o.one_vehicle.node_name);
   // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
   dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
   if (!o.apply_schedule) sc.schedule.clear();
@@ -96,11 +96,11 @@ int controller_command(const ControllerCommandOptions& o) {
   } else {
     // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
     node.use_receipt_clock(steady_ns);
-    if (std::string err = use_realtime_priority(o.rt_priority); !err.empty()) {
+    if (std::string err = use_realtime_priority(o.realtime.rt_priority); !err.empty()) {
       std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
     }
     const auto wall_period_ns =
-        static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.rate_factor);
+        static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.realtime.rate_factor);
     PeriodJitter jitter(wall_period_ns);
     drivers::RealtimeControllerHooks h;
     h.on_wake = [&](std::int64_t now) { jitter.add(now); };
@@ -116,9 +116,9 @@ int controller_command(const ControllerCommandOptions& o) {
     };
     DdsDriverHost host(transport, /*precise_deadlines=*/true);
     drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
-                                             sc.simulation.controller_divider, o.rate_factor, std::move(h), host);
+                                             sc.simulation.controller_divider, o.realtime.rate_factor, std::move(h), host);
     driver.run();
-    if (!o.stats.empty()) write_stats(o.stats, jitter.figures());
+    if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
   }
   std::cerr << "controller: stopped\n";
   return exit_code::kOk;

@@ -54,11 +54,11 @@ class PlantProcess {
       status_ = m;
       have_status_ = true;
     });
-    if (!o_.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.record);
-    if (!o_.mcap.empty()) mcap_ = std::make_unique<io::McapRecorder>(o_.mcap, transport_, topics_);
-    if (!o_.schedule_node.empty()) {
+    if (!o_.one_vehicle.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.one_vehicle.record);
+    if (!o_.one_vehicle.mcap.empty()) mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
+    if (!o_.one_vehicle.schedule_node.empty()) {
       scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
-                                                          dds::parse_node_name(o_.schedule_node));
+                                                          dds::parse_node_name(o_.one_vehicle.schedule_node));
     }
     next_event_ = sc_.schedule.begin();
     // Real time: the watchdog measures how long ago a command arrived on the wall clock, so a
@@ -73,7 +73,7 @@ class PlantProcess {
 
   /// Runs every tick; returns the process's exit code.
   int run() {
-    if ((o_.lockstep || o_.wait_for_controller) && !wait_for_controller()) return kExitNoController;
+    if ((o_.lockstep || o_.realtime.wait_for_controller) && !wait_for_controller()) return kExitNoController;
     loop_start_ns_ = steady_ns();
     const int rc = o_.lockstep ? run_lockstep() : run_realtime();
     finish(rc);
@@ -120,7 +120,7 @@ class PlantProcess {
           [&] { return scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns()); });
       if (r.size() != 1 || !r[0].successful) {
         std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event_->name,
-                                 clock_.seconds(k), o_.schedule_node, r.empty() ? "no result" : r[0].reason);
+                                 clock_.seconds(k), o_.one_vehicle.schedule_node, r.empty() ? "no result" : r[0].reason);
         return false;
       }
     }
@@ -133,7 +133,7 @@ class PlantProcess {
     drivers::RealtimeOptions ro;
     ro.clock = clock_;
     ro.duration_ticks = sc_.simulation.duration_ticks;
-    ro.rate_factor = o_.rate_factor;
+    ro.rate_factor = o_.realtime.rate_factor;
     drivers::RealtimeHooks h;
     h.before_outputs = [this](sim::Tick k) { return apply_due_schedule(k); };
     h.after_latch = [this](std::size_t, sim::Tick k) { after_latch(k); };
@@ -153,7 +153,7 @@ class PlantProcess {
     lo.duration_ticks = sc_.simulation.duration_ticks;
     lo.controller_divider = divider_;
     lo.timeout_ns = timeout_ns();
-    lo.on_timeout = o_.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
+    lo.on_timeout = o_.lockstep_only.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
     drivers::DrivenPlant p{&plant_, [this] { return transport_.matched_writers(topics_.controller_status) > 0; },
                            [this] { return status_.header.stamp.to_ns(); }};
     drivers::LockstepHooks h;
@@ -161,7 +161,7 @@ class PlantProcess {
     h.before_outputs = [this](sim::Tick k) { return apply_due_schedule(k); };
     h.after_latch = [this](std::size_t, sim::Tick k) { after_latch(k); };
     h.on_timeout = [this](std::size_t, sim::Tick k) {
-      std::cerr << lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s, o_.on_timeout);
+      std::cerr << lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s, o_.lockstep_only.on_timeout);
     };
     h.on_resume = [](sim::Tick k) {
       std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
@@ -218,7 +218,7 @@ class PlantProcess {
       while (transport_.spin_once(0) > 0) {  // what is still in the readers
       }
       mcap_->close();
-      const std::filesystem::path p(o_.mcap);
+      const std::filesystem::path p(o_.one_vehicle.mcap);
       mcap_->write_bag_metadata(p.parent_path().empty() ? "." : p.parent_path().string(), p.filename().string());
     }
     return code;
@@ -300,28 +300,28 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->check(CLI::ExistingFile);
   const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
   plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
-  plant_cmd->add_option("--vehicles", plant.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+  plant_cmd->add_option("--vehicles", plant.swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
       ->check(CLI::Range(1, 1'000'000));
-  plant_cmd->add_option("--ns-prefix", plant.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  plant_cmd->add_option("--threads", plant.threads, "with --vehicles: threads, one DDS participant each")
+  plant_cmd->add_option("--ns-prefix", plant.swarm.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  plant_cmd->add_option("--threads", plant.swarm.threads, "with --vehicles: threads, one DDS participant each")
       ->check(CLI::Range(1, 64));
   plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
   add_cpus_option(plant_cmd, plant.cpus);
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
-  plant_cmd->add_option("--rate-factor", plant.rate_factor, "real time: run k times faster")
+  plant_cmd->add_option("--rate-factor", plant.realtime.rate_factor, "real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
   plant_cmd->add_option("--duration", plant.duration_s, "simulated time [s]")->check(CLI::Range(0.0, 1e9));
-  plant_cmd->add_option("--record", plant.record, "write the trajectory CSV here");
-  plant_cmd->add_option("--mcap", plant.mcap, "record the topics as MCAP here (metadata.yaml beside it)");
+  plant_cmd->add_option("--record", plant.one_vehicle.record, "write the trajectory CSV here");
+  plant_cmd->add_option("--mcap", plant.one_vehicle.mcap, "record the topics as MCAP here (metadata.yaml beside it)");
   plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
-  plant_cmd->add_option("--schedule-via", plant.schedule_node,
+  plant_cmd->add_option("--schedule-via", plant.one_vehicle.schedule_node,
                         "lockstep: apply the scenario's schedule through this node's parameter services");
-  plant_cmd->add_flag("--wait-for-controller", plant.wait_for_controller,
+  plant_cmd->add_flag("--wait-for-controller", plant.realtime.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
-  plant_cmd->add_option("--swarm-out", plant.swarm_out, "with --vehicles: write summary.json, vehicles.csv here");
-  plant_cmd->add_option("--on-timeout", plant.on_timeout, "lockstep: abort (exit 4) or hold the last command")
+  plant_cmd->add_option("--swarm-out", plant.swarm.out, "with --vehicles: write summary.json, vehicles.csv here");
+  plant_cmd->add_option("--on-timeout", plant.lockstep_only.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
   plant_cmd->add_option("--watchdog", plant.watchdog_s,
                         "no valid motor command for this long [s] -> the watchdog policy (0: off; "
@@ -364,7 +364,7 @@ int plant_command(const PlantCommandOptions& o) {
     sc.simulation.duration_ticks =
         static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
   }
-  if (o.vehicles > 0) return swarm_plant_command(o, std::move(sc));
+  if (o.swarm.vehicles > 0) return swarm_plant_command(o, std::move(sc));
   PlantProcess process(o, std::move(sc));
   return process.run();
 }

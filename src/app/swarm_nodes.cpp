@@ -250,25 +250,25 @@ class ControllerShard {
 }  // namespace
 
 int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
-  const io::SwarmSpec spec = node_spec(sc, o.vehicles, o.ns_prefix);
+  const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
-  const int threads = std::clamp(o.threads, 1, n);
+  const int threads = std::clamp(o.swarm.threads, 1, n);
   std::vector<bool> recorded(static_cast<std::size_t>(n), false);
-  if (!o.swarm_out.empty()) {
+  if (!o.swarm.out.empty()) {
     for (int i : spec.record_vehicles) recorded[static_cast<std::size_t>(i)] = true;
   }
   std::vector<std::unique_ptr<PlantShard>> shards(static_cast<std::size_t>(threads));
   // Participants are created one after the other (Cyclone's domain setup is not worth racing).
   for (int t = 0; t < threads; ++t) {
     shards[static_cast<std::size_t>(t)] =
-        std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm_out),
+        std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm.out),
                                      o.sensor_qos, o.enclave);
   }
   std::cerr << fmt::format("plant: {} vehicles ({}...), {} thread(s), lockstep, {} ticks of {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads, sc.simulation.duration_ticks,
                            sc.simulation.plant.clock.period_s());
   const int rc = run_threads(threads, [&](int t) {
-    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, o.on_timeout, sc.simulation.controller_divider,
+    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, o.lockstep_only.on_timeout, sc.simulation.controller_divider,
                                                     sc.simulation.duration_ticks);
   });
   if (rc != kExitOk) return rc;
@@ -281,7 +281,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   if (!o.stats.empty()) {
     write_stats(o.stats, {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
   }
-  if (!o.swarm_out.empty()) {
+  if (!o.swarm.out.empty()) {
     std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
     std::vector<std::string> namespaces(static_cast<std::size_t>(n));
     const model::State initial = io::initial_state(sc);
@@ -297,7 +297,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
       }
     }
-    write_swarm_summary(o.swarm_out, sc, spec, namespaces, rows,
+    write_swarm_summary(o.swarm.out, sc, spec, namespaces, rows,
                         {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s},
                          {"real_time_factor", sim_s / wall_s}});
   }
@@ -305,9 +305,9 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
 }
 
 int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc) {
-  const io::SwarmSpec spec = node_spec(sc, o.vehicles, o.ns_prefix);
+  const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
-  const int threads = std::clamp(o.threads, 1, n);
+  const int threads = std::clamp(o.swarm.threads, 1, n);
   if (!o.apply_schedule) sc.schedule.clear();
   const std::int64_t period_ns = sc.simulation.plant.clock.period_ns * sc.simulation.controller_divider;
   std::vector<std::unique_ptr<ControllerShard>> shards;
