@@ -8,6 +8,8 @@
 #include <functional>
 #include <numbers>
 #include <optional>
+#include <span>
+#include <string>
 #include <vector>
 
 namespace quadcosim::analysis {
@@ -71,6 +73,9 @@ double brute_force_first_reach(const std::function<double(double)>& unit, double
   return std::nan("");
 }
 
+/// Value at `tau` after a first-order step of size 2 from 1 with time constant T (for the up-and-down case).
+double v_at(double /*t_step*/, double T, double tau) { return 1.0 + 2.0 * first_order(T, tau); }
+
 StepFigures figures_of(const Sampled& s, double t_step, double target, const StepOptions& opt = {}) {
   return step_figures(s.t, s.y, t_step, target, opt);
 }
@@ -117,10 +122,17 @@ void expect_second_order_figures(double zeta, double wn, double t_step, double y
                       brute_force_first_reach(unit, 0.10, duration - t_step);
   EXPECT_NEAR(*f.rise_time_s, rise, kDt + 1e-9);
 
-  // Over the final second the residual oscillation is below its envelope e^{-zeta wn tau} / sqrt(1 - zeta^2).
+  // The 2 % settling time lies within the envelope bound: |y - 1| <= e^{-zeta wn tau} / sqrt(1 - zeta^2),
+  // which is inside the band from tau = ln(1 / (0.02 sqrt(1 - zeta^2))) / (zeta wn) on.
+  EXPECT_LE(*f.settling_time_2pct_s, std::log(1.0 / (0.02 * root)) / (zeta * wn) + kDt + 1e-9);
+  EXPECT_EQ(f.verdict, StepVerdict::kSettled);
+
+  // The final window is the last 10 % of the 12 s after the step (1.2 s, more than the 1 s minimum);
+  // over it the residual oscillation is below its envelope.
+  EXPECT_DOUBLE_EQ(f.final_window_s, 0.1 * (duration - t_step));
   ASSERT_TRUE(f.steady_state_error_pct.has_value());
   EXPECT_GE(*f.steady_state_error_pct, 0.0);
-  EXPECT_LE(*f.steady_state_error_pct, std::exp(-zeta * wn * (duration - t_step - 1.0)) / root * 100.0 + 1e-9);
+  EXPECT_LE(*f.steady_state_error_pct, std::exp(-zeta * wn * (duration - t_step - 1.2)) / root * 100.0 + 1e-9);
 }
 
 TEST_P(SecondOrderTest, FiguresMatchTheAnalyticResponse) {
@@ -277,7 +289,8 @@ TEST(StepFiguresTest, SteadyStateErrorAveragesOverTheFinalWindow) {
     y.push_back(k == 0 ? 0.0 : (t.back() > 9.5 + 1e-9 ? 1.2 : 1.0));
   }
   StepOptions half;
-  half.final_window_s = 0.5 - 1e-9;  // t > 9.5: exactly the 50 raised samples
+  half.final_window_fraction = 0.0;
+  half.final_window_min_s = 0.5 - 1e-9;  // t > 9.5: exactly the 50 raised samples
   const StepFigures f = step_figures(t, y, 0.0, 1.0, half);
   ASSERT_TRUE(f.steady_state_error_pct.has_value());
   EXPECT_NEAR(*f.steady_state_error_pct, 20.0, 1e-9);
@@ -324,6 +337,167 @@ TEST(StepFiguresTest, FigureLooksUpEveryNameAndRejectsUnknownOnes) {
   }
   EXPECT_FALSE(figure(f, "overshoot").has_value());
   EXPECT_FALSE(figure(f, "").has_value());
+}
+
+
+// --- The verdict: settled, not settled, too short, zero-size step -------------------------------
+
+TEST(StepVerdictTest, ARunThatEndsStillClimbingIsNotSettled) {
+  // 0 -> 2 m, first order with T = 1.4 s, stopped 1.65 s after the step: y(1.65) = 2 (1 - e^{-1.65/1.4})
+  // = 1.38 m, still climbing at 0.44 m/s. The final window is the 1 s minimum (10 % of 1.65 s is less).
+  const double T = 1.4;
+  const Sampled s = sample(1.65, 0.0, 0.0, 2.0, [T](double tau) { return first_order(T, tau); });
+  const StepFigures f = figures_of(s, 0.0, 2.0);
+  EXPECT_EQ(f.verdict, StepVerdict::kNotSettled);
+  EXPECT_DOUBLE_EQ(f.final_window_s, 1.0);
+  EXPECT_FALSE(f.settling_time_2pct_s.has_value());
+  // The mean of 1 - e^{-tau/T} over tau in [0.65, 1.65] s (101 samples), against the target 1.
+  double mean = 0.0;
+  for (int k = 65; k <= 165; ++k) mean += first_order(T, k * kDt);
+  mean /= 101.0;
+  ASSERT_TRUE(f.steady_state_error_pct.has_value());
+  EXPECT_NEAR(*f.steady_state_error_pct, (1.0 - mean) * 100.0, 1e-9);
+  EXPECT_GT(*f.steady_state_error_pct, 40.0);
+  const std::string why = unjudgeable_reason(f, "settling_time_2pct_s");
+  EXPECT_NE(why.find("ended before settling"), std::string::npos) << why;
+  EXPECT_NE(unjudgeable_reason(f, "steady_state_error_pct").find("ended before settling"), std::string::npos);
+  EXPECT_EQ(unjudgeable_reason(f, "t95_s"), "");  // reached or not, t95 is what happened
+}
+
+TEST(StepVerdictTest, InsideTheBandAtTheLastSampleIsNotEnough) {
+  // A ramp that arrives at the target exactly at the end: the last sample is on target, but the
+  // final second is not inside the band, so it has not settled.
+  std::vector<double> t, y;
+  for (int k = 0; k <= 500; ++k) {
+    t.push_back(k * kDt);
+    y.push_back(k / 500.0);
+  }
+  const StepFigures f = step_figures(t, y, 0.0, 1.0);
+  EXPECT_EQ(f.verdict, StepVerdict::kNotSettled);
+  EXPECT_FALSE(f.settling_time_2pct_s.has_value());
+  // Enters the band (y >= 0.98) at 4.90 s and stays: settled once the final window is short enough
+  // to lie after it (window of 0.05 s: t >= 4.95 s).
+  StepOptions tiny;
+  tiny.final_window_fraction = 0.0;
+  tiny.final_window_min_s = 0.05;
+  const StepFigures g = step_figures(t, y, 0.0, 1.0, tiny);
+  EXPECT_EQ(g.verdict, StepVerdict::kSettled);
+  ASSERT_TRUE(g.settling_time_2pct_s.has_value());
+  EXPECT_NEAR(*g.settling_time_2pct_s, 4.90, kDt + 1e-9);  // 490/500 is 0.98 only to rounding
+}
+
+TEST(StepVerdictTest, LeavingTheBandAgainInTheFinalWindowIsNotSettled) {
+  // Settled first order, then a disturbance of 5 % of the step in the last 0.3 s.
+  const auto unit = [](double tau) { return first_order(0.3, tau) + (tau > 9.7 ? 0.05 : 0.0); };
+  const Sampled s = sample(10.0, 0.0, 0.0, 1.0, unit);
+  const StepFigures f = figures_of(s, 0.0, 1.0);
+  EXPECT_EQ(f.verdict, StepVerdict::kNotSettled);
+  EXPECT_FALSE(f.settling_time_2pct_s.has_value());
+}
+
+TEST(StepVerdictTest, ARunTooShortToJudge) {
+  // 0.8 s after the step: the 1 s final window does not fit.
+  const Sampled s = sample(0.8, 0.0, 0.0, 1.0, [](double tau) { return first_order(0.1, tau); });
+  const StepFigures f = figures_of(s, 0.0, 1.0);
+  EXPECT_EQ(f.verdict, StepVerdict::kTooShort);
+  EXPECT_FALSE(f.settling_time_2pct_s.has_value());
+  EXPECT_FALSE(f.steady_state_error_pct.has_value());
+  ASSERT_TRUE(f.t95_s.has_value());  // what happened is still measured
+  EXPECT_NEAR(*f.t95_s, 0.1 * std::log(20.0), kDt);
+  for (const auto& name : figure_names()) {
+    EXPECT_NE(unjudgeable_reason(f, name).find("too short to judge"), std::string::npos) << name;
+  }
+  // 1 s after the step is enough: the window is the whole post-step time, which starts outside the band.
+  const Sampled one = sample(1.0, 0.0, 0.0, 1.0, [](double tau) { return first_order(0.1, tau); });
+  EXPECT_EQ(figures_of(one, 0.0, 1.0).verdict, StepVerdict::kNotSettled);
+  const Sampled two = sample(2.0, 0.0, 0.0, 1.0, [](double tau) { return first_order(0.1, tau); });
+  EXPECT_EQ(figures_of(two, 0.0, 1.0).verdict, StepVerdict::kSettled);
+}
+
+TEST(StepVerdictTest, AZeroSizeStepHasNoFiguresAndSaysWhy) {
+  const Sampled s = sample(5.0, 1.0, 2.0, 2.0, [](double tau) { return first_order(0.3, tau); });
+  const StepFigures f = figures_of(s, 1.0, 2.0);
+  EXPECT_EQ(f.verdict, StepVerdict::kZeroStep);
+  for (const auto& name : figure_names()) {
+    EXPECT_FALSE(figure(f, name).has_value()) << name;
+    EXPECT_NE(unjudgeable_reason(f, name).find("zero-size step"), std::string::npos) << name;
+  }
+}
+
+TEST(StepVerdictTest, AStepMidRunAndBackDownAreJudgedEachOnItsOwnSpan) {
+  // Up 1 -> 3 at 2 s, back down to 1 at 9 s, end at 16 s; each step judged to the next one.
+  const double T = 0.25;
+  std::vector<double> t, y;
+  for (int k = 0; k <= 1600; ++k) {
+    const double tk = k / kRateHz;
+    t.push_back(tk);
+    double v = 1.0;
+    if (tk >= 2.0) v = 1.0 + 2.0 * first_order(T, tk - 2.0);
+    if (tk >= 9.0) v = 1.0 + (v_at(2.0, T, 7.0) - 1.0) * std::exp(-(tk - 9.0) / T);
+    y.push_back(v);
+  }
+  const auto up_end = static_cast<std::ptrdiff_t>(900);  // samples before 9 s
+  const StepFigures up = step_figures(std::span(t).first(up_end), std::span(y).first(up_end), 2.0, 3.0);
+  const StepFigures down = step_figures(t, y, 9.0, 1.0);
+  for (const StepFigures* f : {&up, &down}) {
+    EXPECT_EQ(f->verdict, StepVerdict::kSettled);
+    ASSERT_TRUE(f->settling_time_2pct_s && f->t95_s && f->rise_time_s);
+    EXPECT_NEAR(*f->settling_time_2pct_s, T * std::log(50.0), kDt + 1e-9);
+    EXPECT_NEAR(*f->t95_s, T * std::log(20.0), kDt + 1e-9);
+    EXPECT_NEAR(*f->rise_time_s, T * std::log(9.0), kDt + 1e-9);
+    EXPECT_EQ(f->overshoot_pct, 0.0);
+  }
+  EXPECT_NEAR(up.step, 2.0, 1e-12);
+  EXPECT_NEAR(down.step, -2.0 * (1.0 - std::exp(-7.0 / T)), 1e-12);
+  // Judged to the end of the run instead, the step up would see the step down in its final window.
+  EXPECT_EQ(step_figures(t, y, 2.0, 3.0).verdict, StepVerdict::kNotSettled);
+}
+
+// --- Angles: the shortest-path step on the unwrapped response -----------------------------------
+
+TEST(StepAngleTest, UnwrapRemovesTwoPiJumpsOnly) {
+  const std::vector<double> y = {3.0, 3.1, -3.1, -3.0, -3.1, 3.1, 0.5};
+  const std::vector<double> u = unwrap_angle(y);
+  const double two_pi = 2.0 * kPi;
+  const std::vector<double> expected = {3.0, 3.1, -3.1 + two_pi, -3.0 + two_pi, -3.1 + two_pi, 3.1, 0.5};
+  ASSERT_EQ(u.size(), expected.size());
+  for (std::size_t i = 0; i < u.size(); ++i) EXPECT_NEAR(u[i], expected[i], 1e-12) << i;
+}
+
+TEST(StepAngleTest, YawFrom3ToMinus3IsAStepOfPlus0283) {
+  // The vehicle turns the short way, 3.0 -> 3.0 + (2 pi - 6) rad, and the recorded angle wraps at pi.
+  const double T = 0.3, size = 2.0 * kPi - 6.0;  // 0.2832 rad
+  const Sampled s = sample(8.0, 1.0, 3.0, 3.0 + size, [T](double tau) { return first_order(T, tau); });
+  std::vector<double> wrapped;
+  for (double v : s.y) wrapped.push_back(std::remainder(v, 2.0 * kPi));  // what the recorder writes
+  ASSERT_LT(wrapped.back(), -2.9);                                         // it did wrap
+  StepOptions angle;
+  angle.angle = true;
+  const StepFigures f = step_figures(s.t, wrapped, 1.0, -3.0, angle);
+  EXPECT_NEAR(f.step, size, 1e-12);
+  EXPECT_NEAR(size, 0.2832, 1e-4);
+  EXPECT_EQ(f.target, -3.0);
+  EXPECT_EQ(f.verdict, StepVerdict::kSettled);
+  ASSERT_TRUE(f.rise_time_s && f.t95_s && f.settling_time_2pct_s && f.steady_state_error_pct);
+  EXPECT_NEAR(*f.rise_time_s, T * std::log(9.0), kDt + 1e-9);
+  EXPECT_NEAR(*f.t95_s, T * std::log(20.0), kDt + 1e-9);
+  EXPECT_NEAR(*f.settling_time_2pct_s, T * std::log(50.0), kDt + 1e-9);
+  EXPECT_NEAR(*f.steady_state_error_pct, 0.0, 1e-6);
+  EXPECT_EQ(f.overshoot_pct, 0.0);
+
+  // Judged as a plain signal, the same record is a 6 rad step that "rises" in the one sample where
+  // the angle wraps (what the angle option prevents).
+  const StepFigures plain = step_figures(s.t, wrapped, 1.0, -3.0);
+  EXPECT_NEAR(plain.step, -6.0, 1e-12);
+  ASSERT_TRUE(plain.rise_time_s.has_value());
+  EXPECT_LE(*plain.rise_time_s, kDt + 1e-12);
+}
+
+TEST(StepAngleTest, AStepOfExactlyPiGoesPositive) {
+  StepOptions angle;
+  angle.angle = true;
+  const Sampled s = sample(5.0, 0.0, 0.0, kPi, [](double tau) { return first_order(0.2, tau); });
+  EXPECT_NEAR(step_figures(s.t, s.y, 0.0, -kPi, angle).step, kPi, 1e-12);  // (-pi, pi]
 }
 
 }  // namespace

@@ -232,13 +232,19 @@ int run_command(const RunOptions& opt) {
     const io::Series series = io::read_series(csv_path);
     const auto results = io::evaluate_steps(sc.steps, series);
     const auto hold = sc.hold ? std::optional(io::evaluate_hold(*sc.hold, series)) : std::nullopt;
-    io::write_metrics_json((out / "metrics.json").string(), sc, results, hold);
-    const std::string table = io::format_step_table(sc, results, hold);
+    const auto saturation = io::evaluate_saturation(sc, series);
+    io::write_metrics_json((out / "metrics.json").string(), sc, results, hold, saturation);
+    const std::string table = io::format_step_table(sc, results, hold, saturation);
     std::ofstream((out / "metrics.txt").string()) << table;
     std::cout << table;
+    if (saturation) {
+      if (const std::string w = io::saturation_warning(*saturation); !w.empty()) std::cerr << "run: " << w << '\n';
+    }
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir)) return exit_code::kOutput;
-    return io::all_passed(results) && (!hold || hold->passed) ? exit_code::kOk : exit_code::kFailed;
+    return io::all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed)
+               ? exit_code::kOk
+               : exit_code::kFailed;
   } catch (const control::CareError& e) {
     throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());
   } catch (const std::invalid_argument& e) {

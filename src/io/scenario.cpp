@@ -196,9 +196,27 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
   f.reject_unknown_keys();
 }
 
+// analysis.limits: each key an upper bound >= 0 on a saturation or control-effort figure.
+LimitsSpec read_limits(YamlSection& l, double duration_s) {
+  LimitsSpec spec;
+  auto bound = [&](const std::string& key, double hi, const std::vector<std::string>& figures) {
+    if (!l.has(key)) return;
+    const double v = l.number(key, 0.0, 0.0, hi);
+    for (const auto& f : figures) spec.criteria.push_back(Criterion{f, std::nullopt, v});
+  };
+  bound("max_saturated_s", duration_s, {"saturated_s"});
+  bound("max_rotor_saturated_s", duration_s,
+        {"rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s", "rotor4_saturated_s"});
+  bound("max_tilt_saturated_s", duration_s, {"tilt_saturated_s"});
+  bound("max_rms_u1_deviation_n", kHuge, {"rms_u1_deviation_n"});
+  l.reject_unknown_keys();
+  return spec;
+}
+
 void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
   std::vector<StepSpec>& steps = sc.steps;
   if (auto h = analysis.section("hold")) sc.hold = read_hold(*h, duration_s);
+  if (auto l = analysis.section("limits")) sc.limits = read_limits(*l, duration_s);
   const std::vector<std::string> channels = {"x", "y", "z", "roll", "pitch", "yaw"};
   int index = 0;
   for (const YAML::Node& n : analysis.sequence("steps")) {
@@ -209,6 +227,7 @@ void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
     step.channel = s.choice("channel", "", channels);
     if (step.channel.empty()) s.fail("channel", "missing; expected one of x y z roll pitch yaw");
     step.t_step_s = s.number("at_s", 0.0, 0.0, duration_s);
+    step.settling_band = s.number("settling_band_pct", 2.0, 0.01, 50.0) / 100.0;
     if (auto c = s.section("criteria")) {
       for (const std::string& fig : c->keys()) {
         bool known = false;

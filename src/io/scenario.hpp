@@ -44,6 +44,9 @@ struct Criterion {
 struct StepSpec {
   std::string channel;   ///< x, y, z, roll, pitch or yaw
   double t_step_s = 0.0;
+  /// Band of the settled verdict and of the settling time, as a fraction of the step
+  /// (analysis.steps[].settling_band_pct / 100; 2 % unless set, e.g. wider where sensor noise exceeds it).
+  double settling_band = 0.02;
   std::vector<Criterion> criteria;
   std::string reference_source;             ///< where the reference figures come from
   std::map<std::string, double> reference;  ///< published figures to compare with
@@ -67,6 +70,14 @@ struct HoldSpec {
 /// "max_horizontal_error_m", "rms_horizontal_error_m", "max_vertical_error_m".
 const std::vector<std::string>& hold_figure_names();
 
+/// analysis.limits: upper bounds on the run's saturation and control effort (io::SaturationResult).
+/// Keys max_saturated_s, max_rotor_saturated_s (each rotor), max_tilt_saturated_s and
+/// max_rms_u1_deviation_n become criteria {figure, max} on the figures saturated_s,
+/// rotor1..4_saturated_s, tilt_saturated_s and rms_u1_deviation_n.
+struct LimitsSpec {
+  std::vector<Criterion> criteria;
+};
+
 struct Scenario {
   std::string path;  ///< file it was read from ("" for built-in defaults)
   std::string name;
@@ -79,6 +90,7 @@ struct Scenario {
   std::vector<StepSpec> steps;
   std::optional<SwarmSpec> swarm;  ///< present when the file has a `swarm:` section
   std::optional<HoldSpec> hold;  ///< analysis.hold
+  std::optional<LimitsSpec> limits;  ///< analysis.limits
 };
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).

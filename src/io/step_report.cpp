@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <array>
 #include <fstream>
+#include <limits>
+#include <span>
 #include <sstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -33,6 +36,13 @@ Series read_series(const std::string& path) {
   };
   const int t_col = column("t");
   for (const auto& w : wanted) index.push_back(column(w));
+  // Read when present: a trajectory from before the saturation columns existed still loads.
+  std::vector<std::string> names = wanted;
+  for (const char* optional : {"sat1", "sat2", "sat3", "sat4", "tilt_sat", "U1"}) {
+    if (std::find(header.begin(), header.end(), optional) == header.end()) continue;
+    names.push_back(optional);
+    index.push_back(column(optional));
+  }
   Series s;
   int line_no = 1;
   std::vector<double> row;
@@ -50,10 +60,21 @@ Series read_series(const std::string& path) {
                                std::to_string(header.size()) + " values");
     }
     s.t_s.push_back(row[t_col]);
-    for (std::size_t i = 0; i < wanted.size(); ++i) s.append(wanted[i], row[index[i]]);
+    for (std::size_t i = 0; i < names.size(); ++i) s.append(names[i], row[index[i]]);
   }
   return s;
 }
+
+namespace {
+bool is_angle(const std::string& channel) { return channel == "roll" || channel == "pitch" || channel == "yaw"; }
+
+CriterionResult judge(const Criterion& c, const std::optional<double>& value, std::string note = "") {
+  CriterionResult cr{c, value, false, std::move(note)};
+  cr.passed = cr.note.empty() && cr.value.has_value() && (!c.min || *cr.value >= *c.min) &&
+              (!c.max || *cr.value <= *c.max);
+  return cr;
+}
+}  // namespace
 
 std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series) {
   std::vector<StepResult> out;
@@ -70,16 +91,100 @@ std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const
     // The setpoint in effect at the step; in real time the controller's first status may arrive a
     // few ticks after it, so take the first recorded value from the step on.
     while (i + 1 < sp->second.size() && !std::isfinite(sp->second[i])) ++i;
-    r.figures = analysis::step_figures(series.t_s, y->second, spec.t_step_s, sp->second[i]);
+    // Judged up to the next later step of the same channel (its samples excluded).
+    double end_s = std::numeric_limits<double>::infinity();
+    for (const StepSpec& other : steps) {
+      if (other.channel == spec.channel && other.t_step_s > spec.t_step_s) end_s = std::min(end_s, other.t_step_s);
+    }
+    const auto n = static_cast<std::size_t>(
+        std::lower_bound(series.t_s.begin(), series.t_s.end(), end_s) - series.t_s.begin());
+    analysis::StepOptions options;
+    options.angle = is_angle(spec.channel);
+    options.settling_band = spec.settling_band;
+    r.figures = analysis::step_figures(std::span(series.t_s).first(n), std::span(y->second).first(n),
+                                       spec.t_step_s, sp->second[i], options);
     for (const Criterion& c : spec.criteria) {
-      CriterionResult cr{c, analysis::figure(r.figures, c.figure), false};
-      cr.passed = cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
+      const CriterionResult cr = judge(c, analysis::figure(r.figures, c.figure),
+                                       analysis::unjudgeable_reason(r.figures, c.figure, options));
       r.passed = r.passed && cr.passed;
       r.criteria.push_back(cr);
     }
     out.push_back(r);
   }
   return out;
+}
+
+const std::vector<std::string>& saturation_figure_names() {
+  static const std::vector<std::string> names = {"saturated_s",        "rotor1_saturated_s", "rotor2_saturated_s",
+                                                 "rotor3_saturated_s", "rotor4_saturated_s", "tilt_saturated_s",
+                                                 "rms_u1_deviation_n"};
+  return names;
+}
+
+std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Series& series) {
+  const auto& v = series.values;
+  for (const char* c : {"sat1", "sat2", "sat3", "sat4", "tilt_sat"}) {
+    if (!v.count(c)) return std::nullopt;
+  }
+  SaturationResult r;
+  const std::size_t n = series.t_s.size();
+  // Each row stands for the tick period that follows it (the last row for the one before it).
+  auto period = [&](std::size_t i) {
+    if (n < 2) return 0.0;
+    return i + 1 < n ? series.t_s[i + 1] - series.t_s[i] : series.t_s[i] - series.t_s[i - 1];
+  };
+  std::array<double, 4> rotor{};
+  double any = 0.0, tilt = 0.0, sum_du2 = 0.0;
+  std::size_t n_u = 0;
+  const double hover_n = sc.vehicle.mass_kg * sc.vehicle.gravity_m_s2;
+  const auto u1 = v.find("U1");
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dt = period(i);
+    bool some = false;
+    for (int k = 0; k < 4; ++k) {
+      if (v.at("sat" + std::to_string(k + 1))[i] != 0.0) {
+        rotor[k] += dt;
+        some = true;
+      }
+    }
+    if (some) any += dt;
+    if (v.at("tilt_sat")[i] != 0.0) tilt += dt;
+    if (u1 != v.end() && std::isfinite(u1->second[i])) {
+      sum_du2 += (u1->second[i] - hover_n) * (u1->second[i] - hover_n);
+      ++n_u;
+    }
+  }
+  r.figures["saturated_s"] = any;
+  for (int k = 0; k < 4; ++k) r.figures[SaturationResult::fmt_rotor(k + 1)] = rotor[k];
+  r.figures["tilt_saturated_s"] = tilt;
+  if (n_u > 0) r.figures["rms_u1_deviation_n"] = std::sqrt(sum_du2 / static_cast<double>(n_u));
+  if (sc.limits) {
+    for (const Criterion& c : sc.limits->criteria) {
+      const auto it = r.figures.find(c.figure);
+      const CriterionResult cr = judge(c, it == r.figures.end() ? std::nullopt : std::optional(it->second));
+      r.passed = r.passed && cr.passed;
+      r.criteria.push_back(cr);
+    }
+  }
+  return r;
+}
+
+std::string saturation_warning(const SaturationResult& s) {
+  if (s.saturated_s() <= 0.0 && s.tilt_saturated_s() <= 0.0) return "";
+  std::string rotors, times;
+  for (int k = 1; k <= 4; ++k) {
+    if (s.rotor_saturated_s(k) > 0.0) rotors += (rotors.empty() ? "" : ", ") + std::to_string(k);
+    times += fmt::format("{}{:.3f}", k == 1 ? "" : "/", s.rotor_saturated_s(k));
+  }
+  std::string line = "warning: rotor saturation: ";
+  if (s.saturated_s() > 0.0) {
+    line += fmt::format("rotor{} {} clamped at omega_min/omega_max by the allocation for {:.3f} s in total (rotors 1/2/3/4: {} s)",
+                        rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), times);
+  }
+  if (s.tilt_saturated_s() > 0.0) {
+    line += fmt::format("{}tilt limit acted for {:.3f} s", s.saturated_s() > 0.0 ? "; " : "", s.tilt_saturated_s());
+  }
+  return line + "; the response is the limits', not the controller's alone (sat1..4, tilt_sat in trajectory.csv)";
 }
 
 bool all_passed(const std::vector<StepResult>& results) {
@@ -114,8 +219,7 @@ HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
   }
   for (const Criterion& c : spec.criteria) {
     const auto it = r.figures.find(c.figure);
-    CriterionResult cr{c, it == r.figures.end() ? std::nullopt : std::optional<double>(it->second), false};
-    cr.passed = cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
+    const CriterionResult cr = judge(c, it == r.figures.end() ? std::nullopt : std::optional<double>(it->second));
     r.passed = r.passed && cr.passed;
     r.criteria.push_back(cr);
   }
@@ -124,10 +228,28 @@ HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
 
 namespace {
 nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
+
+nlohmann::json criteria_json(const std::vector<CriterionResult>& criteria) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& c : criteria) {
+    a.push_back({{"figure", c.criterion.figure},
+                 {"min", opt(c.criterion.min)},
+                 {"max", opt(c.criterion.max)},
+                 {"value", opt(c.value)},
+                 {"passed", c.passed},
+                 {"note", c.note.empty() ? nlohmann::json() : nlohmann::json(c.note)}});
+  }
+  return a;
+}
+
+bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
+                    const std::optional<SaturationResult>& saturation) {
+  return all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed);
+}
 }  // namespace
 
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
-                            const std::optional<HoldResult>& hold) {
+                            const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation) {
   nlohmann::json j;
   j["scenario"] = scenario.name;
   j["description"] = scenario.description;
@@ -139,17 +261,15 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
     s["t_step_s"] = r.spec.t_step_s;
     s["initial"] = r.figures.initial;
     s["target"] = r.figures.target;
+    s["step"] = r.figures.step;
+    s["verdict"] = analysis::to_string(r.figures.verdict);
+    s["post_step_s"] = r.figures.post_step_s;
+    s["final_window_s"] = r.figures.final_window_s;
+    s["settling_band_pct"] = r.spec.settling_band * 100.0;
     nlohmann::json figs = nlohmann::json::object();
     for (const auto& name : analysis::figure_names()) figs[name] = opt(analysis::figure(r.figures, name));
     s["figures"] = figs;
-    s["criteria"] = nlohmann::json::array();
-    for (const auto& c : r.criteria) {
-      s["criteria"].push_back({{"figure", c.criterion.figure},
-                               {"min", opt(c.criterion.min)},
-                               {"max", opt(c.criterion.max)},
-                               {"value", opt(c.value)},
-                               {"passed", c.passed}});
-    }
+    s["criteria"] = criteria_json(r.criteria);
     if (!r.spec.reference.empty()) {
       nlohmann::json ref = {{"source", r.spec.reference_source}};
       for (const auto& [k, v] : r.spec.reference) ref[k] = v;
@@ -167,62 +287,97 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
       figs[name] = it == hold->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
     }
     h["figures"] = figs;
-    h["criteria"] = nlohmann::json::array();
-    for (const auto& c : hold->criteria) {
-      h["criteria"].push_back({{"figure", c.criterion.figure},
-                               {"min", opt(c.criterion.min)},
-                               {"max", opt(c.criterion.max)},
-                               {"value", opt(c.value)},
-                               {"passed", c.passed}});
-    }
+    h["criteria"] = criteria_json(hold->criteria);
     h["passed"] = hold->passed;
     j["hold"] = h;
   }
-  j["passed"] = all_passed(results) && (!hold || hold->passed);
+  if (saturation) {
+    nlohmann::json figs = nlohmann::json::object();
+    for (const auto& name : saturation_figure_names()) {
+      const auto it = saturation->figures.find(name);
+      figs[name] = it == saturation->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
+    }
+    j["saturation"] = {{"figures", figs}, {"criteria", criteria_json(saturation->criteria)},
+                       {"passed", saturation->passed}};
+  }
+  j["passed"] = passed_overall(results, hold, saturation);
   return j;
 }
 
 void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold) {
+                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
+                        const std::optional<SaturationResult>& saturation) {
   std::ofstream out(path);
-  out << metrics_json(scenario, results, hold).dump(2) << '\n';
+  out << metrics_json(scenario, results, hold, saturation).dump(2) << '\n';
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
+namespace {
+// The criterion column, verdict and notes of the figure `name` (several criteria may name it).
+struct CriterionCells {
+  std::string crit, verdict;
+  std::vector<std::string> notes;
+};
+CriterionCells cells(const std::vector<CriterionResult>& criteria, const std::string& name) {
+  CriterionCells c;
+  for (const auto& r : criteria) {
+    if (r.criterion.figure != name) continue;
+    c.crit = fmt::format("[{}, {}]", r.criterion.min ? fmt::format("{:g}", *r.criterion.min) : "-",
+                         r.criterion.max ? fmt::format("{:g}", *r.criterion.max) : "-");
+    c.verdict = r.passed ? "ok" : "FAIL";
+    if (!r.note.empty()) c.notes.push_back(r.note);
+  }
+  return c;
+}
+}  // namespace
+
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
-                              const std::optional<HoldResult>& hold) {
+                              const std::optional<HoldResult>& hold,
+                              const std::optional<SaturationResult>& saturation) {
   std::string s = fmt::format("scenario {}\n", scenario.name);
   for (const StepResult& r : results) {
-    s += fmt::format("step {} {:g} -> {:g} at t = {:g} s: {}\n", r.spec.channel, r.figures.initial,
-                     r.figures.target, r.spec.t_step_s, r.passed ? "PASS" : "FAIL");
-    s += fmt::format("  {:<24} {:>10} {:>22} {:>7} {:>10}\n", "figure", "value", "criterion", "", "reference");
+    const auto& f = r.figures;
+    const bool angle = r.spec.channel == "roll" || r.spec.channel == "pitch" || r.spec.channel == "yaw";
+    s += fmt::format("step {} {:g} -> {:g}{} at t = {:g} s: {} ({}; final window {:g} s of {:g} s)\n",
+                     r.spec.channel, f.initial, f.target,
+                     angle && std::abs(f.step - (f.target - f.initial)) > 1e-12
+                         ? fmt::format(" (shortest path {:+.3f})", f.step)
+                         : "",
+                     r.spec.t_step_s, r.passed ? "PASS" : "FAIL", analysis::to_string(f.verdict),
+                     f.final_window_s, f.post_step_s);
+    s += fmt::format("  {:<24} {:>12} {:>22} {:>7} {:>10}\n", "figure", "value", "criterion", "", "reference");
     for (const auto& name : analysis::figure_names()) {
-      const auto v = analysis::figure(r.figures, name);
-      std::string crit, verdict;
-      for (const auto& c : r.criteria) {
-        if (c.criterion.figure != name) continue;
-        crit = fmt::format("[{}, {}]", c.criterion.min ? fmt::format("{:g}", *c.criterion.min) : "-",
-                           c.criterion.max ? fmt::format("{:g}", *c.criterion.max) : "-");
-        verdict = c.passed ? "ok" : "FAIL";
+      const auto v = analysis::figure(f, name);
+      std::string value = v ? fmt::format("{:.3f}", *v) : "-";
+      if (!v && name == "settling_time_2pct_s" && f.verdict == analysis::StepVerdict::kNotSettled) value = "not settled";
+      if (!v && f.verdict == analysis::StepVerdict::kTooShort &&
+          (name == "settling_time_2pct_s" || name == "steady_state_error_pct")) {
+        value = "too short";
       }
+      const CriterionCells c = cells(r.criteria, name);
       const auto ref = r.spec.reference.find(name);
-      s += fmt::format("  {:<24} {:>10} {:>22} {:>7} {:>10}\n", name, v ? fmt::format("{:.3f}", *v) : "-",
-                       crit, verdict, ref != r.spec.reference.end() ? fmt::format("{:g}", ref->second) : "");
+      s += fmt::format("  {:<24} {:>12} {:>22} {:>7} {:>10}\n", name, value, c.crit, c.verdict,
+                       ref != r.spec.reference.end() ? fmt::format("{:g}", ref->second) : "");
+      for (const auto& note : c.notes) s += fmt::format("    {}: {}\n", name, note);
     }
   }
   if (hold) {
     s += fmt::format("hold from t = {:g} s: {}\n", hold->spec.after_s, hold->passed ? "PASS" : "FAIL");
     for (const auto& name : hold_figure_names()) {
       const auto it = hold->figures.find(name);
-      std::string crit, verdict;
-      for (const auto& c : hold->criteria) {
-        if (c.criterion.figure != name) continue;
-        crit = fmt::format("[{}, {}]", c.criterion.min ? fmt::format("{:g}", *c.criterion.min) : "-",
-                           c.criterion.max ? fmt::format("{:g}", *c.criterion.max) : "-");
-        verdict = c.passed ? "ok" : "FAIL";
-      }
-      s += fmt::format("  {:<24} {:>10} {:>22} {:>7}\n", name,
-                       it != hold->figures.end() ? fmt::format("{:.3f}", it->second) : "-", crit, verdict);
+      const CriterionCells c = cells(hold->criteria, name);
+      s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
+                       it != hold->figures.end() ? fmt::format("{:.3f}", it->second) : "-", c.crit, c.verdict);
+    }
+  }
+  if (saturation) {
+    s += fmt::format("limits (rotor speed and tilt saturation, control effort): {}\n",
+                     saturation->passed ? (saturation->criteria.empty() ? "no criteria" : "PASS") : "FAIL");
+    for (const auto& name : saturation_figure_names()) {
+      const auto it = saturation->figures.find(name);
+      const CriterionCells c = cells(saturation->criteria, name);
+      s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
+                       it != saturation->figures.end() ? fmt::format("{:.3f}", it->second) : "-", c.crit, c.verdict);
     }
   }
   return s;

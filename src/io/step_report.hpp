@@ -14,7 +14,8 @@
 namespace quadcosim::io {
 
 /// Recorded signals of a run: time and, per channel (x, y, z, roll, pitch, yaw), the measured value
-/// and its setpoint ("z" and "z_des").
+/// and its setpoint ("z" and "z_des"); from a trajectory.csv also, when it has them, the saturation
+/// flags "sat1".."sat4", "tilt_sat" (0/1) and the collective thrust "U1".
 struct Series {
   std::vector<double> t_s;
   std::map<std::string, std::vector<double>> values;
@@ -25,6 +26,8 @@ struct CriterionResult {
   Criterion criterion;
   std::optional<double> value;
   bool passed = false;
+  /// Why it failed whatever its bounds (e.g. "the run ended before settling: ..."), else "".
+  std::string note;
 };
 
 struct StepResult {
@@ -42,12 +45,37 @@ struct HoldResult {
   bool passed = true;
 };
 
-/// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des). Throws
-/// std::runtime_error naming the file and the missing column or bad line.
+/// What a run did against its motor and tilt limits (docs/outputs.md, "Saturation"), and the
+/// verdicts of the scenario's analysis.limits.
+struct SaturationResult {
+  std::map<std::string, double> figures;  ///< by saturation_figure_names(); rms_u1_deviation_n absent without U1
+  std::vector<CriterionResult> criteria;
+  bool passed = true;
+  double saturated_s() const { return figures.at("saturated_s"); }
+  double tilt_saturated_s() const { return figures.at("tilt_saturated_s"); }
+  double rotor_saturated_s(int rotor) const { return figures.at(fmt_rotor(rotor)); }  ///< rotor 1..4
+  static std::string fmt_rotor(int rotor) { return "rotor" + std::to_string(rotor) + "_saturated_s"; }
+};
+
+/// "saturated_s", "rotor1_saturated_s" .. "rotor4_saturated_s", "tilt_saturated_s", "rms_u1_deviation_n".
+const std::vector<std::string>& saturation_figure_names();
+
+/// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des; the
+/// saturation columns and U1 when present). Throws std::runtime_error naming the file and the
+/// missing column or bad line.
 Series read_series(const std::string& trajectory_csv);
 
-/// Evaluates every step of the scenario. The target is the channel's setpoint at the step time.
+/// Evaluates every step of the scenario. The target is the channel's setpoint at the step time;
+/// roll, pitch and yaw are judged as angles (shortest-path step, unwrapped response). A step is
+/// judged from its instant to the next later step of the same channel, or to the end of the run.
 std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series);
+
+/// The saturation figures of a run and the verdicts of `scenario.limits`; empty when the series has
+/// no saturation columns (a trajectory written before they existed, or a series built in memory).
+std::optional<SaturationResult> evaluate_saturation(const Scenario& scenario, const Series& series);
+
+/// One line for the console when the run hit a limit ("run: warning: rotor saturation: ..."), or "".
+std::string saturation_warning(const SaturationResult& saturation);
 
 bool all_passed(const std::vector<StepResult>& results);
 
@@ -57,15 +85,19 @@ HoldResult evaluate_hold(const HoldSpec& spec, const Series& series);
 /// The content of metrics.json (schema in docs/outputs.md), for callers that add to it (a sweep adds
 /// the run's seed and varied values).
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
-                            const std::optional<HoldResult>& hold = {});
+                            const std::optional<HoldResult>& hold = {},
+                            const std::optional<SaturationResult>& saturation = {});
 
 /// Writes metrics.json (schema in docs/outputs.md). Throws std::runtime_error on I/O failure.
-/// `hold`, when given, is written under "hold" and counts in "passed".
+/// `hold` and `saturation`, when given, are written under "hold" and "saturation" and count in "passed".
 void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold = {});
+                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold = {},
+                        const std::optional<SaturationResult>& saturation = {});
 
-/// A fixed-width table: one line per figure with value, criterion, verdict and reference.
+/// A fixed-width table: one line per figure with value, criterion, verdict and reference; a figure
+/// that could not be judged shows why under its line.
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
-                              const std::optional<HoldResult>& hold = {});
+                              const std::optional<HoldResult>& hold = {},
+                              const std::optional<SaturationResult>& saturation = {});
 
 }  // namespace quadcosim::io

@@ -19,7 +19,8 @@ ControlColumns ControlColumns::none() {
 
 ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
   const auto& s = m.setpoint;
-  return {s[0], s[1], s[2], s[3], s[4], s[5], Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]), m.safety};
+  return {s[0], s[1], s[2], s[3], s[4], s[5], Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]), m.safety,
+          m.rotor_saturated, m.tilt_saturated};
 }
 
 const std::vector<std::string>& TrajectoryWriter::columns() {
@@ -28,7 +29,7 @@ const std::vector<std::string>& TrajectoryWriter::columns() {
       "qy",    "qz",     "roll",    "pitch",   "yaw",      "p",        "q",    "r",   "w1",
       "w2",    "w3",     "w4",      "cmd1",    "cmd2",     "cmd3",     "cmd4", "x_des", "y_des",
       "z_des", "roll_des", "pitch_des", "yaw_des", "U1",   "U2",       "U3",   "U4",  "safety",
-      "watchdog"};
+      "watchdog", "sat1", "sat2",  "sat3",     "sat4",     "tilt_sat"};
   return c;
 }
 
@@ -57,8 +58,11 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
                  x.q_WB.z(), e.roll_rad, e.pitch_rad, e.yaw_rad, x.w_B.x(), x.w_B.y(), x.w_B.z());
   fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1],
                  x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
-  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{}\n", c.x_des, c.y_des, c.z_des, c.roll_des,
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des,
                  c.pitch_des, c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
+  const auto& sat = c.rotor_saturated;
+  fmt::format_to(out, "{},{},{},{},{}\n", sat[0] ? 1 : 0, sat[1] ? 1 : 0, sat[2] ? 1 : 0, sat[3] ? 1 : 0,
+                 c.tilt_saturated ? 1 : 0);
   if (buffer_.size() > (1 << 16)) {
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     buffer_.clear();

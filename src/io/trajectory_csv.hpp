@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -17,6 +18,10 @@ struct ControlColumns {
   double x_des, y_des, z_des, roll_des, pitch_des, yaw_des;
   Eigen::Vector4d U;  ///< U1 [N], U2..U4 [N m]
   bool safety;
+  /// The controller's allocation clamped rotor i's demanded speed at omega_min or omega_max
+  /// (ControllerStatus.rotor_saturated); the position loop's tilt limit acted (tilt_saturated).
+  std::array<bool, 4> rotor_saturated{};
+  bool tilt_saturated = false;
   static ControlColumns none();
   /// The columns of a controller status message.
   static ControlColumns from(const msg::ControllerStatus& status);
