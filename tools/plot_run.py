@@ -62,6 +62,13 @@ REQUIRED_COLUMNS = (
     "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
 )
 
+# Read when present (saturation flags, docs/outputs.md); older trajectories lack them.
+OPTIONAL_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
+# Angles are drawn unwrapped (no 2 pi jumps), their setpoints too.
+ANGLE_COLUMNS = ("roll", "pitch", "yaw", "roll_des", "pitch_des", "yaw_des")
+COLOR_SATURATED = "#d62728"
+COLOR_TILT_LIMIT = "#ff7f0e"
+
 # channel -> display metadata
 CHANNELS = {
     "x": dict(name="X position", sym="x", unit="m", rate="vx", rate_sym="vx", rate_unit="m/s"),
@@ -117,6 +124,9 @@ class Trajectory:
     def __getitem__(self, name):
         return self._data[:, self._index[name]]
 
+    def has(self, name):
+        return name in self._index
+
     def __len__(self):
         return self._data.shape[0]
 
@@ -160,7 +170,8 @@ def load_trajectory(path):
                     f"{path}: missing required column{'s' if len(missing) > 1 else ''} "
                     + ", ".join(repr(c) for c in missing)
                     + f" (header has: {', '.join(names)})")
-            usecols = [index[c] for c in REQUIRED_COLUMNS]
+            loaded = REQUIRED_COLUMNS + tuple(c for c in OPTIONAL_COLUMNS if c in index)
+            usecols = [index[c] for c in loaded]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # "input contained no data"
                 try:
@@ -175,7 +186,10 @@ def load_trajectory(path):
         raise InputError(f"{path}: cannot read: {exc}") from None
     if data.shape[0] == 0:
         raise InputError(f"{path}: no data rows after the header")
-    traj = Trajectory(path, REQUIRED_COLUMNS, data)
+    for name in ANGLE_COLUMNS:
+        col = loaded.index(name)
+        data[:, col] = unwrap_angle(data[:, col])
+    traj = Trajectory(path, loaded, data)
     t = traj["t"]
     if not np.all(np.isfinite(t)):
         raise InputError(f"{path}: column 't' contains non-finite values")
@@ -183,6 +197,67 @@ def load_trajectory(path):
         print(f"{PROG}: warning: {path}: column 't' is not monotonically non-decreasing",
               file=sys.stderr)
     return traj
+
+
+def unwrap_angle(a):
+    """The angle with every jump of more than pi between finite neighbours taken the short way
+    (as the step figures judge it); NaN entries stay NaN and do not break the unwrapping."""
+    a = np.array(a, dtype=np.float64)
+    ok = np.isfinite(a)
+    if np.count_nonzero(ok) > 1:
+        a[ok] = np.unwrap(a[ok])
+    return a
+
+
+def saturated_intervals(t, flags):
+    """[(t_start, t_end)] of the runs of rows with a flag set; each row stands for the tick period
+    after it (the last row for the one before), as the saturation figures count it."""
+    t = np.asarray(t, dtype=np.float64)
+    on = np.asarray(flags) != 0
+    if t.size == 0 or not on.any():
+        return []
+    period = float(t[1] - t[0]) if t.size > 1 else 0.0
+    ends = np.append(t[1:], t[-1] + period)
+    out = []
+    i = 0
+    n = t.size
+    while i < n:
+        if on[i]:
+            j = i
+            while j + 1 < n and on[j + 1]:
+                j += 1
+            out.append((float(t[i]), float(ends[j])))
+            i = j + 1
+        else:
+            i += 1
+    return out
+
+
+def shade_saturation(ax, traj, lo=None, hi=None):
+    """Shades the intervals where a rotor was saturated (red) or the tilt limit acted (orange);
+    returns legend handles for what was shaded."""
+    handles = []
+    if not all(traj.has(c) for c in OPTIONAL_COLUMNS):
+        return handles
+    t = traj["t"]
+    any_rotor = np.zeros(len(t), dtype=bool)
+    rotors = []
+    for k in range(1, 5):
+        if np.any(traj[f"sat{k}"] != 0):
+            rotors.append(str(k))
+        any_rotor |= traj[f"sat{k}"] != 0
+    for flags, color, label in ((any_rotor, COLOR_SATURATED, f"rotor{'s' if len(rotors) > 1 else ''} "
+                                 f"{', '.join(rotors)} saturated"),
+                                (traj["tilt_sat"] != 0, COLOR_TILT_LIMIT, "tilt limit acting")):
+        spans = saturated_intervals(t, flags)
+        if lo is not None:
+            spans = [(max(a, lo), min(b, hi)) for a, b in spans if b > lo and a < hi]
+        for a, b in spans:
+            ax.axvspan(a, b, color=color, alpha=0.12, lw=0, zorder=0)
+        if spans:
+            total = sum(b - a for a, b in spans)
+            handles.append(Patch(facecolor=color, alpha=0.3, label=f"{label} ({total:.2f} s shown)"))
+    return handles
 
 
 def _is_number(v):
@@ -231,6 +306,9 @@ def load_metrics(path):
             if not _is_number(v) or not math.isfinite(float(v)):
                 raise InputError(f"{where}: key {key!r} must be a finite number, got {v!r}")
             step[key] = float(v)
+        # The step judged (shortest path for an angle) and the verdict; absent in older files.
+        step["step"] = float(s["step"]) if _is_number(s.get("step")) and math.isfinite(float(s["step"])) else None
+        step["verdict"] = str(s["verdict"]) if isinstance(s.get("verdict"), str) else None
         figures = s.get("figures") or {}
         if not isinstance(figures, dict):
             raise InputError(f"{where}: key 'figures' must be an object")
@@ -262,6 +340,8 @@ def load_metrics(path):
         "steps": clean,
         # Position-hold figures (analysis.hold), passed through as written; None without one.
         "hold": obj.get("hold") if isinstance(obj.get("hold"), dict) else None,
+        # Saturation figures and limits, passed through as written; None without them.
+        "saturation": obj.get("saturation") if isinstance(obj.get("saturation"), dict) else None,
     }
 
 
@@ -426,6 +506,8 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
     des = traj[f"{ch}_des"][sel]
 
     t_step, initial, target = step["t_step_s"], step["initial"], step["target"]
+    if ch in ("roll", "pitch", "yaw") and step.get("step") is not None:
+        target = initial + step["step"]  # the shortest-path target, on the unwrapped angle
     figs = step["figures"]
     unit = meta["unit"]
 
@@ -449,7 +531,7 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
     h_var, = ax.plot(t, y, color=COLOR_VAR, lw=1.8, zorder=4, label=f"{meta['sym']} [{unit}]")
     h_rate, = ax2.plot(t, rate, color=COLOR_RATE, lw=1.4, zorder=3,
                        label=f"{meta['rate_sym']} [{meta['rate_unit']}]")
-    handles = [h_var, h_rate, h_des] + handles
+    handles = [h_var, h_rate, h_des] + handles + shade_saturation(ax, traj, float(t[0]), float(t[-1]))
 
     # Peak marker (time figures are measured from the step time)
     peak_t = figs.get("peak_time_s")
@@ -599,6 +681,7 @@ def plot_overview(traj, out_path, metrics, run_dir):
                 ax.plot(t, traj[des_cols[i]], color=col, lw=1.0, ls="--", alpha=0.8)
         if des_cols:
             handles.append(Line2D([], [], color=COLOR_SETPOINT, lw=1.0, ls="--", label="setpoint"))
+        handles += shade_saturation(ax, traj)
         ax.set_xlabel("time t [s]", fontsize=9)
         ax.set_ylabel(ylabel, fontsize=9)
         ax.set_title(title, fontsize=10)

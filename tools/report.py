@@ -111,7 +111,10 @@ def step_rows(step):
             p = c.get("passed")
             status = "ok" if p is True else ("FAIL" if p is False else "?")
         reference = plot_run._figure_cell(k, ref[k]) if k in ref else ""
-        rows.append((k, plot_run._figure_cell(k, value), band, status, reference))
+        cell = plot_run._figure_cell(k, value)
+        if value is None and k == "settling_time_2pct_s" and step.get("verdict") == "not settled":
+            cell = "not settled"
+        rows.append((k, cell, band, status, reference))
     return rows
 
 
@@ -206,6 +209,9 @@ def build_html(run_dir, metrics, version_text):
               f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td>"
               + (f"<td class=\"num\">{esc(reference)}</td>" if has_ref else "") + "</tr>")
         w("</table>")
+        notes = [c.get("note") for c in step["criteria"] if isinstance(c.get("note"), str) and c.get("note")]
+        for note in dict.fromkeys(notes):
+            w(f'<p class="note">{esc(note)}</p>')
         if step["reference"].get("source"):
             w(f'<p class="source">reference source: {esc(step["reference"]["source"])}</p>')
 
@@ -223,6 +229,28 @@ def build_html(run_dir, metrics, version_text):
             status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
             cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
             ours = "—" if not plot_run._is_number(value) else f"{float(value):.3f} m"
+            w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
+              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
+        w("</table>")
+
+    sat = metrics.get("saturation")
+    if sat:
+        sp = sat.get("passed")
+        mark = "" if not sat.get("criteria") else (" — ok" if sp else " — FAIL")
+        w(f'<h2 id="saturation">Saturation and control effort{esc(mark)}</h2>')
+        crit = {}
+        for c in sat.get("criteria", []):
+            if isinstance(c, dict):
+                crit[c.get("figure")] = c
+        w("<table>")
+        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
+        for key, value in (sat.get("figures") or {}).items():
+            c = crit.get(key)
+            band = _band(c) if c else "—"
+            status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
+            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+            unit = "N" if key.endswith("_n") else "s"
+            ours = "—" if not plot_run._is_number(value) else f"{float(value):.3f} {unit}"
             w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
               f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
         w("</table>")

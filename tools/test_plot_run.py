@@ -293,5 +293,61 @@ class PlotRunTest(unittest.TestCase):
         self.assertLess(elapsed, 120.0)
 
 
+class UnwrapAndSaturationTest(unittest.TestCase):
+    """The helpers behind unwrapped angle plots and saturation shading, against hand counts."""
+
+    @classmethod
+    def setUpClass(cls):
+        if importlib.util.find_spec("matplotlib") is None:
+            raise unittest.SkipTest("matplotlib not importable in this interpreter")
+        spec = importlib.util.spec_from_file_location("plot_run", SCRIPT)
+        cls.pr = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(cls.pr)
+
+    def test_unwrap_takes_the_short_way_and_keeps_nan(self):
+        # Yaw 3.0 -> 3.283 rad as recorded: wraps to about -3.0 past pi.
+        true = 3.0 + (2 * math.pi - 6.0) * (1 - np.exp(-np.arange(0, 5, 0.01) / 0.3))
+        rec = np.remainder(true + math.pi, 2 * math.pi) - math.pi
+        self.assertLess(rec.min(), -2.9)  # the record does wrap
+        np.testing.assert_allclose(self.pr.unwrap_angle(rec), true, atol=1e-12)
+        with_nan = np.array([math.nan, 3.1, -3.1, math.nan, -3.0])
+        u = self.pr.unwrap_angle(with_nan)
+        self.assertTrue(math.isnan(u[0]) and math.isnan(u[3]))
+        self.assertAlmostEqual(u[2], -3.1 + 2 * math.pi, places=12)
+        self.assertAlmostEqual(u[4], -3.0 + 2 * math.pi, places=12)
+
+    def test_intervals_cover_the_flagged_rows(self):
+        t = np.arange(301) / 100.0
+        flags = np.zeros(301)
+        flags[50:180] = 1
+        flags[300] = 1
+        spans = self.pr.saturated_intervals(t, flags)
+        self.assertEqual(len(spans), 2)
+        self.assertAlmostEqual(spans[0][0], 0.50, places=12)
+        self.assertAlmostEqual(spans[0][1], 1.80, places=12)
+        # Total = flagged rows x period, the count metrics.json reports.
+        self.assertAlmostEqual(sum(b - a for a, b in spans), np.count_nonzero(flags) * 0.01, places=9)
+        self.assertEqual(self.pr.saturated_intervals(t, np.zeros(301)), [])
+
+    def test_shading_is_drawn_only_where_saturated(self):
+        import matplotlib.pyplot as plt
+        t = np.arange(201) / 100.0
+        cols = {"t": t, "sat1": np.zeros(201), "sat2": (t < 0.5).astype(float), "sat3": np.zeros(201),
+                "sat4": ((t >= 1.0) & (t < 1.2)).astype(float), "tilt_sat": np.zeros(201)}
+        names = list(cols)
+        traj = self.pr.Trajectory("mem", names, np.column_stack([cols[n] for n in names]))
+        fig, ax = plt.subplots()
+        handles = self.pr.shade_saturation(ax, traj)
+        spans = sorted((p.get_xy()[0][0], p.get_xy()[2][0]) for p in ax.patches)
+        plt.close(fig)
+        self.assertEqual(len(spans), 2)
+        self.assertAlmostEqual(spans[0][0], 0.0)
+        self.assertAlmostEqual(spans[0][1], 0.5)
+        self.assertAlmostEqual(spans[1][0], 1.0)
+        self.assertAlmostEqual(spans[1][1], 1.2)
+        self.assertEqual(len(handles), 1)
+        self.assertIn("rotors 2, 4 saturated", handles[0].get_label())
+
+
 if __name__ == "__main__":
     unittest.main()
