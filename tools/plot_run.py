@@ -116,10 +116,16 @@ class InputError(Exception):
 class Trajectory:
     """Column-name access to the numeric columns of trajectory.csv."""
 
-    def __init__(self, path, columns, data):
+    def __init__(self, path, columns, data, recorded=None):
         self.path = path
         self._index = {name: i for i, name in enumerate(columns)}
         self._data = data
+        # Angle columns as recorded, before unwrapping (name -> array); absent: as in data.
+        self._recorded = recorded or {}
+
+    def recorded(self, name):
+        """The column as trajectory.csv holds it (angles wrapped, setpoints as commanded)."""
+        return self._recorded[name] if name in self._recorded else self[name]
 
     def __getitem__(self, name):
         return self._data[:, self._index[name]]
@@ -186,10 +192,12 @@ def load_trajectory(path):
         raise InputError(f"{path}: cannot read: {exc}") from None
     if data.shape[0] == 0:
         raise InputError(f"{path}: no data rows after the header")
+    recorded = {}
     for name in ANGLE_COLUMNS:
         col = loaded.index(name)
+        recorded[name] = data[:, col].copy()
         data[:, col] = unwrap_angle(data[:, col])
-    traj = Trajectory(path, loaded, data)
+    traj = Trajectory(path, loaded, data, recorded)
     t = traj["t"]
     if not np.all(np.isfinite(t)):
         raise InputError(f"{path}: column 't' contains non-finite values")
@@ -366,15 +374,22 @@ def detect_steps(traj):
                 steps.append({
                     "channel": ch, "t_step_s": float(t[finite][0]),
                     "initial": float(y0), "target": float(first),
+                    "step": (math.remainder(float(first) - float(y0), 2 * math.pi)
+                             if ch in ("roll", "pitch", "yaw") else None),
                     "figures": {}, "reference": {}, "criteria": [], "passed": None,
                 })
             continue
         k = changed[0]
+        # The step as commanded (the recorded setpoints), and for an angle the shortest path it is
+        # flown on, as metrics.json gives it.
+        commanded = traj.recorded(f"{ch}_des")[finite]
+        initial, target = float(commanded[0]), float(commanded[-1])
         steps.append({
             "channel": ch,
             "t_step_s": float(t[finite][k]),
-            "initial": float(first),
-            "target": float(d[-1]),
+            "initial": initial,
+            "target": target,
+            "step": math.remainder(target - initial, 2 * math.pi) if ch in ("roll", "pitch", "yaw") else None,
             "figures": {}, "reference": {}, "criteria": [], "passed": None,
         })
     return steps
@@ -389,6 +404,21 @@ def _fmt_num(v):
     if s in ("-0", "-0.0"):
         s = "0"
     return s.replace("-", "−")
+
+
+def step_title(step):
+    """'Yaw step 3 → −3 rad': the step as commanded (its initial value and the target the setpoint was
+    set to); for an angle whose shortest path differs from target − initial (a turn through ±pi, or a
+    target more than pi away), that path too: 'Yaw step 3 → −3 rad (shortest path +0.2832 rad, to 3.283)'."""
+    meta = CHANNELS[step["channel"]]
+    unit = meta["unit"]
+    initial, target = step["initial"], step["target"]
+    title = f"{meta['name']} step {_fmt_num(initial)} → {_fmt_num(target)} {unit}"
+    d = step.get("step")
+    if step["channel"] in ("roll", "pitch", "yaw") and d is not None and abs(d - (target - initial)) > 1e-9:
+        sign = "+" if d >= 0 else "−"
+        title += f" (shortest path {sign}{_fmt_num(abs(d))} {unit}, to {_fmt_num(initial + d)})"
+    return title
 
 
 def _figure_cell(key, value):
@@ -574,7 +604,7 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
         tp, yp = peak_line
         ax.plot([tp, tp], [ax.get_ylim()[0], yp], color=COLOR_PEAK, lw=0.8, ls=":", zorder=3)
 
-    title = f"{meta['name']} step {_fmt_num(initial)} → {_fmt_num(target)} {unit}"
+    title = step_title(step)
     fig.text(0.085, 0.955, title, fontsize=13, fontweight="bold", ha="left", va="center")
     sub = []
     if metrics and metrics.get("scenario"):

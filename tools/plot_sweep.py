@@ -17,8 +17,12 @@ Reads SWEEP_DIR/summary.json (written by `quadcosim sweep`) and writes
   SWEEP_DIR/map_pass.png       of each figure over each grid point's runs as a
                                coloured map, and the passing runs of each point
                                ("k/n" in each cell).
-Figures no run produced are skipped. Exit status: 0 on success, 1 when
-summary.json is missing or malformed (the message names the file).
+The figures are those of summary.json: "<channel>.<figure>" of each step,
+"hold.<figure>", and "saturation.<figure>" (time with rotors clamped, per
+rotor, tilt-limited, RMS of U1 - m g; bounded by the scenario's
+analysis.limits). Figures no run produced are skipped. Exit status: 0 on
+success, 1 when summary.json is missing or malformed (the message names the
+file).
 """
 
 import json
@@ -65,8 +69,8 @@ def bounds_of(sweep_dir, summary, figure):
         return None, None
     group, _, name = figure.partition(".")
     blocks = []
-    if group == "hold" and m.get("hold"):
-        blocks = [m["hold"]]
+    if group in ("hold", "saturation"):  # the hold's criteria; the saturation's: analysis.limits
+        blocks = [m[group]] if m.get(group) else []
     else:
         channel = group.split("#")[0]
         blocks = [s for s in m.get("steps", []) if s.get("channel") == channel][:1]

@@ -156,9 +156,8 @@ def figure_files(run_dir):
 
 
 def step_title(step, n):
-    meta = plot_run.CHANNELS[step["channel"]]
-    title = (f"{meta['name']} step {plot_run._fmt_num(step['initial'])} → "
-             f"{plot_run._fmt_num(step['target'])} {meta['unit']} at t = {step['t_step_s']:.2f} s")
+    # As the step plot's title: the step as commanded, and an angle's shortest path where it differs.
+    title = f"{plot_run.step_title(step)} at t = {step['t_step_s']:.2f} s"
     return f"{title} (#{n})" if n > 1 else title
 
 

@@ -316,6 +316,36 @@ class UnwrapAndSaturationTest(unittest.TestCase):
         self.assertAlmostEqual(u[2], -3.1 + 2 * math.pi, places=12)
         self.assertAlmostEqual(u[4], -3.0 + 2 * math.pi, places=12)
 
+    def test_step_title_gives_the_commanded_step_and_the_shortest_path(self):
+        # Yaw 3.0 -> -3.0 rad as commanded; flown the short way: +(2 pi - 6) = +0.2832 rad, to 3.283.
+        yaw = {"channel": "yaw", "initial": 3.0, "target": -3.0, "step": 2 * math.pi - 6.0}
+        self.assertEqual(self.pr.step_title(yaw), "Yaw step 3 → −3 rad (shortest path +0.2832 rad, to 3.283)")
+        # Target more than pi away the other way: 0 -> 4 rad is the -2.283 rad turn.
+        far = {"channel": "roll", "initial": 0.0, "target": 4.0, "step": 4.0 - 2 * math.pi}
+        self.assertEqual(self.pr.step_title(far), "Roll step 0 → 4 rad (shortest path −2.283 rad, to −2.283)")
+        # The short way already: nothing added; a position step is never an angle.
+        self.assertEqual(self.pr.step_title({"channel": "yaw", "initial": 0.0, "target": 1.0, "step": 1.0}),
+                         "Yaw step 0 → 1 rad")
+        self.assertEqual(self.pr.step_title({"channel": "z", "initial": 0.0, "target": 10.0, "step": None}),
+                         "Altitude step 0 → 10 m")
+
+    def test_steps_without_metrics_are_the_commanded_setpoints(self):
+        # yaw_des 3.0 -> -3.0 at t = 1 s: detect_steps on the unwrapped data gives the commanded values.
+        t = np.arange(301) / 100.0
+        des = np.where(t < 1.0, 3.0, -3.0)
+        cols = {"t": t, "yaw": des, "yaw_des": des}
+        for ch in ("x", "y", "z", "roll", "pitch"):
+            cols[ch] = np.zeros(301)
+            cols[ch + "_des"] = np.full(301, math.nan)
+        names = list(cols)
+        recorded = {"yaw": des.copy(), "yaw_des": des.copy()}
+        data = np.column_stack([self.pr.unwrap_angle(cols[n]) if n in recorded else cols[n] for n in names])
+        steps = self.pr.detect_steps(self.pr.Trajectory("mem", names, data, recorded))
+        self.assertEqual(len(steps), 1)
+        s = steps[0]
+        self.assertEqual((s["channel"], s["t_step_s"], s["initial"], s["target"]), ("yaw", 1.0, 3.0, -3.0))
+        self.assertAlmostEqual(s["step"], 2 * math.pi - 6.0, places=12)
+
     def test_intervals_cover_the_flagged_rows(self):
         t = np.arange(301) / 100.0
         flags = np.zeros(301)

@@ -33,7 +33,9 @@ void write_swarm_summary(const std::filesystem::path& out, const io::Scenario& s
                          const std::vector<std::string>& namespaces, const std::vector<SwarmFinal>& rows,
                          const nlohmann::json& run_figures);
 
-/// `run` for a swarm: exit codes as `run` (0 all recorded vehicles pass their step criteria).
+/// `run` for a swarm: exit codes as `run` (0 all recorded vehicles pass their step criteria and the
+/// scenario's analysis.limits); adds "recorded" (each recorded vehicle's verdict and saturation figures)
+/// to summary.json.
 int run_swarm(const RunOptions& options, const io::Scenario& sc, const std::filesystem::path& out);
 
 /// `plant --vehicles N` / `controller --vehicles N`: N vehicles in one process over DDS.

@@ -1,8 +1,9 @@
 // `quadcosim run SCENARIO --vehicles N` (or a scenario with a `swarm:` section): many vehicles,
 // in-process (sim::Swarm) or over DDS (one plant and one controller process hosting all vehicles).
-// What a swarm run writes (docs/outputs.md): summary.json (run figures and the spread of the final
-// tracking errors), vehicles.csv (one row per vehicle: final state, setpoint, error, safety), and a
-// full <ns>/trajectory.csv (+ metrics) only for the vehicles listed in swarm.record_vehicles.
+// What a swarm run writes (docs/outputs.md): summary.json (run figures, the spread of the final
+// tracking errors, the recorded vehicles' verdicts and saturation figures), vehicles.csv (one row per
+// vehicle: final state, setpoint, error, safety), and a full <ns>/trajectory.csv (+ metrics) only for
+// the vehicles listed in swarm.record_vehicles.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -36,16 +37,30 @@ io::SwarmSpec swarm_spec(const io::Scenario& sc, int vehicles, int threads) {
 
 namespace {
 
-// Step figures of each recorded vehicle; true when all pass.
-bool judge_recorded(const fs::path& out, const io::Scenario& sc, const std::vector<std::string>& dirs) {
-  bool pass = true;
-  for (const std::string& d : dirs) {
-    const auto results = io::evaluate_steps(sc.steps, io::read_series((out / d / "trajectory.csv").string()));
-    io::write_metrics_json((out / d / "metrics.json").string(), sc, results);
-    std::ofstream((out / d / "metrics.txt").string()) << io::format_step_table(sc, results);
-    pass = pass && io::all_passed(results);
+// Step figures and saturation (analysis.limits) of each recorded vehicle, judged from its trajectory.csv as
+// `run` judges a single vehicle: writes its metrics.json and metrics.txt, warns when it saturated. Returns
+// one entry per vehicle for summary.json: vehicle, namespace, passed, saturation figures.
+nlohmann::json judge_recorded(const fs::path& out, const io::Scenario& sc, const std::vector<int>& vehicles,
+                              const std::vector<std::string>& dirs) {
+  nlohmann::json entries = nlohmann::json::array();
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    const fs::path dir = out / dirs[i];
+    const io::Series series = io::read_series((dir / "trajectory.csv").string());
+    const auto results = io::evaluate_steps(sc.steps, series);
+    const auto saturation = io::evaluate_saturation(sc, series);
+    const nlohmann::json metrics = io::metrics_json(sc, results, {}, saturation);
+    io::write_metrics_json((dir / "metrics.json").string(), sc, results, {}, saturation);
+    std::ofstream((dir / "metrics.txt").string()) << io::format_step_table(sc, results, {}, saturation);
+    if (saturation) {
+      if (const std::string w = io::saturation_warning(*saturation); !w.empty()) {
+        std::cerr << "run: " << dirs[i] << ": " << w << '\n';
+      }
+    }
+    nlohmann::json e = {{"vehicle", vehicles[i]}, {"namespace", "/" + dirs[i]}, {"passed", metrics.at("passed")}};
+    e["saturation"] = metrics.contains("saturation") ? metrics["saturation"]["figures"] : nlohmann::json();
+    entries.push_back(e);
   }
-  return pass;
+  return entries;
 }
 
 std::string dir_of(const std::string& ns) { return ns.substr(1); }  // "/uav0003" -> "uav0003"
@@ -150,7 +165,17 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     std::cout << fmt::format("swarm: {:g} s simulated in {:.3f} s ({:.1f}x real time, {} threads)\n", sim_s,
                              wall_s, sim_s / wall_s, spec.threads);
   }
-  const bool pass = judge_recorded(out, sc, dirs);
+  const nlohmann::json recorded = judge_recorded(out, sc, spec.record_vehicles, dirs);
+  const bool pass =
+      std::all_of(recorded.begin(), recorded.end(), [](const nlohmann::json& e) { return e["passed"].get<bool>(); });
+  {  // summary.json (written by whichever process ran the swarm) gains the recorded vehicles' verdicts
+    nlohmann::json summary;
+    std::ifstream(out / "summary.json") >> summary;
+    summary["recorded"] = recorded;
+    std::ofstream f(out / "summary.json");
+    f << summary.dump(2) << '\n';
+    if (!f) throw std::runtime_error("cannot write " + (out / "summary.json").string());
+  }
   std::cout << "wrote " << (out / "summary.json").string() << ", vehicles.csv"
             << (dirs.empty() ? "" : fmt::format(", {} recorded vehicle(s)", dirs.size())) << '\n';
   if (opt.plots) {

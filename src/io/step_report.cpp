@@ -15,6 +15,17 @@
 
 namespace quadcosim::io {
 
+namespace {
+constexpr std::ptrdiff_t kJudgedColumns = 12;  // x .. yaw_des, the first of series_columns()
+}  // namespace
+
+const std::vector<std::string>& series_columns() {
+  static const std::vector<std::string> names = {"x",     "y",     "z",     "roll",     "pitch",     "yaw",
+                                                 "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
+                                                 "sat1",  "sat2",  "sat3",  "sat4",     "tilt_sat",  "U1"};
+  return names;
+}
+
 Series read_series(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
@@ -25,8 +36,8 @@ Series read_series(const std::string& path) {
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) header.push_back(c);
   }
-  const std::vector<std::string> wanted = {"x",      "y",     "z",     "roll",      "pitch",     "yaw",
-                                           "x_des",  "y_des", "z_des", "roll_des",  "pitch_des", "yaw_des"};
+  const std::vector<std::string>& all = series_columns();
+  const std::vector<std::string> wanted(all.begin(), all.begin() + kJudgedColumns);
   std::vector<int> index;
   auto column = [&](const std::string& name) {
     for (std::size_t i = 0; i < header.size(); ++i) {
@@ -38,10 +49,10 @@ Series read_series(const std::string& path) {
   for (const auto& w : wanted) index.push_back(column(w));
   // Read when present: a trajectory from before the saturation columns existed still loads.
   std::vector<std::string> names = wanted;
-  for (const char* optional : {"sat1", "sat2", "sat3", "sat4", "tilt_sat", "U1"}) {
-    if (std::find(header.begin(), header.end(), optional) == header.end()) continue;
-    names.push_back(optional);
-    index.push_back(column(optional));
+  for (auto optional = all.begin() + kJudgedColumns; optional != all.end(); ++optional) {
+    if (std::find(header.begin(), header.end(), *optional) == header.end()) continue;
+    names.push_back(*optional);
+    index.push_back(column(*optional));
   }
   Series s;
   int line_no = 1;

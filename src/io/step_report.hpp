@@ -60,6 +60,11 @@ struct SaturationResult {
 /// "saturated_s", "rotor1_saturated_s" .. "rotor4_saturated_s", "tilt_saturated_s", "rms_u1_deviation_n".
 const std::vector<std::string>& saturation_figure_names();
 
+/// The columns a Series holds besides t, in this order: the judged channels and their setpoints (x .. yaw,
+/// x_des .. yaw_des), then the saturation flags sat1..sat4, tilt_sat and U1 (absent from a trajectory.csv
+/// written before they existed).
+const std::vector<std::string>& series_columns();
+
 /// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des; the
 /// saturation columns and U1 when present). Throws std::runtime_error naming the file and the
 /// missing column or bad line.
@@ -71,7 +76,7 @@ Series read_series(const std::string& trajectory_csv);
 std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series);
 
 /// The saturation figures of a run and the verdicts of `scenario.limits`; empty when the series has
-/// no saturation columns (a trajectory written before they existed, or a series built in memory).
+/// no saturation columns (a trajectory.csv written before they existed).
 std::optional<SaturationResult> evaluate_saturation(const Scenario& scenario, const Series& series);
 
 /// One line for the console when the run hit a limit ("run: warning: rotor saturation: ..."), or "".

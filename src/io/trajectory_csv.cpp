@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cassert>
 #include <cmath>
+#include <iterator>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -21,6 +23,11 @@ ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
   const auto& s = m.setpoint;
   return {s[0], s[1], s[2], s[3], s[4], s[5], Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]), m.safety,
           m.rotor_saturated, m.tilt_saturated};
+}
+
+std::array<int, 5> ControlColumns::saturation_columns() const {
+  const auto& sat = rotor_saturated;
+  return {sat[0] ? 1 : 0, sat[1] ? 1 : 0, sat[2] ? 1 : 0, sat[3] ? 1 : 0, tilt_saturated ? 1 : 0};
 }
 
 const std::vector<std::string>& TrajectoryWriter::columns() {
@@ -60,9 +67,8 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
                  x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des,
                  c.pitch_des, c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
-  const auto& sat = c.rotor_saturated;
-  fmt::format_to(out, "{},{},{},{},{}\n", sat[0] ? 1 : 0, sat[1] ? 1 : 0, sat[2] ? 1 : 0, sat[3] ? 1 : 0,
-                 c.tilt_saturated ? 1 : 0);
+  const auto sat = c.saturation_columns();
+  fmt::format_to(out, "{},{},{},{},{}\n", sat[0], sat[1], sat[2], sat[3], sat[4]);
   if (buffer_.size() > (1 << 16)) {
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     buffer_.clear();
@@ -76,6 +82,29 @@ void TrajectoryWriter::close() {
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
   if (!ok || !closed) throw std::runtime_error(path_ + ": write failed");
+}
+
+SeriesRecorder::SeriesRecorder(std::size_t rows) {
+  series_.t_s.reserve(rows);
+  for (const std::string& name : series_columns()) {
+    std::vector<double>& column = series_.values[name];
+    column.reserve(rows);
+    columns_.push_back(&column);
+  }
+}
+
+void SeriesRecorder::add(double t_s, const model::State& x, const ControlColumns& c) {
+  // The values of TrajectoryWriter::write's columns of the same names.
+  const model::Euler e = model::euler_from_quaternion(x.q_WB);
+  const auto sat = c.saturation_columns();
+  const double row[] = {x.p_W.x(), x.p_W.y(), x.p_W.z(), e.roll_rad, e.pitch_rad, e.yaw_rad,
+                        c.x_des,   c.y_des,   c.z_des,   c.roll_des, c.pitch_des, c.yaw_des,
+                        static_cast<double>(sat[0]), static_cast<double>(sat[1]), static_cast<double>(sat[2]),
+                        static_cast<double>(sat[3]), static_cast<double>(sat[4]), c.U[0]};
+  static_assert(std::size(row) == 18);
+  assert(columns_.size() == std::size(row));
+  series_.t_s.push_back(t_s);
+  for (std::size_t i = 0; i < columns_.size(); ++i) columns_[i]->push_back(row[i]);
 }
 
 std::vector<CommandRow> read_command_schedule(const std::string& path) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "io/step_report.hpp"
 #include "model/quadrotor.hpp"
 #include "sim/messages.hpp"
 
@@ -22,6 +23,8 @@ struct ControlColumns {
   /// (ControllerStatus.rotor_saturated); the position loop's tilt limit acted (tilt_saturated).
   std::array<bool, 4> rotor_saturated{};
   bool tilt_saturated = false;
+  /// The columns sat1..sat4, tilt_sat: 1 where the flag is set, else 0.
+  std::array<int, 5> saturation_columns() const;
   static ControlColumns none();
   /// The columns of a controller status message.
   static ControlColumns from(const msg::ControllerStatus& status);
@@ -48,6 +51,24 @@ class TrajectoryWriter {
   std::FILE* file_ = nullptr;
   std::string path_;
   std::string buffer_;
+};
+
+/// Builds in memory the Series that read_series() gives for the trajectory.csv TrajectoryWriter writes from
+/// the same ticks: t, the judged channels and setpoints (series_columns()), the saturation flags and U1, the
+/// same doubles bit for bit (the CSV holds shortest round-trip text), without writing the file.
+class SeriesRecorder {
+ public:
+  /// `rows`: how many ticks to reserve room for (a hint).
+  explicit SeriesRecorder(std::size_t rows = 0);
+  /// Adds the row TrajectoryWriter::write(t_s, x, ..., c) writes.
+  void add(double t_s, const model::State& x, const ControlColumns& c);
+  const Series& series() const { return series_; }
+  /// Moves the series out; add() must not be called after it.
+  Series take() { return std::move(series_); }
+
+ private:
+  Series series_;
+  std::vector<std::vector<double>*> columns_;  ///< into series_.values, in series_columns() order
 };
 
 /// One row of a motor command schedule (openloop input).

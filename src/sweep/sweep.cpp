@@ -12,7 +12,6 @@
 #include "control/care.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/trajectory_csv.hpp"
-#include "model/attitude.hpp"
 #include "sim/simulation.hpp"
 #include "sim/topics.hpp"
 #include "sweep/statistics.hpp"
@@ -35,25 +34,11 @@ io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path*
     mcap.emplace((*mcap_dir / "run.mcap").string(), simulation.transport(),
                  sim::Topics::for_namespace(sc.simulation.ns));
   }
-  io::Series s;
-  const std::size_t n = static_cast<std::size_t>(sc.simulation.duration_ticks + 1);
-  s.t_s.reserve(n);
-  static const char* names[] = {"x", "y", "z", "roll", "pitch", "yaw",
-                                "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des"};
-  std::vector<double>* col[12];
-  for (int i = 0; i < 12; ++i) {
-    col[i] = &s.values[names[i]];
-    col[i]->reserve(n);
-  }
+  io::SeriesRecorder series(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
   bool watchdog = false;
   simulation.run([&](const sim::TickRecord& r) {
-    // The same numbers trajectory.csv holds (TrajectoryWriter, ControlColumns).
-    const model::Euler e = model::euler_from_quaternion(r.state.q_WB);
     const io::ControlColumns c = io::ControlColumns::from(r.status);
-    s.t_s.push_back(r.t_s);
-    const double row[12] = {r.state.p_W.x(), r.state.p_W.y(), r.state.p_W.z(), e.roll_rad, e.pitch_rad, e.yaw_rad,
-                            c.x_des,         c.y_des,         c.z_des,         c.roll_des, c.pitch_des, c.yaw_des};
-    for (int i = 0; i < 12; ++i) col[i]->push_back(row[i]);
+    series.add(r.t_s, r.state, c);  // the numbers trajectory.csv holds
     if (writer) {
       watchdog = simulation.plant().watchdog_active();
       writer->write(r.t_s, r.state, r.applied_command, c, watchdog);
@@ -65,13 +50,14 @@ io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path*
     mcap->close();
     mcap->write_bag_metadata(mcap_dir->string(), "run.mcap");
   }
-  return s;
+  return series.take();
 }
 
 void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
   r.steps = io::evaluate_steps(sc.steps, series);
   if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
-  r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed);
+  r.saturation = io::evaluate_saturation(sc, series);
+  r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed) && (!r.saturation || r.saturation->passed);
 }
 
 void write_json(const fs::path& path, const nlohmann::json& j) {
@@ -81,7 +67,8 @@ void write_json(const fs::path& path, const nlohmann::json& j) {
 }
 
 // Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step
-// of the same channel gets "roll#2.overshoot_pct"), "hold.<figure>" for the hold.
+// of the same channel gets "roll#2.overshoot_pct"), "hold.<figure>" for the hold, "saturation.<figure>" for
+// the rotor and tilt saturation (every run has them; null when the run could not be flown).
 std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunResult& r, const io::Scenario& sc) {
   std::vector<std::pair<std::string, std::optional<double>>> out;
   std::map<std::string, int> seen;
@@ -104,6 +91,13 @@ std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunR
       out.emplace_back("hold." + name, v);
     }
   }
+  for (const auto& name : io::saturation_figure_names()) {
+    std::optional<double> v;
+    if (ok && r.saturation) {
+      if (auto it = r.saturation->figures.find(name); it != r.saturation->figures.end()) v = it->second;
+    }
+    out.emplace_back("saturation." + name, v);
+  }
   return out;
 }
 
@@ -116,7 +110,7 @@ nlohmann::json values_json(const Sample& s) {
 }  // namespace
 
 nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r) {
-  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold);
+  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation);
   nlohmann::json s;
   s["index"] = r.sample.index;
   s["seed"] = r.sample.seed;
@@ -196,7 +190,7 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
   write_json(dir / "metrics.json", run_metrics_json(plan, sc, r));
   std::ofstream txt(dir / "metrics.txt");
-  txt << io::format_step_table(sc, r.steps, r.hold);
+  txt << io::format_step_table(sc, r.steps, r.hold, r.saturation);
   if (!txt) throw std::runtime_error((dir / "metrics.txt").string() + ": write failed");
   return r;
 }

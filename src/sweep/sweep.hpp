@@ -20,6 +20,7 @@ struct RunResult {
   Sample sample;
   std::vector<io::StepResult> steps;
   std::optional<io::HoldResult> hold;
+  std::optional<io::SaturationResult> saturation;  ///< rotor and tilt saturation, analysis.limits
   bool passed = false;
   std::string error;  ///< non-empty when the run could not be done (a refused value, a failed design)
 };
@@ -51,7 +52,8 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
 /// Shards of one sweep have equal headers.
 nlohmann::json header_json(const Plan& plan);
 
-/// A run's entry of summary.json's per_run: index, seed, passed, values, factors, figures, error.
+/// A run's entry of summary.json's per_run: index, seed, passed, values, factors, figures (steps, hold,
+/// saturation), error.
 nlohmann::json per_run_json(const Plan& plan, const RunResult& r);
 
 /// summary.json from the header and every run's per_run entry (any order; sorted by index here).

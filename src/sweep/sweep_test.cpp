@@ -10,6 +10,7 @@
 #include <fstream>
 #include <numbers>
 #include <set>
+#include <sstream>
 #include <unistd.h>
 #include <fmt/format.h>
 
@@ -46,6 +47,21 @@ analysis:
       at_s: 0
       criteria:
         overshoot_pct: [null, 25]
+)";
+  return p;
+}
+
+// Yaw steps from hover at t = 0 (yaw_des from the controller section), 3 s; at most 0.5 s saturated.
+fs::path yaw_scenario_file() {
+  const fs::path dir = fs::temp_directory_path() / ("sweep_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path p = dir / "yaw.yaml";
+  std::ofstream(p) << R"(name: yaw
+simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 3}
+initial: {position_m: [0, 0, 10], hover: true}
+controller: {mode: attitude, z_des: 10, yaw_des: 0.2}
+analysis:
+  limits: {max_saturated_s: 0.5}
 )";
   return p;
 }
@@ -281,6 +297,62 @@ TEST(RunOne, ARefusedDrawFailsThatRunNamingKeyAndValue) {
     ++refused;
   }
   EXPECT_GT(refused, 0);
+}
+
+TEST(RunOne, SaturationIsJudgedAsRunJudgesItFromTheCsv) {
+  // A 1 rad yaw step clamps rotors 2 and 4 for about 1.5 s (the allocation's omega limits); 0.2 rad
+  // clamps nothing. The limit max_saturated_s 0.5 fails exactly the 1 rad run.
+  const Plan p = make_plan(yaw_scenario_file().string(), {"controller.yaw_des=grid(0.2,1)"}, 1, 1, Sampler::kRandom);
+  ASSERT_EQ(p.runs, 2);
+  const RunResult small = run_one(p, 0, {});
+  const RunResult big = run_one(p, 1, {});
+  ASSERT_TRUE(small.error.empty() && big.error.empty()) << small.error << big.error;
+  ASSERT_TRUE(small.saturation && big.saturation);
+  EXPECT_EQ(small.saturation->saturated_s(), 0.0);
+  EXPECT_TRUE(small.passed);
+  EXPECT_GT(big.saturation->rotor_saturated_s(2), 1.0);
+  EXPECT_GT(big.saturation->rotor_saturated_s(4), 1.0);
+  EXPECT_EQ(big.saturation->rotor_saturated_s(1), 0.0);
+  EXPECT_FALSE(big.passed);
+  ASSERT_EQ(big.saturation->criteria.size(), 1u);
+  EXPECT_FALSE(big.saturation->criteria[0].passed);
+  // Flown again and judged from its recorded trajectory.csv (the path `run` takes): the same doubles.
+  const fs::path dir = fs::temp_directory_path() / ("sweep_test_" + std::to_string(::getpid())) / "rerun1";
+  fs::remove_all(dir);
+  const RunResult again = rerun(p, 1, dir);
+  ASSERT_TRUE(again.saturation);
+  EXPECT_EQ(again.saturation->figures, big.saturation->figures);
+  EXPECT_FALSE(again.passed);
+  // ... and counted here from the CSV's rows: ticks with sat2 or sat4 set times the 0.01 s period.
+  std::ifstream csv(dir / "trajectory.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::vector<std::string> header;
+  for (std::stringstream ss(line); std::getline(ss, line, ',');) header.push_back(line);
+  const auto col = [&](const std::string& n) { return std::find(header.begin(), header.end(), n) - header.begin(); };
+  int rows_any = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    for (std::stringstream ss(line); std::getline(ss, line, ',');) cells.push_back(line);
+    bool any = false;
+    for (const char* c : {"sat1", "sat2", "sat3", "sat4"}) any = any || cells.at(col(c)) == "1";
+    rows_any += any ? 1 : 0;
+  }
+  EXPECT_NEAR(big.saturation->saturated_s(), rows_any * 0.01, 1e-9);
+  // metrics.json and summary.json carry them; a run that could not be flown has them null.
+  const nlohmann::json m = run_metrics_json(p, scenario_for(p, big.sample), big);
+  EXPECT_EQ(m["saturation"]["figures"]["saturated_s"].get<double>(), big.saturation->saturated_s());
+  EXPECT_FALSE(m["saturation"]["passed"].get<bool>());
+  EXPECT_FALSE(m["passed"].get<bool>());
+  const nlohmann::json s = summary_json(header_json(p), {per_run_json(p, small), per_run_json(p, big)});
+  EXPECT_EQ(s["figures"]["saturation.saturated_s"]["count"].get<int>(), 2);
+  EXPECT_EQ(s["figures"]["saturation.saturated_s"]["max"].get<double>(), big.saturation->saturated_s());
+  EXPECT_EQ(s["per_run"][0]["figures"]["saturation.rotor2_saturated_s"].get<double>(), 0.0);
+  EXPECT_EQ(s["passed"].get<int>(), 1);
+  RunResult failed = big;
+  failed.error = "controller design failed";
+  EXPECT_TRUE(per_run_json(p, failed)["figures"]["saturation.saturated_s"].is_null());
+  fs::remove_all(dir);
 }
 
 TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {

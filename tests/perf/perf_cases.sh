@@ -53,6 +53,44 @@ PY
     [ "$rc" -eq 2 ] || fail "bad swarm section: exit $rc, expected 2"
     grep -q "swarm.record_vehicles\[0\]" "$tmp/bad.log" || fail "error does not name swarm.record_vehicles[0]"
     ;;
+  swarm_saturation)  # recorded vehicles are judged against analysis.limits as `run` judges one vehicle
+    # A 1 rad yaw step from hover clamps rotors 2 and 4 for about 1.5 s; max_saturated_s 0.5 fails it.
+    cat > "$tmp/yaw.yaml" <<'YAML'
+name: swarm_yaw
+simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 6}
+initial: {position_m: [0, 0, 10], hover: true}
+controller: {mode: attitude, z_des: 10, yaw_des: 1.0}
+analysis:
+  steps:
+    - channel: z
+      at_s: 0
+  limits: {max_saturated_s: 0.5}
+YAML
+    printf 'swarm: {vehicles: 3, record_vehicles: [0, 2]}\n' | cat "$tmp/yaw.yaml" - > "$tmp/swarm.yaml"
+    set +e
+    "$bin" run "$tmp/swarm.yaml" --out "$tmp/s" --no-plots > "$tmp/s.log" 2>&1; rc=$?
+    "$bin" run "$tmp/yaw.yaml" --out "$tmp/one" --no-plots > "$tmp/one.log" 2>&1; rc1=$?
+    set -e
+    [ "$rc" -eq 1 ] || { cat "$tmp/s.log"; fail "swarm over its saturation limit: exit $rc, expected 1"; }
+    [ "$rc1" -eq 1 ] || { cat "$tmp/one.log"; fail "single run over its saturation limit: exit $rc1, expected 1"; }
+    grep -q "run: uav0002: warning: rotor saturation: rotors 2, 4" "$tmp/s.log" || { cat "$tmp/s.log"; fail "no warning"; }
+    "$py" - "$tmp/s" "$tmp/one" <<'PY' || fail "recorded vehicles' saturation wrong"
+import csv, json, sys
+s = json.load(open(sys.argv[1] + "/summary.json")); one = json.load(open(sys.argv[2] + "/metrics.json"))
+rec = s["recorded"]
+assert [(r["vehicle"], r["namespace"], r["passed"]) for r in rec] == [(0, "/uav0000", False), (2, "/uav0002", False)], rec
+for r in rec:
+    m = json.load(open(sys.argv[1] + r["namespace"] + "/metrics.json"))
+    assert m["saturation"]["figures"] == r["saturation"] and m["passed"] is False, (m["saturation"], r)
+    assert m["saturation"]["criteria"][0]["passed"] is False and m["steps"][0]["passed"] is True
+    # Counted here from the vehicle's own CSV rows (period 0.01 s).
+    rows = list(csv.DictReader(open(sys.argv[1] + r["namespace"] + "/trajectory.csv")))
+    n = sum(1 for row in rows if "1" in (row["sat1"], row["sat2"], row["sat3"], row["sat4"]))
+    assert n * 0.01 > 1.0 and abs(n * 0.01 - r["saturation"]["saturated_s"]) < 1e-9, (n, r)
+# Vehicle 0 flies at the scenario's own place: the figures of the single-vehicle run, bit for bit.
+assert rec[0]["saturation"] == one["saturation"]["figures"], (rec[0], one["saturation"])
+PY
+    ;;
   swarm_dds_identical)  # 6 vehicles over DDS (one plant and one controller process, 2 threads each)
     "$bin" run "$grid" --vehicles 6 --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process swarm failed"
     "$bin" run "$grid" --vehicles 6 --out "$tmp/dds" --no-plots --transport dds > "$tmp/dds.log" 2>&1 \

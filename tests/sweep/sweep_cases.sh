@@ -29,6 +29,7 @@ s = json.load(open(sys.argv[1])); m = json.load(open(sys.argv[2])); k = json.loa
 run = s["per_run"][i]
 assert run["index"] == i
 figs = {"hold." + n: v for n, v in m["hold"]["figures"].items()}
+figs.update({"saturation." + n: v for n, v in m["saturation"]["figures"].items()})
 # Floats as JSON shortest round-trip text: equal here means equal bit for bit.
 assert figs == run["figures"], (figs, run["figures"])
 assert m["passed"] == run["passed"]
@@ -141,6 +142,64 @@ for name, d in s["figures"].items():
     if count == 0:
         assert "no run has this figure" in line, line
 assert any(d["missing"] > 0 for d in s["figures"].values()), "expected a figure missing in some runs"
+PYEOF
+    ;;
+
+  saturation)  # a max_saturated_s limit fails exactly the runs that saturate, with `run`'s very figures
+    # Yaw steps of 0.2 and 1 rad from hover: 1 rad clamps rotors 2 and 4 for about 1.5 s, 0.2 rad none.
+    cat > "$TMP/yaw.yaml" <<'YAML'
+name: yaw_limits
+simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 6}
+initial: {position_m: [0, 0, 10], hover: true}
+controller: {mode: attitude, z_des: 10, yaw_des: 0.2}
+analysis:
+  steps:
+    - channel: z
+      at_s: 0
+  limits: {max_saturated_s: 0.5, max_rotor_saturated_s: 2.0}
+YAML
+    "$QC" sweep "$TMP/yaw.yaml" --vary controller.yaw_des=grid\(0.2,1,0.3\) --min-pass-rate 0 --out "$TMP/s" \
+      > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "sweep"; }
+    sed 's/yaw_des: 0.2/yaw_des: 1/' "$TMP/yaw.yaml" > "$TMP/one.yaml"
+    set +e
+    "$QC" run "$TMP/one.yaml" --out "$TMP/run" --no-plots > "$TMP/run.log" 2>&1; rc=$?
+    set -e
+    [ $rc -eq 1 ] || { cat "$TMP/run.log"; fail "run of the 1 rad step: exit $rc, expected 1 (max_saturated_s)"; }
+    "$PY" - "$TMP/s" "$TMP/run" "$TMP/log" <<'PYEOF' || { cat "$TMP/log"; fail "saturation in the sweep"; }
+import csv, json, os, sys
+s = json.load(open(sys.argv[1] + "/summary.json")); run = json.load(open(sys.argv[2] + "/metrics.json"))
+log = open(sys.argv[3]).read().splitlines()
+runs = s["per_run"]
+assert [r["values"]["controller.yaw_des"] for r in runs] == [0.2, 1, 0.3], runs
+# Exactly the saturating run fails, and only by the limit (the altitude step has no criteria).
+assert [r["passed"] for r in runs] == [True, False, True], [r["passed"] for r in runs]
+assert s["passed"] == 2
+f1 = runs[1]["figures"]
+assert f1["saturation.saturated_s"] > 1.0 and f1["saturation.rotor1_saturated_s"] == 0.0, f1
+assert runs[0]["figures"]["saturation.saturated_s"] == 0.0, runs[0]["figures"]
+# The sweep's in-memory run equals `quadcosim run` judged from its trajectory.csv, bit for bit
+# (JSON floats are shortest round-trip text), and the CSV rows give that time independently.
+want = {"saturation." + k: v for k, v in run["saturation"]["figures"].items()}
+assert {k: v for k, v in f1.items() if k.startswith("saturation.")} == want, (f1, want)
+rows = list(csv.DictReader(open(sys.argv[2] + "/trajectory.csv")))
+n = sum(1 for r in rows if "1" in (r["sat1"], r["sat2"], r["sat3"], r["sat4"]))
+assert abs(n * 0.01 - f1["saturation.saturated_s"]) < 1e-9, (n, f1)
+# The run's metrics.json has the limits' verdicts.
+m = json.load(open(sys.argv[1] + "/runs/0001/metrics.json"))
+crit = {c["figure"]: c["passed"] for c in m["saturation"]["criteria"]}
+# (rotors 2 and 4 are clamped for about 1.5 s: under max_rotor_saturated_s 2.)
+assert crit == {"saturated_s": False, "rotor1_saturated_s": True, "rotor2_saturated_s": True,
+                "rotor3_saturated_s": True, "rotor4_saturated_s": True}, crit
+assert m["passed"] is False and m["saturation"]["passed"] is False
+# summary.json's statistics and the console table have every saturation figure.
+for name in ("saturated_s", "rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s",
+             "rotor4_saturated_s", "tilt_saturated_s", "rms_u1_deviation_n"):
+    d = s["figures"]["saturation." + name]
+    assert d["count"] == 3 and d["missing"] == 0, (name, d)
+    assert any(l.split() and l.split()[0] == "saturation." + name for l in log), name
+assert s["figures"]["saturation.saturated_s"]["max"] == f1["saturation.saturated_s"]
+# The plots: a histogram of the saturation time.
+assert os.path.exists(sys.argv[1] + "/hist_saturation.saturated_s.png"), os.listdir(sys.argv[1])
 PYEOF
     ;;
 
