@@ -112,7 +112,7 @@ PYEOF
     touch "$TMP/o1/notes.txt"
     set +e
     "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --out "$TMP/o1" --no-plots > "$TMP/o" 2>&1; rc=$?
-    [ $rc -eq 2 ] && grep -q "$TMP/o1 is not empty: it holds the outputs of \`quadcosim sweep\` (7 files" "$TMP/o" \
+    [ $rc -eq 2 ] && grep -q "$TMP/o1 is not empty: it holds the outputs of \`quadcosim sweep\` (6 files" "$TMP/o" \
       && grep -q "notes.txt" "$TMP/o" && grep -q -- "--force" "$TMP/o" || { cat "$TMP/o"; fail "reuse not refused (rc $rc)"; }
     [ -e "$TMP/o1/runs/0003/metrics.json" ] || fail "the refusal removed files"
     set -e
