@@ -16,8 +16,9 @@ status=0
 dirs=()
 for experiment in altitude_step roll_step pitch_step yaw_step; do
   echo "=== ${experiment}"
+  # --force: a second reproduction replaces the first one's outputs (exactly the files it wrote).
   ./build/bin/quadcosim run "scenarios/paper/${experiment}.yaml" --out "results/${experiment}" \
-    --transport dds || status=1
+    --transport dds --force || status=1
   dirs+=("results/${experiment}")
 done
 echo "=== our step figures beside the paper's (results/paper_comparison.md)"

@@ -770,6 +770,16 @@ def _settle_estimate(t, y, t_step, initial, target, t_hi):
     return float(t[m][outside[-1]] - t_step)
 
 
+def step_figure_names(steps):
+    """The file name of each step's figure: step_<channel>.png, then step_<channel>_2.png, ..."""
+    names, counts = [], {}
+    for step in steps:
+        ch = step["channel"]
+        counts[ch] = counts.get(ch, 0) + 1
+        names.append(f"step_{ch}.png" if counts[ch] == 1 else f"step_{ch}_{counts[ch]}.png")
+    return names
+
+
 def step_windows(steps, traj):
     """Time window [lo, hi] per step. It ends at the next step of the same
     channel (or the end of the run), and in long runs is cut to
@@ -813,11 +823,7 @@ def run(run_dir):
                   file=sys.stderr)
 
     written = []
-    counts = {}
-    for step, window in zip(steps, step_windows(steps, traj)):
-        ch = step["channel"]
-        counts[ch] = counts.get(ch, 0) + 1
-        name = f"step_{ch}.png" if counts[ch] == 1 else f"step_{ch}_{counts[ch]}.png"
+    for step, window, name in zip(steps, step_windows(steps, traj), step_figure_names(steps)):
         out = os.path.join(run_dir, name)
         plot_step(traj, step, window, out, metrics, metrics is not None)
         written.append(out)

@@ -11,7 +11,8 @@ embedded as base64 data URIs, no external URL) with
   - per analysed step a table of the step figures: our value, the criterion
     band, ok/FAIL, and the reference value and its source when metrics.json
     has a "reference",
-  - every step_*.png and overview.png present in RUN_DIR,
+  - the step figure of each step of metrics.json and overview.png, when present
+    (other PNGs in RUN_DIR are not this run's and are left out),
   - the scenario YAML (RUN_DIR/scenario.yaml) in a <pre>,
   - versions: quadcosim (the text given with --version-text, e.g. the output of
     `quadcosim --version`), Python, numpy, matplotlib.
@@ -24,7 +25,6 @@ input is missing or malformed (the message names the file), 2 on a usage error.
 
 import argparse
 import base64
-import glob
 import html
 import os
 import platform
@@ -147,11 +147,12 @@ def _figure_sort_key(path):
     return (1, 0, 0, name)
 
 
-def figure_files(run_dir):
-    files = glob.glob(os.path.join(glob.escape(run_dir), "step_*.png"))
-    ov = os.path.join(run_dir, "overview.png")
-    if os.path.isfile(ov):
-        files.append(ov)
+def figure_files(run_dir, metrics):
+    """The figures of this run that are present: the step figures of metrics.json's steps (named as
+    plot_run.py names them) and overview.png. Any other PNG in RUN_DIR (left by another run) is not
+    this run's and is left out."""
+    names = plot_run.step_figure_names(metrics["steps"]) + ["overview.png"]
+    files = [os.path.join(run_dir, n) for n in names if os.path.isfile(os.path.join(run_dir, n))]
     return sorted(files, key=_figure_sort_key)
 
 
@@ -255,7 +256,7 @@ def build_html(run_dir, metrics, version_text):
         w("</table>")
 
     w("<h2>Figures</h2>")
-    files = figure_files(run_dir)
+    files = figure_files(run_dir, metrics)
     if not files:
         w("<p>No figures in the run directory (run tools/plot_run.py first).</p>")
     for path in files:

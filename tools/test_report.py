@@ -118,6 +118,18 @@ class ReportTest(ToolTestBase):
         with open(path, encoding="utf-8") as f:
             self.assertEqual(f.read(), page)
 
+    def test_only_this_runs_figures(self):
+        # A PNG another run left in the folder (step_x.png of a roll scenario) is not this run's.
+        run = self.make_plotted_run("run", [("z", 0.0, 0.0, 10.0)])
+        shutil.copy(os.path.join(run, "step_z.png"), os.path.join(run, "step_x.png"))
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
+            page = f.read()
+        self.assertEqual(page.count("data:image/png;base64,"), 2)
+        self.assertIn(">step_z.png<", page)
+        self.assertNotIn("step_x.png", page)
+
     def test_failed_verdict(self):
         def fail_roll(m):
             m["steps"][0]["criteria"][0]["passed"] = False

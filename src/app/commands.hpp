@@ -11,12 +11,16 @@
 namespace CLI {
 class App;
 }
+namespace quadcosim::io {
+class OutputFolder;
+}
 
 namespace quadcosim::app {
 
 struct RunOptions {
   std::string scenario;
   std::string out_dir;
+  bool force = false;  ///< replace a previous command's outputs in out_dir (io/output_folder.hpp)
   bool plots = true;
   std::string transport = "inproc";  ///< "inproc" or "dds" (plant and controller as two processes)
   bool realtime = false;             ///< dds: real time instead of lockstep
@@ -250,6 +254,7 @@ int sweep_command(const SweepOptions& options);
 struct MarginsOptions {
   std::string scenario;  ///< "" for the defaults
   std::string out_dir;   ///< "" for stdout only
+  bool force = false;    ///< replace a previous command's outputs in out_dir
   bool json = false;     ///< print JSON instead of the table
   bool plots = true;     ///< with out_dir: Bode and Nyquist PNGs (tools/plot_margins.py)
 };
@@ -260,7 +265,8 @@ int margins_command(const MarginsOptions& options);
 /// override); returns false (after printing why) when it fails.
 bool run_tool(const std::string& script, const std::vector<std::string>& args);
 
-/// `quadcosim plot RUN_DIR`: regenerates the figures and report.html of a run.
+/// `quadcosim plot RUN_DIR`: regenerates the figures and report.html of a run, removing those a previous
+/// plot wrote there first (the "figures" of the folder's manifest, io/output_folder.hpp).
 struct PlotOptions {
   std::string run_dir;
 };
@@ -271,6 +277,7 @@ int plot_command(const PlotOptions& options);
 struct CompareOptions {
   std::string run_a, run_b;
   std::string out;  ///< "" for RUN_B/compare_with_<RUN_A>
+  bool force = false;  ///< write into a folder holding other files or outputs (a previous compare's are replaced)
 };
 CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& options);
 int compare_command(const CompareOptions& options);
@@ -288,7 +295,9 @@ struct BenchOptions {
 int bench_command(const BenchOptions& options);
 CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& options);
 
-/// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py).
-bool make_plots(const std::string& run_dir);
+/// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py). The files
+/// written before are recorded in `folder` as its "outputs", the plots and report as its "figures"
+/// (what `plot` replaces).
+bool make_plots(const std::string& run_dir, io::OutputFolder& folder);
 
 }  // namespace quadcosim::app

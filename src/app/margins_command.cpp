@@ -12,11 +12,13 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 
 #include "analysis/hover_loops.hpp"
 #include "analysis/margins.hpp"
 #include "app/commands.hpp"
-#include "control/care.hpp"
+#include "app/exit_codes.hpp"
+#include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "sim/topics.hpp"
 
@@ -136,36 +138,6 @@ analysis::Margin gain_db(analysis::Margin m) {
   return m;
 }
 
-// The files `margins --out` writes: margins.json, margins.txt, frequency_response.csv and a Bode and
-// a Nyquist plot per loop.
-bool is_margins_output(const std::string& name) {
-  if (name == "margins.json" || name == "margins.txt" || name == "frequency_response.csv") return true;
-  for (const char* loop : {"roll", "pitch", "yaw", "altitude", "position_x", "position_y"}) {
-    if (name == fmt::format("bode_{}.png", loop) || name == fmt::format("nyquist_{}.png", loop)) return true;
-  }
-  return false;
-}
-
-// An output folder holds nothing but a previous analysis's files, which are removed so that none
-// of them outlives this one (a position-mode run's position plots, say). "" or why not.
-std::string prepare_out_dir(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(dir, ec)) return {};
-  if (!fs::is_directory(dir, ec)) return dir.string() + " exists and is not a directory";
-  std::vector<fs::path> ours;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (!is_margins_output(name))
-      return dir.string() + " holds files `margins` does not write (" + name +
-             "); give an empty folder or one a previous `margins --out` wrote";
-    ours.push_back(e.path());
-  }
-  if (ec) return "cannot read " + dir.string() + ": " + ec.message();
-  for (const fs::path& p : ours) fs::remove(p, ec);
-  return {};
-}
-
 bool write_file(const std::filesystem::path& p, const std::string& text) {
   std::ofstream f(p);
   f << text;
@@ -184,7 +156,11 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
                                  "gain, phase and delay margins of each control loop about hover (docs/margins.md)");
   cmd->add_option("scenario", o.scenario, "scenario YAML (default: the paper's vehicle and controller)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", o.out_dir, "write margins.json, frequency_response.csv and Bode/Nyquist PNGs here");
+  cmd->add_option("--out", o.out_dir,
+                  "write margins.json, frequency_response.csv and Bode/Nyquist PNGs here: a new or empty folder");
+  cmd->add_flag("--force", o.force,
+                "--out holds a previous command's outputs or other files: remove exactly the outputs its manifest "
+                "lists first (files quadcosim did not write are kept)");
   cmd->add_flag("--json", o.json, "print the margins as one JSON object instead of the table");
   cmd->add_flag("!--no-plots", o.plots, "with --out: skip the PNGs");
   return cmd;
@@ -193,30 +169,25 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
 int margins_command(const MarginsOptions& o) {
   if (!o.plots && o.out_dir.empty()) {
     std::cerr << "error: --no-plots needs --out (plots are only written into an output directory)\n";
-    return 2;
+    return exit_code::kBadInput;
   }
-  if (!o.out_dir.empty()) {
-    if (std::string why = prepare_out_dir(o.out_dir); !why.empty()) {
-      std::cerr << "error: --out: " << why << '\n';
-      return 2;
-    }
+  if (o.force && o.out_dir.empty()) {
+    std::cerr << "error: --force needs --out (it concerns the output folder)\n";
+    return exit_code::kBadInput;
   }
+  // A bad file (io::ConfigError), a failed LQR design (control::CareError) or a vehicle that cannot
+  // hover: bad input (run_guarded).
   Setup s;
   std::vector<analysis::HoverLoop> loops;
   try {
     s = setup_from(o.scenario);
     loops = analysis::hover_loops(s.plant, s.controller.params, s.controller.setpoint.mode, s.timing);
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const control::CareError& e) {
-    std::cerr << "error: LQR design failed: " << e.what() << '\n';
-    return 2;
   } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << (o.scenario.empty() ? "" : o.scenario + ": ") << "cannot linearise about hover: "
-              << e.what() << '\n';
-    return 2;
+    throw std::invalid_argument(fmt::format("{}cannot linearise about hover: {}",
+                                            o.scenario.empty() ? "" : o.scenario + ": ", e.what()));
   }
+  std::optional<io::OutputFolder> folder;
+  if (!o.out_dir.empty()) folder.emplace(io::OutputFolder::claim(o.out_dir, "margins", {.force = o.force}, std::cerr));
 
   const analysis::LoopTiming& t = s.timing;
   const double T = t.tick_s * t.controller_divider;
@@ -309,15 +280,8 @@ int margins_command(const MarginsOptions& o) {
   else
     std::cout << table;
 
-  if (!o.out_dir.empty()) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    fs::create_directories(o.out_dir, ec);
-    if (ec) {
-      std::cerr << "error: cannot create " << o.out_dir << ": " << ec.message() << '\n';
-      return 3;
-    }
-    const fs::path out(o.out_dir);
+  if (folder) {
+    const std::filesystem::path out(o.out_dir);
     std::string csv = "loop,omega_rad_s,re,im,magnitude_db,phase_deg\n";
     analysis::MarginOptions grid;
     grid.points = 1500;
@@ -330,10 +294,11 @@ int margins_command(const MarginsOptions& o) {
     }
     if (!write_file(out / "margins.json", doc.dump(2) + "\n") || !write_file(out / "margins.txt", table) ||
         !write_file(out / "frequency_response.csv", csv))
-      return 3;
-    if (o.plots && !run_tool("plot_margins.py", {o.out_dir})) return 3;
+      return exit_code::kOutput;
+    if (o.plots && !run_tool("plot_margins.py", {o.out_dir})) return exit_code::kOutput;
+    folder->record("outputs");
   }
-  return all_stable ? 0 : 1;
+  return all_stable ? exit_code::kOk : exit_code::kFailed;
 }
 
 }  // namespace quadcosim::app

@@ -10,6 +10,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "io/output_folder.hpp"
 
 namespace quadcosim::app {
 
@@ -46,10 +47,13 @@ bool run_tool(const std::string& script, const std::vector<std::string>& args) {
   return true;
 }
 
-bool make_plots(const std::string& run_dir) {
+bool make_plots(const std::string& run_dir, io::OutputFolder& folder) {
+  folder.record("outputs");
   // The report embeds the figures, so it comes after them.
-  return run_tool("plot_run.py", {run_dir}) &&
-         run_tool("report.py", {run_dir, "--version-text", std::string("quadcosim ") + QUADCOSIM_VERSION});
+  const bool ok = run_tool("plot_run.py", {run_dir}) &&
+                  run_tool("report.py", {run_dir, "--version-text", std::string("quadcosim ") + QUADCOSIM_VERSION});
+  folder.record("figures");
+  return ok;
 }
 
 namespace {
@@ -67,7 +71,8 @@ std::string check_run_dir(const std::string& what, const std::string& dir) {
 }  // namespace
 
 CLI::App* add_plot_subcommand(CLI::App& app, PlotOptions& plot) {
-  auto* plot_cmd = app.add_subcommand("plot", "regenerate a run directory's figures");
+  auto* plot_cmd = app.add_subcommand("plot", "regenerate a run directory's figures and report.html (the figures a "
+                                              "previous plot wrote there are removed first)");
   plot_cmd->add_option("run_dir", plot.run_dir, "run directory (trajectory.csv, metrics.json)")
       ->required()->check(CLI::ExistingDirectory);
   return plot_cmd;
@@ -77,7 +82,12 @@ CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& compare) {
   auto* cmp_cmd = app.add_subcommand("compare", "overlay two runs (e.g. two gain sets) and tabulate their step figures");
   cmp_cmd->add_option("run_a", compare.run_a, "first run directory")->required()->check(CLI::ExistingDirectory);
   cmp_cmd->add_option("run_b", compare.run_b, "second run directory")->required()->check(CLI::ExistingDirectory);
-  cmp_cmd->add_option("--out", compare.out, "output directory (default: RUN_B/compare_with_<RUN_A>)");
+  cmp_cmd->add_option("--out", compare.out,
+                      "output directory (default: RUN_B/compare_with_<RUN_A>); new or empty, or a previous "
+                      "compare's, whose files are replaced");
+  cmp_cmd->add_flag("--force", compare.force,
+                    "write into a folder holding other outputs or files: remove the outputs its manifest lists "
+                    "(files quadcosim did not write are kept)");
   return cmp_cmd;
 }
 
@@ -86,7 +96,8 @@ int plot_command(const PlotOptions& o) {
     std::cerr << err << '\n';
     return exit_code::kBadInput;
   }
-  return make_plots(o.run_dir) ? exit_code::kOk : exit_code::kOutput;
+  io::OutputFolder folder = io::OutputFolder::reopen(o.run_dir, "plot", "figures");
+  return make_plots(o.run_dir, folder) ? exit_code::kOk : exit_code::kOutput;
 }
 
 int compare_command(const CompareOptions& o) {
@@ -96,12 +107,16 @@ int compare_command(const CompareOptions& o) {
       return exit_code::kBadInput;
     }
   }
-  std::vector<std::string> args = {o.run_a, o.run_b};
-  if (!o.out.empty()) {
-    args.push_back("--out");
-    args.push_back(o.out);
+  std::string out = o.out;
+  if (out.empty()) {  // as compare_runs.py names it
+    std::filesystem::path a = std::filesystem::absolute(o.run_a).lexically_normal();
+    if (!a.has_filename()) a = a.parent_path();
+    out = (std::filesystem::path(o.run_b) / ("compare_with_" + a.filename().string())).string();
   }
-  return run_tool("compare_runs.py", args) ? exit_code::kOk : exit_code::kOutput;
+  io::OutputFolder folder = io::OutputFolder::claim(out, "compare", {.force = o.force, .replace_own = true}, std::cerr);
+  const bool ok = run_tool("compare_runs.py", {o.run_a, o.run_b, "--out", out});
+  folder.record("outputs");
+  return ok ? exit_code::kOk : exit_code::kOutput;
 }
 
 }  // namespace quadcosim::app

@@ -19,6 +19,7 @@
 #include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "io/mcap_recorder.hpp"
+#include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
@@ -104,7 +105,10 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
 CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
   auto* run_cmd = app.add_subcommand("run", "run a scenario: trajectory.csv, metrics.json, plots");
   run_cmd->add_option("scenario", run.scenario, "scenario YAML file")->required()->check(CLI::ExistingFile);
-  run_cmd->add_option("--out", run.out_dir, "output directory (created)")->required();
+  run_cmd->add_option("--out", run.out_dir, "output directory: new or empty (created when missing)")->required();
+  run_cmd->add_flag("--force", run.force,
+                    "--out holds a previous command's outputs or other files: remove exactly the outputs its "
+                    "manifest lists first (files quadcosim did not write are kept)");
   run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots and report.html");
   run_cmd->add_option("--transport", run.transport,
                       "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
@@ -155,24 +159,21 @@ int run_command(const RunOptions& opt) {
     return exit_code::kBadInput;
   }
 
-  std::error_code ec;
-  fs::create_directories(opt.out_dir, ec);
-  if (ec) {
-    std::cerr << "error: cannot create output directory " << opt.out_dir << ": " << ec.message() << '\n';
-    return exit_code::kOutput;
+  if (opt.transport == "dds" && sc.simulation.faults.active() && !(opt.vehicles > 0 || sc.swarm)) {
+    std::cerr << "error: " << opt.scenario << ": message_faults: message loss and delay are injected by the "
+                 "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
+    return exit_code::kBadInput;
   }
+  // Refused (exit 2) when it holds anything, unless --force; every file written below is listed in
+  // its manifest, also when the run is interrupted or fails.
+  io::OutputFolder folder = io::OutputFolder::claim(opt.out_dir, "run", {.force = opt.force}, std::cerr);
   const fs::path out(opt.out_dir);
 
   try {  // the model's and the controller's checks of the scenario name no file: say which
     fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
-    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out);
+    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
-      if (sc.simulation.faults.active()) {
-        std::cerr << "error: " << opt.scenario << ": message_faults: message loss and delay are injected by the "
-                     "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
-        return exit_code::kBadInput;
-      }
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
     } else {
       sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
@@ -241,7 +242,7 @@ int run_command(const RunOptions& opt) {
       if (const std::string w = io::saturation_warning(*saturation); !w.empty()) std::cerr << "run: " << w << '\n';
     }
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
-    if (opt.plots && !make_plots(opt.out_dir)) return exit_code::kOutput;
+    if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
     return io::all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed)
                ? exit_code::kOk
                : exit_code::kFailed;

@@ -33,10 +33,11 @@ void write_swarm_summary(const std::filesystem::path& out, const io::Scenario& s
                          const std::vector<std::string>& namespaces, const std::vector<SwarmFinal>& rows,
                          const nlohmann::json& run_figures);
 
-/// `run` for a swarm: exit codes as `run` (0 all recorded vehicles pass their step criteria and the
-/// scenario's analysis.limits); adds "recorded" (each recorded vehicle's verdict and saturation figures)
-/// to summary.json.
-int run_swarm(const RunOptions& options, const io::Scenario& sc, const std::filesystem::path& out);
+/// `run` for a swarm into `out`, the folder `folder` has claimed: exit codes as `run` (0 all recorded
+/// vehicles pass their step criteria and the scenario's analysis.limits); adds "recorded" (each
+/// recorded vehicle's verdict and saturation figures) to summary.json.
+int run_swarm(const RunOptions& options, const io::Scenario& sc, const std::filesystem::path& out,
+              io::OutputFolder& folder);
 
 /// `plant --vehicles N` / `controller --vehicles N`: N vehicles in one process over DDS.
 int swarm_plant_command(const PlantCommandOptions& options, io::Scenario sc);

@@ -17,9 +17,11 @@
 
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
+#include "io/output_folder.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
 
@@ -108,7 +110,7 @@ void write_swarm_summary(const fs::path& out, const io::Scenario& sc, const io::
                            rows.size(), mean, pct(0.99), sorted.back(), safety);
 }
 
-int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out) {
+int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out, io::OutputFolder& folder) {
   const io::SwarmSpec spec = swarm_spec(sc, opt.vehicles, opt.threads);
   const int n = spec.layout.vehicles;
   std::vector<std::string> dirs;
@@ -180,7 +182,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
             << (dirs.empty() ? "" : fmt::format(", {} recorded vehicle(s)", dirs.size())) << '\n';
   if (opt.plots) {
     for (const std::string& d : dirs) {
-      if (!make_plots((out / d).string())) return 3;
+      if (!make_plots((out / d).string(), folder)) return exit_code::kOutput;
     }
   }
   return pass ? 0 : 1;

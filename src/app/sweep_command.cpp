@@ -11,7 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
-#include "control/care.hpp"
+#include "app/exit_codes.hpp"
+#include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "sweep/sweep.hpp"
@@ -21,28 +22,6 @@ namespace quadcosim::app {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Refuses (false, after printing why) an output folder that holds another sweep's outputs, unless
-// `force`, which removes exactly those files first. A folder holding a run's outputs is refused.
-// The files a sweep writes are the sweep library's list (sweep::sweep_outputs).
-bool prepare_out(const fs::path& out, bool force) {
-  std::error_code ec;
-  if (fs::exists(out / "trajectory.csv", ec) || fs::exists(out / "metrics.json", ec)) {
-    std::cerr << "error: " << out.string() << " holds a run's outputs (metrics.json or trajectory.csv); "
-              << "give the sweep a folder of its own\n";
-    return false;
-  }
-  const auto old = sweep::sweep_outputs(out);
-  if (old.empty()) return true;
-  if (!force) {
-    std::cerr << "error: " << out.string() << " holds another sweep's outputs (" << old.size()
-              << " files, e.g. " << old.front().filename().string()
-              << "); add --force to remove them first, or choose another --out\n";
-    return false;
-  }
-  sweep::remove_sweep_outputs(out);
-  return true;
-}
 
 bool write_json(const fs::path& path, const nlohmann::json& j) {
   std::ofstream f(path);
@@ -79,7 +58,8 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
 }
 
 int verdict(const nlohmann::json& j, double min_pass_rate) {
-  return static_cast<double>(j["passed"].get<int>()) >= min_pass_rate * j["runs"].get<int>() ? 0 : 1;
+  return static_cast<double>(j["passed"].get<int>()) >= min_pass_rate * j["runs"].get<int>() ? exit_code::kOk
+                                                                                              : exit_code::kFailed;
 }
 
 bool parse_shard(const std::string& text, int& k, int& n) {
@@ -96,26 +76,21 @@ bool parse_shard(const std::string& text, int& k, int& n) {
 }
 
 int rerun_command(const SweepOptions& o) {
-  const fs::path out(o.out_dir);
-  std::error_code ec;
-  if (fs::exists(out, ec) && !fs::is_empty(out, ec) && !o.force) {
-    std::cerr << "error: " << o.out_dir << " is not empty; add --force to write the run into it anyway\n";
-    return 2;
-  }
   sweep::Plan plan;
   try {
     plan = sweep::plan_of(o.sweep_dir);
-  } catch (const std::exception& e) {
+  } catch (const std::runtime_error& e) {  // names the file: not a sweep folder, or not this one's
     std::cerr << "error: " << e.what() << '\n';
-    return 2;
+    return exit_code::kBadInput;
   }
   if (o.rerun_index < 0 || o.rerun_index >= plan.runs) {
     std::cerr << fmt::format("error: sweep rerun: run {} is not in {} (runs 0..{})\n", o.rerun_index, o.sweep_dir,
                              plan.runs - 1);
-    return 2;
+    return exit_code::kBadInput;
   }
-  try {
-    fs::create_directories(out);
+  io::OutputFolder folder = io::OutputFolder::claim(o.out_dir, "sweep rerun", {.force = o.force}, std::cerr);
+  const fs::path out(o.out_dir);
+  return run_guarded(fmt::format("sweep run {}", o.rerun_index), [&] {
     fs::copy_file(fs::path(o.sweep_dir) / "scenario.yaml", out / "scenario.yaml", fs::copy_options::overwrite_existing);
     const sweep::RunResult r = sweep::rerun(plan, o.rerun_index, out);
     std::ifstream txt(out / "metrics.txt");
@@ -123,21 +98,9 @@ int rerun_command(const SweepOptions& o) {
     for (const auto& [k, v] : r.sample.values) std::cout << fmt::format(" {}={}", k, v);
     std::cout << '\n' << txt.rdbuf();
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
-    if (o.plots && !make_plots(o.out_dir)) return 3;
-    return r.passed ? 0 : 1;
-  } catch (const control::CareError& e) {
-    std::cerr << "error: sweep run " << o.rerun_index << ": controller design failed: " << e.what() << '\n';
-    return 2;
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: sweep run " << o.rerun_index << ": " << e.what() << '\n';
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: sweep run " << o.rerun_index << ": " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 3;
-  }
+    if (o.plots && !make_plots(o.out_dir, folder)) return exit_code::kOutput;
+    return r.passed ? exit_code::kOk : exit_code::kFailed;
+  });
 }
 
 int merge_command(const SweepOptions& o) {
@@ -150,7 +113,7 @@ int merge_command(const SweepOptions& o) {
       std::ifstream in(file);
       if (!in) {
         std::cerr << "error: " << file.string() << ": not found (not a shard folder)\n";
-        return 2;
+        return exit_code::kBadInput;
       }
       in >> j;
       if (header.is_null()) {
@@ -158,35 +121,24 @@ int merge_command(const SweepOptions& o) {
       } else if (j.at("header") != header) {
         std::cerr << "error: " << file.string() << ": a shard of another sweep (scenario, seed, runs or --vary differ "
                   << "from " << o.shard_dirs.front() << ")\n";
-        return 2;
+        return exit_code::kBadInput;
       }
       for (auto& r : j.at("per_run")) per_run.push_back(std::move(r));
     } catch (const nlohmann::json::exception& e) {
       std::cerr << "error: " << file.string() << ": not a shard's results (" << e.what() << ")\n";
-      return 2;
+      return exit_code::kBadInput;
     }
   }
-  nlohmann::json summary;
-  try {
-    summary = sweep::summary_json(header, std::move(per_run));
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: sweep merge: " << e.what() << " in the shards given\n";
-    return 2;
-  }
+  // A run missing or given twice: std::invalid_argument, bad input (run_guarded).
+  const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
   const fs::path out(o.out_dir);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) {
-    std::cerr << "error: cannot create output directory " << o.out_dir << ": " << ec.message() << '\n';
-    return 3;
-  }
-  if (!prepare_out(out, o.force)) return 2;
+  io::OutputFolder folder = io::OutputFolder::claim(out, "sweep merge", {.force = o.force}, std::cerr);
   fs::copy_file(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml",
-                fs::copy_options::overwrite_existing, ec);
-  if (ec || !write_json(out / "summary.json", summary)) return 3;
+                fs::copy_options::overwrite_existing);
+  if (!write_json(out / "summary.json", summary)) return exit_code::kOutput;
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
-  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return 3;
+  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }
 
@@ -208,8 +160,10 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   c->add_option("--keep", o.keep, "keep trajectory.csv of none, failing or all runs")
       ->check(CLI::IsMember({"none", "failing", "all"}));
   c->add_option("--shard", o.shard, "K/N: run the runs i with i % N == K-1 and write shard.json for `sweep merge`");
-  c->add_flag("--force", o.force, "replace another sweep's outputs in --out (exactly the files a sweep writes)");
-  c->add_option("--out", o.out_dir, "output directory (created)");
+  c->add_flag("--force", o.force,
+              "--out holds a previous command's outputs or other files: remove exactly the outputs its manifest "
+              "lists first (files quadcosim did not write are kept)");
+  c->add_option("--out", o.out_dir, "output directory: new or empty (created when missing)");
   c->add_option("--jobs", o.jobs, "parallel runs (threads)")->check(CLI::Range(1, 64));
   c->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
@@ -218,15 +172,15 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   auto* r = c->add_subcommand("rerun", "fly run I of a sweep again with the outputs of `run`");
   r->add_option("dir", o.sweep_dir, "sweep folder (summary.json or shard.json, scenario.yaml)")->required();
   r->add_option("index", o.rerun_index, "run index")->required();
-  r->add_option("--out", o.out_dir, "run folder (created)")->required();
-  r->add_flag("--force", o.force, "write into a folder that is not empty");
+  r->add_option("--out", o.out_dir, "run folder: new or empty (created when missing)")->required();
+  r->add_flag("--force", o.force, "--out is not empty: remove the outputs its manifest lists first (other files are kept)");
   r->add_flag("!--no-plots", o.plots, "skip the plots and report");
   r->callback([&o] { o.mode = "rerun"; });
 
   auto* m = c->add_subcommand("merge", "join the shards of a sweep into one summary.json");
-  m->add_option("out", o.out_dir, "output folder (created)")->required();
+  m->add_option("out", o.out_dir, "output folder: new or empty (created when missing)")->required();
   m->add_option("dirs", o.shard_dirs, "shard folders (each with shard.json)")->required();
-  m->add_flag("--force", o.force, "replace another sweep's outputs in OUT");
+  m->add_flag("--force", o.force, "OUT is not empty: remove the outputs its manifest lists first (other files are kept)");
   m->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
   m->add_flag("!--no-plots", o.plots, "skip the plots");
@@ -239,46 +193,27 @@ int sweep_command(const SweepOptions& o) {
   if (o.mode == "merge") return merge_command(o);
   if (o.scenario.empty() || o.out_dir.empty()) {
     std::cerr << "error: sweep: give a SCENARIO and --out DIR (or `sweep rerun`, `sweep merge`; see --help)\n";
-    return 2;
+    return exit_code::kBadInput;
   }
   int shard = 1, shards = 1;
   if (!o.shard.empty() && !parse_shard(o.shard, shard, shards)) {
     std::cerr << "error: --shard " << o.shard << ": expected K/N with 1 <= K <= N (e.g. 2/8)\n";
-    return 2;
+    return exit_code::kBadInput;
   }
-  sweep::Plan plan;
-  try {
-    bool grid = false;
-    for (const auto& spec : o.vary) grid = grid || sweep::parse_vary(spec).distribution == sweep::Distribution::kGrid;
-    const int per_point = grid && !o.runs_given ? 1 : o.runs;
-    plan = sweep::make_plan(o.scenario, o.vary, o.seed, per_point,
-                            o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
-  } catch (const io::ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
-  }
+  // A bad --vary or scenario: io::ConfigError or std::invalid_argument, bad input (run_guarded).
+  bool grid = false;
+  for (const auto& spec : o.vary) grid = grid || sweep::parse_vary(spec).distribution == sweep::Distribution::kGrid;
+  const sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
+                                            o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
   if (plan.nominal.steps.empty() && !plan.nominal.hold) {
     std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps and no hold criterion; "
               << "a sweep needs something to judge\n";
-    return 2;
+    return exit_code::kBadInput;
   }
   const fs::path out(o.out_dir);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) {
-    std::cerr << "error: cannot create output directory " << o.out_dir << ": " << ec.message() << '\n';
-    return 3;
-  }
-  if (!prepare_out(out, o.force)) return 2;
-  fs::create_directories(out / "runs", ec);
-  fs::copy_file(o.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing, ec);
-  if (ec) {
-    std::cerr << "error: cannot write " << (out / "scenario.yaml").string() << ": " << ec.message() << '\n';
-    return 3;
-  }
+  io::OutputFolder folder = io::OutputFolder::claim(out, "sweep", {.force = o.force}, std::cerr);
+  fs::create_directories(out / "runs");
+  fs::copy_file(o.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
   const sweep::Keep keep = o.keep == "all" ? sweep::Keep::kAll : o.keep == "failing" ? sweep::Keep::kFailing : sweep::Keep::kNone;
   const std::vector<int> indices = sweep::shard_indices(plan.runs, shard, shards);
   const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep);
@@ -296,18 +231,18 @@ int sweep_command(const SweepOptions& o) {
     int passed = 0;
     for (const auto& r : results) passed += r.passed ? 1 : 0;
     nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
-    if (!write_json(out / "shard.json", j)) return 3;
+    if (!write_json(out / "shard.json", j)) return exit_code::kOutput;
     std::cout << fmt::format("sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
                              "join the shards with `quadcosim sweep merge OUT DIR...`\n",
                              plan.nominal.name, o.shard, results.size(), plan.runs, passed,
                              (out / "shard.json").string());
-    return 0;
+    return exit_code::kOk;
   }
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
-  if (!write_json(out / "summary.json", summary)) return 3;
+  if (!write_json(out / "summary.json", summary)) return exit_code::kOutput;
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
-  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return 3;
+  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }
 

@@ -305,40 +305,4 @@ Plan plan_of(const fs::path& dir) {
   }
 }
 
-std::vector<fs::path> sweep_outputs(const fs::path& dir) {
-  std::vector<fs::path> out;
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return out;
-  for (const char* name : {"summary.json", "shard.json", "scenario.yaml", "box.png"}) {
-    if (fs::exists(dir / name)) out.push_back(dir / name);
-  }
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string n = e.path().filename().string();
-    const bool png = n.size() > 4 && n.ends_with(".png");
-    if (png && (n.starts_with("hist_") || n.starts_with("scatter_") || n.starts_with("map_"))) out.push_back(e.path());
-  }
-  if (fs::is_directory(dir / "runs", ec)) {
-    for (const auto& e : fs::directory_iterator(dir / "runs", ec)) {
-      const std::string n = e.path().filename().string();
-      if (!e.is_directory() || n.empty() || !std::all_of(n.begin(), n.end(), ::isdigit)) continue;
-      for (const char* f : {"metrics.json", "trajectory.csv"}) {
-        if (fs::exists(e.path() / f)) out.push_back(e.path() / f);
-      }
-    }
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-void remove_sweep_outputs(const fs::path& dir) {
-  for (const fs::path& p : sweep_outputs(dir)) fs::remove(p);
-  std::error_code ec;
-  if (fs::is_directory(dir / "runs", ec)) {
-    for (const auto& e : fs::directory_iterator(dir / "runs", ec)) {
-      if (e.is_directory() && fs::is_empty(e.path())) fs::remove(e.path());
-    }
-    if (fs::is_empty(dir / "runs")) fs::remove(dir / "runs");
-  }
-}
-
 }  // namespace quadcosim::sweep

@@ -64,11 +64,4 @@ nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::
 /// Throws std::runtime_error naming the file.
 Plan plan_of(const std::filesystem::path& sweep_dir);
 
-/// Files a sweep writes in `dir` that are there now (summary.json, shard.json, scenario.yaml,
-/// runs/NNNN/{metrics.json,trajectory.csv}, the plots of tools/plot_sweep.py): what --force removes.
-std::vector<std::filesystem::path> sweep_outputs(const std::filesystem::path& dir);
-
-/// Removes sweep_outputs(dir) and the run folders left empty.
-void remove_sweep_outputs(const std::filesystem::path& dir);
-
 }  // namespace quadcosim::sweep

@@ -107,8 +107,14 @@ PYEOF
     "$QC" margins --out "$TMP/np" --no-plots > /dev/null || fail "--no-plots failed"
     ls "$TMP/np"/*.png > /dev/null 2>&1 && fail "--no-plots wrote PNGs"
     [ -s "$TMP/np/margins.json" ] || fail "no margins.json with --no-plots"
-    # Again into the same folder, in attitude mode: the position plots of the first analysis go.
-    "$QC" margins "$P/roll_step.yaml" --out "$TMP/m" > /dev/null || fail "re-using a margins folder failed"
+    # Again into the same folder: refused; with --force, in attitude mode, the position plots of the
+    # first analysis go.
+    set +e
+    "$QC" margins "$P/roll_step.yaml" --out "$TMP/m" > /dev/null 2> "$TMP/err"; rc=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q "$TMP/m is not empty: it holds the outputs of \`quadcosim margins\`" "$TMP/err" \
+      || fail "re-using a margins folder without --force: exit $rc: $(cat "$TMP/err")"
+    "$QC" margins "$P/roll_step.yaml" --out "$TMP/m" --force > /dev/null || fail "re-using a margins folder failed"
     [ -e "$TMP/m/bode_position_x.png" ] && fail "a stale position_x plot survived"
     [ -s "$TMP/m/bode_roll.png" ] || fail "no bode_roll.png the second time"
     # A folder with someone else's files is refused, and left as it was.

@@ -108,23 +108,34 @@ assert float(row["z"]) == 3.0, row["z"]
 PYEOF
     ;;
 
-  hygiene)  # another sweep's outputs: refused without --force; --force removes exactly a sweep's files
+  hygiene)  # a used folder: refused without --force; --force removes exactly the files the last command wrote
     "$QC" sweep "$HOVER" --runs 4 --min-pass-rate 0 --out "$TMP/o1" --no-plots > /dev/null
-    touch "$TMP/o1/hist_old.png" "$TMP/o1/notes.txt"
+    touch "$TMP/o1/notes.txt"
     set +e
     "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --out "$TMP/o1" --no-plots > "$TMP/o" 2>&1; rc=$?
-    [ $rc -eq 2 ] && grep -q "holds another sweep's outputs" "$TMP/o" && grep -q -- "--force" "$TMP/o" || fail "reuse not refused (rc $rc)"
+    [ $rc -eq 2 ] && grep -q "$TMP/o1 is not empty: it holds the outputs of \`quadcosim sweep\` (6 files" "$TMP/o" \
+      && grep -q "notes.txt" "$TMP/o" && grep -q -- "--force" "$TMP/o" || { cat "$TMP/o"; fail "reuse not refused (rc $rc)"; }
     [ -e "$TMP/o1/runs/0003/metrics.json" ] || fail "the refusal removed files"
     set -e
-    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --out "$TMP/o1" --no-plots --force > /dev/null || fail "--force"
-    [ ! -e "$TMP/o1/runs/0003" ] && [ ! -e "$TMP/o1/runs/0002" ] && [ ! -e "$TMP/o1/hist_old.png" ] || fail "stale runs or plots left"
-    [ -e "$TMP/o1/notes.txt" ] && [ -e "$TMP/o1/runs/0001/metrics.json" ] || fail "--force removed a file no sweep writes, or the new runs are missing"
+    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --out "$TMP/o1" --no-plots --force > /dev/null 2> "$TMP/e" || fail "--force"
+    [ ! -e "$TMP/o1/runs/0003" ] && [ ! -e "$TMP/o1/runs/0002" ] || fail "stale runs left: $(ls "$TMP/o1/runs")"
+    [ -e "$TMP/o1/notes.txt" ] && [ -e "$TMP/o1/runs/0001/metrics.json" ] || fail "--force removed a file no sweep wrote, or the new runs are missing"
+    grep -q "kept 1 file quadcosim did not write: notes.txt" "$TMP/e" || { cat "$TMP/e"; fail "the kept file is not named"; }
     grep -q '"runs": 2' "$TMP/o1/summary.json" || fail "summary.json is not the new sweep's"
+    "$PY" - "$TMP/o1/.quadcosim-outputs.json" <<'PYEOF' || fail "manifest"
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["command"] == "sweep", m
+assert m["files"] == {"outputs": ["runs/0000/metrics.json", "runs/0001/metrics.json", "scenario.yaml", "summary.json"]}, m
+PYEOF
+    # A run's folder: refused, and with --force the run's files go (trajectory.csv), the sweep's come.
     "$QC" run "$HOVER" --out "$TMP/run" --no-plots > /dev/null
     set +e
-    "$QC" sweep "$HOVER" --runs 2 --out "$TMP/run" --no-plots --force > "$TMP/o" 2>&1; rc=$?
-    [ $rc -eq 2 ] && grep -q "holds a run's outputs" "$TMP/o" || fail "sweep into a run folder (rc $rc)"
+    "$QC" sweep "$HOVER" --runs 2 --out "$TMP/run" --no-plots > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 2 ] && grep -q "the outputs of \`quadcosim run\`" "$TMP/o" || { cat "$TMP/o"; fail "sweep into a run folder (rc $rc)"; }
     set -e
+    "$QC" sweep "$HOVER" --runs 2 --out "$TMP/run" --no-plots --min-pass-rate 0 --force > /dev/null || fail "--force on a run folder"
+    [ ! -e "$TMP/run/trajectory.csv" ] && [ ! -e "$TMP/run/run.mcap" ] && [ -s "$TMP/run/summary.json" ] || fail "a run's file survived"
     ;;
 
   console)  # every figure with its count and missing runs; a figure no run has says so

@@ -1,0 +1,233 @@
+// Output folders: a manifest lists exactly what a command wrote; a used folder is refused unless
+// --force, which removes exactly the listed files; plot-style reopening replaces one group.
+#include "io/output_folder.hpp"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace quadcosim::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "quadcosim_outdir_test_XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+void write(const fs::path& p, const std::string& text = "x") {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+}
+
+nlohmann::json manifest_json(const fs::path& dir) {
+  std::ifstream in(dir / kOutputManifest);
+  return nlohmann::json::parse(in);
+}
+
+std::string refusal(const fs::path& dir, const std::string& command, OutputFolder::Options o = {}) {
+  std::ostringstream notes;
+  try {
+    OutputFolder f = OutputFolder::claim(dir, command, o, notes);
+  } catch (const OutputFolderRefused& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(OutputFolder, NewFolderIsCreatedAndItsManifestListsExactlyWhatWasWritten) {
+  TempDir t;
+  const fs::path dir = t.path() / "a" / "b";
+  std::ostringstream notes;
+  {
+    OutputFolder f = OutputFolder::claim(dir, "run", {}, notes);
+    write(dir / "trajectory.csv");
+    write(dir / "sub" / "metrics.json");
+    f.record("outputs");
+    write(dir / "step_z.png");
+  }  // the destructor records the rest under the default group
+  const nlohmann::json j = manifest_json(dir);
+  EXPECT_EQ(j["command"], "run");
+  EXPECT_EQ(j["files"]["outputs"], nlohmann::json({"step_z.png", "sub/metrics.json", "trajectory.csv"}));
+  EXPECT_EQ(j["files"].size(), 1u);
+  EXPECT_TRUE(notes.str().empty());
+}
+
+TEST(OutputFolder, GroupsSplitTheFilesByWhenTheyWereWritten) {
+  TempDir t;
+  std::ostringstream notes;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
+    write(t.path() / "trajectory.csv");
+    f.record("outputs");
+    write(t.path() / "overview.png");
+    f.record("figures");
+  }
+  const nlohmann::json j = manifest_json(t.path());
+  EXPECT_EQ(j["files"]["outputs"], nlohmann::json({"trajectory.csv"}));
+  EXPECT_EQ(j["files"]["figures"], nlohmann::json({"overview.png"}));
+}
+
+TEST(OutputFolder, UsedFolderIsRefusedNamingItAndWhatItHolds) {
+  TempDir t;
+  std::ostringstream notes;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
+    write(t.path() / "step_x.png");
+  }
+  write(t.path() / "notes.txt");
+  const std::string why = refusal(t.path(), "sweep");
+  EXPECT_NE(why.find(t.path().string() + " is not empty"), std::string::npos) << why;
+  EXPECT_NE(why.find("`quadcosim run` (1 file: step_x.png)"), std::string::npos) << why;
+  EXPECT_NE(why.find("1 file quadcosim did not write (notes.txt)"), std::string::npos) << why;
+  EXPECT_NE(why.find("--force"), std::string::npos) << why;
+  EXPECT_TRUE(fs::exists(t.path() / "step_x.png"));  // a refusal changes nothing
+}
+
+TEST(OutputFolder, ForeignFilesAloneAreRefusedToo) {
+  TempDir t;
+  write(t.path() / "mine.txt");
+  const std::string why = refusal(t.path(), "run");
+  EXPECT_NE(why.find("1 file quadcosim did not write (mine.txt)"), std::string::npos) << why;
+  EXPECT_EQ(why.find("outputs of"), std::string::npos) << why;
+}
+
+TEST(OutputFolder, ForceRemovesExactlyTheListedFilesAndKeepsTheRest) {
+  TempDir t;
+  std::ostringstream notes;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "sweep", {}, notes);
+    for (int i = 0; i < 4; ++i) write(t.path() / "runs" / ("000" + std::to_string(i)) / "metrics.json");
+    write(t.path() / "summary.json");
+  }
+  write(t.path() / "notes.txt", "mine");
+  write(t.path() / "runs" / "0003" / "keep.me");
+  OutputFolder::Options force;
+  force.force = true;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "sweep", force, notes);
+    EXPECT_FALSE(fs::exists(t.path() / "summary.json"));
+    EXPECT_FALSE(fs::exists(t.path() / "runs" / "0001"));  // emptied run folders go too
+    EXPECT_TRUE(fs::exists(t.path() / "runs" / "0003" / "keep.me"));
+    for (int i = 0; i < 2; ++i) write(t.path() / "runs" / ("000" + std::to_string(i)) / "metrics.json");
+  }
+  EXPECT_NE(notes.str().find("kept 2 files quadcosim did not write: notes.txt, runs/0003/keep.me"),
+            std::string::npos)
+      << notes.str();
+  EXPECT_EQ(manifest_json(t.path())["files"]["outputs"],
+            nlohmann::json({"runs/0000/metrics.json", "runs/0001/metrics.json"}));
+  std::ifstream in(t.path() / "notes.txt");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "mine");
+}
+
+TEST(OutputFolder, ReplaceOwnReplacesTheSameCommandsOutputsOnly) {
+  TempDir t;
+  std::ostringstream notes;
+  OutputFolder::Options own;
+  own.replace_own = true;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "compare", own, notes);
+    write(t.path() / "compare_x.png");
+  }
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "compare", own, notes);
+    EXPECT_FALSE(fs::exists(t.path() / "compare_x.png"));
+    write(t.path() / "compare_z.png");
+  }
+  EXPECT_NE(refusal(t.path(), "margins", own).find("`quadcosim compare`"), std::string::npos);
+  write(t.path() / "mine.txt");
+  EXPECT_NE(refusal(t.path(), "compare", own).find("mine.txt"), std::string::npos);
+}
+
+TEST(OutputFolder, ReopenReplacesOneGroupOfTheFolder) {
+  TempDir t;
+  std::ostringstream notes;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
+    write(t.path() / "trajectory.csv");
+    f.record("outputs");
+    write(t.path() / "step_x.png");
+    write(t.path() / "overview.png");
+    f.record("figures");
+  }
+  {
+    OutputFolder f = OutputFolder::reopen(t.path(), "plot", "figures");
+    EXPECT_FALSE(fs::exists(t.path() / "step_x.png"));
+    EXPECT_TRUE(fs::exists(t.path() / "trajectory.csv"));
+    write(t.path() / "step_z.png");
+    write(t.path() / "overview.png");
+  }
+  const nlohmann::json j = manifest_json(t.path());
+  EXPECT_EQ(j["command"], "run");
+  EXPECT_EQ(j["files"]["figures"], nlohmann::json({"overview.png", "step_z.png"}));
+  EXPECT_EQ(j["files"]["outputs"], nlohmann::json({"trajectory.csv"}));
+}
+
+TEST(OutputFolder, ReopenOfASubFolderUsesTheEnclosingManifest) {
+  TempDir t;
+  std::ostringstream notes;
+  {
+    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
+    write(t.path() / "uav0000" / "trajectory.csv");
+    write(t.path() / "uav0001" / "trajectory.csv");
+    f.record("outputs");
+    write(t.path() / "uav0000" / "step_x.png");
+    write(t.path() / "uav0001" / "step_x.png");
+    f.record("figures");
+  }
+  {
+    OutputFolder f = OutputFolder::reopen(t.path() / "uav0000", "plot", "figures");
+    EXPECT_FALSE(fs::exists(t.path() / "uav0000" / "step_x.png"));
+    EXPECT_TRUE(fs::exists(t.path() / "uav0001" / "step_x.png"));  // another vehicle's: not this plot's
+    write(t.path() / "uav0000" / "step_z.png");
+  }
+  EXPECT_FALSE(fs::exists(t.path() / "uav0000" / kOutputManifest));
+  EXPECT_EQ(manifest_json(t.path())["files"]["figures"],
+            nlohmann::json({"uav0000/step_z.png", "uav0001/step_x.png"}));
+}
+
+TEST(OutputFolder, NestedOutputFoldersAreKeptAndNamed) {
+  TempDir t;
+  std::ostringstream notes;
+  { OutputFolder f = OutputFolder::claim(t.path() / "cmp", "compare", {}, notes); write(t.path() / "cmp" / "c.md"); }
+  EXPECT_NE(refusal(t.path(), "run").find("the outputs of other commands in cmp/"), std::string::npos);
+  OutputFolder::Options force;
+  force.force = true;
+  { OutputFolder f = OutputFolder::claim(t.path(), "run", force, notes); }
+  EXPECT_TRUE(fs::exists(t.path() / "cmp" / "c.md"));
+}
+
+TEST(OutputFolder, AManifestNamingFilesOutsideItsFolderIsRefused) {
+  TempDir t;
+  write(t.path() / "out" / kOutputManifest, R"({"command": "run", "files": {"outputs": ["../victim"]}})");
+  write(t.path() / "victim");
+  OutputFolder::Options force;
+  force.force = true;
+  EXPECT_NE(refusal(t.path() / "out", "run", force).find("not a quadcosim output manifest"), std::string::npos);
+  EXPECT_TRUE(fs::exists(t.path() / "victim"));
+}
+
+TEST(OutputFolder, AFileInPlaceOfTheFolderIsRefused) {
+  TempDir t;
+  write(t.path() / "f");
+  EXPECT_NE(refusal(t.path() / "f", "run").find("exists and is not a folder"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace quadcosim::io
