@@ -96,6 +96,8 @@ enum class Mode {
 };
 
 // Walks one struct: the fields its fields() hands over, against the C struct's instructions from `op`.
+// Only kCheck compares; kToC and kFromC trust the instructions, so run kCheck (check_fields) on the
+// pair first (dds/ros_types.cpp does, for every type, before it hands out a conversion).
 template <Mode kMode>
 class Walk {
  public:
@@ -122,7 +124,7 @@ class Walk {
 
   /// After the last field: the C struct must have no member left.
   void end() const {
-    if (DDS_OP(*op_) != DDS_OP_RTS) fail({}, "the IDL type has a member after the last field fields() lists");
+    if (kMode == Mode::kCheck && DDS_OP(*op_) != DDS_OP_RTS) fail({}, "the IDL type has a member after the last field fields() lists");
   }
 
  private:
@@ -245,11 +247,11 @@ class Walk {
 
   // The instruction for the field `name`, which must be a member's (ADR).
   std::uint32_t next(std::string_view name) const {
-    if (DDS_OP(*op_) != DDS_OP_ADR) fail(name, "fields() lists a field after the IDL type's last member");
+    if (kMode == Mode::kCheck && DDS_OP(*op_) != DDS_OP_ADR) fail(name, "fields() lists a field after the IDL type's last member");
     return *op_;
   }
   void expect(std::string_view name, bool ok, std::uint32_t insn, const char* want) const {
-    if (!ok) {
+    if (kMode == Mode::kCheck && !ok) {
       char hex[16];
       std::snprintf(hex, sizeof hex, "0x%08x", insn);
       fail(name, std::string("the C++ field wants ") + want + ", the IDL member's instruction is " + hex);

@@ -63,8 +63,7 @@ TypeOps ops_for() {
   idl_walk::check_fields<T>(d);
   return TypeOps{&d,
                  [](dds_entity_t writer, const void* message) -> dds_return_t {
-                   alignas(std::max_align_t) unsigned char sample[kMaxSample];
-                   std::memset(sample, 0, idl<T>().m_size);
+                   alignas(std::max_align_t) unsigned char sample[kMaxSample];  // every member gets written
                    Arena arena;
                    Walk<Mode::kToC> w(T::kRosType, idl<T>().m_ops, sample, &arena);
                    T::fields(*static_cast<const T*>(message), w);
