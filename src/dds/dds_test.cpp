@@ -7,6 +7,12 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <typeindex>
 #include <chrono>
 #include <stdexcept>
 #include <thread>
@@ -14,6 +20,7 @@
 
 #include "dds/arrival_executor.hpp"
 #include "dds/dds_transport.hpp"
+#include "dds/idl_walk.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::dds {
@@ -26,154 +33,225 @@ RosEnvironment test_env() {
   return e;
 }
 
-TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
-  DdsTransport a(test_env()), b(test_env());
-  msg::PoseStamped pose_in;
-  msg::Imu imu_in;
-  msg::Float64MultiArray cmd_in;
-  msg::ControllerStatus status_in;
-  int got = 0;
-  b.subscribe<msg::PoseStamped>("/t/Pose", [&](const msg::PoseStamped& m) { pose_in = m; ++got; });
-  b.subscribe<msg::Imu>("/t/Imu", [&](const msg::Imu& m) { imu_in = m; ++got; });
-  b.subscribe<msg::Float64MultiArray>("/t/cmd", [&](const msg::Float64MultiArray& m) { cmd_in = m; ++got; });
-  b.subscribe<msg::ControllerStatus>("/t/status", [&](const msg::ControllerStatus& m) { status_in = m; ++got; });
-  auto pose = a.advertise<msg::PoseStamped>("/t/Pose");
-  auto imu = a.advertise<msg::Imu>("/t/Imu");
-  auto cmd = a.advertise<msg::Float64MultiArray>("/t/cmd");
-  auto status = a.advertise<msg::ControllerStatus>("/t/status");
-  ASSERT_TRUE(b.spin_until([&] { return b.matched_writers("/t/Pose") == 1 && b.matched_writers("/t/status") == 1; },
-                           5'000'000'000));
-  ASSERT_TRUE(a.spin_until([&] { return a.matched_readers("/t/cmd") == 1; }, 5'000'000'000));
+// Every field of a message, from its fields() list: FillFields gives each leaf a value of its own
+// (so a field written to or read from its neighbour shows), Flatten lists them exactly (doubles in
+// hex), so a round trip compares whole messages whatever fields they have.
+struct FillFields {
+  int next = 1;
+  template <class T>
+  void field(std::string_view, T& v, msg::FieldNote = {}) {
+    put(v);
+  }
+  template <class F>
+  void group(std::string_view, std::string_view, F&& visit) {
+    visit(*this);
+  }
+  template <class T>
+  void put(T& v) {
+    const int k = next++;
+    if constexpr (std::is_same_v<T, bool>) {
+      v = k % 2 == 0;
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      v = std::string(static_cast<std::size_t>(k % 7), 'a' + static_cast<char>(k % 26)) + std::to_string(k);
+    } else if constexpr (std::is_floating_point_v<T>) {
+      v = k + 1.0 / (k + 2);
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      v = static_cast<T>(k * 1000003);
+    } else if constexpr (requires { v.size(); v.resize(2); }) {
+      v.resize(2);
+      for (auto& e : v) put(e);
+    } else if constexpr (requires { v.size(); }) {
+      for (auto& e : v) put(e);
+    } else {
+      T::fields(v, *this);
+    }
+  }
+};
 
-  msg::PoseStamped p;
-  p.header = {{12, 345}, "world"};
-  p.position = {1.5, -2.25, 1e-300};
-  p.orientation = {0.1, 0.2, 0.3, 0.9};
-  msg::Imu i;
-  i.header = {{1, 2}, "base_link"};
-  i.orientation_covariance[8] = 7.0;
-  i.linear_acceleration = {0.0, -0.0, 9.81};
-  msg::Float64MultiArray c;
-  c.data = {4830.5, 1.0 / 3.0, 0.0, 1e9};
-  c.dim = {{"rotors@5", 4, 4}};
-  msg::ControllerStatus s;
-  s.header.stamp = {3, 4};
-  s.mode = "position";
-  s.setpoint = {1, 2, 3, 0.1, 0.2, 0.3};
-  s.rotor_saturated = {true, false, true, false};
-  s.safety = true;
-  pose.publish(p);
-  imu.publish(i);
-  cmd.publish(c);
-  status.publish(s);
-  ASSERT_TRUE(b.spin_until([&] { return got == 4; }, 5'000'000'000));
+struct Flatten {
+  std::vector<std::string> out;
+  template <class T>
+  void field(std::string_view name, const T& v, msg::FieldNote = {}) {
+    put(std::string(name), v);
+  }
+  template <class F>
+  void group(std::string_view, std::string_view, F&& visit) {
+    visit(*this);
+  }
+  template <class T>
+  void put(const std::string& name, const T& v) {
+    char buf[64];
+    if constexpr (std::is_same_v<T, std::string>) {
+      out.push_back(name + "='" + v + "'");
+    } else if constexpr (std::is_floating_point_v<T>) {
+      std::snprintf(buf, sizeof buf, "%a", v);
+      out.push_back(name + "=" + buf);
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      out.push_back(name + "=" + std::to_string(v));
+    } else if constexpr (requires { v.size(); }) {
+      out.push_back(name + ".size=" + std::to_string(v.size()));
+      for (std::size_t i = 0; i < v.size(); ++i) put(name + "[" + std::to_string(i) + "]", v[i]);
+    } else {
+      Flatten sub;
+      T::fields(v, sub);
+      for (const std::string& f : sub.out) out.push_back(name + "." + f);
+    }
+  }
+};
 
-  EXPECT_EQ(pose_in.header.stamp.sec, 12);
-  EXPECT_EQ(pose_in.header.stamp.nanosec, 345u);
-  EXPECT_EQ(pose_in.header.frame_id, "world");
-  EXPECT_EQ(pose_in.position.x, 1.5);
-  EXPECT_EQ(pose_in.position.z, 1e-300);
-  EXPECT_EQ(pose_in.orientation.w, 0.9);
-  EXPECT_EQ(imu_in.header.frame_id, "base_link");
-  EXPECT_EQ(imu_in.orientation_covariance[8], 7.0);
-  EXPECT_TRUE(std::signbit(imu_in.linear_acceleration.y));
-  EXPECT_EQ(cmd_in.data, c.data);
-  ASSERT_EQ(cmd_in.dim.size(), 1u);
-  EXPECT_EQ(cmd_in.dim[0].label, "rotors@5");
-  EXPECT_EQ(msg::command_stamp_ns(cmd_in), 5);
-  EXPECT_EQ(status_in.mode, "position");
-  EXPECT_EQ(status_in.setpoint, s.setpoint);
-  EXPECT_EQ(status_in.rotor_saturated, s.rotor_saturated);
-  EXPECT_TRUE(status_in.safety);
+template <class T>
+std::vector<std::string> flatten(const T& m) {
+  Flatten f;
+  T::fields(m, f);
+  return f.out;
 }
 
-// The types the test above leaves out, and every field of the two status types, each with a value
-// of its own so a field read from or written to its neighbour shows.
-TEST(DdsTransportTest, RoundTripsTheRestFieldForField) {
+// Sends a message with every field its own value from one transport to another and compares what
+// arrives, field by field.
+template <class T>
+void expect_round_trip(const std::string& topic) {
   DdsTransport a(test_env()), b(test_env());
-  msg::TwistStamped twist_in;
-  msg::Clock clock_in;
-  msg::ControllerStatus cs_in;
-  msg::PlantStatus ps_in;
-  int got = 0;
-  b.subscribe<msg::TwistStamped>("/r/Velocity", [&](const msg::TwistStamped& m) { twist_in = m; ++got; });
-  b.subscribe<msg::Clock>("/r/clock", [&](const msg::Clock& m) { clock_in = m; ++got; });
-  b.subscribe<msg::ControllerStatus>("/r/cs", [&](const msg::ControllerStatus& m) { cs_in = m; ++got; });
-  b.subscribe<msg::PlantStatus>("/r/ps", [&](const msg::PlantStatus& m) { ps_in = m; ++got; });
-  auto twist = a.advertise<msg::TwistStamped>("/r/Velocity");
-  auto clock = a.advertise<msg::Clock>("/r/clock");
-  auto cs = a.advertise<msg::ControllerStatus>("/r/cs");
-  auto ps = a.advertise<msg::PlantStatus>("/r/ps");
-  ASSERT_TRUE(b.spin_until([&] { return b.matched_writers("/r/Velocity") == 1 && b.matched_writers("/r/clock") == 1 &&
-                                        b.matched_writers("/r/cs") == 1 && b.matched_writers("/r/ps") == 1; },
+  std::optional<T> got;
+  b.subscribe<T>(topic, [&](const T& m) { got = m; });
+  auto pub = a.advertise<T>(topic);
+  ASSERT_TRUE(a.spin_until([&] { return a.matched_readers(topic) == 1; }, 5'000'000'000)) << T::kRosType;
+  T m;
+  FillFields fill;
+  T::fields(m, fill);
+  pub.publish(m);
+  ASSERT_TRUE(b.spin_until([&] { return got.has_value(); }, 5'000'000'000)) << T::kRosType;
+  EXPECT_EQ(flatten(*got), flatten(m)) << T::kRosType;
+}
+
+TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
+  expect_round_trip<msg::PoseStamped>("/t/Pose");
+  expect_round_trip<msg::TwistStamped>("/t/Velocity");
+  expect_round_trip<msg::Imu>("/t/Imu");
+  expect_round_trip<msg::Float64MultiArray>("/t/cmd");
+  expect_round_trip<msg::Clock>("/t/clock");
+  expect_round_trip<msg::ControllerStatus>("/t/status");
+  expect_round_trip<msg::PlantStatus>("/t/plant_status");
+}
+
+TEST(DdsTransportTest, RoundTripsExtremesAndEmpties) {
+  msg::Float64MultiArray empty;  // no dimension, no data
+  msg::Float64MultiArray cmd;
+  cmd.data = {4830.5, -0.0, 1e-300, std::numeric_limits<double>::infinity()};
+  cmd.dim = {{"rotors@5", 4, 4}, {"", 0, 0}};
+  msg::Clock clock;
+  clock.clock = {2147483647, 999999999};
+  DdsTransport a(test_env()), b(test_env());
+  std::vector<msg::Float64MultiArray> cmds;
+  std::optional<msg::Clock> clock_in;
+  b.subscribe<msg::Float64MultiArray>("/e/cmd", [&](const msg::Float64MultiArray& m) { cmds.push_back(m); });
+  b.subscribe<msg::Clock>("/e/clock", [&](const msg::Clock& m) { clock_in = m; });
+  auto cmd_pub = a.advertise<msg::Float64MultiArray>("/e/cmd");
+  auto clock_pub = a.advertise<msg::Clock>("/e/clock");
+  ASSERT_TRUE(a.spin_until([&] { return a.matched_readers("/e/cmd") == 1 && a.matched_readers("/e/clock") == 1; },
                            5'000'000'000));
-  ASSERT_TRUE(a.spin_until([&] { return a.matched_readers("/r/ps") == 1; }, 5'000'000'000));
+  cmd_pub.publish(empty);
+  cmd_pub.publish(cmd);
+  clock_pub.publish(clock);
+  ASSERT_TRUE(b.spin_until([&] { return cmds.size() == 2 && clock_in; }, 5'000'000'000));
+  EXPECT_TRUE(cmds[0].data.empty());
+  EXPECT_TRUE(cmds[0].dim.empty());
+  EXPECT_EQ(flatten(cmds[1]), flatten(cmd));
+  EXPECT_TRUE(std::signbit(cmds[1].data[1]));
+  EXPECT_EQ(clock_in->clock.sec, 2147483647);
+  EXPECT_EQ(clock_in->clock.nanosec, 999999999u);
+}
 
-  msg::TwistStamped t;
-  t.header = {{7, 8}, "world"};
-  t.linear = {1, 2, 3};
-  t.angular = {4, 5, 6};
-  msg::Clock k;
-  k.clock = {2147483647, 999999999};
-  msg::ControllerStatus c;
-  c.header = {{9, 10}, "base_link"};
-  c.mode = "attitude";
-  c.setpoint = {1, 2, 3, 4, 5, 6};
-  c.u = {7, 8, 9, 10};
-  c.error = {11, 12, 13, 14};
-  c.rotor_saturated = {false, true, false, true};
-  c.tilt_saturated = true;
-  c.safety = false;
-  c.rejected_non_finite = 101;
-  c.rejected_bad_quaternion = 102;
-  c.rejected_bad_stamp = 103;
-  c.rejected_stamp_backwards = 18446744073709551615u;
-  msg::PlantStatus p;
-  p.header = {{11, 12}, ""};
-  p.commands_accepted = 201;
-  p.commands_clamped = 202;
-  p.commands_rejected_length = 203;
-  p.commands_rejected_non_finite = 204;
-  p.last_problem = "speed 1e+09 rad/s above omega_max";
-  p.watchdog_active = true;
-  p.watchdog_trips = 205;
-  p.watchdog_ticks = 206;
-  twist.publish(t);
-  clock.publish(k);
-  cs.publish(c);
-  ps.publish(p);
-  ASSERT_TRUE(b.spin_until([&] { return got == 4; }, 5'000'000'000));
+// The conversions pair fields() with idlc's instructions and refuse any difference, naming it.
+struct Pair {
+  static constexpr std::string_view kRosType = "test_msgs/msg/Pair";
+  double a = 0;
+  std::uint32_t b = 0;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("a", m.a);
+    v.field("b", m.b);
+  }
+};
+struct PairOfPairs {
+  static constexpr std::string_view kRosType = "test_msgs/msg/PairOfPairs";
+  Pair first;
+  std::vector<Pair> rest;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("first", m.first);
+    v.group("more", "test_msgs/msg/More", [&](auto& g) { g.field("rest", m.rest); });
+  }
+};
 
-  EXPECT_EQ(twist_in.header.stamp.to_ns(), t.header.stamp.to_ns());
-  EXPECT_EQ(twist_in.header.frame_id, "world");
-  EXPECT_EQ(twist_in.linear.x, 1);
-  EXPECT_EQ(twist_in.linear.z, 3);
-  EXPECT_EQ(twist_in.angular.x, 4);
-  EXPECT_EQ(twist_in.angular.z, 6);
-  EXPECT_EQ(clock_in.clock.sec, 2147483647);
-  EXPECT_EQ(clock_in.clock.nanosec, 999999999u);
-  EXPECT_EQ(cs_in.header.frame_id, "base_link");
-  EXPECT_EQ(cs_in.header.stamp.to_ns(), c.header.stamp.to_ns());
-  EXPECT_EQ(cs_in.mode, "attitude");
-  EXPECT_EQ(cs_in.setpoint, c.setpoint);
-  EXPECT_EQ(cs_in.u, c.u);
-  EXPECT_EQ(cs_in.error, c.error);
-  EXPECT_EQ(cs_in.rotor_saturated, c.rotor_saturated);
-  EXPECT_TRUE(cs_in.tilt_saturated);
-  EXPECT_FALSE(cs_in.safety);
-  EXPECT_EQ(cs_in.rejected_non_finite, 101u);
-  EXPECT_EQ(cs_in.rejected_bad_quaternion, 102u);
-  EXPECT_EQ(cs_in.rejected_bad_stamp, 103u);
-  EXPECT_EQ(cs_in.rejected_stamp_backwards, 18446744073709551615u);
-  EXPECT_EQ(ps_in.header.stamp.to_ns(), p.header.stamp.to_ns());
-  EXPECT_EQ(ps_in.commands_accepted, 201u);
-  EXPECT_EQ(ps_in.commands_clamped, 202u);
-  EXPECT_EQ(ps_in.commands_rejected_length, 203u);
-  EXPECT_EQ(ps_in.commands_rejected_non_finite, 204u);
-  EXPECT_EQ(ps_in.last_problem, p.last_problem);
-  EXPECT_TRUE(ps_in.watchdog_active);
-  EXPECT_EQ(ps_in.watchdog_trips, 205u);
-  EXPECT_EQ(ps_in.watchdog_ticks, 206u);
+constexpr std::uint32_t kAdr = DDS_OP_ADR;  // as an integer: ORing two enumerations is deprecated
+
+std::string layout_error(const std::function<void()>& check) {
+  try {
+    check();
+  } catch (const std::logic_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(IdlWalkTest, RefusesAFieldTheIdlTypeDoesNotHaveOrTypesDifferently) {
+  dds_topic_descriptor_t d{};
+  const std::uint32_t same[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_4BY, 8,
+                                DDS_OP_RTS};
+  d.m_ops = same;
+  EXPECT_EQ(layout_error([&] { idl_walk::check_fields<Pair>(d); }), "");
+  const std::uint32_t signed_b[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,
+                                    kAdr | DDS_OP_TYPE_4BY | DDS_OP_FLAG_SGN, 8, DDS_OP_RTS};
+  d.m_ops = signed_b;
+  EXPECT_NE(layout_error([&] { idl_walk::check_fields<Pair>(d); }).find("test_msgs/msg/Pair field 'b'"),
+            std::string::npos);
+  const std::uint32_t b_double[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,
+                                    kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 8, DDS_OP_RTS};
+  d.m_ops = b_double;
+  EXPECT_NE(layout_error([&] { idl_walk::check_fields<Pair>(d); }).find("field 'b'"), std::string::npos);
+  const std::uint32_t one[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, DDS_OP_RTS};
+  d.m_ops = one;
+  const std::string extra = layout_error([&] { idl_walk::check_fields<Pair>(d); });
+  EXPECT_NE(extra.find("field 'b'"), std::string::npos) << extra;
+  EXPECT_NE(extra.find("fields() lists a field after the IDL type's last member"), std::string::npos) << extra;
+  const std::uint32_t three[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_4BY, 8,
+                                 kAdr | DDS_OP_TYPE_BLN, 12, DDS_OP_RTS};
+  d.m_ops = three;
+  EXPECT_NE(layout_error([&] { idl_walk::check_fields<Pair>(d); }).find("a member after the last field"),
+            std::string::npos);
+  // A real pair that differs: Vector3's fields against PoseStamped's members (header first).
+  EXPECT_NE(layout_error([&] {
+              idl_walk::check_fields<msg::Vector3>(*type_ops(typeid(msg::PoseStamped))->descriptor);
+            }).find("geometry_msgs/msg/Vector3 field 'x'"),
+            std::string::npos);
+}
+
+TEST(IdlWalkTest, WalksNestedStructsAndSequencesOfStructsEvenWhenEmpty) {
+  dds_topic_descriptor_t d{};
+  // PairOfPairs_ { Pair_ first; More_ more; }; More_ { sequence<Pair_> rest; }; element type wrong (int32 b).
+  const std::uint32_t ops[] = {
+      kAdr | DDS_OP_TYPE_EXT, 0, (3u << 16u) + 7u,    // 0: first -> Pair_ at 7
+      kAdr | DDS_OP_TYPE_EXT, 16, (3u << 16u) + 9u,   // 3: more -> More_ at 12
+      DDS_OP_RTS,                                           // 6
+      kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,     // 7: Pair_
+      kAdr | DDS_OP_TYPE_4BY, 8, DDS_OP_RTS,          // 9
+      kAdr | DDS_OP_TYPE_SEQ | DDS_OP_SUBTYPE_STU, 0, 16, (4u << 16u) + 5u,  // 12: More_.rest -> 17
+      DDS_OP_RTS,                                           // 16
+      kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,     // 17: element Pair_
+      kAdr | DDS_OP_TYPE_4BY | DDS_OP_FLAG_SGN, 8, DDS_OP_RTS};
+  d.m_ops = ops;
+  EXPECT_NE(layout_error([&] { idl_walk::check_fields<PairOfPairs>(d); }).find("field 'more.rest.b'"),
+            std::string::npos);
+}
+
+// Every message type the transport carries is checked against its idlc type when the table is made.
+TEST(IdlWalkTest, EveryMessageTypeMatchesItsIdlcType) {
+  for (const std::type_index t : {std::type_index(typeid(msg::PoseStamped)), std::type_index(typeid(msg::TwistStamped)),
+                                  std::type_index(typeid(msg::Imu)), std::type_index(typeid(msg::Float64MultiArray)),
+                                  std::type_index(typeid(msg::Clock)), std::type_index(typeid(msg::ControllerStatus)),
+                                  std::type_index(typeid(msg::PlantStatus))}) {
+    EXPECT_NE(type_ops(t), nullptr) << t.name();
+  }
 }
 
 // Waits (without spinning `t`) until `done()`, up to 5 s.

@@ -6,9 +6,9 @@
 // visitor as v.field("name", member) (v.field("name", member, note) where the ROS type or a .msg
 // default differs from what the C++ type says), and a ROS sub-message that has no C++ struct of its
 // own (Pose, Twist, MultiArrayLayout) as v.group("name", "pkg/msg/Type", [&](auto& g) { ... }).
-// The CDR writer and the `.msg` schema text MCAP stores (io/ros2_cdr.cpp) follow from these lists;
-// the idlc conversions (dds/ros_types.cpp) pair each listed field with its C member, and the
-// byte-for-byte tests against Cyclone (io/mcap_test.cpp) fail when the two disagree.
+// From these lists follow the CDR writer and `.msg` schema text of recordings (io/ros2_cdr.cpp) and the copies to and
+// from the C types idlc generates (dds/idl_walk.hpp), which walk a list in step with idlc's instructions and refuse,
+// naming it, a field whose type differs or that only one side has. A new field: one line here plus its .idl member.
 #pragma once
 
 #include <array>
