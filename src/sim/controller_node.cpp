@@ -16,21 +16,21 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
   transport.subscribe<msg::PoseStamped>(topics.pose, [this, topic = topics.pose](const msg::PoseStamped& m) {
-    if (!accept(pose_ok(m, pose_stamp_ns_), [&] { return validate_pose(m, pose_stamp_ns_); }, topic, pose_backwards_)) return;
+    if (!accept(check_pose(m, pose_stamp_ns_), topic, pose_backwards_)) return;
     estimate_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
     if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
-    if (!accept(velocity_ok(m, velocity_stamp_ns_), [&] { return validate_velocity(m, velocity_stamp_ns_); }, topic, velocity_backwards_)) return;
+    if (!accept(check_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) return;
     estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
     if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
-    if (!accept(imu_ok(m, imu_stamp_ns_), [&] { return validate_imu(m, imu_stamp_ns_); }, topic, imu_backwards_)) return;
+    if (!accept(check_imu(m, imu_stamp_ns_), topic, imu_backwards_)) return;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -46,13 +46,13 @@ bool ControllerNode::accept_refused(const SensorCheck& check, const std::string&
   if (check.fault == SensorFault::kStampBackwards && ++backwards > kStampRestartCount) {
     log_("controller: " + topic + ": " + std::to_string(kStampRestartCount) +
          " samples in a row older than the newest accepted; taking it that the sender's clock restarted (" +
-         check.reason + ")");
+         check.reason() + ")");
     backwards = 0;
     return true;
   }
   LogThrottle& counter = fault_log_[static_cast<int>(check.fault)];
   if (counter.count()) {
-    log_("controller: " + topic + " message rejected, " + to_string(check.fault) + " (" + check.reason + "); " +
+    log_("controller: " + topic + " message rejected, " + to_string(check.fault) + " (" + check.reason() + "); " +
          std::to_string(counter.total()) + " rejected for this reason so far (logged: 1st, then every 100th)");
   }
   return false;

@@ -72,17 +72,16 @@ class ControllerNode {
  private:
   static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
 
-  /// True when a message on `topic` is to be used: `ok` (the plain check, *_ok), or else the
-  /// SensorCheck that `validate` returns, counted and logged by accept_refused. `backwards`: the
+  /// True when a message on `topic` is to be used: its check passed, or else (accept_refused) it is
+  /// the sample after a sender's clock restart; a refusal is counted and logged. `backwards`: the
   /// topic's run of well-formed samples refused as older than the newest (kStampRestartCount of them
   /// in a row: the sender's clock restarted, and the sample is accepted).
-  template <class Validate>
-  bool accept(bool ok, const Validate& validate, const std::string& topic, int& backwards) {
-    if (ok) {
+  bool accept(const SensorCheck& check, const std::string& topic, int& backwards) {
+    if (check.ok()) {
       backwards = 0;
       return true;
     }
-    return accept_refused(validate(), topic, backwards);
+    return accept_refused(check, topic, backwards);
   }
   bool accept_refused(const SensorCheck& check, const std::string& topic, int& backwards);
 

@@ -54,29 +54,24 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     return;
   }
   if (stamp >= 0) last_label_seen_ns_ = stamp;
-  const double omega_max = model_.params().motor.omega_max_rad_s;
-  if (command_ok(m, omega_max)) {
-    ++stats_.commands_accepted;
-    accept_command(stamp, model::Vector4(m.data[0], m.data[1], m.data[2], m.data[3]));
-    return;
-  }
-  const CommandCheck check = validate_command(m, omega_max);
-  if (check.verdict == CommandVerdict::kRejected) {
-    stats_.last_problem = check.reason;
+  const CommandCheck check = check_command(m, model_.params().motor.omega_max_rad_s);
+  if (check.verdict() == CommandVerdict::kRejected) {
+    stats_.last_problem = check.reason();
     ++stats_.commands_rejected;
-    ++(m.data.size() != 4 ? stats_.commands_rejected_length : stats_.commands_rejected_non_finite);
+    ++(check.fault == CommandFault::kWrongLength ? stats_.commands_rejected_length
+                                                 : stats_.commands_rejected_non_finite);
     if (rejected_log_.count()) {
-      log_("plant: motor command rejected (" + check.reason + "), last good command held; " +
+      log_("plant: motor command rejected (" + stats_.last_problem + "), last good command held; " +
            std::to_string(rejected_log_.total()) + " rejected so far (logged: 1st, then every 100th)");
     }
     return;
   }
   ++stats_.commands_accepted;
-  if (check.verdict == CommandVerdict::kClamped) {
-    stats_.last_problem = check.reason;
+  if (check.fault == CommandFault::kOutOfRange) {
+    stats_.last_problem = check.reason();
     ++stats_.commands_clamped;
     if (clamped_log_.count()) {
-      log_("plant: motor command clamped (" + check.reason + "); " + std::to_string(clamped_log_.total()) +
+      log_("plant: motor command clamped (" + stats_.last_problem + "); " + std::to_string(clamped_log_.total()) +
            " clamped so far (logged: 1st, then every 100th)");
     }
   }

@@ -51,7 +51,7 @@ struct PlantOptions {
   bool publish_clock = true;
 };
 
-/// What became of the motor commands (sim/validation.hpp validate_command).
+/// What became of the motor commands (sim/validation.hpp check_command).
 struct PlantStats {
   std::uint64_t commands_received = 0;
   std::uint64_t commands_accepted = 0;  ///< used, clamped ones included (not repeats)
@@ -91,7 +91,7 @@ class PlantNode final : public SteppablePlant {
 
   const model::State& state() const { return state_; }
   const model::Quadrotor& model() const { return model_; }
-  /// The command latched for the current interval, as received after validate_command (speeds within
+  /// The command latched for the current interval, as received after check_command (speeds within
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& applied_command() const { return applied_; }
   const PlantStats& stats() const { return stats_; }

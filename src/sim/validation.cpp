@@ -5,6 +5,81 @@
 
 namespace quadcosim::sim {
 
+// ---------------------------------------------------------------------------------------------
+// Motor commands
+
+namespace {
+
+// The acceptance rule for one speed [rad/s]: in the motor range [0, omega_max] (-0 included); false
+// for NaN and Inf.
+bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_max_rad_s; }
+
+// A command with a speed out of range: the first non-finite speed rejects it; otherwise the speeds out
+// of range are clamped to the nearer end and the first of them is named. Out of line: the common
+// case (all four in range) never comes here.
+[[gnu::noinline, gnu::cold]] void find_command_fault(const double* w, CommandCheck& out) {
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(w[i])) {
+      out.fault = CommandFault::kNonFinite;
+      out.rotor = i;
+      out.value = w[i];
+      out.omega_rad_s.setZero();
+      return;
+    }
+  }
+  for (int i = 3; i >= 0; --i) {  // downwards, so that the first rotor out of range is the one named
+    if (in_range(w[i], out.omega_max_rad_s)) continue;
+    out.omega_rad_s[i] = w[i] > out.omega_max_rad_s ? out.omega_max_rad_s : 0.0;
+    out.fault = CommandFault::kOutOfRange;
+    out.rotor = i;
+    out.value = w[i];
+  }
+}
+
+}  // namespace
+
+CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
+  CommandCheck out;
+  out.omega_max_rad_s = omega_max_rad_s;
+  if (m.data.size() != 4) {
+    out.fault = CommandFault::kWrongLength;
+    out.values = m.data.size();
+    return out;
+  }
+  const double* w = m.data.data();
+  out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
+  bool ok = true;
+  for (int i = 0; i < 4; ++i) ok &= in_range(w[i], omega_max_rad_s);  // no branch per speed
+  if (!ok) find_command_fault(w, out);
+  return out;
+}
+
+CommandVerdict CommandCheck::verdict() const {
+  switch (fault) {
+    case CommandFault::kNone: return CommandVerdict::kAccepted;
+    case CommandFault::kOutOfRange: return CommandVerdict::kClamped;
+    case CommandFault::kWrongLength:
+    case CommandFault::kNonFinite: break;
+  }
+  return CommandVerdict::kRejected;
+}
+
+std::string CommandCheck::reason() const {
+  switch (fault) {
+    case CommandFault::kNone: return "";
+    case CommandFault::kWrongLength: return fmt::format("{} values, expected 4 rotor speeds", values);
+    case CommandFault::kNonFinite:
+      return fmt::format("rotor {} speed is {}, expected a finite number", rotor + 1, value);
+    case CommandFault::kOutOfRange:
+      return fmt::format("rotor {} speed {:g} rad/s clamped to {:g} (range [0, {:g}])", rotor + 1, value,
+                         omega_rad_s[rotor], omega_max_rad_s);
+  }
+  return "?";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sensor messages
+
 namespace {
 
 // x - x is 0 for a finite x and NaN for an infinite or NaN one, and a NaN survives the sum: one test
@@ -12,97 +87,81 @@ namespace {
 bool finite(const msg::Vector3& v) { return (v.x - v.x) + (v.y - v.y) + (v.z - v.z) == 0.0; }
 bool finite(const msg::Quaternion& q) { return (q.x - q.x) + (q.y - q.y) + (q.z - q.z) + (q.w - q.w) == 0.0; }
 
-// | |q| - 1 | <= tolerance, tested on |q|^2 (no square root on every sample); false for NaN.
+// | |q| - 1 | <= tolerance, tested on |q|^2 (no square root on every sample); false for NaN and Inf.
 constexpr double kMinNormSquared = (1.0 - kQuaternionNormTolerance) * (1.0 - kQuaternionNormTolerance);
 constexpr double kMaxNormSquared = (1.0 + kQuaternionNormTolerance) * (1.0 + kQuaternionNormTolerance);
-double norm_squared(const msg::Quaternion& q) { return q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w; }
-bool unit_norm(double n2) { return n2 >= kMinNormSquared && n2 <= kMaxNormSquared; }
-std::string shown(const msg::Vector3& v) { return fmt::format("({:g}, {:g}, {:g})", v.x, v.y, v.z); }
-std::string shown(const msg::Quaternion& q) {
-  return fmt::format("(x {:g}, y {:g}, z {:g}, w {:g})", q.x, q.y, q.z, q.w);
+double norm_squared(double x, double y, double z, double w) { return x * x + y * y + z * z + w * w; }
+
+// Each rule below is stated once: true when the field passes; otherwise the fault is written into
+// `c` (out of line: the common case never comes there) and false returned, so that `&&` over a
+// message's rules stops at the first fault.
+[[gnu::noinline, gnu::cold]] bool refuse_vector(SensorCheck& c, SensorField field, const msg::Vector3& v) {
+  c.fault = SensorFault::kNonFinite;
+  c.field = field;
+  c.value = {v.x, v.y, v.z, 0.0};
+  return false;
 }
 
-SensorCheck fault(SensorFault f, std::string reason) { return {f, std::move(reason)}; }
-
-SensorCheck check_stamp(const msg::Time& t, std::int64_t last_stamp_ns) {
-  if (t.sec < 0 || t.nanosec >= 1'000'000'000u) {
-    return fault(SensorFault::kBadStamp,
-                 fmt::format("stamp sec {} nanosec {}: expected sec >= 0 and nanosec < 1e9", t.sec, t.nanosec));
-  }
-  if (t.to_ns() < last_stamp_ns) {
-    return fault(SensorFault::kStampBackwards,
-                 fmt::format("stamp {} ns is older than the newest accepted, {} ns", t.to_ns(), last_stamp_ns));
-  }
-  return {};
+bool vector_ok(SensorCheck& c, SensorField field, const msg::Vector3& v) {
+  return finite(v) || refuse_vector(c, field, v);
 }
 
-SensorCheck check_vector(const char* field, const msg::Vector3& v) {
-  if (finite(v)) return {};
-  return fault(SensorFault::kNonFinite, std::string(field) + " " + shown(v) + ": expected finite values");
+// A refused orientation is named non-finite before non-unit.
+[[gnu::noinline, gnu::cold]] bool refuse_orientation(SensorCheck& c, const msg::Quaternion& q) {
+  c.fault = finite(q) ? SensorFault::kBadQuaternion : SensorFault::kNonFinite;
+  c.field = SensorField::kOrientation;
+  c.value = {q.x, q.y, q.z, q.w};
+  return false;
 }
 
-SensorCheck check_orientation(const msg::Quaternion& q) {
-  if (!finite(q)) return fault(SensorFault::kNonFinite, "orientation " + shown(q) + ": expected finite values");
-  const double n2 = norm_squared(q);
-  if (!unit_norm(n2)) {
-    return fault(SensorFault::kBadQuaternion,
-                 fmt::format("orientation {} has norm {:g}: expected a unit quaternion (within {:g})", shown(q),
-                             std::sqrt(n2), kQuaternionNormTolerance));
-  }
-  return {};
+// A unit norm implies finite values (a NaN or Inf makes |q|^2 NaN or Inf), so the norm is the one
+// test on the common path.
+bool orientation_ok(SensorCheck& c, const msg::Quaternion& q) {
+  const double n2 = norm_squared(q.x, q.y, q.z, q.w);
+  return (n2 >= kMinNormSquared && n2 <= kMaxNormSquared) || refuse_orientation(c, q);
 }
 
-// The same acceptance tests as the check_* functions, as plain booleans: every sample is checked, so
-// the common case (all fine) builds no SensorCheck per field; only a refused sample goes through the
-// check_* functions, which say why.
-bool stamp_ok(const msg::Time& t, std::int64_t last_stamp_ns) {
-  return t.sec >= 0 && t.nanosec < 1'000'000'000u && t.to_ns() >= last_stamp_ns;
+[[gnu::noinline, gnu::cold]] bool refuse_stamp(SensorCheck& c, SensorFault f, const msg::Time& t,
+                                               std::int64_t newest_ns) {
+  c.fault = f;
+  c.field = SensorField::kStamp;
+  c.stamp = t;
+  c.newest_ns = newest_ns;
+  return false;
 }
-bool orientation_ok(const msg::Quaternion& q) { return unit_norm(norm_squared(q)); }  // NaN, Inf: false
 
-// The first fault among the checks, in order.
-template <class... Checks>
-SensorCheck first_fault(Checks&&... checks) {
-  SensorCheck out;
-  ((out.ok() ? (out = checks(), 0) : 0), ...);
-  return out;
+bool stamp_ok(SensorCheck& c, const msg::Time& t, std::int64_t last_stamp_ns) {
+  if (t.sec < 0 || t.nanosec >= 1'000'000'000u) return refuse_stamp(c, SensorFault::kBadStamp, t, 0);
+  return t.to_ns() >= last_stamp_ns || refuse_stamp(c, SensorFault::kStampBackwards, t, last_stamp_ns);
+}
+
+std::string shown(const std::array<double, 4>& v, bool quaternion) {
+  if (quaternion) return fmt::format("(x {:g}, y {:g}, z {:g}, w {:g})", v[0], v[1], v[2], v[3]);
+  return fmt::format("({:g}, {:g}, {:g})", v[0], v[1], v[2]);
 }
 
 }  // namespace
 
-bool command_ok(const msg::Float64MultiArray& m, double omega_max_rad_s) {
-  if (m.data.size() != 4) return false;
-  bool ok = true;
-  for (int i = 0; i < 4; ++i) ok &= m.data[i] >= 0.0 && m.data[i] <= omega_max_rad_s;  // NaN: false
-  return ok;
+SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
+  SensorCheck c;
+  (void)(vector_ok(c, SensorField::kPosition, m.position) && orientation_ok(c, m.orientation) &&
+         stamp_ok(c, m.header.stamp, last_stamp_ns));
+  return c;
 }
 
-CommandCheck validate_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
-  CommandCheck out;
-  if (m.data.size() != 4) {
-    out.reason = fmt::format("{} values, expected 4 rotor speeds", m.data.size());
-    return out;
-  }
-  for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(m.data[i])) {
-      out.reason = fmt::format("rotor {} speed is {}, expected a finite number", i + 1, m.data[i]);
-      return out;
-    }
-  }
-  out.verdict = CommandVerdict::kAccepted;
-  for (int i = 0; i < 4; ++i) {
-    const double w = m.data[i];
-    double c = w;
-    if (w < 0.0) c = 0.0;
-    if (w > omega_max_rad_s) c = omega_max_rad_s;
-    if (c != w && out.verdict == CommandVerdict::kAccepted) {
-      out.verdict = CommandVerdict::kClamped;
-      out.reason = fmt::format("rotor {} speed {:g} rad/s clamped to {:g} (range [0, {:g}])", i + 1, w, c,
-                               omega_max_rad_s);
-    }
-    out.omega_rad_s[i] = c;
-  }
-  return out;
+SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
+  SensorCheck c;
+  (void)(vector_ok(c, SensorField::kLinear, m.linear) && vector_ok(c, SensorField::kAngular, m.angular) &&
+         stamp_ok(c, m.header.stamp, last_stamp_ns));
+  return c;
+}
+
+SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns) {
+  SensorCheck c;
+  (void)(orientation_ok(c, m.orientation) && vector_ok(c, SensorField::kAngularVelocity, m.angular_velocity) &&
+         vector_ok(c, SensorField::kLinearAcceleration, m.linear_acceleration) &&
+         stamp_ok(c, m.header.stamp, last_stamp_ns));
+  return c;
 }
 
 const char* to_string(SensorFault f) {
@@ -116,39 +175,36 @@ const char* to_string(SensorFault f) {
   return "?";
 }
 
-bool pose_ok(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
-  return finite(m.position) && orientation_ok(m.orientation) && stamp_ok(m.header.stamp, last_stamp_ns);
+const char* to_string(SensorField f) {
+  switch (f) {
+    case SensorField::kNone: return "";
+    case SensorField::kStamp: return "stamp";
+    case SensorField::kPosition: return "position";
+    case SensorField::kOrientation: return "orientation";
+    case SensorField::kLinear: return "linear";
+    case SensorField::kAngular: return "angular";
+    case SensorField::kAngularVelocity: return "angular_velocity";
+    case SensorField::kLinearAcceleration: return "linear_acceleration";
+  }
+  return "?";
 }
 
-bool velocity_ok(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
-  return finite(m.linear) && finite(m.angular) && stamp_ok(m.header.stamp, last_stamp_ns);
-}
-
-bool imu_ok(const msg::Imu& m, std::int64_t last_stamp_ns) {
-  return orientation_ok(m.orientation) && finite(m.angular_velocity) && finite(m.linear_acceleration) &&
-         stamp_ok(m.header.stamp, last_stamp_ns);
-}
-
-SensorCheck validate_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
-  if (pose_ok(m, last_stamp_ns)) return {};
-  return first_fault([&] { return check_vector("position", m.position); },
-                     [&] { return check_orientation(m.orientation); },
-                     [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
-}
-
-SensorCheck validate_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
-  if (velocity_ok(m, last_stamp_ns)) return {};
-  return first_fault([&] { return check_vector("linear", m.linear); },
-                     [&] { return check_vector("angular", m.angular); },
-                     [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
-}
-
-SensorCheck validate_imu(const msg::Imu& m, std::int64_t last_stamp_ns) {
-  if (imu_ok(m, last_stamp_ns)) return {};
-  return first_fault([&] { return check_orientation(m.orientation); },
-                     [&] { return check_vector("angular_velocity", m.angular_velocity); },
-                     [&] { return check_vector("linear_acceleration", m.linear_acceleration); },
-                     [&] { return check_stamp(m.header.stamp, last_stamp_ns); });
+std::string SensorCheck::reason() const {
+  const bool quaternion = field == SensorField::kOrientation;
+  switch (fault) {
+    case SensorFault::kNone: return "";
+    case SensorFault::kNonFinite:
+      return fmt::format("{} {}: expected finite values", to_string(field), shown(value, quaternion));
+    case SensorFault::kBadQuaternion:
+      return fmt::format("orientation {} has norm {:g}: expected a unit quaternion (within {:g})",
+                         shown(value, true), std::sqrt(norm_squared(value[0], value[1], value[2], value[3])),
+                         kQuaternionNormTolerance);
+    case SensorFault::kBadStamp:
+      return fmt::format("stamp sec {} nanosec {}: expected sec >= 0 and nanosec < 1e9", stamp.sec, stamp.nanosec);
+    case SensorFault::kStampBackwards:
+      return fmt::format("stamp {} ns is older than the newest accepted, {} ns", stamp.to_ns(), newest_ns);
+  }
+  return "?";
 }
 
 }  // namespace quadcosim::sim

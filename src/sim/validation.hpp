@@ -1,9 +1,13 @@
 // Checks on messages that arrive from outside a node (another process, another vehicle, a foreign ROS 2
 // node): pure functions of the message and what the node last accepted, so each node only asks and
-// counts. What is rejected, clamped and counted, and where it shows: docs/reliability.md.
+// counts. Each acceptance rule is stated once, in one check per message that returns plain data (what
+// was wrong, in which field, with which values); the text is formed from it by reason() only when a
+// refused or clamped message is recorded or logged. What is rejected, clamped and counted, and where
+// it shows: docs/reliability.md.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -21,25 +25,41 @@ enum class CommandVerdict {
   kRejected,  ///< wrong length (also empty) or a NaN/Inf entry: ignored, the last good command holds
 };
 
+/// What was wrong with a motor command; kNone when it was used as sent.
+enum class CommandFault : std::uint8_t {
+  kNone,
+  kWrongLength,  ///< not exactly 4 values (kRejected)
+  kNonFinite,    ///< a NaN or Inf speed (kRejected)
+  kOutOfRange,   ///< four finite speeds, some < 0 or > omega_max (kClamped)
+};
+
+/// The outcome of check_command: plain data, no allocation; reason() says it in words.
 struct CommandCheck {
-  CommandVerdict verdict = CommandVerdict::kRejected;
+  CommandFault fault = CommandFault::kNone;
   model::Vector4 omega_rad_s = model::Vector4::Zero();  ///< the speeds to use (not kRejected) [rad/s]
-  std::string reason;  ///< why rejected or clamped, naming the entry and value; "" when accepted
+  std::size_t values = 4;        ///< how many values the message held
+  int rotor = 0;                 ///< the rotor at fault, 0..3: the first non-finite one, or the first clamped one
+  double value = 0.0;            ///< that rotor's speed as sent [rad/s] (kNonFinite, kOutOfRange)
+  double omega_max_rad_s = 0.0;  ///< the upper end of the range checked against [rad/s]
+
+  CommandVerdict verdict() const;
+  /// Why rejected or clamped, naming the rotor (1..4) and its value, e.g. "rotor 2 speed is nan, expected a
+  /// finite number" or "rotor 1 speed -5 rad/s clamped to 0 (range [0, 12000])"; "" when accepted.
+  std::string reason() const;
 };
 
 /// Checks a /<ns>/motor_commands message: `data` must hold exactly 4 finite rotor speeds [rad/s].
-/// Finite speeds below 0 become 0 and above `omega_max_rad_s` become omega_max (kClamped). The layout
-/// (dim, data_offset) is not checked: it only carries the lockstep label (msg::command_stamp_ns).
-CommandCheck validate_command(const msg::Float64MultiArray& m, double omega_max_rad_s);
-/// True when validate_command would accept `m` as sent (four finite speeds in [0, omega_max]):
-/// asked first on every command, so only a clamped or rejected one builds a CommandCheck.
-bool command_ok(const msg::Float64MultiArray& m, double omega_max_rad_s);
+/// Finite speeds below 0 become 0 and above `omega_max_rad_s` become omega_max (kOutOfRange, kClamped).
+/// Checked in this order, the first fault reported: the length, then each speed for NaN/Inf (rotor 1
+/// first), then the range. The layout (dim, data_offset) is not checked: it only carries the lockstep
+/// label (msg::command_stamp_ns). Allocates nothing.
+CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s);
 
 // ---------------------------------------------------------------------------------------------
 // Sensor messages into the controller
 
 /// Why a sensor message was refused; kNone when it was accepted.
-enum class SensorFault {
+enum class SensorFault : std::uint8_t {
   kNone,
   kNonFinite,       ///< a NaN or Inf in a field the message carries for the controller
   kBadQuaternion,   ///< orientation norm not within kQuaternionNormTolerance of 1 (zero included)
@@ -49,31 +69,52 @@ enum class SensorFault {
 constexpr int kSensorFaultCount = 5;
 const char* to_string(SensorFault f);
 
+/// The field of a sensor message at fault (its name in the ROS 2 message).
+enum class SensorField : std::uint8_t {
+  kNone,
+  kStamp,               ///< header.stamp
+  kPosition,            ///< Pose position
+  kOrientation,         ///< Pose or Imu orientation
+  kLinear,              ///< Velocity linear
+  kAngular,             ///< Velocity angular
+  kAngularVelocity,     ///< Imu angular_velocity
+  kLinearAcceleration,  ///< Imu linear_acceleration
+};
+const char* to_string(SensorField f);
+
 /// | |q| - 1 | above this refuses an orientation (tested as |q|^2 within [(1 - tol)^2, (1 + tol)^2],
 /// without a square root). The plant sends |q| = 1 to about 1e-15; a sender that normalises in single
 /// precision stays within about 1e-7. 1e-3 lets those through and refuses a zero, a
 /// default-constructed (0,0,0,0) or a garbled quaternion. Accepted ones are used as sent.
 constexpr double kQuaternionNormTolerance = 1e-3;
 
+/// The outcome of check_pose, check_velocity or check_imu: plain data, no allocation; reason() says it
+/// in words.
 struct SensorCheck {
   SensorFault fault = SensorFault::kNone;
-  std::string reason;  ///< the field and value at fault; "" when accepted
+  SensorField field = SensorField::kNone;  ///< the field at fault
+  /// That field's values as sent: x, y, z of a vector (kNonFinite), x, y, z, w of an orientation
+  /// (kNonFinite, kBadQuaternion). Unused for the stamp.
+  std::array<double, 4> value{};
+  msg::Time stamp;             ///< the stamp as sent (kBadStamp, kStampBackwards)
+  std::int64_t newest_ns = 0;  ///< the newest accepted stamp it is older than [ns] (kStampBackwards)
+
   bool ok() const { return fault == SensorFault::kNone; }
+  /// The field and value at fault and what was expected, e.g. "position (nan, 2, 3): expected finite
+  /// values" or "stamp 10 ns is older than the newest accepted, 20 ns"; "" when accepted.
+  std::string reason() const;
 };
 
 /// `last_stamp_ns`: the newest stamp [ns] accepted on this topic, or INT64_MIN before any. A stamp
 /// equal to it is accepted (a lockstep peer may repeat a tick's sample); an older one is refused.
-/// The content is checked first: kStampBackwards means a well-formed sample that is only too old.
-/// Checked: stamp, position and orientation (Pose); stamp, linear and angular (Velocity); stamp,
-/// orientation, angular_velocity, linear_acceleration (Imu). Covariances and frame_id are not read.
-SensorCheck validate_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
-SensorCheck validate_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
-SensorCheck validate_imu(const msg::Imu& m, std::int64_t last_stamp_ns);
-/// The same acceptance tests as plain booleans (true: the validate_* function would accept): asked
-/// first on every sample, so only a refused one builds a SensorCheck with its reason.
-bool pose_ok(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
-bool velocity_ok(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
-bool imu_ok(const msg::Imu& m, std::int64_t last_stamp_ns);
+/// Checked in this order, the first fault reported (content first, so kStampBackwards means a
+/// well-formed sample that is only too old): Pose position, orientation, stamp; Velocity linear,
+/// angular, stamp; Imu orientation, angular_velocity, linear_acceleration, stamp. An orientation is
+/// checked for NaN/Inf, then for its norm; a stamp for its form, then its age. Covariances and
+/// frame_id are not read. Allocate nothing.
+SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
+SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
+SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns);
 
 /// A sender whose clock restarted (a plant process started again under a running controller) sends
 /// only well-formed samples older than the newest accepted. After this many such samples in a row

@@ -2,6 +2,7 @@
 // controller count, log and survive what they refuse.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -25,58 +26,98 @@ msg::Float64MultiArray command(std::vector<double> w) {
   return m;
 }
 
-TEST(ValidateCommandTest, FourFiniteSpeedsInRangeAreUsedAsSent) {
-  const CommandCheck c = validate_command(command({0.0, 1.5, 4830.6, 12000.0}), 12000.0);
-  EXPECT_EQ(c.verdict, CommandVerdict::kAccepted);
+TEST(CheckCommandTest, FourFiniteSpeedsInRangeAreUsedAsSent) {
+  const CommandCheck c = check_command(command({0.0, 1.5, 4830.6, 12000.0}), 12000.0);
+  EXPECT_EQ(c.verdict(), CommandVerdict::kAccepted);
+  EXPECT_EQ(c.fault, CommandFault::kNone);
   EXPECT_EQ(c.omega_rad_s, model::Vector4(0.0, 1.5, 4830.6, 12000.0));
-  EXPECT_EQ(c.reason, "");
+  EXPECT_EQ(c.reason(), "");
+  // A negative zero is in range and is used as sent, sign included.
+  const CommandCheck z = check_command(command({-0.0, 1e-300, 1.0, 2.0}), 12000.0);
+  EXPECT_EQ(z.fault, CommandFault::kNone);
+  EXPECT_TRUE(std::signbit(z.omega_rad_s[0]));
+  EXPECT_EQ(z.omega_rad_s[1], 1e-300);
 }
 
-TEST(ValidateCommandTest, TheQuickCheckAcceptsExactlyWhatTheFullCheckAcceptsAsSent) {
-  const double kInfinity = std::numeric_limits<double>::infinity();
-  const double kNotANumber = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<double> speeds = {0.0, -0.0, 1e-300, -1e-300, 4830.6, 12000.0, std::nextafter(12000.0, 1e9),
-                                      -5.0, 1e9, kInfinity, -kInfinity, kNotANumber};
-  int accepted = 0;
-  for (const double a : speeds) {
-    for (const double b : speeds) {
-      for (const std::vector<double>& d : {std::vector<double>{a, 100.0, b, 200.0}, std::vector<double>{b, a, 3.0, 4.0},
-                                           std::vector<double>{a, b, 1.0}, std::vector<double>{a, b, 1.0, 2.0, 3.0}}) {
-        const CommandCheck full = validate_command(command(d), 12000.0);
-        const bool quick = command_ok(command(d), 12000.0);
-        EXPECT_EQ(quick, full.verdict == CommandVerdict::kAccepted) << d.size() << " values, " << a << ", " << b;
-        accepted += quick;
-      }
-    }
-  }
-  EXPECT_EQ(accepted, 2 * 5 * 5);  // 0, -0, 1e-300, 4830.6, 12000 paired, in the two four-value layouts
-}
-
-TEST(ValidateCommandTest, WrongLengthAndNonFiniteAreRejectedWithTheReason) {
+// One speed at a time in rotor 3 of {100, 200, x, 300}, each outcome stated by hand.
+TEST(CheckCommandTest, EachSpeedGetsItsVerdictTheSpeedToUseAndTheReason) {
   struct Case {
-    std::vector<double> data;
+    double sent;
+    CommandFault fault;
+    double used;  // rotor 3's speed to use (not for a rejection)
     std::string reason;
   };
   const std::vector<Case> cases = {
-      {{}, "0 values, expected 4 rotor speeds"},
-      {{1, 2, 3}, "3 values, expected 4 rotor speeds"},
-      {{1, 2, 3, 4, 5}, "5 values, expected 4 rotor speeds"},
-      {{1, kNaN, 3, 4}, "rotor 2 speed is nan, expected a finite number"},
-      {{1, 2, 3, kInf}, "rotor 4 speed is inf, expected a finite number"},
-      {{-kInf, 2, 3, 4}, "rotor 1 speed is -inf, expected a finite number"},
+      {0.0, CommandFault::kNone, 0.0, ""},
+      {1e-300, CommandFault::kNone, 1e-300, ""},
+      {4830.6, CommandFault::kNone, 4830.6, ""},
+      {12000.0, CommandFault::kNone, 12000.0, ""},
+      {-1e-300, CommandFault::kOutOfRange, 0.0, "rotor 3 speed -1e-300 rad/s clamped to 0 (range [0, 12000])"},
+      {-5.0, CommandFault::kOutOfRange, 0.0, "rotor 3 speed -5 rad/s clamped to 0 (range [0, 12000])"},
+      {std::nextafter(12000.0, 1e9), CommandFault::kOutOfRange, 12000.0,
+       "rotor 3 speed 12000 rad/s clamped to 12000 (range [0, 12000])"},
+      {1e9, CommandFault::kOutOfRange, 12000.0, "rotor 3 speed 1e+09 rad/s clamped to 12000 (range [0, 12000])"},
+      {kInf, CommandFault::kNonFinite, 0.0, "rotor 3 speed is inf, expected a finite number"},
+      {-kInf, CommandFault::kNonFinite, 0.0, "rotor 3 speed is -inf, expected a finite number"},
+      {kNaN, CommandFault::kNonFinite, 0.0, "rotor 3 speed is nan, expected a finite number"},
   };
-  for (const auto& c : cases) {
-    const CommandCheck r = validate_command(command(c.data), 12000.0);
-    EXPECT_EQ(r.verdict, CommandVerdict::kRejected) << c.reason;
-    EXPECT_EQ(r.reason, c.reason);
+  for (const Case& k : cases) {
+    const CommandCheck c = check_command(command({100.0, 200.0, k.sent, 300.0}), 12000.0);
+    SCOPED_TRACE(k.reason.empty() ? std::to_string(k.sent) : k.reason);
+    EXPECT_EQ(c.fault, k.fault);
+    EXPECT_EQ(c.reason(), k.reason);
+    const CommandVerdict verdict = k.fault == CommandFault::kNone         ? CommandVerdict::kAccepted
+                                   : k.fault == CommandFault::kOutOfRange ? CommandVerdict::kClamped
+                                                                          : CommandVerdict::kRejected;
+    EXPECT_EQ(c.verdict(), verdict);
+    if (k.fault != CommandFault::kNone) {
+      EXPECT_EQ(c.rotor, 2);
+      EXPECT_TRUE(c.value == k.sent || (std::isnan(c.value) && std::isnan(k.sent))) << c.value;
+    }
+    if (verdict != CommandVerdict::kRejected) {
+      EXPECT_EQ(c.omega_rad_s, model::Vector4(100.0, 200.0, k.used, 300.0));
+    }
   }
 }
 
-TEST(ValidateCommandTest, NegativeAndTooFastAreClampedToTheMotorRange) {
-  const CommandCheck c = validate_command(command({-5.0, 100.0, 1e9, -1e-300}), 12000.0);
-  EXPECT_EQ(c.verdict, CommandVerdict::kClamped);
+TEST(CheckCommandTest, WrongLengthAndNonFiniteAreRejectedWithTheReason) {
+  struct Case {
+    std::vector<double> data;
+    CommandFault fault;
+    std::string reason;
+  };
+  const std::vector<Case> cases = {
+      {{}, CommandFault::kWrongLength, "0 values, expected 4 rotor speeds"},
+      {{1, 2, 3}, CommandFault::kWrongLength, "3 values, expected 4 rotor speeds"},
+      {{1, 2, 3, 4, 5}, CommandFault::kWrongLength, "5 values, expected 4 rotor speeds"},
+      {{kNaN, kNaN, kNaN}, CommandFault::kWrongLength, "3 values, expected 4 rotor speeds"},  // length first
+      {{1, kNaN, 3, 4}, CommandFault::kNonFinite, "rotor 2 speed is nan, expected a finite number"},
+      {{1, 2, 3, kInf}, CommandFault::kNonFinite, "rotor 4 speed is inf, expected a finite number"},
+      {{-kInf, 2, 3, 4}, CommandFault::kNonFinite, "rotor 1 speed is -inf, expected a finite number"},
+      // A non-finite speed is reported before an out-of-range one on an earlier rotor, and the first
+      // non-finite one is named.
+      {{-5, 1e9, kInf, kNaN}, CommandFault::kNonFinite, "rotor 3 speed is inf, expected a finite number"},
+  };
+  for (const auto& c : cases) {
+    const CommandCheck r = check_command(command(c.data), 12000.0);
+    EXPECT_EQ(r.verdict(), CommandVerdict::kRejected) << c.reason;
+    EXPECT_EQ(r.fault, c.fault) << c.reason;
+    EXPECT_EQ(r.values, c.data.size()) << c.reason;
+    EXPECT_EQ(r.omega_rad_s, model::Vector4::Zero()) << c.reason;
+    EXPECT_EQ(r.reason(), c.reason);
+  }
+}
+
+TEST(CheckCommandTest, NegativeAndTooFastAreClampedToTheMotorRangeAndTheFirstIsNamed) {
+  const CommandCheck c = check_command(command({-5.0, 100.0, 1e9, -1e-300}), 12000.0);
+  EXPECT_EQ(c.verdict(), CommandVerdict::kClamped);
   EXPECT_EQ(c.omega_rad_s, model::Vector4(0.0, 100.0, 12000.0, 0.0));
-  EXPECT_EQ(c.reason, "rotor 1 speed -5 rad/s clamped to 0 (range [0, 12000])");
+  EXPECT_EQ(c.rotor, 0);
+  EXPECT_EQ(c.value, -5.0);
+  EXPECT_EQ(c.reason(), "rotor 1 speed -5 rad/s clamped to 0 (range [0, 12000])");
+  const CommandCheck d = check_command(command({1.0, 2.0, 1e9, -1.0}), 800.0);
+  EXPECT_EQ(d.omega_rad_s, model::Vector4(1.0, 2.0, 800.0, 0.0));
+  EXPECT_EQ(d.reason(), "rotor 3 speed 1e+09 rad/s clamped to 800 (range [0, 800])");
 }
 
 msg::PoseStamped pose_at(std::int64_t ns) {
@@ -86,60 +127,190 @@ msg::PoseStamped pose_at(std::int64_t ns) {
   return m;
 }
 
-TEST(ValidateSensorTest, PlantOutputsPass) {
-  EXPECT_TRUE(validate_pose(pose_at(0), kNever).ok());
+TEST(CheckSensorTest, PlantOutputsPass) {
+  const SensorCheck p = check_pose(pose_at(0), kNever);
+  EXPECT_TRUE(p.ok());
+  EXPECT_EQ(p.field, SensorField::kNone);
+  EXPECT_EQ(p.reason(), "");
   msg::TwistStamped t;
-  EXPECT_TRUE(validate_velocity(t, kNever).ok());
+  EXPECT_TRUE(check_velocity(t, kNever).ok());
   msg::Imu imu;
   imu.orientation = {0.0, 0.0, std::sin(0.5), std::cos(0.5)};  // yaw 1 rad
-  EXPECT_TRUE(validate_imu(imu, kNever).ok());
+  EXPECT_TRUE(check_imu(imu, kNever).ok());
 }
 
-TEST(ValidateSensorTest, NonFiniteFieldsAreNamed) {
+// Every field checked, each fault, and the text of each reason.
+TEST(CheckSensorTest, EachFaultNamesTheFieldAndValue) {
+  struct Case {
+    SensorCheck check;
+    SensorFault fault;
+    SensorField field;
+    std::string reason;
+  };
+  std::vector<Case> cases;
+  auto pose = [&](auto change, std::int64_t last, SensorFault f, SensorField field, std::string reason) {
+    msg::PoseStamped m = pose_at(30'000'000);
+    change(m);
+    cases.push_back({check_pose(m, last), f, field, std::move(reason)});
+  };
+  auto velocity = [&](auto change, std::int64_t last, SensorFault f, SensorField field, std::string reason) {
+    msg::TwistStamped m;
+    m.header.stamp = msg::Time::from_ns(30'000'000);
+    change(m);
+    cases.push_back({check_velocity(m, last), f, field, std::move(reason)});
+  };
+  auto imu = [&](auto change, std::int64_t last, SensorFault f, SensorField field, std::string reason) {
+    msg::Imu m;
+    m.header.stamp = msg::Time::from_ns(30'000'000);
+    change(m);
+    cases.push_back({check_imu(m, last), f, field, std::move(reason)});
+  };
+  using F = SensorFault;
+  using S = SensorField;
+  pose([](auto& m) { m.position.y = kNaN; }, kNever, F::kNonFinite, S::kPosition,
+       "position (1, nan, 3): expected finite values");
+  pose([](auto& m) { m.orientation.x = kInf; }, kNever, F::kNonFinite, S::kOrientation,
+       "orientation (x inf, y 0, z 0, w 1): expected finite values");
+  pose([](auto& m) { m.orientation = {0, 0, 0, 0}; }, kNever, F::kBadQuaternion, S::kOrientation,
+       "orientation (x 0, y 0, z 0, w 0) has norm 0: expected a unit quaternion (within 0.001)");
+  pose([](auto& m) { m.header.stamp = {1, 1'000'000'000u}; }, kNever, F::kBadStamp, S::kStamp,
+       "stamp sec 1 nanosec 1000000000: expected sec >= 0 and nanosec < 1e9");
+  pose([](auto& m) { m.header.stamp = {-1, 0}; }, kNever, F::kBadStamp, S::kStamp,
+       "stamp sec -1 nanosec 0: expected sec >= 0 and nanosec < 1e9");
+  pose([](auto&) {}, 40'000'000, F::kStampBackwards, S::kStamp,
+       "stamp 30000000 ns is older than the newest accepted, 40000000 ns");
+  velocity([](auto& m) { m.linear.x = -kInf; }, kNever, F::kNonFinite, S::kLinear,
+           "linear (-inf, 0, 0): expected finite values");
+  velocity([](auto& m) { m.angular.z = kNaN; }, kNever, F::kNonFinite, S::kAngular,
+           "angular (0, 0, nan): expected finite values");
+  velocity([](auto& m) { m.header.stamp.nanosec = 2'000'000'000u; }, kNever, F::kBadStamp, S::kStamp,
+           "stamp sec 0 nanosec 2000000000: expected sec >= 0 and nanosec < 1e9");
+  velocity([](auto&) {}, 30'000'001, F::kStampBackwards, S::kStamp,
+           "stamp 30000000 ns is older than the newest accepted, 30000001 ns");
+  imu([](auto& m) { m.orientation.w = kNaN; }, kNever, F::kNonFinite, S::kOrientation,
+      "orientation (x 0, y 0, z 0, w nan): expected finite values");
+  imu([](auto& m) { m.orientation = {0.6, 0, 0, 0.6}; }, kNever, F::kBadQuaternion, S::kOrientation,
+      "orientation (x 0.6, y 0, z 0, w 0.6) has norm 0.848528: expected a unit quaternion (within 0.001)");
+  // Finite, but |q|^2 overflows: not a unit quaternion (not a non-finite value).
+  imu([](auto& m) { m.orientation = {1e200, 0, 0, 1}; }, kNever, F::kBadQuaternion, S::kOrientation,
+      "orientation (x 1e+200, y 0, z 0, w 1) has norm inf: expected a unit quaternion (within 0.001)");
+  imu([](auto& m) { m.angular_velocity.y = kInf; }, kNever, F::kNonFinite, S::kAngularVelocity,
+      "angular_velocity (0, inf, 0): expected finite values");
+  imu([](auto& m) { m.linear_acceleration.z = kNaN; }, kNever, F::kNonFinite, S::kLinearAcceleration,
+      "linear_acceleration (0, 0, nan): expected finite values");
+  imu([](auto& m) { m.header.stamp = {-5, 7}; }, kNever, F::kBadStamp, S::kStamp,
+      "stamp sec -5 nanosec 7: expected sec >= 0 and nanosec < 1e9");
+  imu([](auto&) {}, 1'000'000'000, F::kStampBackwards, S::kStamp,
+      "stamp 30000000 ns is older than the newest accepted, 1000000000 ns");
+  ASSERT_EQ(cases.size(), 17u);
+  for (const Case& c : cases) {
+    EXPECT_FALSE(c.check.ok()) << c.reason;
+    EXPECT_EQ(c.check.fault, c.fault) << c.reason;
+    EXPECT_EQ(c.check.field, c.field) << c.reason;
+    EXPECT_EQ(c.check.reason(), c.reason);
+  }
+}
+
+TEST(CheckSensorTest, TheCheckCarriesTheValuesAndStampsAsPlainData) {
   msg::PoseStamped p = pose_at(0);
-  p.position.y = kNaN;
-  SensorCheck c = validate_pose(p, kNever);
-  EXPECT_EQ(c.fault, SensorFault::kNonFinite);
-  EXPECT_NE(c.reason.find("position"), std::string::npos) << c.reason;
-  msg::TwistStamped t;
-  t.angular.z = -kInf;
-  c = validate_velocity(t, kNever);
-  EXPECT_EQ(c.fault, SensorFault::kNonFinite);
-  EXPECT_NE(c.reason.find("angular"), std::string::npos) << c.reason;
-  msg::Imu imu;
-  imu.linear_acceleration.x = kInf;
-  EXPECT_EQ(validate_imu(imu, kNever).fault, SensorFault::kNonFinite);
-  imu = {};
-  imu.orientation.w = kNaN;
-  EXPECT_EQ(validate_imu(imu, kNever).fault, SensorFault::kNonFinite);
+  p.position.z = -kInf;
+  SensorCheck c = check_pose(p, kNever);
+  EXPECT_EQ(c.value, (std::array<double, 4>{1.0, 2.0, -kInf, 0.0}));
+  p = pose_at(0);
+  p.orientation = {0.1, 0.2, 0.3, 0.4};
+  c = check_pose(p, kNever);
+  EXPECT_EQ(c.value, (std::array<double, 4>{0.1, 0.2, 0.3, 0.4}));
+  c = check_pose(pose_at(1'500'000'000), 2'000'000'000);
+  EXPECT_EQ(c.stamp.sec, 1);
+  EXPECT_EQ(c.stamp.nanosec, 500'000'000u);
+  EXPECT_EQ(c.newest_ns, 2'000'000'000);
 }
 
-TEST(ValidateSensorTest, QuaternionsMustBeUnitWithinTheStatedTolerance) {
+TEST(CheckSensorTest, TheFirstFaultInTheStatedOrderIsReported) {
+  // Pose: position, orientation, stamp.
+  msg::PoseStamped p = pose_at(0);
+  p.position.x = kNaN;
+  p.orientation = {0, 0, 0, 0};
+  p.header.stamp = {-1, 0};
+  EXPECT_EQ(check_pose(p, kNever).field, SensorField::kPosition);
+  p.position.x = 1.0;
+  EXPECT_EQ(check_pose(p, kNever).fault, SensorFault::kBadQuaternion);
+  // An orientation: NaN/Inf before the norm.
+  p.orientation.x = kNaN;
+  EXPECT_EQ(check_pose(p, kNever).fault, SensorFault::kNonFinite);
+  // The content before the stamp: old and NaN is reported as NaN.
+  p = pose_at(0);
+  p.position.x = kNaN;
+  EXPECT_EQ(check_pose(p, 10).fault, SensorFault::kNonFinite);
+  // A stamp: malformed before backwards (sec -1 is also older than 0).
+  p = pose_at(0);
+  p.header.stamp = {-1, 0};
+  EXPECT_EQ(check_pose(p, 0).fault, SensorFault::kBadStamp);
+  // Velocity: linear, angular, stamp.
+  msg::TwistStamped t;
+  t.linear.y = kNaN;
+  t.angular.y = kNaN;
+  EXPECT_EQ(check_velocity(t, 10).field, SensorField::kLinear);
+  t.linear.y = 0.0;
+  EXPECT_EQ(check_velocity(t, 10).field, SensorField::kAngular);
+  t.angular.y = 0.0;
+  EXPECT_EQ(check_velocity(t, 10).field, SensorField::kStamp);
+  // Imu: orientation, angular_velocity, linear_acceleration, stamp.
+  msg::Imu i;
+  i.orientation = {0, 0, 0, 0};
+  i.angular_velocity.x = kInf;
+  i.linear_acceleration.x = kInf;
+  EXPECT_EQ(check_imu(i, 10).field, SensorField::kOrientation);
+  i.orientation.w = 1.0;
+  EXPECT_EQ(check_imu(i, 10).field, SensorField::kAngularVelocity);
+  i.angular_velocity.x = 0.0;
+  EXPECT_EQ(check_imu(i, 10).field, SensorField::kLinearAcceleration);
+  i.linear_acceleration.x = 0.0;
+  EXPECT_EQ(check_imu(i, 10).field, SensorField::kStamp);
+  EXPECT_TRUE(check_imu(i, 0).ok());
+}
+
+TEST(CheckSensorTest, QuaternionsMustBeUnitWithinTheStatedTolerance) {
   msg::Imu imu;
   const double tol = kQuaternionNormTolerance;
   auto with_w = [&](double x, double w) {
     imu.orientation = {x, 0.0, 0.0, w};
-    return validate_imu(imu, kNever).fault;
+    return check_imu(imu, kNever).fault;
   };
   EXPECT_EQ(with_w(0.0, 0.0), SensorFault::kBadQuaternion);  // zero
   EXPECT_EQ(with_w(0.0, 1.0 + 2 * tol), SensorFault::kBadQuaternion);
   EXPECT_EQ(with_w(0.0, 1.0 - 2 * tol), SensorFault::kBadQuaternion);
   EXPECT_EQ(with_w(0.0, 1.0 + 0.5 * tol), SensorFault::kNone);
-  EXPECT_EQ(with_w(0.6, 0.8), SensorFault::kNone);        // 0.36 + 0.64 = 1
+  EXPECT_EQ(with_w(0.0, 1.0 - 0.5 * tol), SensorFault::kNone);
+  EXPECT_EQ(with_w(0.0, -1.0), SensorFault::kNone);          // -q is the same rotation
+  EXPECT_EQ(with_w(0.6, 0.8), SensorFault::kNone);           // 0.36 + 0.64 = 1
   EXPECT_EQ(with_w(0.6, 0.6), SensorFault::kBadQuaternion);  // norm 0.849
   msg::PoseStamped p = pose_at(0);
   p.orientation = {0, 0, 0, 0};
-  EXPECT_EQ(validate_pose(p, kNever).fault, SensorFault::kBadQuaternion);
+  EXPECT_EQ(check_pose(p, kNever).fault, SensorFault::kBadQuaternion);
 }
 
-TEST(ValidateSensorTest, StampsMayRepeatButNotGoBackOrBeMalformed) {
-  EXPECT_EQ(validate_pose(pose_at(20'000'000), 20'000'000).fault, SensorFault::kNone);
-  EXPECT_EQ(validate_pose(pose_at(10'000'000), 20'000'000).fault, SensorFault::kStampBackwards);
+TEST(CheckSensorTest, StampsMayRepeatButNotGoBackOrBeMalformed) {
+  EXPECT_EQ(check_pose(pose_at(20'000'000), 20'000'000).fault, SensorFault::kNone);
+  EXPECT_EQ(check_pose(pose_at(10'000'000), 20'000'000).fault, SensorFault::kStampBackwards);
+  EXPECT_EQ(check_pose(pose_at(0), kNever).fault, SensorFault::kNone);
   msg::PoseStamped p = pose_at(0);
+  p.header.stamp = {1, 999'999'999u};
+  EXPECT_EQ(check_pose(p, kNever).fault, SensorFault::kNone);
   p.header.stamp = {1, 1'000'000'000u};
-  EXPECT_EQ(validate_pose(p, kNever).fault, SensorFault::kBadStamp);
+  EXPECT_EQ(check_pose(p, kNever).fault, SensorFault::kBadStamp);
   p.header.stamp = {-1, 0};
-  EXPECT_EQ(validate_pose(p, kNever).fault, SensorFault::kBadStamp);
+  EXPECT_EQ(check_pose(p, kNever).fault, SensorFault::kBadStamp);
+}
+
+TEST(CheckSensorTest, NamesOfFaultsAndFields) {
+  EXPECT_STREQ(to_string(SensorFault::kNone), "accepted");
+  EXPECT_STREQ(to_string(SensorFault::kNonFinite), "non-finite value");
+  EXPECT_STREQ(to_string(SensorFault::kBadQuaternion), "non-unit quaternion");
+  EXPECT_STREQ(to_string(SensorFault::kBadStamp), "malformed stamp");
+  EXPECT_STREQ(to_string(SensorFault::kStampBackwards), "stamp went backwards");
+  EXPECT_STREQ(to_string(SensorField::kLinearAcceleration), "linear_acceleration");
+  EXPECT_STREQ(to_string(SensorField::kStamp), "stamp");
 }
 
 TEST(LogThrottleTest, LogsTheFirstThenEveryNth) {
@@ -196,6 +367,11 @@ TEST(PlantValidationTest, StatusCountsRefusedAndClampedCommandsAndGoesOutOnTheNe
   EXPECT_EQ(s.commands_rejected_length, 1u);
   EXPECT_EQ(s.commands_rejected_non_finite, 1u);
   EXPECT_EQ(s.last_problem, "rotor 1 speed -1 rad/s clamped to 0 (range [0, 12000])");
+  EXPECT_EQ(rig.log, (std::vector<std::string>{
+                         "plant: motor command rejected (3 values, expected 4 rotor speeds), last good command "
+                         "held; 1 rejected so far (logged: 1st, then every 100th)",
+                         "plant: motor command clamped (rotor 1 speed -1 rad/s clamped to 0 (range [0, 12000])); 1 "
+                         "clamped so far (logged: 1st, then every 100th)"}));
   EXPECT_EQ(rig.plant->applied_command(), model::Vector4(0, 2, 3, 4));
   for (Tick k = 3; k < 100; ++k) rig.tick(k);
   EXPECT_EQ(rig.statuses.size(), 2u);
@@ -318,7 +494,13 @@ TEST(ControllerValidationTest, OnlyInvalidSensorDataGivesTheSafetyCommand) {
   EXPECT_EQ(s.rejected_stamp_backwards, 0u);
   // Logged per reason: the 1st, then the 101st, ...: 100 quaternion and 50 non-finite refusals give
   // one line each.
-  EXPECT_EQ(rig.log.size(), 2u);
+  EXPECT_EQ(rig.log, (std::vector<std::string>{
+                         "controller: /drone/Pose message rejected, non-unit quaternion (orientation (x 0, y 0, z 0, "
+                         "w 0) has norm 0: expected a unit quaternion (within 0.001)); 1 rejected for this reason so "
+                         "far (logged: 1st, then every 100th)",
+                         "controller: /drone/Velocity message rejected, non-finite value (linear (nan, 0, 0): "
+                         "expected finite values); 1 rejected for this reason so far (logged: 1st, then every "
+                         "100th)"}));
 }
 
 TEST(ControllerValidationTest, ValidDataRecoversAndBackwardStampsAreRefused) {
@@ -353,17 +535,14 @@ TEST(ControllerValidationTest, ASenderWhoseClockRestartedIsFollowedAfterARunOfOl
   EXPECT_EQ(rig.node->status().rejected_stamp_backwards, 3u * kStampRestartCount);
   rig.send(kStampRestartCount * 10'000'000LL, 1.0, 7.0);
   EXPECT_EQ(rig.node->estimate().p_W.z(), 7.0);
+  EXPECT_EQ(rig.log.back(),
+            "controller: /drone/Imu: 50 samples in a row older than the newest accepted; taking it that the "
+            "sender's clock restarted (stamp 500000000 ns is older than the newest accepted, 50000000000 ns)");
   // Time is measured by stamps here, so "now" follows the sender's new clock.
   EXPECT_FALSE(rig.node->step(kStampRestartCount * 10'000'000LL, 0.02).safety);
   // A single old sample after that is refused again.
   rig.send(0, 1.0, 9.0);
   EXPECT_EQ(rig.node->estimate().p_W.z(), 7.0);
-}
-
-TEST(ValidateSensorTest, ContentIsCheckedBeforeTheStamp) {
-  msg::PoseStamped p = pose_at(0);
-  p.position.x = kNaN;
-  EXPECT_EQ(validate_pose(p, 10).fault, SensorFault::kNonFinite);  // old and NaN: reported as NaN
 }
 
 }  // namespace
