@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "sim/simulation.hpp"
-#include "sim/swarm.hpp"
+#include "inproc/simulation.hpp"
+#include "inproc/swarm.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -48,6 +48,9 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace quadcosim::sim {
 namespace {
+
+using inproc::Simulation;
+using inproc::Swarm;
 
 SimulationConfig config(Tick duration) {
   SimulationConfig c;

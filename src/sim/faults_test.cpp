@@ -10,10 +10,12 @@
 #include "model/quadrotor.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
-#include "sim/simulation.hpp"
+#include "inproc/simulation.hpp"
 
 namespace quadcosim::sim {
 namespace {
+
+using inproc::Simulation;
 
 struct WatchdogRig {
   InProcessTransport bus;

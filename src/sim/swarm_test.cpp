@@ -5,10 +5,13 @@
 
 #include <vector>
 
-#include "sim/swarm.hpp"
+#include "inproc/swarm.hpp"
 
 namespace quadcosim::sim {
 namespace {
+
+using inproc::Simulation;
+using inproc::Swarm;
 
 TEST(SwarmTest, NamespacesAreZeroPaddedToTheLargestIndex) {
   EXPECT_EQ(vehicle_namespace("/uav", 7, 16), "/uav0007");
