@@ -12,7 +12,7 @@
 #include "control/flight_controller.hpp"
 #include "io/scenario.hpp"
 #include "model/quadrotor.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 #ifndef QUADCOSIM_SOURCE_DIR
 #error "QUADCOSIM_SOURCE_DIR must be defined"
@@ -102,7 +102,7 @@ void BM_SimulationTick(benchmark::State& st) {
   auto cfg = sc.simulation;
   cfg.duration_ticks = kTicks;
   auto make = [&] {
-    return std::make_unique<qc::inproc::Simulation>(cfg, sc.vehicle, qc::io::initial_state(sc), sc.controller,
+    return std::make_unique<qc::sim::Simulation>(cfg, sc.vehicle, qc::io::initial_state(sc), sc.controller,
                                                  sc.schedule);
   };
   auto sim = make();

@@ -8,7 +8,7 @@
 #include "analysis/hover_loops.hpp"
 #include "analysis/margins.hpp"
 #include "model/attitude.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace quadcosim::analysis {
 namespace {
@@ -305,7 +305,7 @@ TEST_P(SimulationCrossCheck, LinearLoopsPredictTheSimulatedFreeResponse) {
   x0.p_W = {0, 0, 10.0 + dz0};
   x0.q_WB = Eigen::Quaterniond(Eigen::AngleAxisd(roll0, Eigen::Vector3d::UnitX()));
   x0.omega_rad_s.setConstant(v.hover_omega_rad_s());
-  inproc::Simulation sim(cfg, v, x0, controller, {});
+  sim::Simulation sim(cfg, v, x0, controller, {});
   std::vector<double> roll, z;
   sim.run([&](const sim::TickRecord& r) {
     roll.push_back(model::euler_from_quaternion(r.state.q_WB).roll_rad);
@@ -367,7 +367,7 @@ TEST(SimulationCrossCheckPosition, PositionLoopsPredictTheSimulatedFreeResponse)
   model::State s0;
   s0.p_W = {x0, y0, 5.0};
   s0.omega_rad_s.setConstant(v.hover_omega_rad_s());
-  inproc::Simulation sim(cfg, v, s0, controller, {});
+  sim::Simulation sim(cfg, v, s0, controller, {});
   std::vector<double> x, y;
   sim.run([&](const sim::TickRecord& r) {
     x.push_back(r.state.p_W.x());

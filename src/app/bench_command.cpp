@@ -32,8 +32,8 @@
 #include "app/node_common.hpp"
 #include "app/swarm.hpp"
 #include "bench/micro/baseline_setup.hpp"
-#include "inproc/simulation.hpp"
-#include "inproc/swarm.hpp"
+#include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
 
 namespace quadcosim::app {
 
@@ -51,7 +51,7 @@ void note(const std::string& s) { std::cerr << "bench: " << s << std::endl; }
 double inproc_rtf(const io::Scenario& sc, double sim_s) {
   sim::SimulationConfig cfg = sc.simulation;
   cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
-  inproc::Simulation s(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+  sim::Simulation s(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
   const auto t0 = std::chrono::steady_clock::now();
   for (sim::Tick k = 0; k <= cfg.duration_ticks; ++k) s.tick(k);
   return sim_s / seconds_since(t0);
@@ -73,7 +73,7 @@ double swarm_inproc_rtf(const io::Scenario& sc, int n, double sim_s) {
   io::SwarmSpec spec = swarm_spec(sc, n, 2);
   sim::SimulationConfig cfg = sc.simulation;
   cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
-  inproc::Swarm swarm(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
+  sim::Swarm swarm(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
   const auto t0 = std::chrono::steady_clock::now();
   swarm.run(spec.threads, kSwarmBlockTicks);
   return sim_s / seconds_since(t0);

@@ -22,7 +22,7 @@
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace quadcosim::app {
 
@@ -175,7 +175,7 @@ int run_command(const RunOptions& opt) {
       }
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
     } else {
-      inproc::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+      sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
       io::TrajectoryWriter csv(csv_path);
       io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
                             sim::Topics::for_namespace(sc.simulation.ns));

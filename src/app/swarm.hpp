@@ -13,7 +13,7 @@
 
 namespace quadcosim::app {
 
-/// In-process swarms advance each vehicle 100 ticks (1 s at 100 Hz) at a time (inproc::Swarm::run).
+/// In-process swarms advance each vehicle 100 ticks (1 s at 100 Hz) at a time (sim::Swarm::run).
 constexpr sim::Tick kSwarmBlockTicks = 100;
 
 /// The scenario's swarm section (defaults when it has none) with --vehicles / --threads applied

@@ -1,5 +1,5 @@
 // `quadcosim run SCENARIO --vehicles N` (or a scenario with a `swarm:` section): many vehicles,
-// in-process (inproc::Swarm) or over DDS (one plant and one controller process hosting all vehicles).
+// in-process (sim::Swarm) or over DDS (one plant and one controller process hosting all vehicles).
 // What a swarm run writes (docs/outputs.md): summary.json (run figures and the spread of the final
 // tracking errors), vehicles.csv (one row per vehicle: final state, setpoint, error, safety), and a
 // full <ns>/trajectory.csv (+ metrics) only for the vehicles listed in swarm.record_vehicles.
@@ -19,7 +19,6 @@
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
-#include "inproc/swarm.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
 
@@ -114,7 +113,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     install_stop_handlers();
     if (const int rc = run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;
   } else {
-    inproc::Swarm swarm(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
+    sim::Swarm swarm(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
     std::vector<bool> recorded(static_cast<std::size_t>(n), false);
     std::vector<std::unique_ptr<io::TrajectoryWriter>> writers(static_cast<std::size_t>(n));
     for (std::size_t j = 0; j < dirs.size(); ++j) {
@@ -133,7 +132,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
     std::vector<std::string> namespaces(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
-      const inproc::Simulation& v = swarm.vehicle(i);
+      const sim::Simulation& v = swarm.vehicle(i);
       auto& r = rows[static_cast<std::size_t>(i)];
       r.p_W = v.plant().state().p_W;
       r.p_des_W = v.controller().config().setpoint.p_des_W;

@@ -1,5 +1,5 @@
-// Tests of the drivers without processes: the lockstep plant driver against a hand-written tick loop
-// (an independent formulation of the tick order) bit for bit, for one
+// Tests of the drivers without processes: the lockstep plant driver against the in-process
+// Simulation (its own loop, an independent formulation of the tick order) bit for bit, for one
 // vehicle and for a swarm, with answers delivered synchronously and from a queue as over DDS (on
 // delivery or on the host's thread); the one answer rule (labelled, unlabelled, repeats, statuses);
 // timeouts, retries, hold and resume; the real-time plant driver's pacing; both controller drivers.
@@ -16,9 +16,8 @@
 #include "drivers/realtime_plant_driver.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
-#include "sim/controller_node.hpp"
-#include "sim/parameter_schedule.hpp"
-#include "sim/swarm_layout.hpp"
+#include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
 
 namespace quadcosim::drivers {
 namespace {
@@ -30,27 +29,12 @@ bool same(const model::State& a, const model::State& b) {
          a.omega_rad_s == b.omega_rad_s;
 }
 
-// The reference: a hand-written tick loop in the order of sim/steppable_plant.hpp, the schedule
-// applied and the controller stepped by the tick, independent of the drivers (and of
-// inproc::Simulation, which runs on them).
 std::vector<model::State> reference_run(const sim::SimulationConfig& sc, const model::State& x0,
                                         const control::ControllerConfig& c,
                                         const std::vector<sim::ScheduledParameter>& schedule) {
-  sim::InProcessTransport bus;
-  const sim::Topics t = sim::Topics::for_namespace(sc.ns);
-  sim::PlantNode plant(bus, t, c.params.vehicle, sc.plant, x0);
-  sim::ControllerNode node(bus, t, c);
-  sim::ParameterSchedule changes(schedule, sc.plant.clock);
-  const double dt_s = sc.plant.clock.period_s() * sc.controller_divider;
+  sim::Simulation s(sc, c.params.vehicle, x0, c, schedule);
   std::vector<model::State> states;
-  for (Tick k = 0; k <= sc.duration_ticks; ++k) {
-    changes.apply(node, sc.plant.clock.ns(k));
-    plant.publish_outputs(k);
-    if (k % sc.controller_divider == 0) node.step(sc.plant.clock.ns(k), dt_s);
-    plant.latch_command(k);
-    states.push_back(plant.state());
-    if (k < sc.duration_ticks) plant.integrate(k);
-  }
+  s.run([&](const sim::TickRecord& r) { states.push_back(r.state); });
   return states;
 }
 

@@ -1,6 +1,5 @@
 #include "drivers/lockstep_plant_driver.hpp"
 
-#include <algorithm>
 #include <utility>
 
 namespace quadcosim::drivers {
@@ -12,13 +11,10 @@ LockstepPlantDriver::LockstepPlantDriver(std::vector<DrivenPlant> plants, const 
     : o_(options), hooks_(std::move(hooks)), host_(host) {
   plants_.reserve(plants.size());
   for (DrivenPlant& p : plants) plants_.push_back(Slot{std::move(p)});
-  if (o_.record_round_trips) {
-    round_trips_ns_.reserve(static_cast<std::size_t>(o_.duration_ticks / o_.controller_divider + 1));
-  }
+  round_trips_ns_.reserve(static_cast<std::size_t>(o_.duration_ticks / o_.controller_divider + 1));
 }
 
-LockstepResult LockstepPlantDriver::run_until(sim::Tick last) {
-  last_ = std::min(last, o_.duration_ticks);
+LockstepResult LockstepPlantDriver::run() {
   host_.deliver_on_arrival(true);
   struct Off {  // also when a hook throws
     DriverHost& h;
@@ -55,7 +51,7 @@ LockstepPlantDriver::Phase LockstepPlantDriver::advance_ticks(bool on_delivery) 
     const sim::Tick k = k_;
     const bool control = k % o_.controller_divider == 0;
     if (!published_) {
-      if (k > last_ || host_.stop_requested()) return Phase::kDone;
+      if (k > o_.duration_ticks || host_.stop_requested()) return Phase::kDone;
       if (on_delivery && (!waiting_ || (hooks_.main_thread_due && hooks_.main_thread_due(k)))) {
         return Phase::kMainThread;
       }
@@ -67,7 +63,6 @@ LockstepPlantDriver::Phase LockstepPlantDriver::advance_ticks(bool on_delivery) 
       asked_ns_ = last_ask_ns_ = host_.now_ns();
       published_ = true;
       answered_ = 0;
-      if (hooks_.after_outputs) hooks_.after_outputs(k);
       if (!waiting_) collect_while_holding(k);
       if (waiting_ && control) {
         for (Slot& s : plants_) s.status_expected = s.p.status_awaited && s.p.status_awaited();
@@ -75,7 +70,7 @@ LockstepPlantDriver::Phase LockstepPlantDriver::advance_ticks(bool on_delivery) 
     }
     if (waiting_ && control) {
       if (!all_answered(k)) return Phase::kAwaiting;
-      if (o_.record_round_trips) round_trips_ns_.push_back(host_.now_ns() - asked_ns_);
+      round_trips_ns_.push_back(host_.now_ns() - asked_ns_);
     }
     end_tick(k);
     ++k_;

@@ -3,11 +3,10 @@
 // slow the controllers are. The same driver runs in-process and over DDS; where the answers come
 // from is the host's business (drivers/driver_host.hpp).
 //
-// Per tick k: the host's before_outputs(k) (a scheduled change), every plant publishes its outputs,
-// the host's after_outputs(k) (in-process controllers stepped on the tick); on control ticks
-// (k % controller_divider == 0) the driver waits for the answer of every plant; then each plant
-// latches its command, after_latch(i, k) records it, and the plant integrates to t_k+1 (not after
-// the last tick).
+// Per tick k: the host's before_outputs(k) (a scheduled change), every plant publishes its outputs;
+// on control ticks (k % controller_divider == 0) the driver waits for the answer of every plant;
+// then each plant latches its command, after_latch(i, k) records it, and the plant integrates to
+// t_k+1 (not after the last tick).
 //
 // The answer to tick k (one rule, for every plant and host):
 //   - a command labelled with t_k (msg::command_stamp_ns), or, when the newest command taken carries
@@ -58,9 +57,6 @@ struct LockstepOptions {
   /// Run ticks on the delivering thread when their answer completes (one thread per period), or
   /// only wake the host's thread (a swarm's shards, whose participants share one receive thread).
   bool ticks_on_delivery = true;
-  /// Keep round_trips_ns() (one figure per awaited control tick); off for hosts that deliver
-  /// synchronously (in-process), where every figure is 0 and a swarm's vehicles would each keep one.
-  bool record_round_trips = true;
 };
 
 /// One plant as the driver sees it.
@@ -79,9 +75,6 @@ struct LockstepHooks {
   /// Before tick k's outputs go out, on whichever thread runs the tick (the host's when
   /// main_thread_due(k)); false refuses the run (run() returns kRefused).
   std::function<bool(sim::Tick)> before_outputs;
-  /// After tick k's outputs went out, before its answers are awaited: a host whose controllers step
-  /// on the tick rather than on a complete sample (in-process under injected sensor loss) steps them.
-  std::function<void(sim::Tick)> after_outputs;
   /// After plant i latched tick k's command, before it integrates: record, log.
   std::function<void(std::size_t, sim::Tick)> after_latch;
   /// Plant i's answer to tick k did not come within the timeout (before the policy acts).
@@ -100,10 +93,7 @@ class LockstepPlantDriver {
   LockstepPlantDriver& operator=(const LockstepPlantDriver&) = delete;
 
   /// Runs ticks 0..duration_ticks (or to a stop, a timeout under kAbort, a refusal).
-  LockstepResult run() { return run_until(o_.duration_ticks); }
-  /// The same up to tick `last` (<= duration_ticks) only: kDone once `last` is latched, recorded and
-  /// integrated; a later call goes on from there (an in-process swarm runs its vehicles in blocks).
-  LockstepResult run_until(sim::Tick last);
+  LockstepResult run();
   /// After each delivery, on the delivering thread (see Threading above). Returns true when the
   /// host's waiting thread is to wake.
   bool on_delivery();
@@ -137,7 +127,6 @@ class LockstepPlantDriver {
   // Shared by the host's thread and the delivering thread (never at once: see Threading).
   Phase phase_ = Phase::kAwaiting;
   sim::Tick k_ = 0;          ///< the tick in progress
-  sim::Tick last_ = 0;       ///< the last tick of this run_until
   bool published_ = false;   ///< k_'s outputs are out
   bool advancing_ = false;   ///< inside advance (a plant's own publications may be delivered to it)
   bool waiting_ = true;      ///< answers awaited (off while holding)

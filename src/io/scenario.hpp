@@ -12,8 +12,8 @@
 #include "control/parameters.hpp"
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
-#include "sim/simulation_config.hpp"
-#include "sim/swarm_layout.hpp"
+#include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
 
 namespace YAML {
 class Node;
@@ -52,7 +52,7 @@ struct StepSpec {
   std::map<std::string, double> reference;  ///< published figures to compare with
 };
 
-/// A scenario's `swarm:` section: many vehicles of the same scenario on a grid (sim/swarm_layout.hpp).
+/// A scenario's `swarm:` section: many vehicles of the same scenario on a grid (sim/swarm.hpp).
 struct SwarmSpec {
   sim::SwarmLayout layout;
   int threads = 2;                   ///< in-process worker threads (1..64)

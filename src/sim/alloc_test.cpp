@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "inproc/simulation.hpp"
-#include "inproc/swarm.hpp"
+#include "sim/simulation.hpp"
+#include "sim/swarm.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -48,9 +48,6 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace quadcosim::sim {
 namespace {
-
-using inproc::Simulation;
-using inproc::Swarm;
 
 SimulationConfig config(Tick duration) {
   SimulationConfig c;

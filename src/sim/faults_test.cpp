@@ -10,12 +10,10 @@
 #include "model/quadrotor.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace quadcosim::sim {
 namespace {
-
-using inproc::Simulation;
 
 struct WatchdogRig {
   InProcessTransport bus;

@@ -10,12 +10,10 @@
 #include "sim/inprocess_transport.hpp"
 #include "sim/lockstep_stepper.hpp"
 #include "sim/plant_node.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace quadcosim::sim {
 namespace {
-
-using inproc::Simulation;
 
 // A plant on a bus and a controller hosted by a LockstepStepper, as `quadcosim controller` runs it.
 struct LockstepRig {

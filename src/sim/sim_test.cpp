@@ -8,12 +8,10 @@
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace quadcosim::sim {
 namespace {
-
-using inproc::Simulation;
 
 TEST(TimeTest, FromNanosecondsSplitsSecondsAndNanoseconds) {
   EXPECT_EQ(msg::Time::from_ns(1'500'000'000).sec, 1);

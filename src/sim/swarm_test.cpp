@@ -5,13 +5,10 @@
 
 #include <vector>
 
-#include "inproc/swarm.hpp"
+#include "sim/swarm.hpp"
 
 namespace quadcosim::sim {
 namespace {
-
-using inproc::Simulation;
-using inproc::Swarm;
 
 TEST(SwarmTest, NamespacesAreZeroPaddedToTheLargestIndex) {
   EXPECT_EQ(vehicle_namespace("/uav", 7, 16), "/uav0007");

@@ -13,7 +13,7 @@
 #include "io/mcap_recorder.hpp"
 #include "io/trajectory_csv.hpp"
 #include "model/attitude.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 #include "sim/topics.hpp"
 #include "sweep/statistics.hpp"
 
@@ -27,7 +27,7 @@ namespace {
 // same numbers trajectory.csv holds. With `csv` it writes trajectory.csv there, with `mcap_dir` also
 // run.mcap and metadata.yaml.
 io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path* mcap_dir) {
-  inproc::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+  sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
   std::optional<io::TrajectoryWriter> writer;
   if (csv) writer.emplace(csv->string());
   std::optional<io::McapRecorder> mcap;

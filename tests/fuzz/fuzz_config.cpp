@@ -16,7 +16,7 @@
 
 #include "control/care.hpp"
 #include "io/scenario.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace {
 
@@ -47,7 +47,7 @@ void try_scenario(const std::string& path) {
   }
   sc.simulation.duration_ticks = std::min<sim::Tick>(sc.simulation.duration_ticks, 4);
   try {
-    inproc::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+    sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
     simulation.run([](const sim::TickRecord&) {});
   } catch (const control::CareError&) {
   } catch (const std::invalid_argument&) {

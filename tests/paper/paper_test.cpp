@@ -8,7 +8,7 @@
 #include "analysis/step_metrics.hpp"
 #include "io/scenario.hpp"
 #include "model/attitude.hpp"
-#include "inproc/simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace quadcosim {
 namespace {
@@ -21,7 +21,7 @@ struct Flight {
 };
 
 Flight simulate(const io::Scenario& sc) {
-  inproc::Simulation s(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+  sim::Simulation s(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
   Flight r;
   s.run([&](const sim::TickRecord& rec) {
     const model::Euler e = model::euler_from_quaternion(rec.state.q_WB);
