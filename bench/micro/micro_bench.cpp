@@ -43,7 +43,7 @@ BENCHMARK(BM_PlantStep)->Arg(1)->Arg(2)->Arg(4)->Arg(8);
 
 void BM_ControllerStep(benchmark::State& st) {
   qc::control::FlightController c{qc::control::ControllerParams{}};
-  qc::control::Estimate e;
+  qc::control::Observation e;
   e.p_W = {0.1, -0.2, 4.9};
   e.v_W = {0.01, 0.02, -0.1};
   e.roll_rad = 0.01;

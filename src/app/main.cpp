@@ -49,11 +49,11 @@ int main(int argc, char** argv) {
   SweepOptions sweep;
   MarginsOptions margins;
   BenchOptions bench;
-  struct Command {
+  struct Subcommand {
     CLI::App* cli;
     std::function<int()> run;
   };
-  const std::vector<Command> commands = {
+  const std::vector<Subcommand> commands = {
       {add_run_subcommand(app, run), [&] { return run_command(run); }},
       {add_plant_subcommand(app, plant), [&] { return plant_command(plant); }},
       {add_controller_subcommand(app, controller), [&] { return controller_command(controller); }},
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? exit_code::kOk : exit_code::kBadInput;
   }
-  for (const Command& c : commands) {
+  for (const Subcommand& c : commands) {
     if (*c.cli) return run_guarded(c.cli->get_name(), c.run);
   }
   return exit_code::kBadInput;

@@ -205,7 +205,7 @@ class PlantProcess {
 
   void record(sim::Tick k) {
     if (!csv_) return;
-    csv_->write(clock_.seconds(k), plant_.state(), plant_.applied_command(),
+    csv_->write(clock_.seconds(k), plant_.state(), plant_.latched_command(),
                 have_status_ ? io::ControlColumns::from(status_) : io::ControlColumns::none(),
                 plant_.watchdog_active());
   }

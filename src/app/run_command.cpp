@@ -195,7 +195,7 @@ int run_command(const RunOptions& opt) {
                                                  sim::to_string(plant.options().watchdog_policy))
                                    : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
           }
-          csv.write(r.t_s, r.state, r.applied_command, c, watchdog);
+          csv.write(r.t_s, r.state, r.latched_command, c, watchdog);
           mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
           progress.update(r.t_s);
           if (stop_requested()) throw Interrupted{};

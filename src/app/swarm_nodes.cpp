@@ -149,7 +149,7 @@ class PlantShard {
     h.after_latch = [this](std::size_t i, sim::Tick k) {
       Vehicle& v = *vehicles_[i];
       if (!v.csv) return;
-      v.csv->write(clock_.seconds(k), v.plant->state(), v.plant->applied_command(),
+      v.csv->write(clock_.seconds(k), v.plant->state(), v.plant->latched_command(),
                    v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status)
                                                       : io::ControlColumns::none());
     };

@@ -140,7 +140,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     }
     const auto start = std::chrono::steady_clock::now();
     swarm.run(spec.threads, kSwarmBlockTicks, recorded, [&](int i, const sim::TickRecord& r) {
-      writers[static_cast<std::size_t>(i)]->write(r.t_s, r.state, r.applied_command, io::ControlColumns::from(r.status));
+      writers[static_cast<std::size_t>(i)]->write(r.t_s, r.state, r.latched_command, io::ControlColumns::from(r.status));
     });
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (auto& w : writers) {
@@ -153,7 +153,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
       auto& r = rows[static_cast<std::size_t>(i)];
       r.p_W = v.plant().state().p_W;
       r.p_des_W = v.controller().config().setpoint.p_des_W;
-      r.safety = v.controller().last_command().safety;
+      r.safety = v.controller().last_output().safety;
       r.rejected = v.plant().stats().commands_rejected;
       namespaces[static_cast<std::size_t>(i)] = swarm.vehicle_ns(i);
     }

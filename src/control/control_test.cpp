@@ -403,8 +403,8 @@ TEST(PositionPid, AntiWindupStopsTheIntegralWhileSaturated) {
 // sqrt(m g / (4 kt)) from Table 1, the number in architecture.md (~4830.6 rad/s).
 double hover_speed() { return std::sqrt(kMass * kG / (4.0 * kKt)); }
 
-Estimate hover_estimate(double z) {
-  Estimate e;
+Observation hover_observation(double z) {
+  Observation e;
   e.p_W = {0.0, 0.0, z};
   e.age_s = 0.0;
   return e;
@@ -425,17 +425,17 @@ TEST(FlightController, StaleOrMissingDataGivesTheSafetyCommand) {
   const Setpoint sp = hold(5.0);
   for (double age : {0.1 + 1e-9, 0.2, 10.0, kInf, kNaN}) {
     SCOPED_TRACE(testing::Message() << "age " << age);
-    Estimate e = hover_estimate(5.0);
+    Observation e = hover_observation(5.0);
     e.age_s = age;
-    const Command c = fc.step(e, sp, 0.02);
+    const ControllerOutput c = fc.step(e, sp, 0.02);
     EXPECT_TRUE(c.safety);
     EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Constant(350.0));
   }
   // A default-constructed estimate has never received anything.
-  EXPECT_TRUE(std::isinf(Estimate{}.age_s));
-  EXPECT_TRUE(fc.step(Estimate{}, sp, 0.02).safety);
+  EXPECT_TRUE(std::isinf(Observation{}.age_s));
+  EXPECT_TRUE(fc.step(Observation{}, sp, 0.02).safety);
   // At the limit the data still counts as fresh.
-  Estimate fresh = hover_estimate(5.0);
+  Observation fresh = hover_observation(5.0);
   fresh.age_s = 0.1;
   EXPECT_FALSE(fc.step(fresh, sp, 0.02).safety);
 }
@@ -444,45 +444,45 @@ TEST(FlightController, SafetyStopIsOmegaMinAndSafetyHoverIsHoverSpeed) {
   ControllerParams p;
   ASSERT_EQ(p.safety, SafetyMode::kStop);
   ASSERT_EQ(p.vehicle.motor.omega_min_rad_s, 0.0);
-  Estimate stale = hover_estimate(5.0);
+  Observation stale = hover_observation(5.0);
   stale.age_s = 1.0;
   {
     FlightController fc(p);
-    const Command c = fc.step(stale, hold(5.0), 0.02);
+    const ControllerOutput c = fc.step(stale, hold(5.0), 0.02);
     EXPECT_TRUE(c.safety);
     EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Zero());
   }
   {
     p.safety = SafetyMode::kHover;
     FlightController fc(p);
-    const Command c = fc.step(stale, hold(5.0), 0.02);
+    const ControllerOutput c = fc.step(stale, hold(5.0), 0.02);
     EXPECT_TRUE(c.safety);
     for (int i = 0; i < 4; ++i) EXPECT_NEAR(c.omega_rad_s[i], hover_speed(), 1e-9 * hover_speed());
   }
 }
 
-TEST(FlightController, NonFiniteEstimateGivesSafetyAndLeavesTheIntegratorAlone) {
+TEST(FlightController, NonFiniteObservationGivesSafetyAndLeavesTheIntegratorAlone) {
   ControllerParams p;
   FlightController fc(p);
   Setpoint sp = hold(5.0);
   sp.mode = Mode::kPosition;
   sp.p_des_W.x() = 1.0;
   // Build some integral first.
-  for (int i = 0; i < 10; ++i) ASSERT_FALSE(fc.step(hover_estimate(5.0), sp, 0.02).safety);
+  for (int i = 0; i < 10; ++i) ASSERT_FALSE(fc.step(hover_observation(5.0), sp, 0.02).safety);
   const Eigen::Vector2d integral = fc.position_state().integral_m_s;
   ASSERT_GT(integral.x(), 0.0);
 
   for (int field = 0; field < 12; ++field) {
     for (double bad : {kNaN, kInf}) {
       SCOPED_TRACE(testing::Message() << "field " << field << " value " << bad);
-      Estimate e = hover_estimate(5.0);
+      Observation e = hover_observation(5.0);
       if (field < 3) e.p_W[field] = bad;
       else if (field < 6) e.v_W[field - 3] = bad;
       else if (field < 9) e.w_B[field - 6] = bad;
       else if (field == 9) e.roll_rad = bad;
       else if (field == 10) e.pitch_rad = bad;
       else e.yaw_rad = bad;
-      const Command c = fc.step(e, sp, 0.02);
+      const ControllerOutput c = fc.step(e, sp, 0.02);
       EXPECT_TRUE(c.safety);
       EXPECT_TRUE(c.omega_rad_s.allFinite());
       EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Zero());
@@ -490,7 +490,7 @@ TEST(FlightController, NonFiniteEstimateGivesSafetyAndLeavesTheIntegratorAlone) 
     }
   }
   // And the next good sample is controlled normally.
-  const Command c = fc.step(hover_estimate(5.0), sp, 0.02);
+  const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
   EXPECT_FALSE(c.safety);
   EXPECT_TRUE(c.omega_rad_s.allFinite());
 }
@@ -498,7 +498,7 @@ TEST(FlightController, NonFiniteEstimateGivesSafetyAndLeavesTheIntegratorAlone) 
 TEST(FlightController, HoverCommandsHoverSpeedOnAllRotors) {
   FlightController fc{ControllerParams{}};
   for (double z : {0.0, 5.0, 100.0}) {
-    const Command c = fc.step(hover_estimate(z), hold(z), 0.02);
+    const ControllerOutput c = fc.step(hover_observation(z), hold(z), 0.02);
     EXPECT_FALSE(c.safety);
     EXPECT_EQ(c.U[0], kMass * kG);
     EXPECT_EQ(c.U.tail<3>(), Eigen::Vector3d::Zero());
@@ -514,7 +514,7 @@ TEST(FlightController, RollErrorGivesPositiveTorqueAndRotor4FasterThanRotor2) {
   FlightController fc(p);
   Setpoint sp = hold(5.0);
   sp.roll_des_rad = 0.1;
-  const Command c = fc.step(hover_estimate(5.0), sp, 0.02);
+  const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
   ASSERT_FALSE(c.safety);
   // U2 = k1 e with k1 = sqrt(q_angle / r) (closed form, see care_test.cpp).
   const double k1 = std::sqrt(p.roll.q_angle / p.roll.r);
@@ -539,7 +539,7 @@ TEST(FlightController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
   {
     Setpoint sp = hold(5.0);
     sp.pitch_des_rad = 0.15;
-    const Command c = fc.step(hover_estimate(5.0), sp, 0.02);
+    const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
     // U3 = L kt (w3^2 - w1^2) > 0: rotor 3 (tail) faster than rotor 1 (nose).
     EXPECT_NEAR(c.U[2], std::sqrt(p.pitch.q_angle / p.pitch.r) * 0.15, 1e-10);
     EXPECT_GT(c.omega_rad_s[2], c.omega_rad_s[0]);
@@ -550,7 +550,7 @@ TEST(FlightController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
     // Yaw authority is small (k_m / k_t ~ 5e-4 m): 0.01 rad keeps every rotor inside its range.
     Setpoint sp = hold(5.0);
     sp.yaw_des_rad = 0.01;
-    const Command c = fc.step(hover_estimate(5.0), sp, 0.02);
+    const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
     for (int i = 0; i < 4; ++i) ASSERT_FALSE(c.rotor_saturated[i]);
     // U4 = km (w1^2 - w2^2 + w3^2 - w4^2) > 0: rotors 1 and 3 faster than 2 and 4.
     EXPECT_NEAR(c.U[3], std::sqrt(p.yaw.q_angle / p.yaw.r) * 0.01, 1e-12);
@@ -561,9 +561,9 @@ TEST(FlightController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
   }
   {
     // A body rate is damped: positive roll rate, no error -> negative roll torque -k2 p.
-    Estimate e = hover_estimate(5.0);
+    Observation e = hover_observation(5.0);
     e.w_B = {0.5, 0.0, 0.0};
-    const Command c = fc.step(e, hold(5.0), 0.02);
+    const ControllerOutput c = fc.step(e, hold(5.0), 0.02);
     const double k1 = std::sqrt(p.roll.q_angle / p.roll.r);
     const double k2 = std::sqrt(p.roll.q_rate / p.roll.r + 2.0 * p.vehicle.Ixx_kg_m2 * k1);
     EXPECT_NEAR(c.U[1], -k2 * 0.5, 1e-10);
@@ -582,9 +582,9 @@ TEST(FlightController, YawErrorIsWrapped) {
     SCOPED_TRACE(testing::Message() << "des " << c.des << " yaw " << c.yaw);
     Setpoint sp = hold(5.0);
     sp.yaw_des_rad = c.des;
-    Estimate e = hover_estimate(5.0);
+    Observation e = hover_observation(5.0);
     e.yaw_rad = c.yaw;
-    const Command cmd = fc.step(e, sp, 0.02);
+    const ControllerOutput cmd = fc.step(e, sp, 0.02);
     EXPECT_NEAR(cmd.error[3], c.error, 1e-12);
     EXPECT_NEAR(cmd.U[3], k1 * c.error, 1e-12);
   }
@@ -595,7 +595,7 @@ TEST(FlightController, PositionModeTiltsTowardsTheTarget) {
   Setpoint sp = hold(5.0);
   sp.mode = Mode::kPosition;
   sp.p_des_W.x() = 0.5;
-  const Command c = fc.step(hover_estimate(5.0), sp, 0.02);
+  const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
   EXPECT_GT(c.pitch_des_rad, 0.0);
   EXPECT_EQ(c.roll_des_rad, 0.0);
   EXPECT_GT(c.U[2], 0.0);
@@ -603,7 +603,7 @@ TEST(FlightController, PositionModeTiltsTowardsTheTarget) {
   // Attitude setpoints in the Setpoint struct are ignored in position mode.
   sp.roll_des_rad = 1.0;
   FlightController fc2{ControllerParams{}};
-  EXPECT_EQ(fc2.step(hover_estimate(5.0), sp, 0.02).roll_des_rad, 0.0);
+  EXPECT_EQ(fc2.step(hover_observation(5.0), sp, 0.02).roll_des_rad, 0.0);
 }
 
 TEST(FlightController, SetParamsWithInvalidDesignThrowsAndChangesNothing) {
@@ -612,7 +612,7 @@ TEST(FlightController, SetParamsWithInvalidDesignThrowsAndChangesNothing) {
   Setpoint sp = hold(5.0);
   sp.mode = Mode::kPosition;
   sp.p_des_W.x() = 1.0;
-  Estimate e = hover_estimate(4.8);
+  Observation e = hover_observation(4.8);
   e.roll_rad = 0.05;
   e.w_B = {0.1, -0.2, 0.3};
   for (int i = 0; i < 5; ++i) fc.step(e, sp, 0.02);
@@ -638,7 +638,7 @@ TEST(FlightController, SetParamsWithInvalidDesignThrowsAndChangesNothing) {
     for (int a = 0; a < 3; ++a) EXPECT_EQ(fc.axis(a).K, K_before[a]);
     EXPECT_EQ(fc.position_state().integral_m_s, state_before.integral_m_s);
   }
-  const Command c1 = fc.step(e, sp, 0.02), c2 = reference.step(e, sp, 0.02);
+  const ControllerOutput c1 = fc.step(e, sp, 0.02), c2 = reference.step(e, sp, 0.02);
   EXPECT_EQ(c1.omega_rad_s, c2.omega_rad_s);
   EXPECT_EQ(c1.U, c2.U);
 

@@ -21,8 +21,8 @@ void FlightController::set_params(const ControllerParams& params) {
   params_ = params;
 }
 
-Command FlightController::safety_command() const {
-  Command c;
+ControllerOutput FlightController::safety_command() const {
+  ControllerOutput c;
   c.safety = true;
   const auto& v = params_.vehicle;
   const double w = params_.safety == SafetyMode::kHover ? v.hover_omega_rad_s()
@@ -32,22 +32,22 @@ Command FlightController::safety_command() const {
 }
 
 namespace {
-bool finite(const Estimate& e) {
+bool finite(const Observation& e) {
   return e.p_W.allFinite() && e.v_W.allFinite() && e.w_B.allFinite() && std::isfinite(e.roll_rad) &&
          std::isfinite(e.pitch_rad) && std::isfinite(e.yaw_rad);
 }
 }  // namespace
 
-Command FlightController::step(const Estimate& est, const Setpoint& sp, double dt_s) {
+ControllerOutput FlightController::step(const Observation& obs, const Setpoint& sp, double dt_s) {
   // Algorithm 1, lines 3-5.
-  if (!(est.age_s <= params_.stale_limit_s) || !finite(est)) return safety_command();
+  if (!(obs.age_s <= params_.stale_limit_s) || !finite(obs)) return safety_command();
 
   const auto& v = params_.vehicle;
-  Command c;
+  ControllerOutput c;
   c.yaw_des_rad = sp.yaw_des_rad;
   if (sp.mode == Mode::kPosition) {
     const TiltSetpoint tilt = position_pid(params_.position, position_state_, sp.p_des_W.head<2>(),
-                                           est.p_W.head<2>(), est.v_W.head<2>(), est.yaw_rad,
+                                           obs.p_W.head<2>(), obs.v_W.head<2>(), obs.yaw_rad,
                                            v.gravity_m_s2, dt_s);
     c.roll_des_rad = tilt.roll_rad;
     c.pitch_des_rad = tilt.pitch_rad;
@@ -58,17 +58,17 @@ Command FlightController::step(const Estimate& est, const Setpoint& sp, double d
   }
 
   // Lines 7-11: attitude LQR on e = des - angle and the body rates.
-  const double e_roll = c.roll_des_rad - est.roll_rad;
-  const double e_pitch = c.pitch_des_rad - est.pitch_rad;
-  const double e_yaw = model::wrap_pi(c.yaw_des_rad - est.yaw_rad);
-  c.U[1] = axes_[0].torque(e_roll, est.w_B.x());
-  c.U[2] = axes_[1].torque(e_pitch, est.w_B.y());
-  c.U[3] = axes_[2].torque(e_yaw, est.w_B.z());
+  const double e_roll = c.roll_des_rad - obs.roll_rad;
+  const double e_pitch = c.pitch_des_rad - obs.pitch_rad;
+  const double e_yaw = model::wrap_pi(c.yaw_des_rad - obs.yaw_rad);
+  c.U[1] = axes_[0].torque(e_roll, obs.w_B.x());
+  c.U[2] = axes_[1].torque(e_pitch, obs.w_B.y());
+  c.U[3] = axes_[2].torque(e_yaw, obs.w_B.z());
 
   // Lines 12-14: altitude PD, eq. (13).
   c.U[0] = collective_thrust(params_.altitude, v.mass_kg, v.gravity_m_s2, sp.p_des_W.z(),
-                             est.p_W.z(), est.v_W.z(), est.roll_rad, est.pitch_rad);
-  c.error << sp.p_des_W.z() - est.p_W.z(), e_roll, e_pitch, e_yaw;
+                             obs.p_W.z(), obs.v_W.z(), obs.roll_rad, obs.pitch_rad);
+  c.error << sp.p_des_W.z() - obs.p_W.z(), e_roll, e_pitch, e_yaw;
 
   // Lines 15-20.
   const Allocation a =

@@ -46,8 +46,9 @@ struct ControllerParams {
   SafetyMode safety = SafetyMode::kStop;
 };
 
-/// The latest measurements, as the controller node assembled them from its subscriptions.
-struct Estimate {
+/// What the controller observes: the latest measurements the node took from its sensor topics, as
+/// received (no filtering: not an estimate), and how old they are.
+struct Observation {
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< [m], from Pose
   Eigen::Vector3d v_W = Eigen::Vector3d::Zero();  ///< [m/s], from Velocity
   double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;  ///< from the IMU quaternion
@@ -57,7 +58,7 @@ struct Estimate {
 };
 
 /// Everything one step decided, for the command topic and the controller's status.
-struct Command {
+struct ControllerOutput {
   Eigen::Vector4d omega_rad_s = Eigen::Vector4d::Zero();  ///< rotor speed commands [rad/s]
   Eigen::Vector4d U = Eigen::Vector4d::Zero();  ///< requested U1 [N], U2..U4 [N m]
   double roll_des_rad = 0.0, pitch_des_rad = 0.0, yaw_des_rad = 0.0;  ///< attitude actually tracked
@@ -78,14 +79,14 @@ class FlightController {
   const AxisLqr& axis(int i) const { return axes_[i]; }  ///< 0 roll, 1 pitch, 2 yaw
 
   /// One control period. dt_s is the controller period [s].
-  Command step(const Estimate& estimate, const Setpoint& setpoint, double dt_s);
+  ControllerOutput step(const Observation& observation, const Setpoint& setpoint, double dt_s);
 
   /// Clears the integrators (e.g. after a restart).
   void reset() { position_state_ = {}; }
   const PositionPidState& position_state() const { return position_state_; }
 
  private:
-  Command safety_command() const;
+  ControllerOutput safety_command() const;
 
   ControllerParams params_;
   std::array<AxisLqr, 3> axes_;

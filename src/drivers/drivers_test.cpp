@@ -252,7 +252,7 @@ TEST(LockstepPlantDriverTest, AnUnlabelledCommandAnswersTheTickItArrivesAfter) {
   host.driver = &driver;
   ASSERT_EQ(driver.run(), LockstepResult::kDone);
   EXPECT_EQ(c.answered, 6);                       // ticks 0, 2, ..., 10
-  EXPECT_EQ(c.plant->applied_command()[0], 105);  // tick 10's own command acts at tick 10
+  EXPECT_EQ(c.plant->latched_command()[0], 105);  // tick 10's own command acts at tick 10
   EXPECT_EQ(host.clock_ns, 0) << "the driver waited for an answer that was there";
 }
 

@@ -190,7 +190,7 @@ Quadrotor::RigidInputs Quadrotor::rigid_inputs(const Wrench& f) const {
           params_.gyroscopic == GyroscopicModel::kFull};
 }
 
-Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const AppliedCommand& cmd,
+Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInput& cmd,
                                                  const Environment* env) const {
   const bool ideal = params_.motor.model == MotorModel::kIdeal;
   if (!env) return rigid_inputs(ideal ? cmd.wrench : wrench(Vector4(y[13], y[14], y[15], y[16])));
@@ -209,7 +209,7 @@ Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const AppliedC
 }
 
 template <bool kVaryingInputs, bool kRotorLag>
-void Quadrotor::stage_derivative(const double* __restrict y, const AppliedCommand& cmd, const Environment* env,
+void Quadrotor::stage_derivative(const double* __restrict y, const RotorInput& cmd, const Environment* env,
                                  const RigidInputs& held_inputs, double* __restrict d) const {
   if constexpr (kVaryingInputs) {
     rigid_derivative(y, varying_inputs(y, cmd, env), d);
@@ -226,7 +226,7 @@ void Quadrotor::stage_derivative(const double* __restrict y, const AppliedComman
 }
 
 template <bool kVaryingInputs, bool kRotorLag>
-[[gnu::always_inline]] inline void Quadrotor::integrate(State& x, const AppliedCommand& cmd, double h, int substeps,
+[[gnu::always_inline]] inline void Quadrotor::integrate(State& x, const RotorInput& cmd, double h, int substeps,
                           const Environment* env) const {
   constexpr int n = kRotorLag ? kWithRotors : kRigid;  // ideal rotors: their speeds are the command
   Packed r;
@@ -255,17 +255,17 @@ template <bool kVaryingInputs, bool kRotorLag>
 
 StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd,
                                       const Environment* env) const {
-  AppliedCommand applied;
-  applied.omega_rad_s = cmd;  // already clamped, as the caller promises
+  RotorInput input;
+  input.omega_rad_s = cmd;  // already clamped, as the caller promises
   const bool lag = params_.motor.model == MotorModel::kFirstOrder;
   Packed y, r;
   pack(x, lag, y);
   if (!lag) {
-    applied.wrench = wrench(cmd);
-    stage_derivative<true, false>(y, applied, env, RigidInputs{}, r);
+    input.wrench = wrench(cmd);
+    stage_derivative<true, false>(y, input, env, RigidInputs{}, r);
     for (int i = 0; i < 4; ++i) r[13 + i] = 0.0;
   } else {
-    stage_derivative<true, true>(y, applied, env, RigidInputs{}, r);
+    stage_derivative<true, true>(y, input, env, RigidInputs{}, r);
   }
   StateDerivative d;
   d.p_W = {r[0], r[1], r[2]};
@@ -276,19 +276,19 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
   return d;
 }
 
-AppliedCommand Quadrotor::apply(const Vector4& cmd) const {
-  AppliedCommand a;
+RotorInput Quadrotor::rotor_input(const Vector4& cmd) const {
+  RotorInput a;
   a.omega_rad_s = clamp_command(cmd);
   a.wrench = wrench(a.omega_rad_s);
   return a;
 }
 
 Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const Environment* env) const {
-  return outputs(t_s, x, apply(cmd), env);
+  return outputs(t_s, x, rotor_input(cmd), env);
 }
 
 template <bool kVaryingInputs>
-[[gnu::always_inline]] inline Eigen::Vector3d Quadrotor::specific_force_W(const State& x, const AppliedCommand& cmd, const Environment* env) const {
+[[gnu::always_inline]] inline Eigen::Vector3d Quadrotor::specific_force_W(const State& x, const RotorInput& cmd, const Environment* env) const {
   Packed y;
   pack(x, params_.motor.model == MotorModel::kFirstOrder, y);
   bool held = false;
@@ -299,7 +299,7 @@ template <bool kVaryingInputs>
   return a_minus_g;
 }
 
-Outputs Quadrotor::outputs(double /*t_s*/, const State& x, const AppliedCommand& cmd, const Environment* env) const {
+Outputs Quadrotor::outputs(double /*t_s*/, const State& x, const RotorInput& cmd, const Environment* env) const {
   // As step(), compiled for what varies: nothing but the state for ideal motors without an Environment.
   const bool varying = env || params_.motor.model == MotorModel::kFirstOrder;
   const Eigen::Vector3d a_minus_g_W = varying ? specific_force_W<true>(x, cmd, env) : specific_force_W<false>(x, cmd, env);
@@ -308,10 +308,10 @@ Outputs Quadrotor::outputs(double /*t_s*/, const State& x, const AppliedCommand&
 
 void Quadrotor::step(State& x, double t_s, const Vector4& cmd, double dt_s, int substeps,
                      const Environment* env) const {
-  step(x, t_s, apply(cmd), dt_s, substeps, env);
+  step(x, t_s, rotor_input(cmd), dt_s, substeps, env);
 }
 
-void Quadrotor::step(State& x, double /*t_s*/, const AppliedCommand& applied, double dt_s, int substeps,
+void Quadrotor::step(State& x, double /*t_s*/, const RotorInput& input, double dt_s, int substeps,
                      const Environment* env) const {
   assert(substeps >= 1);
   const double h = dt_s / substeps;
@@ -319,11 +319,11 @@ void Quadrotor::step(State& x, double /*t_s*/, const AppliedCommand& applied, do
   // an Environment (the rotors' wrench was formed with the command), the wrench and drag at each
   // stage's state otherwise, and the rotor speeds too for a lagging motor.
   if (params_.motor.model == MotorModel::kFirstOrder) {
-    integrate<true, true>(x, applied, h, substeps, env);
+    integrate<true, true>(x, input, h, substeps, env);
   } else if (env) {
-    integrate<true, false>(x, applied, h, substeps, env);
+    integrate<true, false>(x, input, h, substeps, env);
   } else {
-    integrate<false, false>(x, applied, h, substeps, nullptr);
+    integrate<false, false>(x, input, h, substeps, nullptr);
   }
 }
 

@@ -44,9 +44,9 @@ struct Wrench {
 };
 
 /// A motor command as the model applies it: clamped (Quadrotor::clamp_command), with the rotors'
-/// wrench for those speeds (eq. (4)). Formed once by Quadrotor::apply and reused while the command
+/// wrench for those speeds (eq. (4)). Formed once by Quadrotor::rotor_input and reused while the command
 /// holds, so that neither step() nor outputs() forms it again on every tick.
-struct AppliedCommand {
+struct RotorInput {
   Vector4 omega_rad_s = Vector4::Zero();
   Wrench wrench{0.0, Eigen::Vector3d::Zero()};
 };
@@ -65,7 +65,7 @@ class Quadrotor {
   Wrench wrench(const Vector4& omega_rad_s) const;
 
   /// The command clamped and its wrench, for the step() and outputs() overloads that take it.
-  AppliedCommand apply(const Vector4& omega_cmd_rad_s) const;
+  RotorInput rotor_input(const Vector4& omega_cmd_rad_s) const;
 
   /// dx/dt at state x under the (already clamped) commanded rotor speeds:
   ///  - translation, eq. (7) in vector form: dv_W = R_WB (0, 0, U1) / m + (0, 0, -g);
@@ -84,16 +84,16 @@ class Quadrotor {
   /// accelerometer measures).
   Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
                   const Environment* env = nullptr) const;
-  /// The same for a command already applied (apply(omega_cmd_rad_s)): the same numbers.
-  Outputs outputs(double t_s, const State& x, const AppliedCommand& cmd, const Environment* env = nullptr) const;
+  /// The same for a command already turned into its rotor input (rotor_input(omega_cmd_rad_s)): the same numbers.
+  Outputs outputs(double t_s, const State& x, const RotorInput& cmd, const Environment* env = nullptr) const;
 
   /// Advances x by dt_s with `substeps` classical RK4 steps, command held constant. After each step
   /// the quaternion is renormalised and ground contact is enforced (z >= 0; an impact is inelastic).
   /// `env` (optional) is held constant over the step.
   void step(State& x, double t_s, const Vector4& omega_cmd_rad_s, double dt_s, int substeps,
             const Environment* env = nullptr) const;
-  /// The same for a command already applied (apply(omega_cmd_rad_s)): the same numbers.
-  void step(State& x, double t_s, const AppliedCommand& cmd, double dt_s, int substeps,
+  /// The same for a command already turned into its rotor input (rotor_input(omega_cmd_rad_s)): the same numbers.
+  void step(State& x, double t_s, const RotorInput& cmd, double dt_s, int substeps,
             const Environment* env = nullptr) const;
 
   /// A state at rest at p_W with rotors stopped (or at hover speed when `hover` is true).
@@ -108,18 +108,18 @@ class Quadrotor {
   /// The inputs at the packed state y where they vary from stage to stage (quadrotor.cpp): the
   /// rotors' wrench, eq. (4), at the command (ideal motors) or at y's rotor speeds (lag); with an
   /// Environment, each rotor's efficiency, the ground effect on U1 and the air's drag as an extra
-  /// acceleration. Without either, the command's own wrench (AppliedCommand) is used instead.
-  RigidInputs varying_inputs(const double* y, const AppliedCommand& cmd, const Environment* env) const;
+  /// acceleration. Without either, the command's own wrench (RotorInput) is used instead.
+  RigidInputs varying_inputs(const double* y, const RotorInput& cmd, const Environment* env) const;
   /// dy/dt at the packed state y; `held_inputs` are used when kVaryingInputs is false.
   template <bool kVaryingInputs, bool kRotorLag>
-  void stage_derivative(const double* y, const AppliedCommand& cmd, const Environment* env,
+  void stage_derivative(const double* y, const RotorInput& cmd, const Environment* env,
                         const RigidInputs& held_inputs, double* d) const;
   /// The RK4 integrator of step(): `substeps` steps of h on x packed into plain doubles.
   template <bool kVaryingInputs, bool kRotorLag>
-  void integrate(State& x, const AppliedCommand& cmd, double h, int substeps, const Environment* env) const;
+  void integrate(State& x, const RotorInput& cmd, double h, int substeps, const Environment* env) const;
   /// The specific force at x in the world frame, a_W - g_W (Outputs::specific_force_B rotated).
   template <bool kVaryingInputs>
-  Eigen::Vector3d specific_force_W(const State& x, const AppliedCommand& cmd, const Environment* env) const;
+  Eigen::Vector3d specific_force_W(const State& x, const RotorInput& cmd, const Environment* env) const;
 
   VehicleParams params_;
   Matrix4 mixer_;

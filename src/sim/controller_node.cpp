@@ -17,14 +17,14 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
   command_msg_.dim = {{"", 4, 4}};
   transport.subscribe<msg::PoseStamped>(topics.pose, [this, topic = topics.pose](const msg::PoseStamped& m) {
     if (!accept(check_pose(m, pose_stamp_ns_), topic, pose_backwards_)) return;
-    estimate_.p_W = {m.position.x, m.position.y, m.position.z};
+    observation_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
     if (on_sample_) on_sample_();
   });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
     if (!accept(check_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) return;
-    estimate_.v_W = {m.linear.x, m.linear.y, m.linear.z};
+    observation_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
     if (on_sample_) on_sample_();
@@ -35,7 +35,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
     imu_pending_ = true;
-    estimate_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
+    observation_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
     if (on_sample_) on_sample_();
@@ -58,18 +58,18 @@ bool ControllerNode::accept_refused(const SensorCheck& check, const std::string&
   return false;
 }
 
-const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
+const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   if (imu_pending_) {
     const model::Euler e = model::euler_from_quaternion(imu_q_WB_);
-    estimate_.roll_rad = e.roll_rad;
-    estimate_.pitch_rad = e.pitch_rad;
-    estimate_.yaw_rad = e.yaw_rad;
+    observation_.roll_rad = e.roll_rad;
+    observation_.pitch_rad = e.pitch_rad;
+    observation_.yaw_rad = e.yaw_rad;
     imu_pending_ = false;
   }
   const std::int64_t oldest = std::min({pose_ref_ns_, velocity_ref_ns_, imu_ref_ns_});
-  estimate_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
+  observation_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
                                      : static_cast<double>(now_ns - oldest) / 1e9;
-  command_ = controller_.step(estimate_, config_.setpoint, dt_s);
+  output_ = controller_.step(observation_, config_.setpoint, dt_s);
 
   const auto& sp = config_.setpoint;
   const bool position = sp.mode == control::Mode::kPosition;
@@ -80,27 +80,27 @@ const control::Command& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   status_.setpoint = {sp.p_des_W.x(),
                       sp.p_des_W.y(),
                       sp.p_des_W.z(),
-                      position ? command_.roll_des_rad : sp.roll_des_rad,
-                      position ? command_.pitch_des_rad : sp.pitch_des_rad,
+                      position ? output_.roll_des_rad : sp.roll_des_rad,
+                      position ? output_.pitch_des_rad : sp.pitch_des_rad,
                       sp.yaw_des_rad};
   for (int i = 0; i < 4; ++i) {
-    status_.u[i] = command_.U[i];
-    status_.error[i] = command_.error[i];
-    status_.rotor_saturated[i] = command_.rotor_saturated[i];
+    status_.u[i] = output_.U[i];
+    status_.error[i] = output_.error[i];
+    status_.rotor_saturated[i] = output_.rotor_saturated[i];
   }
-  status_.tilt_saturated = command_.tilt_saturated;
-  status_.safety = command_.safety;
+  status_.tilt_saturated = output_.tilt_saturated;
+  status_.safety = output_.safety;
   status_.rejected_non_finite = fault_log_[static_cast<int>(SensorFault::kNonFinite)].total();
   status_.rejected_bad_quaternion = fault_log_[static_cast<int>(SensorFault::kBadQuaternion)].total();
   status_.rejected_bad_stamp = fault_log_[static_cast<int>(SensorFault::kBadStamp)].total();
   status_.rejected_stamp_backwards = fault_log_[static_cast<int>(SensorFault::kStampBackwards)].total();
   status_pub_.publish(status_);
 
-  for (int i = 0; i < 4; ++i) command_msg_.data[i] = command_.omega_rad_s[i];
+  for (int i = 0; i < 4; ++i) command_msg_.data[i] = output_.omega_rad_s[i];
   msg::write_command_label(command_msg_.dim[0].label, sim_now_ns);
   command_pub_.publish(command_msg_);
   last_step_ns_ = now_ns;
-  return command_;
+  return output_;
 }
 
 void ControllerNode::republish() {

@@ -3,7 +3,7 @@
 // its period, and publishes the rotor speeds on /<ns>/motor_commands. Parameters (gains, setpoints)
 // change between steps through the declared parameter table. Sensor messages that fail the checks of
 // sim/validation.hpp (NaN/Inf, non-unit quaternion, malformed or backward stamp) are dropped, counted
-// in the status and logged (1st of each reason, then every 100th): the estimate keeps its last valid
+// in the status and logged (1st of each reason, then every 100th): the observation keeps its last valid
 // values and ages, so the stale-data safety (Algorithm 1) takes over when nothing valid arrives.
 #pragma once
 
@@ -31,7 +31,7 @@ class ControllerNode {
   /// One control period ending now. `now_ns` is the node's current (simulated) time, `dt_s` its
   /// period; the age of the sensor data is measured against now_ns. Publishes the status, then the
   /// motor command.
-  const control::Command& step(std::int64_t now_ns, double dt_s);
+  const control::ControllerOutput& step(std::int64_t now_ns, double dt_s);
 
   /// Real time: measure the age of sensor data by when it arrived on `clock` [ns] instead of by its
   /// stamp, so a plant that stops publishing is noticed even though its simulated time stops too.
@@ -51,10 +51,10 @@ class ControllerNode {
   std::string set_parameter(const std::string& name, const control::ParameterValue& value);
 
   const control::ControllerConfig& config() const { return config_; }
-  const control::Command& last_command() const { return command_; }
+  const control::ControllerOutput& last_output() const { return output_; }
   const control::FlightController& controller() const { return controller_; }
-  /// The estimate the last step used.
-  const control::Estimate& estimate() const { return estimate_; }
+  /// The observation the last step used.
+  const control::Observation& observation() const { return observation_; }
   /// The stamp [ns] shared by the newest Pose, Velocity and Imu, when all three have arrived with the
   /// same stamp (a complete sample of one plant tick); -1 otherwise.
   std::int64_t synchronized_stamp_ns() const;
@@ -87,8 +87,8 @@ class ControllerNode {
 
   control::ControllerConfig config_;
   control::FlightController controller_;
-  control::Estimate estimate_;
-  control::Command command_;
+  control::Observation observation_;
+  control::ControllerOutput output_;
   /// Header stamps of the newest samples, and the times their age is measured from (the stamps, or
   /// the receipt times under use_receipt_clock).
   std::int64_t pose_stamp_ns_ = kNever, velocity_stamp_ns_ = kNever, imu_stamp_ns_ = kNever;
@@ -97,7 +97,7 @@ class ControllerNode {
   std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
   std::int64_t last_step_ns_ = kNever;
   Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
-  bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into estimate_'s Euler angles
+  bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into observation_'s Euler angles
   msg::ControllerStatus status_;
   std::function<void(const std::string&)> log_;
   std::function<void()> on_sample_;

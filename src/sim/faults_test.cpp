@@ -49,18 +49,18 @@ TEST(PlantWatchdogTest, StopPolicyActsAtTheLimitInTicksAndReleasesOnTheNextComma
   for (Tick k = 1; k < 5; ++k) {  // 4 ticks without a command: within the limit
     rig.tick(k);
     EXPECT_FALSE(rig.plant->watchdog_active()) << k;
-    EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(4000.0)) << k;
+    EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Constant(4000.0)) << k;
   }
   rig.tick(5);  // 5 ticks = 50 ms after the last command: the limit
   EXPECT_TRUE(rig.plant->watchdog_active());
   EXPECT_EQ(rig.plant->command_age_ns(), 50'000'000);
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(150.0));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Constant(150.0));
   rig.tick(6);
   EXPECT_EQ(rig.plant->stats().watchdog_trips, 1u);
   EXPECT_EQ(rig.plant->stats().watchdog_ticks, 2u);
   rig.tick(7, 3000.0);  // a valid command: released at once
   EXPECT_FALSE(rig.plant->watchdog_active());
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(3000.0));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Constant(3000.0));
   for (Tick k = 8; k <= 12; ++k) rig.tick(k);
   EXPECT_TRUE(rig.plant->watchdog_active());
   EXPECT_EQ(rig.plant->stats().watchdog_trips, 2u);
@@ -90,7 +90,7 @@ TEST(PlantWatchdogTest, HoldPolicyKeepsTheLastCommandButCountsTheEvent) {
   rig.tick(0, 4321.0);
   for (Tick k = 1; k <= 4; ++k) rig.tick(k);
   EXPECT_TRUE(rig.plant->watchdog_active());
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(4321.0));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Constant(4321.0));
   EXPECT_EQ(rig.plant->stats().watchdog_trips, 1u);
   EXPECT_EQ(rig.plant->stats().watchdog_ticks, 3u);  // ticks 2, 3, 4
 }
@@ -102,7 +102,7 @@ TEST(PlantWatchdogTest, ZeroSwitchesItOff) {
   rig.tick(0, 4000.0);
   for (Tick k = 1; k < 1000; ++k) rig.tick(k);
   EXPECT_FALSE(rig.plant->watchdog_active());
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(4000.0));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Constant(4000.0));
 }
 
 TEST(PlantWatchdogTest, ReceiptClockMeasuresWallTimeNotTicks) {
@@ -155,7 +155,7 @@ TEST(PlantWatchdogTest, ALockstepRepeatOfTheCurrentTickIsNotANewCommand) {
   rig.plant->latch_command(4);
   EXPECT_EQ(rig.plant->stats().commands_accepted, 1u);
   EXPECT_EQ(rig.plant->stats().commands_stale, 1u);
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Constant(4000.0));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Constant(4000.0));
 }
 
 // --- injected faults ----------------------------------------------------------------------------
@@ -256,7 +256,7 @@ HoverRun hover(const FaultConfig& faults, Tick ticks) {
                                             [&](const msg::PlantStatus& m) { r.plant_status.push_back(m); });
   s.run([&](const TickRecord& rec) {
     r.states.push_back(rec.state);
-    r.applied.push_back(rec.applied_command);
+    r.applied.push_back(rec.latched_command);
     r.safety_ticks += rec.status.safety && rec.tick >= kSettleTicks ? 1 : 0;
   });
   const Topics t = Topics::for_namespace(cfg.ns);

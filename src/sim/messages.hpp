@@ -185,7 +185,7 @@ struct ControllerStatus {
   bool tilt_saturated = false;
   bool safety = false;              ///< the stale-data safety command was sent
   /// Sensor messages refused so far, by reason (sim/validation.hpp, docs/reliability.md); a refused
-  /// message leaves the estimate as it was, so its age grows until the safety command takes over.
+  /// message leaves the observation as it was, so its age grows until the safety command takes over.
   std::uint64_t rejected_non_finite = 0;       ///< NaN/Inf in a field
   std::uint64_t rejected_bad_quaternion = 0;   ///< orientation not a unit quaternion (zero included)
   std::uint64_t rejected_bad_stamp = 0;        ///< sec < 0 or nanosec >= 1e9

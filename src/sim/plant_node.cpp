@@ -18,8 +18,8 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
     : model_(vehicle),
       options_(options),
       state_(initial),
-      applied_(initial.omega_rad_s),
-      model_command_(model_.apply(applied_)) {
+      latched_(initial.omega_rad_s),
+      rotor_input_(model_.rotor_input(latched_)) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   status_pub_ = transport.advertise<msg::PlantStatus>(topics.plant_status);
   if (options.realism.active() || vehicle.aero.active()) {
@@ -108,7 +108,7 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, model_command_,
+  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, rotor_input_,
                                           realism_ ? &realism_->environment(k) : nullptr);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
@@ -143,7 +143,7 @@ void PlantNode::publish_outputs(Tick k) {
 void PlantNode::latch_command(Tick k) {
   const std::size_t first = pending_head_;
   while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
-  if (pending_head_ > first) set_applied(pending_[pending_head_ - 1].omega);  // the newest one due
+  if (pending_head_ > first) set_latched(pending_[pending_head_ - 1].omega);  // the newest one due
   if (pending_head_ == pending_.size()) {
     pending_.clear();  // keeps the capacity
     pending_head_ = 0;
@@ -165,17 +165,17 @@ void PlantNode::latch_command(Tick k) {
   if (!expired) return;
   ++stats_.watchdog_ticks;
   if (options_.watchdog_policy == WatchdogPolicy::kStop) {
-    set_applied(model::Vector4::Constant(model_.params().motor.omega_min_rad_s));
+    set_latched(model::Vector4::Constant(model_.params().motor.omega_min_rad_s));
   }
 }
 
-void PlantNode::set_applied(const model::Vector4& omega_rad_s) {
-  applied_ = omega_rad_s;
-  model_command_ = model_.apply(omega_rad_s);  // clamped and turned into a wrench once per latch
+void PlantNode::set_latched(const model::Vector4& omega_rad_s) {
+  latched_ = omega_rad_s;
+  rotor_input_ = model_.rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
 }
 
 void PlantNode::integrate(Tick k) {
-  model_.step(state_, options_.clock.seconds(k), model_command_, options_.clock.period_s(), options_.substeps,
+  model_.step(state_, options_.clock.seconds(k), rotor_input_, options_.clock.period_s(), options_.substeps,
               realism_ ? &realism_->environment(k) : nullptr);
 }
 

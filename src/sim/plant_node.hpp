@@ -93,7 +93,7 @@ class PlantNode final : public SteppablePlant {
   const model::Quadrotor& model() const { return model_; }
   /// The command latched for the current interval, as received after check_command (speeds within
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
-  const model::Vector4& applied_command() const { return applied_; }
+  const model::Vector4& latched_command() const { return latched_; }
   const PlantStats& stats() const { return stats_; }
   /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet). Labels are read
   /// with drop_stale_commands (lockstep) only; otherwise this stays -1.
@@ -107,8 +107,8 @@ class PlantNode final : public SteppablePlant {
   /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
   void accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
-  /// Latches a command: applied_ and, formed once here, model_command_.
-  void set_applied(const model::Vector4& omega_rad_s);
+  /// Latches a command: latched_ and, formed once here, rotor_input_.
+  void set_latched(const model::Vector4& omega_rad_s);
 
   model::Quadrotor model_;
   PlantOptions options_;
@@ -116,8 +116,8 @@ class PlantNode final : public SteppablePlant {
   Tick current_tick_ = 0;
   std::int64_t last_command_stamp_ns_ = -1;
   std::int64_t last_label_seen_ns_ = -1;  ///< newest command label received (accepted or not)
-  model::Vector4 applied_ = model::Vector4::Zero();
-  model::AppliedCommand model_command_;  ///< applied_ as the model applies it (model_.apply(applied_))
+  model::Vector4 latched_ = model::Vector4::Zero();
+  model::RotorInput rotor_input_;  ///< latched_ as the model applies it (model_.rotor_input(latched_))
   struct Pending {
     Tick effective_tick;
     model::Vector4 omega;

@@ -111,7 +111,7 @@ TEST(PlantNodeTest, RejectsMalformedCommandsAndHoldsTheLastGoodOne) {
   rig.plant->latch_command(0);
   EXPECT_EQ(rig.plant->stats().commands_received, 5u);
   EXPECT_EQ(rig.plant->stats().commands_rejected, 4u);
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4(100, 200, 300, 400));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
 }
 
 TEST(PlantNodeTest, OutOfRangeCommandsAreClampedByTheModel) {
@@ -135,10 +135,10 @@ TEST(PlantNodeTest, CommandDelayShiftsTheEffectByWholeTicks) {
   rig.send({1, 1, 1, 1});
   for (Tick k = 10; k < 13; ++k) {
     rig.plant->latch_command(k);
-    EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Zero()) << "tick " << k;
+    EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Zero()) << "tick " << k;
   }
   rig.plant->latch_command(13);
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4::Ones());
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Ones());
 }
 
 TEST(ControllerNodeTest, PublishesTheSafetyCommandUntilSensorsArrive) {
@@ -205,7 +205,7 @@ Recorded run(const SimulationConfig& cfg, std::vector<ScheduledParameter> schedu
     r.t.push_back(rec.t_s);
     r.z.push_back(rec.state.p_W.z());
     r.states.push_back(rec.state);
-    r.applied.push_back(rec.applied_command);
+    r.applied.push_back(rec.latched_command);
   });
   return r;
 }

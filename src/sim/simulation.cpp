@@ -33,7 +33,7 @@ void Simulation::begin_tick(Tick k) {
 }
 
 TickRecord Simulation::record(Tick k) const {
-  return TickRecord{k, config_.plant.clock.seconds(k), plant_.state(), plant_.applied_command(), *delivered_status_};
+  return TickRecord{k, config_.plant.clock.seconds(k), plant_.state(), plant_.latched_command(), *delivered_status_};
 }
 
 void Simulation::run(const std::function<void(const TickRecord&)>& on_tick) {

@@ -41,7 +41,7 @@ struct TickRecord {
   Tick tick;
   double t_s;
   const model::State& state;
-  const model::Vector4& applied_command;  ///< rotor command acting over [t_k, t_k+1) [rad/s]
+  const model::Vector4& latched_command;  ///< rotor command acting over [t_k, t_k+1) [rad/s]
   const msg::ControllerStatus& status;    ///< the controller's latest step, as published
 };
 

@@ -35,7 +35,7 @@ struct Trace {
   void add(const TickRecord& r) {
     const auto& x = r.state;
     for (double v : {x.p_W.x(), x.p_W.y(), x.p_W.z(), x.v_W.x(), x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.w_B.y(),
-                     r.applied_command[0], r.applied_command[3], r.status.u[0]}) {
+                     r.latched_command[0], r.latched_command[3], r.status.u[0]}) {
       values.push_back(v);
     }
   }

@@ -372,7 +372,7 @@ TEST(PlantValidationTest, StatusCountsRefusedAndClampedCommandsAndGoesOutOnTheNe
                          "held; 1 rejected so far (logged: 1st, then every 100th)",
                          "plant: motor command clamped (rotor 1 speed -1 rad/s clamped to 0 (range [0, 12000])); 1 "
                          "clamped so far (logged: 1st, then every 100th)"}));
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4(0, 2, 3, 4));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(0, 2, 3, 4));
   for (Tick k = 3; k < 100; ++k) rig.tick(k);
   EXPECT_EQ(rig.statuses.size(), 2u);
   rig.tick(100);
@@ -406,7 +406,7 @@ TEST(PlantValidationTest, LockstepRepeatsOfACommandAreNotCountedTwice) {
   EXPECT_EQ(st.commands_accepted, 1u);
   EXPECT_EQ(st.commands_rejected_length, 1u);
   EXPECT_EQ(st.commands_stale, 3u);
-  EXPECT_EQ(rig.plant->applied_command(), model::Vector4(100, 200, 300, 400));
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
 }
 
 TEST(PlantValidationTest, LogIsRateLimitedAndSaysHowMany) {
@@ -482,7 +482,7 @@ TEST(ControllerValidationTest, OnlyInvalidSensorDataGivesTheSafetyCommand) {
     t.header.stamp = msg::Time::from_ns(ns);
     t.linear.x = kNaN;
     rig.velocity.publish(t);
-    const control::Command& c = rig.node->step(ns, 0.02);
+    const control::ControllerOutput& c = rig.node->step(ns, 0.02);
     ASSERT_TRUE(c.safety) << "step " << k;
     for (int i = 0; i < 4; ++i) EXPECT_NEAR(c.omega_rad_s[i], hover, 1e-9);
   }
@@ -507,13 +507,13 @@ TEST(ControllerValidationTest, ValidDataRecoversAndBackwardStampsAreRefused) {
   ControllerRig rig;
   rig.send(0, 1.0, 5.0);
   EXPECT_FALSE(rig.node->step(0, 0.02).safety);
-  EXPECT_EQ(rig.node->estimate().p_W.z(), 5.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 5.0);
   // Newer data, then a stale replay with a different position: the replay is refused.
   rig.send(40'000'000, 1.0, 5.0);
   rig.send(20'000'000, 1.0, 99.0);
   EXPECT_EQ(rig.node->status().rejected_stamp_backwards, 0u) << "counted at arrival, published at step";
   EXPECT_FALSE(rig.node->step(40'000'000, 0.02).safety);
-  EXPECT_EQ(rig.node->estimate().p_W.z(), 5.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 5.0);
   EXPECT_EQ(rig.node->status().rejected_stamp_backwards, 3u);
   // Only refused data from now on: the valid data of t = 0.04 s ages past the 0.1 s limit.
   for (std::int64_t ns = 60'000'000; ns <= 200'000'000; ns += 20'000'000) {
@@ -530,11 +530,11 @@ TEST(ControllerValidationTest, ASenderWhoseClockRestartedIsFollowedAfterARunOfOl
   // The sender starts again from t = 0: refused (and the data ages into the safety) until
   // kStampRestartCount samples in a row were refused on each topic; the next is accepted.
   for (int k = 0; k < kStampRestartCount; ++k) rig.send(k * 10'000'000LL, 1.0, 7.0);
-  EXPECT_EQ(rig.node->estimate().p_W.z(), 5.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 5.0);
   EXPECT_TRUE(rig.node->step(50'500'000'000, 0.02).safety);
   EXPECT_EQ(rig.node->status().rejected_stamp_backwards, 3u * kStampRestartCount);
   rig.send(kStampRestartCount * 10'000'000LL, 1.0, 7.0);
-  EXPECT_EQ(rig.node->estimate().p_W.z(), 7.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 7.0);
   EXPECT_EQ(rig.log.back(),
             "controller: /drone/Imu: 50 samples in a row older than the newest accepted; taking it that the "
             "sender's clock restarted (stamp 500000000 ns is older than the newest accepted, 50000000000 ns)");
@@ -542,7 +542,7 @@ TEST(ControllerValidationTest, ASenderWhoseClockRestartedIsFollowedAfterARunOfOl
   EXPECT_FALSE(rig.node->step(kStampRestartCount * 10'000'000LL, 0.02).safety);
   // A single old sample after that is refused again.
   rig.send(0, 1.0, 9.0);
-  EXPECT_EQ(rig.node->estimate().p_W.z(), 7.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 7.0);
 }
 
 }  // namespace

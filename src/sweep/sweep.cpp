@@ -41,7 +41,7 @@ io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path*
     series.add(r.t_s, r.state, c);  // the numbers trajectory.csv holds
     if (writer) {
       watchdog = simulation.plant().watchdog_active();
-      writer->write(r.t_s, r.state, r.applied_command, c, watchdog);
+      writer->write(r.t_s, r.state, r.latched_command, c, watchdog);
     }
     if (mcap) mcap->flush_settled(sc.simulation.plant.clock.ns(r.tick));
   });

@@ -47,7 +47,7 @@ class ClosedLoop {
 
   void end(sim::Tick k) {
     if (k % 2 == 0) {
-      const control::Command& c = controller_.step(k * 10'000'000, 2 * kPeriod_s);
+      const control::ControllerOutput& c = controller_.step(k * 10'000'000, 2 * kPeriod_s);
       for (int i = 0; i < 4; ++i) {
         if (!std::isfinite(c.omega_rad_s[i])) fail("the controller sent a non-finite rotor speed", k);
       }
