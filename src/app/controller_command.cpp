@@ -22,21 +22,14 @@
 namespace quadcosim::app {
 
 CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl) {
-  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
   auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
   ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
-  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
-  ctl_cmd->add_option("--vehicles", ctl.swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
-      ->check(CLI::Range(1, 1'000'000));
-  ctl_cmd->add_option("--ns-prefix", ctl.swarm.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  ctl_cmd->add_option("--threads", ctl.swarm.threads, "with --vehicles: threads, one DDS participant each")
-      ->check(CLI::Range(1, 64));
-  ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
-  add_cpus_option(ctl_cmd, ctl.cpus);
+  add_node_host_options(ctl_cmd, ctl.ns, ctl.swarm, ctl.sensor_qos,
+                        "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)", ctl.cpus);
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");
@@ -54,18 +47,10 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
 }
 
 int controller_command(const ControllerCommandOptions& o) {
-  install_stop_handlers();
-  // Before any DDS participant: Cyclone's threads inherit the affinity.
-  if (std::string err = use_cpus(o.cpus); !err.empty()) {
-    std::cerr << "error: controller: --cpus: " << err << '\n';
-    return exit_code::kBadInput;
-  }
-  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
-  if (!o.cpus.empty()) std::cerr << fmt::format("controller: on CPU(s) {} only\n", o.cpus);
-  io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
+  std::optional<io::Scenario> started = start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns);
+  if (!started) return exit_code::kBadInput;
+  io::Scenario& sc = *started;
   if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
-  if (!o.ns.empty()) sc.simulation.ns = o.ns;
-  refuse_faults_over_dds(sc);
   if (o.swarm.vehicles > 0) return swarm_controller_command(o, std::move(sc));
   const sim::TickClock clock = sc.simulation.plant.clock;
   const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;

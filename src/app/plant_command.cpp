@@ -298,15 +298,8 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->check(CLI::ExistingFile);
   plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
       ->check(CLI::ExistingFile);
-  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
-  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
-  plant_cmd->add_option("--vehicles", plant.swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
-      ->check(CLI::Range(1, 1'000'000));
-  plant_cmd->add_option("--ns-prefix", plant.swarm.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  plant_cmd->add_option("--threads", plant.swarm.threads, "with --vehicles: threads, one DDS participant each")
-      ->check(CLI::Range(1, 64));
-  plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
-  add_cpus_option(plant_cmd, plant.cpus);
+  add_node_host_options(plant_cmd, plant.ns, plant.swarm, plant.sensor_qos,
+                        "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)", plant.cpus);
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
   plant_cmd->add_option("--rate-factor", plant.realtime.rate_factor, "real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
@@ -336,17 +329,9 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
 }
 
 int plant_command(const PlantCommandOptions& o) {
-  install_stop_handlers();
-  // Before any DDS participant: Cyclone's threads inherit the affinity.
-  if (std::string err = use_cpus(o.cpus); !err.empty()) {
-    std::cerr << "error: plant: --cpus: " << err << '\n';
-    return exit_code::kBadInput;
-  }
-  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
-  if (!o.cpus.empty()) std::cerr << fmt::format("plant: on CPU(s) {} only\n", o.cpus);
-  io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
-  if (!o.ns.empty()) sc.simulation.ns = o.ns;
-  refuse_faults_over_dds(sc);
+  std::optional<io::Scenario> started = start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns);
+  if (!started) return exit_code::kBadInput;
+  io::Scenario& sc = *started;
   if (o.watchdog_s >= 0.0) {
     const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
     if (std::abs(ticks - std::round(ticks)) > 1e-6) {
