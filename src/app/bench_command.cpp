@@ -100,7 +100,7 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
   fs::remove(ps);
   fs::remove(cs);
-  std::vector<std::string> c = {self, "controller", "--scenario", scenario, "--stats", cs};
+  std::vector<std::string> c = {self, "controller", "--scenario", scenario};
   std::vector<std::string> p = {self, "plant", "--scenario", scenario, "--duration", fmt::format("{}", sim_s),
                                 "--stats", ps, "--timeout", "60"};
   if (vehicles > 0) {
@@ -111,7 +111,8 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   }
   if (pinned) pin_apart(p, c);
   if (realtime) {
-    c.push_back("--realtime");
+    // The controller's --stats (its period jitter) is real time only.
+    for (const std::string& a : {std::string("--realtime"), std::string("--stats"), cs}) c.push_back(a);
     if (rt_priority > 0) {
       c.push_back("--rt-priority");
       c.push_back(std::to_string(rt_priority));

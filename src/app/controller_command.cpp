@@ -30,7 +30,7 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
       ->check(CLI::ExistingFile);
   add_node_host_options(ctl_cmd, ctl.ns, ctl.swarm, ctl.sensor_qos,
                         "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)", ctl.cpus);
-  ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
+  ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep (one vehicle)");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.realtime.rate_factor, "real time: run the timer k times faster")
@@ -39,10 +39,25 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
                       "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
       ->check(CLI::Range(0, 99));
   ctl_cmd->add_option("--stats", ctl.realtime.stats, "real time: write the control period jitter as JSON here on exit");
-  ctl_cmd->add_option("--node-name", ctl.one_vehicle.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
+  ctl_cmd->add_option("--node-name", ctl.one_vehicle.node_name,
+                      "one vehicle: ROS node name (parameter services /NAME/..., ros2 node list)")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
   add_enclave_option(ctl_cmd, ctl.enclave);
+  // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
+  ctl_cmd->parse_complete_callback([ctl_cmd, &ctl] {
+    const bool swarm = ctl.swarm.vehicles > 0, realtime = !ctl.lockstep;
+    refuse_idle_flags(*ctl_cmd, {
+        {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
+        {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
+        {"--node-name", !swarm, "--vehicles; a swarm offers no parameter services"},
+        {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
+        {"--threads", swarm, "one vehicle; it needs --vehicles N"},
+        {"--rate-factor", realtime, "lockstep; it needs --realtime"},
+        {"--rt-priority", realtime, "lockstep; it needs --realtime"},
+        {"--stats", realtime, "lockstep; it needs --realtime (in lockstep the plant's --stats has the figures)"},
+    });
+  });
   return ctl_cmd;
 }
 

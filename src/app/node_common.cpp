@@ -161,7 +161,7 @@ void add_cpus_option(CLI::App* command, std::string& cpus) {
 void add_node_host_options(CLI::App* command, std::string& ns, NodeSwarmOptions& swarm, bool& sensor_qos,
                            const std::string& sensor_qos_help, std::string& cpus) {
   const CLI::Validator ros_namespace(sim::validate_namespace, "NAMESPACE");
-  command->add_option("--namespace", ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
+  command->add_option("--namespace", ns, "topic namespace, e.g. /uav1 (one vehicle)")->check(ros_namespace);
   command->add_option("--vehicles", swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
       ->check(CLI::Range(1, 1'000'000));
   command->add_option("--ns-prefix", swarm.ns_prefix,
