@@ -1,12 +1,12 @@
 // Micro-benchmarks (Google Benchmark): the plant step per RK4 sub-step count, one controller step, the
 // CARE solve, the allocation, one tick of the full in-process co-simulation, and the BASELINE minimal
-// loop (bench/micro/baseline_loop.hpp). Built with the project, never run by CTest:
+// loop (src/baseline/baseline_loop.hpp). Built with the project, never run by CTest:
 //   build/bench/quadcosim_bench [--benchmark_filter=REGEX]
 #include <benchmark/benchmark.h>
 
 #include <memory>
 
-#include "bench/micro/baseline_setup.hpp"
+#include "baseline/baseline_setup.hpp"
 #include "control/allocation.hpp"
 #include "control/care.hpp"
 #include "control/flight_controller.hpp"
@@ -84,7 +84,7 @@ BENCHMARK(BM_Allocation);
 
 // One 100 Hz tick (plant step + half a controller step) of the BASELINE minimal loop.
 void BM_BaselineTick(benchmark::State& st) {
-  qc::bench::BaselineLoop loop = qc::bench::make_baseline(qc::control::ControllerParams{}, 10.0);
+  qc::baseline::BaselineLoop loop = qc::baseline::make_baseline(qc::control::ControllerParams{}, 10.0);
   long k = 0;
   for (auto _ : st) {
     loop.tick(k++, 0.01);

@@ -1,7 +1,7 @@
 // `quadcosim bench [--json] [--quick]`: the framework's speed on this machine, measured end to end
 // (docs/performance.md). Prints figures; asserts nothing.
 //   inproc_rtf                 one vehicle in-process (paper altitude scenario, recording off)
-//   baseline_rtf               the BASELINE minimal loop (bench/micro/baseline_loop.hpp) on the same
+//   baseline_rtf               the BASELINE minimal loop (src/baseline/baseline_loop.hpp) on the same
 //                              vehicle and gains: the machine's floor for this model
 //   dds_lockstep_rtf, dds_cmd_roundtrip_us_p50/p99
 //                              plant and controller as two processes over DDS, lockstep
@@ -31,7 +31,7 @@
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/swarm.hpp"
-#include "bench/micro/baseline_setup.hpp"
+#include "baseline/baseline_setup.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
 
@@ -60,7 +60,7 @@ double inproc_rtf(const io::Scenario& sc, double sim_s) {
 double baseline_rtf(const io::Scenario& sc, double sim_s) {
   const double dt = sc.simulation.plant.clock.period_s();
   const long ticks = static_cast<long>(sim_s / dt + 0.5);
-  bench::BaselineLoop loop = bench::make_baseline(sc.controller.params, 10.0);
+  baseline::BaselineLoop loop = baseline::make_baseline(sc.controller.params, 10.0);
   const auto t0 = std::chrono::steady_clock::now();
   for (long k = 0; k <= ticks; ++k) loop.tick(k, dt);
   const double rtf = sim_s / seconds_since(t0);
@@ -100,7 +100,7 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
   fs::remove(ps);
   fs::remove(cs);
-  std::vector<std::string> c = {self, "controller", "--scenario", scenario, "--stats", cs};
+  std::vector<std::string> c = {self, "controller", "--scenario", scenario};
   std::vector<std::string> p = {self, "plant", "--scenario", scenario, "--duration", fmt::format("{}", sim_s),
                                 "--stats", ps, "--timeout", "60"};
   if (vehicles > 0) {
@@ -111,7 +111,8 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   }
   if (pinned) pin_apart(p, c);
   if (realtime) {
-    c.push_back("--realtime");
+    // The controller's --stats (its period jitter) is real time only.
+    for (const std::string& a : {std::string("--realtime"), std::string("--stats"), cs}) c.push_back(a);
     if (rt_priority > 0) {
       c.push_back("--rt-priority");
       c.push_back(std::to_string(rt_priority));

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,13 @@ struct SummaryOptions {
 int summary_command(const SummaryOptions& options);
 CLI::App* add_summary_subcommand(CLI::App& app, SummaryOptions& options);
 
+/// --vehicles N: how `plant` and `controller` host a swarm (lockstep only).
+struct NodeSwarmOptions {
+  int vehicles = 0;       ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...)
+  std::string ns_prefix;  ///< overrides the scenario's swarm.namespace_prefix
+  int threads = 2;        ///< threads (one DDS participant each)
+};
+
 /// `quadcosim plant`: what every mode takes, then what one mode alone takes (its own struct).
 struct PlantCommandOptions {
   /// Lockstep only (one vehicle or --vehicles N).
@@ -91,11 +99,8 @@ struct PlantCommandOptions {
     std::string schedule_node;
   };
   /// --vehicles N (lockstep).
-  struct Swarm {
-    int vehicles = 0;       ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...)
-    std::string ns_prefix;  ///< overrides the scenario's swarm.namespace_prefix
-    int threads = 2;        ///< threads (one DDS participant each)
-    std::string out;        ///< directory for summary.json, vehicles.csv, recorded vehicles
+  struct Swarm : NodeSwarmOptions {
+    std::string out;  ///< directory for summary.json, vehicles.csv, recorded vehicles
   };
 
   // Every mode.
@@ -132,12 +137,8 @@ struct ControllerCommandOptions {
   struct OneVehicle {
     std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
   };
-  /// --vehicles N (lockstep).
-  struct Swarm {
-    int vehicles = 0;       ///< > 0: host this many vehicles' controllers
-    std::string ns_prefix;  ///< overrides the scenario's swarm.namespace_prefix
-    int threads = 2;        ///< threads (one DDS participant each)
-  };
+  /// --vehicles N (lockstep): this many vehicles' controllers.
+  using Swarm = NodeSwarmOptions;
 
   // Every mode.
   std::string scenario;  ///< controller parameters, rates, schedule ("" for defaults)
@@ -218,6 +219,22 @@ int security_command(const SecurityOptions& options);
 void add_enclave_option(CLI::App* command, std::string& enclave);
 /// `--cpus LIST` (plant, controller): the CPUs the process runs on, checked as a CPU list.
 void add_cpus_option(CLI::App* command, std::string& cpus);
+/// The flags with which `plant` and `controller` host their vehicles: --namespace (one vehicle),
+/// --vehicles, --ns-prefix, --threads (a swarm), --sensor-qos (`sensor_qos_help` says which way) and --cpus.
+void add_node_host_options(CLI::App* command, std::string& ns, NodeSwarmOptions& swarm, bool& sensor_qos,
+                           const std::string& sensor_qos_help, std::string& cpus);
+
+/// One row of a command's table of flags that act in some modes only: `flag` acts when `acts` holds;
+/// when it does not, `mode` names the mode chosen and what the flag needs ("lockstep; it needs --realtime").
+struct FlagRule {
+  const char* flag;
+  bool acts;
+  const char* mode;
+};
+/// Refuses a flag that would do nothing: throws CLI::ValidationError "FLAG: does nothing with MODE" (exit 2)
+/// for the first rule whose flag was given to `command` and does not act. Call it from the command's
+/// parse_complete_callback, once every flag is parsed and before anything runs.
+void refuse_idle_flags(const CLI::App& command, std::initializer_list<FlagRule> rules);
 /// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
 /// existing ones are used as they are. 0, or 2 after printing why not.
 int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);

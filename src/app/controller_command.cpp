@@ -22,22 +22,15 @@
 namespace quadcosim::app {
 
 CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl) {
-  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
   auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
   ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
-  ctl_cmd->add_option("--namespace", ctl.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
-  ctl_cmd->add_option("--vehicles", ctl.swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
-      ->check(CLI::Range(1, 1'000'000));
-  ctl_cmd->add_option("--ns-prefix", ctl.swarm.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  ctl_cmd->add_option("--threads", ctl.swarm.threads, "with --vehicles: threads, one DDS participant each")
-      ->check(CLI::Range(1, 64));
-  ctl_cmd->add_flag("--sensor-qos", ctl.sensor_qos, "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)");
-  add_cpus_option(ctl_cmd, ctl.cpus);
-  ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep");
+  add_node_host_options(ctl_cmd, ctl.ns, ctl.swarm, ctl.sensor_qos,
+                        "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)", ctl.cpus);
+  ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep (one vehicle)");
   ctl_cmd->add_flag("!--no-schedule", ctl.apply_schedule,
                     "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.realtime.rate_factor, "real time: run the timer k times faster")
@@ -46,26 +39,33 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
                       "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
       ->check(CLI::Range(0, 99));
   ctl_cmd->add_option("--stats", ctl.realtime.stats, "real time: write the control period jitter as JSON here on exit");
-  ctl_cmd->add_option("--node-name", ctl.one_vehicle.node_name, "ROS node name: parameter services /NAME/..., ros2 node list")
+  ctl_cmd->add_option("--node-name", ctl.one_vehicle.node_name,
+                      "one vehicle: ROS node name (parameter services /NAME/..., ros2 node list)")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
   add_enclave_option(ctl_cmd, ctl.enclave);
+  // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
+  ctl_cmd->parse_complete_callback([ctl_cmd, &ctl] {
+    const bool swarm = ctl.swarm.vehicles > 0, realtime = !ctl.lockstep;
+    refuse_idle_flags(*ctl_cmd, {
+        {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
+        {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
+        {"--node-name", !swarm, "--vehicles; a swarm offers no parameter services"},
+        {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
+        {"--threads", swarm, "one vehicle; it needs --vehicles N"},
+        {"--rate-factor", realtime, "lockstep; it needs --realtime"},
+        {"--rt-priority", realtime, "lockstep; it needs --realtime"},
+        {"--stats", realtime, "lockstep; it needs --realtime (in lockstep the plant's --stats has the figures)"},
+    });
+  });
   return ctl_cmd;
 }
 
 int controller_command(const ControllerCommandOptions& o) {
-  install_stop_handlers();
-  // Before any DDS participant: Cyclone's threads inherit the affinity.
-  if (std::string err = use_cpus(o.cpus); !err.empty()) {
-    std::cerr << "error: controller: --cpus: " << err << '\n';
-    return exit_code::kBadInput;
-  }
-  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
-  if (!o.cpus.empty()) std::cerr << fmt::format("controller: on CPU(s) {} only\n", o.cpus);
-  io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
+  std::optional<io::Scenario> started = start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns);
+  if (!started) return exit_code::kBadInput;
+  io::Scenario& sc = *started;
   if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
-  if (!o.ns.empty()) sc.simulation.ns = o.ns;
-  refuse_faults_over_dds(sc);
   if (o.swarm.vehicles > 0) return swarm_controller_command(o, std::move(sc));
   const sim::TickClock clock = sc.simulation.plant.clock;
   const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;

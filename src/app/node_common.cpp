@@ -21,23 +21,31 @@
 
 namespace quadcosim::app {
 
-io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file) {
+std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
+                                               const std::string& scenario, const std::string& vehicle,
+                                               const std::string& ns) {
+  install_stop_handlers();
+  if (std::string err = use_cpus(cpus); !err.empty()) {
+    std::cerr << "error: " << who << ": --cpus: " << err << '\n';
+    return std::nullopt;
+  }
+  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
+  if (!cpus.empty()) std::cerr << fmt::format("{}: on CPU(s) {} only\n", who, cpus);
   io::Scenario sc;
-  if (!path.empty()) {
-    sc = io::load_scenario(path);
+  if (!scenario.empty()) {
+    sc = io::load_scenario(scenario);
   } else {
     sc.name = "defaults";
   }
-  if (!vehicle_file.empty()) sc.vehicle = io::load_vehicle(vehicle_file);
+  if (!vehicle.empty()) sc.vehicle = io::load_vehicle(vehicle);
   sc.controller.params.vehicle = sc.vehicle;
+  if (!ns.empty()) sc.simulation.ns = ns;
+  if (sc.simulation.faults.active()) {
+    throw io::ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) +
+                          ": message_faults: message loss and delay are injected by the in-process transport only "
+                          "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
+  }
   return sc;
-}
-
-void refuse_faults_over_dds(const io::Scenario& sc) {
-  if (!sc.simulation.faults.active()) return;
-  throw io::ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) +
-                        ": message_faults: message loss and delay are injected by the in-process transport only "
-                        "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
 }
 
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
@@ -148,6 +156,28 @@ void add_cpus_option(CLI::App* command, std::string& cpus) {
             return parse_cpu_list(text, cpus);
           },
           "LIST"));
+}
+
+void add_node_host_options(CLI::App* command, std::string& ns, NodeSwarmOptions& swarm, bool& sensor_qos,
+                           const std::string& sensor_qos_help, std::string& cpus) {
+  const CLI::Validator ros_namespace(sim::validate_namespace, "NAMESPACE");
+  command->add_option("--namespace", ns, "topic namespace, e.g. /uav1 (one vehicle)")->check(ros_namespace);
+  command->add_option("--vehicles", swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
+      ->check(CLI::Range(1, 1'000'000));
+  command->add_option("--ns-prefix", swarm.ns_prefix,
+                      "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
+  command->add_option("--threads", swarm.threads, "with --vehicles: threads, one DDS participant each")
+      ->check(CLI::Range(1, 64));
+  command->add_flag("--sensor-qos", sensor_qos, sensor_qos_help);
+  add_cpus_option(command, cpus);
+}
+
+void refuse_idle_flags(const CLI::App& command, std::initializer_list<FlagRule> rules) {
+  for (const FlagRule& r : rules) {
+    if (command.count(r.flag) > 0 && !r.acts) {
+      throw CLI::ValidationError(r.flag, std::string("does nothing with ") + r.mode);
+    }
+  }
 }
 
 std::string use_cpus(const std::string& list) {

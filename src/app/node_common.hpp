@@ -25,13 +25,17 @@ constexpr std::int64_t kMs = 1'000'000;  ///< [ns]
 /// Monotonic wall clock [ns]; only the real-time loops and the latency figures read it.
 using dds::steady_ns;
 
-/// The scenario at `path` (the built-in defaults when empty), its vehicle replaced by the one in
-/// `vehicle_file` when given. Throws io::ConfigError.
-io::Scenario scenario_or_defaults(const std::string& path, const std::string& vehicle_file);
+/// The start of a `plant` or `controller` process (`who` names it in messages): Ctrl-C handlers, the
+/// --cpus affinity (before any DDS participant, so Cyclone's threads inherit it), then the scenario at
+/// `scenario` (the built-in defaults when empty) with its vehicle replaced by the one in `vehicle` and
+/// its namespace by `ns` when they are given. nullopt, after printing why, when the CPUs are refused
+/// (exit 2); throws io::ConfigError for a bad file or when the scenario asks for injected faults,
+/// which only the in-process transport can inject (over DDS, faults come from the network: tc netem,
+/// docs/reliability.md).
+std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
+                                               const std::string& scenario, const std::string& vehicle,
+                                               const std::string& ns);
 
-/// Throws io::ConfigError when the scenario asks for injected faults, which only the in-process
-/// transport can inject (over DDS, faults come from the network: tc netem, docs/reliability.md).
-void refuse_faults_over_dds(const io::Scenario& sc);
 /// Real-time loops: lets the DDS transport deliver messages until 1 ms before `deadline_ns`
 /// (steady_ns), then spins on the clock until the deadline (5 % of a core for a 20 ms period), so
 /// the wake-up lands on the deadline instead of a scheduler wake-up later. The first call also asks

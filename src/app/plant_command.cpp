@@ -298,25 +298,21 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->check(CLI::ExistingFile);
   plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
       ->check(CLI::ExistingFile);
-  const CLI::Validator ros_namespace(quadcosim::sim::validate_namespace, "NAMESPACE");
-  plant_cmd->add_option("--namespace", plant.ns, "topic namespace, e.g. /uav1")->check(ros_namespace);
-  plant_cmd->add_option("--vehicles", plant.swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
-      ->check(CLI::Range(1, 1'000'000));
-  plant_cmd->add_option("--ns-prefix", plant.swarm.ns_prefix, "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  plant_cmd->add_option("--threads", plant.swarm.threads, "with --vehicles: threads, one DDS participant each")
-      ->check(CLI::Range(1, 64));
-  plant_cmd->add_flag("--sensor-qos", plant.sensor_qos, "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)");
-  add_cpus_option(plant_cmd, plant.cpus);
-  plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep");
+  add_node_host_options(plant_cmd, plant.ns, plant.swarm, plant.sensor_qos,
+                        "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)", plant.cpus);
+  plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep (one vehicle)");
   plant_cmd->add_option("--rate-factor", plant.realtime.rate_factor, "real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
   plant_cmd->add_option("--duration", plant.duration_s, "simulated time [s]")->check(CLI::Range(0.0, 1e9));
-  plant_cmd->add_option("--record", plant.one_vehicle.record, "write the trajectory CSV here");
-  plant_cmd->add_option("--mcap", plant.one_vehicle.mcap, "record the topics as MCAP here (metadata.yaml beside it)");
-  plant_cmd->add_option("--timeout", plant.timeout_s, "lockstep: wait for the controller / a command [s]")
+  plant_cmd->add_option("--record", plant.one_vehicle.record, "one vehicle: write the trajectory CSV here");
+  plant_cmd->add_option("--mcap", plant.one_vehicle.mcap,
+                        "one vehicle: record the topics as MCAP here (metadata.yaml beside it)");
+  plant_cmd->add_option("--timeout", plant.timeout_s,
+                        "lockstep: wait for the controller / a command; real time: for the controller "
+                        "(--wait-for-controller) and each --schedule-via answer [s]")
       ->check(CLI::Range(0.01, 3600.0));
   plant_cmd->add_option("--schedule-via", plant.one_vehicle.schedule_node,
-                        "lockstep: apply the scenario's schedule through this node's parameter services");
+                        "one vehicle: apply the scenario's schedule through this node's parameter services");
   plant_cmd->add_flag("--wait-for-controller", plant.realtime.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
@@ -332,21 +328,32 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->check(CLI::IsMember({"hold", "stop"}));
 
   add_enclave_option(plant_cmd, plant.enclave);
+  // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
+  plant_cmd->parse_complete_callback([plant_cmd, &plant] {
+    const bool swarm = plant.swarm.vehicles > 0, realtime = !plant.lockstep;
+    refuse_idle_flags(*plant_cmd, {
+        {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
+        {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
+        {"--record", !swarm, "--vehicles; a swarm records with --swarm-out"},
+        {"--mcap", !swarm, "--vehicles; a swarm records with --swarm-out"},
+        {"--schedule-via", !swarm, "--vehicles; each vehicle's controller applies the schedule"},
+        {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
+        {"--threads", swarm, "one vehicle; it needs --vehicles N"},
+        {"--swarm-out", swarm, "one vehicle; it needs --vehicles N"},
+        {"--rate-factor", realtime, "lockstep; it needs --realtime"},
+        {"--wait-for-controller", realtime, "lockstep; it needs --realtime (lockstep always waits)"},
+        {"--on-timeout", !realtime, "--realtime; it is the lockstep timeout's policy"},
+        {"--timeout", !realtime || plant.realtime.wait_for_controller || !plant.one_vehicle.schedule_node.empty(),
+         "--realtime alone; it needs lockstep, --wait-for-controller or --schedule-via"},
+    });
+  });
   return plant_cmd;
 }
 
 int plant_command(const PlantCommandOptions& o) {
-  install_stop_handlers();
-  // Before any DDS participant: Cyclone's threads inherit the affinity.
-  if (std::string err = use_cpus(o.cpus); !err.empty()) {
-    std::cerr << "error: plant: --cpus: " << err << '\n';
-    return exit_code::kBadInput;
-  }
-  // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
-  if (!o.cpus.empty()) std::cerr << fmt::format("plant: on CPU(s) {} only\n", o.cpus);
-  io::Scenario sc = scenario_or_defaults(o.scenario, o.vehicle);
-  if (!o.ns.empty()) sc.simulation.ns = o.ns;
-  refuse_faults_over_dds(sc);
+  std::optional<io::Scenario> started = start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns);
+  if (!started) return exit_code::kBadInput;
+  io::Scenario& sc = *started;
   if (o.watchdog_s >= 0.0) {
     const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
     if (std::abs(ticks - std::round(ticks)) > 1e-6) {

@@ -1,14 +1,7 @@
 #!/usr/bin/env bash
 # `quadcosim margins`, one case per CTest test.
 #   usage: margins_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE
-set -euo pipefail
-QC=$1
-SRC=$2
-CASE=$3
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fail() { echo "FAIL [$CASE]: $*" >&2; exit 1; }
-PY=${QUADCOSIM_PYTHON:-/usr/bin/python3}
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/cli_case.sh" "$@"
 P="$SRC/scenarios/paper"
 
 # A copy of the paper's roll scenario with one `simulation:` key set: with_simulation NAME KEY VALUE

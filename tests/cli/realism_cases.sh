@@ -1,14 +1,7 @@
 #!/usr/bin/env bash
 # The realism scenarios and `quadcosim sweep`, one case per CTest test.
 #   usage: realism_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE
-set -euo pipefail
-QC=$1
-SRC=$2
-CASE=$3
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fail() { echo "FAIL [$CASE]: $*" >&2; exit 1; }
-PY=${QUADCOSIM_PYTHON:-/usr/bin/python3}
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/cli_case.sh" "$@"
 R="$SRC/scenarios/realism"
 
 case "$CASE" in

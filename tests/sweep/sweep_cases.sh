@@ -2,14 +2,7 @@
 # `quadcosim sweep` beyond one batch of runs: rerun, shards and merge, kept trajectories, keys by
 # their YAML path, output folder hygiene, the console table. One case per CTest test.
 #   usage: sweep_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE
-set -euo pipefail
-QC=$1
-SRC=$2
-CASE=$3
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fail() { echo "FAIL [$CASE]: $*" >&2; exit 1; }
-PY=${QUADCOSIM_PYTHON:-/usr/bin/python3}
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/cli_case.sh" "$@"
 HOVER="$SRC/scenarios/realism/hover_wind_gusts.yaml"
 ALT="$SRC/scenarios/paper/altitude_step.yaml"
 

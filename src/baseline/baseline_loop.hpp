@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace quadcosim::bench {
+namespace quadcosim::baseline {
 
 struct BaselineVehicle {
   double mass_kg, gravity_m_s2;
@@ -112,4 +112,4 @@ class BaselineLoop {
   double omega_[4] = {0, 0, 0, 0};
 };
 
-}  // namespace quadcosim::bench
+}  // namespace quadcosim::baseline

@@ -1,16 +1,12 @@
-// Builds the BASELINE loop's plain numbers from the framework's vehicle and controller parameters
-// (setup only), so the baseline flies the same vehicle with the same gains.
-#pragma once
+#include "baseline/baseline_setup.hpp"
 
 #include <Eigen/LU>
 
-#include "bench/micro/baseline_loop.hpp"
-#include "control/flight_controller.hpp"
 #include "model/mixer.hpp"
 
-namespace quadcosim::bench {
+namespace quadcosim::baseline {
 
-inline BaselineLoop make_baseline(const control::ControllerParams& p, double z_des_m) {
+BaselineLoop make_baseline(const control::ControllerParams& p, double z_des_m) {
   const auto& veh = p.vehicle;
   BaselineVehicle v{};
   v.mass_kg = veh.mass_kg;
@@ -41,4 +37,4 @@ inline BaselineLoop make_baseline(const control::ControllerParams& p, double z_d
   return BaselineLoop(v, g, z_des_m);
 }
 
-}  // namespace quadcosim::bench
+}  // namespace quadcosim::baseline

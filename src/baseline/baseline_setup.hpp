@@ -1,0 +1,14 @@
+// Builds the BASELINE loop's plain numbers from the framework's vehicle and controller parameters
+// (setup only), so the baseline flies the same vehicle with the same gains.
+#pragma once
+
+#include "baseline/baseline_loop.hpp"
+#include "control/flight_controller.hpp"
+
+namespace quadcosim::baseline {
+
+/// The BASELINE loop for the vehicle and gains of `p` (its vehicle, mixer, per-axis LQR designs,
+/// altitude PD), holding altitude `z_des_m` [m]. Throws control::CareError when an LQR design fails.
+BaselineLoop make_baseline(const control::ControllerParams& p, double z_des_m);
+
+}  // namespace quadcosim::baseline
