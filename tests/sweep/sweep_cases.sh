@@ -214,5 +214,70 @@ assert os.path.exists(sys.argv[1] + "/hist_saturation.saturated_s.png"), os.list
 PYEOF
     ;;
 
+  slurm_submit)  # scripts/slurm/submit.sh with relative paths, through a stand-in sbatch that runs the jobs
+    # The stand-in runs each job at once in its --chdir folder, as Slurm does (array tasks in turn with
+    # SLURM_ARRAY_TASK_ID, an afterok job only when its dependency succeeded), and records its arguments.
+    mkdir -p "$TMP/bin" "$TMP/jobs" "$TMP/cwd"
+    cat > "$TMP/bin/sbatch" <<'SH'
+#!/usr/bin/env bash
+set -u
+printf '%s\n' "$*" >> "$FAKE_SBATCH_DIR/log"
+id=$((100 + $(wc -l < "$FAKE_SBATCH_DIR/log")))
+array="" chdir=$PWD dep="" wrap="" out="" exports=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --parsable | --job-name=*) ;;
+    --array=*) array=${1#--array=} ;;
+    --chdir=*) chdir=${1#--chdir=} ;;
+    --dependency=afterok:*) dep=${1#--dependency=afterok:} ;;
+    --export=*) exports=${1#--export=} ;;
+    --output=*) out=${1#--output=} ;;
+    --wrap) wrap=$2; shift ;;
+    -*) echo "stand-in sbatch: unexpected option $1" >&2; exit 2 ;;
+    *) break ;;
+  esac
+  shift
+done
+echo "$id"
+if [ -n "$dep" ] && [ -e "$FAKE_SBATCH_DIR/failed.$dep" ]; then touch "$FAKE_SBATCH_DIR/never.$id"; exit 0; fi
+cd "$chdir" || exit 1
+IFS=, read -ra kv <<< "$exports"
+for e in "${kv[@]}"; do [ "$e" = ALL ] || export "${e?}"; done
+if [ -n "$wrap" ]; then
+  bash -c "$wrap" > "${out:-slurm-$id.out}" 2>&1 || touch "$FAKE_SBATCH_DIR/failed.$id"
+else
+  script=$1
+  shift
+  for k in $(seq "${array%-*}" "${array#*-}"); do
+    SLURM_ARRAY_TASK_ID=$k bash "$script" "$@" > "slurm-${id}_$k.out" 2>&1 || touch "$FAKE_SBATCH_DIR/failed.$id"
+  done
+fi
+SH
+    chmod +x "$TMP/bin/sbatch"
+    A=(--runs 6 --seed 8 --vary mass=10% --vary controller.altitude.kd=uniform\(2,3.5\) --min-pass-rate 0)
+    ABS=$(realpath "$HOVER")
+    "$QC" sweep "$ABS" "${A[@]}" --no-plots --out "$TMP/all" > /dev/null 2>&1 || fail "unsharded sweep"
+    # From a folder of its own, as a user would: OUT, SCENARIO and QUADCOSIM relative to it.
+    cd "$TMP/cwd"
+    REL=$(realpath --relative-to=. "$ABS")
+    RELQC=$(realpath --relative-to=. "$QC")
+    [ "${REL#/}" = "$REL" ] && [ "${RELQC#/}" = "$RELQC" ] || fail "relative paths expected: $REL $RELQC"
+    PATH=$TMP/bin:$PATH FAKE_SBATCH_DIR=$TMP/jobs QUADCOSIM=$RELQC \
+      bash "$SRC/scripts/slurm/submit.sh" out 2 "$REL" "${A[@]}" > "$TMP/submit.log" 2>&1 \
+      || { cat "$TMP/submit.log"; fail "submit.sh"; }
+    for f in "$TMP"/jobs/failed.*; do
+      [ -e "$f" ] || continue
+      cat "$TMP"/cwd/out/slurm-*.out "$TMP/cwd/out/merge.out" 2> /dev/null || true
+      fail "job ${f##*.} failed"
+    done
+    grep -q -- "--array=1-2 --chdir=$TMP/cwd/out .* $ABS --runs 6" "$TMP/jobs/log" || { cat "$TMP/jobs/log"; fail "array job"; }
+    cmp "$TMP/all/summary.json" "$TMP/cwd/out/merged/summary.json" || fail "merged summary.json differs from the unsharded one"
+    set +e
+    PATH=$TMP/bin:$PATH FAKE_SBATCH_DIR=$TMP/jobs bash "$SRC/scripts/slurm/submit.sh" out2 2 nowhere.yaml > "$TMP/o" 2>&1
+    rc=$?
+    set -e
+    [ $rc -eq 2 ] && grep -q "scenario nowhere.yaml is not a file" "$TMP/o" || { cat "$TMP/o"; fail "a missing scenario (rc $rc)"; }
+    ;;
+
   *) echo "unknown case $CASE" >&2; exit 2 ;;
 esac
