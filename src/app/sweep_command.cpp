@@ -58,7 +58,7 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
 }
 
 int verdict(const nlohmann::json& j, double min_pass_rate) {
-  return static_cast<double>(j["passed"].get<int>()) >= min_pass_rate * j["runs"].get<int>() ? exit_code::kOk
+  return j["passed"].get<int>() >= sweep::passes_needed(min_pass_rate, j["runs"].get<int>()) ? exit_code::kOk
                                                                                               : exit_code::kFailed;
 }
 

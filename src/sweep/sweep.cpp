@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <thread>
 
 #include "analysis/step_metrics.hpp"
@@ -169,6 +171,16 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
   return results;
+}
+
+int passes_needed(double rate, int runs) {
+  if (!(rate >= 0.0 && rate <= 1.0) || runs < 0) {
+    throw std::invalid_argument(fmt::format("pass rate {} of {} runs: expected a rate in [0, 1]", rate, runs));
+  }
+  // A rate written in decimal is not exact in binary, nor is its product with runs: 1e-12 relative
+  // covers both (a few units in the last place) and is far below one run in 10^7.
+  const double needed = std::ceil(rate * runs * (1.0 - 1e-12));
+  return std::clamp(static_cast<int>(needed), 0, runs);
 }
 
 std::vector<int> shard_indices(int runs, int shard, int count) {

@@ -38,6 +38,12 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
 /// Runs i with i % count == shard - 1 (shard in 1..count), ascending.
 std::vector<int> shard_indices(int runs, int shard, int count);
 
+/// The fewest passing runs out of `runs` that meet a pass rate `rate` (--min-pass-rate, in [0, 1]):
+/// ceil(rate × runs), forgiving the rounding of the product (below 1e-12 relative), so that 0.55 of
+/// 100 is 55 (0.55 × 100 is 55.000000000000007 in binary). Throws std::invalid_argument for a rate
+/// outside [0, 1] (or NaN) or negative runs.
+int passes_needed(double rate, int runs);
+
 /// Flies run `index` again into `dir` with the outputs of `quadcosim run` in-process: trajectory.csv,
 /// run.mcap, metadata.yaml, metrics.json (with the "sweep" section), metrics.txt; judged from the
 /// recorded CSV as `run` is. Throws io::ConfigError / std::invalid_argument for a refused value,

@@ -217,6 +217,26 @@ TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
               HasSubstr("already varied"));
 }
 
+TEST(PassesNeeded, CeilOfRateTimesRunsWithoutTheProductsRoundingError) {
+  // 0.55 * 100 is 55.000000000000007 in binary: exactly 55 of 100 passing meets --min-pass-rate 0.55.
+  ASSERT_GT(0.55 * 100, 55.0);
+  EXPECT_EQ(passes_needed(0.55, 100), 55);
+  EXPECT_EQ(passes_needed(0.07, 100), 7);  // 0.07 * 100 = 7.000000000000001
+  EXPECT_EQ(passes_needed(0.29, 100), 29);  // 0.29 * 100 = 28.999999999999996
+  EXPECT_EQ(passes_needed(0.57, 100), 57);  // 0.57 * 100 = 56.99999999999999
+  EXPECT_EQ(passes_needed(0.551, 100), 56);  // a fraction of a run more: the next whole run
+  EXPECT_EQ(passes_needed(1.0 / 3.0, 3), 1);
+  EXPECT_EQ(passes_needed(0.5, 3), 2);
+  EXPECT_EQ(passes_needed(1.0, 10'000'000), 10'000'000);
+  EXPECT_EQ(passes_needed(0.1, 10'000'000), 1'000'000);
+  EXPECT_EQ(passes_needed(0.0, 7), 0);
+  EXPECT_EQ(passes_needed(1.0, 0), 0);
+  // Every rate k/100 of 100 runs needs exactly k runs.
+  for (int k = 0; k <= 100; ++k) EXPECT_EQ(passes_needed(k / 100.0, 100), k) << k;
+  EXPECT_THROW(passes_needed(1.5, 10), std::invalid_argument);
+  EXPECT_THROW(passes_needed(std::nan(""), 10), std::invalid_argument);
+}
+
 TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
   const std::string f = scenario_file().string();
   const Plan a = make_plan(f, {"mass=10%", "controller.altitude.kp=uniform(2,6)"}, 42, 100, Sampler::kRandom);
