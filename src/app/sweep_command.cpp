@@ -108,26 +108,30 @@ int merge_command(const SweepOptions& o) {
   std::vector<nlohmann::json> per_run;
   for (const std::string& dir : o.shard_dirs) {
     const fs::path file = fs::path(dir) / "shard.json";
-    nlohmann::json j;
-    try {
-      std::ifstream in(file);
-      if (!in) {
-        std::cerr << "error: " << file.string() << ": not found (not a shard folder)\n";
-        return exit_code::kBadInput;
-      }
-      in >> j;
-      if (header.is_null()) {
-        header = j.at("header");
-      } else if (j.at("header") != header) {
-        std::cerr << "error: " << file.string() << ": a shard of another sweep (scenario, seed, runs or --vary differ "
-                  << "from " << o.shard_dirs.front() << ")\n";
-        return exit_code::kBadInput;
-      }
-      for (auto& r : j.at("per_run")) per_run.push_back(std::move(r));
-    } catch (const nlohmann::json::exception& e) {
-      std::cerr << "error: " << file.string() << ": not a shard's results (" << e.what() << ")\n";
+    std::ifstream in(file);
+    if (!in) {
+      std::cerr << "error: " << file.string() << ": not found (not a shard folder)\n";
       return exit_code::kBadInput;
     }
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(in);
+      sweep::check_shard_json(j);
+    } catch (const nlohmann::json::parse_error& e) {
+      std::cerr << "error: " << file.string() << ": not JSON (" << e.what() << ")\n";
+      return exit_code::kBadInput;
+    } catch (const std::invalid_argument& e) {  // check_shard_json: the field and what it holds
+      std::cerr << "error: " << file.string() << ": not a shard's results: " << e.what() << '\n';
+      return exit_code::kBadInput;
+    }
+    if (header.is_null()) {
+      header = j["header"];
+    } else if (j["header"] != header) {
+      std::cerr << "error: " << file.string() << ": a shard of another sweep (scenario, seed, runs or --vary differ "
+                << "from " << o.shard_dirs.front() << ")\n";
+      return exit_code::kBadInput;
+    }
+    for (auto& r : j["per_run"]) per_run.push_back(std::move(r));
   }
   // A run missing or given twice: std::invalid_argument, bad input (run_guarded).
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));

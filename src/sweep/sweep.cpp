@@ -291,6 +291,47 @@ nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::
   return j;
 }
 
+void check_shard_json(const nlohmann::json& shard) {
+  const auto got = [](const nlohmann::json& v) {
+    if (v.is_object()) return std::string("an object");
+    if (v.is_array()) return std::string("an array");
+    const std::string text = v.dump();
+    return text.size() > 40 ? text.substr(0, 37) + "..." : text;
+  };
+  const auto object = [&](const nlohmann::json& v, const std::string& where) {
+    if (!v.is_object()) throw std::invalid_argument(where + ": expected an object, got " + got(v));
+  };
+  const auto field = [&](const nlohmann::json& v, const std::string& where, const char* key) -> const nlohmann::json& {
+    if (!v.contains(key)) throw std::invalid_argument(fmt::format("{}'{}' is missing", where.empty() ? "" : where + ": ", key));
+    return v.at(key);
+  };
+  const auto whole = [&](const nlohmann::json& v, const std::string& where) {
+    if (!v.is_number_integer()) throw std::invalid_argument(where + ": expected a whole number, got " + got(v));
+  };
+  object(shard, "shard.json");
+  const nlohmann::json& header = field(shard, "", "header");
+  object(header, "header");
+  whole(field(header, "header", "runs"), "header.runs");
+  const nlohmann::json& per_run = field(shard, "", "per_run");
+  if (!per_run.is_array()) throw std::invalid_argument("per_run: expected an array, got " + got(per_run));
+  for (std::size_t i = 0; i < per_run.size(); ++i) {
+    const std::string where = fmt::format("per_run[{}]", i);
+    const nlohmann::json& r = per_run[i];
+    object(r, where);
+    whole(field(r, where, "index"), where + ".index");
+    if (!field(r, where, "passed").is_boolean()) {
+      throw std::invalid_argument(where + ".passed: expected true or false, got " + got(r.at("passed")));
+    }
+    const nlohmann::json& figures = field(r, where, "figures");
+    object(figures, where + ".figures");
+    for (const auto& [name, v] : figures.items()) {
+      if (!v.is_number() && !v.is_null()) {
+        throw std::invalid_argument(fmt::format("{}.figures[\"{}\"]: expected a number or null, got {}", where, name, got(v)));
+      }
+    }
+  }
+}
+
 Plan plan_of(const fs::path& dir) {
   nlohmann::json h;
   fs::path file = dir / "summary.json";

@@ -66,6 +66,12 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r);
 /// Throws std::invalid_argument when an index is missing, repeated or out of range.
 nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run);
 
+/// Checks a parsed shard.json for what `sweep merge` reads: "header" an object with "runs" a whole
+/// number, "per_run" an array of objects each with "index" (a whole number), "passed" (true or false)
+/// and "figures" (an object of numbers or nulls). Throws std::invalid_argument naming the first field
+/// missing or of another type and what it holds ("per_run[3].passed: expected true or false, got \"yes\"").
+void check_shard_json(const nlohmann::json& shard);
+
 /// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it).
 /// Throws std::runtime_error naming the file.
 Plan plan_of(const std::filesystem::path& sweep_dir);

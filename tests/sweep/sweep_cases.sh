@@ -82,6 +82,33 @@ PYEOF
     [ $rc -eq 2 ] && grep -q "appears twice" "$TMP/o" || fail "merge with a shard twice (rc $rc)"
     "$QC" sweep "$HOVER" --shard 4/3 --out "$TMP/x" > "$TMP/o" 2>&1; rc=$?
     [ $rc -eq 2 ] && grep -q "expected K/N" "$TMP/o" || fail "--shard 4/3 (rc $rc)"
+    # A malformed shard.json: exit 2 naming the file and what is wrong (first or later in the list).
+    bad_shard() {  # bad_shard EXPECTED_TEXT PYTHON_EDIT_OF_j
+      rm -rf "$TMP/bad" "$TMP/mb"
+      cp -r "$TMP/p1" "$TMP/bad"
+      "$PY" - "$TMP/bad/shard.json" "$2" <<'PYEOF'
+import json, sys
+j = json.load(open(sys.argv[1]))
+exec(sys.argv[2])
+open(sys.argv[1], "w").write(j if isinstance(j, str) else json.dumps(j))
+PYEOF
+      for order in "$TMP/bad $TMP/p2 $TMP/p3" "$TMP/p2 $TMP/p3 $TMP/bad"; do
+        # shellcheck disable=SC2086
+        "$QC" sweep merge "$TMP/mb" $order --no-plots > "$TMP/o" 2>&1; rc=$?
+        [ $rc -eq 2 ] && grep -qF "$TMP/bad/shard.json" "$TMP/o" && grep -qF "$1" "$TMP/o" \
+          || { cat "$TMP/o"; fail "malformed shard.json ($2): exit $rc, expected 2 naming the file and '$1'"; }
+      done
+    }
+    bad_shard "not JSON" 'j = "{\"header\": "'
+    bad_shard "'header' is missing" 'del j["header"]'
+    bad_shard "per_run: expected an array, got an object" 'j["per_run"] = {"a": 1}'
+    bad_shard "header.runs: expected a whole number, got \"12\"" 'j["header"]["runs"] = "12"'
+    bad_shard "per_run[0]: 'passed' is missing" 'del j["per_run"][0]["passed"]'
+    bad_shard "per_run[1].passed: expected true or false, got \"yes\"" 'j["per_run"][1]["passed"] = "yes"'
+    bad_shard "per_run[0].index: expected a whole number, got \"0\"" 'j["per_run"][0]["index"] = "0"'
+    bad_shard "per_run[2]: expected an object, got 7" 'j["per_run"][2] = 7'
+    bad_shard "per_run[0].figures[\"hold.rms_horizontal_error_m\"]: expected a number or null, got \"big\"" \
+      'j["per_run"][0]["figures"]["hold.rms_horizontal_error_m"] = "big"'
     set -e
     ;;
 
