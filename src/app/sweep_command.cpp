@@ -23,16 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool write_json(const fs::path& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  f << j.dump(2) << '\n';
-  if (!f) {
-    std::cerr << "error: " << path.string() << ": write failed\n";
-    return false;
-  }
-  return true;
-}
-
 // Console summary: pass count, then per figure the runs that have it and the missing ones, and the
 // statistics of those that have it.
 void print_summary(const nlohmann::json& j, std::ostream& os) {
@@ -139,7 +129,7 @@ int merge_command(const SweepOptions& o) {
   io::OutputFolder folder = io::OutputFolder::claim(out, "sweep merge", {.force = o.force}, std::cerr);
   fs::copy_file(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml",
                 fs::copy_options::overwrite_existing);
-  if (!write_json(out / "summary.json", summary)) return exit_code::kOutput;
+  sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
   if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
@@ -235,7 +225,7 @@ int sweep_command(const SweepOptions& o) {
     int passed = 0;
     for (const auto& r : results) passed += r.passed ? 1 : 0;
     nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
-    if (!write_json(out / "shard.json", j)) return exit_code::kOutput;
+    sweep::write_json(out / "shard.json", j);
     std::cout << fmt::format("sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
                              "join the shards with `quadcosim sweep merge OUT DIR...`\n",
                              plan.nominal.name, o.shard, results.size(), plan.runs, passed,
@@ -243,7 +233,7 @@ int sweep_command(const SweepOptions& o) {
     return exit_code::kOk;
   }
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
-  if (!write_json(out / "summary.json", summary)) return exit_code::kOutput;
+  sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
   if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;

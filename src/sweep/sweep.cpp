@@ -62,12 +62,6 @@ void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
   r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed) && (!r.saturation || r.saturation->passed);
 }
 
-void write_json(const fs::path& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  f << j.dump(2) << '\n';
-  if (!f) throw std::runtime_error(path.string() + ": write failed");
-}
-
 // Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step
 // of the same channel gets "roll#2.overshoot_pct"), "hold.<figure>" for the hold, "saturation.<figure>" for
 // the rotor and tilt saturation (every run has them; null when the run could not be flown).
@@ -171,6 +165,12 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
   return results;
+}
+
+void write_json(const fs::path& path, const nlohmann::json& j) {
+  std::ofstream f(path);
+  f << j.dump(2) << '\n';
+  if (!f) throw std::runtime_error(path.string() + ": write failed");
 }
 
 int passes_needed(double rate, int runs) {

@@ -38,6 +38,10 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
 /// Runs i with i % count == shard - 1 (shard in 1..count), ascending.
 std::vector<int> shard_indices(int runs, int shard, int count);
 
+/// Writes `j` to `path` as JSON indented by 2, with a final newline (summary.json, shard.json, a
+/// run's metrics.json). Throws std::runtime_error naming the file when it cannot be written.
+void write_json(const std::filesystem::path& path, const nlohmann::json& j);
+
 /// The fewest passing runs out of `runs` that meet a pass rate `rate` (--min-pass-rate, in [0, 1]):
 /// ceil(rate × runs), forgiving the rounding of the product (below 1e-12 relative), so that 0.55 of
 /// 100 is 55 (0.55 × 100 is 55.000000000000007 in binary). Throws std::invalid_argument for a rate

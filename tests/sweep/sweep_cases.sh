@@ -163,6 +163,15 @@ PYEOF
     set -e
     "$QC" sweep "$HOVER" --runs 2 --out "$TMP/run" --no-plots --min-pass-rate 0 --force > /dev/null || fail "--force on a run folder"
     [ ! -e "$TMP/run/trajectory.csv" ] && [ ! -e "$TMP/run/run.mcap" ] && [ -s "$TMP/run/summary.json" ] || fail "a run's file survived"
+    # An output that cannot be written (a folder, kept by --force, where summary.json or shard.json
+    # goes): exit 3 naming the file.
+    mkdir -p "$TMP/w1/summary.json" "$TMP/w2/shard.json"
+    set +e
+    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --no-plots --out "$TMP/w1" --force > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 3 ] && grep -q "$TMP/w1/summary.json: write failed" "$TMP/o" || { cat "$TMP/o"; fail "summary.json unwritable (rc $rc)"; }
+    "$QC" sweep "$HOVER" --runs 2 --shard 1/2 --no-plots --out "$TMP/w2" --force > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 3 ] && grep -q "$TMP/w2/shard.json: write failed" "$TMP/o" || { cat "$TMP/o"; fail "shard.json unwritable (rc $rc)"; }
+    set -e
     ;;
 
   console)  # every figure with its count and missing runs; a figure no run has says so
