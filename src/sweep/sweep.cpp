@@ -302,7 +302,9 @@ void check_shard_json(const nlohmann::json& shard) {
     if (!v.is_object()) throw std::invalid_argument(where + ": expected an object, got " + got(v));
   };
   const auto field = [&](const nlohmann::json& v, const std::string& where, const char* key) -> const nlohmann::json& {
-    if (!v.contains(key)) throw std::invalid_argument(fmt::format("{}'{}' is missing", where.empty() ? "" : where + ": ", key));
+    if (!v.contains(key)) {
+      throw std::invalid_argument(fmt::format("{}'{}' is missing", where.empty() ? "" : where + ": ", key));
+    }
     return v.at(key);
   };
   const auto whole = [&](const nlohmann::json& v, const std::string& where) {
@@ -326,7 +328,8 @@ void check_shard_json(const nlohmann::json& shard) {
     object(figures, where + ".figures");
     for (const auto& [name, v] : figures.items()) {
       if (!v.is_number() && !v.is_null()) {
-        throw std::invalid_argument(fmt::format("{}.figures[\"{}\"]: expected a number or null, got {}", where, name, got(v)));
+        throw std::invalid_argument(
+            fmt::format("{}.figures[\"{}\"]: expected a number or null, got {}", where, name, got(v)));
       }
     }
   }

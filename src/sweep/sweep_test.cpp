@@ -194,8 +194,9 @@ TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
   EXPECT_EQ(error_of({"initial.position_m[0]=grid(1)", "initial.position_m.z=grid(2)"}), "accepted");
 
   // A vehicle list entry by its index is the vehicle key .x/.y/.z: the table's range, the plant's key.
-  const Plan p = make_plan(f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"},
-                           3, 50, Sampler::kRandom);
+  const Plan p = make_plan(
+      f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
+      Sampler::kRandom);
   ASSERT_EQ(p.vary.size(), 2u);
   const Key& lin = p.vary[0].keys.at(0);
   EXPECT_EQ(lin.path, "vehicle.aero.linear_drag_N_s_m.x");

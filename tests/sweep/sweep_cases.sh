@@ -168,9 +168,11 @@ PYEOF
     mkdir -p "$TMP/w1/summary.json" "$TMP/w2/shard.json"
     set +e
     "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --no-plots --out "$TMP/w1" --force > "$TMP/o" 2>&1; rc=$?
-    [ $rc -eq 3 ] && grep -q "$TMP/w1/summary.json: write failed" "$TMP/o" || { cat "$TMP/o"; fail "summary.json unwritable (rc $rc)"; }
+    [ $rc -eq 3 ] && grep -q "$TMP/w1/summary.json: write failed" "$TMP/o" \
+      || { cat "$TMP/o"; fail "summary.json unwritable (rc $rc)"; }
     "$QC" sweep "$HOVER" --runs 2 --shard 1/2 --no-plots --out "$TMP/w2" --force > "$TMP/o" 2>&1; rc=$?
-    [ $rc -eq 3 ] && grep -q "$TMP/w2/shard.json: write failed" "$TMP/o" || { cat "$TMP/o"; fail "shard.json unwritable (rc $rc)"; }
+    [ $rc -eq 3 ] && grep -q "$TMP/w2/shard.json: write failed" "$TMP/o" \
+      || { cat "$TMP/o"; fail "shard.json unwritable (rc $rc)"; }
     set -e
     ;;
 
@@ -306,13 +308,16 @@ SH
       cat "$TMP"/cwd/out/slurm-*.out "$TMP/cwd/out/merge.out" 2> /dev/null || true
       fail "job ${f##*.} failed"
     done
-    grep -q -- "--array=1-2 --chdir=$TMP/cwd/out .* $ABS --runs 6" "$TMP/jobs/log" || { cat "$TMP/jobs/log"; fail "array job"; }
-    cmp "$TMP/all/summary.json" "$TMP/cwd/out/merged/summary.json" || fail "merged summary.json differs from the unsharded one"
+    grep -q -- "--array=1-2 --chdir=$TMP/cwd/out .* $ABS --runs 6" "$TMP/jobs/log" \
+      || { cat "$TMP/jobs/log"; fail "array job"; }
+    cmp "$TMP/all/summary.json" "$TMP/cwd/out/merged/summary.json" || fail "merged summary.json differs"
     set +e
-    PATH=$TMP/bin:$PATH FAKE_SBATCH_DIR=$TMP/jobs bash "$SRC/scripts/slurm/submit.sh" out2 2 nowhere.yaml > "$TMP/o" 2>&1
+    PATH=$TMP/bin:$PATH FAKE_SBATCH_DIR=$TMP/jobs bash "$SRC/scripts/slurm/submit.sh" out2 2 nowhere.yaml \
+      > "$TMP/o" 2>&1
     rc=$?
     set -e
-    [ $rc -eq 2 ] && grep -q "scenario nowhere.yaml is not a file" "$TMP/o" || { cat "$TMP/o"; fail "a missing scenario (rc $rc)"; }
+    [ $rc -eq 2 ] && grep -q "scenario nowhere.yaml is not a file" "$TMP/o" \
+      || { cat "$TMP/o"; fail "a missing scenario (rc $rc)"; }
     ;;
 
   *) echo "unknown case $CASE" >&2; exit 2 ;;
