@@ -132,9 +132,14 @@ def markdown_table(steps_a, steps_b, label_a, label_b):
             continue
         lines.append("| figure | A | B | difference (B − A) |")
         lines.append("|---|---:|---:|---:|")
+        # The settling band of each run's step: "settle 2%", or "settle 2%/5%" when they differ.
+        bands = [s.get("settling_band_pct", plot_run.DEFAULT_SETTLING_BAND_PCT) for s in (sa, sb) if s]
         for k in keys:
             a, b = fa.get(k), fb.get(k)
-            lines.append(f"| {plot_run._figure_label(k)} | "
+            label = plot_run._figure_label(k, bands[0])
+            if k == "settling_time_2pct_s" and len(set(bands)) > 1:
+                label += f"/{bands[1]:g}%"
+            lines.append(f"| {label} | "
                          f"{plot_run._figure_cell(k, a) if sa else '—'} | "
                          f"{plot_run._figure_cell(k, b) if sb else '—'} | {_diff_cell(k, a, b)} |")
         lines.append("")

@@ -11,8 +11,9 @@ writes PNG figures into RUN_DIR, printing the path of every file written:
                       changes during the run, or is constant but differs from
                       the channel's value in the first row), in the style of the paper's
                       Figs. 4-7: variable (red) and its rate (blue) vs. time,
-                      setpoint dashed grey, +-2 % band around the target,
-                      peak / 2 % settling markers and a box with the step
+                      setpoint dashed grey, settling band around the target
+                      (+-2 % unless metrics.json gives the step's
+                      settling_band_pct), peak / settling markers and a box with the step
                       figures next to the paper's reference figures.
                       A channel stepped more than once gets
                       step_<channel>.png, step_<channel>_2.png, ...
@@ -24,8 +25,11 @@ writes PNG figures into RUN_DIR, printing the path of every file written:
 
 Conventions assumed for metrics.json: the time figures (peak_time_s, rise_time_s,
 t95_s, settling_time_2pct_s) are measured from the step time t_step_s; the
-+-2 % band is 2 % of the step size |target - initial| (of |target| if the step
-size is zero).
+settling band is settling_band_pct (2 when absent) % of the step size
+|target - initial| (of |target| if the step size is zero), and settling_time_2pct_s
+is the settling time in that band, whatever its width. An angle is drawn
+unwrapped from the first row; initial (wrapped, at the step sample) and target
+are moved by the whole turns that put them on that trace.
 
 Only the Python standard library, numpy and matplotlib (Debian 12 packages)
 are used; the Agg backend is forced, so no display is needed.
@@ -93,6 +97,8 @@ FIGURE_INFO = {
     "steady_state_error_pct": ("ss error", "%", "{:.2f}"),
 }
 FIGURE_ORDER = tuple(FIGURE_INFO)
+# The settling band when metrics.json gives none (percent of the step size).
+DEFAULT_SETTLING_BAND_PCT = 2.0
 
 STEP_FIGSIZE = (8.0, 5.0)
 OVERVIEW_FIGSIZE = (15.0, 9.0)
@@ -317,6 +323,10 @@ def load_metrics(path):
         # The step judged (shortest path for an angle) and the verdict; absent in older files.
         step["step"] = float(s["step"]) if _is_number(s.get("step")) and math.isfinite(float(s["step"])) else None
         step["verdict"] = str(s["verdict"]) if isinstance(s.get("verdict"), str) else None
+        band = s.get("settling_band_pct", DEFAULT_SETTLING_BAND_PCT)  # absent in older files
+        if not _is_number(band) or not math.isfinite(float(band)) or float(band) <= 0:
+            raise InputError(f"{where}: key 'settling_band_pct' must be a positive number, got {band!r}")
+        step["settling_band_pct"] = float(band)
         figures = s.get("figures") or {}
         if not isinstance(figures, dict):
             raise InputError(f"{where}: key 'figures' must be an object")
@@ -376,6 +386,7 @@ def detect_steps(traj):
                     "initial": float(y0), "target": float(first),
                     "step": (math.remainder(float(first) - float(y0), 2 * math.pi)
                              if ch in ("roll", "pitch", "yaw") else None),
+                    "settling_band_pct": DEFAULT_SETTLING_BAND_PCT,
                     "figures": {}, "reference": {}, "criteria": [], "passed": None,
                 })
             continue
@@ -390,6 +401,7 @@ def detect_steps(traj):
             "initial": initial,
             "target": target,
             "step": math.remainder(target - initial, 2 * math.pi) if ch in ("roll", "pitch", "yaw") else None,
+            "settling_band_pct": DEFAULT_SETTLING_BAND_PCT,
             "figures": {}, "reference": {}, "criteria": [], "passed": None,
         })
     return steps
@@ -436,7 +448,10 @@ def _unit_from_key(key):
     return ""
 
 
-def _figure_label(key):
+def _figure_label(key, settling_band_pct=DEFAULT_SETTLING_BAND_PCT):
+    """A figure's short label; the settling time's names its band ("settle 5%")."""
+    if key == "settling_time_2pct_s":
+        return f"settle {settling_band_pct:g}%"
     if key in FIGURE_INFO:
         return FIGURE_INFO[key][0]
     base = key
@@ -446,7 +461,7 @@ def _figure_label(key):
     return base.replace("_", " ")
 
 
-def _criterion_line(c):
+def _criterion_line(c, settling_band_pct=DEFAULT_SETTLING_BAND_PCT):
     fig = str(c.get("figure", "?"))
     lo, hi = c.get("min"), c.get("max")
     lo = lo if _is_number(lo) else None
@@ -461,7 +476,7 @@ def _criterion_line(c):
         rng = "defined"
     passed = c.get("passed")
     mark = "✓" if passed is True else ("✗" if passed is False else "?")
-    return f"{mark} {_figure_label(fig)} {rng}"
+    return f"{mark} {_figure_label(fig, settling_band_pct)} {rng}"
 
 
 def _align_zero(ax_left, ax_right):
@@ -522,6 +537,32 @@ def _finite_minmax(*arrays):
 # --------------------------------------------------------------------------- step figure
 
 
+def step_on_trace(traj, step):
+    """The step in the values of the trace as drawn: {"initial", "target", "half_band", "band_pct",
+    "turns"}. An angle is drawn unwrapped from the first row, while metrics.json gives its initial
+    value wrapped to (-pi, pi] at the step sample (the first with t >= t_step_s): initial moves by the
+    whole turns 2 pi k ("turns" = 2 pi k) that bring it nearest the drawn trace there, and the target
+    is initial + the shortest-path step. The band's half width is settling_band_pct % of |target -
+    initial| (of |target| for a zero step). A position, or an angle without a finite sample at the
+    step, is taken as given."""
+    ch = step["channel"]
+    initial, target = step["initial"], step["target"]
+    band_pct = step.get("settling_band_pct", DEFAULT_SETTLING_BAND_PCT)
+    span = abs(target - initial)
+    half = band_pct / 100.0 * (span if span > 0 else abs(target))
+    turns = 0.0
+    if ch in ("roll", "pitch", "yaw"):
+        if step.get("step") is not None:
+            target = initial + step["step"]
+            half = band_pct / 100.0 * (abs(step["step"]) if step["step"] != 0 else abs(step["target"]))
+        t, y = traj["t"], traj[ch]
+        k = int(np.searchsorted(t, step["t_step_s"], side="left"))
+        if k < len(t) and np.isfinite(y[k]):
+            turns = 2 * math.pi * round((float(y[k]) - initial) / (2 * math.pi))
+    return {"initial": initial + turns, "target": target + turns, "half_band": half,
+            "band_pct": band_pct, "turns": turns}
+
+
 def plot_step(traj, step, window, out_path, metrics, has_metrics):
     ch = step["channel"]
     meta = CHANNELS[ch]
@@ -535,9 +576,15 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
     rate = traj[meta["rate"]][sel]
     des = traj[f"{ch}_des"][sel]
 
-    t_step, initial, target = step["t_step_s"], step["initial"], step["target"]
-    if ch in ("roll", "pitch", "yaw") and step.get("step") is not None:
-        target = initial + step["step"]  # the shortest-path target, on the unwrapped angle
+    t_step = step["t_step_s"]
+    on_trace = step_on_trace(traj, step)
+    initial, target, half = on_trace["initial"], on_trace["target"], on_trace["half_band"]
+    band_pct = on_trace["band_pct"]
+    if ch in ("roll", "pitch", "yaw"):
+        # The setpoint, unwrapped from its own first row, by the whole turns that put it on the target.
+        k = int(np.searchsorted(t, t_step, side="left"))
+        if k < len(des) and np.isfinite(des[k]):
+            des = des + 2 * math.pi * round((target - float(des[k])) / (2 * math.pi))
     figs = step["figures"]
     unit = meta["unit"]
 
@@ -546,15 +593,13 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
     ax2 = ax.twinx()
 
     handles = []
-    # +-2 % band around the target, from the step time on
-    span = abs(target - initial)
-    half = 0.02 * (span if span > 0 else abs(target))
+    # The settling band around the target, from the step time on
     t_end = float(t[-1])
     if half > 0 and t_end > t_step:
         ax.fill_between([max(t_step, float(t[0])), t_end], target - half, target + half,
                         color=COLOR_BAND, alpha=0.15, lw=0, zorder=1)
         handles.append(Patch(facecolor=COLOR_BAND, alpha=0.25,
-                             label=f"±2 % band ({_fmt_num(target)} ± {half:.3g} {unit})"))
+                             label=f"±{band_pct:g} % band ({_fmt_num(target)} ± {half:.3g} {unit})"))
 
     h_des, = ax.plot(t, des, ls="--", color=COLOR_SETPOINT, lw=1.3, zorder=2,
                      label=f"setpoint {ch}_des")
@@ -578,7 +623,7 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
                           label=label)
             handles.append(hp)
 
-    # 2 % settling time
+    # Settling time (in the step's band)
     ts_rel = figs.get("settling_time_2pct_s")
     if ts_rel is not None:
         ts = t_step + ts_rel
@@ -586,7 +631,7 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
             ys = float(np.interp(ts, t, y))
             ax.axvline(ts, color=COLOR_SETTLE, lw=1.2, ls="-.", zorder=3)
             hs, = ax.plot([ts], [ys], marker="o", ms=7, mfc="white", mec=COLOR_SETTLE, mew=1.8,
-                          ls="none", zorder=6, label=f"2 % settling at {ts_rel:.2f} s")
+                          ls="none", zorder=6, label=f"{band_pct:g} % settling at {ts_rel:.2f} s")
             handles.append(hs)
 
     ax.set_xlim(float(t[0]), float(t[-1]) if t[-1] > t[0] else float(t[0]) + 1.0)
@@ -639,6 +684,7 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
 
 def _figures_text(step, has_metrics):
     figs, ref = step["figures"], step["reference"]
+    band = step.get("settling_band_pct", DEFAULT_SETTLING_BAND_PCT)
     if not has_metrics:
         return "no metrics.json:\nstep figures not available"
     keys = [k for k in FIGURE_ORDER if k in figs] + [k for k in figs if k not in FIGURE_INFO]
@@ -651,7 +697,7 @@ def _figures_text(step, has_metrics):
     lw, cw = 10, 9
     lines = ["step figures".ljust(lw) + "run".rjust(cw) + ("paper".rjust(cw) if has_ref else "")]
     for k in keys:
-        row = _figure_label(k)[:lw].ljust(lw) + _figure_cell(k, figs.get(k)).rjust(cw)
+        row = _figure_label(k, band)[:lw].ljust(lw) + _figure_cell(k, figs.get(k)).rjust(cw)
         if has_ref:
             row += (_figure_cell(k, ref[k]) if k in ref else "").rjust(cw)
         lines.append(row.rstrip())
@@ -664,7 +710,7 @@ def _figures_text(step, has_metrics):
         npass = sum(1 for c in crit if c.get("passed") is True)
         lines.append("")
         lines.append(f"criteria {npass}/{len(crit)} passed")
-        lines.extend(_criterion_line(c)[: lw + 2 * cw] for c in crit)
+        lines.extend(_criterion_line(c, band)[: lw + 2 * cw] for c in crit)
     return "\n".join(lines)
 
 
@@ -758,13 +804,12 @@ def plot_overview(traj, out_path, metrics, run_dir):
 # --------------------------------------------------------------------------- main
 
 
-def _settle_estimate(t, y, t_step, initial, target, t_hi):
-    """Rough 2 % settling time (for choosing the plot window only)."""
+def _settle_estimate(t, y, t_step, target, half_band, t_hi):
+    """Rough settling time in target +- half_band (for choosing the plot window only)."""
     m = (t >= t_step) & (t <= t_hi)
     if not m.any():
         return 0.0
-    span = abs(target - initial) or abs(target) or 1.0
-    outside = np.nonzero(~(np.abs(y[m] - target) <= 0.02 * span))[0]
+    outside = np.nonzero(~(np.abs(y[m] - target) <= (half_band or 0.02)))[0]
     if outside.size == 0:
         return 0.0
     return float(t[m][outside[-1]] - t_step)
@@ -795,7 +840,8 @@ def step_windows(steps, traj):
         hi_lim = min([v for v in same if v > ts], default=t1)
         settle = s["figures"].get("settling_time_2pct_s")
         if settle is None:
-            settle = _settle_estimate(t, traj[s["channel"]], ts, s["initial"], s["target"], hi_lim)
+            on_trace = step_on_trace(traj, s)
+            settle = _settle_estimate(t, traj[s["channel"]], ts, on_trace["target"], on_trace["half_band"], hi_lim)
         hi = min(hi_lim, ts + max(15.0, 2.5 * settle))
         if hi_lim - hi < 0.25 * (hi - ts):  # not worth cutting
             hi = hi_lim

@@ -205,7 +205,8 @@ def build_html(run_dir, metrics, version_text):
           + ("<th>reference</th>" if has_ref else "") + "</tr>")
         for key, ours, band, status, reference in rows:
             cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
-            w(f"<tr><td>{esc(plot_run._figure_label(key))}</td><td class=\"num\">{esc(ours)}</td>"
+            label = plot_run._figure_label(key, step.get("settling_band_pct", plot_run.DEFAULT_SETTLING_BAND_PCT))
+            w(f"<tr><td>{esc(label)}</td><td class=\"num\">{esc(ours)}</td>"
               f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td>"
               + (f"<td class=\"num\">{esc(reference)}</td>" if has_ref else "") + "</tr>")
         w("</table>")

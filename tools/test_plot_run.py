@@ -379,5 +379,104 @@ class UnwrapAndSaturationTest(unittest.TestCase):
         self.assertIn("rotors 2, 4 saturated", handles[0].get_label())
 
 
+class StepOnTraceTest(unittest.TestCase):
+    """The target, band and setpoint of a step figure lie on the trace as drawn (an angle unwrapped
+    from the first row), with the settling band metrics.json gives."""
+
+    @classmethod
+    def setUpClass(cls):
+        if importlib.util.find_spec("matplotlib") is None:
+            raise unittest.SkipTest("matplotlib not importable in this interpreter")
+        spec = importlib.util.spec_from_file_location("plot_run", SCRIPT)
+        cls.pr = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(cls.pr)
+
+    def draw(self, run_dir):
+        """plot_step on the run's first step; the figure it drew (kept open for inspection)."""
+        traj = self.pr.load_trajectory(os.path.join(run_dir, "trajectory.csv"))
+        metrics = self.pr.load_metrics(os.path.join(run_dir, "metrics.json"))
+        step = metrics["steps"][0]
+        figs = []
+        from unittest import mock
+        with mock.patch.object(self.pr.plt, "close", side_effect=figs.append):
+            self.pr.plot_step(traj, step, (0.0, float(traj["t"][-1])), os.path.join(run_dir, "s.png"), metrics, True)
+        figs = [f for f in figs if isinstance(f, self.pr.matplotlib.figure.Figure)]
+        self.assertEqual(len(figs), 1, figs)
+        self.addCleanup(self.pr.plt.close, figs[0])
+        return figs[0]
+
+    @staticmethod
+    def band_of(fig):
+        ax = fig.axes[0]
+        (band,) = [c for c in ax.collections if len(c.get_paths()) == 1]
+        y = band.get_paths()[0].vertices[:, 1]
+        return float(y.min()), float(y.max())
+
+    @staticmethod
+    def labels(fig):
+        return [t.get_text() for leg in fig.legends for t in leg.get_texts()]
+
+    def write_yaw_run(self, run_dir, band_pct):
+        # Yaw drifts 3.10 -> 3.20 rad over 2 s, so the record wraps past pi (to -3.08) before the
+        # step; at t = 2 s the setpoint steps by +0.2 rad to 3.40 (recorded -2.883). metrics.json
+        # gives initial wrapped at the step sample, as the C++ side writes it.
+        os.makedirs(run_dir)
+        t = np.arange(0, 8.0001, 0.01)
+        true = np.where(t < 2.0, 3.10 + 0.05 * t, 3.40 - 0.2 * np.exp(-(t - 2.0) / 0.4))
+        des = np.where(t < 2.0, 3.10, 3.40)
+        wrap = lambda a: np.remainder(a + math.pi, 2 * math.pi) - math.pi  # noqa: E731
+        cols = {c: np.zeros_like(t) for c in self.pr.REQUIRED_COLUMNS}
+        cols.update(t=t, yaw=wrap(true), yaw_des=wrap(des), z=np.full_like(t, 10.0))
+        self.assertLess(cols["yaw"][199], -3.0)  # wrapped before the step
+        np.savetxt(os.path.join(run_dir, "trajectory.csv"), np.column_stack([cols[c] for c in cols]),
+                   delimiter=",", header=",".join(cols), comments="")
+        k = int(np.searchsorted(t, 2.0))
+        initial, target = float(cols["yaw"][k]), float(cols["yaw_des"][-1])
+        self.assertAlmostEqual(initial, 3.20 - 2 * math.pi, places=9)
+        step = {"channel": "yaw", "t_step_s": 2.0, "initial": initial, "target": target,
+                "step": math.remainder(target - initial, 2 * math.pi),
+                "figures": {"settling_time_2pct_s": 1.5}, "criteria": [], "passed": True}
+        if band_pct is not None:
+            step["settling_band_pct"] = band_pct
+        with open(os.path.join(run_dir, "metrics.json"), "w") as f:
+            json.dump({"scenario": "wrap", "steps": [step]}, f)
+
+    def test_angle_wrapped_before_the_step_gets_its_band_on_the_trace(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = os.path.join(tmp, "run")
+            self.write_yaw_run(run, band_pct=None)
+            fig = self.draw(run)
+            # Target 3.40 rad on the unwrapped trace, band 2 % of the 0.2 rad step: +-0.004 rad.
+            lo, hi = self.band_of(fig)
+            self.assertAlmostEqual(lo, 3.396, places=9)
+            self.assertAlmostEqual(hi, 3.404, places=9)
+            des = [ln for ln in fig.axes[0].lines if ln.get_label() == "setpoint yaw_des"][0].get_ydata()
+            self.assertAlmostEqual(float(des[0]), 3.10, places=9)
+            self.assertAlmostEqual(float(des[-1]), 3.40, places=9)
+            self.assertTrue(any(lb.startswith("±2 % band (3.4 ±") for lb in self.labels(fig)), self.labels(fig))
+
+    def test_band_is_the_settling_band_of_metrics_json(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = os.path.join(tmp, "run")
+            self.write_yaw_run(run, band_pct=5)
+            fig = self.draw(run)
+            lo, hi = self.band_of(fig)  # 5 % of 0.2 rad
+            self.assertAlmostEqual(lo, 3.39, places=9)
+            self.assertAlmostEqual(hi, 3.41, places=9)
+            labels = self.labels(fig)
+            self.assertTrue(any(lb.startswith("±5 % band") for lb in labels), labels)
+            self.assertIn("5 % settling at 1.50 s", labels)
+            self.assertIn("settle 5%", "\n".join(t.get_text() for t in fig.texts))
+            self.assertNotIn("2 %", " ".join(labels))
+            # A band that is no positive number is a malformed metrics.json.
+            with open(os.path.join(run, "metrics.json")) as f:
+                m = json.load(f)
+            m["steps"][0]["settling_band_pct"] = "wide"
+            with open(os.path.join(run, "metrics.json"), "w") as f:
+                json.dump(m, f)
+            with self.assertRaisesRegex(self.pr.InputError, "settling_band_pct"):
+                self.pr.load_metrics(os.path.join(run, "metrics.json"))
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -140,6 +140,16 @@ class ReportTest(ToolTestBase):
         self.assertIn(">FAIL<", page)
         self.assertNotIn("data:image/png;base64,", page)  # no plots were made
 
+    def test_settling_label_names_the_steps_band(self):
+        # settling_band_pct from metrics.json (5 in the noisy-IMU roll scenario); 2 when absent.
+        def band5(m):
+            m["steps"][0]["settling_band_pct"] = 5
+        page = self.report_with_metrics(band5)
+        self.assertIn("<td>settle 5%</td>", page)
+        self.assertNotIn("settle 2%", page)
+        page = self.report_with_metrics(lambda m: None)
+        self.assertIn("<td>settle 2%</td>", page)
+
     def test_hold_section(self):
         # A position-hold block (analysis.hold) is shown with its values, bands and verdict.
         def add_hold(m):
@@ -224,6 +234,21 @@ class CompareTest(ToolTestBase):
         self.assertIn(f"{12.34 - over_a:+.1f} %", row[0])
         with open(os.path.join(out_dir, "compare.md"), encoding="utf-8") as f:
             self.assertEqual(f.read(), res.stdout)
+
+    def test_compare_names_both_settling_bands(self):
+        run_a = os.path.join(self.tmp, "a")
+        run_b = os.path.join(self.tmp, "b")
+        make_run(run_a, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
+        make_run(run_b, [("roll", 1.0, 0.0, 0.1)], n_rows=300)
+        mpath = os.path.join(run_b, "metrics.json")
+        with open(mpath) as f:
+            m = json.load(f)
+        m["steps"][0]["settling_band_pct"] = 5
+        with open(mpath, "w") as f:
+            json.dump(m, f)
+        res = self.run_tool(COMPARE, run_a, run_b, "--out", os.path.join(self.tmp, "cmp"))
+        self.assertEqual(res.returncode, 0, res.stderr)
+        self.assertIn("| settle 2%/5% |", res.stdout)
 
     def test_compare_out_dir_and_channel_in_one_run(self):
         run_a = self.make_plotted_run("a", [("z", 0.0, 0.0, 10.0)])

@@ -23,16 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool write_json(const fs::path& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  f << j.dump(2) << '\n';
-  if (!f) {
-    std::cerr << "error: " << path.string() << ": write failed\n";
-    return false;
-  }
-  return true;
-}
-
 // Console summary: pass count, then per figure the runs that have it and the missing ones, and the
 // statistics of those that have it.
 void print_summary(const nlohmann::json& j, std::ostream& os) {
@@ -58,7 +48,7 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
 }
 
 int verdict(const nlohmann::json& j, double min_pass_rate) {
-  return static_cast<double>(j["passed"].get<int>()) >= min_pass_rate * j["runs"].get<int>() ? exit_code::kOk
+  return j["passed"].get<int>() >= sweep::passes_needed(min_pass_rate, j["runs"].get<int>()) ? exit_code::kOk
                                                                                               : exit_code::kFailed;
 }
 
@@ -108,26 +98,30 @@ int merge_command(const SweepOptions& o) {
   std::vector<nlohmann::json> per_run;
   for (const std::string& dir : o.shard_dirs) {
     const fs::path file = fs::path(dir) / "shard.json";
-    nlohmann::json j;
-    try {
-      std::ifstream in(file);
-      if (!in) {
-        std::cerr << "error: " << file.string() << ": not found (not a shard folder)\n";
-        return exit_code::kBadInput;
-      }
-      in >> j;
-      if (header.is_null()) {
-        header = j.at("header");
-      } else if (j.at("header") != header) {
-        std::cerr << "error: " << file.string() << ": a shard of another sweep (scenario, seed, runs or --vary differ "
-                  << "from " << o.shard_dirs.front() << ")\n";
-        return exit_code::kBadInput;
-      }
-      for (auto& r : j.at("per_run")) per_run.push_back(std::move(r));
-    } catch (const nlohmann::json::exception& e) {
-      std::cerr << "error: " << file.string() << ": not a shard's results (" << e.what() << ")\n";
+    std::ifstream in(file);
+    if (!in) {
+      std::cerr << "error: " << file.string() << ": not found (not a shard folder)\n";
       return exit_code::kBadInput;
     }
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(in);
+      sweep::check_shard_json(j);
+    } catch (const nlohmann::json::parse_error& e) {
+      std::cerr << "error: " << file.string() << ": not JSON (" << e.what() << ")\n";
+      return exit_code::kBadInput;
+    } catch (const std::invalid_argument& e) {  // check_shard_json: the field and what it holds
+      std::cerr << "error: " << file.string() << ": not a shard's results: " << e.what() << '\n';
+      return exit_code::kBadInput;
+    }
+    if (header.is_null()) {
+      header = j["header"];
+    } else if (j["header"] != header) {
+      std::cerr << "error: " << file.string() << ": a shard of another sweep (scenario, seed, runs or --vary differ "
+                << "from " << o.shard_dirs.front() << ")\n";
+      return exit_code::kBadInput;
+    }
+    for (auto& r : j["per_run"]) per_run.push_back(std::move(r));
   }
   // A run missing or given twice: std::invalid_argument, bad input (run_guarded).
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
@@ -135,7 +129,7 @@ int merge_command(const SweepOptions& o) {
   io::OutputFolder folder = io::OutputFolder::claim(out, "sweep merge", {.force = o.force}, std::cerr);
   fs::copy_file(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml",
                 fs::copy_options::overwrite_existing);
-  if (!write_json(out / "summary.json", summary)) return exit_code::kOutput;
+  sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
   if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
@@ -231,7 +225,7 @@ int sweep_command(const SweepOptions& o) {
     int passed = 0;
     for (const auto& r : results) passed += r.passed ? 1 : 0;
     nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
-    if (!write_json(out / "shard.json", j)) return exit_code::kOutput;
+    sweep::write_json(out / "shard.json", j);
     std::cout << fmt::format("sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
                              "join the shards with `quadcosim sweep merge OUT DIR...`\n",
                              plan.nominal.name, o.shard, results.size(), plan.runs, passed,
@@ -239,7 +233,7 @@ int sweep_command(const SweepOptions& o) {
     return exit_code::kOk;
   }
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
-  if (!write_json(out / "summary.json", summary)) return exit_code::kOutput;
+  sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
   if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;

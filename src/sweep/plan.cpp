@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <set>
 
 #include "control/parameters.hpp"
 #include "model/random.hpp"
@@ -85,6 +84,29 @@ std::string join(const std::vector<std::string>& parts, std::size_t from, std::s
   std::string s;
   for (std::size_t i = from; i < to; ++i) s += (i == from ? "" : ".") + parts[i];
   return s;
+}
+
+// A key path in one spelling, for telling keys apart: list entries as [i] ("initial.position_m.z",
+// "initial.position_m[2]" and "initial.position_m.2" are all "initial.position_m[2]"). x, y, z
+// after the first part are taken as the indexes 0, 1, 2, as setting the key takes them on a list.
+std::string canonical_path(const std::string& path) {
+  const std::vector<std::string> parts = split_path(path);
+  std::string s;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const int index = i == 0 ? -1 : index_of(parts[i]);
+    s += index >= 0 ? fmt::format("[{}]", index) : fmt::format("{}{}", i == 0 ? "" : ".", parts[i]);
+  }
+  return s;
+}
+
+// A vehicle field by its name as the parameter table spells it (entries of a 3-vector as .x/.y/.z:
+// "aero.linear_drag_N_s_m[0]" finds "aero.linear_drag_N_s_m.x"); nullptr when it is none.
+const model::VehicleParameter* find_vehicle_field(const std::string& name) {
+  std::vector<std::string> parts = split_path(name);
+  for (std::size_t i = 1; i < parts.size(); ++i) {
+    if (parts[i] == "0" || parts[i] == "1" || parts[i] == "2") parts[i] = std::string(1, "xyz"[parts[i][0] - '0']);
+  }
+  return parts.empty() ? nullptr : find_field(join(parts, 0, parts.size()));
 }
 
 void set_at(YAML::Node node, const std::vector<std::string>& parts, std::size_t pos, double value,
@@ -177,9 +199,9 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
     for (const auto& n : a->second) keys.push_back(vehicle_key(*find_field(n)));
     return keys;
   }
-  if (const auto* f = find_field(v.name)) return {vehicle_key(*f)};
+  if (const auto* f = find_vehicle_field(v.name)) return {vehicle_key(*f)};
   if (v.name.rfind("vehicle.", 0) == 0) {
-    if (const auto* f = find_field(v.name.substr(8))) return {vehicle_key(*f)};
+    if (const auto* f = find_vehicle_field(v.name.substr(8))) return {vehicle_key(*f)};
   }
   if (v.name.find('.') == std::string::npos) {
     throw PlanError("--vary " + v.spec + ": unknown parameter '" + v.name + "' (expected an alias (" + known_aliases() +
@@ -367,7 +389,7 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
   p.repeats = runs_per_point;
   if (runs_per_point < 1) throw PlanError("--runs must be at least 1");
   const auto lists = default_lists(p.nominal);
-  std::set<std::string> used;
+  std::map<std::string, std::string> used;  // canonical_path -> the key as the earlier --vary set it
   // Loads the scenario with `value` at every key of `v` (the check of a grid value or a typical one).
   const auto try_load = [&](const Vary& v, double value, const char* what) {
     YAML::Node root = YAML::Clone(p.root);
@@ -388,8 +410,9 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
     Vary v = parse_vary(spec);
     v.keys = resolve(v, p.nominal, p.root);
     for (const Key& k : v.keys) {
-      if (!used.insert(k.path).second) {
-        throw PlanError("--vary " + spec + ": " + k.stream + " is already varied by an earlier --vary");
+      if (const auto [it, fresh] = used.emplace(canonical_path(k.path), k.path); !fresh) {
+        throw PlanError("--vary " + spec + ": " + k.stream + " is already varied by an earlier --vary" +
+                        (it->second == k.path ? std::string() : " (as " + it->second + ")"));
       }
       if (v.distribution == Distribution::kPercent && !k.nominal) {
         throw PlanError("--vary " + spec + ": " + k.path + " has no value in " + scenario_file +

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <thread>
 
 #include "analysis/step_metrics.hpp"
@@ -58,12 +60,6 @@ void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
   if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
   r.saturation = io::evaluate_saturation(sc, series);
   r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed) && (!r.saturation || r.saturation->passed);
-}
-
-void write_json(const fs::path& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  f << j.dump(2) << '\n';
-  if (!f) throw std::runtime_error(path.string() + ": write failed");
 }
 
 // Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step
@@ -169,6 +165,22 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
   return results;
+}
+
+void write_json(const fs::path& path, const nlohmann::json& j) {
+  std::ofstream f(path);
+  f << j.dump(2) << '\n';
+  if (!f) throw std::runtime_error(path.string() + ": write failed");
+}
+
+int passes_needed(double rate, int runs) {
+  if (!(rate >= 0.0 && rate <= 1.0) || runs < 0) {
+    throw std::invalid_argument(fmt::format("pass rate {} of {} runs: expected a rate in [0, 1]", rate, runs));
+  }
+  // A rate written in decimal is not exact in binary, nor is its product with runs: 1e-12 relative
+  // covers both (a few units in the last place) and is far below one run in 10^7.
+  const double needed = std::ceil(rate * runs * (1.0 - 1e-12));
+  return std::clamp(static_cast<int>(needed), 0, runs);
 }
 
 std::vector<int> shard_indices(int runs, int shard, int count) {
@@ -277,6 +289,50 @@ nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::
   j["per_run"] = std::move(per_run);
   j["figures"] = dist;
   return j;
+}
+
+void check_shard_json(const nlohmann::json& shard) {
+  const auto got = [](const nlohmann::json& v) {
+    if (v.is_object()) return std::string("an object");
+    if (v.is_array()) return std::string("an array");
+    const std::string text = v.dump();
+    return text.size() > 40 ? text.substr(0, 37) + "..." : text;
+  };
+  const auto object = [&](const nlohmann::json& v, const std::string& where) {
+    if (!v.is_object()) throw std::invalid_argument(where + ": expected an object, got " + got(v));
+  };
+  const auto field = [&](const nlohmann::json& v, const std::string& where, const char* key) -> const nlohmann::json& {
+    if (!v.contains(key)) {
+      throw std::invalid_argument(fmt::format("{}'{}' is missing", where.empty() ? "" : where + ": ", key));
+    }
+    return v.at(key);
+  };
+  const auto whole = [&](const nlohmann::json& v, const std::string& where) {
+    if (!v.is_number_integer()) throw std::invalid_argument(where + ": expected a whole number, got " + got(v));
+  };
+  object(shard, "shard.json");
+  const nlohmann::json& header = field(shard, "", "header");
+  object(header, "header");
+  whole(field(header, "header", "runs"), "header.runs");
+  const nlohmann::json& per_run = field(shard, "", "per_run");
+  if (!per_run.is_array()) throw std::invalid_argument("per_run: expected an array, got " + got(per_run));
+  for (std::size_t i = 0; i < per_run.size(); ++i) {
+    const std::string where = fmt::format("per_run[{}]", i);
+    const nlohmann::json& r = per_run[i];
+    object(r, where);
+    whole(field(r, where, "index"), where + ".index");
+    if (!field(r, where, "passed").is_boolean()) {
+      throw std::invalid_argument(where + ".passed: expected true or false, got " + got(r.at("passed")));
+    }
+    const nlohmann::json& figures = field(r, where, "figures");
+    object(figures, where + ".figures");
+    for (const auto& [name, v] : figures.items()) {
+      if (!v.is_number() && !v.is_null()) {
+        throw std::invalid_argument(
+            fmt::format("{}.figures[\"{}\"]: expected a number or null, got {}", where, name, got(v)));
+      }
+    }
+  }
 }
 
 Plan plan_of(const fs::path& dir) {

@@ -38,6 +38,16 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
 /// Runs i with i % count == shard - 1 (shard in 1..count), ascending.
 std::vector<int> shard_indices(int runs, int shard, int count);
 
+/// Writes `j` to `path` as JSON indented by 2, with a final newline (summary.json, shard.json, a
+/// run's metrics.json). Throws std::runtime_error naming the file when it cannot be written.
+void write_json(const std::filesystem::path& path, const nlohmann::json& j);
+
+/// The fewest passing runs out of `runs` that meet a pass rate `rate` (--min-pass-rate, in [0, 1]):
+/// ceil(rate × runs), forgiving the rounding of the product (below 1e-12 relative), so that 0.55 of
+/// 100 is 55 (0.55 × 100 is 55.000000000000007 in binary). Throws std::invalid_argument for a rate
+/// outside [0, 1] (or NaN) or negative runs.
+int passes_needed(double rate, int runs);
+
 /// Flies run `index` again into `dir` with the outputs of `quadcosim run` in-process: trajectory.csv,
 /// run.mcap, metadata.yaml, metrics.json (with the "sweep" section), metrics.txt; judged from the
 /// recorded CSV as `run` is. Throws io::ConfigError / std::invalid_argument for a refused value,
@@ -59,6 +69,12 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r);
 /// summary.json from the header and every run's per_run entry (any order; sorted by index here).
 /// Throws std::invalid_argument when an index is missing, repeated or out of range.
 nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run);
+
+/// Checks a parsed shard.json for what `sweep merge` reads: "header" an object with "runs" a whole
+/// number, "per_run" an array of objects each with "index" (a whole number), "passed" (true or false)
+/// and "figures" (an object of numbers or nulls). Throws std::invalid_argument naming the first field
+/// missing or of another type and what it holds ("per_run[3].passed: expected true or false, got \"yes\"").
+void check_shard_json(const nlohmann::json& shard);
 
 /// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it).
 /// Throws std::runtime_error naming the file.

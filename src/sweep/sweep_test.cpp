@@ -176,6 +176,68 @@ TEST(Plan, RefusesUnknownKeysDoubleVariationAndValuesTheLoaderRefuses) {
   EXPECT_EQ(error_of({"controller.altitude.kp=uniform(1,2)", "environment.gusts.w20_m_s=uniform(0,2)"}), "accepted");
 }
 
+TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
+  const std::string f = scenario_file().string();
+  const auto error_of = [&](const std::vector<std::string>& specs) {
+    try {
+      make_plan(f, specs, 1, 4, Sampler::kRandom);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  // initial.position_m[2] and initial.position_m.z are one key (docs/sweeps.md): varied twice, refused.
+  EXPECT_THAT(error_of({"initial.position_m[2]=grid(1)", "initial.position_m.z=grid(2)"}),
+              AllOf(HasSubstr("--vary initial.position_m.z=grid(2)"), HasSubstr("already varied"),
+                    HasSubstr("initial.position_m[2]")));
+  EXPECT_THAT(error_of({"initial.position_m.x=grid(1)", "initial.position_m.0=grid(2)"}), HasSubstr("already varied"));
+  EXPECT_EQ(error_of({"initial.position_m[0]=grid(1)", "initial.position_m.z=grid(2)"}), "accepted");
+
+  // A vehicle list entry by its index is the vehicle key .x/.y/.z: the table's range, the plant's key.
+  const Plan p = make_plan(
+      f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
+      Sampler::kRandom);
+  ASSERT_EQ(p.vary.size(), 2u);
+  const Key& lin = p.vary[0].keys.at(0);
+  EXPECT_EQ(lin.path, "vehicle.aero.linear_drag_N_s_m.x");
+  EXPECT_EQ(lin.stream, "aero.linear_drag_N_s_m.x");
+  EXPECT_TRUE(lin.is_vehicle);
+  ASSERT_TRUE(lin.declared.has_value());
+  EXPECT_EQ(lin.declared->min, 0.0);
+  EXPECT_EQ(lin.declared->max, 1e6);
+  EXPECT_EQ(p.vary[1].keys.at(0).path, "vehicle.aero.quadratic_drag_N_s2_m2.z");
+  EXPECT_TRUE(p.vary[1].keys.at(0).is_vehicle);
+  // normal(0, 1) truncated at the declared minimum 0: no negative drag drawn (half would be, untruncated).
+  for (int i = 0; i < p.runs; ++i) EXPECT_GE(sample(p, i).values[0].second, 0.0) << i;
+  const io::Scenario sc = scenario_for(p, sample(p, 7));
+  EXPECT_EQ(sc.vehicle.aero.linear_drag_N_s_m.x(), sample(p, 7).values[0].second);
+  EXPECT_EQ(sc.vehicle.aero.quadratic_drag_N_s2_m2.z(), 0.5);
+  EXPECT_THAT(error_of({"vehicle.aero.linear_drag_N_s_m[1]=grid(-1)"}),
+              AllOf(HasSubstr("vehicle.aero.linear_drag_N_s_m.y = -1"), HasSubstr("declared range [0, 1e+06]")));
+  EXPECT_THAT(error_of({"linear_drag=uniform(0,1)", "vehicle.aero.linear_drag_N_s_m[1]=grid(0.3)"}),
+              HasSubstr("already varied"));
+}
+
+TEST(PassesNeeded, CeilOfRateTimesRunsWithoutTheProductsRoundingError) {
+  // 0.55 * 100 is 55.000000000000007 in binary: exactly 55 of 100 passing meets --min-pass-rate 0.55.
+  ASSERT_GT(0.55 * 100, 55.0);
+  EXPECT_EQ(passes_needed(0.55, 100), 55);
+  EXPECT_EQ(passes_needed(0.07, 100), 7);  // 0.07 * 100 = 7.000000000000001
+  EXPECT_EQ(passes_needed(0.29, 100), 29);  // 0.29 * 100 = 28.999999999999996
+  EXPECT_EQ(passes_needed(0.57, 100), 57);  // 0.57 * 100 = 56.99999999999999
+  EXPECT_EQ(passes_needed(0.551, 100), 56);  // a fraction of a run more: the next whole run
+  EXPECT_EQ(passes_needed(1.0 / 3.0, 3), 1);
+  EXPECT_EQ(passes_needed(0.5, 3), 2);
+  EXPECT_EQ(passes_needed(1.0, 10'000'000), 10'000'000);
+  EXPECT_EQ(passes_needed(0.1, 10'000'000), 1'000'000);
+  EXPECT_EQ(passes_needed(0.0, 7), 0);
+  EXPECT_EQ(passes_needed(1.0, 0), 0);
+  // Every rate k/100 of 100 runs needs exactly k runs.
+  for (int k = 0; k <= 100; ++k) EXPECT_EQ(passes_needed(k / 100.0, 100), k) << k;
+  EXPECT_THROW(passes_needed(1.5, 10), std::invalid_argument);
+  EXPECT_THROW(passes_needed(std::nan(""), 10), std::invalid_argument);
+}
+
 TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
   const std::string f = scenario_file().string();
   const Plan a = make_plan(f, {"mass=10%", "controller.altitude.kp=uniform(2,6)"}, 42, 100, Sampler::kRandom);

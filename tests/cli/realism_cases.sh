@@ -79,6 +79,15 @@ PYEOF
     [ $rc -eq 1 ] && grep -q "0 of 2 runs passed" "$TMP/o" || fail "expected exit 1 and 0 of 2 passed (rc $rc)"
     "$QC" sweep "$TMP/tight.yaml" --runs 2 --out "$TMP/t2" --no-plots --min-pass-rate 0 > "$TMP/o" 2>&1; rc=$?
     [ $rc -eq 0 ] || fail "--min-pass-rate 0 should exit 0 (rc $rc)"
+    # Exactly 55 of 100 runs pass (the paper's kp 4 passes, kp 0.5 misses the overshoot band):
+    # --min-pass-rate 0.55 is met although 0.55 x 100 is 55.000000000000007 in binary; 0.56 is not.
+    G=$(printf '4,%.0s' $(seq 11))$(printf '0.5,%.0s' $(seq 8))0.5
+    for want in 0.55:0 0.56:1; do
+      "$QC" sweep "$SRC/scenarios/paper/altitude_step.yaml" --vary "controller.altitude.kp=grid($G)" --runs 5 \
+        --min-pass-rate "${want%:*}" --no-plots --out "$TMP/r${want%:*}" > "$TMP/o" 2>&1; rc=$?
+      grep -q "55 of 100 runs passed" "$TMP/o" || { cat "$TMP/o"; fail "expected 55 of 100 runs to pass"; }
+      [ $rc -eq "${want#*:}" ] || fail "55 of 100 passed with --min-pass-rate ${want%:*}: exit $rc, expected ${want#*:}"
+    done
     # The plot tool on a directory without summary.json: exit 1, naming the file.
     "$PY" "$SRC/tools/plot_sweep.py" "$TMP/nothing" > "$TMP/o" 2>&1; rc=$?
     [ $rc -eq 1 ] && grep -q "nothing/summary.json: file not found" "$TMP/o" || fail "plot_sweep.py on a missing summary (rc $rc)"

@@ -6,7 +6,7 @@
 #   usage: slurm_test.sh QUADCOSIM_BINARY SOURCE_DIR PORT_BASE
 set -uo pipefail
 QC=$(realpath "$1")
-SRC=$2
+SRC=$(realpath "$2")
 PORT=${3:-16917}
 skip() { echo "SKIPPED: $*" >&2; exit 77; }
 fail() { echo "FAIL [slurm]: $*" >&2; for f in "$TMP"/*.log; do echo "== $f"; tail -20 "$f"; done >&2; exit 1; }
@@ -77,7 +77,7 @@ slurmd -D -f "$SLURM_CONF" -N "$HOST" > "$TMP/slurmd.out.log" 2>&1 &
 PIDS+=($!)
 idle=""
 for _ in $(seq 60); do
-  for p in "${PIDS[@]}"; do kill -0 "$p" 2> /dev/null || skip "a Slurm daemon exited at start: $(tail -2 "$TMP"/slurm*.log | tr '\n' ' ')"; done
+  for p in "${PIDS[@]}"; do kill -0 "$p" 2> /dev/null || skip "a Slurm daemon exited at start: $(tail -n 2 "$TMP"/slurm*.log | tr '\n' ' ')"; done
   idle=$(sinfo -h -N -o '%t' 2> /dev/null | head -1)
   [ "$idle" = "idle" ] && break
   sleep 0.5
@@ -85,9 +85,13 @@ done
 [ "$idle" = "idle" ] || skip "the node did not become idle in 30 s (state '$idle')"
 
 OUT=$TMP/out
-ARGS=("$SRC/scenarios/realism/hover_wind_gusts.yaml" --runs 12 --seed 8 --vary mass=10% --vary controller.altitude.kd=uniform\(2,3.5\) --min-pass-rate 0)
-"$QC" sweep "${ARGS[@]}" --no-plots --out "$TMP/unsharded" > "$TMP/unsharded.log" 2>&1 || fail "unsharded sweep"
-merge=$(QUADCOSIM=$QC bash "$SRC/scripts/slurm/submit.sh" "$OUT" 3 "${ARGS[@]}" 2> "$TMP/submit.log") || fail "submit: $(cat "$TMP/submit.log")"
+SCN=$(realpath "$SRC/scenarios/realism/hover_wind_gusts.yaml")
+ARGS=(--runs 12 --seed 8 --vary mass=10% --vary controller.altitude.kd=uniform\(2,3.5\) --min-pass-rate 0)
+"$QC" sweep "$SCN" "${ARGS[@]}" --no-plots --out "$TMP/unsharded" > "$TMP/unsharded.log" 2>&1 || fail "unsharded sweep"
+# Submitted as docs/sweeps.md shows, with OUT and SCENARIO relative to the current folder (the jobs
+# run in OUT): submit.sh makes them absolute, so the header and summary.json name $SCN.
+merge=$(cd "$TMP" && QUADCOSIM=$QC bash "$SRC/scripts/slurm/submit.sh" out 3 "$(realpath --relative-to=. "$SCN")" \
+        "${ARGS[@]}" 2> "$TMP/submit.log") || fail "submit: $(cat "$TMP/submit.log")"
 for _ in $(seq 240); do
   [ -z "$(squeue -h -o %i 2> /dev/null)" ] && break
   sleep 0.5

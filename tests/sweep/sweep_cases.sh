@@ -75,6 +75,33 @@ PYEOF
     [ $rc -eq 2 ] && grep -q "appears twice" "$TMP/o" || fail "merge with a shard twice (rc $rc)"
     "$QC" sweep "$HOVER" --shard 4/3 --out "$TMP/x" > "$TMP/o" 2>&1; rc=$?
     [ $rc -eq 2 ] && grep -q "expected K/N" "$TMP/o" || fail "--shard 4/3 (rc $rc)"
+    # A malformed shard.json: exit 2 naming the file and what is wrong (first or later in the list).
+    bad_shard() {  # bad_shard EXPECTED_TEXT PYTHON_EDIT_OF_j
+      rm -rf "$TMP/bad" "$TMP/mb"
+      cp -r "$TMP/p1" "$TMP/bad"
+      "$PY" - "$TMP/bad/shard.json" "$2" <<'PYEOF'
+import json, sys
+j = json.load(open(sys.argv[1]))
+exec(sys.argv[2])
+open(sys.argv[1], "w").write(j if isinstance(j, str) else json.dumps(j))
+PYEOF
+      for order in "$TMP/bad $TMP/p2 $TMP/p3" "$TMP/p2 $TMP/p3 $TMP/bad"; do
+        # shellcheck disable=SC2086
+        "$QC" sweep merge "$TMP/mb" $order --no-plots > "$TMP/o" 2>&1; rc=$?
+        [ $rc -eq 2 ] && grep -qF "$TMP/bad/shard.json" "$TMP/o" && grep -qF "$1" "$TMP/o" \
+          || { cat "$TMP/o"; fail "malformed shard.json ($2): exit $rc, expected 2 naming the file and '$1'"; }
+      done
+    }
+    bad_shard "not JSON" 'j = "{\"header\": "'
+    bad_shard "'header' is missing" 'del j["header"]'
+    bad_shard "per_run: expected an array, got an object" 'j["per_run"] = {"a": 1}'
+    bad_shard "header.runs: expected a whole number, got \"12\"" 'j["header"]["runs"] = "12"'
+    bad_shard "per_run[0]: 'passed' is missing" 'del j["per_run"][0]["passed"]'
+    bad_shard "per_run[1].passed: expected true or false, got \"yes\"" 'j["per_run"][1]["passed"] = "yes"'
+    bad_shard "per_run[0].index: expected a whole number, got \"0\"" 'j["per_run"][0]["index"] = "0"'
+    bad_shard "per_run[2]: expected an object, got 7" 'j["per_run"][2] = 7'
+    bad_shard "per_run[0].figures[\"hold.rms_horizontal_error_m\"]: expected a number or null, got \"big\"" \
+      'j["per_run"][0]["figures"]["hold.rms_horizontal_error_m"] = "big"'
     set -e
     ;;
 
@@ -129,6 +156,17 @@ PYEOF
     set -e
     "$QC" sweep "$HOVER" --runs 2 --out "$TMP/run" --no-plots --min-pass-rate 0 --force > /dev/null || fail "--force on a run folder"
     [ ! -e "$TMP/run/trajectory.csv" ] && [ ! -e "$TMP/run/run.mcap" ] && [ -s "$TMP/run/summary.json" ] || fail "a run's file survived"
+    # An output that cannot be written (a folder, kept by --force, where summary.json or shard.json
+    # goes): exit 3 naming the file.
+    mkdir -p "$TMP/w1/summary.json" "$TMP/w2/shard.json"
+    set +e
+    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --no-plots --out "$TMP/w1" --force > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 3 ] && grep -q "$TMP/w1/summary.json: write failed" "$TMP/o" \
+      || { cat "$TMP/o"; fail "summary.json unwritable (rc $rc)"; }
+    "$QC" sweep "$HOVER" --runs 2 --shard 1/2 --no-plots --out "$TMP/w2" --force > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 3 ] && grep -q "$TMP/w2/shard.json: write failed" "$TMP/o" \
+      || { cat "$TMP/o"; fail "shard.json unwritable (rc $rc)"; }
+    set -e
     ;;
 
   console)  # every figure with its count and missing runs; a figure no run has says so
@@ -205,6 +243,74 @@ assert s["figures"]["saturation.saturated_s"]["max"] == f1["saturation.saturated
 # The plots: a histogram of the saturation time.
 assert os.path.exists(sys.argv[1] + "/hist_saturation.saturated_s.png"), os.listdir(sys.argv[1])
 PYEOF
+    ;;
+
+  slurm_submit)  # scripts/slurm/submit.sh with relative paths, through a stand-in sbatch that runs the jobs
+    # The stand-in runs each job at once in its --chdir folder, as Slurm does (array tasks in turn with
+    # SLURM_ARRAY_TASK_ID, an afterok job only when its dependency succeeded), and records its arguments.
+    mkdir -p "$TMP/bin" "$TMP/jobs" "$TMP/cwd"
+    cat > "$TMP/bin/sbatch" <<'SH'
+#!/usr/bin/env bash
+set -u
+printf '%s\n' "$*" >> "$FAKE_SBATCH_DIR/log"
+id=$((100 + $(wc -l < "$FAKE_SBATCH_DIR/log")))
+array="" chdir=$PWD dep="" wrap="" out="" exports=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --parsable | --job-name=*) ;;
+    --array=*) array=${1#--array=} ;;
+    --chdir=*) chdir=${1#--chdir=} ;;
+    --dependency=afterok:*) dep=${1#--dependency=afterok:} ;;
+    --export=*) exports=${1#--export=} ;;
+    --output=*) out=${1#--output=} ;;
+    --wrap) wrap=$2; shift ;;
+    -*) echo "stand-in sbatch: unexpected option $1" >&2; exit 2 ;;
+    *) break ;;
+  esac
+  shift
+done
+echo "$id"
+if [ -n "$dep" ] && [ -e "$FAKE_SBATCH_DIR/failed.$dep" ]; then touch "$FAKE_SBATCH_DIR/never.$id"; exit 0; fi
+cd "$chdir" || exit 1
+IFS=, read -ra kv <<< "$exports"
+for e in "${kv[@]}"; do [ "$e" = ALL ] || export "${e?}"; done
+if [ -n "$wrap" ]; then
+  bash -c "$wrap" > "${out:-slurm-$id.out}" 2>&1 || touch "$FAKE_SBATCH_DIR/failed.$id"
+else
+  script=$1
+  shift
+  for k in $(seq "${array%-*}" "${array#*-}"); do
+    SLURM_ARRAY_TASK_ID=$k bash "$script" "$@" > "slurm-${id}_$k.out" 2>&1 || touch "$FAKE_SBATCH_DIR/failed.$id"
+  done
+fi
+SH
+    chmod +x "$TMP/bin/sbatch"
+    A=(--runs 6 --seed 8 --vary mass=10% --vary controller.altitude.kd=uniform\(2,3.5\) --min-pass-rate 0)
+    ABS=$(realpath "$HOVER")
+    "$QC" sweep "$ABS" "${A[@]}" --no-plots --out "$TMP/all" > /dev/null 2>&1 || fail "unsharded sweep"
+    # From a folder of its own, as a user would: OUT, SCENARIO and QUADCOSIM relative to it.
+    cd "$TMP/cwd"
+    REL=$(realpath --relative-to=. "$ABS")
+    RELQC=$(realpath --relative-to=. "$QC")
+    [ "${REL#/}" = "$REL" ] && [ "${RELQC#/}" = "$RELQC" ] || fail "relative paths expected: $REL $RELQC"
+    PATH=$TMP/bin:$PATH FAKE_SBATCH_DIR=$TMP/jobs QUADCOSIM=$RELQC \
+      bash "$SRC/scripts/slurm/submit.sh" out 2 "$REL" "${A[@]}" > "$TMP/submit.log" 2>&1 \
+      || { cat "$TMP/submit.log"; fail "submit.sh"; }
+    for f in "$TMP"/jobs/failed.*; do
+      [ -e "$f" ] || continue
+      cat "$TMP"/cwd/out/slurm-*.out "$TMP/cwd/out/merge.out" 2> /dev/null || true
+      fail "job ${f##*.} failed"
+    done
+    grep -q -- "--array=1-2 --chdir=$TMP/cwd/out .* $ABS --runs 6" "$TMP/jobs/log" \
+      || { cat "$TMP/jobs/log"; fail "array job"; }
+    cmp "$TMP/all/summary.json" "$TMP/cwd/out/merged/summary.json" || fail "merged summary.json differs"
+    set +e
+    PATH=$TMP/bin:$PATH FAKE_SBATCH_DIR=$TMP/jobs bash "$SRC/scripts/slurm/submit.sh" out2 2 nowhere.yaml \
+      > "$TMP/o" 2>&1
+    rc=$?
+    set -e
+    [ $rc -eq 2 ] && grep -q "scenario nowhere.yaml is not a file" "$TMP/o" \
+      || { cat "$TMP/o"; fail "a missing scenario (rc $rc)"; }
     ;;
 
   *) echo "unknown case $CASE" >&2; exit 2 ;;
