@@ -154,6 +154,20 @@ PYEOF
     [ "$rc" = 2 ] && grep -q "broken.yaml" "$TMP/err2" || fail "broken YAML: exit $rc: $(cat "$TMP/err2")"
     [ "$rc3" = 2 ] && grep -q -- "--no-plots needs --out" "$TMP/err3" || fail "--no-plots alone: exit $rc3"
     [ "$rc4" = 2 ] || fail "missing file: exit $rc4"
+    # A bad scenario is refused before --out is touched: --force removes no previous outputs for it.
+    "$QC" margins --out "$TMP/prev" --no-plots > /dev/null || fail "margins --out failed"
+    ls -l --time-style=full-iso "$TMP/prev" > "$TMP/prev.before"
+    sed 's/^schedule:/schedule:\n  - at_s: 1\n    set: {altitude.kp: -4.0}/' "$P/roll_step.yaml" > "$TMP/refused.yaml"
+    grep -q "altitude.kp: -4.0" "$TMP/refused.yaml" || fail "the refused-schedule scenario was not made"
+    for bad in weak broken refused; do
+      set +e
+      "$QC" margins "$TMP/$bad.yaml" --out "$TMP/prev" --force > /dev/null 2> "$TMP/err"; rc=$?
+      set -e
+      [ "$rc" = 2 ] && grep -q "$bad.yaml" "$TMP/err" \
+        || fail "$bad.yaml with --out --force: exit $rc: $(cat "$TMP/err")"
+      ls -l --time-style=full-iso "$TMP/prev" | cmp -s - "$TMP/prev.before" || fail "$bad.yaml: --out changed"
+    done
+    grep -q "altitude.kp" "$TMP/err" || fail "the refused change is not named: $(cat "$TMP/err")"
     ;;
 
   *) fail "unknown case" ;;
