@@ -16,8 +16,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Frequency response of one state-space system at many frequencies: A is reduced once to upper
-// Hessenberg form, so each frequency costs one O(n^2) solve (delay lines make n large).
+// Frequency response of one state-space system at many frequencies, C (lambda I - A)^-1 B + D with
+// lambda = j omega (continuous) or exp(j omega period) (discrete), outputs x inputs (a pole exactly
+// at omega gives non-finite entries): A is reduced once to upper Hessenberg form, so each frequency
+// costs one O(n^2) solve (delay lines make n large).
 class ResponseEvaluator {
  public:
   explicit ResponseEvaluator(const StateSpace& sys) : sys_(sys) {
@@ -143,8 +145,6 @@ double wrap_pi(double a) {
 }
 
 }  // namespace
-
-Eigen::MatrixXcd StateSpace::response(double omega_rad_s) const { return ResponseEvaluator(*this)(omega_rad_s); }
 
 StateSpace zoh_discretise(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
                           double period_s) {
