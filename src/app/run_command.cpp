@@ -229,9 +229,7 @@ int run_command(const RunOptions& opt) {
     }
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
-    return io::all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed)
-               ? exit_code::kOk
-               : exit_code::kFailed;
+    return io::passed_overall(results, hold, saturation) ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {
     throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());
   } catch (const std::invalid_argument& e) {
