@@ -9,6 +9,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "model/angle.hpp"
+
 namespace quadcosim::analysis {
 
 namespace {
@@ -136,12 +138,6 @@ double refine(F f, double a, double b) {
     }
   }
   return std::sqrt(a * b);
-}
-
-double wrap_pi(double a) {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a <= 0.0) a += 2.0 * kPi;
-  return a - kPi;
 }
 
 }  // namespace
@@ -286,7 +282,7 @@ std::vector<FrequencyPoint> frequency_response(const Loop& loop, const MarginOpt
       if (phase > 0.0) phase -= 2.0 * kPi;  // start in (-360, 0]
       first = false;
     } else if (std::isfinite(phase)) {
-      phase = previous + wrap_pi(phase - previous);
+      phase = previous + model::wrap_pi(phase - previous);
     }
     if (std::isfinite(phase)) previous = phase;
     out.push_back({w, v, 20.0 * std::log10(std::abs(v)), phase * 180.0 / kPi});
@@ -392,7 +388,7 @@ LoopMargins analyse_margins(const Loop& loop, const MarginOptions& options) {
   r.phase_margin.status = MarginStatus::kInfinite;
   r.delay_margin.status = MarginStatus::kInfinite;
   for (double wc : r.gain_crossovers_rad_s) {
-    const double pm = wrap_pi(std::arg(L(wc)) + kPi);
+    const double pm = model::wrap_pi(std::arg(L(wc)) + kPi);
     if (r.phase_margin.status == MarginStatus::kInfinite || std::abs(pm) < std::abs(r.phase_margin.value))
       r.phase_margin = {MarginStatus::kFinite, pm, wc};
     const double lag = pm >= 0.0 ? pm : pm + 2.0 * kPi;
