@@ -28,6 +28,10 @@ case "$CASE" in
     "$QC" margins "$P/roll_step.yaml" > "$TMP/table.txt"
     for loop in roll pitch yaw altitude; do grep -q "^$loop " "$TMP/table.txt" || fail "no $loop row"; done
     grep -qi nan "$TMP/table.txt" && fail "NaN in the table"
+    grep -q "^note: .*rotor clamp, the tilt limit and the integral bound are not" "$TMP/table.txt" \
+      || fail "no note that saturation is not in the linear loops"
+    "$PY" -c "import json,sys; assert any('rotor clamp' in n for n in json.load(open(sys.argv[1]))['notes'])" \
+      "$TMP/roll_step.json" || fail "margins.json notes lack saturation"
     "$PY" - "$TMP/lqr.txt" "$TMP/roll_step.json" <<'PYEOF' || fail "margins differ from the closed form"
 import cmath, json, math, re, sys
 lqr = open(sys.argv[1]).read()
