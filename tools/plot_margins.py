@@ -43,7 +43,7 @@ def read_response(path):
     return {k: {kk: np.array(vv) for kk, vv in v.items()} for k, v in loops.items()}
 
 
-def margin_text(loop, period_s):
+def margin_text(loop):
     def fmt(m, key, unit, scale=1.0, digits=2):
         if m["status"] == "finite":
             return f"{m[key] * scale:.{digits}f} {unit} at {m['frequency_rad_s']:.3g} rad/s"
@@ -102,7 +102,7 @@ def bode(name, d, loop, nyquist_w, out):
     for ax in (ax1, ax2):
         ax.grid(True, which="both", alpha=0.3)
     ax1.set_title(f"{name}: loop broken at {loop['broken_at']}")
-    ax1.text(0.01, 0.03, margin_text(loop, None), transform=ax1.transAxes, fontsize=8, va="bottom",
+    ax1.text(0.01, 0.03, margin_text(loop), transform=ax1.transAxes, fontsize=8, va="bottom",
              bbox=dict(boxstyle="round", fc="white", alpha=0.85))
     fig.tight_layout()
     fig.savefig(out, dpi=110)
@@ -130,7 +130,7 @@ def nyquist(name, d, loop, out):
     ax.set_title(f"{name}: Nyquist plot (broken at {loop['broken_at']})", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
-    ax.text(0.02, 0.02, margin_text(loop, None), transform=ax.transAxes, fontsize=8, va="bottom",
+    ax.text(0.02, 0.02, margin_text(loop), transform=ax.transAxes, fontsize=8, va="bottom",
             bbox=dict(boxstyle="round", fc="white", alpha=0.85))
     fig.tight_layout()
     fig.savefig(out, dpi=110)

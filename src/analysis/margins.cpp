@@ -9,6 +9,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "model/angle.hpp"
+
 namespace quadcosim::analysis {
 
 namespace {
@@ -16,8 +18,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Frequency response of one state-space system at many frequencies: A is reduced once to upper
-// Hessenberg form, so each frequency costs one O(n^2) solve (delay lines make n large).
+// Frequency response of one state-space system at many frequencies, C (lambda I - A)^-1 B + D with
+// lambda = j omega (continuous) or exp(j omega period) (discrete), outputs x inputs (a pole exactly
+// at omega gives non-finite entries): A is reduced once to upper Hessenberg form, so each frequency
+// costs one O(n^2) solve (delay lines make n large).
 class ResponseEvaluator {
  public:
   explicit ResponseEvaluator(const StateSpace& sys) : sys_(sys) {
@@ -136,15 +140,7 @@ double refine(F f, double a, double b) {
   return std::sqrt(a * b);
 }
 
-double wrap_pi(double a) {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a <= 0.0) a += 2.0 * kPi;
-  return a - kPi;
-}
-
 }  // namespace
-
-Eigen::MatrixXcd StateSpace::response(double omega_rad_s) const { return ResponseEvaluator(*this)(omega_rad_s); }
 
 StateSpace zoh_discretise(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
                           double period_s) {
@@ -286,7 +282,7 @@ std::vector<FrequencyPoint> frequency_response(const Loop& loop, const MarginOpt
       if (phase > 0.0) phase -= 2.0 * kPi;  // start in (-360, 0]
       first = false;
     } else if (std::isfinite(phase)) {
-      phase = previous + wrap_pi(phase - previous);
+      phase = previous + model::wrap_pi(phase - previous);
     }
     if (std::isfinite(phase)) previous = phase;
     out.push_back({w, v, 20.0 * std::log10(std::abs(v)), phase * 180.0 / kPi});
@@ -392,7 +388,7 @@ LoopMargins analyse_margins(const Loop& loop, const MarginOptions& options) {
   r.phase_margin.status = MarginStatus::kInfinite;
   r.delay_margin.status = MarginStatus::kInfinite;
   for (double wc : r.gain_crossovers_rad_s) {
-    const double pm = wrap_pi(std::arg(L(wc)) + kPi);
+    const double pm = model::wrap_pi(std::arg(L(wc)) + kPi);
     if (r.phase_margin.status == MarginStatus::kInfinite || std::abs(pm) < std::abs(r.phase_margin.value))
       r.phase_margin = {MarginStatus::kFinite, pm, wc};
     const double lag = pm >= 0.0 ? pm : pm + 2.0 * kPi;

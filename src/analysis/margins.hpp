@@ -18,10 +18,6 @@ struct StateSpace {
   double period_s = 0.0;
 
   bool discrete() const { return period_s > 0.0; }
-  /// Frequency response at omega [rad/s]: C (lambda I - A)^-1 B + D with lambda = j omega
-  /// (continuous) or exp(j omega period) (discrete); outputs x inputs. A pole on the imaginary axis /
-  /// unit circle exactly at omega gives non-finite entries.
-  Eigen::MatrixXcd response(double omega_rad_s) const;
 };
 
 /// Exact zero-order-hold discretisation of dx/dt = A x + B u, y = C x at period T [s] (matrix

@@ -6,22 +6,13 @@
 
 #include <fmt/format.h>
 
-namespace quadcosim::analysis {
+#include "model/angle.hpp"
 
-namespace {
-// (-pi, pi], as model::wrap_pi (analysis does not depend on the model library).
-double wrap(double a) {
-  constexpr double pi = std::numbers::pi;
-  if (a > -pi && a <= pi) return a;
-  double r = std::remainder(a, 2.0 * pi);
-  if (r <= -pi) r += 2.0 * pi;
-  return r;
-}
-}  // namespace
+namespace quadcosim::analysis {
 
 std::vector<double> unwrap_angle(std::span<const double> y) {
   std::vector<double> out(y.begin(), y.end());
-  for (std::size_t i = 1; i < out.size(); ++i) out[i] = out[i - 1] + wrap(y[i] - y[i - 1]);
+  for (std::size_t i = 1; i < out.size(); ++i) out[i] = out[i - 1] + model::wrap_pi(y[i] - y[i - 1]);
   return out;
 }
 
@@ -40,7 +31,7 @@ StepFigures step_figures(std::span<const double> t, std::span<const double> y_in
   std::vector<double> y(y_in.begin() + static_cast<std::ptrdiff_t>(first), y_in.end());
   if (opt.angle) y = unwrap_angle(y);
   const std::span<const double> tt = t.subspan(first);
-  f.step = opt.angle ? wrap(target - f.initial) : target - f.initial;
+  f.step = opt.angle ? model::wrap_pi(target - f.initial) : target - f.initial;
   if (!std::isfinite(f.step)) return f;
   const double goal = f.initial + f.step;  // the target on the unwrapped response
   const double post_s = f.post_step_s;

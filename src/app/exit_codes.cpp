@@ -16,7 +16,7 @@ namespace quadcosim::app {
 
 const std::vector<ExitCodeRow>& exit_code_table() {
   using namespace exit_code;
-  // README.md "Exit codes" shows these rows; tests/cli/exit_codes.sh compares the two.
+  // README.md "Exit codes" shows these rows; tests/cli/exit_codes.py compares the two.
   static const std::vector<ExitCodeRow> table = {
       {kOk, "success", "*"},
       {kFailed, "a step or hold criterion failed", "run summary"},

@@ -1,5 +1,5 @@
 // The process exit codes of the quadcosim commands, stated once: the values the commands return,
-// the table rendered into each command's --help footer, and (checked by tests/cli/exit_codes.sh)
+// the table rendered into each command's --help footer, and (checked by tests/cli/exit_codes.py)
 // the README's "Exit codes" table.
 #pragma once
 

@@ -181,6 +181,8 @@ int margins_command(const MarginsOptions& o) {
   std::vector<analysis::HoverLoop> loops;
   try {
     s = setup_from(o.scenario);
+    s.notes.push_back("the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
+                      "in them");
     loops = analysis::hover_loops(s.plant, s.controller.params, s.controller.setpoint.mode, s.timing);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(fmt::format("{}cannot linearise about hover: {}",

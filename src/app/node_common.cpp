@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "analysis/percentile.hpp"
 #include "app/commands.hpp"
 #include "app/signals.hpp"
 
@@ -225,9 +226,7 @@ void PeriodJitter::add(std::int64_t now_ns) {
 nlohmann::json PeriodJitter::figures() const {
   std::vector<std::int64_t> j = jitter_ns_;
   std::sort(j.begin(), j.end());
-  auto pct = [&](double q) {
-    return j.empty() ? 0.0 : static_cast<double>(j[static_cast<std::size_t>(q * static_cast<double>(j.size() - 1))]) / 1e3;
-  };
+  auto pct = [&](double q) { return j.empty() ? 0.0 : static_cast<double>(analysis::percentile_lower(j, q)) / 1e3; };
   return {{"period_jitter_us_p50", pct(0.5)}, {"period_jitter_us_p99", pct(0.99)},
           {"period_jitter_us_max", pct(1.0)}, {"periods", j.size()}};
 }

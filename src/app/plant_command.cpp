@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "analysis/percentile.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
@@ -230,9 +231,7 @@ class PlantProcess {
     if (lockstep_) round_trip_ns = lockstep_->round_trips_ns();
     if (!round_trip_ns.empty()) {
       std::sort(round_trip_ns.begin(), round_trip_ns.end());
-      auto pct = [&](double q) {
-        return static_cast<double>(round_trip_ns[static_cast<std::size_t>(q * (round_trip_ns.size() - 1))]) / 1e3;
-      };
+      auto pct = [&](double q) { return static_cast<double>(analysis::percentile_lower(round_trip_ns, q)) / 1e3; };
       std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
                                "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
                                round_trip_ns.size(), pct(0.5), pct(0.99), pct(1.0));

@@ -145,11 +145,6 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
 int run_command(const RunOptions& opt) {
   const io::Scenario sc = io::load_scenario(opt.scenario);
 
-  if (!opt.keystore.empty() && opt.transport != "dds") {
-    std::cerr << "error: --keystore secures the DDS transport; add --transport dds\n";
-    return exit_code::kBadInput;
-  }
-
   if (opt.transport == "dds" && sc.simulation.faults.active() && !(opt.vehicles > 0 || sc.swarm)) {
     std::cerr << "error: " << opt.scenario << ": message_faults: message loss and delay are injected by the "
                  "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
@@ -234,9 +229,7 @@ int run_command(const RunOptions& opt) {
     }
     std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
-    return io::all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed)
-               ? exit_code::kOk
-               : exit_code::kFailed;
+    return io::passed_overall(results, hold, saturation) ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {
     throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());
   } catch (const std::invalid_argument& e) {

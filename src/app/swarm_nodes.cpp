@@ -13,6 +13,7 @@
 #include <mutex>
 #include <thread>
 
+#include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
@@ -30,8 +31,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kExitOk = 0, kExitRefused = 2, kExitNoPeer = 4, kExitInterrupted = 130;
-
 io::SwarmSpec node_spec(const io::Scenario& sc, int vehicles, const std::string& ns_prefix) {
   io::SwarmSpec spec = swarm_spec(sc, vehicles, 0);
   if (!ns_prefix.empty()) {
@@ -46,14 +45,14 @@ io::SwarmSpec node_spec(const io::Scenario& sc, int vehicles, const std::string&
 /// Runs `body(t)` on `threads` threads (t = 0 on the caller's); returns the largest exit code.
 template <class F>
 int run_threads(int threads, F body) {
-  std::atomic<int> worst{0};
+  std::atomic<int> worst{exit_code::kOk};
   auto one = [&](int t) {
     int rc;
     try {
       rc = body(t);
     } catch (const std::exception& e) {
       std::cerr << "error: " << e.what() << '\n';
-      rc = 3;
+      rc = exit_code::kOutput;
     }
     int cur = worst.load();
     while (rc > cur && !worst.compare_exchange_weak(cur, rc)) {
@@ -123,7 +122,7 @@ class PlantShard {
     if (!found) {
       std::cerr << fmt::format("plant: no controller for {} within {} s ({} of {} vehicles of this thread matched)\n",
                                vehicles_[ready]->topics.motor_commands, timeout_s, ready, vehicles_.size());
-      return kExitNoPeer;
+      return exit_code::kNoPeer;
     }
     drivers::LockstepOptions lo;
     lo.clock = clock_;
@@ -168,8 +167,8 @@ class PlantShard {
     for (auto& v : vehicles_) {
       if (v->csv) v->csv->close();
     }
-    if (r == drivers::LockstepResult::kTimedOut) return kExitNoPeer;
-    return r == drivers::LockstepResult::kStopped ? kExitInterrupted : kExitOk;
+    if (r == drivers::LockstepResult::kTimedOut) return exit_code::kNoPeer;
+    return r == drivers::LockstepResult::kStopped ? exit_code::kInterrupted : exit_code::kOk;
   }
 
   SwarmFinal final_of(int i) const {
@@ -231,9 +230,9 @@ class ControllerShard {
       driver_->run();
     } catch (const std::invalid_argument& e) {
       std::cerr << "controller: " << e.what() << '\n';
-      return kExitRefused;
+      return exit_code::kBadInput;
     }
-    return kExitOk;
+    return exit_code::kOk;
   }
 
  private:
@@ -271,7 +270,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
     return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, o.lockstep_only.on_timeout, sc.simulation.controller_divider,
                                                     sc.simulation.duration_ticks);
   });
-  if (rc != kExitOk) return rc;
+  if (rc != exit_code::kOk) return rc;
   std::int64_t wall_ns = 0;
   for (const auto& s : shards) wall_ns = std::max(wall_ns, s->wall_ns());
   const double wall_s = static_cast<double>(wall_ns) / 1e9;
@@ -301,7 +300,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
                         {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s},
                          {"real_time_factor", sim_s / wall_s}});
   }
-  return kExitOk;
+  return exit_code::kOk;
 }
 
 int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc) {

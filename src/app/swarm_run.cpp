@@ -15,6 +15,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "analysis/percentile.hpp"
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
@@ -89,7 +90,7 @@ void write_swarm_summary(const fs::path& out, const io::Scenario& sc, const io::
   if (!csv) throw std::runtime_error("cannot write " + (out / "vehicles.csv").string());
   std::vector<double> sorted = errors;
   std::sort(sorted.begin(), sorted.end());
-  auto pct = [&](double q) { return sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))]; };
+  auto pct = [&](double q) { return analysis::percentile_lower(sorted, q); };
   double mean = 0.0;
   for (double e : errors) mean += e / static_cast<double>(errors.size());
   nlohmann::json j = run_figures;

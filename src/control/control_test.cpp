@@ -400,7 +400,7 @@ TEST(PositionPid, AntiWindupStopsTheIntegralWhileSaturated) {
 // ---------------------------------------------------------------------------------------------------
 // FlightController (Algorithm 1).
 
-// sqrt(m g / (4 kt)) from Table 1, the number in architecture.md (~4830.6 rad/s).
+// sqrt(m g / (4 kt)) from Table 1, the number in docs/model.md (~4830.6 rad/s).
 double hover_speed() { return std::sqrt(kMass * kG / (4.0 * kKt)); }
 
 Observation hover_observation(double z) {

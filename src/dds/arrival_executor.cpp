@@ -14,9 +14,22 @@ ArrivalExecutor::ArrivalExecutor(DdsTransport& transport)
   // wait() resets the guard itself, right after its wait.
   wake_work_ = transport_.add_extra_work({wake_}, [] {});
   mutex_.lock();  // held by the owner but in its waits
-  transport_.set_arrival_sink([this](std::size_t i) { on_data(i); });
-  for (std::size_t i = 0; i < transport_.subscription_count(); ++i) {
-    delivered_ += transport_.take(i);  // what came before the listeners
+  try {
+    transport_.set_arrival_sink([this](std::size_t i) { on_data(i); });
+  } catch (...) {  // no executor then: undo what was set up (the destructor will not run)
+    mutex_.unlock();
+    transport_.remove_extra_work(wake_work_);
+    dds_delete(wake_);
+    throw;
+  }
+  // What came before the listeners. A delivery that throws is kept as on_data keeps it (the sink
+  // is set: throwing out of here would leave it pointing at this executor): the first wait()
+  // rethrows it, the rest is dropped.
+  try {
+    for (std::size_t i = 0; i < transport_.subscription_count(); ++i) delivered_ += transport_.take(i);
+  } catch (...) {
+    failure_ = std::current_exception();
+    dds_set_guardcondition(wake_, true);
   }
 }
 

@@ -35,7 +35,8 @@ namespace quadcosim::dds {
 
 class ArrivalExecutor {
  public:
-  /// From now on `transport`'s samples are delivered on arrival; what came before is delivered now.
+  /// From now on `transport`'s samples are delivered on arrival; what came before is delivered now
+  /// (what such a delivery throws is kept, as on arrival: the first wait() rethrows it).
   explicit ArrivalExecutor(DdsTransport& transport);
   ~ArrivalExecutor();
   ArrivalExecutor(const ArrivalExecutor&) = delete;

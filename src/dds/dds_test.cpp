@@ -378,6 +378,36 @@ TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesTheWaitAndIsRethrown) {
   EXPECT_EQ(rig.count, 2);  // 1 and 2; nothing after the failure
 }
 
+// Samples already in the reader when the executor is made are delivered by its constructor; one
+// that throws there comes out of the first wait(), and the transport is left as on any executor.
+TEST(DdsTransportTest, OnArrivalAPendingDeliveryThatThrowsIsRethrownByTheFirstWait) {
+  ArrivalRig rig([](const msg::Clock& m) {
+    if (m.clock.to_ns() == 2) throw std::invalid_argument("pending sample 2 refused");
+  });
+  ASSERT_TRUE(rig.matched());
+  for (int i = 1; i <= 3; ++i) rig.in.publish(clock_at(i));  // in b's reader, undelivered
+  EXPECT_EQ(rig.count, 0);
+  {
+    std::unique_ptr<ArrivalExecutor> arrival;
+    ASSERT_NO_THROW(arrival = std::make_unique<ArrivalExecutor>(rig.b));
+    EXPECT_EQ(rig.count, 1);  // sample 1; 2 threw, 3 is dropped
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      arrival->wait(10'000'000'000);
+      FAIL() << "not rethrown";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_STREQ(e.what(), "pending sample 2 refused");
+    }
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));  // woken, not timed out
+    EXPECT_EQ(arrival->wait(0), 0);  // rethrown once
+  }
+  // The executor's end returned the transport to spin_once: a later sample reaches b there.
+  std::thread later([&] { rig.in.publish(clock_at(4)); });
+  later.join();
+  ASSERT_TRUE(rig.b.spin_until([&] { return rig.count == 2; }, 5'000'000'000));
+  EXPECT_EQ(rig.got, (std::vector<std::int64_t>{1, 2, 4}));  // 2 reached the callback, which threw; 3 did not
+}
+
 TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) {
   ArrivalRig rig;
   ASSERT_TRUE(rig.matched());

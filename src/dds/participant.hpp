@@ -25,7 +25,7 @@ dds_return_t check(dds_return_t rc, const char* what);
 
 enum class DiscoveryRange { kSubnet, kLocalhost, kOff, kSystemDefault };
 
-/// The ROS 2 environment, parsed (see ros2-wire.md section 6).
+/// The ROS 2 environment, parsed (docs/ros2.md, Domain and discovery).
 struct RosEnvironment {
   std::uint32_t domain_id = 0;
   DiscoveryRange range = DiscoveryRange::kSubnet;

@@ -102,8 +102,6 @@ class LockstepPlantDriver {
   sim::Tick ticks_run() const { return k_; }
   /// Outputs published -> every answer in, per awaited control tick [ns, wall clock].
   const std::vector<std::int64_t>& round_trips_ns() const { return round_trips_ns_; }
-  /// False while holding after a timeout.
-  bool awaiting_answers() const { return waiting_; }
 
  private:
   enum class Phase { kAwaiting, kMainThread, kDone, kRefused };

@@ -252,12 +252,12 @@ nlohmann::json criteria_json(const std::vector<CriterionResult>& criteria) {
   }
   return a;
 }
+}  // namespace
 
 bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
                     const std::optional<SaturationResult>& saturation) {
   return all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed);
 }
-}  // namespace
 
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
                             const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation) {
@@ -348,7 +348,7 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
   std::string s = fmt::format("scenario {}\n", scenario.name);
   for (const StepResult& r : results) {
     const auto& f = r.figures;
-    const bool angle = r.spec.channel == "roll" || r.spec.channel == "pitch" || r.spec.channel == "yaw";
+    const bool angle = is_angle(r.spec.channel);
     s += fmt::format("step {} {:g} -> {:g}{} at t = {:g} s: {} ({}; final window {:g} s of {:g} s)\n",
                      r.spec.channel, f.initial, f.target,
                      angle && std::abs(f.step - (f.target - f.initial)) > 1e-12

@@ -84,6 +84,11 @@ std::string saturation_warning(const SaturationResult& saturation);
 
 bool all_passed(const std::vector<StepResult>& results);
 
+/// The verdict of a run (metrics.json "passed", the exit code of `run`, a sweep run's "passed"):
+/// every step passed, and the hold and the saturation limits when judged.
+bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
+                    const std::optional<SaturationResult>& saturation);
+
 /// Evaluates the hold criterion over the samples with t >= spec.after_s.
 HoldResult evaluate_hold(const HoldSpec& spec, const Series& series);
 

@@ -40,12 +40,4 @@ Euler euler_from_quaternion(const Eigen::Quaterniond& q_in) {
   return e;
 }
 
-double wrap_pi(double a) {
-  // Already in (-pi, pi]: std::remainder would return it unchanged (quotient rounds to 0).
-  if (a > -std::numbers::pi && a <= std::numbers::pi) return a;
-  if (!std::isfinite(a)) return a;
-  a = std::remainder(a, 2.0 * std::numbers::pi);  // in [-pi, pi]
-  return a <= -std::numbers::pi ? a + 2.0 * std::numbers::pi : a;
-}
-
 }  // namespace quadcosim::model

@@ -6,6 +6,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "model/angle.hpp"  // wrap_pi
+
 namespace quadcosim::model {
 
 /// Euler angles [rad], Z-Y-X convention.
@@ -21,8 +23,5 @@ Eigen::Quaterniond quaternion_from_euler(const Euler& e);
 /// Z-Y-X angles of a unit quaternion. At pitch = +-pi/2 (gimbal lock) roll is reported as 0 and the
 /// whole heading goes to yaw. The input is normalised first; a zero quaternion gives all zeros.
 Euler euler_from_quaternion(const Eigen::Quaterniond& q_WB);
-
-/// Wraps an angle to (-pi, pi] [rad].
-double wrap_pi(double angle_rad);
 
 }  // namespace quadcosim::model

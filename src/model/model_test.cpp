@@ -92,7 +92,7 @@ TEST(VehicleParams, DefaultsAreTable1) {
 TEST(VehicleParams, HoverOmegaIsSqrtOfWeightOverFourKt) {
   const VehicleParams p;
   const double expected = std::sqrt(kMass * kG / (4.0 * kKt));
-  EXPECT_NEAR(expected, 4830.6, 0.05);  // the figure quoted in architecture.md
+  EXPECT_NEAR(expected, 4830.6, 0.05);  // the figure quoted in docs/model.md
   EXPECT_NEAR(p.hover_omega_rad_s(), expected, 1e-12 * expected);
   // And it really carries the weight: 4 k_t w^2 = m g.
   EXPECT_NEAR(4.0 * kKt * p.hover_omega_rad_s() * p.hover_omega_rad_s(), kMass * kG, 1e-12);

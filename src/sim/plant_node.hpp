@@ -95,9 +95,8 @@ class PlantNode final : public SteppablePlant {
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& latched_command() const { return latched_; }
   const PlantStats& stats() const { return stats_; }
-  /// Stamp label [ns] of the newest accepted command (-1: unlabelled or none yet). Labels are read
-  /// with drop_stale_commands (lockstep) only; otherwise this stays -1.
-  std::int64_t last_command_stamp_ns() const { return last_command_stamp_ns_; }
+  /// Its label_ns is the stamp label of the newest accepted command; labels are read with
+  /// drop_stale_commands (lockstep) only, otherwise it stays -1.
   CommandReceipt command_receipt() const override { return {stats_.commands_received, last_command_stamp_ns_}; }
   const PlantOptions& options() const { return options_; }
   Tick current_tick() const { return current_tick_; }

@@ -3,14 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace quadcosim::sweep {
+#include "analysis/percentile.hpp"
 
-double percentile(const std::vector<double>& sorted, double q) {
-  const double pos = q * static_cast<double>(sorted.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
-}
+namespace quadcosim::sweep {
 
 FigureStats figure_stats(const std::vector<std::optional<double>>& values) {
   FigureStats d;
@@ -31,11 +26,11 @@ FigureStats figure_stats(const std::vector<std::optional<double>>& values) {
   std::sort(v.begin(), v.end());
   d.min = v.front();
   d.max = v.back();
-  d.p5 = percentile(v, 0.05);
-  d.p25 = percentile(v, 0.25);
-  d.p50 = percentile(v, 0.5);
-  d.p75 = percentile(v, 0.75);
-  d.p95 = percentile(v, 0.95);
+  d.p5 = analysis::percentile_linear(v, 0.05);
+  d.p25 = analysis::percentile_linear(v, 0.25);
+  d.p50 = analysis::percentile_linear(v, 0.5);
+  d.p75 = analysis::percentile_linear(v, 0.75);
+  d.p95 = analysis::percentile_linear(v, 0.95);
   return d;
 }
 

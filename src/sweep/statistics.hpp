@@ -7,12 +7,9 @@
 
 namespace quadcosim::sweep {
 
-/// Percentile q in [0, 1] of sorted (ascending, non-empty) values by linear interpolation between
-/// closest ranks (numpy's default method, "linear").
-double percentile(const std::vector<double>& sorted, double q);
-
 /// Count, missing runs and, when count > 0, min, max, mean, sample standard deviation (n - 1; 0 for a
-/// single value) and the 5/25/50/75/95th percentiles of the values a figure took.
+/// single value) and the 5/25/50/75/95th percentiles of the values a figure took
+/// (analysis::percentile_linear).
 struct FigureStats {
   std::size_t count = 0;
   std::size_t missing = 0;  ///< runs that produced no value (figure absent, run failed)

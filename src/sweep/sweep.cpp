@@ -59,7 +59,7 @@ void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
   r.steps = io::evaluate_steps(sc.steps, series);
   if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
   r.saturation = io::evaluate_saturation(sc, series);
-  r.passed = io::all_passed(r.steps) && (!r.hold || r.hold->passed) && (!r.saturation || r.saturation->passed);
+  r.passed = io::passed_overall(r.steps, r.hold, r.saturation);
 }
 
 // Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step

@@ -28,6 +28,10 @@ case "$CASE" in
     "$QC" margins "$P/roll_step.yaml" > "$TMP/table.txt"
     for loop in roll pitch yaw altitude; do grep -q "^$loop " "$TMP/table.txt" || fail "no $loop row"; done
     grep -qi nan "$TMP/table.txt" && fail "NaN in the table"
+    grep -q "^note: .*rotor clamp, the tilt limit and the integral bound are not" "$TMP/table.txt" \
+      || fail "no note that saturation is not in the linear loops"
+    "$PY" -c "import json,sys; assert any('rotor clamp' in n for n in json.load(open(sys.argv[1]))['notes'])" \
+      "$TMP/roll_step.json" || fail "margins.json notes lack saturation"
     "$PY" - "$TMP/lqr.txt" "$TMP/roll_step.json" <<'PYEOF' || fail "margins differ from the closed form"
 import cmath, json, math, re, sys
 lqr = open(sys.argv[1]).read()
@@ -154,6 +158,20 @@ PYEOF
     [ "$rc" = 2 ] && grep -q "broken.yaml" "$TMP/err2" || fail "broken YAML: exit $rc: $(cat "$TMP/err2")"
     [ "$rc3" = 2 ] && grep -q -- "--no-plots needs --out" "$TMP/err3" || fail "--no-plots alone: exit $rc3"
     [ "$rc4" = 2 ] || fail "missing file: exit $rc4"
+    # A bad scenario is refused before --out is touched: --force removes no previous outputs for it.
+    "$QC" margins --out "$TMP/prev" --no-plots > /dev/null || fail "margins --out failed"
+    ls -l --time-style=full-iso "$TMP/prev" > "$TMP/prev.before"
+    sed 's/^schedule:/schedule:\n  - at_s: 1\n    set: {altitude.kp: -4.0}/' "$P/roll_step.yaml" > "$TMP/refused.yaml"
+    grep -q "altitude.kp: -4.0" "$TMP/refused.yaml" || fail "the refused-schedule scenario was not made"
+    for bad in weak broken refused; do
+      set +e
+      "$QC" margins "$TMP/$bad.yaml" --out "$TMP/prev" --force > /dev/null 2> "$TMP/err"; rc=$?
+      set -e
+      [ "$rc" = 2 ] && grep -q "$bad.yaml" "$TMP/err" \
+        || fail "$bad.yaml with --out --force: exit $rc: $(cat "$TMP/err")"
+      ls -l --time-style=full-iso "$TMP/prev" | cmp -s - "$TMP/prev.before" || fail "$bad.yaml: --out changed"
+    done
+    grep -q "altitude.kp" "$TMP/err" || fail "the refused change is not named: $(cat "$TMP/err")"
     ;;
 
   *) fail "unknown case" ;;

@@ -74,7 +74,7 @@ dds_domainid_t ros_domain_id() {
   return static_cast<dds_domainid_t>(v);
 }
 
-// rmw_cyclonedds' configuration for ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST (ros2-wire.md section 6):
+// rmw_cyclonedds' configuration for ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST (docs/ros2.md, Domain and discovery):
 // participant index auto (max 32), no multicast, localhost as the static peer; CYCLONEDDS_URI is
 // appended after it.
 std::string localhost_config() {

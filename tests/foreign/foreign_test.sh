@@ -106,7 +106,7 @@ check(seen["last_stamp"] is not None and 2.5 <= seen["last_stamp"] <= 6.0,
       f"last Pose stamp {seen['last_stamp']} s, expected 2.5..6 s (the plant's time)")
 check(seen["last_z"] is not None and 1.0 <= seen["last_z"] <= 3.0, f"last z seen {seen['last_z']}, expected 1..3 m")
 check(seen["commands_sent"] >= 100, f"only {seen['commands_sent']} commands sent")
-# What the plant announced in discovery, as a ROS 2 tool sees it (ros2-wire.md sections 1, 3, 4):
+# What the plant announced in discovery, as a ROS 2 tool sees it (docs/ros2.md, What is on the wire):
 # USER_DATA with the enclave key (else `ros2 node list` ignores it), and its endpoints with ROS type
 # names, RELIABLE VOLATILE, XCDR1.
 remote = seen["remote"]
