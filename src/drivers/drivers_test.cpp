@@ -1,6 +1,7 @@
 // Tests of the drivers without processes: the lockstep plant driver against the in-process
-// Simulation (its own loop, an independent formulation of the tick order) bit for bit, for one
-// vehicle and for a swarm, with answers delivered synchronously and from a queue as over DDS (on
+// Simulation (the same sim::LockstepCore over a synchronous host: no waiting, no answer check, so
+// the reference for the asynchronous path's waiting, retries and answer matching) bit for bit, for
+// one vehicle and for a swarm, with answers delivered synchronously and from a queue as over DDS (on
 // delivery or on the host's thread); the one answer rule (labelled, unlabelled, repeats, statuses);
 // timeouts, retries, hold and resume; the real-time plant driver's pacing; both controller drivers.
 #include <gtest/gtest.h>

@@ -101,7 +101,7 @@ TEST(LockstepStepperTest, UnhooksWhenDestroyed) {
 }
 
 TEST(LockstepStepperTest, FliesTheSameBitsAsTheInProcessSimulation) {
-  // The reference: Simulation's own loop (schedule in begin_tick, controller stepped by the tick).
+  // The reference: Simulation (schedule before the outputs, controller stepped by the tick).
   const std::vector<ScheduledParameter> schedule = {{50, "z_des", 1.0}, {120, "yaw_des", 0.3}};
   SimulationConfig sc;
   sc.duration_ticks = 300;

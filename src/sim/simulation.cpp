@@ -2,13 +2,30 @@
 
 namespace quadcosim::sim {
 
+namespace {
+LockstepOptions lockstep_options(const SimulationConfig& config) {
+  LockstepOptions o;
+  o.clock = config.plant.clock;
+  o.duration_ticks = config.duration_ticks;
+  o.controller_divider = config.controller_divider;
+  return o;
+}
+
+/// Clears the on-tick pointer when the run ends (also when a hook throws).
+struct ClearOnTick {
+  const std::function<void(const TickRecord&)>*& f;
+  ~ClearOnTick() { f = nullptr; }
+};
+}  // namespace
+
 Simulation::Simulation(const SimulationConfig& config, const model::VehicleParams& vehicle,
                        const model::State& initial, const control::ControllerConfig& controller,
                        std::vector<ScheduledParameter> schedule)
     : config_(config),
       plant_(transport_, Topics::for_namespace(config.ns), vehicle, config.plant, initial),
       controller_(transport_, Topics::for_namespace(config.ns), controller),
-      schedule_(std::move(schedule), config.plant.clock) {
+      schedule_(std::move(schedule), config.plant.clock),
+      loop_({&plant_}, lockstep_options(config), Hooks{this}, host_) {
   transport_.set_faults(config.faults);
   const std::string status_topic = Topics::for_namespace(config.ns).controller_status;
   if (const auto f = config.faults.topics.find(status_topic); f != config.faults.topics.end() && f->second.active()) {
@@ -23,25 +40,20 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
   control_dt_s_ = config_.plant.clock.period_s() * config_.controller_divider;
 }
 
-void Simulation::begin_tick(Tick k) {
-  const TickClock& clock = config_.plant.clock;
-  transport_.advance_to(k);  // messages held back by injected delay are delivered now
-  schedule_.apply(controller_, clock.ns(k));
-  plant_.publish_outputs(k);
-  if (k % config_.controller_divider == 0) controller_.step(clock.ns(k), control_dt_s_);
-  plant_.latch_command(k);
-}
-
 TickRecord Simulation::record(Tick k) const {
   return TickRecord{k, config_.plant.clock.seconds(k), plant_.state(), plant_.latched_command(), *delivered_status_};
 }
 
 void Simulation::run(const std::function<void(const TickRecord&)>& on_tick) {
-  for (Tick k = 0; k <= config_.duration_ticks; ++k) {
-    begin_tick(k);
-    if (on_tick) on_tick(record(k));
-    end_tick(k);
-  }
+  if (on_tick) on_tick_ = &on_tick;
+  const ClearOnTick clear{on_tick_};
+  loop_.run();  // the hooks never refuse a tick
+}
+
+void Simulation::tick(Tick k, const std::function<void(const TickRecord&)>& on_tick) {
+  if (on_tick) on_tick_ = &on_tick;
+  const ClearOnTick clear{on_tick_};
+  loop_.tick(k);
 }
 
 }  // namespace quadcosim::sim

@@ -5,7 +5,7 @@
 //   2. latch_command(k): the command acting over [t_k, t_k+1) is fixed from what has arrived;
 //   3. integrate(k): the state goes to t_k+1.
 // Between 1 and 2 a lockstep driver waits for the answer to tick k, which it recognises by what
-// command_receipt() reports (drivers/lockstep_plant_driver.hpp states the rule). The native 6-DOF plant
+// command_receipt() reports (sim/lockstep_core.hpp states the rule). The native 6-DOF plant
 // (sim::PlantNode) is one; an FMU or a batch of vehicles stepped as one is another.
 #pragma once
 

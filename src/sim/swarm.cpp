@@ -78,9 +78,7 @@ void Swarm::run_ticks(Tick first_tick, Tick last_tick, int threads, Tick block_t
           const bool rec = recorder && !recorded.empty() && recorded[static_cast<std::size_t>(i)];
           for (Tick k = start; k <= end; ++k) {
             if (rec) {
-              s.begin_tick(k);
-              recorder(i, s.record(k));
-              s.end_tick(k);
+              s.tick(k, [&recorder, i](const TickRecord& r) { recorder(i, r); });
             } else {
               s.tick(k);
             }

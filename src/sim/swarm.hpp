@@ -55,7 +55,7 @@ class Swarm {
         const control::ControllerConfig& controller, const std::vector<ScheduledParameter>& schedule,
         const SwarmLayout& layout);
 
-  /// Called after begin_tick for recorded vehicles only (on the thread that owns the vehicle).
+  /// Called after the tick's latch for recorded vehicles only (on the thread that owns the vehicle).
   using Recorder = std::function<void(int vehicle, const TickRecord&)>;
 
   /// Runs ticks 0..duration_ticks of every vehicle on `threads` threads (vehicles split in
