@@ -740,6 +740,172 @@ TEST(TopicToolsTest, MessagesAsRos2TopicEcho) {
   EXPECT_NE(to_yaml(msg::TwistStamped{}).find("twist:\n  linear:\n    x: 0.0\n"), std::string::npos);
 }
 
+// Every message type with a distinct value in every field, against the text `ros2 topic echo` prints for
+// it, written out by hand from the .msg definitions (field order, nesting, PyYAML's block style).
+TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
+  msg::PoseStamped p;
+  p.header.stamp = {1700000000, 999999999};
+  p.header.frame_id = "map";
+  p.position = {1.25, -0.5, 1e-05};
+  p.orientation = {0.1, -0.2, 0.3, 0.9};
+  EXPECT_EQ(to_yaml(p),
+            "header:\n"
+            "  stamp:\n"
+            "    sec: 1700000000\n"
+            "    nanosec: 999999999\n"
+            "  frame_id: map\n"
+            "pose:\n"
+            "  position:\n"
+            "    x: 1.25\n"
+            "    y: -0.5\n"
+            "    z: 1.0e-05\n"
+            "  orientation:\n"
+            "    x: 0.1\n"
+            "    y: -0.2\n"
+            "    z: 0.3\n"
+            "    w: 0.9\n");
+
+  msg::TwistStamped t;
+  t.header.stamp = {-1, 5};
+  t.linear = {2.0, 3.5, -4.25};
+  t.angular = {1e16, -0.0, 123456.789};
+  EXPECT_EQ(to_yaml(t),
+            "header:\n"
+            "  stamp:\n"
+            "    sec: -1\n"
+            "    nanosec: 5\n"
+            "  frame_id: ''\n"
+            "twist:\n"
+            "  linear:\n"
+            "    x: 2.0\n"
+            "    y: 3.5\n"
+            "    z: -4.25\n"
+            "  angular:\n"
+            "    x: 1.0e+16\n"
+            "    y: -0.0\n"
+            "    z: 123456.789\n");
+
+  msg::Imu imu;
+  imu.header.stamp = {7, 8};
+  imu.header.frame_id = "imu_link";
+  imu.orientation = {0.0, 0.0, 0.6, 0.8};
+  imu.orientation_covariance = {-1, 0, 0, 0, 0, 0, 0, 0, 0};
+  imu.angular_velocity = {0.01, -0.02, 0.03};
+  imu.angular_velocity_covariance = {1e-4, 0, 0, 0, 2e-4, 0, 0, 0, 3e-4};
+  imu.linear_acceleration = {0.125, -0.25, 9.81};
+  imu.linear_acceleration_covariance = {0.5, std::nan(""), INFINITY, -INFINITY, 1.5, 0, 0, 0, 2.5};
+  EXPECT_EQ(to_yaml(imu),
+            "header:\n"
+            "  stamp:\n"
+            "    sec: 7\n"
+            "    nanosec: 8\n"
+            "  frame_id: imu_link\n"
+            "orientation:\n"
+            "  x: 0.0\n"
+            "  y: 0.0\n"
+            "  z: 0.6\n"
+            "  w: 0.8\n"
+            "orientation_covariance:\n"
+            "- -1.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n"
+            "angular_velocity:\n"
+            "  x: 0.01\n"
+            "  y: -0.02\n"
+            "  z: 0.03\n"
+            "angular_velocity_covariance:\n"
+            "- 0.0001\n- 0.0\n- 0.0\n- 0.0\n- 0.0002\n- 0.0\n- 0.0\n- 0.0\n- 0.0003\n"
+            "linear_acceleration:\n"
+            "  x: 0.125\n"
+            "  y: -0.25\n"
+            "  z: 9.81\n"
+            "linear_acceleration_covariance:\n"
+            "- 0.5\n- .nan\n- .inf\n- -.inf\n- 1.5\n- 0.0\n- 0.0\n- 0.0\n- 2.5\n");
+
+  msg::Float64MultiArray a;
+  a.dim = {{"rotors@10000000", 4, 4}, {"true", 2, 1}};
+  a.data_offset = 3;
+  a.data = {400.0, -0.001, 1.5e-07};
+  EXPECT_EQ(to_yaml(a),
+            "layout:\n"
+            "  dim:\n"
+            "  - label: rotors@10000000\n"
+            "    size: 4\n"
+            "    stride: 4\n"
+            "  - label: 'true'\n"
+            "    size: 2\n"
+            "    stride: 1\n"
+            "  data_offset: 3\n"
+            "data:\n"
+            "- 400.0\n"
+            "- -0.001\n"
+            "- 1.5e-07\n");
+
+  msg::Clock k;
+  k.clock = {2147483647, 4294967295u};
+  EXPECT_EQ(to_yaml(k), "clock:\n  sec: 2147483647\n  nanosec: 4294967295\n");
+
+  msg::ControllerStatus s;
+  s.header.stamp = {3, 250000000};
+  s.header.frame_id = "world";
+  s.mode = "position";
+  s.setpoint = {1.0, 2.0, -3.0, 0.1, 0.2, 3.5};
+  s.u = {9.81, 0.01, -0.02, 0.0};
+  s.error = {-0.5, 0.25, -0.125, 1e-06};
+  s.rotor_saturated = {true, false, false, true};
+  s.tilt_saturated = true;
+  s.safety = false;
+  s.rejected_non_finite = 1;
+  s.rejected_bad_quaternion = 22;
+  s.rejected_bad_stamp = 333;
+  s.rejected_stamp_backwards = 18446744073709551615u;  // uint64 max: a Python int, not -1
+  EXPECT_EQ(to_yaml(s),
+            "header:\n"
+            "  stamp:\n"
+            "    sec: 3\n"
+            "    nanosec: 250000000\n"
+            "  frame_id: world\n"
+            "mode: position\n"
+            "setpoint:\n"
+            "- 1.0\n- 2.0\n- -3.0\n- 0.1\n- 0.2\n- 3.5\n"
+            "u:\n"
+            "- 9.81\n- 0.01\n- -0.02\n- 0.0\n"
+            "error:\n"
+            "- -0.5\n- 0.25\n- -0.125\n- 1.0e-06\n"
+            "rotor_saturated:\n"
+            "- true\n- false\n- false\n- true\n"
+            "tilt_saturated: true\n"
+            "safety: false\n"
+            "rejected_non_finite: 1\n"
+            "rejected_bad_quaternion: 22\n"
+            "rejected_bad_stamp: 333\n"
+            "rejected_stamp_backwards: 18446744073709551615\n");
+
+  msg::PlantStatus ps;
+  ps.header.stamp = {9, 1};
+  ps.header.frame_id = "base_link";
+  ps.commands_accepted = 10;
+  ps.commands_clamped = 2;
+  ps.commands_rejected_length = 1;
+  ps.commands_rejected_non_finite = 4;
+  ps.last_problem = "rotor 2: speed above omega_max";
+  ps.watchdog_active = true;
+  ps.watchdog_trips = 3;
+  ps.watchdog_ticks = 250;
+  EXPECT_EQ(to_yaml(ps),
+            "header:\n"
+            "  stamp:\n"
+            "    sec: 9\n"
+            "    nanosec: 1\n"
+            "  frame_id: base_link\n"
+            "commands_accepted: 10\n"
+            "commands_clamped: 2\n"
+            "commands_rejected_length: 1\n"
+            "commands_rejected_non_finite: 4\n"
+            "last_problem: 'rotor 2: speed above omega_max'\n"
+            "watchdog_active: true\n"
+            "watchdog_trips: 3\n"
+            "watchdog_ticks: 250\n");
+}
+
 TEST(TopicToolsTest, RateWindowAsRos2TopicHz) {
   RateWindow w(3);
   EXPECT_FALSE(w.stats());

@@ -35,14 +35,8 @@ struct CSeq {
   bool _release;
 };
 
-template <class T>
-struct IsArray : std::false_type {};
-template <class T, std::size_t N>
-struct IsArray<std::array<T, N>> : std::true_type {};
-template <class T>
-struct IsVector : std::false_type {};
-template <class T>
-struct IsVector<std::vector<T>> : std::true_type {};
+using msg::IsArray;
+using msg::IsVector;
 
 template <class T>
 constexpr bool kPrimitive = std::is_arithmetic_v<T>;

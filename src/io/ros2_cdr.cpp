@@ -47,14 +47,8 @@ class CdrWriter {
   std::vector<std::uint8_t> bytes_;
 };
 
-template <class T>
-struct IsArray : std::false_type {};
-template <class T, std::size_t N>
-struct IsArray<std::array<T, N>> : std::true_type {};
-template <class T>
-struct IsVector : std::false_type {};
-template <class T>
-struct IsVector<std::vector<T>> : std::true_type {};
+using msg::IsArray;
+using msg::IsVector;
 
 // Writes the fields of a message in the order its fields() lists them (sim/messages.hpp).
 struct CdrFields {

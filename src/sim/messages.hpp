@@ -6,15 +6,17 @@
 // visitor as v.field("name", member) (v.field("name", member, note) where the ROS type or a .msg
 // default differs from what the C++ type says), and a ROS sub-message that has no C++ struct of its
 // own (Pose, Twist, MultiArrayLayout) as v.group("name", "pkg/msg/Type", [&](auto& g) { ... }).
-// From these lists follow the CDR writer and `.msg` schema text of recordings (io/ros2_cdr.cpp) and the copies to and
-// from the C types idlc generates (dds/idl_walk.hpp), which walk a list in step with idlc's instructions and refuse,
-// naming it, a field whose type differs or that only one side has. A new field: one line here plus its .idl member.
+// From these lists follow the CDR writer and `.msg` schema text of recordings (io/ros2_cdr.cpp), the YAML that
+// `topic echo` prints (dds/topic_tools.hpp) and the copies to and from the C types idlc generates (dds/idl_walk.hpp),
+// which walk a list in step with idlc's instructions and refuse, naming it, a field whose type differs or that only
+// one side has. A new field: one line here plus its .idl member.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 namespace quadcosim::msg {
@@ -25,6 +27,17 @@ struct FieldNote {
   std::string_view ros_type;       ///< "pkg/msg/Type", "" for the C++ type's own
   std::string_view default_value;  ///< .msg default ("0"), "" for none
 };
+
+/// For visitors of fields(): whether a field's type is a ROS fixed array (std::array) or sequence
+/// (std::vector); a field that is neither, nor a primitive or std::string, is a nested message.
+template <class T>
+struct IsArray : std::false_type {};
+template <class T, std::size_t N>
+struct IsArray<std::array<T, N>> : std::true_type {};
+template <class T>
+struct IsVector : std::false_type {};
+template <class T>
+struct IsVector<std::vector<T>> : std::true_type {};
 
 /// builtin_interfaces/msg/Time
 struct Time {
