@@ -1,9 +1,10 @@
-// Tests of the drivers without processes: the lockstep plant driver against the in-process
-// Simulation (the same sim::LockstepCore over a synchronous host: no waiting, no answer check, so
-// the reference for the asynchronous path's waiting, retries and answer matching) bit for bit, for
-// one vehicle and for a swarm, with answers delivered synchronously and from a queue as over DDS (on
-// delivery or on the host's thread); the one answer rule (labelled, unlabelled, repeats, statuses);
-// timeouts, retries, hold and resume; the real-time plant driver's pacing; both controller drivers.
+// Tests of the drivers without processes: the lockstep plant driver against a hand-written tick loop
+// (the order of sim/steppable_plant.hpp written out here, independent of sim::LockstepCore, which
+// both the drivers and the in-process Simulation run on) bit for bit, for one vehicle and for a
+// swarm, with answers delivered synchronously and from a queue as over DDS (on delivery or on the
+// host's thread); the one answer rule (labelled, unlabelled, repeats, statuses); timeouts, retries,
+// hold and resume; the real-time plant driver's pacing; both controller drivers. The in-process
+// Simulation is checked against the same loop.
 #include <gtest/gtest.h>
 
 #include <deque>
@@ -15,7 +16,9 @@
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
 #include "drivers/realtime_plant_driver.hpp"
+#include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
+#include "sim/parameter_schedule.hpp"
 #include "sim/plant_node.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
@@ -33,9 +36,21 @@ bool same(const model::State& a, const model::State& b) {
 std::vector<model::State> reference_run(const sim::SimulationConfig& sc, const model::State& x0,
                                         const control::ControllerConfig& c,
                                         const std::vector<sim::ScheduledParameter>& schedule) {
-  sim::Simulation s(sc, c.params.vehicle, x0, c, schedule);
+  sim::InProcessTransport bus;
+  const sim::Topics t = sim::Topics::for_namespace(sc.ns);
+  sim::PlantNode plant(bus, t, c.params.vehicle, sc.plant, x0);
+  sim::ControllerNode node(bus, t, c);
+  sim::ParameterSchedule changes(schedule, sc.plant.clock);
+  const double dt_s = sc.plant.clock.period_s() * sc.controller_divider;
   std::vector<model::State> states;
-  s.run([&](const sim::TickRecord& r) { states.push_back(r.state); });
+  for (Tick k = 0; k <= sc.duration_ticks; ++k) {
+    changes.apply(node, sc.plant.clock.ns(k));
+    plant.publish_outputs(k);
+    if (k % sc.controller_divider == 0) node.step(sc.plant.clock.ns(k), dt_s);
+    plant.latch_command(k);
+    states.push_back(plant.state());
+    if (k < sc.duration_ticks) plant.integrate(k);
+  }
   return states;
 }
 
@@ -179,6 +194,21 @@ sim::SimulationConfig config(Tick ticks) {
   sim::SimulationConfig sc;
   sc.duration_ticks = ticks;
   return sc;
+}
+
+// The in-process Simulation (sim::LockstepCore over a synchronous host) against the same loop.
+TEST(SimulationOnTheLockstepCoreTest, FliesTheHandWrittenLoopsBits) {
+  const sim::SimulationConfig sc = config(300);
+  const auto expected = reference_run(sc, {}, control::ControllerConfig{}, kSchedule);
+  sim::Simulation s(sc, control::ControllerConfig{}.params.vehicle, {}, control::ControllerConfig{}, kSchedule);
+  std::size_t i = 0, differ = 0;
+  s.run([&](const sim::TickRecord& r) {
+    if (i >= expected.size() || !same(r.state, expected[i])) ++differ;
+    ++i;
+  });
+  EXPECT_EQ(i, expected.size());
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(expected.back().p_W.z(), 0.5);  // it climbed toward z_des = 1 m
 }
 
 TEST(LockstepPlantDriverTest, OneVehicleFliesTheSimulationsBitsWithTicksRunOnDelivery) {

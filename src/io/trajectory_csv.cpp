@@ -93,6 +93,15 @@ SeriesRecorder::SeriesRecorder(std::size_t rows) {
   }
 }
 
+void SeriesRecorder::clear(std::size_t rows) {
+  series_.t_s.clear();
+  series_.t_s.reserve(rows);
+  for (std::vector<double>* column : columns_) {
+    column->clear();
+    column->reserve(rows);
+  }
+}
+
 void SeriesRecorder::add(double t_s, const model::State& x, const ControlColumns& c) {
   // The values of TrajectoryWriter::write's columns of the same names.
   const model::Euler e = model::euler_from_quaternion(x.q_WB);

@@ -63,6 +63,9 @@ class SeriesRecorder {
   /// Adds the row TrajectoryWriter::write(t_s, x, ..., c) writes.
   void add(double t_s, const model::State& x, const ControlColumns& c);
   const Series& series() const { return series_; }
+  /// Empties the series for another run of `rows` ticks, keeping its memory (a sweep's worker
+  /// records every run it flies in one recorder instead of allocating the columns again per run).
+  void clear(std::size_t rows);
   /// Moves the series out; add() must not be called after it.
   Series take() { return std::move(series_); }
 

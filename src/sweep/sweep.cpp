@@ -27,7 +27,9 @@ namespace {
 // Simulates `sc` (plant: sc.vehicle; controller: sc.controller) and returns the signals judged, the
 // same numbers trajectory.csv holds. With `csv` it writes trajectory.csv there, with `mcap_dir` also
 // run.mcap and metadata.yaml.
-io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path* mcap_dir) {
+// Flies the scenario into `series` (emptied first), writing trajectory.csv and run.mcap when asked.
+const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, const fs::path* csv,
+                           const fs::path* mcap_dir) {
   sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
   std::optional<io::TrajectoryWriter> writer;
   if (csv) writer.emplace(csv->string());
@@ -36,7 +38,7 @@ io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path*
     mcap.emplace((*mcap_dir / "run.mcap").string(), simulation.transport(),
                  sim::Topics::for_namespace(sc.simulation.ns));
   }
-  io::SeriesRecorder series(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
+  series.clear(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
   bool watchdog = false;
   simulation.run([&](const sim::TickRecord& r) {
     const io::ControlColumns c = io::ControlColumns::from(r.status);
@@ -52,7 +54,7 @@ io::Series simulate(const io::Scenario& sc, const fs::path* csv, const fs::path*
     mcap->close();
     mcap->write_bag_metadata(mcap_dir->string(), "run.mcap");
   }
-  return series.take();
+  return series.series();
 }
 
 void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
@@ -129,7 +131,9 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
   return j;
 }
 
-RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep keep) {
+namespace {
+// run_one, recording into `series` (a worker's, reused run after run).
+RunResult run_into(const Plan& plan, int index, const fs::path& run_dir, Keep keep, io::SeriesRecorder& series) {
   RunResult r;
   r.sample = sample(plan, index);
   io::Scenario sc;
@@ -138,8 +142,8 @@ RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep kee
     if (!run_dir.empty()) fs::create_directories(run_dir);
     const fs::path csv = run_dir / "trajectory.csv";
     const bool record_now = keep == Keep::kAll && !run_dir.empty();
-    judge(sc, simulate(sc, record_now ? &csv : nullptr, nullptr), r);
-    if (keep == Keep::kFailing && !r.passed && !run_dir.empty()) (void)simulate(sc, &csv, nullptr);
+    judge(sc, simulate(sc, series, record_now ? &csv : nullptr, nullptr), r);
+    if (keep == Keep::kFailing && !r.passed && !run_dir.empty()) (void)simulate(sc, series, &csv, nullptr);
     if (!run_dir.empty()) write_json(run_dir / "metrics.json", run_metrics_json(plan, sc, r));
   } catch (const control::CareError& e) {
     r.error = std::string("controller design failed: ") + e.what();
@@ -149,15 +153,23 @@ RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep kee
   if (!r.error.empty()) r.passed = false;
   return r;
 }
+}  // namespace
+
+RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep keep) {
+  io::SeriesRecorder series;
+  return run_into(plan, index, run_dir, keep, series);
+}
 
 std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs, const fs::path& runs_dir,
                                 Keep keep) {
   std::vector<RunResult> results(indices.size());
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
+    io::SeriesRecorder series;  // one per thread, reused run after run
     for (std::size_t i; (i = next.fetch_add(1)) < indices.size();) {
       const int index = indices[i];
-      results[i] = run_one(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep);
+      results[i] = run_into(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep,
+                          series);
     }
   };
   std::vector<std::thread> pool;
@@ -198,7 +210,8 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   const io::Scenario sc = scenario_for(plan, r.sample);
   fs::create_directories(dir);
   const fs::path csv = dir / "trajectory.csv";
-  (void)simulate(sc, &csv, &dir);
+  io::SeriesRecorder series;
+  (void)simulate(sc, series, &csv, &dir);
   judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
   write_json(dir / "metrics.json", run_metrics_json(plan, sc, r));
   std::ofstream txt(dir / "metrics.txt");
