@@ -148,11 +148,11 @@ std::string hover_trim_problem(const model::VehicleParams& p) {
   const double w = p.hover_omega_rad_s();
   std::ostringstream s;
   if (!(w < p.motor.omega_max_rad_s)) {
-    s << "the vehicle cannot hover: each rotor would need " << w << " rad/s, not below motor.omega_max_rad_s = "
-      << p.motor.omega_max_rad_s;
+    s << "the vehicle cannot hover: each rotor would need " << w
+      << " rad/s, not below motor.omega_max_rad_s = " << p.motor.omega_max_rad_s;
   } else if (!(w > p.motor.omega_min_rad_s)) {
-    s << "the vehicle cannot hover: each rotor would need " << w << " rad/s, not above motor.omega_min_rad_s = "
-      << p.motor.omega_min_rad_s;
+    s << "the vehicle cannot hover: each rotor would need " << w
+      << " rad/s, not above motor.omega_min_rad_s = " << p.motor.omega_min_rad_s;
   }
   return s.str();
 }
@@ -191,9 +191,9 @@ std::vector<HoverLoop> hover_loops(const model::VehicleParams& plant, const cont
       continue;
     }
     const double sign = i == 1 ? 1.0 : -1.0;  // x through pitch (+g theta), y through roll (-g phi)
-    const Channel ch = horizontal_channel(plant.mass_kg, plant.gravity_m_s2,
-                                          plant.aero.linear_drag_N_s_m[i == 1 ? 0 : 1] + rotor_drag,
-                                          inertia[i], alloc(i + 1, i + 1), tau, sign, t);
+    const Channel ch =
+        horizontal_channel(plant.mass_kg, plant.gravity_m_s2, plant.aero.linear_drag_N_s_m[i == 1 ? 0 : 1] + rotor_drag,
+                           inertia[i], alloc(i + 1, i + 1), tau, sign, t);
     RowVectorXd inner = RowVectorXd::Zero(4);
     inner(2) = att(0);
     inner(3) = att(1);

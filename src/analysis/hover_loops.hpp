@@ -13,11 +13,11 @@ namespace quadcosim::analysis {
 
 /// When the controller samples and how late its inputs and outputs are, in plant ticks.
 struct LoopTiming {
-  double tick_s = 0.01;         ///< plant period [s]
-  int controller_divider = 2;   ///< controller period = divider * tick
-  int command_delay_ticks = 0;  ///< a command acts this many ticks after it was computed
-  int imu_latency_ticks = 0;    ///< age of the attitude and body rates the controller reads
-  int pose_latency_ticks = 0;   ///< age of the position
+  double tick_s = 0.01;            ///< plant period [s]
+  int controller_divider = 2;      ///< controller period = divider * tick
+  int command_delay_ticks = 0;     ///< a command acts this many ticks after it was computed
+  int imu_latency_ticks = 0;       ///< age of the attitude and body rates the controller reads
+  int pose_latency_ticks = 0;      ///< age of the position
   int velocity_latency_ticks = 0;  ///< age of the linear velocity
   /// True: the loops in continuous time (no sample-and-hold, no delays), for comparison.
   bool continuous = false;

@@ -2,12 +2,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <unsupported/Eigen/MatrixFunctions>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <unsupported/Eigen/MatrixFunctions>
 
 #include "model/angle.hpp"
 
@@ -72,9 +72,7 @@ class ResponseEvaluator {
 class LoopEvaluator {
  public:
   explicit LoopEvaluator(const Loop& loop) : plant_(loop.plant), controller_(loop.controller) {}
-  std::complex<double> operator()(double omega) const {
-    return -(controller_(omega) * plant_(omega))(0, 0);
-  }
+  std::complex<double> operator()(double omega) const { return -(controller_(omega) * plant_(omega))(0, 0); }
 
  private:
   ResponseEvaluator plant_, controller_;
@@ -92,8 +90,7 @@ void check_loop(const Loop& loop) {
     throw std::invalid_argument("loop: the plant must have one input and the controller one output");
   if (c.B.cols() != p.C.rows())
     throw std::invalid_argument("loop: the controller's inputs must be the plant's outputs");
-  if (p.period_s != c.period_s)
-    throw std::invalid_argument("loop: plant and controller must share their time base");
+  if (p.period_s != c.period_s) throw std::invalid_argument("loop: plant and controller must share their time base");
 }
 
 // Strictly stable: a pole on the boundary (an integrator left open) is not.
@@ -296,8 +293,10 @@ LoopMargins analyse_margins(const Loop& loop, const MarginOptions& options) {
   LoopMargins r;
 
   Eigen::VectorXcd open(loop.plant.A.rows() + loop.controller.A.rows());
-  if (loop.plant.A.rows() > 0) open.head(loop.plant.A.rows()) = Eigen::EigenSolver<Eigen::MatrixXd>(loop.plant.A, false).eigenvalues();
-  if (loop.controller.A.rows() > 0) open.tail(loop.controller.A.rows()) = Eigen::EigenSolver<Eigen::MatrixXd>(loop.controller.A, false).eigenvalues();
+  if (loop.plant.A.rows() > 0)
+    open.head(loop.plant.A.rows()) = Eigen::EigenSolver<Eigen::MatrixXd>(loop.plant.A, false).eigenvalues();
+  if (loop.controller.A.rows() > 0)
+    open.tail(loop.controller.A.rows()) = Eigen::EigenSolver<Eigen::MatrixXd>(loop.controller.A, false).eigenvalues();
   constexpr double kTol = 1e-7;
   r.open_loop_unstable_poles = unstable_count(open, discrete, kTol);
   for (Eigen::Index i = 0; i < open.size(); ++i) {
@@ -321,8 +320,7 @@ LoopMargins analyse_margins(const Loop& loop, const MarginOptions& options) {
     if (!finite(v[i]) || !finite(v[i + 1])) continue;
     const double a = std::abs(v[i]) - 1.0, b = std::abs(v[i + 1]) - 1.0;
     if ((a < 0) != (b < 0)) {
-      r.gain_crossovers_rad_s.push_back(
-          refine([&](double x) { return std::abs(L(x)) - 1.0; }, w[i], w[i + 1]));
+      r.gain_crossovers_rad_s.push_back(refine([&](double x) { return std::abs(L(x)) - 1.0; }, w[i], w[i + 1]));
     }
     if (nyquist_end && i + 2 == w.size()) continue;  // the Nyquist point is taken below
     const double ia = v[i].imag(), ib = v[i + 1].imag();

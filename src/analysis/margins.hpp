@@ -72,22 +72,22 @@ const char* to_string(MarginStatus s);
 
 struct Margin {
   MarginStatus status = MarginStatus::kUndefined;
-  double value = 0.0;           ///< meaningful when kFinite (units per field below)
-  double frequency_rad_s = 0.0; ///< the crossover it was found at, when kFinite
+  double value = 0.0;            ///< meaningful when kFinite (units per field below)
+  double frequency_rad_s = 0.0;  ///< the crossover it was found at, when kFinite
 };
 
 struct MarginOptions {
   double omega_min_rad_s = 1e-4;  ///< low end of the log grid [rad/s]
   /// High end [rad/s]; 0: the Nyquist frequency pi / T (discrete) or 1e4 rad/s (continuous).
   double omega_max_rad_s = 0.0;
-  int points = 6000;              ///< log-spaced grid points (crossings are refined by bisection)
+  int points = 6000;  ///< log-spaced grid points (crossings are refined by bisection)
 };
 
 /// Everything the margin analysis finds for one loop.
 struct LoopMargins {
-  bool closed_loop_stable = false;  ///< at the nominal gain (1)
-  int open_loop_unstable_poles = 0; ///< of plant and controller together, strictly unstable
-  int open_loop_marginal_poles = 0; ///< on the imaginary axis / unit circle (integrators)
+  bool closed_loop_stable = false;   ///< at the nominal gain (1)
+  int open_loop_unstable_poles = 0;  ///< of plant and controller together, strictly unstable
+  int open_loop_marginal_poles = 0;  ///< on the imaginary axis / unit circle (integrators)
   Eigen::VectorXcd closed_loop_poles;
   /// Upper gain margin: the closed loop stays stable for gains in [1, value) [factor, not dB];
   /// frequency = the phase crossover where it is lost (0 for a loss at omega = 0).

@@ -100,7 +100,8 @@ TEST(MarginsTest, SampledDoubleIntegratorResponseIsTheZohTransferFunction) {
   const Loop loop = pd_loop(J, kp, kd, tick, N);
   for (double w : {0.05, 0.7, 3.0, 11.0, 60.0, 150.0}) {
     const std::complex<double> z = std::polar(1.0, w * T);
-    const std::complex<double> expected = kp * T * T * (z + 1.0) / (2 * J * (z - 1.0) * (z - 1.0)) + kd * T / (J * (z - 1.0));
+    const std::complex<double> expected =
+        kp * T * T * (z + 1.0) / (2 * J * (z - 1.0) * (z - 1.0)) + kd * T / (J * (z - 1.0));
     const std::complex<double> got = loop.transfer(w);
     EXPECT_NEAR(std::abs(got - expected), 0.0, 1e-9 * std::abs(expected)) << "at " << w << " rad/s";
   }
@@ -181,7 +182,8 @@ TEST(MarginsTest, OpenLoopUnstablePlantHasALowerGainMargin) {
   // dx/dt = a x + u, u = -k x: stable for k > a. Nominal k = 3a: the gain may drop to a / k = 1/3
   // and grow without bound; L = k / (s - a) crosses the negative real axis at omega = 0.
   const double a = 2.0, k = 6.0;
-  const StateSpace plant{MatrixXd::Constant(1, 1, a), MatrixXd::Ones(1, 1), MatrixXd::Ones(1, 1), MatrixXd::Zero(1, 1), 0.0};
+  const StateSpace plant{MatrixXd::Constant(1, 1, a), MatrixXd::Ones(1, 1), MatrixXd::Ones(1, 1), MatrixXd::Zero(1, 1),
+                         0.0};
   LoopMargins m = analyse_margins({plant, gains(RowVectorXd::Constant(1, -k), 0.0)}, {1e-6, 1e4, 4000});
   EXPECT_EQ(m.open_loop_unstable_poles, 1);
   ASSERT_TRUE(m.closed_loop_stable);
@@ -216,7 +218,8 @@ TEST(HoverLoopsTest, ContinuousAttitudeLoopsHaveTheLqrClosedLoopPoles) {
     auto by_real = [](const std::complex<double>& a, const std::complex<double>& b) { return a.real() < b.real(); };
     std::sort(got.begin(), got.end(), by_real);
     std::sort(want.begin(), want.end(), by_real);
-    for (int j = 0; j < 2; ++j) EXPECT_NEAR(std::abs(got(j) - want(j)), 0.0, 1e-9) << loops[static_cast<std::size_t>(i)].name;
+    for (int j = 0; j < 2; ++j)
+      EXPECT_NEAR(std::abs(got(j) - want(j)), 0.0, 1e-9) << loops[static_cast<std::size_t>(i)].name;
   }
   // Altitude: m s^2 + kd s + kp.
   const Eigen::VectorXcd alt = closed_loop_poles(loops[3].loop);
@@ -237,7 +240,8 @@ TEST(HoverLoopsTest, FastSampledLoopsApproachTheContinuousPoles) {
     const Eigen::VectorXcd z = closed_loop_poles(loops[static_cast<std::size_t>(i)].loop);
     for (Eigen::Index j = 0; j < z.size(); ++j) {
       const std::complex<double> s = std::log(z(j)) / t.tick_s;
-      const double d = std::min(std::abs(s - fc.axis(i).closed_loop_poles(0)), std::abs(s - fc.axis(i).closed_loop_poles(1)));
+      const double d =
+          std::min(std::abs(s - fc.axis(i).closed_loop_poles(0)), std::abs(s - fc.axis(i).closed_loop_poles(1)));
       EXPECT_LT(d, 1e-3 * std::abs(s)) << loops[static_cast<std::size_t>(i)].name << " pole " << s;
     }
   }
@@ -256,7 +260,8 @@ TEST(HoverLoopsTest, PositionModeAddsTwoLoopsAndAnIntegratorOnlyWithKi) {
   // Broken anywhere, the closed loop is the same system: the pitch loop at the torque and the x loop
   // at the tilt setpoint have the same closed-loop poles.
   auto sorted = [](Eigen::VectorXcd p) {
-    std::sort(p.begin(), p.end(), [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
+    std::sort(p.begin(), p.end(),
+              [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
     return p;
   };
   const Eigen::VectorXcd a = sorted(closed_loop_poles(loops[1].loop)), b = sorted(closed_loop_poles(loops[4].loop));

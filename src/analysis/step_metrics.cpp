@@ -16,8 +16,8 @@ std::vector<double> unwrap_angle(std::span<const double> y) {
   return out;
 }
 
-StepFigures step_figures(std::span<const double> t, std::span<const double> y_in, double t_step,
-                         double target, const StepOptions& opt) {
+StepFigures step_figures(std::span<const double> t, std::span<const double> y_in, double t_step, double target,
+                         const StepOptions& opt) {
   StepFigures f;
   f.target = target;
   if (t.size() != y_in.size()) return f;
@@ -88,9 +88,8 @@ StepFigures step_figures(std::span<const double> t, std::span<const double> y_in
 }
 
 const std::vector<std::string>& figure_names() {
-  static const std::vector<std::string> names = {"overshoot_pct", "peak_time_s", "rise_time_s",
-                                                 "t95_s", "settling_time_2pct_s",
-                                                 "steady_state_error_pct"};
+  static const std::vector<std::string> names = {"overshoot_pct", "peak_time_s",          "rise_time_s",
+                                                 "t95_s",         "settling_time_2pct_s", "steady_state_error_pct"};
   return names;
 }
 

@@ -28,12 +28,12 @@ struct StepFigures {
   double target = 0.0;   ///< setpoint after the step (as recorded; an angle is not unwrapped)
   double step = 0.0;     ///< the step judged: target - initial, for an angle wrapped to (-pi, pi]
   StepVerdict verdict = StepVerdict::kTooShort;
-  double post_step_s = 0.0;     ///< recorded time from the step to the last sample [s]
-  double final_window_s = 0.0;  ///< length of the final window the verdict and the error were judged on
-  std::optional<double> overshoot_pct;       ///< (peak - target) / (target - y0) * 100, >= 0
-  std::optional<double> peak_time_s;         ///< time of the extreme beyond the target (if any)
-  std::optional<double> rise_time_s;         ///< 10 % -> 90 % of the step
-  std::optional<double> t95_s;               ///< first time 95 % of the step is reached
+  double post_step_s = 0.0;                    ///< recorded time from the step to the last sample [s]
+  double final_window_s = 0.0;                 ///< length of the final window the verdict and the error were judged on
+  std::optional<double> overshoot_pct;         ///< (peak - target) / (target - y0) * 100, >= 0
+  std::optional<double> peak_time_s;           ///< time of the extreme beyond the target (if any)
+  std::optional<double> rise_time_s;           ///< 10 % -> 90 % of the step
+  std::optional<double> t95_s;                 ///< first time 95 % of the step is reached
   std::optional<double> settling_time_2pct_s;  ///< last entry into the band, staying in it to the end
   std::optional<double> steady_state_error_pct;  ///< |mean(y over the final window) - target| / |step|
 };
@@ -48,8 +48,8 @@ struct StepOptions {
 };
 
 /// t and y sampled together (t increasing). Samples before t_step are ignored.
-StepFigures step_figures(std::span<const double> t_s, std::span<const double> y, double t_step_s,
-                         double target, const StepOptions& options = {});
+StepFigures step_figures(std::span<const double> t_s, std::span<const double> y, double t_step_s, double target,
+                         const StepOptions& options = {});
 
 /// `y` with every jump of more than pi between neighbours taken the short way (numpy.unwrap).
 std::vector<double> unwrap_angle(std::span<const double> y_rad);

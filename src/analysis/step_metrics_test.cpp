@@ -34,8 +34,7 @@ double first_order(double T, double tau) { return 1.0 - std::exp(-tau / T); }
 struct Sampled {
   std::vector<double> t, y;
 };
-Sampled sample(double duration_s, double t_step, double y0, double target,
-               const std::function<double(double)>& unit,
+Sampled sample(double duration_s, double t_step, double y0, double target, const std::function<double(double)>& unit,
                const std::function<double(double)>& before = nullptr) {
   Sampled s;
   const auto n = static_cast<int>(std::lround(duration_s * kRateHz));
@@ -53,8 +52,8 @@ Sampled sample(double duration_s, double t_step, double y0, double target,
 
 /// Brute-force 2 % settling time of a unit response on a fine grid: the first grid time after the
 /// last one at which |y - 1| exceeds the band.
-double brute_force_settling(const std::function<double(double)>& unit, double duration_s,
-                            double band = 0.02, double h = 1e-5) {
+double brute_force_settling(const std::function<double(double)>& unit, double duration_s, double band = 0.02,
+                            double h = 1e-5) {
   const auto n = static_cast<long>(std::lround(duration_s / h));
   long last_out = -1;
   for (long i = 0; i <= n; ++i) {
@@ -88,8 +87,8 @@ class SecondOrderTest : public ::testing::TestWithParam<SecondOrderCase> {};
 
 // Checks the figures of a second-order step however it is placed: from y0 to target at t_step.
 void expect_second_order_figures(double zeta, double wn, double t_step, double y0, double target) {
-  SCOPED_TRACE(testing::Message() << "zeta " << zeta << ", wn " << wn << ", step at " << t_step
-                                  << " s from " << y0 << " to " << target);
+  SCOPED_TRACE(testing::Message() << "zeta " << zeta << ", wn " << wn << ", step at " << t_step << " s from " << y0
+                                  << " to " << target);
   const double duration = t_step + 12.0;
   const auto unit = [&](double tau) { return second_order(zeta, wn, tau); };
   const Sampled s = sample(duration, t_step, y0, target, unit);
@@ -118,8 +117,8 @@ void expect_second_order_figures(double zeta, double wn, double t_step, double y
   EXPECT_NEAR(*f.t95_s, brute_force_first_reach(unit, 0.95, duration - t_step), kDt + 1e-9);
 
   ASSERT_TRUE(f.rise_time_s.has_value());
-  const double rise = brute_force_first_reach(unit, 0.90, duration - t_step) -
-                      brute_force_first_reach(unit, 0.10, duration - t_step);
+  const double rise =
+      brute_force_first_reach(unit, 0.90, duration - t_step) - brute_force_first_reach(unit, 0.10, duration - t_step);
   EXPECT_NEAR(*f.rise_time_s, rise, kDt + 1e-9);
 
   // The 2 % settling time lies within the envelope bound: |y - 1| <= e^{-zeta wn tau} / sqrt(1 - zeta^2),
@@ -329,8 +328,8 @@ TEST(StepFiguresTest, FigureLooksUpEveryNameAndRejectsUnknownOnes) {
   f.t95_s = 4.0;
   f.settling_time_2pct_s = 5.0;
   f.steady_state_error_pct = 6.0;
-  const std::vector<std::string> expected = {"overshoot_pct", "peak_time_s", "rise_time_s",
-                                             "t95_s", "settling_time_2pct_s", "steady_state_error_pct"};
+  const std::vector<std::string> expected = {"overshoot_pct", "peak_time_s",          "rise_time_s",
+                                             "t95_s",         "settling_time_2pct_s", "steady_state_error_pct"};
   ASSERT_EQ(figure_names(), expected);
   for (std::size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(figure(f, expected[i]), static_cast<double>(i + 1)) << expected[i];
@@ -338,7 +337,6 @@ TEST(StepFiguresTest, FigureLooksUpEveryNameAndRejectsUnknownOnes) {
   EXPECT_FALSE(figure(f, "overshoot").has_value());
   EXPECT_FALSE(figure(f, "").has_value());
 }
-
 
 // --- The verdict: settled, not settled, too short, zero-size step -------------------------------
 
@@ -470,7 +468,7 @@ TEST(StepAngleTest, YawFrom3ToMinus3IsAStepOfPlus0283) {
   const Sampled s = sample(8.0, 1.0, 3.0, 3.0 + size, [T](double tau) { return first_order(T, tau); });
   std::vector<double> wrapped;
   for (double v : s.y) wrapped.push_back(std::remainder(v, 2.0 * kPi));  // what the recorder writes
-  ASSERT_LT(wrapped.back(), -2.9);                                         // it did wrap
+  ASSERT_LT(wrapped.back(), -2.9);                                       // it did wrap
   StepOptions angle;
   angle.angle = true;
   const StepFigures f = step_figures(s.t, wrapped, 1.0, -3.0, angle);

@@ -12,9 +12,9 @@
 //                              the largest swarm found at >= 1x real time (doubling, then bisection)
 //   *_pinned                   the DDS figures again with the plant and the controller each on its
 //                              own CPU (--cpus; pinned_cpus names them, null with fewer than 2 CPUs)
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/utsname.h>
+#include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -101,8 +101,8 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   fs::remove(ps);
   fs::remove(cs);
   std::vector<std::string> c = {self, "controller", "--scenario", scenario};
-  std::vector<std::string> p = {self, "plant", "--scenario", scenario, "--duration", fmt::format("{}", sim_s),
-                                "--stats", ps, "--timeout", "60"};
+  std::vector<std::string> p = {self,      "plant", "--scenario", scenario, "--duration", fmt::format("{}", sim_s),
+                                "--stats", ps,      "--timeout",  "60"};
   if (vehicles > 0) {
     for (auto* v : {&c, &p}) {
       v->push_back("--vehicles");
@@ -203,7 +203,9 @@ nlohmann::json machine() {
            }()}};
 }
 
-nlohmann::json number_or_null(double v) { return std::isfinite(v) && v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) && v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 }  // namespace
 
@@ -217,7 +219,8 @@ CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& bench) {
       ->check(CLI::IsMember({"inproc", "dds", "realtime", "swarm_inproc", "swarm_dds"}));
   bench_cmd->add_option("--seconds", bench.seconds, "simulated seconds of the inproc/dds part")
       ->check(CLI::Range(0.0, 1e6));
-  bench_cmd->add_option("--rt-priority", bench.rt_priority, "realtime part: SCHED_FIFO priority of the controller (0: skip)")
+  bench_cmd
+      ->add_option("--rt-priority", bench.rt_priority, "realtime part: SCHED_FIFO priority of the controller (0: skip)")
       ->check(CLI::Range(0, 99));
   bench_cmd->add_option("--scenario", bench.scenario, "single-vehicle scenario")->check(CLI::ExistingFile);
   bench_cmd->add_option("--swarm-scenario", bench.swarm_scenario, "swarm scenario")->check(CLI::ExistingFile);
@@ -278,7 +281,8 @@ int bench_command(const BenchOptions& o) {
     // SCHED_FIFO when the machine allows it.
     const double s = q ? 2.0 : 20.0;
     auto measure = [&](int priority, const std::string& suffix) {
-      note(fmt::format("real time, one vehicle, {} s{}", s, priority > 0 ? fmt::format(", SCHED_FIFO {}", priority) : ""));
+      note(fmt::format("real time, one vehicle, {} s{}", s,
+                       priority > 0 ? fmt::format(", SCHED_FIFO {}", priority) : ""));
       const NodeRun r = run_nodes(tmp, o.scenario, s, 0, true, priority);
       for (const char* k : {"p50", "p99", "max"}) {
         const std::string key = std::string("period_jitter_us_") + k;

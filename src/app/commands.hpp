@@ -40,10 +40,10 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& options);
 struct OpenloopOptions {
   std::string commands;
   std::string out;
-  std::string vehicle;        ///< "" for the paper's vehicle
+  std::string vehicle;  ///< "" for the paper's vehicle
   double rate_hz = 100.0;
   int substeps = 1;
-  double duration_s = -1.0;   ///< < 0: until the last command row's time
+  double duration_s = -1.0;  ///< < 0: until the last command row's time
   double initial_z_m = 0.0;
 };
 int openloop_command(const OpenloopOptions& options);
@@ -104,18 +104,18 @@ struct PlantCommandOptions {
   };
 
   // Every mode.
-  std::string scenario;     ///< vehicle, rates, duration, initial state ("" for defaults)
-  std::string vehicle;      ///< vehicle file, replaces the scenario's vehicle when set
-  std::string ns;           ///< overrides the scenario's namespace when set
-  bool sensor_qos = false;  ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
-  std::string cpus;         ///< run on these CPUs only ("0", "0-1"; "" for any)
-  bool lockstep = true;     ///< false: real time
-  double duration_s = -1.0; ///< overrides the scenario's duration when >= 0
-  double timeout_s = 10.0;  ///< how long to wait for a controller (and, in lockstep, for one command)
+  std::string scenario;         ///< vehicle, rates, duration, initial state ("" for defaults)
+  std::string vehicle;          ///< vehicle file, replaces the scenario's vehicle when set
+  std::string ns;               ///< overrides the scenario's namespace when set
+  bool sensor_qos = false;      ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
+  std::string cpus;             ///< run on these CPUs only ("0", "0-1"; "" for any)
+  bool lockstep = true;         ///< false: real time
+  double duration_s = -1.0;     ///< overrides the scenario's duration when >= 0
+  double timeout_s = 10.0;      ///< how long to wait for a controller (and, in lockstep, for one command)
   double watchdog_s = -1.0;     ///< overrides simulation.watchdog_s when >= 0 (0: off)
   std::string watchdog_policy;  ///< overrides simulation.watchdog_policy when set: "hold" or "stop"
-  std::string stats;        ///< write run figures (real-time factor, round trip) as JSON here ("" none)
-  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
+  std::string stats;            ///< write run figures (real-time factor, round trip) as JSON here ("" none)
+  std::string enclave = "/";    ///< DDS Security enclave (rcl --enclave)
 
   Lockstep lockstep_only;
   Realtime realtime;
@@ -163,13 +163,13 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& opt
 /// 1 when the node refuses a set or lacks the parameter, 2 on bad input, 4 when the node is not
 /// found or does not answer within timeout_s.
 struct ParamOptions {
-  std::string verb;        ///< "get", "set", "list" or "describe" (set by the subcommand parsed)
-  std::string node;        ///< "/attitude_controller" or "attitude_controller"
-  std::string name;        ///< the parameter (get, set, describe)
-  std::string value;       ///< set: read as `ros2 param set` reads it (10 integer, 10.0 double, ...)
+  std::string verb;                   ///< "get", "set", "list" or "describe" (set by the subcommand parsed)
+  std::string node;                   ///< "/attitude_controller" or "attitude_controller"
+  std::string name;                   ///< the parameter (get, set, describe)
+  std::string value;                  ///< set: read as `ros2 param set` reads it (10 integer, 10.0 double, ...)
   std::vector<std::string> prefixes;  ///< list: only names under these prefixes
-  double timeout_s = 5.0;  ///< how long to look for the node and wait for its answer
-  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
+  double timeout_s = 5.0;             ///< how long to look for the node and wait for its answer
+  std::string enclave = "/";          ///< DDS Security enclave (rcl --enclave)
 };
 /// Adds the `param` subcommand with get/set/list/describe under `app`, parsing into `options`.
 CLI::App* add_param_subcommand(CLI::App& app, ParamOptions& options);
@@ -179,15 +179,15 @@ std::string check_node_name(const std::string& text);
 
 /// `quadcosim topic list|echo|hz` (topic_command.cpp). Negative wait_s: the verb's default.
 struct TopicOptions {
-  std::string verb;          ///< "list", "echo" or "hz" (set by the subcommand parsed)
-  bool show_types = false;   ///< list -t
+  std::string verb;         ///< "list", "echo" or "hz" (set by the subcommand parsed)
+  bool show_types = false;  ///< list -t
   bool include_hidden = false;
-  double wait_s = -1.0;      ///< list: discovery time (1 s); echo/hz: how long to look for the topic (5 s)
+  double wait_s = -1.0;  ///< list: discovery time (1 s); echo/hz: how long to look for the topic (5 s)
   std::string topic;
-  int count = 0;             ///< echo: stop after this many messages (0: until Ctrl-C)
-  std::string qos;           ///< "default" (reliable) or "sensor" (best effort); "": the verb's default
-  int window = 10000;        ///< hz: intervals the statistics cover
-  double duration_s = 0.0;   ///< hz: stop after this long (0: until Ctrl-C)
+  int count = 0;              ///< echo: stop after this many messages (0: until Ctrl-C)
+  std::string qos;            ///< "default" (reliable) or "sensor" (best effort); "": the verb's default
+  int window = 10000;         ///< hz: intervals the statistics cover
+  double duration_s = 0.0;    ///< hz: stop after this long (0: until Ctrl-C)
   std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
 };
 /// Adds the `topic` subcommand with list/echo/hz under `app`, parsing into `options`.
@@ -243,9 +243,9 @@ int prepare_keystore_for_run(const std::string& keystore, const std::vector<std:
 /// the outputs of `run`; `sweep merge OUT DIR...` joins shards. Exit 0 when at least min_pass_rate of
 /// the runs pass (a shard: when it ran), 1 otherwise, 2 on bad input, 3 when an output cannot be written.
 struct SweepOptions {
-  std::string mode = "sweep";      ///< "sweep", "rerun" or "merge"
+  std::string mode = "sweep";  ///< "sweep", "rerun" or "merge"
   std::string scenario;
-  int runs = 20;                   ///< runs, or runs per grid point with a grid (default 1 then)
+  int runs = 20;  ///< runs, or runs per grid point with a grid (default 1 then)
   bool runs_given = false;
   std::uint64_t seed = 1;
   std::vector<std::string> vary;   ///< KEY=P%, KEY=uniform(a,b), ... (sweep/plan.hpp)
@@ -254,10 +254,10 @@ struct SweepOptions {
   std::string shard;               ///< "K/N" or ""
   bool force = false;
   std::string out_dir;
-  int jobs = 2;                    ///< threads
+  int jobs = 2;  ///< threads
   double min_pass_rate = 1.0;
   bool plots = true;
-  std::string sweep_dir;           ///< rerun: the sweep
+  std::string sweep_dir;  ///< rerun: the sweep
   int rerun_index = 0;
   std::vector<std::string> shard_dirs;  ///< merge: the shards
 };
@@ -293,20 +293,20 @@ int plot_command(const PlotOptions& options);
 /// `quadcosim compare RUN_A RUN_B [--out DIR]`: overlays two runs and tabulates their step figures.
 struct CompareOptions {
   std::string run_a, run_b;
-  std::string out;  ///< "" for RUN_B/compare_with_<RUN_A>
+  std::string out;     ///< "" for RUN_B/compare_with_<RUN_A>
   bool force = false;  ///< write into a folder holding other files or outputs (a previous compare's are replaced)
 };
 CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& options);
 int compare_command(const CompareOptions& options);
 
 struct BenchOptions {
-  bool json = false;          ///< one JSON object on stdout (else the same, indented)
-  bool quick = false;         ///< short runs and small searches (a smoke test, not figures)
-  std::string only;           ///< one part: inproc, dds, realtime, swarm_inproc, swarm_dds ("" all)
-  double seconds = 0.0;       ///< > 0: simulated seconds of the inproc / dds part (e.g. for callgrind)
-  std::string scenario;       ///< single-vehicle scenario (default: scenarios/paper/altitude_step.yaml)
-  std::string swarm_scenario; ///< swarm scenario (default: scenarios/swarm/grid_takeoff.yaml)
-  int rt_priority = 50;       ///< realtime part: also measure with the controller under SCHED_FIFO (0: not)
+  bool json = false;           ///< one JSON object on stdout (else the same, indented)
+  bool quick = false;          ///< short runs and small searches (a smoke test, not figures)
+  std::string only;            ///< one part: inproc, dds, realtime, swarm_inproc, swarm_dds ("" all)
+  double seconds = 0.0;        ///< > 0: simulated seconds of the inproc / dds part (e.g. for callgrind)
+  std::string scenario;        ///< single-vehicle scenario (default: scenarios/paper/altitude_step.yaml)
+  std::string swarm_scenario;  ///< swarm scenario (default: scenarios/swarm/grid_takeoff.yaml)
+  int rt_priority = 50;        ///< realtime part: also measure with the controller under SCHED_FIFO (0: not)
 };
 /// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
 int bench_command(const BenchOptions& options);

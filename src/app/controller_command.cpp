@@ -1,7 +1,7 @@
 // `quadcosim controller`: the flight controller node as a long-running process over DDS, stepping
 // once per complete sensor sample in lockstep, or on a wall-clock timer in real time.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <iostream>
 
@@ -14,8 +14,8 @@
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_service.hpp"
-#include "io/scenario.hpp"
 #include "drivers/controller_drivers.hpp"
+#include "io/scenario.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/topics.hpp"
 
@@ -35,28 +35,32 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
                     "ignore the scenario's schedule (someone else sets the parameters)");
   ctl_cmd->add_option("--rate-factor", ctl.realtime.rate_factor, "real time: run the timer k times faster")
       ->check(CLI::Range(1e-3, 1e6));
-  ctl_cmd->add_option("--rt-priority", ctl.realtime.rt_priority,
-                      "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
+  ctl_cmd
+      ->add_option("--rt-priority", ctl.realtime.rt_priority,
+                   "real time: run the control loop under SCHED_FIFO at this priority (needs CAP_SYS_NICE)")
       ->check(CLI::Range(0, 99));
   ctl_cmd->add_option("--stats", ctl.realtime.stats, "real time: write the control period jitter as JSON here on exit");
-  ctl_cmd->add_option("--node-name", ctl.one_vehicle.node_name,
-                      "one vehicle: ROS node name (parameter services /NAME/..., ros2 node list)")
+  ctl_cmd
+      ->add_option("--node-name", ctl.one_vehicle.node_name,
+                   "one vehicle: ROS node name (parameter services /NAME/..., ros2 node list)")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
   add_enclave_option(ctl_cmd, ctl.enclave);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   ctl_cmd->parse_complete_callback([ctl_cmd, &ctl] {
     const bool swarm = ctl.swarm.vehicles > 0, realtime = !ctl.lockstep;
-    refuse_idle_flags(*ctl_cmd, {
-        {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
-        {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
-        {"--node-name", !swarm, "--vehicles; a swarm offers no parameter services"},
-        {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
-        {"--threads", swarm, "one vehicle; it needs --vehicles N"},
-        {"--rate-factor", realtime, "lockstep; it needs --realtime"},
-        {"--rt-priority", realtime, "lockstep; it needs --realtime"},
-        {"--stats", realtime, "lockstep; it needs --realtime (in lockstep the plant's --stats has the figures)"},
-    });
+    refuse_idle_flags(
+        *ctl_cmd,
+        {
+            {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
+            {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
+            {"--node-name", !swarm, "--vehicles; a swarm offers no parameter services"},
+            {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
+            {"--threads", swarm, "one vehicle; it needs --vehicles N"},
+            {"--rate-factor", realtime, "lockstep; it needs --realtime"},
+            {"--rt-priority", realtime, "lockstep; it needs --realtime"},
+            {"--stats", realtime, "lockstep; it needs --realtime (in lockstep the plant's --stats has the figures)"},
+        });
   });
   return ctl_cmd;
 }
@@ -82,16 +86,16 @@ int controller_command(const ControllerCommandOptions& o) {
   dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
   announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
   std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
-                           transport.participant().domain_id(), sc.simulation.ns,
-                           o.lockstep ? "lockstep" : "real-time", dt_s);
+                           transport.participant().domain_id(), sc.simulation.ns, o.lockstep ? "lockstep" : "real-time",
+                           dt_s);
 
   if (o.lockstep) {
     // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
     // arrival, so answering a tick wakes no other thread; the host's waits serve the parameter
     // services.
     DdsDriverHost host(transport);
-    drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
-                                             sc.simulation.controller_divider, host);
+    drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,
+                                             host);
     driver.run();
   } else {
     // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
@@ -115,8 +119,8 @@ int controller_command(const ControllerCommandOptions& o) {
                                static_cast<double>(now) / 1e9);
     };
     DdsDriverHost host(transport, /*precise_deadlines=*/true);
-    drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock,
-                                             sc.simulation.controller_divider, o.realtime.rate_factor, std::move(h), host);
+    drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,
+                                             o.realtime.rate_factor, std::move(h), host);
     driver.run();
     if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
   }

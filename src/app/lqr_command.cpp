@@ -1,6 +1,6 @@
 // `quadcosim lqr` and `quadcosim params [--vehicle]`.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <iostream>
 
@@ -48,8 +48,8 @@ int lqr_command(const LqrOptions& opt) {
     std::cout << fmt::format("  A = [[{:g}, {:g}], [{:g}, {:g}]]\n", a.A(0, 0), a.A(0, 1), a.A(1, 0), a.A(1, 1));
     std::cout << fmt::format("  B = [{:g}, {:.6g}]\n", a.B(0), a.B(1));
     std::cout << fmt::format("  Q = diag({:g}, {:g})   R = {:g}\n", a.Q(0, 0), a.Q(1, 1), a.R);
-    std::cout << fmt::format("  K = [{:.6g}, {:.6g}]   (Algorithm 1: k1 = {:.6g}, k2 = {:.6g})\n", a.K(0),
-                             a.K(1), -a.K(0), a.K(1));
+    std::cout << fmt::format("  K = [{:.6g}, {:.6g}]   (Algorithm 1: k1 = {:.6g}, k2 = {:.6g})\n", a.K(0), a.K(1),
+                             -a.K(0), a.K(1));
     std::cout << fmt::format("  closed-loop poles: {}, {}\n", complex_str(a.closed_loop_poles(0)),
                              complex_str(a.closed_loop_poles(1)));
   }
@@ -73,18 +73,14 @@ int vehicle_params_table(bool markdown) {
   for (const auto& p : model::vehicle_parameters()) {
     std::string range;
     switch (p.kind) {
-      case model::VehicleParameter::Kind::kNumber:
-        range = p.range.text();
-        break;
+      case model::VehicleParameter::Kind::kNumber: range = p.range.text(); break;
       case model::VehicleParameter::Kind::kChoice:
         for (auto c : p.choices) {
           if (!range.empty()) range += markdown ? " \\| " : "|";
           range.append(c);
         }
         break;
-      case model::VehicleParameter::Kind::kSigns:
-        range = "+1 or -1 each";
-        break;
+      case model::VehicleParameter::Kind::kSigns: range = "+1 or -1 each"; break;
     }
     if (markdown) {
       std::cout << fmt::format(md_row, fmt::format("`{}`", p.name), p.unit, range, p.text(defaults), p.meaning);
@@ -111,8 +107,8 @@ int params_command(const ParamsOptions& options) {
     } else {
       range = fmt::format("[{:g}, {:g}]", p.min, p.max);
     }
-    std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", p.name, p.is_choice() ? "" : p.unit,
-                             range, control::to_string(p.get(defaults)), p.description);
+    std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", p.name, p.is_choice() ? "" : p.unit, range,
+                             control::to_string(p.get(defaults)), p.description);
   }
   return exit_code::kOk;
 }

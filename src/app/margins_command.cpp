@@ -2,8 +2,8 @@
 // every loop of the scenario's controller, linearised about level hover, sampled at the controller's
 // rate with the scenario's command delay and sensor latencies (analysis/hover_loops.hpp,
 // docs/margins.md).
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -65,8 +65,9 @@ Setup setup_from(const std::string& path) {
     if (p.tick > 0 && spec != nullptr && (spec->affects_design || p.name == "mode")) later_design_change = true;
   }
   if (later_design_change)
-    s.notes.push_back("the schedule changes gains or mode after t = 0: these are the margins of the configuration "
-                      "after its last change");
+    s.notes.push_back(
+        "the schedule changes gains or mode after t = 0: these are the margins of the configuration "
+        "after its last change");
 
   const sim::SimulationConfig& sim = sc.simulation;
   const sim::Topics topics = sim::Topics::for_namespace(sim.ns);
@@ -99,11 +100,12 @@ Setup setup_from(const std::string& path) {
     s.notes.push_back(fmt::format("motor lag linearised with the larger time constant, {:g} s",
                                   std::max(s.plant.motor.tau_up_s, s.plant.motor.tau_down_s)));
   const double worst_age_s = s.timing.tick_s * std::max({s.timing.imu_latency_ticks, s.timing.pose_latency_ticks,
-                                                          s.timing.velocity_latency_ticks});
+                                                         s.timing.velocity_latency_ticks});
   if (worst_age_s > s.controller.params.stale_limit_s)
-    s.notes.push_back(fmt::format("sensor latency {:g} s exceeds stale_limit {:g} s: the controller would command "
-                                  "its safety mode, which these loops do not model",
-                                  worst_age_s, s.controller.params.stale_limit_s));
+    s.notes.push_back(
+        fmt::format("sensor latency {:g} s exceeds stale_limit {:g} s: the controller would command "
+                    "its safety mode, which these loops do not model",
+                    worst_age_s, s.controller.params.stale_limit_s));
   return s;
 }
 
@@ -152,8 +154,8 @@ bool write_file(const std::filesystem::path& p, const std::string& text) {
 }  // namespace
 
 CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
-  auto* cmd = app.add_subcommand("margins",
-                                 "gain, phase and delay margins of each control loop about hover (docs/margins.md)");
+  auto* cmd =
+      app.add_subcommand("margins", "gain, phase and delay margins of each control loop about hover (docs/margins.md)");
   cmd->add_option("scenario", o.scenario, "scenario YAML (default: the paper's vehicle and controller)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o.out_dir,
@@ -181,12 +183,13 @@ int margins_command(const MarginsOptions& o) {
   std::vector<analysis::HoverLoop> loops;
   try {
     s = setup_from(o.scenario);
-    s.notes.push_back("the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
-                      "in them");
+    s.notes.push_back(
+        "the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
+        "in them");
     loops = analysis::hover_loops(s.plant, s.controller.params, s.controller.setpoint.mode, s.timing);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(fmt::format("{}cannot linearise about hover: {}",
-                                            o.scenario.empty() ? "" : o.scenario + ": ", e.what()));
+    throw std::invalid_argument(
+        fmt::format("{}cannot linearise about hover: {}", o.scenario.empty() ? "" : o.scenario + ": ", e.what()));
   }
   std::optional<io::OutputFolder> folder;
   if (!o.out_dir.empty()) folder.emplace(io::OutputFolder::claim(o.out_dir, "margins", {.force = o.force}, std::cerr));
@@ -203,8 +206,8 @@ int margins_command(const MarginsOptions& o) {
   doc["plant_period_s"] = t.tick_s;
   doc["controller_period_s"] = T;
   doc["command_delay_ticks"] = t.command_delay_ticks;
-  doc["latency_ticks"] = {{"imu", t.imu_latency_ticks}, {"pose", t.pose_latency_ticks},
-                          {"velocity", t.velocity_latency_ticks}};
+  doc["latency_ticks"] = {
+      {"imu", t.imu_latency_ticks}, {"pose", t.pose_latency_ticks}, {"velocity", t.velocity_latency_ticks}};
   doc["notes"] = s.notes;
   doc["loops"] = nlohmann::json::array();
   bool all_stable = true;
@@ -219,7 +222,7 @@ int margins_command(const MarginsOptions& o) {
     j["open_loop_marginal_poles"] = m.open_loop_marginal_poles;
     nlohmann::json gm = margin_json(m.gain_margin, "factor", 1.0);
     gm["db"] = m.gain_margin.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(m.gain_margin.value))
-                                                               : nlohmann::json(nullptr);
+                                                             : nlohmann::json(nullptr);
     j["gain_margin"] = gm;
     nlohmann::json gr = margin_json(m.gain_reduction_margin, "factor", 1.0);
     gr["db"] = m.gain_reduction_margin.status == MarginStatus::kFinite
@@ -254,10 +257,11 @@ int margins_command(const MarginsOptions& o) {
 
   std::string table;
   table += fmt::format("margins of {}\n", s.source);
-  table += fmt::format("linearised about level hover ({} mode); controller {:g} Hz (T = {:g} s, zero-order hold), "
-                       "plant {:g} Hz; command delay {} ticks; sensor latency imu {}, pose {}, velocity {} ticks\n",
-                       control::to_string(s.controller.setpoint.mode), 1.0 / T, T, 1.0 / t.tick_s, t.command_delay_ticks,
-                       t.imu_latency_ticks, t.pose_latency_ticks, t.velocity_latency_ticks);
+  table += fmt::format(
+      "linearised about level hover ({} mode); controller {:g} Hz (T = {:g} s, zero-order hold), "
+      "plant {:g} Hz; command delay {} ticks; sensor latency imu {}, pose {}, velocity {} ticks\n",
+      control::to_string(s.controller.setpoint.mode), 1.0 / T, T, 1.0 / t.tick_s, t.command_delay_ticks,
+      t.imu_latency_ticks, t.pose_latency_ticks, t.velocity_latency_ticks);
   table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", "loop", "broken at", "GM [dB]",
                        "w_pc", "GMlo[dB]", "PM [deg]", "w_gc", "DM [s]", "DM [smp]", "closed loop");
   for (std::size_t i = 0; i < loops.size(); ++i) {
@@ -268,11 +272,11 @@ int margins_command(const MarginsOptions& o) {
                             m.open_loop_unstable_poles == 1 ? "" : "s");
     analysis::Margin dms = m.delay_margin;
     if (dms.status == MarginStatus::kFinite) dms.value /= T;
-    table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", loops[i].name,
-                         loops[i].broken_at, cell(gain_db(m.gain_margin), 1.0, "inf"), freq_cell(m.gain_margin),
-                         cell(gain_db(m.gain_reduction_margin), 1.0, "-inf"), cell(m.phase_margin, kDeg, "inf", 1),
-                         freq_cell(m.phase_margin), cell(m.delay_margin, 1.0, "inf", 3), cell(dms, 1.0, "inf", 1),
-                         status);
+    table +=
+        fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", loops[i].name, loops[i].broken_at,
+                    cell(gain_db(m.gain_margin), 1.0, "inf"), freq_cell(m.gain_margin),
+                    cell(gain_db(m.gain_reduction_margin), 1.0, "-inf"), cell(m.phase_margin, kDeg, "inf", 1),
+                    freq_cell(m.phase_margin), cell(m.delay_margin, 1.0, "inf", 3), cell(dms, 1.0, "inf", 1), status);
   }
   table += "w_pc, w_gc [rad/s]: phase and gain crossover; GMlo: gain reduction margin (-inf: the gain may drop to 0)\n";
   for (const std::string& n : s.notes) table += "note: " + n + '\n';

@@ -89,10 +89,10 @@ void DdsDriverHost::wait_until(std::int64_t deadline_ns) {
 std::string lockstep_timeout_message(const dds::DdsTransport& transport, const sim::Topics& topics,
                                      const sim::TickClock& clock, sim::Tick k, double timeout_s,
                                      const std::string& policy) {
-  return fmt::format("plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
-                     "matched command writers: {}; policy: {}\n",
-                     topics.motor_commands, k, clock.seconds(k), timeout_s,
-                     transport.matched_writers(topics.motor_commands), policy);
+  return fmt::format(
+      "plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
+      "matched command writers: {}; policy: {}\n",
+      topics.motor_commands, k, clock.seconds(k), timeout_s, transport.matched_writers(topics.motor_commands), policy);
 }
 
 bool DdsDriverHost::stop_requested() { return app::stop_requested(); }
@@ -227,8 +227,10 @@ nlohmann::json PeriodJitter::figures() const {
   std::vector<std::int64_t> j = jitter_ns_;
   std::sort(j.begin(), j.end());
   auto pct = [&](double q) { return j.empty() ? 0.0 : static_cast<double>(analysis::percentile_lower(j, q)) / 1e3; };
-  return {{"period_jitter_us_p50", pct(0.5)}, {"period_jitter_us_p99", pct(0.99)},
-          {"period_jitter_us_max", pct(1.0)}, {"periods", j.size()}};
+  return {{"period_jitter_us_p50", pct(0.5)},
+          {"period_jitter_us_p99", pct(0.99)},
+          {"period_jitter_us_max", pct(1.0)},
+          {"periods", j.size()}};
 }
 
 void write_stats(const std::string& path, const nlohmann::json& stats) {

@@ -13,8 +13,8 @@
 
 #include "dds/arrival_executor.hpp"
 #include "dds/dds_transport.hpp"
-#include "drivers/driver_host.hpp"
 #include "dds/steady_clock.hpp"
+#include "drivers/driver_host.hpp"
 #include "io/scenario.hpp"
 #include "sim/topics.hpp"
 

@@ -15,16 +15,15 @@ namespace quadcosim::app {
 CLI::App* add_openloop_subcommand(CLI::App& app, OpenloopOptions& ol) {
   auto* ol_cmd = app.add_subcommand("openloop", "the plant alone under a rotor speed schedule");
   ol_cmd->add_option("--commands", ol.commands, "CSV with header t,w1,w2,w3,w4 [s, rad/s]")
-      ->required()->check(CLI::ExistingFile);
-  ol_cmd->add_option("--out", ol.out, "trajectory CSV to write")->required();
-  ol_cmd->add_option("--vehicle", ol.vehicle, "vehicle YAML (default: the paper's Table 1)")
+      ->required()
       ->check(CLI::ExistingFile);
+  ol_cmd->add_option("--out", ol.out, "trajectory CSV to write")->required();
+  ol_cmd->add_option("--vehicle", ol.vehicle, "vehicle YAML (default: the paper's Table 1)")->check(CLI::ExistingFile);
   ol_cmd->add_option("--rate-hz", ol.rate_hz, "plant rate [Hz]")->check(CLI::Range(1e-3, 1e6));
   ol_cmd->add_option("--substeps", ol.substeps, "RK4 steps per plant tick")->check(CLI::Range(1, 10000));
   ol_cmd->add_option("--duration", ol.duration_s, "simulated time [s] (default: last command time)")
       ->check(CLI::Range(0.0, 1e7));
-  ol_cmd->add_option("--initial-z", ol.initial_z_m, "start at rest at this height [m]")
-      ->check(CLI::Range(0.0, 1e6));
+  ol_cmd->add_option("--initial-z", ol.initial_z_m, "start at rest at this height [m]")->check(CLI::Range(0.0, 1e6));
   return ol_cmd;
 }
 

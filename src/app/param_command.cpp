@@ -105,12 +105,12 @@ int param_command(const ParamOptions& o) {
       return exit_code::kOutput;
     }
     if (!results.front().successful) {
-      std::cerr << "Setting parameter failed" << (results.front().reason.empty() ? "" : ": ")
-                << results.front().reason << '\n';
+      std::cerr << "Setting parameter failed" << (results.front().reason.empty() ? "" : ": ") << results.front().reason
+                << '\n';
       return exit_code::kFailed;
     }
-    std::cout << "Set parameter successful" << (results.front().reason.empty() ? "" : ": ")
-              << results.front().reason << '\n';
+    std::cout << "Set parameter successful" << (results.front().reason.empty() ? "" : ": ") << results.front().reason
+              << '\n';
     return exit_code::kOk;
   }
   if (o.verb == "list") {

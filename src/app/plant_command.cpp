@@ -1,7 +1,7 @@
 // `quadcosim plant`: the plant node as a long-running process over DDS, in lockstep (deterministic,
 // as fast as plant and controller can go) or in real time (paced by the wall clock).
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -56,7 +56,8 @@ class PlantProcess {
       have_status_ = true;
     });
     if (!o_.one_vehicle.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.one_vehicle.record);
-    if (!o_.one_vehicle.mcap.empty()) mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
+    if (!o_.one_vehicle.mcap.empty())
+      mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
     if (!o_.one_vehicle.schedule_node.empty()) {
       scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));
@@ -68,8 +69,7 @@ class PlantProcess {
     announcer_.announce();  // `ros2 node list` shows /quadrotor_plant
     std::cerr << fmt::format("plant: domain {}, namespace {}, {} mode, {} ticks of {} s\n",
                              transport_.participant().domain_id(), sc_.simulation.ns,
-                             o_.lockstep ? "lockstep" : "real-time", sc_.simulation.duration_ticks,
-                             clock_.period_s());
+                             o_.lockstep ? "lockstep" : "real-time", sc_.simulation.duration_ticks, clock_.period_s());
   }
 
   /// Runs every tick; returns the process's exit code.
@@ -97,17 +97,18 @@ class PlantProcess {
     const int own = mcap_ ? 1 : 0;
     const bool found = transport_.spin_until(
         [&] {
-          return stop_requested() || (transport_.matched_writers(topics_.motor_commands) > 0 &&
-                                      transport_.matched_readers(topics_.pose) > own &&
-                                      transport_.matched_readers(topics_.velocity) > own &&
-                                      transport_.matched_readers(topics_.imu) > own);
+          return stop_requested() ||
+                 (transport_.matched_writers(topics_.motor_commands) > 0 &&
+                  transport_.matched_readers(topics_.pose) > own &&
+                  transport_.matched_readers(topics_.velocity) > own && transport_.matched_readers(topics_.imu) > own);
         },
         timeout_ns());
     if (!found) {
-      std::cerr << fmt::format("plant: no controller on {} within {} s (matched command writers: {}, "
-                               "pose readers: {}); is it running on ROS_DOMAIN_ID {}?\n",
-                               topics_.motor_commands, o_.timeout_s, transport_.matched_writers(topics_.motor_commands),
-                               transport_.matched_readers(topics_.pose), transport_.participant().domain_id());
+      std::cerr << fmt::format(
+          "plant: no controller on {} within {} s (matched command writers: {}, "
+          "pose readers: {}); is it running on ROS_DOMAIN_ID {}?\n",
+          topics_.motor_commands, o_.timeout_s, transport_.matched_writers(topics_.motor_commands),
+          transport_.matched_readers(topics_.pose), transport_.participant().domain_id());
     }
     return found;
   }
@@ -117,11 +118,13 @@ class PlantProcess {
   bool apply_due_schedule(sim::Tick k) {
     for (; scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k; ++next_event_) {
       // The reply comes through Cyclone's receive thread: let deliveries on arrival through meanwhile.
-      const auto r = host_.unlocked(
-          [&] { return scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns()); });
+      const auto r = host_.unlocked([&] {
+        return scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns());
+      });
       if (r.size() != 1 || !r[0].successful) {
         std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event_->name,
-                                 clock_.seconds(k), o_.one_vehicle.schedule_node, r.empty() ? "no result" : r[0].reason);
+                                 clock_.seconds(k), o_.one_vehicle.schedule_node,
+                                 r.empty() ? "no result" : r[0].reason);
         return false;
       }
     }
@@ -154,7 +157,8 @@ class PlantProcess {
     lo.duration_ticks = sc_.simulation.duration_ticks;
     lo.controller_divider = divider_;
     lo.timeout_ns = timeout_ns();
-    lo.on_timeout = o_.lockstep_only.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
+    lo.on_timeout =
+        o_.lockstep_only.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
     drivers::DrivenPlant p{&plant_, [this] { return transport_.matched_writers(topics_.controller_status) > 0; },
                            [this] { return status_.header.stamp.to_ns(); }};
     drivers::LockstepHooks h;
@@ -193,11 +197,11 @@ class PlantProcess {
     watchdog_logged_ = plant_.watchdog_active();
     const double mono_s = static_cast<double>(steady_ns()) / 1e9;
     if (watchdog_logged_) {
-      std::cerr << fmt::format("plant: watchdog: no valid motor command for {:.3f} s (limit {:g} s) at t = {:g} s "
-                               "(monotonic {:.6f} s); policy {}\n",
-                               static_cast<double>(plant_.command_age_ns()) / 1e9,
-                               clock_.seconds(plant_.options().watchdog_ticks), clock_.seconds(k), mono_s,
-                               sim::to_string(plant_.options().watchdog_policy));
+      std::cerr << fmt::format(
+          "plant: watchdog: no valid motor command for {:.3f} s (limit {:g} s) at t = {:g} s "
+          "(monotonic {:.6f} s); policy {}\n",
+          static_cast<double>(plant_.command_age_ns()) / 1e9, clock_.seconds(plant_.options().watchdog_ticks),
+          clock_.seconds(k), mono_s, sim::to_string(plant_.options().watchdog_policy));
     } else {
       std::cerr << fmt::format("plant: watchdog: valid motor commands again at t = {:g} s (monotonic {:.6f} s)\n",
                                clock_.seconds(k), mono_s);
@@ -232,9 +236,10 @@ class PlantProcess {
     if (!round_trip_ns.empty()) {
       std::sort(round_trip_ns.begin(), round_trip_ns.end());
       auto pct = [&](double q) { return static_cast<double>(analysis::percentile_lower(round_trip_ns, q)) / 1e3; };
-      std::cerr << fmt::format("plant: lockstep round trip (outputs published -> command received) over {} "
-                               "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
-                               round_trip_ns.size(), pct(0.5), pct(0.99), pct(1.0));
+      std::cerr << fmt::format(
+          "plant: lockstep round trip (outputs published -> command received) over {} "
+          "control periods: p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us\n",
+          round_trip_ns.size(), pct(0.5), pct(0.99), pct(1.0));
       stats["roundtrip_us_p50"] = pct(0.5);
       stats["roundtrip_us_p99"] = pct(0.99);
       stats["roundtrip_us_max"] = pct(1.0);
@@ -246,18 +251,20 @@ class PlantProcess {
     const sim::Tick asked = sc_.simulation.duration_ticks;
     const sim::Tick completed = realtime_ ? realtime_->ticks_run() : lockstep_ ? lockstep_->ticks_run() : asked;
     const double sim_s = clock_.seconds(std::min(completed, asked));
-    std::cerr << fmt::format("plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
-                             "rejected {}, clamped {}, stale {}\n",
-                             sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected,
-                             st.commands_clamped, st.commands_stale);
+    std::cerr << fmt::format(
+        "plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
+        "rejected {}, clamped {}, stale {}\n",
+        sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected, st.commands_clamped,
+        st.commands_stale);
     std::cerr << fmt::format("plant: watchdog ({:g} s, policy {}) took over {} times for {} ticks\n",
                              clock_.seconds(plant_.options().watchdog_ticks),
                              sim::to_string(plant_.options().watchdog_policy), st.watchdog_trips, st.watchdog_ticks);
     if (realtime_) {
-      std::cerr << fmt::format("plant: real-time pacing: {} ticks in {:.3f} s wall ({:.1f} ticks/s), max lateness "
-                               "{:.1f} ms, {} ticks more than one period late\n",
-                               realtime_->ticks_run(), wall_s, static_cast<double>(realtime_->ticks_run()) / wall_s,
-                               static_cast<double>(realtime_->max_late_ns()) / 1e6, realtime_->late_ticks());
+      std::cerr << fmt::format(
+          "plant: real-time pacing: {} ticks in {:.3f} s wall ({:.1f} ticks/s), max lateness "
+          "{:.1f} ms, {} ticks more than one period late\n",
+          realtime_->ticks_run(), wall_s, static_cast<double>(realtime_->ticks_run()) / wall_s,
+          static_cast<double>(realtime_->max_late_ns()) / 1e6, realtime_->late_ticks());
     }
     stats["simulated_s"] = sim_s;
     stats["wall_s"] = wall_s;
@@ -306,9 +313,10 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
   plant_cmd->add_option("--record", plant.one_vehicle.record, "one vehicle: write the trajectory CSV here");
   plant_cmd->add_option("--mcap", plant.one_vehicle.mcap,
                         "one vehicle: record the topics as MCAP here (metadata.yaml beside it)");
-  plant_cmd->add_option("--timeout", plant.timeout_s,
-                        "lockstep: wait for the controller / a command; real time: for the controller "
-                        "(--wait-for-controller) and each --schedule-via answer [s]")
+  plant_cmd
+      ->add_option("--timeout", plant.timeout_s,
+                   "lockstep: wait for the controller / a command; real time: for the controller "
+                   "(--wait-for-controller) and each --schedule-via answer [s]")
       ->check(CLI::Range(0.01, 3600.0));
   plant_cmd->add_option("--schedule-via", plant.one_vehicle.schedule_node,
                         "one vehicle: apply the scenario's schedule through this node's parameter services");
@@ -316,35 +324,40 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
                       "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
   plant_cmd->add_option("--swarm-out", plant.swarm.out, "with --vehicles: write summary.json, vehicles.csv here");
-  plant_cmd->add_option("--on-timeout", plant.lockstep_only.on_timeout, "lockstep: abort (exit 4) or hold the last command")
+  plant_cmd
+      ->add_option("--on-timeout", plant.lockstep_only.on_timeout, "lockstep: abort (exit 4) or hold the last command")
       ->check(CLI::IsMember({"abort", "hold"}));
-  plant_cmd->add_option("--watchdog", plant.watchdog_s,
-                        "no valid motor command for this long [s] -> the watchdog policy (0: off; "
-                        "default: the scenario's simulation.watchdog_s, 0.5)")
+  plant_cmd
+      ->add_option("--watchdog", plant.watchdog_s,
+                   "no valid motor command for this long [s] -> the watchdog policy (0: off; "
+                   "default: the scenario's simulation.watchdog_s, 0.5)")
       ->check(CLI::Range(0.0, 1e6));
-  plant_cmd->add_option("--watchdog-policy", plant.watchdog_policy,
-                        "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
+  plant_cmd
+      ->add_option("--watchdog-policy", plant.watchdog_policy,
+                   "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
       ->check(CLI::IsMember({"hold", "stop"}));
 
   add_enclave_option(plant_cmd, plant.enclave);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   plant_cmd->parse_complete_callback([plant_cmd, &plant] {
     const bool swarm = plant.swarm.vehicles > 0, realtime = !plant.lockstep;
-    refuse_idle_flags(*plant_cmd, {
-        {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
-        {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
-        {"--record", !swarm, "--vehicles; a swarm records with --swarm-out"},
-        {"--mcap", !swarm, "--vehicles; a swarm records with --swarm-out"},
-        {"--schedule-via", !swarm, "--vehicles; each vehicle's controller applies the schedule"},
-        {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
-        {"--threads", swarm, "one vehicle; it needs --vehicles N"},
-        {"--swarm-out", swarm, "one vehicle; it needs --vehicles N"},
-        {"--rate-factor", realtime, "lockstep; it needs --realtime"},
-        {"--wait-for-controller", realtime, "lockstep; it needs --realtime (lockstep always waits)"},
-        {"--on-timeout", !realtime, "--realtime; it is the lockstep timeout's policy"},
-        {"--timeout", !realtime || plant.realtime.wait_for_controller || !plant.one_vehicle.schedule_node.empty(),
-         "--realtime alone; it needs lockstep, --wait-for-controller or --schedule-via"},
-    });
+    refuse_idle_flags(
+        *plant_cmd,
+        {
+            {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
+            {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
+            {"--record", !swarm, "--vehicles; a swarm records with --swarm-out"},
+            {"--mcap", !swarm, "--vehicles; a swarm records with --swarm-out"},
+            {"--schedule-via", !swarm, "--vehicles; each vehicle's controller applies the schedule"},
+            {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
+            {"--threads", swarm, "one vehicle; it needs --vehicles N"},
+            {"--swarm-out", swarm, "one vehicle; it needs --vehicles N"},
+            {"--rate-factor", realtime, "lockstep; it needs --realtime"},
+            {"--wait-for-controller", realtime, "lockstep; it needs --realtime (lockstep always waits)"},
+            {"--on-timeout", !realtime, "--realtime; it is the lockstep timeout's policy"},
+            {"--timeout", !realtime || plant.realtime.wait_for_controller || !plant.one_vehicle.schedule_node.empty(),
+             "--realtime alone; it needs lockstep, --wait-for-controller or --schedule-via"},
+        });
   });
   return plant_cmd;
 }
@@ -367,8 +380,7 @@ int plant_command(const PlantCommandOptions& o) {
         o.watchdog_policy == "hold" ? sim::WatchdogPolicy::kHold : sim::WatchdogPolicy::kStop;
   }
   if (o.duration_s >= 0.0) {
-    sc.simulation.duration_ticks =
-        static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
+    sc.simulation.duration_ticks = static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
   }
   if (o.swarm.vehicles > 0) return swarm_plant_command(o, std::move(sc));
   PlantProcess process(o, std::move(sc));

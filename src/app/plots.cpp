@@ -1,7 +1,7 @@
 // The Python tools (tools/*.py: plots, report, comparison) run with Debian's /usr/bin/python3,
 // where python3-matplotlib lives.
-#include <CLI/CLI.hpp>
 #include <sys/wait.h>
+#include <CLI/CLI.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -71,15 +71,18 @@ std::string check_run_dir(const std::string& what, const std::string& dir) {
 }  // namespace
 
 CLI::App* add_plot_subcommand(CLI::App& app, PlotOptions& plot) {
-  auto* plot_cmd = app.add_subcommand("plot", "regenerate a run directory's figures and report.html (the figures a "
-                                              "previous plot wrote there are removed first)");
+  auto* plot_cmd = app.add_subcommand("plot",
+                                      "regenerate a run directory's figures and report.html (the figures a "
+                                      "previous plot wrote there are removed first)");
   plot_cmd->add_option("run_dir", plot.run_dir, "run directory (trajectory.csv, metrics.json)")
-      ->required()->check(CLI::ExistingDirectory);
+      ->required()
+      ->check(CLI::ExistingDirectory);
   return plot_cmd;
 }
 
 CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& compare) {
-  auto* cmp_cmd = app.add_subcommand("compare", "overlay two runs (e.g. two gain sets) and tabulate their step figures");
+  auto* cmp_cmd =
+      app.add_subcommand("compare", "overlay two runs (e.g. two gain sets) and tabulate their step figures");
   cmp_cmd->add_option("run_a", compare.run_a, "first run directory")->required()->check(CLI::ExistingDirectory);
   cmp_cmd->add_option("run_b", compare.run_b, "second run directory")->required()->check(CLI::ExistingDirectory);
   cmp_cmd->add_option("--out", compare.out,

@@ -1,6 +1,6 @@
 // `quadcosim record`: like `ros2 bag record`, for runs where quadcosim is only one side.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <filesystem>
@@ -34,9 +34,9 @@ int record_command(const RecordOptions& o) {
     return exit_code::kBadInput;
   }
   const sim::Topics topics = sim::Topics::for_namespace(o.ns);
-  const std::vector<std::string> known = {topics.clock, topics.pose, topics.velocity, topics.imu,
-                                          topics.controller_status, topics.plant_status,
-                                          topics.motor_commands};
+  const std::vector<std::string> known = {
+      topics.clock,        topics.pose,          topics.velocity, topics.imu, topics.controller_status,
+      topics.plant_status, topics.motor_commands};
   for (const auto& t : o.topics) {
     if (std::find(known.begin(), known.end(), t) == known.end()) {
       std::string list;
@@ -49,8 +49,8 @@ int record_command(const RecordOptions& o) {
   if (!parent.empty()) std::filesystem::create_directories(parent);  // a bag folder, as ros2 bag makes
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   io::McapRecorder recorder(o.out, transport, topics, o.topics);
-  std::cerr << fmt::format("record: domain {}, writing {} (Ctrl-C to stop)\n",
-                           transport.participant().domain_id(), o.out);
+  std::cerr << fmt::format("record: domain {}, writing {} (Ctrl-C to stop)\n", transport.participant().domain_id(),
+                           o.out);
   const auto start = std::chrono::steady_clock::now();
   while (!stop_requested()) {
     if (o.duration_s >= 0 &&

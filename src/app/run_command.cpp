@@ -1,6 +1,6 @@
 // `quadcosim run SCENARIO --out DIR`
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <stdlib.h>
 #include <unistd.h>
@@ -37,16 +37,14 @@ struct Interrupted {};
 class Progress {
  public:
   explicit Progress(double total_s)
-      : total_s_(total_s), tty_(isatty(STDERR_FILENO) == 1), start_(std::chrono::steady_clock::now()),
-        last_(start_) {}
+      : total_s_(total_s), tty_(isatty(STDERR_FILENO) == 1), start_(std::chrono::steady_clock::now()), last_(start_) {}
   void update(double t_s) {
     if (!tty_) return;
     const auto now = std::chrono::steady_clock::now();
     if (now - last_ < std::chrono::milliseconds(200) || now - start_ < std::chrono::milliseconds(500)) return;
     last_ = now;
     const double wall = std::chrono::duration<double>(now - start_).count();
-    std::cerr << fmt::format("\r  t = {:.1f} / {:.1f} s simulated ({:.0f}x real time)   ", t_s, total_s_,
-                             t_s / wall)
+    std::cerr << fmt::format("\r  t = {:.1f} / {:.1f} s simulated ({:.0f}x real time)   ", t_s, total_s_, t_s / wall)
               << std::flush;
     shown_ = true;
   }
@@ -71,8 +69,8 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
   // parameter services, each change before its tick; in real time the controller applies it itself.
   std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario};
   const std::string mcap_path = (std::filesystem::path(csv_path).parent_path() / "run.mcap").string();
-  std::vector<std::string> plant_args = {self, "plant", "--scenario", opt.scenario, "--record", csv_path,
-                                         "--mcap", mcap_path, "--timeout", timeout};
+  std::vector<std::string> plant_args = {self,     "plant",  "--scenario", opt.scenario, "--record",
+                                         csv_path, "--mcap", mcap_path,    "--timeout",  timeout};
   if (!opt.realtime) {
     controller_args.push_back("--no-schedule");
     for (std::string a : {"--schedule-via", "/attitude_controller"}) plant_args.push_back(a);
@@ -110,8 +108,9 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
                     "--out holds a previous command's outputs or other files: remove exactly the outputs its "
                     "manifest lists first (files quadcosim did not write are kept)");
   run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots and report.html");
-  run_cmd->add_option("--transport", run.transport,
-                      "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
+  run_cmd
+      ->add_option("--transport", run.transport,
+                   "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
       ->check(CLI::IsMember({"inproc", "dds"}));
   run_cmd->add_option("--timeout", run.timeout_s, "dds: lockstep wait for a command [s]")
       ->check(CLI::Range(0.01, 3600.0));
@@ -123,21 +122,24 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
   run_cmd->add_flag("--realtime", run.realtime, "dds: pace by the wall clock, as in the paper, not lockstep");
   run_cmd->add_option("--rate-factor", run.rate_factor, "dds real time: run k times faster")
       ->check(CLI::Range(1e-3, 1e6));
-  run_cmd->add_option("--vehicles", run.vehicles, "a swarm of N vehicles on a grid (default: the scenario's swarm section)")
+  run_cmd
+      ->add_option("--vehicles", run.vehicles,
+                   "a swarm of N vehicles on a grid (default: the scenario's swarm section)")
       ->check(CLI::Range(1, 10'000'000));
   run_cmd->add_option("--threads", run.threads, "in-process swarm: worker threads (default: swarm.threads, 2)")
       ->check(CLI::Range(1, 64));
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   run_cmd->parse_complete_callback([run_cmd, &run] {
     const bool dds = run.transport == "dds";
-    refuse_idle_flags(*run_cmd, {
-        {"--realtime", dds, "--transport inproc; it needs --transport dds"},
-        {"--pin", dds, "--transport inproc; it needs --transport dds"},
-        {"--timeout", dds, "--transport inproc; it needs --transport dds"},
-        {"--keystore", dds, "--transport inproc; it needs --transport dds"},
-        {"--rate-factor", dds && run.realtime, "lockstep; it needs --transport dds --realtime"},
-        {"--threads", !dds, "--transport dds; it sets the in-process swarm's threads"},
-    });
+    refuse_idle_flags(*run_cmd,
+                      {
+                          {"--realtime", dds, "--transport inproc; it needs --transport dds"},
+                          {"--pin", dds, "--transport inproc; it needs --transport dds"},
+                          {"--timeout", dds, "--transport inproc; it needs --transport dds"},
+                          {"--keystore", dds, "--transport inproc; it needs --transport dds"},
+                          {"--rate-factor", dds && run.realtime, "lockstep; it needs --transport dds --realtime"},
+                          {"--threads", !dds, "--transport dds; it sets the in-process swarm's threads"},
+                      });
   });
   return run_cmd;
 }
@@ -146,7 +148,8 @@ int run_command(const RunOptions& opt) {
   const io::Scenario sc = io::load_scenario(opt.scenario);
 
   if (opt.transport == "dds" && sc.simulation.faults.active() && !(opt.vehicles > 0 || sc.swarm)) {
-    std::cerr << "error: " << opt.scenario << ": message_faults: message loss and delay are injected by the "
+    std::cerr << "error: " << opt.scenario
+              << ": message_faults: message loss and delay are injected by the "
                  "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
     return exit_code::kBadInput;
   }
@@ -175,11 +178,12 @@ int run_command(const RunOptions& opt) {
           const sim::PlantNode& plant = simulation.plant();
           if (plant.watchdog_active() != watchdog) {
             watchdog = plant.watchdog_active();
-            std::cerr << (watchdog ? fmt::format("run: plant watchdog: no valid motor command for {:g} s at t = {:g} s; "
-                                                 "policy {}\n",
-                                                 static_cast<double>(plant.command_age_ns()) / 1e9, r.t_s,
-                                                 sim::to_string(plant.options().watchdog_policy))
-                                   : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
+            std::cerr << (watchdog
+                              ? fmt::format("run: plant watchdog: no valid motor command for {:g} s at t = {:g} s; "
+                                            "policy {}\n",
+                                            static_cast<double>(plant.command_age_ns()) / 1e9, r.t_s,
+                                            sim::to_string(plant.options().watchdog_policy))
+                              : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
           }
           csv.write(r.t_s, r.state, r.latched_command, c, watchdog);
           mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
@@ -227,7 +231,8 @@ int run_command(const RunOptions& opt) {
     if (saturation) {
       if (const std::string w = io::saturation_warning(*saturation); !w.empty()) std::cerr << "run: " << w << '\n';
     }
-    std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
+    std::cout << "wrote " << (out / "trajectory.csv").string()
+              << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
     return io::passed_overall(results, hold, saturation) ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {

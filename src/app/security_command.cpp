@@ -1,8 +1,8 @@
 // `quadcosim security create-keystore|create-enclave|check`: an SROS2-compatible DDS Security keystore
 // (security/keystore.hpp), and the --enclave option every DDS command takes.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <CLI/CLI.hpp>
 
 #include <iostream>
 
@@ -27,9 +27,10 @@ std::uint32_t domain_or_env(int domain_id) {
 }  // namespace
 
 void add_enclave_option(CLI::App* command, std::string& enclave) {
-  command->add_option("--enclave", enclave,
-                      "security enclave, as `--ros-args --enclave` (default /; files from "
-                      "$ROS_SECURITY_KEYSTORE/enclaves/<name> when ROS_SECURITY_ENABLE=true)")
+  command
+      ->add_option("--enclave", enclave,
+                   "security enclave, as `--ros-args --enclave` (default /; files from "
+                   "$ROS_SECURITY_KEYSTORE/enclaves/<name> when ROS_SECURITY_ENABLE=true)")
       ->check(CLI::Validator(check_enclave_name, "ENCLAVE"));
 }
 
@@ -41,13 +42,14 @@ CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& o) {
         ->check(CLI::Range(0, 232));
   };
 
-  auto* ks = sec->add_subcommand("create-keystore", "a new keystore: CA, governance (as `ros2 security create_keystore`)");
+  auto* ks =
+      sec->add_subcommand("create-keystore", "a new keystore: CA, governance (as `ros2 security create_keystore`)");
   ks->add_option("dir", o.dir, "keystore directory (created when missing)")->required();
   domain(ks);
   ks->callback([&o] { o.verb = "create-keystore"; });
 
-  auto* en = sec->add_subcommand("create-enclave",
-                                 "an enclave: identity, permissions (as `ros2 security create_enclave`)");
+  auto* en =
+      sec->add_subcommand("create-enclave", "an enclave: identity, permissions (as `ros2 security create_enclave`)");
   en->add_option("dir", o.dir, "keystore directory")->required()->check(CLI::ExistingDirectory);
   en->add_option("name", o.name, "enclave name, e.g. /quadcosim/plant")
       ->required()
@@ -76,8 +78,9 @@ int security_command(const SecurityOptions& o) {
     policy.deny_publish = o.deny_publish;
     policy.domain_id = domain_or_env(o.domain_id);
     const fs::path dir = security::create_enclave(o.dir, o.name, policy);
-    std::cout << fmt::format("created enclave {} in {} (domain {}{})\n", o.name, dir.string(), policy.domain_id,
-                             o.deny_publish.empty() ? "" : fmt::format(", may not publish {}", fmt::join(o.deny_publish, " ")));
+    std::cout << fmt::format(
+        "created enclave {} in {} (domain {}{})\n", o.name, dir.string(), policy.domain_id,
+        o.deny_publish.empty() ? "" : fmt::format(", may not publish {}", fmt::join(o.deny_publish, " ")));
     return exit_code::kOk;
   }
   if (o.verb == "check") {

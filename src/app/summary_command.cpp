@@ -1,6 +1,6 @@
 // `quadcosim summary RUN_DIR... [--out FILE.md]`: our step figures beside the reference ones.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -13,9 +13,7 @@
 namespace quadcosim::app {
 
 namespace {
-std::string num(const nlohmann::json& v) {
-  return v.is_number() ? fmt::format("{:.2f}", v.get<double>()) : "-";
-}
+std::string num(const nlohmann::json& v) { return v.is_number() ? fmt::format("{:.2f}", v.get<double>()) : "-"; }
 std::string band(const nlohmann::json& criteria, const std::string& fig) {
   for (const auto& c : criteria) {
     if (c.value("figure", "") != fig) continue;
@@ -37,10 +35,11 @@ CLI::App* add_summary_subcommand(CLI::App& app, SummaryOptions& sum) {
 }
 
 int summary_command(const SummaryOptions& opt) {
-  const std::vector<std::pair<std::string, std::string>> figs = {
-      {"overshoot_pct", "overshoot %"},     {"peak_time_s", "peak s"},
-      {"t95_s", "95 % s"},                  {"settling_time_2pct_s", "2 % settling s"},
-      {"steady_state_error_pct", "error %"}};
+  const std::vector<std::pair<std::string, std::string>> figs = {{"overshoot_pct", "overshoot %"},
+                                                                 {"peak_time_s", "peak s"},
+                                                                 {"t95_s", "95 % s"},
+                                                                 {"settling_time_2pct_s", "2 % settling s"},
+                                                                 {"steady_state_error_pct", "error %"}};
   std::string md = "| run | step | figure | ours | reference | accepted | verdict |\n|---|---|---|---|---|---|---|\n";
   bool all_ok = true;
   for (const auto& dir : opt.run_dirs) {
@@ -55,8 +54,8 @@ int summary_command(const SummaryOptions& opt) {
       return exit_code::kBadInput;
     }
     for (const auto& s : j.value("steps", nlohmann::json::array())) {
-      const std::string step = fmt::format("{} {:g} → {:g}", s.value("channel", "?"),
-                                           s.value("initial", 0.0), s.value("target", 0.0));
+      const std::string step =
+          fmt::format("{} {:g} → {:g}", s.value("channel", "?"), s.value("initial", 0.0), s.value("target", 0.0));
       const auto ref = s.value("reference", nlohmann::json::object());
       for (const auto& [key, label] : figs) {
         const std::string accepted = band(s["criteria"], key);

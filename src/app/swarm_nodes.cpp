@@ -19,9 +19,9 @@
 #include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/node_announcer.hpp"
-#include "io/trajectory_csv.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
+#include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/plant_node.hpp"
 
@@ -148,9 +148,9 @@ class PlantShard {
     h.after_latch = [this](std::size_t i, sim::Tick k) {
       Vehicle& v = *vehicles_[i];
       if (!v.csv) return;
-      v.csv->write(clock_.seconds(k), v.plant->state(), v.plant->latched_command(),
-                   v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status)
-                                                      : io::ControlColumns::none());
+      v.csv->write(
+          clock_.seconds(k), v.plant->state(), v.plant->latched_command(),
+          v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status) : io::ControlColumns::none());
     };
     h.on_timeout = [&](std::size_t i, sim::Tick k) {
       std::cerr << lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
@@ -259,16 +259,15 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   std::vector<std::unique_ptr<PlantShard>> shards(static_cast<std::size_t>(threads));
   // Participants are created one after the other (Cyclone's domain setup is not worth racing).
   for (int t = 0; t < threads; ++t) {
-    shards[static_cast<std::size_t>(t)] =
-        std::make_unique<PlantShard>(sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm.out),
-                                     o.sensor_qos, o.enclave);
+    shards[static_cast<std::size_t>(t)] = std::make_unique<PlantShard>(
+        sc, spec, n * t / threads, n * (t + 1) / threads, recorded, fs::path(o.swarm.out), o.sensor_qos, o.enclave);
   }
   std::cerr << fmt::format("plant: {} vehicles ({}...), {} thread(s), lockstep, {} ticks of {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads, sc.simulation.duration_ticks,
                            sc.simulation.plant.clock.period_s());
   const int rc = run_threads(threads, [&](int t) {
-    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, o.lockstep_only.on_timeout, sc.simulation.controller_divider,
-                                                    sc.simulation.duration_ticks);
+    return shards[static_cast<std::size_t>(t)]->run(o.timeout_s, o.lockstep_only.on_timeout,
+                                                    sc.simulation.controller_divider, sc.simulation.duration_ticks);
   });
   if (rc != exit_code::kOk) return rc;
   std::int64_t wall_ns = 0;
@@ -278,7 +277,8 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   std::cerr << fmt::format("plant: done; {} vehicles, {:g} s simulated in {:.3f} s ({:.2f}x real time)\n", n, sim_s,
                            wall_s, sim_s / wall_s);
   if (!o.stats.empty()) {
-    write_stats(o.stats, {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
+    write_stats(o.stats,
+                {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
   }
   if (!o.swarm.out.empty()) {
     std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
@@ -286,7 +286,8 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
     const model::State initial = io::initial_state(sc);
     for (int t = 0; t < threads; ++t) {
       for (int i = n * t / threads; i < n * (t + 1) / threads; ++i) {
-        const sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
+        const sim::SwarmVehicle v =
+            sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
         SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
         // The setpoint at the end: the vehicle's initial one with its whole schedule applied.
         control::ControllerConfig c = v.controller;
@@ -296,9 +297,9 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
       }
     }
-    write_swarm_summary(o.swarm.out, sc, spec, namespaces, rows,
-                        {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s},
-                         {"real_time_factor", sim_s / wall_s}});
+    write_swarm_summary(
+        o.swarm.out, sc, spec, namespaces, rows,
+        {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
   }
   return exit_code::kOk;
 }
@@ -311,15 +312,13 @@ int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc)
   const std::int64_t period_ns = sc.simulation.plant.clock.period_ns * sc.simulation.controller_divider;
   std::vector<std::unique_ptr<ControllerShard>> shards;
   for (int t = 0; t < threads; ++t) {
-    shards.push_back(std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads, o.sensor_qos,
-                                                       o.enclave));
+    shards.push_back(
+        std::make_unique<ControllerShard>(sc, spec, n * t / threads, n * (t + 1) / threads, o.sensor_qos, o.enclave));
   }
   std::cerr << fmt::format("controller: {} vehicles ({}...), {} thread(s), lockstep, period {} s\n", n,
                            sim::vehicle_namespace(spec.layout.ns_prefix, 0, n), threads,
                            static_cast<double>(period_ns) / 1e9);
-  const int rc = run_threads(threads, [&](int t) {
-    return shards[static_cast<std::size_t>(t)]->run();
-  });
+  const int rc = run_threads(threads, [&](int t) { return shards[static_cast<std::size_t>(t)]->run(); });
   std::cerr << "controller: stopped\n";
   return rc;
 }

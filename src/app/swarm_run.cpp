@@ -106,9 +106,10 @@ void write_swarm_summary(const fs::path& out, const io::Scenario& sc, const io::
   j["vehicles_non_finite"] = non_finite;
   j["recorded_vehicles"] = spec.record_vehicles;
   std::ofstream(out / "summary.json") << j.dump(2) << '\n';
-  std::cout << fmt::format("swarm: {} vehicles, final position error mean {:.3g} m, p99 {:.3g} m, max {:.3g} m; "
-                           "{} in safety\n",
-                           rows.size(), mean, pct(0.99), sorted.back(), safety);
+  std::cout << fmt::format(
+      "swarm: {} vehicles, final position error mean {:.3g} m, p99 {:.3g} m, max {:.3g} m; "
+      "{} in safety\n",
+      rows.size(), mean, pct(0.99), sorted.back(), safety);
 }
 
 int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out, io::OutputFolder& folder) {
@@ -123,10 +124,12 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
   if (opt.transport == "dds") {
     // The plant process records; the controller process answers.
     const std::string self = self_executable();
-    std::vector<std::string> plant_args = {self, "plant", "--scenario", opt.scenario, "--vehicles", std::to_string(n),
-                                           "--timeout", fmt::format("{}", opt.timeout_s), "--swarm-out", out.string()};
-    std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario, "--vehicles",
-                                                std::to_string(n)};
+    std::vector<std::string> plant_args = {
+        self,          "plant",           "--scenario", opt.scenario,
+        "--vehicles",  std::to_string(n), "--timeout",  fmt::format("{}", opt.timeout_s),
+        "--swarm-out", out.string()};
+    std::vector<std::string> controller_args = {self,         "controller", "--scenario",
+                                                opt.scenario, "--vehicles", std::to_string(n)};
     if (opt.pin) pin_apart(plant_args, controller_args);
     install_stop_handlers();
     if (const int rc = run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;
@@ -141,7 +144,8 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     }
     const auto start = std::chrono::steady_clock::now();
     swarm.run(spec.threads, kSwarmBlockTicks, recorded, [&](int i, const sim::TickRecord& r) {
-      writers[static_cast<std::size_t>(i)]->write(r.t_s, r.state, r.latched_command, io::ControlColumns::from(r.status));
+      writers[static_cast<std::size_t>(i)]->write(r.t_s, r.state, r.latched_command,
+                                                  io::ControlColumns::from(r.status));
     });
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (auto& w : writers) {
@@ -165,8 +169,8 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
                          {"block_ticks", kSwarmBlockTicks},
                          {"wall_s", wall_s},
                          {"real_time_factor", sim_s / wall_s}});
-    std::cout << fmt::format("swarm: {:g} s simulated in {:.3f} s ({:.1f}x real time, {} threads)\n", sim_s,
-                             wall_s, sim_s / wall_s, spec.threads);
+    std::cout << fmt::format("swarm: {:g} s simulated in {:.3f} s ({:.1f}x real time, {} threads)\n", sim_s, wall_s,
+                             sim_s / wall_s, spec.threads);
   }
   const nlohmann::json recorded = judge_recorded(out, sc, spec.record_vehicles, dirs);
   const bool pass =

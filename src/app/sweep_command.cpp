@@ -32,7 +32,8 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
                     runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
   int failed_runs = 0;
   for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
-  if (failed_runs > 0) os << fmt::format("  {} runs could not be flown (their error is in summary.json)\n", failed_runs);
+  if (failed_runs > 0)
+    os << fmt::format("  {} runs could not be flown (their error is in summary.json)\n", failed_runs);
   os << fmt::format("  {:<36} {:>6} {:>7}  {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "figure", "count", "missing",
                     "mean", "std", "min", "p50", "p95", "max");
   for (const auto& [name, d] : j["figures"].items()) {
@@ -41,15 +42,15 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
       os << fmt::format("  {:<36} {:>6} {:>7}  (no run has this figure)\n", name, count, missing);
       continue;
     }
-    os << fmt::format("  {:<36} {:>6} {:>7}  {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g}\n", name, count,
-                      missing, d["mean"].get<double>(), d["std"].get<double>(), d["min"].get<double>(),
+    os << fmt::format("  {:<36} {:>6} {:>7}  {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g}\n", name,
+                      count, missing, d["mean"].get<double>(), d["std"].get<double>(), d["min"].get<double>(),
                       d["p50"].get<double>(), d["p95"].get<double>(), d["max"].get<double>());
   }
 }
 
 int verdict(const nlohmann::json& j, double min_pass_rate) {
   return j["passed"].get<int>() >= sweep::passes_needed(min_pass_rate, j["runs"].get<int>()) ? exit_code::kOk
-                                                                                              : exit_code::kFailed;
+                                                                                             : exit_code::kFailed;
 }
 
 bool parse_shard(const std::string& text, int& k, int& n) {
@@ -87,7 +88,8 @@ int rerun_command(const SweepOptions& o) {
     std::cout << fmt::format("sweep run {} (seed {}):", o.rerun_index, r.sample.seed);
     for (const auto& [k, v] : r.sample.values) std::cout << fmt::format(" {}={}", k, v);
     std::cout << '\n' << txt.rdbuf();
-    std::cout << "wrote " << (out / "trajectory.csv").string() << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
+    std::cout << "wrote " << (out / "trajectory.csv").string()
+              << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (o.plots && !make_plots(o.out_dir, folder)) return exit_code::kOutput;
     return r.passed ? exit_code::kOk : exit_code::kFailed;
   });
@@ -167,14 +169,16 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   r->add_option("dir", o.sweep_dir, "sweep folder (summary.json or shard.json, scenario.yaml)")->required();
   r->add_option("index", o.rerun_index, "run index")->required();
   r->add_option("--out", o.out_dir, "run folder: new or empty (created when missing)")->required();
-  r->add_flag("--force", o.force, "--out is not empty: remove the outputs its manifest lists first (other files are kept)");
+  r->add_flag("--force", o.force,
+              "--out is not empty: remove the outputs its manifest lists first (other files are kept)");
   r->add_flag("!--no-plots", o.plots, "skip the plots and report");
   r->callback([&o] { o.mode = "rerun"; });
 
   auto* m = c->add_subcommand("merge", "join the shards of a sweep into one summary.json");
   m->add_option("out", o.out_dir, "output folder: new or empty (created when missing)")->required();
   m->add_option("dirs", o.shard_dirs, "shard folders (each with shard.json)")->required();
-  m->add_flag("--force", o.force, "OUT is not empty: remove the outputs its manifest lists first (other files are kept)");
+  m->add_flag("--force", o.force,
+              "OUT is not empty: remove the outputs its manifest lists first (other files are kept)");
   m->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
   m->add_flag("!--no-plots", o.plots, "skip the plots");
@@ -208,7 +212,9 @@ int sweep_command(const SweepOptions& o) {
   io::OutputFolder folder = io::OutputFolder::claim(out, "sweep", {.force = o.force}, std::cerr);
   fs::create_directories(out / "runs");
   fs::copy_file(o.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
-  const sweep::Keep keep = o.keep == "all" ? sweep::Keep::kAll : o.keep == "failing" ? sweep::Keep::kFailing : sweep::Keep::kNone;
+  const sweep::Keep keep = o.keep == "all"       ? sweep::Keep::kAll
+                           : o.keep == "failing" ? sweep::Keep::kFailing
+                                                 : sweep::Keep::kNone;
   const std::vector<int> indices = sweep::shard_indices(plan.runs, shard, shards);
   const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep);
 
@@ -226,10 +232,10 @@ int sweep_command(const SweepOptions& o) {
     for (const auto& r : results) passed += r.passed ? 1 : 0;
     nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
     sweep::write_json(out / "shard.json", j);
-    std::cout << fmt::format("sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
-                             "join the shards with `quadcosim sweep merge OUT DIR...`\n",
-                             plan.nominal.name, o.shard, results.size(), plan.runs, passed,
-                             (out / "shard.json").string());
+    std::cout << fmt::format(
+        "sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
+        "join the shards with `quadcosim sweep merge OUT DIR...`\n",
+        plan.nominal.name, o.shard, results.size(), plan.runs, passed, (out / "shard.json").string());
     return exit_code::kOk;
   }
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));

@@ -1,8 +1,8 @@
 // `quadcosim topic list|echo|hz`: a look at the ROS 2 graph without ROS 2 installed. Topics and their
 // types come from DDS discovery (dds/graph.hpp); echo and hz subscribe through DdsTransport, so they
 // decode the message types quadcosim itself speaks.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <functional>
@@ -35,17 +35,17 @@ using Subscriber = std::function<void(dds::DdsTransport&, const std::string& top
 
 template <class T>
 std::pair<const std::string, Subscriber> entry() {
-  return {std::string(T::kRosType), [](dds::DdsTransport& t, const std::string& topic,
-                                       std::function<void(const std::string&)> sink) {
+  return {std::string(T::kRosType),
+          [](dds::DdsTransport& t, const std::string& topic, std::function<void(const std::string&)> sink) {
             t.subscribe<T>(topic, [sink = std::move(sink)](const T& m) { sink(dds::to_yaml(m)); });
           }};
 }
 
 const std::map<std::string, Subscriber>& known_types() {
-  static const std::map<std::string, Subscriber> table = {
-      entry<msg::PoseStamped>(), entry<msg::TwistStamped>(), entry<msg::Imu>(),
-      entry<msg::Float64MultiArray>(), entry<msg::Clock>(), entry<msg::ControllerStatus>(),
-      entry<msg::PlantStatus>()};
+  static const std::map<std::string, Subscriber> table = {entry<msg::PoseStamped>(), entry<msg::TwistStamped>(),
+                                                          entry<msg::Imu>(),         entry<msg::Float64MultiArray>(),
+                                                          entry<msg::Clock>(),       entry<msg::ControllerStatus>(),
+                                                          entry<msg::PlantStatus>()};
   return table;
 }
 
@@ -73,9 +73,10 @@ dds::RosTopic find_topic(dds::DdsTransport& transport, const std::string& topic,
                                                  [&](const auto& e) { return find(e).has_value(); });
   const auto found = find(endpoints);
   if (!found) {
-    throw TopicError(fmt::format("topic {} not found on ROS_DOMAIN_ID {} within {} s (no publisher or "
-                                 "subscription seen); `quadcosim topic list` shows what is there",
-                                 topic, transport.participant().domain_id(), wait_s));
+    throw TopicError(
+        fmt::format("topic {} not found on ROS_DOMAIN_ID {} within {} s (no publisher or "
+                    "subscription seen); `quadcosim topic list` shows what is there",
+                    topic, transport.participant().domain_id(), wait_s));
   }
   if (found->types.size() != 1) {
     throw TopicError(fmt::format("topic {} has more than one type: {}", topic, fmt::join(found->types, ", ")));
@@ -110,8 +111,10 @@ int topic_echo(const TopicOptions& o) {
   const dds::RosTopic found = find_topic(transport, topic, o.wait_s);
   const dds::QosProfile qos = qos_named(o.qos);
   if (qos.reliable && found.publishers > 0 && found.best_effort_publishers == found.publishers) {
-    std::cerr << fmt::format("note: every publisher of {} is best effort, which a reliable reader does not "
-                             "match; use --qos sensor\n", topic);
+    std::cerr << fmt::format(
+        "note: every publisher of {} is best effort, which a reliable reader does not "
+        "match; use --qos sensor\n",
+        topic);
   }
   transport.set_qos(topic, qos);
   int printed = 0;
@@ -188,7 +191,8 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
       ->check(CLI::Range(1, 1 << 30));
   echo->add_option("--qos", o.qos, "default: reliable (ROS default); sensor: best effort (matches any writer)")
       ->check(CLI::IsMember({"default", "sensor"}));
-  echo->add_option("--wait", o.wait_s, "how long to look for the topic [s] (default 5)")->check(CLI::Range(0.0, 3600.0));
+  echo->add_option("--wait", o.wait_s, "how long to look for the topic [s] (default 5)")
+      ->check(CLI::Range(0.0, 3600.0));
   add_enclave_option(echo, o.enclave);
   echo->callback([&o] { o.verb = "echo"; });
 

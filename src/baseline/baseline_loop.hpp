@@ -34,8 +34,7 @@ struct BaselineState {
 
 class BaselineLoop {
  public:
-  BaselineLoop(const BaselineVehicle& v, const BaselineGains& g, double z_des_m)
-      : v_(v), g_(g), z_des_m_(z_des_m) {}
+  BaselineLoop(const BaselineVehicle& v, const BaselineGains& g, double z_des_m) : v_(v), g_(g), z_des_m_(z_des_m) {}
 
   /// One 100 Hz tick; the controller runs on even ticks.
   void tick(long k, double dt_s) {
@@ -87,8 +86,8 @@ class BaselineLoop {
     const double* x = s_.x;
     const double w = x[6], qx = x[7], qy = x[8], qz = x[9];
     const double roll = std::atan2(2.0 * (w * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy));
-    const double pitch = std::atan2(2.0 * (w * qy - qx * qz),
-                                    std::hypot(1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy + w * qz)));
+    const double pitch =
+        std::atan2(2.0 * (w * qy - qx * qz), std::hypot(1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy + w * qz)));
     const double yaw = std::atan2(2.0 * (w * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
     const double angle[3] = {roll, pitch, yaw};
     double U[4];
@@ -97,8 +96,8 @@ class BaselineLoop {
     U[0] = std::max(0.0, (v_.mass_kg * v_.gravity_m_s2 + g_.kp_z * (z_des_m_ - x[2]) - g_.kd_z * x[5]) / tilt);
     const double hi = v_.omega_max_rad_s * v_.omega_max_rad_s;
     for (int r = 0; r < 4; ++r) {
-      const double d = v_.mixer_inverse[r][0] * U[0] + v_.mixer_inverse[r][1] * U[1] +
-                       v_.mixer_inverse[r][2] * U[2] + v_.mixer_inverse[r][3] * U[3];
+      const double d = v_.mixer_inverse[r][0] * U[0] + v_.mixer_inverse[r][1] * U[1] + v_.mixer_inverse[r][2] * U[2] +
+                       v_.mixer_inverse[r][3] * U[3];
       w2_[r] = std::clamp(d, 0.0, hi);  // ideal motors: the plant uses omega^2 = the command squared
       omega_[r] = std::sqrt(w2_[r]);
     }

@@ -5,8 +5,8 @@
 
 namespace quadcosim::control {
 
-Allocation allocate(const Eigen::Matrix4d& mixer_inverse, const Eigen::Vector4d& U,
-                    double omega_min_rad_s, double omega_max_rad_s) {
+Allocation allocate(const Eigen::Matrix4d& mixer_inverse, const Eigen::Vector4d& U, double omega_min_rad_s,
+                    double omega_max_rad_s) {
   const Eigen::Vector4d omega_sq = mixer_inverse * U;
   const double lo = omega_min_rad_s * omega_min_rad_s;
   const double hi = omega_max_rad_s * omega_max_rad_s;

@@ -8,9 +8,7 @@ namespace quadcosim::control {
 
 namespace {
 
-std::string dims(const Eigen::MatrixXd& M) {
-  return std::to_string(M.rows()) + "x" + std::to_string(M.cols());
-}
+std::string dims(const Eigen::MatrixXd& M) { return std::to_string(M.rows()) + "x" + std::to_string(M.cols()); }
 
 void check_inputs(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
                   const Eigen::MatrixXd& R) {
@@ -36,8 +34,8 @@ void check_inputs(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eige
 
 }  // namespace
 
-Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
-                           const Eigen::MatrixXd& Q, const Eigen::MatrixXd& R) {
+Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
+                           const Eigen::MatrixXd& R) {
   check_inputs(A, B, Q, R);
   const auto n = A.rows();
   const Eigen::MatrixXd G = B * R.llt().solve(B.transpose());
@@ -52,8 +50,9 @@ Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(Z);
     const double logdet = lu.matrixLU().diagonal().array().abs().log().sum();
     if (!std::isfinite(logdet)) {
-      throw CareError("CARE: the Hamiltonian is singular (eigenvalue on the imaginary axis); "
-                      "(A, B) is not stabilisable or (Q, A) not detectable");
+      throw CareError(
+          "CARE: the Hamiltonian is singular (eigenvalue on the imaginary axis); "
+          "(A, B) is not stabilisable or (Q, A) not detectable");
     }
     const double c = std::exp(logdet / static_cast<double>(2 * n));
     const Eigen::MatrixXd Znext = 0.5 * (Z / c + c * lu.inverse());
@@ -66,8 +65,9 @@ Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
     }
   }
   if (!converged) {
-    throw CareError("CARE: sign iteration did not converge (eigenvalues near the imaginary axis); "
-                    "(A, B) is not stabilisable or (Q, A) not detectable");
+    throw CareError(
+        "CARE: sign iteration did not converge (eigenvalues near the imaginary axis); "
+        "(A, B) is not stabilisable or (Q, A) not detectable");
   }
 
   // With W = sign(H): [W12; W22 + I] X = -[W11 + I; W21].
@@ -91,8 +91,8 @@ Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
   return X;
 }
 
-Eigen::MatrixXd lqr_gain(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
-                         const Eigen::MatrixXd& Q, const Eigen::MatrixXd& R) {
+Eigen::MatrixXd lqr_gain(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
+                         const Eigen::MatrixXd& R) {
   const Eigen::MatrixXd X = solve_care(A, B, Q, R);
   return R.llt().solve(B.transpose() * X);
 }

@@ -19,12 +19,12 @@ class CareError : public std::runtime_error {
 /// stable invariant subspace by least squares. Throws CareError when the sizes disagree, R is not
 /// positive definite, or H has eigenvalues on the imaginary axis ((A, B) not stabilisable or
 /// (Q, A) not detectable there).
-Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
-                           const Eigen::MatrixXd& Q, const Eigen::MatrixXd& R);
+Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
+                           const Eigen::MatrixXd& R);
 
 /// The LQR gain K = R^-1 B^T X for u = -K x minimising the integral of x^T Q x + u^T R u.
-Eigen::MatrixXd lqr_gain(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
-                         const Eigen::MatrixXd& Q, const Eigen::MatrixXd& R);
+Eigen::MatrixXd lqr_gain(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
+                         const Eigen::MatrixXd& R);
 
 /// Frobenius norm of the Riccati residual A^T X + X A - X B R^-1 B^T X + Q.
 double care_residual(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,

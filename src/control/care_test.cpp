@@ -223,8 +223,7 @@ struct KleinmanResult {
 // K_{k+1} = R^-1 B^T X_k. Converges monotonically (quadratically near the end) to the stabilising X.
 // Stops one iteration after the step falls below 1e-10 relative: quadratic convergence puts that
 // last iterate at the rounding floor (~1e-12 here; asking for less than the floor never ends).
-KleinmanResult kleinman(const MatrixXd& A, const MatrixXd& B, const MatrixXd& Q, const MatrixXd& R,
-                        MatrixXd K) {
+KleinmanResult kleinman(const MatrixXd& A, const MatrixXd& B, const MatrixXd& Q, const MatrixXd& R, MatrixXd K) {
   KleinmanResult out;
   MatrixXd X_prev;
   bool small_step = false;
@@ -296,8 +295,7 @@ TEST(CareRandom, ResidualDefinitenessStabilityAndKleinmanAgree) {
         ASSERT_TRUE(kl.converged) << "Kleinman stopped after " << kl.iterations << " iterations";
         // Two different O(eps cond) solutions of the same problem: observed worst 6e-10 (the same
         // nearly uncontrollable n = 7 system); bound 1e-8.
-        EXPECT_LE((kl.X - X).norm(), 1e-8 * X.norm())
-            << "Kleinman X:\n" << kl.X << "\nsolve_care X:\n" << X;
+        EXPECT_LE((kl.X - X).norm(), 1e-8 * X.norm()) << "Kleinman X:\n" << kl.X << "\nsolve_care X:\n" << X;
         ++systems;
       }
     }
@@ -309,39 +307,40 @@ TEST(CareRandom, ResidualDefinitenessStabilityAndKleinmanAgree) {
 // stabilising X exists (large, ~1/d) and must be found, not refused. K_0 = 0 already stabilises.
 TEST(CareRandom, LightlyDampedUncontrollableModeIsSolved) {
   for (double coupling : {0.0, 0.5}) {
-  for (double d : {1e-1, 1e-3}) {
-    SCOPED_TRACE(testing::Message() << "d=" << d << " coupling=" << coupling);
-    // State 3 (the controlled one) is driven by the oscillator when coupling != 0.
-    const MatrixXd A = mat(3, 3, {0, 1, 0, -1, -d, 0, coupling, 0, -1});
-    const MatrixXd B = mat(3, 1, {0, 0, 1});
-    const MatrixXd Q = MatrixXd::Identity(3, 3);
-    const MatrixXd R = scalar(1);
-    const MatrixXd X = solve_care(A, B, Q, R);
-    EXPECT_LE(riccati_residual(A, B, Q, R, X).rel_bound(), kResidualBound);
-    EXPECT_LE(riccati_residual(A, B, Q, R, X).rel(), kResidualTerms);
-    const KleinmanResult kl = kleinman(A, B, Q, R, MatrixXd::Zero(1, 3));
-    ASSERT_TRUE(kl.converged);
-    EXPECT_LE((kl.X - X).norm(), 1e-8 * X.norm());
-    if (coupling == 0.0) {
-      // Decoupled: the oscillator block is the Lyapunov solution of A11 alone, whose (1,1) entry is
-      // (2 + d^2)/(2 d) by hand (A11 = [0 1; -1 -d], Q11 = I), and the third state the scalar case
-      // a = -1, b = q = r = 1: x = sqrt(2) - 1.
-      EXPECT_NEAR(X(0, 0), (2.0 + d * d) / (2.0 * d), 1e-9 * X(0, 0));
-      EXPECT_NEAR(X(0, 1), 0.5, 1e-9 * X(0, 0));
-      EXPECT_NEAR(X(1, 1), 1.0 / d, 1e-9 * X(0, 0));
-      EXPECT_NEAR(X(2, 2), std::sqrt(2.0) - 1.0, 1e-9);
+    for (double d : {1e-1, 1e-3}) {
+      SCOPED_TRACE(testing::Message() << "d=" << d << " coupling=" << coupling);
+      // State 3 (the controlled one) is driven by the oscillator when coupling != 0.
+      const MatrixXd A = mat(3, 3, {0, 1, 0, -1, -d, 0, coupling, 0, -1});
+      const MatrixXd B = mat(3, 1, {0, 0, 1});
+      const MatrixXd Q = MatrixXd::Identity(3, 3);
+      const MatrixXd R = scalar(1);
+      const MatrixXd X = solve_care(A, B, Q, R);
+      EXPECT_LE(riccati_residual(A, B, Q, R, X).rel_bound(), kResidualBound);
+      EXPECT_LE(riccati_residual(A, B, Q, R, X).rel(), kResidualTerms);
+      const KleinmanResult kl = kleinman(A, B, Q, R, MatrixXd::Zero(1, 3));
+      ASSERT_TRUE(kl.converged);
+      EXPECT_LE((kl.X - X).norm(), 1e-8 * X.norm());
+      if (coupling == 0.0) {
+        // Decoupled: the oscillator block is the Lyapunov solution of A11 alone, whose (1,1) entry is
+        // (2 + d^2)/(2 d) by hand (A11 = [0 1; -1 -d], Q11 = I), and the third state the scalar case
+        // a = -1, b = q = r = 1: x = sqrt(2) - 1.
+        EXPECT_NEAR(X(0, 0), (2.0 + d * d) / (2.0 * d), 1e-9 * X(0, 0));
+        EXPECT_NEAR(X(0, 1), 0.5, 1e-9 * X(0, 0));
+        EXPECT_NEAR(X(1, 1), 1.0 / d, 1e-9 * X(0, 0));
+        EXPECT_NEAR(X(2, 2), std::sqrt(2.0) - 1.0, 1e-9);
+      }
     }
-  }
   }
 }
 
 // A lightly damped, badly scaled plant (two oscillators with very different stiffness) still solves
 // to a small residual and agrees with Kleinman.
 TEST(CareRandom, OscillatorsOfDifferentScale) {
-  const MatrixXd A = mat(4, 4, {0, 1, 0, 0,  //
-                                -1e-2, -1e-3, 0, 0,  //
-                                0, 0, 0, 1,  //
-                                0, 0, -1e2, 1e-3});  // unstable: negative damping
+  const MatrixXd A = mat(4, 4,
+                         {0, 1, 0, 0,          //
+                          -1e-2, -1e-3, 0, 0,  //
+                          0, 0, 0, 1,          //
+                          0, 0, -1e2, 1e-3});  // unstable: negative damping
   const MatrixXd B = mat(4, 2, {0, 0, 1, 0, 0, 0, 0.5, 1});
   const MatrixXd Q = MatrixXd::Identity(4, 4);
   const MatrixXd R = mat(2, 2, {2, 0.5, 0.5, 1});
@@ -365,11 +364,13 @@ TEST(CareErrors, NotStabilisable) {
   expect_care_error([&] { lqr_gain(A, mat(2, 1, {0, 1}), Q, R); }, {"stabilis"}, "lqr_gain");
   expect_care_error([&] { solve_care(A, mat(2, 1, {0, 0}), Q, R); }, {"stabilis"}, "B = 0");
   // Coupled: A upper triangular with the unstable mode upstream of the input.
-  expect_care_error([&] { solve_care(mat(2, 2, {0.5, 0, 1, -1}), mat(2, 1, {0, 1}), Q, R); },
-                    {"stabilis"}, "unstable mode feeds the controlled one");
+  expect_care_error(
+      [&] {
+        solve_care(mat(2, 2, {0.5, 0, 1, -1}), mat(2, 1, {0, 1}), Q, R);
+      },
+      {"stabilis"}, "unstable mode feeds the controlled one");
   // An uncontrollable mode on the imaginary axis: x' = 0, B = 0.
-  expect_care_error([&] { solve_care(scalar(0), scalar(0), scalar(1), scalar(1)); }, {"stabilis"},
-                    "marginal, B = 0");
+  expect_care_error([&] { solve_care(scalar(0), scalar(0), scalar(1), scalar(1)); }, {"stabilis"}, "marginal, B = 0");
   // An uncontrollable undamped oscillator (eigenvalues +-i w): feedback cannot move it, so there is
   // no stabilising solution, whatever Q weights.
   for (double w : {1.0, 2.0, 0.3}) {
@@ -377,12 +378,15 @@ TEST(CareErrors, NotStabilisable) {
     const MatrixXd Bo = mat(3, 1, {0, 0, 1});
     expect_care_error([&] { solve_care(Ao, Bo, MatrixXd::Identity(3, 3), R); }, {"stabilis"},
                       "uncontrollable oscillator, Q = I, w = " + std::to_string(w));
-    expect_care_error([&] { solve_care(Ao, Bo, mat(3, 3, {0, 0, 0, 0, 0, 0, 0, 0, 1}), R); }, {"stabilis"},
-                      "uncontrollable oscillator, Q = 0 on it, w = " + std::to_string(w));
+    expect_care_error(
+        [&] {
+          solve_care(Ao, Bo, mat(3, 3, {0, 0, 0, 0, 0, 0, 0, 0, 1}), R);
+        },
+        {"stabilis"}, "uncontrollable oscillator, Q = 0 on it, w = " + std::to_string(w));
     // The same plant in rotated coordinates (T orthogonal), so the structure is not visible.
     const Eigen::Matrix3d T = (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
-    expect_care_error([&] { solve_care(T * Ao * T.transpose(), T * Bo, MatrixXd::Identity(3, 3), R); },
-                      {"stabilis"}, "rotated uncontrollable oscillator, w = " + std::to_string(w));
+    expect_care_error([&] { solve_care(T * Ao * T.transpose(), T * Bo, MatrixXd::Identity(3, 3), R); }, {"stabilis"},
+                      "rotated uncontrollable oscillator, w = " + std::to_string(w));
   }
 }
 
@@ -393,14 +397,18 @@ TEST(CareErrors, RNotPositiveDefinite) {
   const MatrixXd Q = MatrixXd::Identity(2, 2);
   expect_care_error([&] { solve_care(A, B1, Q, scalar(0)); }, {"R", "positive definite"}, "R = 0");
   expect_care_error([&] { solve_care(A, B1, Q, scalar(-1)); }, {"R", "positive definite"}, "R = -1");
-  expect_care_error([&] { solve_care(A, B2, Q, mat(2, 2, {1, 2, 2, 1})); }, {"R", "positive definite"},
-                    "R indefinite");
-  expect_care_error([&] { solve_care(A, B2, Q, mat(2, 2, {1, 0.5, 0, 1})); }, {"R", "symmetric"},
-                    "R not symmetric");
-  expect_care_error([&] { solve_care(A, B1, mat(2, 2, {1, 0, 0, -1}), scalar(1)); },
-                    {"Q", "positive semidefinite"}, "Q indefinite");
-  expect_care_error([&] { solve_care(A, B1, mat(2, 2, {1, 1, 0, 1}), scalar(1)); }, {"Q", "symmetric"},
-                    "Q not symmetric");
+  expect_care_error([&] { solve_care(A, B2, Q, mat(2, 2, {1, 2, 2, 1})); }, {"R", "positive definite"}, "R indefinite");
+  expect_care_error([&] { solve_care(A, B2, Q, mat(2, 2, {1, 0.5, 0, 1})); }, {"R", "symmetric"}, "R not symmetric");
+  expect_care_error(
+      [&] {
+        solve_care(A, B1, mat(2, 2, {1, 0, 0, -1}), scalar(1));
+      },
+      {"Q", "positive semidefinite"}, "Q indefinite");
+  expect_care_error(
+      [&] {
+        solve_care(A, B1, mat(2, 2, {1, 1, 0, 1}), scalar(1));
+      },
+      {"Q", "symmetric"}, "Q not symmetric");
 }
 
 TEST(CareErrors, MismatchedSizes) {
@@ -457,7 +465,8 @@ struct AxisCase {
 
 std::vector<AxisCase> default_axes() {
   const ControllerParams p;
-  return {{"roll", p.vehicle.Ixx_kg_m2, p.roll}, {"pitch", p.vehicle.Iyy_kg_m2, p.pitch},
+  return {{"roll", p.vehicle.Ixx_kg_m2, p.roll},
+          {"pitch", p.vehicle.Iyy_kg_m2, p.pitch},
           {"yaw", p.vehicle.Izz_kg_m2, p.yaw}};
 }
 
@@ -469,9 +478,8 @@ std::vector<std::complex<double>> second_order_poles(double I, double k1, double
 }
 
 void sort_poles(std::vector<std::complex<double>>& p) {
-  std::sort(p.begin(), p.end(), [](auto a, auto b) {
-    return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag();
-  });
+  std::sort(p.begin(), p.end(),
+            [](auto a, auto b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
 }
 
 TEST(AxisLqr, GainMatchesClosedFormAndPolesFollowFromIt) {
@@ -539,9 +547,7 @@ TEST(AxisLqr, DefaultStepResponseSettlesWithoutOvershoot) {
     SCOPED_TRACE(c.name);
     const AxisLqr d = design_axis_lqr(c.inertia, c.w);
     const double des = 0.1, h = 1e-3;
-    auto f = [&](const Eigen::Vector2d& s) {
-      return Eigen::Vector2d(s(1), d.torque(des - s(0), s(1)) / c.inertia);
-    };
+    auto f = [&](const Eigen::Vector2d& s) { return Eigen::Vector2d(s(1), d.torque(des - s(0), s(1)) / c.inertia); };
     Eigen::Vector2d s = Eigen::Vector2d::Zero();
     double peak = 0.0;
     for (int i = 0; i < 30000; ++i) {  // 30 s

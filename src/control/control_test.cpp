@@ -39,9 +39,9 @@ constexpr double kMass = 1.96, kG = 9.81, kL = 0.59, kKt = 2.06e-7, kKm = 1.01e-
 // Eq. (4) for the '+' layout, written out by hand.
 Eigen::Matrix4d eq4(double kt = kKt, double km = kKm, double L = kL) {
   Eigen::Matrix4d M;
-  M << kt, kt, kt, kt,            //
-      0, -L * kt, 0, L * kt,      //
-      -L * kt, 0, L * kt, 0,      //
+  M << kt, kt, kt, kt,        //
+      0, -L * kt, 0, L * kt,  //
+      -L * kt, 0, L * kt, 0,  //
       km, -km, km, -km;
   return M;
 }
@@ -61,9 +61,8 @@ TEST(Allocation, RoundTripThroughTheMixer) {
   const Eigen::Matrix4d M = eq4();
   const Eigen::Matrix4d Minv = M.inverse();
   const double wmin = 0.0, wmax = 12000.0;
-  std::vector<Eigen::Vector4d> speeds = {{4830.6, 4830.6, 4830.6, 4830.6},
-                                         {4000, 5200, 4700, 6100},
-                                         {100, 11900, 3000, 9000}};
+  std::vector<Eigen::Vector4d> speeds = {
+      {4830.6, 4830.6, 4830.6, 4830.6}, {4000, 5200, 4700, 6100}, {100, 11900, 3000, 9000}};
   // Plus a deterministic spread over the feasible range.
   for (int k = 0; k < 50; ++k) {
     Eigen::Vector4d w;
@@ -137,10 +136,9 @@ TEST(Allocation, NegativeSquaredSpeedsGiveOmegaMin) {
 TEST(Allocation, NonFiniteDemandGivesFiniteBoundedOutput) {
   const Eigen::Matrix4d Minv = eq4().inverse();
   const double wmin = 200.0, wmax = 9000.0;
-  for (const Eigen::Vector4d& U : {Eigen::Vector4d(kNaN, 0, 0, 0), Eigen::Vector4d(19.0, kNaN, 0, 0),
-                                  Eigen::Vector4d(19.0, 0, 0, kNaN), Eigen::Vector4d(kInf, 0, 0, 0),
-                                  Eigen::Vector4d(19.0, -kInf, 0, 0),
-                                  Eigen::Vector4d(kNaN, kNaN, kNaN, kNaN)}) {
+  for (const Eigen::Vector4d& U :
+       {Eigen::Vector4d(kNaN, 0, 0, 0), Eigen::Vector4d(19.0, kNaN, 0, 0), Eigen::Vector4d(19.0, 0, 0, kNaN),
+        Eigen::Vector4d(kInf, 0, 0, 0), Eigen::Vector4d(19.0, -kInf, 0, 0), Eigen::Vector4d(kNaN, kNaN, kNaN, kNaN)}) {
     SCOPED_TRACE(testing::Message() << "U = " << U.transpose());
     const Allocation a = allocate(Minv, U, wmin, wmax);
     EXPECT_TRUE(a.omega_rad_s.allFinite());
@@ -226,10 +224,10 @@ Eigen::Vector2d small_angle_accel(double roll, double pitch, double yaw, double 
 
 // Horizontal direction of the thrust axis z_B in the world for R_WB = Rz(yaw) Ry(pitch) Rx(roll).
 Eigen::Vector2d thrust_direction(double roll, double pitch, double yaw) {
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                                .toRotationMatrix();
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   return R.col(2).head<2>();
 }
 
@@ -476,12 +474,18 @@ TEST(FlightController, NonFiniteObservationGivesSafetyAndLeavesTheIntegratorAlon
     for (double bad : {kNaN, kInf}) {
       SCOPED_TRACE(testing::Message() << "field " << field << " value " << bad);
       Observation e = hover_observation(5.0);
-      if (field < 3) e.p_W[field] = bad;
-      else if (field < 6) e.v_W[field - 3] = bad;
-      else if (field < 9) e.w_B[field - 6] = bad;
-      else if (field == 9) e.roll_rad = bad;
-      else if (field == 10) e.pitch_rad = bad;
-      else e.yaw_rad = bad;
+      if (field < 3)
+        e.p_W[field] = bad;
+      else if (field < 6)
+        e.v_W[field - 3] = bad;
+      else if (field < 9)
+        e.w_B[field - 6] = bad;
+      else if (field == 9)
+        e.roll_rad = bad;
+      else if (field == 10)
+        e.pitch_rad = bad;
+      else
+        e.yaw_rad = bad;
       const ControllerOutput c = fc.step(e, sp, 0.02);
       EXPECT_TRUE(c.safety);
       EXPECT_TRUE(c.omega_rad_s.allFinite());
@@ -660,7 +664,8 @@ TEST(FlightController, SetParamsWithInvalidDesignThrowsAndChangesNothing) {
 // Every parameter's current value, by name, for before/after comparisons.
 std::vector<std::pair<std::string, ParameterValue>> snapshot(const ControllerConfig& c) {
   std::vector<std::pair<std::string, ParameterValue>> out;
-  for (const auto& spec : controller_parameters()) out.emplace_back(std::string(spec.name), *get_parameter(c, spec.name));
+  for (const auto& spec : controller_parameters())
+    out.emplace_back(std::string(spec.name), *get_parameter(c, spec.name));
   return out;
 }
 
@@ -783,8 +788,7 @@ TEST(Parameters, TableIsWellFormedAndDefaultsAreInRange) {
   }
   // The documented names the rest of the project relies on exist.
   for (const char* n : {"mode", "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "altitude.kp",
-                        "altitude.kd", "lqr.roll.q_angle", "lqr.yaw.r", "position.kp", "stale_limit",
-                        "safety_mode"}) {
+                        "altitude.kd", "lqr.roll.q_angle", "lqr.yaw.r", "position.kp", "stale_limit", "safety_mode"}) {
     EXPECT_NE(find_parameter(n), nullptr) << n;
   }
   EXPECT_EQ(find_parameter("no_such"), nullptr);

@@ -13,8 +13,7 @@ FlightController::FlightController(const ControllerParams& params) { set_params(
 void FlightController::set_params(const ControllerParams& params) {
   const auto& v = params.vehicle;
   // Design everything first, so a failing design leaves the controller unchanged.
-  std::array<AxisLqr, 3> axes = {design_axis_lqr(v.Ixx_kg_m2, params.roll),
-                                 design_axis_lqr(v.Iyy_kg_m2, params.pitch),
+  std::array<AxisLqr, 3> axes = {design_axis_lqr(v.Ixx_kg_m2, params.roll), design_axis_lqr(v.Iyy_kg_m2, params.pitch),
                                  design_axis_lqr(v.Izz_kg_m2, params.yaw)};
   mixer_inverse_ = model::mixer_matrix(v).inverse();
   axes_ = axes;
@@ -25,8 +24,7 @@ ControllerOutput FlightController::safety_command() const {
   ControllerOutput c;
   c.safety = true;
   const auto& v = params_.vehicle;
-  const double w = params_.safety == SafetyMode::kHover ? v.hover_omega_rad_s()
-                                                        : v.motor.omega_min_rad_s;
+  const double w = params_.safety == SafetyMode::kHover ? v.hover_omega_rad_s() : v.motor.omega_min_rad_s;
   c.omega_rad_s.setConstant(w);
   return c;
 }
@@ -46,9 +44,8 @@ ControllerOutput FlightController::step(const Observation& obs, const Setpoint& 
   ControllerOutput c;
   c.yaw_des_rad = sp.yaw_des_rad;
   if (sp.mode == Mode::kPosition) {
-    const TiltSetpoint tilt = position_pid(params_.position, position_state_, sp.p_des_W.head<2>(),
-                                           obs.p_W.head<2>(), obs.v_W.head<2>(), obs.yaw_rad,
-                                           v.gravity_m_s2, dt_s);
+    const TiltSetpoint tilt = position_pid(params_.position, position_state_, sp.p_des_W.head<2>(), obs.p_W.head<2>(),
+                                           obs.v_W.head<2>(), obs.yaw_rad, v.gravity_m_s2, dt_s);
     c.roll_des_rad = tilt.roll_rad;
     c.pitch_des_rad = tilt.pitch_rad;
     c.tilt_saturated = tilt.saturated;
@@ -66,13 +63,12 @@ ControllerOutput FlightController::step(const Observation& obs, const Setpoint& 
   c.U[3] = axes_[2].torque(e_yaw, obs.w_B.z());
 
   // Lines 12-14: altitude PD, eq. (13).
-  c.U[0] = collective_thrust(params_.altitude, v.mass_kg, v.gravity_m_s2, sp.p_des_W.z(),
-                             obs.p_W.z(), obs.v_W.z(), obs.roll_rad, obs.pitch_rad);
+  c.U[0] = collective_thrust(params_.altitude, v.mass_kg, v.gravity_m_s2, sp.p_des_W.z(), obs.p_W.z(), obs.v_W.z(),
+                             obs.roll_rad, obs.pitch_rad);
   c.error << sp.p_des_W.z() - obs.p_W.z(), e_roll, e_pitch, e_yaw;
 
   // Lines 15-20.
-  const Allocation a =
-      allocate(mixer_inverse_, c.U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
+  const Allocation a = allocate(mixer_inverse_, c.U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
   c.omega_rad_s = a.omega_rad_s;
   c.rotor_saturated = a.saturated;
   return c;

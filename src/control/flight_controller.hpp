@@ -29,8 +29,8 @@ enum class SafetyMode {
 struct Setpoint {
   Mode mode = Mode::kAttitude;
   Eigen::Vector3d p_des_W = Eigen::Vector3d::Zero();  ///< [m]; x, y used in position mode
-  double roll_des_rad = 0.0;   ///< used in attitude mode
-  double pitch_des_rad = 0.0;  ///< used in attitude mode
+  double roll_des_rad = 0.0;                          ///< used in attitude mode
+  double pitch_des_rad = 0.0;                         ///< used in attitude mode
   double yaw_des_rad = 0.0;
 };
 
@@ -49,20 +49,20 @@ struct ControllerParams {
 /// What the controller observes: the latest measurements the node took from its sensor topics, as
 /// received (no filtering: not an estimate), and how old they are.
 struct Observation {
-  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< [m], from Pose
-  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();  ///< [m/s], from Velocity
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();          ///< [m], from Pose
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();          ///< [m/s], from Velocity
   double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;  ///< from the IMU quaternion
-  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();  ///< body rates [rad/s], from the IMU
+  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();          ///< body rates [rad/s], from the IMU
   /// Age of the oldest of the inputs above [s]; +inf when any input never arrived.
   double age_s = std::numeric_limits<double>::infinity();
 };
 
 /// Everything one step decided, for the command topic and the controller's status.
 struct ControllerOutput {
-  Eigen::Vector4d omega_rad_s = Eigen::Vector4d::Zero();  ///< rotor speed commands [rad/s]
-  Eigen::Vector4d U = Eigen::Vector4d::Zero();  ///< requested U1 [N], U2..U4 [N m]
+  Eigen::Vector4d omega_rad_s = Eigen::Vector4d::Zero();              ///< rotor speed commands [rad/s]
+  Eigen::Vector4d U = Eigen::Vector4d::Zero();                        ///< requested U1 [N], U2..U4 [N m]
   double roll_des_rad = 0.0, pitch_des_rad = 0.0, yaw_des_rad = 0.0;  ///< attitude actually tracked
-  Eigen::Vector4d error = Eigen::Vector4d::Zero();  ///< e_z [m], e_roll, e_pitch, e_yaw [rad]
+  Eigen::Vector4d error = Eigen::Vector4d::Zero();                    ///< e_z [m], e_roll, e_pitch, e_yaw [rad]
   std::array<bool, 4> rotor_saturated{};
   bool tilt_saturated = false;
   bool safety = false;  ///< the stale-data safety command was sent

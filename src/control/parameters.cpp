@@ -13,17 +13,21 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kBig = 1e9;
 
 // One numeric parameter bound to a double inside ControllerConfig.
-#define QC_NUMBER(NAME, UNIT, MIN, MAX, DESIGN, FIELD, DESC)                                     \
-  ParameterSpec {                                                                              \
-    NAME, UNIT, DESC, MIN, MAX, {}, DESIGN,                                                    \
-        [](const ControllerConfig& c) -> ParameterValue { return c.FIELD; },                  \
-        [](ControllerConfig& c, const ParameterValue& v) { c.FIELD = std::get<double>(v); }    \
+#define QC_NUMBER(NAME, UNIT, MIN, MAX, DESIGN, FIELD, DESC)                                                     \
+  ParameterSpec {                                                                                                \
+    NAME, UNIT, DESC, MIN, MAX, {}, DESIGN, [](const ControllerConfig& c) -> ParameterValue { return c.FIELD; }, \
+        [](ControllerConfig& c, const ParameterValue& v) { c.FIELD = std::get<double>(v); }                      \
   }
 
 std::vector<ParameterSpec> make_table() {
   std::vector<ParameterSpec> t = {
-      ParameterSpec{"mode", "choice", "attitude: roll/pitch/yaw setpoints + altitude hold; position: x/y/z/yaw",
-                    0, 0, {"attitude", "position"}, false,
+      ParameterSpec{"mode",
+                    "choice",
+                    "attitude: roll/pitch/yaw setpoints + altitude hold; position: x/y/z/yaw",
+                    0,
+                    0,
+                    {"attitude", "position"},
+                    false,
                     [](const ControllerConfig& c) -> ParameterValue { return to_string(c.setpoint.mode); },
                     [](ControllerConfig& c, const ParameterValue& v) {
                       c.setpoint.mode = std::get<std::string>(v) == "position" ? Mode::kPosition : Mode::kAttitude;
@@ -56,8 +60,13 @@ std::vector<ParameterSpec> make_table() {
                 "tilt limit on the roll/pitch the position loop commands"),
       QC_NUMBER("stale_limit", "s", 1e-4, 1e4, true, params.stale_limit_s,
                 "sensor data older than this triggers the safety command (Algorithm 1)"),
-      ParameterSpec{"safety_mode", "choice", "safety command: stop (omega_min) or hover (hover speed)",
-                    0, 0, {"stop", "hover"}, true,
+      ParameterSpec{"safety_mode",
+                    "choice",
+                    "safety command: stop (omega_min) or hover (hover speed)",
+                    0,
+                    0,
+                    {"stop", "hover"},
+                    true,
                     [](const ControllerConfig& c) -> ParameterValue { return to_string(c.params.safety); },
                     [](ControllerConfig& c, const ParameterValue& v) {
                       c.params.safety = std::get<std::string>(v) == "hover" ? SafetyMode::kHover : SafetyMode::kStop;

@@ -25,7 +25,7 @@ struct ParameterSpec {
   std::string_view name;
   std::string_view unit;  ///< SI unit, "" when dimensionless, "choice" for string parameters
   std::string_view description;
-  double min = 0.0, max = 0.0;          ///< inclusive range of a numeric parameter
+  double min = 0.0, max = 0.0;            ///< inclusive range of a numeric parameter
   std::vector<std::string_view> choices;  ///< allowed values of a string parameter
   /// True when changing it needs the LQR re-solved / gains re-applied (not a setpoint).
   bool affects_design = false;

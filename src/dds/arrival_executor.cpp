@@ -7,8 +7,7 @@
 
 namespace quadcosim::dds {
 
-ArrivalExecutor::ArrivalExecutor(DdsTransport& transport)
-    : transport_(transport), owner_(std::this_thread::get_id()) {
+ArrivalExecutor::ArrivalExecutor(DdsTransport& transport) : transport_(transport), owner_(std::this_thread::get_id()) {
   if (transport_.arrival_sink_) throw std::logic_error("ArrivalExecutor: a second executor on one transport");
   wake_ = check(dds_create_guardcondition(transport_.participant().handle()), "dds_create_guardcondition");
   // wait() resets the guard itself, right after its wait.

@@ -1,21 +1,21 @@
 // DDS transport tests on a private domain with localhost-only discovery.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <typeindex>
-#include <chrono>
-#include <stdexcept>
-#include <thread>
 #include <vector>
 
 #include "dds/arrival_executor.hpp"
@@ -57,7 +57,10 @@ struct FillFields {
       v = k + 1.0 / (k + 2);
     } else if constexpr (std::is_arithmetic_v<T>) {
       v = static_cast<T>(k * 1000003);
-    } else if constexpr (requires { v.size(); v.resize(2); }) {
+    } else if constexpr (requires {
+                           v.size();
+                           v.resize(2);
+                         }) {
       v.resize(2);
       for (auto& e : v) put(e);
     } else if constexpr (requires { v.size(); }) {
@@ -196,8 +199,7 @@ std::string layout_error(const std::function<void()>& check) {
 
 TEST(IdlWalkTest, RefusesAFieldTheIdlTypeDoesNotHaveOrTypesDifferently) {
   dds_topic_descriptor_t d{};
-  const std::uint32_t same[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_4BY, 8,
-                                DDS_OP_RTS};
+  const std::uint32_t same[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_4BY, 8, DDS_OP_RTS};
   d.m_ops = same;
   EXPECT_EQ(layout_error([&] { idl_walk::check_fields<Pair>(d); }), "");
   const std::uint32_t signed_b[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,
@@ -205,8 +207,8 @@ TEST(IdlWalkTest, RefusesAFieldTheIdlTypeDoesNotHaveOrTypesDifferently) {
   d.m_ops = signed_b;
   EXPECT_NE(layout_error([&] { idl_walk::check_fields<Pair>(d); }).find("test_msgs/msg/Pair field 'b'"),
             std::string::npos);
-  const std::uint32_t b_double[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,
-                                    kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 8, DDS_OP_RTS};
+  const std::uint32_t b_double[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP,
+                                    8, DDS_OP_RTS};
   d.m_ops = b_double;
   EXPECT_NE(layout_error([&] { idl_walk::check_fields<Pair>(d); }).find("field 'b'"), std::string::npos);
   const std::uint32_t one[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, DDS_OP_RTS};
@@ -214,8 +216,8 @@ TEST(IdlWalkTest, RefusesAFieldTheIdlTypeDoesNotHaveOrTypesDifferently) {
   const std::string extra = layout_error([&] { idl_walk::check_fields<Pair>(d); });
   EXPECT_NE(extra.find("field 'b'"), std::string::npos) << extra;
   EXPECT_NE(extra.find("fields() lists a field after the IDL type's last member"), std::string::npos) << extra;
-  const std::uint32_t three[] = {kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_4BY, 8,
-                                 kAdr | DDS_OP_TYPE_BLN, 12, DDS_OP_RTS};
+  const std::uint32_t three[] = {
+      kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0, kAdr | DDS_OP_TYPE_4BY, 8, kAdr | DDS_OP_TYPE_BLN, 12, DDS_OP_RTS};
   d.m_ops = three;
   EXPECT_NE(layout_error([&] { idl_walk::check_fields<Pair>(d); }).find("a member after the last field"),
             std::string::npos);
@@ -229,16 +231,28 @@ TEST(IdlWalkTest, RefusesAFieldTheIdlTypeDoesNotHaveOrTypesDifferently) {
 TEST(IdlWalkTest, WalksNestedStructsAndSequencesOfStructsEvenWhenEmpty) {
   dds_topic_descriptor_t d{};
   // PairOfPairs_ { Pair_ first; More_ more; }; More_ { sequence<Pair_> rest; }; element type wrong (int32 b).
-  const std::uint32_t ops[] = {
-      kAdr | DDS_OP_TYPE_EXT, 0, (3u << 16u) + 7u,    // 0: first -> Pair_ at 7
-      kAdr | DDS_OP_TYPE_EXT, 16, (3u << 16u) + 9u,   // 3: more -> More_ at 12
-      DDS_OP_RTS,                                           // 6
-      kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,     // 7: Pair_
-      kAdr | DDS_OP_TYPE_4BY, 8, DDS_OP_RTS,          // 9
-      kAdr | DDS_OP_TYPE_SEQ | DDS_OP_SUBTYPE_STU, 0, 16, (4u << 16u) + 5u,  // 12: More_.rest -> 17
-      DDS_OP_RTS,                                           // 16
-      kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP, 0,     // 17: element Pair_
-      kAdr | DDS_OP_TYPE_4BY | DDS_OP_FLAG_SGN, 8, DDS_OP_RTS};
+  const std::uint32_t ops[] = {kAdr | DDS_OP_TYPE_EXT,
+                               0,
+                               (3u << 16u) + 7u,  // 0: first -> Pair_ at 7
+                               kAdr | DDS_OP_TYPE_EXT,
+                               16,
+                               (3u << 16u) + 9u,  // 3: more -> More_ at 12
+                               DDS_OP_RTS,        // 6
+                               kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP,
+                               0,  // 7: Pair_
+                               kAdr | DDS_OP_TYPE_4BY,
+                               8,
+                               DDS_OP_RTS,  // 9
+                               kAdr | DDS_OP_TYPE_SEQ | DDS_OP_SUBTYPE_STU,
+                               0,
+                               16,
+                               (4u << 16u) + 5u,  // 12: More_.rest -> 17
+                               DDS_OP_RTS,        // 16
+                               kAdr | DDS_OP_TYPE_8BY | DDS_OP_FLAG_FP,
+                               0,  // 17: element Pair_
+                               kAdr | DDS_OP_TYPE_4BY | DDS_OP_FLAG_SGN,
+                               8,
+                               DDS_OP_RTS};
   d.m_ops = ops;
   EXPECT_NE(layout_error([&] { idl_walk::check_fields<PairOfPairs>(d); }).find("field 'more.rest.b'"),
             std::string::npos);
@@ -303,7 +317,7 @@ TEST(DdsTransportTest, OnArrivalOnlyTheOwningThreadMayWaitAndTheTransportItselfN
   });
   other.join();
   EXPECT_NE(error.find("ArrivalExecutor::wait"), std::string::npos) << error;
-  EXPECT_EQ(arrival.wait(0), 0);  // the owner may
+  EXPECT_EQ(arrival.wait(0), 0);                       // the owner may
   EXPECT_THROW(rig.b.spin_once(0), std::logic_error);  // not past the executor
   EXPECT_THROW(ArrivalExecutor second(rig.b), std::logic_error);
 }
@@ -375,7 +389,7 @@ TEST(DdsTransportTest, OnArrivalAFailedDeliveryWakesTheWaitAndIsRethrown) {
     EXPECT_STREQ(e.what(), "sample 3 refused");
   }
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));  // woken, not timed out
-  EXPECT_EQ(rig.count, 2);  // 1 and 2; nothing after the failure
+  EXPECT_EQ(rig.count, 2);                                                    // 1 and 2; nothing after the failure
 }
 
 // Samples already in the reader when the executor is made are delivered by its constructor; one
@@ -399,7 +413,7 @@ TEST(DdsTransportTest, OnArrivalAPendingDeliveryThatThrowsIsRethrownByTheFirstWa
       EXPECT_STREQ(e.what(), "pending sample 2 refused");
     }
     EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));  // woken, not timed out
-    EXPECT_EQ(arrival->wait(0), 0);  // rethrown once
+    EXPECT_EQ(arrival->wait(0), 0);                                             // rethrown once
   }
   // The executor's end returned the transport to spin_once: a later sample reaches b there.
   std::thread later([&] { rig.in.publish(clock_at(4)); });
@@ -438,8 +452,7 @@ TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) 
 
 TEST(DdsTransportTest, TopicAndTypeNamesFollowRos2) {
   EXPECT_EQ(dds_topic_name("/drone/Pose"), "rt/drone/Pose");
-  EXPECT_STREQ(type_ops(typeid(msg::PoseStamped))->descriptor->m_typename,
-               "geometry_msgs::msg::dds_::PoseStamped_");
+  EXPECT_STREQ(type_ops(typeid(msg::PoseStamped))->descriptor->m_typename, "geometry_msgs::msg::dds_::PoseStamped_");
   EXPECT_STREQ(type_ops(typeid(msg::Imu))->descriptor->m_typename, "sensor_msgs::msg::dds_::Imu_");
   EXPECT_STREQ(type_ops(typeid(msg::Float64MultiArray))->descriptor->m_typename,
                "std_msgs::msg::dds_::Float64MultiArray_");

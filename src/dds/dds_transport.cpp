@@ -23,22 +23,20 @@ QosProfile DdsTransport::qos_for(const std::string& ros_topic) const {
   return it == qos_.end() ? QosProfile::ros_default() : it->second;
 }
 
-dds_entity_t DdsTransport::topic_for(const std::string& ros_topic, const sim::TopicType& type,
-                                     const TypeOps*& ops) {
+dds_entity_t DdsTransport::topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops) {
   ops = type_ops(type.cpp_type);
   if (!ops) throw DdsError("no DDS mapping for message type " + std::string(type.ros_type));
   auto it = topics_.find(ros_topic);
   if (it != topics_.end()) return it->second;
   const std::string name = dds_topic_name(ros_topic);
-  const dds_entity_t t =
-      check(dds_create_topic(participant_.handle(), ops->descriptor, name.c_str(), nullptr, nullptr),
-            ("dds_create_topic " + name).c_str());
+  const dds_entity_t t = check(dds_create_topic(participant_.handle(), ops->descriptor, name.c_str(), nullptr, nullptr),
+                               ("dds_create_topic " + name).c_str());
   topics_.emplace(ros_topic, t);
   return t;
 }
 
-dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const sim::TopicType& type,
-                                           bool writer, const TypeOps*& ops) {
+dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const sim::TopicType& type, bool writer,
+                                           const TypeOps*& ops) {
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
   const QosProfile p = qos_for(ros_topic);
   dds_qos_t* qos = ros_qos(p.depth, p.reliable);
@@ -59,8 +57,7 @@ void DdsTransport::attach(dds_entity_t e, dds_attach_t arg) {
   triggered_.push_back(0);
 }
 
-std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic,
-                                                          const sim::TopicType& type) {
+std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic, const sim::TopicType& type) {
   const TypeOps* ops = nullptr;
   const dds_entity_t writer = create_endpoint(ros_topic, type, true, ops);
   writers_[ros_topic].push_back(writer);
@@ -155,8 +152,9 @@ int DdsTransport::drain(Reader& r) {
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {
   if (arrival_sink_) {
-    throw std::logic_error("DdsTransport::spin_once called while an ArrivalExecutor delivers on arrival "
-                           "(wait through the executor)");
+    throw std::logic_error(
+        "DdsTransport::spin_once called while an ArrivalExecutor delivers on arrival "
+        "(wait through the executor)");
   }
   if (readers_.empty() && writers_.empty() && extra_.empty()) return 0;
   return serve_wait(wait_waitset(timeout_ns));

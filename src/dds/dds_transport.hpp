@@ -20,8 +20,8 @@
 namespace quadcosim::dds {
 
 struct QosProfile {
-  int depth = 10;         ///< KEEP_LAST depth
-  bool reliable = true;   ///< RELIABLE (ROS default) or BEST_EFFORT (ROS sensor data)
+  int depth = 10;        ///< KEEP_LAST depth
+  bool reliable = true;  ///< RELIABLE (ROS default) or BEST_EFFORT (ROS sensor data)
   static QosProfile ros_default() { return {10, true}; }
   static QosProfile sensor_data() { return {5, false}; }
 };

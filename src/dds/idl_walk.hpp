@@ -48,8 +48,10 @@ constexpr std::uint32_t primitive_code() {
     return DDS_OP_VAL_BLN;
   } else {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4 || sizeof(T) == 8);
-    return sizeof(T) == 1 ? DDS_OP_VAL_1BY : sizeof(T) == 2 ? DDS_OP_VAL_2BY : sizeof(T) == 4 ? DDS_OP_VAL_4BY
-                                                                                              : DDS_OP_VAL_8BY;
+    return sizeof(T) == 1   ? DDS_OP_VAL_1BY
+           : sizeof(T) == 2 ? DDS_OP_VAL_2BY
+           : sizeof(T) == 4 ? DDS_OP_VAL_4BY
+                            : DDS_OP_VAL_8BY;
   }
 }
 template <class T>
@@ -108,8 +110,8 @@ class Walk {
   template <class F>
   void group(std::string_view name, std::string_view /*ros_type*/, F&& visit) {
     const std::uint32_t insn = next(name);
-    expect(name, DDS_OP_TYPE(insn) == DDS_OP_VAL_EXT && DDS_OP_TYPE_FLAGS(insn) == 0 && DDS_OP_FLAGS(insn) == 0,
-           insn, "a nested struct");
+    expect(name, DDS_OP_TYPE(insn) == DDS_OP_VAL_EXT && DDS_OP_TYPE_FLAGS(insn) == 0 && DDS_OP_FLAGS(insn) == 0, insn,
+           "a nested struct");
     Walk sub(type_, op_ + DDS_OP_ADR_JSR(op_[2]), at(op_[1]), arena_, this, name);
     visit(sub);
     sub.end();
@@ -118,7 +120,8 @@ class Walk {
 
   /// After the last field: the C struct must have no member left.
   void end() const {
-    if (kMode == Mode::kCheck && DDS_OP(*op_) != DDS_OP_RTS) fail({}, "the IDL type has a member after the last field fields() lists");
+    if (kMode == Mode::kCheck && DDS_OP(*op_) != DDS_OP_RTS)
+      fail({}, "the IDL type has a member after the last field fields() lists");
   }
 
  private:
@@ -129,8 +132,9 @@ class Walk {
     const auto type = DDS_OP_TYPE(insn);
     Byte* const c = at(op_[1]);
     if constexpr (kPrimitive<U>) {
-      expect(name, type == primitive_code<U>() && DDS_OP_FLAGS(insn) == primitive_flags<U>() &&
-                       DDS_OP_TYPE_FLAGS(insn) == 0, insn, "a primitive of the C++ field's size and kind");
+      expect(name,
+             type == primitive_code<U>() && DDS_OP_FLAGS(insn) == primitive_flags<U>() && DDS_OP_TYPE_FLAGS(insn) == 0,
+             insn, "a primitive of the C++ field's size and kind");
       if constexpr (kMode == Mode::kToC) std::memcpy(c, &v, sizeof(U));
       if constexpr (kMode == Mode::kFromC) std::memcpy(&v, c, sizeof(U));
       op_ += 2;
@@ -143,9 +147,11 @@ class Walk {
     } else if constexpr (IsArray<U>::value) {
       using E = typename U::value_type;
       static_assert(kPrimitive<E>, "fixed arrays of primitives only");
-      expect(name, type == DDS_OP_VAL_ARR && DDS_OP_SUBTYPE(insn) == primitive_code<E>() &&
-                       DDS_OP_FLAGS(insn) == primitive_flags<E>() && DDS_OP_TYPE_FLAGS(insn) == 0 &&
-                       op_[2] == std::tuple_size_v<U>, insn, "a fixed array of the C++ field's length and element");
+      expect(name,
+             type == DDS_OP_VAL_ARR && DDS_OP_SUBTYPE(insn) == primitive_code<E>() &&
+                 DDS_OP_FLAGS(insn) == primitive_flags<E>() && DDS_OP_TYPE_FLAGS(insn) == 0 &&
+                 op_[2] == std::tuple_size_v<U>,
+             insn, "a fixed array of the C++ field's length and element");
       if constexpr (kMode == Mode::kToC) std::memcpy(c, v.data(), sizeof(E) * v.size());
       if constexpr (kMode == Mode::kFromC) std::memcpy(v.data(), c, sizeof(E) * v.size());
       op_ += 3;
@@ -241,7 +247,8 @@ class Walk {
 
   // The instruction for the field `name`, which must be a member's (ADR).
   std::uint32_t next(std::string_view name) const {
-    if (kMode == Mode::kCheck && DDS_OP(*op_) != DDS_OP_ADR) fail(name, "fields() lists a field after the IDL type's last member");
+    if (kMode == Mode::kCheck && DDS_OP(*op_) != DDS_OP_ADR)
+      fail(name, "fields() lists a field after the IDL type's last member");
     return *op_;
   }
   void expect(std::string_view name, bool ok, std::uint32_t insn, const char* want) const {

@@ -37,13 +37,12 @@ std::vector<dds_entity_t> children(dds_entity_t e) {
 NodeAnnouncer::NodeAnnouncer(dds_entity_t participant, std::string name, std::string ns)
     : participant_(participant), name_(std::move(name)), ns_(std::move(ns)) {
   if (name_.empty() || name_.size() > 256 || ns_.size() > 256) {
-    throw DdsError("node name must be 1-256 characters and the namespace at most 256: '" + ns_ + "', '" +
-                   name_ + "'");
+    throw DdsError("node name must be 1-256 characters and the namespace at most 256: '" + ns_ + "', '" + name_ + "'");
   }
-  const dds_entity_t topic = check(
-      dds_create_topic(participant_, &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc,
-                       "ros_discovery_info", nullptr, nullptr),
-      "dds_create_topic ros_discovery_info");
+  const dds_entity_t topic =
+      check(dds_create_topic(participant_, &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc, "ros_discovery_info",
+                             nullptr, nullptr),
+            "dds_create_topic ros_discovery_info");
   dds_qos_t* qos = ros_qos(1, true);
   dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
   writer_ = dds_create_writer(participant_, topic, qos, nullptr);

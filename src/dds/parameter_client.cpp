@@ -46,8 +46,8 @@ ParameterClient::Endpoints& ParameterClient::endpoints(ParamService service) {
   if (e.writer > 0) return e;
   const wire::ServiceTypes types = wire::service_types(service);
   const std::string rq = request_topic(node_, service), rr = reply_topic(node_, service);
-  const dds_entity_t rq_topic =
-      check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr), ("dds_create_topic " + rq).c_str());
+  const dds_entity_t rq_topic = check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr),
+                                      ("dds_create_topic " + rq).c_str());
   const dds_entity_t rr_topic = check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
                                       ("dds_create_topic " + rr).c_str());
   // rclpy's parameter client uses the parameter-service profile: KEEP_LAST 1000, RELIABLE, VOLATILE.
@@ -128,8 +128,8 @@ void ParameterClient::call(ParamService service, void* request, std::int64_t tim
   Endpoints& e = endpoints(service);
   if (!wait_for_service(service, deadline - start)) {
     throw ParameterCallError("node " + node_.fully_qualified() + " not found: no " +
-                             std::string(service_suffix(service)) + " service within " + seconds(timeout_ns) +
-                             " (" + describe_matches(service) + "); is the node running on this domain?");
+                             std::string(service_suffix(service)) + " service within " + seconds(timeout_ns) + " (" +
+                             describe_matches(service) + "); is the node running on this domain?");
   }
   // Every request type starts with the in-band header {uint64 guid; int64 seq}.
   struct InBandHeader {
@@ -201,8 +201,7 @@ std::vector<SetResult> ParameterClient::set(const std::vector<Param>& parameters
 
 SetResult ParameterClient::set_atomically(const std::vector<Param>& parameters, std::int64_t timeout_ns) {
   auto rq = wire::new_sample(wire::service_types(ParamService::kSetAtomically).request);
-  wire::to_c(parameters,
-             static_cast<rcl_interfaces_srv_dds__SetParametersAtomically_Request_*>(rq.get())->parameters);
+  wire::to_c(parameters, static_cast<rcl_interfaces_srv_dds__SetParametersAtomically_Request_*>(rq.get())->parameters);
   SetResult out;
   call(ParamService::kSetAtomically, rq.get(), timeout_ns, [&](const void* reply) {
     out = wire::from_c(static_cast<const rcl_interfaces_srv_dds__SetParametersAtomically_Response_*>(reply)->result);
@@ -210,8 +209,7 @@ SetResult ParameterClient::set_atomically(const std::vector<Param>& parameters, 
   return out;
 }
 
-std::vector<ParamDescriptor> ParameterClient::describe(const std::vector<std::string>& names,
-                                                       std::int64_t timeout_ns) {
+std::vector<ParamDescriptor> ParameterClient::describe(const std::vector<std::string>& names, std::int64_t timeout_ns) {
   auto rq = wire::new_sample(wire::service_types(ParamService::kDescribe).request);
   wire::to_c(names, static_cast<rcl_interfaces_srv_dds__DescribeParameters_Request_*>(rq.get())->names);
   std::vector<ParamDescriptor> out;

@@ -5,8 +5,8 @@
 
 #include "dds/dds_transport.hpp"
 #include "dds/parameter_wire.hpp"
-#include "dds/steady_clock.hpp"
 #include "dds/participant.hpp"
+#include "dds/steady_clock.hpp"
 
 namespace quadcosim::dds {
 
@@ -36,8 +36,8 @@ ParameterServer::ParameterServer(dds_entity_t participant, NodeName node, Parame
   for (ParamService s : kParamServices) {
     const wire::ServiceTypes types = wire::service_types(s);
     const std::string rq = request_topic(node_, s), rr = reply_topic(node_, s);
-    const dds_entity_t rq_topic =
-        check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr), ("dds_create_topic " + rq).c_str());
+    const dds_entity_t rq_topic = check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr),
+                                        ("dds_create_topic " + rq).c_str());
     const dds_entity_t rr_topic = check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
                                         ("dds_create_topic " + rr).c_str());
     dds_qos_t* qos = ros_qos(options_.depth, true);
@@ -54,10 +54,9 @@ ParameterServer::ParameterServer(dds_entity_t participant, NodeName node, Parame
     check(dds_set_status_mask(e.writer, DDS_PUBLICATION_MATCHED_STATUS), "dds_set_status_mask");
   }
   if (options_.publish_events) {
-    const dds_entity_t topic =
-        check(dds_create_topic(participant_, &rcl_interfaces_msg_dds__ParameterEvent__desc, "rt/parameter_events",
-                               nullptr, nullptr),
-              "dds_create_topic rt/parameter_events");
+    const dds_entity_t topic = check(dds_create_topic(participant_, &rcl_interfaces_msg_dds__ParameterEvent__desc,
+                                                      "rt/parameter_events", nullptr, nullptr),
+                                     "dds_create_topic rt/parameter_events");
     dds_qos_t* qos = ros_qos(1000, true);
     events_writer_ = dds_create_writer(participant_, topic, qos, nullptr);
     dds_delete_qos(qos);
@@ -116,8 +115,8 @@ void ParameterServer::take_requests(ParamService service, int& taken) {
       if (!infos[i].valid_data) continue;
       ++taken;
       ++stats_.requests;
-      pending_.push_back({service, infos[i].publication_handle, steady_ns() + options_.reply_wait_ns,
-                          answer(service, samples[i])});
+      pending_.push_back(
+          {service, infos[i].publication_handle, steady_ns() + options_.reply_wait_ns, answer(service, samples[i])});
     }
     dds_return_loan(e.reader, samples, n);
     if (n < kBatch) break;
@@ -143,9 +142,8 @@ void ParameterServer::publish_event(const std::vector<Param>& changed) {
   auto sample = wire::new_sample(&rcl_interfaces_msg_dds__ParameterEvent__desc);
   auto& ev = *static_cast<rcl_interfaces_msg_dds__ParameterEvent_*>(sample.get());
   // rclcpp stamps events with the node's clock: system time unless use_sim_time.
-  const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                       std::chrono::system_clock::now().time_since_epoch())
-                       .count();
+  const auto now =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   ev.stamp.sec = static_cast<std::int32_t>(now / 1'000'000'000);
   ev.stamp.nanosec = static_cast<std::uint32_t>(now % 1'000'000'000);
   ev.node = dds_string_dup(node_.fully_qualified().c_str());

@@ -54,9 +54,9 @@ struct ParameterCallbacks {
 };
 
 struct ParameterServerOptions {
-  int depth = 1000;                             ///< KEEP_LAST depth (rclcpp's parameter services)
-  std::int64_t reply_wait_ns = 2'000'000'000;   ///< how long a reply waits for the client's reader
-  bool publish_events = true;                   ///< /parameter_events on successful sets
+  int depth = 1000;                            ///< KEEP_LAST depth (rclcpp's parameter services)
+  std::int64_t reply_wait_ns = 2'000'000'000;  ///< how long a reply waits for the client's reader
+  bool publish_events = true;                  ///< /parameter_events on successful sets
 };
 
 class ParameterServer {
@@ -82,10 +82,10 @@ class ParameterServer {
   int serve();
 
   struct Stats {
-    std::uint64_t requests = 0;        ///< requests taken
-    std::uint64_t replies = 0;         ///< replies written
-    std::uint64_t replies_dropped = 0; ///< client gone, or its reader not matched within reply_wait_ns
-    std::uint64_t events = 0;          ///< ParameterEvent messages published
+    std::uint64_t requests = 0;         ///< requests taken
+    std::uint64_t replies = 0;          ///< replies written
+    std::uint64_t replies_dropped = 0;  ///< client gone, or its reader not matched within reply_wait_ns
+    std::uint64_t events = 0;           ///< ParameterEvent messages published
   };
   const Stats& stats() const { return stats_; }
   const NodeName& node() const { return node_; }
@@ -98,7 +98,7 @@ class ParameterServer {
     ParamService service;
     dds_instance_handle_t request_writer;  ///< as our request reader knows it
     std::int64_t deadline_ns;
-    std::shared_ptr<void> sample;          ///< the reply, a generated C struct
+    std::shared_ptr<void> sample;  ///< the reply, a generated C struct
   };
 
   void take_requests(ParamService service, int& taken);

@@ -243,8 +243,8 @@ TEST(ParameterServiceTest, GetSetListDescribeTypesRoundTrip) {
   EXPECT_FALSE(r.successful);
   EXPECT_EQ(r.reason, "mode must be one of 'attitude' 'position', got 'upside_down'");
   EXPECT_EQ(table.number("z_des"), 10.0);  // rolled back
-  r = client.set_atomically({param("z_des", ParamValue::of_integer(6)), param("mode", ParamValue::of_string("attitude"))},
-                            t);
+  r = client.set_atomically(
+      {param("z_des", ParamValue::of_integer(6)), param("mode", ParamValue::of_string("attitude"))}, t);
   EXPECT_TRUE(r.successful) << r.reason;
   EXPECT_EQ(table.number("z_des"), 6.0);
   EXPECT_EQ(table.mode(), "attitude");
@@ -283,12 +283,10 @@ TEST(ParameterServiceTest, RepliesEchoGuidAndSequenceAndEventsAnnounceChanges) {
 
   // A bare DDS requester, without the "clientid" USER_DATA, with its own header values.
   Participant raw(test_env());
-  const dds_entity_t rq_topic =
-      dds_create_topic(raw.handle(), &rcl_interfaces_srv_dds__GetParameters_Request__desc,
-                       request_topic(name, ParamService::kGet).c_str(), nullptr, nullptr);
-  const dds_entity_t rr_topic =
-      dds_create_topic(raw.handle(), &rcl_interfaces_srv_dds__GetParameters_Response__desc,
-                       reply_topic(name, ParamService::kGet).c_str(), nullptr, nullptr);
+  const dds_entity_t rq_topic = dds_create_topic(raw.handle(), &rcl_interfaces_srv_dds__GetParameters_Request__desc,
+                                                 request_topic(name, ParamService::kGet).c_str(), nullptr, nullptr);
+  const dds_entity_t rr_topic = dds_create_topic(raw.handle(), &rcl_interfaces_srv_dds__GetParameters_Response__desc,
+                                                 reply_topic(name, ParamService::kGet).c_str(), nullptr, nullptr);
   const dds_entity_t ev_topic = dds_create_topic(raw.handle(), &rcl_interfaces_msg_dds__ParameterEvent__desc,
                                                  "rt/parameter_events", nullptr, nullptr);
   ASSERT_GT(rq_topic, 0);

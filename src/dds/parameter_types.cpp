@@ -122,8 +122,8 @@ ListResult list_parameters(const std::vector<std::string>& declared, const std::
         listed = true;
       } else if (name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
                  name[prefix.size()] == '.') {
-        listed = depth == kDepthRecursive ||
-                 fewer_separators_than_depth(std::string_view(name).substr(prefix.size() + 1));
+        listed =
+            depth == kDepthRecursive || fewer_separators_than_depth(std::string_view(name).substr(prefix.size() + 1));
       }
     }
     if (!listed) continue;

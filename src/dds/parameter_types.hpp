@@ -94,9 +94,9 @@ inline constexpr std::uint64_t kDepthRecursive = 0;
 
 /// The six parameter services of a ROS 2 node, named "/<node>/<service>" (rclcpp ParameterService).
 enum class ParamService { kGet, kGetTypes, kSet, kSetAtomically, kDescribe, kList };
-inline constexpr std::array<ParamService, 6> kParamServices = {
-    ParamService::kGet,      ParamService::kGetTypes, ParamService::kSet,
-    ParamService::kSetAtomically, ParamService::kDescribe, ParamService::kList};
+inline constexpr std::array<ParamService, 6> kParamServices = {ParamService::kGet,      ParamService::kGetTypes,
+                                                               ParamService::kSet,      ParamService::kSetAtomically,
+                                                               ParamService::kDescribe, ParamService::kList};
 /// Position of `service` in kParamServices (and in per-service tables).
 inline constexpr std::size_t index(ParamService service) { return static_cast<std::size_t>(service); }
 /// "get_parameters", "get_parameter_types", "set_parameters", "set_parameters_atomically",

@@ -188,9 +188,7 @@ void to_c(const ListResult& v, rcl_interfaces_msg_dds__ListParametersResult_& c)
 std::vector<Param> from_c(const dds_sequence_rcl_interfaces_msg_dds__Parameter_& s) { return from_seq<Param>(s); }
 
 void to_c(const std::vector<Param>& v, dds_sequence_rcl_interfaces_msg_dds__Parameter_& c) { to_seq(v, c); }
-void to_c(const std::vector<ParamValue>& v, dds_sequence_rcl_interfaces_msg_dds__ParameterValue_& c) {
-  to_seq(v, c);
-}
+void to_c(const std::vector<ParamValue>& v, dds_sequence_rcl_interfaces_msg_dds__ParameterValue_& c) { to_seq(v, c); }
 void to_c(const std::vector<SetResult>& v, dds_sequence_rcl_interfaces_msg_dds__SetParametersResult_& c) {
   to_seq(v, c);
 }

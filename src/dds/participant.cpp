@@ -51,8 +51,7 @@ RosEnvironment read_ros_environment(const std::string& enclave) {
   } else if (range == "SYSTEM_DEFAULT") {
     e.range = DiscoveryRange::kSystemDefault;
   } else {
-    throw DdsError("ROS_AUTOMATIC_DISCOVERY_RANGE='" + range +
-                   "': expected SUBNET, LOCALHOST, OFF or SYSTEM_DEFAULT");
+    throw DdsError("ROS_AUTOMATIC_DISCOVERY_RANGE='" + range + "': expected SUBNET, LOCALHOST, OFF or SYSTEM_DEFAULT");
   }
   if (env("ROS_LOCALHOST_ONLY") == "1") e.range = DiscoveryRange::kLocalhost;
   e.static_peers = env("ROS_STATIC_PEERS");
@@ -120,8 +119,7 @@ Participant::~Participant() {
 dds_qos_t* ros_qos(int depth, bool reliable) {
   dds_qos_t* q = dds_create_qos();
   dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
-  dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
-                       DDS_INFINITY);
+  dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_INFINITY);
   dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
   dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_INFINITY);
   dds_qset_writer_data_lifecycle(q, false);

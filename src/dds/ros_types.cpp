@@ -33,19 +33,33 @@ static_assert(sizeof(idl_walk::CSeq) == sizeof(dds_sequence_double) &&
 template <class T>
 const dds_topic_descriptor_t& idl();
 template <>
-const dds_topic_descriptor_t& idl<msg::PoseStamped>() { return geometry_msgs_msg_dds__PoseStamped__desc; }
+const dds_topic_descriptor_t& idl<msg::PoseStamped>() {
+  return geometry_msgs_msg_dds__PoseStamped__desc;
+}
 template <>
-const dds_topic_descriptor_t& idl<msg::TwistStamped>() { return geometry_msgs_msg_dds__TwistStamped__desc; }
+const dds_topic_descriptor_t& idl<msg::TwistStamped>() {
+  return geometry_msgs_msg_dds__TwistStamped__desc;
+}
 template <>
-const dds_topic_descriptor_t& idl<msg::Imu>() { return sensor_msgs_msg_dds__Imu__desc; }
+const dds_topic_descriptor_t& idl<msg::Imu>() {
+  return sensor_msgs_msg_dds__Imu__desc;
+}
 template <>
-const dds_topic_descriptor_t& idl<msg::Float64MultiArray>() { return std_msgs_msg_dds__Float64MultiArray__desc; }
+const dds_topic_descriptor_t& idl<msg::Float64MultiArray>() {
+  return std_msgs_msg_dds__Float64MultiArray__desc;
+}
 template <>
-const dds_topic_descriptor_t& idl<msg::Clock>() { return rosgraph_msgs_msg_dds__Clock__desc; }
+const dds_topic_descriptor_t& idl<msg::Clock>() {
+  return rosgraph_msgs_msg_dds__Clock__desc;
+}
 template <>
-const dds_topic_descriptor_t& idl<msg::ControllerStatus>() { return quadcosim_msgs_msg_dds__ControllerStatus__desc; }
+const dds_topic_descriptor_t& idl<msg::ControllerStatus>() {
+  return quadcosim_msgs_msg_dds__ControllerStatus__desc;
+}
 template <>
-const dds_topic_descriptor_t& idl<msg::PlantStatus>() { return quadcosim_msgs_msg_dds__PlantStatus__desc; }
+const dds_topic_descriptor_t& idl<msg::PlantStatus>() {
+  return quadcosim_msgs_msg_dds__PlantStatus__desc;
+}
 
 // Room for the C sample of any message type on the stack (checked per type by ops_for).
 constexpr std::size_t kMaxSample = 1024;
@@ -54,8 +68,7 @@ template <class T>
 TypeOps ops_for() {
   const dds_topic_descriptor_t& d = idl<T>();
   if (demangle_ros_type(d.m_typename) != T::kRosType) {
-    throw std::logic_error("ros_types: " + std::string(T::kRosType) + " is paired with the idlc type " +
-                           d.m_typename);
+    throw std::logic_error("ros_types: " + std::string(T::kRosType) + " is paired with the idlc type " + d.m_typename);
   }
   if (d.m_size > kMaxSample || d.m_align > alignof(std::max_align_t)) {
     throw std::logic_error("ros_types: the C sample of " + std::string(d.m_typename) + " is larger than kMaxSample");

@@ -16,11 +16,11 @@ enum class SecurityStrategy { kPermissive, kEnforce };
 
 /// The ROS 2 security environment, as read (no files are looked at here).
 struct SecurityEnvironment {
-  bool enabled = false;  ///< ROS_SECURITY_ENABLE is exactly "true"
+  bool enabled = false;                                       ///< ROS_SECURITY_ENABLE is exactly "true"
   SecurityStrategy strategy = SecurityStrategy::kPermissive;  ///< ROS_SECURITY_STRATEGY == "Enforce"
-  std::string keystore;          ///< ROS_SECURITY_KEYSTORE ("" when unset)
-  std::string enclave_override;  ///< ROS_SECURITY_ENCLAVE_OVERRIDE ("" when unset)
-  std::string warning;           ///< a value rcl would silently read differently than written, or ""
+  std::string keystore;                                       ///< ROS_SECURITY_KEYSTORE ("" when unset)
+  std::string enclave_override;                               ///< ROS_SECURITY_ENCLAVE_OVERRIDE ("" when unset)
+  std::string warning;  ///< a value rcl would silently read differently than written, or ""
 };
 
 /// Reads the four variables. As rcl: only "true" enables, only "Enforce" enforces. A value that is

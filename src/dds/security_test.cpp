@@ -17,8 +17,8 @@ namespace fs = std::filesystem;
 class SecurityEnvTest : public ::testing::Test {
  protected:
   void TearDown() override {
-    for (const char* v : {"ROS_SECURITY_ENABLE", "ROS_SECURITY_STRATEGY", "ROS_SECURITY_KEYSTORE",
-                          "ROS_SECURITY_ENCLAVE_OVERRIDE"}) {
+    for (const char* v :
+         {"ROS_SECURITY_ENABLE", "ROS_SECURITY_STRATEGY", "ROS_SECURITY_KEYSTORE", "ROS_SECURITY_ENCLAVE_OVERRIDE"}) {
       unsetenv(v);
     }
   }

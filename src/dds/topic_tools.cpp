@@ -52,16 +52,20 @@ std::string yaml_string(std::string_view s) {
   if (!printable) {  // double quotes with escapes
     std::string out = "\"";
     for (unsigned char c : s) {
-      if (c == '\n') out += "\\n";
-      else if (c == '\t') out += "\\t";
-      else if (c == '"') out += "\\\"";
-      else if (c == '\\') out += "\\\\";
+      if (c == '\n')
+        out += "\\n";
+      else if (c == '\t')
+        out += "\\t";
+      else if (c == '"')
+        out += "\\\"";
+      else if (c == '\\')
+        out += "\\\\";
       else if (c < 0x20 || c == 0x7f) {
         char x[8];
         std::snprintf(x, sizeof x, "\\x%02X", c);
         out += x;
-      }
-      else out += static_cast<char>(c);
+      } else
+        out += static_cast<char>(c);
     }
     return out + "\"";
   }

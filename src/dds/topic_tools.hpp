@@ -107,9 +107,9 @@ std::string to_yaml(const M& m) {
 class RateWindow {
  public:
   struct Stats {
-    double rate_hz = 0;    ///< 1 / mean interval
+    double rate_hz = 0;  ///< 1 / mean interval
     double min_s = 0, max_s = 0;
-    double std_dev_s = 0;  ///< population standard deviation of the intervals
+    double std_dev_s = 0;    ///< population standard deviation of the intervals
     std::size_t window = 0;  ///< intervals used
   };
 

@@ -30,11 +30,10 @@ void LockstepControllerDriver::run() {
 
 RealtimeControllerDriver::RealtimeControllerDriver(std::vector<DrivenController> controllers,
                                                    const sim::TickClock& clock, int controller_divider,
-                                                   double rate_factor, RealtimeControllerHooks hooks,
-                                                   DriverHost& host)
+                                                   double rate_factor, RealtimeControllerHooks hooks, DriverHost& host)
     : dt_s_(static_cast<double>(clock.period_ns * controller_divider) / 1e9),
-      wall_period_ns_(static_cast<std::int64_t>(static_cast<double>(clock.period_ns * controller_divider) /
-                                                rate_factor)),
+      wall_period_ns_(
+          static_cast<std::int64_t>(static_cast<double>(clock.period_ns * controller_divider) / rate_factor)),
       hooks_(std::move(hooks)),
       host_(host) {
   controllers_.reserve(controllers.size());

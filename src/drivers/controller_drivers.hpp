@@ -60,8 +60,7 @@ struct RealtimeControllerHooks {
 class RealtimeControllerDriver {
  public:
   RealtimeControllerDriver(std::vector<DrivenController> controllers, const sim::TickClock& clock,
-                           int controller_divider, double rate_factor, RealtimeControllerHooks hooks,
-                           DriverHost& host);
+                           int controller_divider, double rate_factor, RealtimeControllerHooks hooks, DriverHost& host);
   /// Steps every period until the host asks to stop. Throws std::invalid_argument on a refused
   /// scheduled parameter.
   void run();

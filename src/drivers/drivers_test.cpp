@@ -494,8 +494,7 @@ TEST(RealtimeControllerDriverTest, CommandsNothingBeforeTheFirstCompleteSample) 
   driver.run();
   EXPECT_EQ(first, std::vector<std::int64_t>{30'000'000});
   EXPECT_EQ(commands, 4);  // wake-ups 3..6
-  EXPECT_EQ(wakes, (std::vector<std::int64_t>{5'000'000, 10'000'000, 15'000'000, 20'000'000, 25'000'000,
-                                              30'000'000}));
+  EXPECT_EQ(wakes, (std::vector<std::int64_t>{5'000'000, 10'000'000, 15'000'000, 20'000'000, 25'000'000, 30'000'000}));
 }
 
 }  // namespace

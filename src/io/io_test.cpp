@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +14,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -87,17 +87,27 @@ std::vector<PaperScenario> paper_scenarios() {
                                            {"settling_time_2pct_s", 5.0, 7.0},
                                            {"steady_state_error_pct", none, 1.0}};
   return {
-      {"altitude_step.yaml", "altitude_step", "z", 10.0, 0.0, false, 0.0,
+      {"altitude_step.yaml",
+       "altitude_step",
+       "z",
+       10.0,
+       0.0,
+       false,
+       0.0,
        {{"overshoot_pct", 15.0, 21.0},
         {"peak_time_s", 2.0, 3.0},
         {"settling_time_2pct_s", none, 8.5},
         {"steady_state_error_pct", none, 1.0}}},
       {"roll_step.yaml", "roll_step", "roll", 0.1, 10.0, true, 10.0, attitude},
       {"pitch_step.yaml", "pitch_step", "pitch", 0.15, 10.0, true, 10.0, attitude},
-      {"yaw_step.yaml", "yaw_step", "yaw", 0.2, 10.0, true, 10.0,
-       {{"overshoot_pct", none, 2.0},
-        {"settling_time_2pct_s", 7.0, 9.0},
-        {"steady_state_error_pct", none, 1.0}}},
+      {"yaw_step.yaml",
+       "yaw_step",
+       "yaw",
+       0.2,
+       10.0,
+       true,
+       10.0,
+       {{"overshoot_pct", none, 2.0}, {"settling_time_2pct_s", 7.0, 9.0}, {"steady_state_error_pct", none, 1.0}}},
   };
 }
 
@@ -188,7 +198,8 @@ TEST(ScenarioTest, EmptyMappingGivesTheDefaults) {
 
 TEST(ScenarioTest, ScheduleTimesBecomeTicks) {
   TempDir dir;
-  const std::string path = dir.write("sched.yaml", R"(simulation: {plant_rate_hz: 200, controller_rate_hz: 50, duration_s: 3}
+  const std::string path =
+      dir.write("sched.yaml", R"(simulation: {plant_rate_hz: 200, controller_rate_hz: 50, duration_s: 3}
 schedule:
   - at_s: 0.5
     set: {z_des: 2, altitude: {kp: 5}}
@@ -362,20 +373,24 @@ TEST_P(BadScenarioTest, ConfigErrorNamesFileKeyAndValue) {
 INSTANTIATE_TEST_SUITE_P(
     Scenario, BadScenarioTest,
     ::testing::Values(
-        BadScenario{"unknown_top_level_key", "name: x\nsimulaton: {duration_s: 1}\n",
-                    {"simulaton: unknown key"}},
-        BadScenario{"unknown_limit", "simulation: {duration_s: 5}\nanalysis:\n  limits: {max_sat_s: 1}\n",
+        BadScenario{"unknown_top_level_key", "name: x\nsimulaton: {duration_s: 1}\n", {"simulaton: unknown key"}},
+        BadScenario{"unknown_limit",
+                    "simulation: {duration_s: 5}\nanalysis:\n  limits: {max_sat_s: 1}\n",
                     {"analysis.limits.max_sat_s: unknown key"}},
-        BadScenario{"negative_limit", "simulation: {duration_s: 5}\nanalysis:\n  limits: {max_saturated_s: -1}\n",
+        BadScenario{"negative_limit",
+                    "simulation: {duration_s: 5}\nanalysis:\n  limits: {max_saturated_s: -1}\n",
                     {"analysis.limits.max_saturated_s: ", "'-1'"}},
-        BadScenario{"string_limit", "analysis:\n  limits: {max_rms_u1_deviation_n: lots}\n",
+        BadScenario{"string_limit",
+                    "analysis:\n  limits: {max_rms_u1_deviation_n: lots}\n",
                     {"analysis.limits.max_rms_u1_deviation_n: ", "'lots'", "expected a number"}},
         BadScenario{"unknown_nested_key", "vehicle:\n  mas_kg: 2\n", {"vehicle.mas_kg: unknown key"}},
-        BadScenario{"unknown_motor_key", "vehicle:\n  motor: {tau_upp_s: 0.1}\n",
-                    {"vehicle.motor.tau_upp_s: unknown key"}},
-        BadScenario{"string_for_number", "simulation:\n  plant_rate_hz: fast\n",
+        BadScenario{
+            "unknown_motor_key", "vehicle:\n  motor: {tau_upp_s: 0.1}\n", {"vehicle.motor.tau_upp_s: unknown key"}},
+        BadScenario{"string_for_number",
+                    "simulation:\n  plant_rate_hz: fast\n",
                     {"simulation.plant_rate_hz: ", "'fast'", "expected a number"}},
-        BadScenario{"list_for_number", "simulation:\n  duration_s: [1, 2]\n",
+        BadScenario{"list_for_number",
+                    "simulation:\n  duration_s: [1, 2]\n",
                     {"simulation.duration_s: ", "a list", "expected a number"}},
         BadScenario{"negative_mass", "vehicle: {mass_kg: -1}\n", {"vehicle.mass_kg: ", "'-1'"}},
         BadScenario{"motor_lag_too_fast_for_step",
@@ -387,8 +402,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadScenario{"controller_faster_than_plant",
                     "simulation: {plant_rate_hz: 100, controller_rate_hz: 200}\n",
                     {"simulation.controller_rate_hz: ", "200"}},
-        BadScenario{"duration_not_on_a_tick", "simulation: {duration_s: 1.005}\n",
-                    {"simulation.duration_s: ", "1.005"}},
+        BadScenario{
+            "duration_not_on_a_tick", "simulation: {duration_s: 1.005}\n", {"simulation.duration_s: ", "1.005"}},
         BadScenario{"schedule_time_not_on_a_tick",
                     "schedule:\n  - at_s: 0.0125\n    set: {z_des: 1}\n",
                     {"schedule[0].at_s: ", "0.0125", "whole number of plant periods"}},
@@ -400,32 +415,36 @@ INSTANTIATE_TEST_SUITE_P(
         BadScenario{"schedule_unknown_parameter",
                     "schedule:\n  - at_s: 1\n    set: {z_dse: 1}\n",
                     {"schedule[0].set.z_dse: ", "z_dse"}},
-        BadScenario{"unknown_controller_parameter", "controller:\n  z_dse: 3\n",
+        BadScenario{"unknown_controller_parameter",
+                    "controller:\n  z_dse: 3\n",
                     {"controller.z_dse: ", "unknown controller parameter 'z_dse'"}},
-        BadScenario{"unknown_nested_controller_parameter", "controller:\n  altitude: {kq: 3}\n",
+        BadScenario{"unknown_nested_controller_parameter",
+                    "controller:\n  altitude: {kq: 3}\n",
                     {"controller.altitude.kq: ", "'altitude.kq'"}},
-        BadScenario{"parameter_out_of_range", "controller:\n  roll_des: 5\n",
+        BadScenario{"parameter_out_of_range",
+                    "controller:\n  roll_des: 5\n",
                     {"controller.roll_des: ", "got 5", "[-1.5, 1.5]"}},
-        BadScenario{"parameter_not_a_number", "controller:\n  altitude.kp: strong\n",
+        BadScenario{"parameter_not_a_number",
+                    "controller:\n  altitude.kp: strong\n",
                     {"controller.altitude.kp: ", "'strong'", "number"}},
-        BadScenario{"bad_choice", "controller:\n  mode: hover\n",
-                    {"controller.mode: ", "'hover'", "'attitude'", "'position'"}},
+        BadScenario{
+            "bad_choice", "controller:\n  mode: hover\n", {"controller.mode: ", "'hover'", "'attitude'", "'position'"}},
         BadScenario{"bad_layout", "vehicle: {layout: h}\n", {"vehicle.layout: ", "'h'", "'plus'"}},
         BadScenario{"spin_not_unit", "vehicle:\n  spin: [1, -1, 2, -1]\n", {"vehicle.spin: ", "2"}},
-        BadScenario{"spin_unbalanced", "vehicle:\n  spin: [1, 1, 1, -1]\n",
-                    {"vehicle.spin: ", "[1, 1, 1, -1]"}},
-        BadScenario{"gravity_zero", "vehicle: {gravity_m_s2: 0}\n",
-                    {"vehicle.gravity_m_s2: ", "got '0'", "(0, 1000]"}},
+        BadScenario{"spin_unbalanced", "vehicle:\n  spin: [1, 1, 1, -1]\n", {"vehicle.spin: ", "[1, 1, 1, -1]"}},
+        BadScenario{"gravity_zero", "vehicle: {gravity_m_s2: 0}\n", {"vehicle.gravity_m_s2: ", "got '0'", "(0, 1000]"}},
         BadScenario{"mass_below_range", "vehicle: {mass_kg: 1e-9}\n", {"vehicle.mass_kg: ", "[1e-06, 1e+12]"}},
-        BadScenario{"drag_entry_negative", "vehicle:\n  aero: {linear_drag_N_s_m: [0, -0.5, 0]}\n",
+        BadScenario{"drag_entry_negative",
+                    "vehicle:\n  aero: {linear_drag_N_s_m: [0, -0.5, 0]}\n",
                     {"vehicle.aero.linear_drag_N_s_m: ", "-0.5", "[0, 1e+06]"}},
-        BadScenario{"omega_min_above_max", "vehicle:\n  motor: {omega_min_rad_s: 500, omega_max_rad_s: 400}\n",
+        BadScenario{"omega_min_above_max",
+                    "vehicle:\n  motor: {omega_min_rad_s: 500, omega_max_rad_s: 400}\n",
                     {"vehicle.motor.omega_min_rad_s: ", "below motor.omega_max_rad_s", "500"}},
-        BadScenario{"unknown_aero_key", "vehicle:\n  aero: {sideways_drag: 1}\n",
-                    {"vehicle.aero.sideways_drag: unknown key"}},
+        BadScenario{
+            "unknown_aero_key", "vehicle:\n  aero: {sideways_drag: 1}\n", {"vehicle.aero.sideways_drag: unknown key"}},
         BadScenario{"spin_too_short", "vehicle:\n  spin: [1, -1]\n", {"vehicle.spin: ", "a list", "4"}},
-        BadScenario{"initial_below_ground", "initial: {position_m: [0, 0, -1]}\n",
-                    {"initial.position_m: ", "z must be >= 0"}},
+        BadScenario{
+            "initial_below_ground", "initial: {position_m: [0, 0, -1]}\n", {"initial.position_m: ", "z must be >= 0"}},
         BadScenario{"unknown_step_channel",
                     "analysis:\n  steps:\n    - {channel: altitude, at_s: 0}\n",
                     {"analysis.steps[0].channel: ", "'altitude'"}},
@@ -447,14 +466,16 @@ INSTANTIATE_TEST_SUITE_P(
         // key threw yaml-cpp's conversion error past the loader; an alias containing itself made the
         // parameter walk recurse until the stack overflowed.
         BadScenario{"list_as_key", "? [a, b]\n: 1\n", {"a list as a key", "expected a plain name"}},
-        BadScenario{"mapping_as_controller_key", "controller:\n  ? {a: 1}\n  : 2\n",
-                    {"controller: ", "a mapping as a key"}},
-        BadScenario{"alias_containing_itself", "controller: &c\n  lqr: *c\n",
+        BadScenario{
+            "mapping_as_controller_key", "controller:\n  ? {a: 1}\n  : 2\n", {"controller: ", "a mapping as a key"}},
+        BadScenario{"alias_containing_itself",
+                    "controller: &c\n  lqr: *c\n",
                     {"controller.lqr.lqr.lqr: ", "nested too deeply"}},
         BadScenario{"criterion_bound_a_list",
                     "analysis:\n  steps:\n    - channel: z\n      criteria: {overshoot_pct: [[1], 2]}\n",
                     {"analysis.steps[0].criteria.overshoot_pct: ", "got a list, expected a number or null"}},
-        BadScenario{"parameter_a_list", "controller:\n  z_des: [1, 2]\n",
+        BadScenario{"parameter_a_list",
+                    "controller:\n  z_des: [1, 2]\n",
                     {"controller.z_des: ", "got a list, expected a single value"}},
         BadScenario{"yaml_syntax_error",
                     "name: broken\nsimulation:\n  plant_rate_hz: 100\n  duration_s: 15: 3\n"
@@ -478,8 +499,7 @@ TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
   const model::VehicleParams v = load_vehicle(dir.write("v.yaml", "mass_kg: 3\nIzz_kg_m2: 0.06\n"));
   EXPECT_EQ(v.mass_kg, 3.0);
   EXPECT_EQ(v.Izz_kg_m2, 0.06);
-  const control::ControllerConfig c =
-      load_controller(dir.write("c.yaml", "lqr: {roll: {r: 20}}\nyaw_des: 0.5\n"), v);
+  const control::ControllerConfig c = load_controller(dir.write("c.yaml", "lqr: {roll: {r: 20}}\nyaw_des: 0.5\n"), v);
   EXPECT_EQ(c.params.roll.r, 20.0);
   EXPECT_EQ(c.setpoint.yaw_des_rad, 0.5);
   EXPECT_EQ(c.params.vehicle.mass_kg, 3.0);
@@ -539,9 +559,8 @@ double parse_cell(const std::string& cell) {
 
 TEST(TrajectoryWriterTest, HeaderHasTheDocumentedColumns) {
   const std::vector<std::string> required = {
-      "t",  "x",  "y",  "z",  "vx", "vy", "vz", "qw", "qx", "qy",    "qz",    "roll",     "pitch", "yaw",
-      "p",  "q",  "r",  "w1", "w2", "w3", "w4", "x_des", "y_des", "z_des", "roll_des", "pitch_des",
-      "yaw_des"};
+      "t", "x", "y", "z",  "vx", "vy", "vz", "qw",    "qx",    "qy",    "qz",       "roll",      "pitch",  "yaw",
+      "p", "q", "r", "w1", "w2", "w3", "w4", "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des"};
   // Appended after watchdog, so that readers by position of the older columns still work.
   const std::vector<std::string> tail = {"watchdog", "sat1", "sat2", "sat3", "sat4", "tilt_sat"};
   TempDir dir;
@@ -591,22 +610,61 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
       x.w_B = {a(6), a(7), a(8)};
       x.omega_rad_s = model::Vector4(a(9), a(10), a(11), a(12));
       const Eigen::Vector4d cmd(a(13), a(0) * 3.0, a(5) / 7.0, 1e10 / 3.0);
-      ControlColumns c{a(1), a(2), a(3), a(4), a(5), a(6), Eigen::Vector4d(a(7), a(8), a(9), a(10)),
-                       k % 2 == 1, {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3}, k % 3 == 1};
+      ControlColumns c{a(1),
+                       a(2),
+                       a(3),
+                       a(4),
+                       a(5),
+                       a(6),
+                       Eigen::Vector4d(a(7), a(8), a(9), a(10)),
+                       k % 2 == 1,
+                       {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3},
+                       k % 3 == 1};
       const double t = static_cast<double>(k) * 1e7 / 1e9;
       const bool watchdog = k % 3 == 0;
       w.write(t, x, cmd, c, watchdog);
       const model::Euler e = model::euler_from_quaternion(x.q_WB);
-      expected.push_back({t,          x.p_W.x(),      x.p_W.y(),      x.p_W.z(),      x.v_W.x(),
-                          x.v_W.y(),  x.v_W.z(),      x.q_WB.w(),     x.q_WB.x(),     x.q_WB.y(),
-                          x.q_WB.z(), e.roll_rad,     e.pitch_rad,    e.yaw_rad,      x.w_B.x(),
-                          x.w_B.y(),  x.w_B.z(),      x.omega_rad_s[0], x.omega_rad_s[1],
-                          x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3],
-                          c.x_des,    c.y_des,        c.z_des,        c.roll_des,     c.pitch_des,
-                          c.yaw_des,  c.U[0],         c.U[1],         c.U[2],         c.U[3],
-                          c.safety ? 1.0 : 0.0, watchdog ? 1.0 : 0.0,
-                          c.rotor_saturated[0] ? 1.0 : 0.0, c.rotor_saturated[1] ? 1.0 : 0.0,
-                          c.rotor_saturated[2] ? 1.0 : 0.0, c.rotor_saturated[3] ? 1.0 : 0.0,
+      expected.push_back({t,
+                          x.p_W.x(),
+                          x.p_W.y(),
+                          x.p_W.z(),
+                          x.v_W.x(),
+                          x.v_W.y(),
+                          x.v_W.z(),
+                          x.q_WB.w(),
+                          x.q_WB.x(),
+                          x.q_WB.y(),
+                          x.q_WB.z(),
+                          e.roll_rad,
+                          e.pitch_rad,
+                          e.yaw_rad,
+                          x.w_B.x(),
+                          x.w_B.y(),
+                          x.w_B.z(),
+                          x.omega_rad_s[0],
+                          x.omega_rad_s[1],
+                          x.omega_rad_s[2],
+                          x.omega_rad_s[3],
+                          cmd[0],
+                          cmd[1],
+                          cmd[2],
+                          cmd[3],
+                          c.x_des,
+                          c.y_des,
+                          c.z_des,
+                          c.roll_des,
+                          c.pitch_des,
+                          c.yaw_des,
+                          c.U[0],
+                          c.U[1],
+                          c.U[2],
+                          c.U[3],
+                          c.safety ? 1.0 : 0.0,
+                          watchdog ? 1.0 : 0.0,
+                          c.rotor_saturated[0] ? 1.0 : 0.0,
+                          c.rotor_saturated[1] ? 1.0 : 0.0,
+                          c.rotor_saturated[2] ? 1.0 : 0.0,
+                          c.rotor_saturated[3] ? 1.0 : 0.0,
                           c.tilt_saturated ? 1.0 : 0.0});
     }
     w.close();
@@ -629,8 +687,9 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
 TEST(SeriesRecorderTest, HoldsWhatReadSeriesReadsFromTheWrittenCsvBitForBit) {
   // The in-memory series (sweeps) and the CSV read back (run) must judge the same numbers: every
   // column, saturation flags and U1 included, and NaN setpoints (open loop) alike.
-  const std::vector<double> awkward = {0.1, 1.0 / 3.0, -2.0 / 7.0, 1e-300, -0.0, 4830.6078372347,
-                                       std::nextafter(1.0, 2.0), 19.227600000000003, -9.81e-17};
+  const std::vector<double> awkward = {
+      0.1,      1.0 / 3.0, -2.0 / 7.0, 1e-300, -0.0, 4830.6078372347, std::nextafter(1.0, 2.0), 19.227600000000003,
+      -9.81e-17};
   TempDir dir;
   const std::string path = dir.file("trajectory.csv");
   SeriesRecorder recorder;
@@ -642,9 +701,16 @@ TEST(SeriesRecorderTest, HoldsWhatReadSeriesReadsFromTheWrittenCsvBitForBit) {
       x.p_W = {a(0), a(1), a(2)};
       x.q_WB = Eigen::Quaterniond(0.5 + 1e-3 * k, std::sqrt(0.2) / (k + 1), -1.0 / 3.0, 0.1 * k).normalized();
       ControlColumns c = k % 6 == 5 ? ControlColumns::none()
-                                    : ControlColumns{a(1), a(2), a(3), a(4), a(5), a(6),
-                                                     Eigen::Vector4d(a(7), a(8), 0.0, 0.0), false,
-                                                     {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3}, k % 3 == 1};
+                                    : ControlColumns{a(1),
+                                                     a(2),
+                                                     a(3),
+                                                     a(4),
+                                                     a(5),
+                                                     a(6),
+                                                     Eigen::Vector4d(a(7), a(8), 0.0, 0.0),
+                                                     false,
+                                                     {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3},
+                                                     k % 3 == 1};
       const double t = static_cast<double>(k) * 1e7 / 1e9;
       w.write(t, x, Eigen::Vector4d::Zero(), c);
       recorder.add(t, x, c);
@@ -767,25 +833,24 @@ TEST_P(BadScheduleTest, RejectedWithFileAndLine) {
 
 INSTANTIATE_TEST_SUITE_P(
     Csv, BadScheduleTest,
-    ::testing::Values(
-        BadSchedule{"bad_header", "time,w1,w2,w3,w4\n0,1,1,1,1\n", 1, "header"},
-        BadSchedule{"header_missing_column", "t,w1,w2,w3\n0,1,1,1\n", 1, "t,w1,w2,w3,w4"},
-        BadSchedule{"empty_file", "", 1, "empty"},
-        BadSchedule{"no_rows", "t,w1,w2,w3,w4\n", 1, "no command rows"},
-        BadSchedule{"not_a_number", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,fast,1,1\n", 3, "'fast'"},
-        BadSchedule{"number_with_junk", "t,w1,w2,w3,w4\n0,1,1,1,1x\n", 2, "'1x'"},
-        BadSchedule{"empty_cell", "t,w1,w2,w3,w4\n0,1,,1,1\n", 2, "not a number"},
-        BadSchedule{"equal_times", "t,w1,w2,w3,w4\n0,1,1,1,1\n0.5,1,1,1,1\n0.5,2,2,2,2\n", 4, "increase"},
-        BadSchedule{"decreasing_times", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,1,1\n\n0.5,2,2,2,2\n", 5,
-                    "increase"},
-        BadSchedule{"negative_time", "t,w1,w2,w3,w4\n-1,1,1,1,1\n", 2, "time"},
-        BadSchedule{"negative_speed", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,-5,1\n", 3, "w3"},
-        BadSchedule{"infinite_speed", "t,w1,w2,w3,w4\n0,1,inf,1,1\n", 2, "finite"},
-        BadSchedule{"nan_time", "t,w1,w2,w3,w4\nnan,1,1,1,1\n", 2, "finite"},
-        BadSchedule{"too_few_columns", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,1\n", 3, "got 4"},
-        BadSchedule{"too_many_columns", "t,w1,w2,w3,w4\n0,1,1,1,1,1\n", 2, "got 6"},
-        BadSchedule{"trailing_comma_row", "t,w1,w2,w3,w4\n0,1,1,1,1,\n", 2, "trailing comma"},
-        BadSchedule{"trailing_comma_header", "t,w1,w2,w3,w4,\n0,1,1,1,1\n", 1, "trailing comma"}),
+    ::testing::Values(BadSchedule{"bad_header", "time,w1,w2,w3,w4\n0,1,1,1,1\n", 1, "header"},
+                      BadSchedule{"header_missing_column", "t,w1,w2,w3\n0,1,1,1\n", 1, "t,w1,w2,w3,w4"},
+                      BadSchedule{"empty_file", "", 1, "empty"},
+                      BadSchedule{"no_rows", "t,w1,w2,w3,w4\n", 1, "no command rows"},
+                      BadSchedule{"not_a_number", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,fast,1,1\n", 3, "'fast'"},
+                      BadSchedule{"number_with_junk", "t,w1,w2,w3,w4\n0,1,1,1,1x\n", 2, "'1x'"},
+                      BadSchedule{"empty_cell", "t,w1,w2,w3,w4\n0,1,,1,1\n", 2, "not a number"},
+                      BadSchedule{"equal_times", "t,w1,w2,w3,w4\n0,1,1,1,1\n0.5,1,1,1,1\n0.5,2,2,2,2\n", 4, "increase"},
+                      BadSchedule{"decreasing_times", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,1,1\n\n0.5,2,2,2,2\n", 5,
+                                  "increase"},
+                      BadSchedule{"negative_time", "t,w1,w2,w3,w4\n-1,1,1,1,1\n", 2, "time"},
+                      BadSchedule{"negative_speed", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,-5,1\n", 3, "w3"},
+                      BadSchedule{"infinite_speed", "t,w1,w2,w3,w4\n0,1,inf,1,1\n", 2, "finite"},
+                      BadSchedule{"nan_time", "t,w1,w2,w3,w4\nnan,1,1,1,1\n", 2, "finite"},
+                      BadSchedule{"too_few_columns", "t,w1,w2,w3,w4\n0,1,1,1,1\n1,1,1,1\n", 3, "got 4"},
+                      BadSchedule{"too_many_columns", "t,w1,w2,w3,w4\n0,1,1,1,1,1\n", 2, "got 6"},
+                      BadSchedule{"trailing_comma_row", "t,w1,w2,w3,w4\n0,1,1,1,1,\n", 2, "trailing comma"},
+                      BadSchedule{"trailing_comma_header", "t,w1,w2,w3,w4,\n0,1,1,1,1\n", 1, "trailing comma"}),
     [](const auto& info) { return info.param.label; });
 
 TEST(CommandScheduleTest, MissingFileNamesIt) {
@@ -818,8 +883,8 @@ Series first_order_series(double t_step, double T, double final_value) {
 }
 
 StepSpec z_step(double at, std::vector<Criterion> criteria) {
-  return StepSpec{.channel = "z", .t_step_s = at, .criteria = std::move(criteria), .reference_source = {},
-                  .reference = {}};
+  return StepSpec{
+      .channel = "z", .t_step_s = at, .criteria = std::move(criteria), .reference_source = {}, .reference = {}};
 }
 
 TEST(StepReportTest, CriteriaPassAndFail) {
@@ -828,11 +893,11 @@ TEST(StepReportTest, CriteriaPassAndFail) {
   const auto none = std::nullopt;
   const std::vector<StepSpec> steps = {
       z_step(1.0, {{"t95_s", 1.4, 1.6}, {"overshoot_pct", none, 1.0}, {"overshoot_pct", 0.0, 0.0}}),
-      z_step(1.0, {{"t95_s", 1.6, none}}),                     // too fast for a lower bound
-      z_step(1.0, {{"t95_s", none, 1.4}}),                     // too slow for an upper bound
-      z_step(1.0, {{"peak_time_s", none, none}}),              // no value: fails even unbounded
-      z_step(1.0, {}),                                         // nothing to check: passes
-      z_step(1.0, {{"t95_s", 1.5, 1.5}}),                      // bounds are inclusive
+      z_step(1.0, {{"t95_s", 1.6, none}}),         // too fast for a lower bound
+      z_step(1.0, {{"t95_s", none, 1.4}}),         // too slow for an upper bound
+      z_step(1.0, {{"peak_time_s", none, none}}),  // no value: fails even unbounded
+      z_step(1.0, {}),                             // nothing to check: passes
+      z_step(1.0, {{"t95_s", 1.5, 1.5}}),          // bounds are inclusive
   };
   const auto results = evaluate_steps(steps, series);
   ASSERT_EQ(results.size(), steps.size());
@@ -865,10 +930,9 @@ TEST(StepReportTest, CriteriaPassAndFail) {
 
 TEST(StepReportTest, SteadyStateErrorCriterion) {
   const Series short_of_target = first_order_series(0.0, 0.3, 9.5);  // 5 % short
-  const auto results = evaluate_steps(
-      {z_step(0.0, {{"steady_state_error_pct", std::nullopt, 1.0}}),
-       z_step(0.0, {{"steady_state_error_pct", 4.9, 5.1}})},
-      short_of_target);
+  const auto results = evaluate_steps({z_step(0.0, {{"steady_state_error_pct", std::nullopt, 1.0}}),
+                                       z_step(0.0, {{"steady_state_error_pct", 4.9, 5.1}})},
+                                      short_of_target);
   ASSERT_TRUE(results[0].figures.steady_state_error_pct.has_value());
   EXPECT_NEAR(*results[0].figures.steady_state_error_pct, 5.0, 1e-6);
   EXPECT_FALSE(results[0].passed);
@@ -899,9 +963,8 @@ Series climbing_series() {
 }
 
 TEST(StepReportTest, ASettlingCriterionFailsWhenTheRunEndsBeforeSettling) {
-  const auto results = evaluate_steps({z_step(0.0, {{"settling_time_2pct_s", std::nullopt, 2.0},
-                                                   {"t95_s", std::nullopt, 5.0}})},
-                                      climbing_series());
+  const auto results = evaluate_steps(
+      {z_step(0.0, {{"settling_time_2pct_s", std::nullopt, 2.0}, {"t95_s", std::nullopt, 5.0}})}, climbing_series());
   const StepResult& r = results[0];
   EXPECT_EQ(r.figures.verdict, analysis::StepVerdict::kNotSettled);
   EXPECT_FALSE(r.passed);
@@ -947,9 +1010,8 @@ TEST(StepReportTest, AStepIsJudgedUpToTheNextStepOfItsChannel) {
   StepSpec roll;
   roll.channel = "roll";
   roll.t_step_s = 3.0;
-  const auto r = evaluate_steps({z_step(1.0, {{"settling_time_2pct_s", 0.7, 0.9}}), roll,
-                                 z_step(6.0, {{"settling_time_2pct_s", 0.7, 0.9}})},
-                                s);
+  const auto r = evaluate_steps(
+      {z_step(1.0, {{"settling_time_2pct_s", 0.7, 0.9}}), roll, z_step(6.0, {{"settling_time_2pct_s", 0.7, 0.9}})}, s);
   ASSERT_EQ(r.size(), 3u);
   for (const StepResult* step : {&r[0], &r[2]}) {
     EXPECT_EQ(step->figures.verdict, analysis::StepVerdict::kSettled);
@@ -1022,10 +1084,11 @@ TEST(SaturationTest, TimesAreTicksTimesThePeriod) {
   EXPECT_NE(w.find("rotors 2, 4"), std::string::npos) << w;
   EXPECT_NE(w.find("1.400 s"), std::string::npos) << w;
   EXPECT_NE(w.find("tilt limit acted for 0.100 s"), std::string::npos) << w;
-  EXPECT_EQ(saturation_warning(*evaluate_saturation(sc, Series{{0.0, 0.01}, {{"sat1", {0, 0}}, {"sat2", {0, 0}},
-                                                                          {"sat3", {0, 0}}, {"sat4", {0, 0}},
-                                                                          {"tilt_sat", {0, 0}}}})),
-            "");
+  EXPECT_EQ(
+      saturation_warning(*evaluate_saturation(
+          sc, Series{{0.0, 0.01},
+                     {{"sat1", {0, 0}}, {"sat2", {0, 0}}, {"sat3", {0, 0}}, {"sat4", {0, 0}}, {"tilt_sat", {0, 0}}}})),
+      "");
 }
 
 TEST(SaturationTest, LimitsAreCriteria) {
@@ -1041,7 +1104,7 @@ analysis:
   EXPECT_FALSE(r->passed);
   std::map<std::string, bool> verdict;
   for (const auto& c : r->criteria) verdict[c.criterion.figure] = c.passed;
-  EXPECT_TRUE(verdict.at("saturated_s"));          // 1.4 <= 1.5
+  EXPECT_TRUE(verdict.at("saturated_s"));  // 1.4 <= 1.5
   EXPECT_TRUE(verdict.at("rotor1_saturated_s"));
   EXPECT_FALSE(verdict.at("rotor2_saturated_s"));  // 1.3 > 1.0
   EXPECT_TRUE(verdict.at("rotor3_saturated_s"));
@@ -1084,11 +1147,11 @@ TEST(SaturationTest, ColumnsRoundTripThroughTrajectoryCsv) {
   EXPECT_FALSE(r->figures.count("rms_u1_deviation_n"));  // U1 is NaN without a controller
 
   // A trajectory without the columns (written before they existed) still loads; no saturation figures.
-  const std::string old_path = dir.write("old.csv", "t,x,y,z,roll,pitch,yaw,x_des,y_des,z_des,roll_des,pitch_des,yaw_des\n"
-                                                    "0,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  const std::string old_path = dir.write("old.csv",
+                                         "t,x,y,z,roll,pitch,yaw,x_des,y_des,z_des,roll_des,pitch_des,yaw_des\n"
+                                         "0,0,0,0,0,0,0,0,0,0,0,0,0\n");
   EXPECT_FALSE(evaluate_saturation(sc, read_series(old_path)).has_value());
 }
-
 
 TEST(StepReportTest, MissingChannelIsALogicError) {
   const Series series = first_order_series(0.0, 0.5, 10.0);

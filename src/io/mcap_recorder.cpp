@@ -75,8 +75,8 @@ void McapRecorder::push(std::uint16_t channel, std::int64_t t_ns, std::vector<st
 }
 
 void McapRecorder::flush_before(std::int64_t sim_ns) {
-  auto ready = std::stable_partition(pending_.begin(), pending_.end(),
-                                     [sim_ns](const Pending& p) { return p.t_ns < sim_ns; });
+  auto ready =
+      std::stable_partition(pending_.begin(), pending_.end(), [sim_ns](const Pending& p) { return p.t_ns < sim_ns; });
   std::sort(pending_.begin(), ready, [](const Pending& a, const Pending& b) {
     if (a.t_ns != b.t_ns) return a.t_ns < b.t_ns;
     if (a.channel != b.channel) return a.channel < b.channel;

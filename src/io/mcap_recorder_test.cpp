@@ -34,7 +34,7 @@ TEST(McapRecorderTest, RecordsARepeatedTickOnceAndKeepsUnlabelledCommands) {
   labelled.data = {1, 2, 3, 4};
   labelled.dim = {{msg::command_label(20'000'000), 4, 4}};
   cmd.publish(labelled);
-  cmd.publish(labelled);  // the controller answered the repeat again
+  cmd.publish(labelled);         // the controller answered the repeat again
   msg::Float64MultiArray plain;  // a foreign controller: no label, all kept
   plain.data = {5, 6, 7, 8};
   cmd.publish(plain);

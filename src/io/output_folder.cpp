@@ -88,9 +88,10 @@ bool read_output_manifest(const fs::path& dir, OutputManifest& manifest) {
     manifest = std::move(m);
     return true;
   } catch (const std::exception& e) {
-    throw OutputFolderRefused(fmt::format("{}: not a quadcosim output manifest ({}); remove it by hand, or choose "
-                                          "another folder",
-                                          file.string(), e.what()));
+    throw OutputFolderRefused(
+        fmt::format("{}: not a quadcosim output manifest ({}); remove it by hand, or choose "
+                    "another folder",
+                    file.string(), e.what()));
   }
 }
 
@@ -98,8 +99,11 @@ OutputFolder::OutputFolder(fs::path root, OutputManifest manifest, std::string d
     : root_(std::move(root)), manifest_(std::move(manifest)), default_group_(std::move(default_group)) {}
 
 OutputFolder::OutputFolder(OutputFolder&& o) noexcept
-    : root_(std::move(o.root_)), manifest_(std::move(o.manifest_)), default_group_(std::move(o.default_group_)),
-      seen_(std::move(o.seen_)), active_(o.active_) {
+    : root_(std::move(o.root_)),
+      manifest_(std::move(o.manifest_)),
+      default_group_(std::move(o.default_group_)),
+      seen_(std::move(o.seen_)),
+      active_(o.active_) {
   o.active_ = false;
 }
 
@@ -165,8 +169,8 @@ OutputFolder OutputFolder::claim(const fs::path& dir, const std::string& command
                            some_names(listed));
       }
       if (!others.empty()) {
-        what += fmt::format("{}{} quadcosim did not write ({})", what.empty() ? "" : " and ",
-                            files_word(others.size()), some_names(others));
+        what += fmt::format("{}{} quadcosim did not write ({})", what.empty() ? "" : " and ", files_word(others.size()),
+                            some_names(others));
       }
       if (!nested.empty()) {
         what += fmt::format("{}the outputs of other commands in {}", what.empty() ? "" : " and ", some_names(nested));

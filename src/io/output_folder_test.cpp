@@ -127,8 +127,7 @@ TEST(OutputFolder, ForceRemovesExactlyTheListedFilesAndKeepsTheRest) {
     EXPECT_TRUE(fs::exists(t.path() / "runs" / "0003" / "keep.me"));
     for (int i = 0; i < 2; ++i) write(t.path() / "runs" / ("000" + std::to_string(i)) / "metrics.json");
   }
-  EXPECT_NE(notes.str().find("kept 2 files quadcosim did not write: notes.txt, runs/0003/keep.me"),
-            std::string::npos)
+  EXPECT_NE(notes.str().find("kept 2 files quadcosim did not write: notes.txt, runs/0003/keep.me"), std::string::npos)
       << notes.str();
   EXPECT_EQ(manifest_json(t.path())["files"]["outputs"],
             nlohmann::json({"runs/0000/metrics.json", "runs/0001/metrics.json"}));
@@ -198,14 +197,16 @@ TEST(OutputFolder, ReopenOfASubFolderUsesTheEnclosingManifest) {
     write(t.path() / "uav0000" / "step_z.png");
   }
   EXPECT_FALSE(fs::exists(t.path() / "uav0000" / kOutputManifest));
-  EXPECT_EQ(manifest_json(t.path())["files"]["figures"],
-            nlohmann::json({"uav0000/step_z.png", "uav0001/step_x.png"}));
+  EXPECT_EQ(manifest_json(t.path())["files"]["figures"], nlohmann::json({"uav0000/step_z.png", "uav0001/step_x.png"}));
 }
 
 TEST(OutputFolder, NestedOutputFoldersAreKeptAndNamed) {
   TempDir t;
   std::ostringstream notes;
-  { OutputFolder f = OutputFolder::claim(t.path() / "cmp", "compare", {}, notes); write(t.path() / "cmp" / "c.md"); }
+  {
+    OutputFolder f = OutputFolder::claim(t.path() / "cmp", "compare", {}, notes);
+    write(t.path() / "cmp" / "c.md");
+  }
   EXPECT_NE(refusal(t.path(), "run").find("the outputs of other commands in cmp/"), std::string::npos);
   OutputFolder::Options force;
   force.force = true;

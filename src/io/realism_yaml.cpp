@@ -14,11 +14,11 @@ namespace {
 
 constexpr double kBig = 1e6;
 
-Eigen::Vector3d vec3(YamlSection& s, const std::string& key, const Eigen::Vector3d& fallback, double min,
-                     double max) {
+Eigen::Vector3d vec3(YamlSection& s, const std::string& key, const Eigen::Vector3d& fallback, double min, double max) {
   const auto v = s.numbers(key, {fallback.x(), fallback.y(), fallback.z()}, 3);
   for (double e : v) {
-    if (e < min || e > max) s.fail(key, fmt::format("got an entry {:g}, expected numbers in [{:g}, {:g}]", e, min, max));
+    if (e < min || e > max)
+      s.fail(key, fmt::format("got an entry {:g}, expected numbers in [{:g}, {:g}]", e, min, max));
   }
   return {v[0], v[1], v[2]};
 }
@@ -33,8 +33,7 @@ sim::SensorTiming read_timing(YamlSection& s, const sim::SimulationConfig& cfg) 
   if (std::abs(div - std::round(div)) > 1e-9 || cfg.controller_divider % static_cast<int>(std::round(div)) != 0) {
     s.fail("rate_hz", fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
                                   "also divides the controller period ({} plant ticks), e.g. {:g} or {:g}",
-                                  rate, plant_hz, cfg.controller_divider, plant_hz,
-                                  plant_hz / cfg.controller_divider));
+                                  rate, plant_hz, cfg.controller_divider, plant_hz, plant_hz / cfg.controller_divider));
   }
   t.divider = static_cast<int>(std::round(div));
   t.latency_ticks = static_cast<int>(s.integer("latency_ticks", 0, 0, 1000));
@@ -116,8 +115,9 @@ HoldSpec read_hold(YamlSection& s, double duration_s) {
   for (const std::string& fig : c->keys()) {
     const auto& names = hold_figure_names();
     if (std::find(names.begin(), names.end(), fig) == names.end()) {
-      c->fail(fig, "unknown hold figure (expected max_horizontal_error_m, rms_horizontal_error_m or "
-                   "max_vertical_error_m)");
+      c->fail(fig,
+              "unknown hold figure (expected max_horizontal_error_m, rms_horizontal_error_m or "
+              "max_vertical_error_m)");
     }
     const auto [min, max] = c->bounds(fig);
     h.criteria.push_back(Criterion{fig, min, max});

@@ -86,8 +86,8 @@ void read_vehicle(YamlSection& root, model::VehicleParams& v) {
   }
 }
 
-control::ParameterValue parameter_value(YamlSection& s, const std::string& key,
-                                        const control::ParameterSpec& spec, const YAML::Node& n) {
+control::ParameterValue parameter_value(YamlSection& s, const std::string& key, const control::ParameterSpec& spec,
+                                        const YAML::Node& n) {
   if (!n.IsScalar()) s.fail(key, "got " + YamlSection::describe(n) + ", expected a single value");
   if (spec.is_choice()) return n.Scalar();
   try {
@@ -139,16 +139,16 @@ void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duratio
   const double plant_hz = s.number("plant_rate_hz", 100.0, 1e-3, 1e6);
   const double period_ns = 1e9 / plant_hz;
   if (std::abs(period_ns - std::round(period_ns)) > 1e-6) {
-    s.fail("plant_rate_hz", "got " + fmt::format("{:g}", plant_hz) +
-                                ", expected a rate whose period is a whole number of nanoseconds");
+    s.fail("plant_rate_hz",
+           "got " + fmt::format("{:g}", plant_hz) + ", expected a rate whose period is a whole number of nanoseconds");
   }
   cfg.plant.clock.period_ns = static_cast<std::int64_t>(std::round(period_ns));
   const double controller_hz = s.number("controller_rate_hz", 50.0, 1e-3, plant_hz);
   const double divider = plant_hz / controller_hz;
   if (std::abs(divider - std::round(divider)) > 1e-9) {
     s.fail("controller_rate_hz", "got " + fmt::format("{:g}", controller_hz) +
-                                     ", expected a whole divisor of plant_rate_hz (" +
-                                     fmt::format("{:g}", plant_hz) + ")");
+                                     ", expected a whole divisor of plant_rate_hz (" + fmt::format("{:g}", plant_hz) +
+                                     ")");
   }
   cfg.controller_divider = static_cast<int>(std::round(divider));
   cfg.plant.substeps = static_cast<int>(s.integer("substeps", 1, 1, 10000));
@@ -174,9 +174,12 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
   all.drop_probability = f.number("drop_probability", 0.0, 0.0, 1.0);
   all.delay_ticks = f.integer("delay_ticks", 0, 0, 100000);
   const sim::Topics t = sim::Topics::for_namespace(cfg.ns);
-  const std::map<std::string, std::string> by_name = {
-      {"motor_commands", t.motor_commands}, {"Pose", t.pose},   {"Velocity", t.velocity},
-      {"Imu", t.imu},                       {"clock", t.clock}, {"controller_status", t.controller_status}};
+  const std::map<std::string, std::string> by_name = {{"motor_commands", t.motor_commands},
+                                                      {"Pose", t.pose},
+                                                      {"Velocity", t.velocity},
+                                                      {"Imu", t.imu},
+                                                      {"clock", t.clock},
+                                                      {"controller_status", t.controller_status}};
   for (const std::string* name : {&t.pose, &t.velocity, &t.imu, &t.motor_commands}) out.topics[*name] = all;
   if (auto per = f.section("topics")) {
     for (const std::string& key : per->keys()) {
@@ -232,7 +235,10 @@ void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
       for (const std::string& fig : c->keys()) {
         bool known = false;
         for (const auto& f : analysis::figure_names()) known = known || f == fig;
-        if (!known) c->fail(fig, "unknown step figure (expected overshoot_pct, peak_time_s, rise_time_s, t95_s, settling_time_2pct_s or steady_state_error_pct)");
+        if (!known)
+          c->fail(fig,
+                  "unknown step figure (expected overshoot_pct, peak_time_s, rise_time_s, t95_s, settling_time_2pct_s "
+                  "or steady_state_error_pct)");
         const auto [min, max] = c->bounds(fig);
         step.criteria.push_back(Criterion{fig, min, max});
       }
@@ -293,8 +299,8 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
                         "', expected a vehicle index (an integer)");
     }
     if (v < 0 || v >= l.vehicles) {
-      s.fail(where, "got " + std::to_string(v) + ", expected a vehicle index in [0, " +
-                        std::to_string(l.vehicles - 1) + "]");
+      s.fail(where,
+             "got " + std::to_string(v) + ", expected a vehicle index in [0, " + std::to_string(l.vehicles - 1) + "]");
     }
     spec.record_vehicles.push_back(static_cast<int>(v));
   }
@@ -315,9 +321,7 @@ model::State initial_state(const Scenario& sc) {
   return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
 }
 
-Scenario load_scenario(const std::string& path) {
-  return read_scenario(YamlSection::load_file(path), path);
-}
+Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path); }
 
 Scenario load_scenario(const YAML::Node& node, const std::string& path) {
   if (!node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
@@ -340,8 +344,8 @@ Scenario read_scenario(YamlSection root, const std::string& path) {
     sc.simulation.duration_ticks = 1500;
   }
 
-  if (std::string err = model::validate_step(sc.vehicle, sc.simulation.plant.clock.period_s(),
-                                             sc.simulation.plant.substeps);
+  if (std::string err =
+          model::validate_step(sc.vehicle, sc.simulation.plant.clock.period_s(), sc.simulation.plant.substeps);
       !err.empty()) {
     root.fail("simulation.substeps", err);
   }

@@ -42,7 +42,7 @@ struct Criterion {
 
 /// A step to analyse: the channel's setpoint changes at t_step_s.
 struct StepSpec {
-  std::string channel;   ///< x, y, z, roll, pitch or yaw
+  std::string channel;  ///< x, y, z, roll, pitch or yaw
   double t_step_s = 0.0;
   /// Band of the settled verdict and of the settling time, as a fraction of the step
   /// (analysis.steps[].settling_band_pct / 100; 2 % unless set, e.g. wider where sensor noise exceeds it).
@@ -88,8 +88,8 @@ struct Scenario {
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
-  std::optional<SwarmSpec> swarm;  ///< present when the file has a `swarm:` section
-  std::optional<HoldSpec> hold;  ///< analysis.hold
+  std::optional<SwarmSpec> swarm;    ///< present when the file has a `swarm:` section
+  std::optional<HoldSpec> hold;      ///< analysis.hold
   std::optional<LimitsSpec> limits;  ///< analysis.limits
 };
 

@@ -3,14 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
-#include <array>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <sstream>
-#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 namespace quadcosim::io {
@@ -67,8 +67,8 @@ Series read_series(const std::string& path) {
       if (end == c.c_str()) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad number '" + c + "'");
     }
     if (row.size() != header.size()) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected " +
-                               std::to_string(header.size()) + " values");
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected " + std::to_string(header.size()) +
+                               " values");
     }
     s.t_s.push_back(row[t_col]);
     for (std::size_t i = 0; i < names.size(); ++i) s.append(names[i], row[index[i]]);
@@ -81,8 +81,8 @@ bool is_angle(const std::string& channel) { return channel == "roll" || channel 
 
 CriterionResult judge(const Criterion& c, const std::optional<double>& value, std::string note = "") {
   CriterionResult cr{c, value, false, std::move(note)};
-  cr.passed = cr.note.empty() && cr.value.has_value() && (!c.min || *cr.value >= *c.min) &&
-              (!c.max || *cr.value <= *c.max);
+  cr.passed =
+      cr.note.empty() && cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
   return cr;
 }
 }  // namespace
@@ -107,16 +107,16 @@ std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const
     for (const StepSpec& other : steps) {
       if (other.channel == spec.channel && other.t_step_s > spec.t_step_s) end_s = std::min(end_s, other.t_step_s);
     }
-    const auto n = static_cast<std::size_t>(
-        std::lower_bound(series.t_s.begin(), series.t_s.end(), end_s) - series.t_s.begin());
+    const auto n =
+        static_cast<std::size_t>(std::lower_bound(series.t_s.begin(), series.t_s.end(), end_s) - series.t_s.begin());
     analysis::StepOptions options;
     options.angle = is_angle(spec.channel);
     options.settling_band = spec.settling_band;
-    r.figures = analysis::step_figures(std::span(series.t_s).first(n), std::span(y->second).first(n),
-                                       spec.t_step_s, sp->second[i], options);
+    r.figures = analysis::step_figures(std::span(series.t_s).first(n), std::span(y->second).first(n), spec.t_step_s,
+                                       sp->second[i], options);
     for (const Criterion& c : spec.criteria) {
-      const CriterionResult cr = judge(c, analysis::figure(r.figures, c.figure),
-                                       analysis::unjudgeable_reason(r.figures, c.figure, options));
+      const CriterionResult cr =
+          judge(c, analysis::figure(r.figures, c.figure), analysis::unjudgeable_reason(r.figures, c.figure, options));
       r.passed = r.passed && cr.passed;
       r.criteria.push_back(cr);
     }
@@ -189,8 +189,9 @@ std::string saturation_warning(const SaturationResult& s) {
   }
   std::string line = "warning: rotor saturation: ";
   if (s.saturated_s() > 0.0) {
-    line += fmt::format("rotor{} {} clamped at omega_min/omega_max by the allocation for {:.3f} s in total (rotors 1/2/3/4: {} s)",
-                        rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), times);
+    line += fmt::format(
+        "rotor{} {} clamped at omega_min/omega_max by the allocation for {:.3f} s in total (rotors 1/2/3/4: {} s)",
+        rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), times);
   }
   if (s.tilt_saturated_s() > 0.0) {
     line += fmt::format("{}tilt limit acted for {:.3f} s", s.saturated_s() > 0.0 ? "; " : "", s.tilt_saturated_s());
@@ -308,16 +309,15 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
       const auto it = saturation->figures.find(name);
       figs[name] = it == saturation->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
     }
-    j["saturation"] = {{"figures", figs}, {"criteria", criteria_json(saturation->criteria)},
-                       {"passed", saturation->passed}};
+    j["saturation"] = {
+        {"figures", figs}, {"criteria", criteria_json(saturation->criteria)}, {"passed", saturation->passed}};
   }
   j["passed"] = passed_overall(results, hold, saturation);
   return j;
 }
 
-void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
-                        const std::optional<SaturationResult>& saturation) {
+void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
+                        const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation) {
   std::ofstream out(path);
   out << metrics_json(scenario, results, hold, saturation).dump(2) << '\n';
   if (!out) throw std::runtime_error(path + ": write failed");
@@ -349,18 +349,18 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
   for (const StepResult& r : results) {
     const auto& f = r.figures;
     const bool angle = is_angle(r.spec.channel);
-    s += fmt::format("step {} {:g} -> {:g}{} at t = {:g} s: {} ({}; final window {:g} s of {:g} s)\n",
-                     r.spec.channel, f.initial, f.target,
-                     angle && std::abs(f.step - (f.target - f.initial)) > 1e-12
-                         ? fmt::format(" (shortest path {:+.3f})", f.step)
-                         : "",
-                     r.spec.t_step_s, r.passed ? "PASS" : "FAIL", analysis::to_string(f.verdict),
-                     f.final_window_s, f.post_step_s);
+    s += fmt::format(
+        "step {} {:g} -> {:g}{} at t = {:g} s: {} ({}; final window {:g} s of {:g} s)\n", r.spec.channel, f.initial,
+        f.target,
+        angle && std::abs(f.step - (f.target - f.initial)) > 1e-12 ? fmt::format(" (shortest path {:+.3f})", f.step)
+                                                                   : "",
+        r.spec.t_step_s, r.passed ? "PASS" : "FAIL", analysis::to_string(f.verdict), f.final_window_s, f.post_step_s);
     s += fmt::format("  {:<24} {:>12} {:>22} {:>7} {:>10}\n", "figure", "value", "criterion", "", "reference");
     for (const auto& name : analysis::figure_names()) {
       const auto v = analysis::figure(f, name);
       std::string value = v ? fmt::format("{:.3f}", *v) : "-";
-      if (!v && name == "settling_time_2pct_s" && f.verdict == analysis::StepVerdict::kNotSettled) value = "not settled";
+      if (!v && name == "settling_time_2pct_s" && f.verdict == analysis::StepVerdict::kNotSettled)
+        value = "not settled";
       if (!v && f.verdict == analysis::StepVerdict::kTooShort &&
           (name == "settling_time_2pct_s" || name == "steady_state_error_pct")) {
         value = "too short";

@@ -100,8 +100,8 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
 
 /// Writes metrics.json (schema in docs/outputs.md). Throws std::runtime_error on I/O failure.
 /// `hold` and `saturation`, when given, are written under "hold" and "saturation" and count in "passed".
-void write_metrics_json(const std::string& path, const Scenario& scenario,
-                        const std::vector<StepResult>& results, const std::optional<HoldResult>& hold = {},
+void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
+                        const std::optional<HoldResult>& hold = {},
                         const std::optional<SaturationResult>& saturation = {});
 
 /// A fixed-width table: one line per figure with value, criterion, verdict and reference; a figure

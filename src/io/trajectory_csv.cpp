@@ -4,8 +4,8 @@
 
 #include <cassert>
 #include <cmath>
-#include <iterator>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -21,8 +21,16 @@ ControlColumns ControlColumns::none() {
 
 ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
   const auto& s = m.setpoint;
-  return {s[0], s[1], s[2], s[3], s[4], s[5], Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]), m.safety,
-          m.rotor_saturated, m.tilt_saturated};
+  return {s[0],
+          s[1],
+          s[2],
+          s[3],
+          s[4],
+          s[5],
+          Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]),
+          m.safety,
+          m.rotor_saturated,
+          m.tilt_saturated};
 }
 
 std::array<int, 5> ControlColumns::saturation_columns() const {
@@ -32,11 +40,10 @@ std::array<int, 5> ControlColumns::saturation_columns() const {
 
 const std::vector<std::string>& TrajectoryWriter::columns() {
   static const std::vector<std::string> c = {
-      "t",     "x",      "y",       "z",       "vx",       "vy",       "vz",   "qw",  "qx",
-      "qy",    "qz",     "roll",    "pitch",   "yaw",      "p",        "q",    "r",   "w1",
-      "w2",    "w3",     "w4",      "cmd1",    "cmd2",     "cmd3",     "cmd4", "x_des", "y_des",
-      "z_des", "roll_des", "pitch_des", "yaw_des", "U1",   "U2",       "U3",   "U4",  "safety",
-      "watchdog", "sat1", "sat2",  "sat3",     "sat4",     "tilt_sat"};
+      "t",    "x",     "y",      "z",        "vx",    "vy",    "vz",       "qw",        "qx",      "qy", "qz",
+      "roll", "pitch", "yaw",    "p",        "q",     "r",     "w1",       "w2",        "w3",      "w4", "cmd1",
+      "cmd2", "cmd3",  "cmd4",   "x_des",    "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "U1", "U2",
+      "U3",   "U4",    "safety", "watchdog", "sat1",  "sat2",  "sat3",     "sat4",      "tilt_sat"};
   return c;
 }
 
@@ -56,17 +63,17 @@ TrajectoryWriter::~TrajectoryWriter() {
   }
 }
 
-void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vector4d& cmd,
-                             const ControlColumns& c, bool watchdog) {
+void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vector4d& cmd, const ControlColumns& c,
+                             bool watchdog) {
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   auto out = std::back_inserter(buffer_);
-  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},", t, x.p_W.x(), x.p_W.y(),
-                 x.p_W.z(), x.v_W.x(), x.v_W.y(), x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(),
-                 x.q_WB.z(), e.roll_rad, e.pitch_rad, e.yaw_rad, x.w_B.x(), x.w_B.y(), x.w_B.z());
-  fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1],
-                 x.omega_rad_s[2], x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
-  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des,
-                 c.pitch_des, c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},", t, x.p_W.x(), x.p_W.y(), x.p_W.z(),
+                 x.v_W.x(), x.v_W.y(), x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z(), e.roll_rad,
+                 e.pitch_rad, e.yaw_rad, x.w_B.x(), x.w_B.y(), x.w_B.z());
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2],
+                 x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
+  fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des, c.pitch_des,
+                 c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
   const auto sat = c.saturation_columns();
   fmt::format_to(out, "{},{},{},{},{}\n", sat[0], sat[1], sat[2], sat[3], sat[4]);
   if (buffer_.size() > (1 << 16)) {
@@ -106,10 +113,24 @@ void SeriesRecorder::add(double t_s, const model::State& x, const ControlColumns
   // The values of TrajectoryWriter::write's columns of the same names.
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   const auto sat = c.saturation_columns();
-  const double row[] = {x.p_W.x(), x.p_W.y(), x.p_W.z(), e.roll_rad, e.pitch_rad, e.yaw_rad,
-                        c.x_des,   c.y_des,   c.z_des,   c.roll_des, c.pitch_des, c.yaw_des,
-                        static_cast<double>(sat[0]), static_cast<double>(sat[1]), static_cast<double>(sat[2]),
-                        static_cast<double>(sat[3]), static_cast<double>(sat[4]), c.U[0]};
+  const double row[] = {x.p_W.x(),
+                        x.p_W.y(),
+                        x.p_W.z(),
+                        e.roll_rad,
+                        e.pitch_rad,
+                        e.yaw_rad,
+                        c.x_des,
+                        c.y_des,
+                        c.z_des,
+                        c.roll_des,
+                        c.pitch_des,
+                        c.yaw_des,
+                        static_cast<double>(sat[0]),
+                        static_cast<double>(sat[1]),
+                        static_cast<double>(sat[2]),
+                        static_cast<double>(sat[3]),
+                        static_cast<double>(sat[4]),
+                        c.U[0]};
   static_assert(std::size(row) == 18);
   assert(columns_.size() == std::size(row));
   series_.t_s.push_back(t_s);

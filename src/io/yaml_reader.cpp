@@ -87,8 +87,7 @@ double YamlSection::number(const std::string& key, double fallback, const model:
 long long YamlSection::integer(const std::string& key, long long fallback, long long min, long long max) {
   const YAML::Node n = get(key);
   if (!n.IsDefined()) return fallback;
-  const std::string expected =
-      "expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  const std::string expected = "expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
   long long v = 0;
   try {
     if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
@@ -132,8 +131,7 @@ std::string YamlSection::choice(const std::string& key, const std::string& fallb
   fail(key, "got " + shown(n) + ", " + expected);
 }
 
-std::vector<double> YamlSection::numbers(const std::string& key, std::vector<double> fallback,
-                                         std::size_t count) {
+std::vector<double> YamlSection::numbers(const std::string& key, std::vector<double> fallback, std::size_t count) {
   const YAML::Node n = get(key);
   if (!n.IsDefined()) return fallback;
   const std::string expected = "expected a list of " + std::to_string(count) + " numbers";

@@ -32,8 +32,7 @@ class YamlSection {
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback);
   /// One of `choices`; `fallback` when absent.
-  std::string choice(const std::string& key, const std::string& fallback,
-                     const std::vector<std::string>& choices);
+  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices);
   /// A list of exactly n numbers; `fallback` when absent.
   std::vector<double> numbers(const std::string& key, std::vector<double> fallback, std::size_t n);
   /// A pass band `[min, max]` under `key`, null for an absent bound; throws ConfigError when it is not

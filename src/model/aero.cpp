@@ -7,8 +7,8 @@
 namespace quadcosim::model {
 
 bool AeroParams::active() const {
-  return !linear_drag_N_s_m.isZero(0.0) || !quadratic_drag_N_s2_m2.isZero(0.0) ||
-         rotor_drag_N_s_m_per_rad_s != 0.0 || ground_effect_rotor_radius_m != 0.0;
+  return !linear_drag_N_s_m.isZero(0.0) || !quadratic_drag_N_s2_m2.isZero(0.0) || rotor_drag_N_s_m_per_rad_s != 0.0 ||
+         ground_effect_rotor_radius_m != 0.0;
 }
 
 Eigen::Vector3d aero_force_W(const AeroParams& a, const Eigen::Matrix3d& R_WB, const Eigen::Vector3d& v_W,

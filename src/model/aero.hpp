@@ -18,9 +18,9 @@
 namespace quadcosim::model {
 
 struct AeroParams {
-  Eigen::Vector3d linear_drag_N_s_m = Eigen::Vector3d::Zero();          ///< D_lin per body axis [N/(m/s)]
-  Eigen::Vector3d quadratic_drag_N_s2_m2 = Eigen::Vector3d::Zero();     ///< D_quad per body axis [N/(m/s)^2]
-  double rotor_drag_N_s_m_per_rad_s = 0.0;  ///< k_rd [N/((m/s) (rad/s))], summed over the rotors
+  Eigen::Vector3d linear_drag_N_s_m = Eigen::Vector3d::Zero();       ///< D_lin per body axis [N/(m/s)]
+  Eigen::Vector3d quadratic_drag_N_s2_m2 = Eigen::Vector3d::Zero();  ///< D_quad per body axis [N/(m/s)^2]
+  double rotor_drag_N_s_m_per_rad_s = 0.0;    ///< k_rd [N/((m/s) (rad/s))], summed over the rotors
   double ground_effect_rotor_radius_m = 0.0;  ///< rotor radius R [m] for ground effect; 0: off
 
   /// True when any coefficient is non-zero (the plant then takes the environment path).
@@ -29,8 +29,8 @@ struct AeroParams {
 
 /// What the air and the rotors do to the vehicle over one plant tick (held constant across it).
 struct Environment {
-  Eigen::Vector3d wind_W = Eigen::Vector3d::Zero();  ///< air velocity in the world frame [m/s]
-  Eigen::Vector4d rotor_efficiency = Eigen::Vector4d::Ones();       ///< per-rotor factor on thrust and drag torque [0, 1]
+  Eigen::Vector3d wind_W = Eigen::Vector3d::Zero();            ///< air velocity in the world frame [m/s]
+  Eigen::Vector4d rotor_efficiency = Eigen::Vector4d::Ones();  ///< per-rotor factor on thrust and drag torque [0, 1]
 };
 
 /// Drag force in the world frame [N] for attitude R_WB, velocity v_W, wind wind_W, rotor speeds.

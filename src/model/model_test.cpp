@@ -42,8 +42,7 @@ constexpr double kL = 0.59, kKt = 2.06e-7, kKm = 1.01e-10;
 // R_WB = Rz(yaw) Ry(pitch) Rx(roll), built from Eigen's axis-angle type (independent of
 // attitude.cpp).
 Eigen::Matrix3d rotation_zyx(double roll, double pitch, double yaw) {
-  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
@@ -63,8 +62,7 @@ Eigen::Vector4d eq4_by_hand(const VehicleParams& p, const Vector4& w) {
           km * (w1 - w2 + w3 - w4)};  // U4 (yaw)
 }
 
-State airborne_state(const Quadrotor& quad, const Eigen::Vector3d& p_W, const Euler& e,
-                     const Eigen::Vector3d& w_B) {
+State airborne_state(const Quadrotor& quad, const Eigen::Vector3d& p_W, const Euler& e, const Eigen::Vector3d& w_B) {
   State x = quad.initial_state(p_W, 0.0, false);
   x.q_WB = Eigen::Quaterniond(rotation_zyx(e.roll_rad, e.pitch_rad, e.yaw_rad));
   x.w_B = w_B;
@@ -211,8 +209,8 @@ TEST(Validate, RejectsBadSpinSigns) {
 
 using quadcosim::model::find_vehicle_parameter;
 using quadcosim::model::Range;
-using quadcosim::model::VehicleParameter;
 using quadcosim::model::vehicle_parameters;
+using quadcosim::model::VehicleParameter;
 
 TEST(VehicleParameterTable, DefaultsReadThroughTheTableAreTable1) {
   const VehicleParams p;
@@ -384,8 +382,7 @@ TEST(Mixer, RotorPositionsFollowTheLayouts) {
   // '+': 1 nose (+x), 2 right (-y), 3 tail (-x), 4 left (+y).
   const Eigen::Vector3d plus[4] = {{kL, 0, 0}, {0, -kL, 0}, {-kL, 0, 0}, {0, kL, 0}};
   for (int i = 0; i < 4; ++i) {
-    EXPECT_LT((quadcosim::model::rotor_position_B(p, i) - plus[i]).norm(), 1e-15)
-        << "rotor " << i + 1;
+    EXPECT_LT((quadcosim::model::rotor_position_B(p, i) - plus[i]).norm(), 1e-15) << "rotor " << i + 1;
   }
   // 'x': 1 front-left, 2 front-right, 3 rear-right, 4 rear-left, all at distance L.
   p.layout = RotorLayout::kX;
@@ -402,8 +399,7 @@ TEST(Mixer, InverseRoundTrip) {
     p.layout = layout;
     const Eigen::Matrix4d M = quadcosim::model::mixer_matrix(p);
     const Eigen::Matrix4d Minv = M.inverse();
-    const std::vector<Vector4> speeds = {Vector4(4000, 5000, 4500, 4800),
-                                         Vector4(0, 12000, 300, 9000),
+    const std::vector<Vector4> speeds = {Vector4(4000, 5000, 4500, 4800), Vector4(0, 12000, 300, 9000),
                                          Vector4::Constant(p.hover_omega_rad_s())};
     for (const Vector4& w : speeds) {
       const Vector4 w2 = w.cwiseProduct(w);
@@ -457,12 +453,11 @@ TEST(Attitude, QuaternionFromEulerMatchesRzRyRx) {
         const Eigen::Quaterniond q = quadcosim::model::quaternion_from_euler({roll, pitch, yaw});
         EXPECT_NEAR(q.norm(), 1.0, 1e-15);
         const Eigen::Matrix3d R = rotation_zyx(roll, pitch, yaw);
-        EXPECT_LT((q.toRotationMatrix() - R).cwiseAbs().maxCoeff(), 1e-14)
-            << roll << " " << pitch << " " << yaw;
+        EXPECT_LT((q.toRotationMatrix() - R).cwiseAbs().maxCoeff(), 1e-14) << roll << " " << pitch << " " << yaw;
 
         // The paper's eq. (3), C_{fru/enu} (world -> body), is the transpose of R_WB.
-        const double cf = std::cos(roll), sf = std::sin(roll), ct = std::cos(pitch),
-                     st = std::sin(pitch), cp = std::cos(yaw), sp = std::sin(yaw);
+        const double cf = std::cos(roll), sf = std::sin(roll), ct = std::cos(pitch), st = std::sin(pitch),
+                     cp = std::cos(yaw), sp = std::sin(yaw);
         Eigen::Matrix3d C;
         // clang-format off
         C << ct * cp,                ct * sp,                -st,
@@ -527,8 +522,7 @@ TEST(Attitude, NearGimbalLockStaysAFaithfulRotation) {
       const double pitch = sign * (kPi / 2.0 - delta);
       const Eigen::Matrix3d R = rotation_zyx(0.8, pitch, -2.1);
       const Euler e = quadcosim::model::euler_from_quaternion(Eigen::Quaterniond(R));
-      EXPECT_LT(rotation_distance(rotation_zyx(e.roll_rad, e.pitch_rad, e.yaw_rad), R), 5e-8)
-          << "delta " << delta;
+      EXPECT_LT(rotation_distance(rotation_zyx(e.roll_rad, e.pitch_rad, e.yaw_rad), R), 5e-8) << "delta " << delta;
     }
   }
 }
@@ -669,8 +663,7 @@ TEST(GroundContact, LandedAtRestStaysExactlyAtRestBelowHover) {
       Vector4::Constant(0.9 * w_h),
       Vector4::Constant(w_h * (1.0 - 1e-9)),
       // sub-hover with a roll and a yaw torque: friction holds the airframe, nothing rotates
-      Vector4(0.9 * w_h, std::sqrt(0.81 * w_h * w_h - d), 0.9 * w_h,
-              std::sqrt(0.81 * w_h * w_h + d)),
+      Vector4(0.9 * w_h, std::sqrt(0.81 * w_h * w_h - d), 0.9 * w_h, std::sqrt(0.81 * w_h * w_h + d)),
       Vector4(0.95 * w_h, 0.8 * w_h, 0.95 * w_h, 0.8 * w_h),
   };
   for (const Vector4& cmd : commands) {
@@ -730,14 +723,12 @@ TEST(TorqueResponse, PureRollPitchYawTorquesGiveUOverI) {
     const double expected = U[c.axis + 1] / c.inertia;
     EXPECT_GT(expected, 0.0) << c.name;
     for (int i = 0; i < 3; ++i) {
-      EXPECT_NEAR(dx.w_B[i], i == c.axis ? expected : 0.0, 1e-12 * std::abs(expected))
-          << c.name << " component " << i;
+      EXPECT_NEAR(dx.w_B[i], i == c.axis ? expected : 0.0, 1e-12 * std::abs(expected)) << c.name << " component " << i;
     }
     // The thrust is unchanged (sum of w^2 is the hover value): the linear acceleration is that of
     // hover thrust tilted by the attitude, g (R_WB e_z - e_z).
     EXPECT_NEAR(U[0], kMass * kG, 1e-12);
-    const Eigen::Vector3d a_expected =
-        kG * (rotation_zyx(0.2, -0.1, 0.5).col(2) - Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d a_expected = kG * (rotation_zyx(0.2, -0.1, 0.5).col(2) - Eigen::Vector3d::UnitZ());
     EXPECT_LT((dx.v_W - a_expected).norm(), 1e-12) << c.name;
   }
 }
@@ -758,8 +749,7 @@ TEST(TorqueResponse, GyroscopicCouplingIsEq10AndDroppedInEq11) {
     const Eigen::Vector3d expected((U[1] + (full ? (kIyy - kIzz) * Q * R : 0.0)) / kIxx,
                                    (U[2] + (full ? (kIzz - kIxx) * P * R : 0.0)) / kIyy,
                                    (U[3] + (full ? (kIxx - kIyy) * P * Q : 0.0)) / kIzz);
-    EXPECT_LT((dx.w_B - expected).norm(), 1e-12 * expected.norm())
-        << quadcosim::model::to_string(g);
+    EXPECT_LT((dx.w_B - expected).norm(), 1e-12 * expected.norm()) << quadcosim::model::to_string(g);
   }
 }
 
@@ -804,9 +794,7 @@ TEST(AttitudeKinematics, QuaternionRateIsHalfQTimesOmega) {
 // Motors
 
 // RK4 amplification factor for y' = -y/tau over one step h: the Taylor series of exp(-z) to z^4.
-double rk4_factor(double z) {
-  return 1.0 - z + z * z / 2.0 - z * z * z / 6.0 + z * z * z * z / 24.0;
-}
+double rk4_factor(double z) { return 1.0 - z + z * z / 2.0 - z * z * z / 6.0 + z * z * z * z / 24.0; }
 
 TEST(MotorLag, SpinUpAndSpinDownFollowTheirTimeConstants) {
   VehicleParams p;
@@ -887,10 +875,8 @@ TEST(ClampCommand, ClampsAndReplacesNonFiniteWithOmegaMin) {
   const Quadrotor quad(p);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(quad.clamp_command(Vector4(-5.0, 20000.0, nan, 3000.0)),
-            Vector4(100.0, 9000.0, 100.0, 3000.0));
-  EXPECT_EQ(quad.clamp_command(Vector4(inf, -inf, 100.0, 9000.0)),
-            Vector4(100.0, 100.0, 100.0, 9000.0));
+  EXPECT_EQ(quad.clamp_command(Vector4(-5.0, 20000.0, nan, 3000.0)), Vector4(100.0, 9000.0, 100.0, 3000.0));
+  EXPECT_EQ(quad.clamp_command(Vector4(inf, -inf, 100.0, 9000.0)), Vector4(100.0, 100.0, 100.0, 9000.0));
 
   // The ideal motor takes the clamped command as its speed.
   State x = quad.initial_state({0, 0, 100}, 0.0, false);
@@ -959,15 +945,16 @@ Vec17 textbook_derivative(const VehicleParams& p, const Vec17& x, const Vector4&
     const Eigen::Vector3d r(p.arm_length_m * std::cos(a), p.arm_length_m * std::sin(a), 0.0);
     const double f = p.kt_N_per_rad2_s2 * w[i] * w[i];
     thrust += f;
-    tau += r.cross(Eigen::Vector3d(0.0, 0.0, f)) + Eigen::Vector3d(0.0, 0.0, p.spin[i] * p.km_Nm_per_rad2_s2 * w[i] * w[i]);
+    tau += r.cross(Eigen::Vector3d(0.0, 0.0, f)) +
+           Eigen::Vector3d(0.0, 0.0, p.spin[i] * p.km_Nm_per_rad2_s2 * w[i] * w[i]);
   }
   const Eigen::Quaterniond q(x[6], x[7], x[8], x[9]);
   const Eigen::Vector3d w_B = x.segment<3>(10);
   const Eigen::Vector3d I(p.Ixx_kg_m2, p.Iyy_kg_m2, p.Izz_kg_m2);
   Vec17 d = Vec17::Zero();
   d.segment<3>(0) = x.segment<3>(3);
-  d.segment<3>(3) = q.toRotationMatrix() * Eigen::Vector3d(0.0, 0.0, thrust / p.mass_kg) -
-                    Eigen::Vector3d(0.0, 0.0, p.gravity_m_s2);
+  d.segment<3>(3) =
+      q.toRotationMatrix() * Eigen::Vector3d(0.0, 0.0, thrust / p.mass_kg) - Eigen::Vector3d(0.0, 0.0, p.gravity_m_s2);
   const Eigen::Quaterniond dq = q * Eigen::Quaterniond(0.0, w_B.x(), w_B.y(), w_B.z());
   d.segment<4>(6) = 0.5 * Eigen::Vector4d(dq.w(), dq.x(), dq.y(), dq.z());
   d.segment<3>(10) = (tau - w_B.cross(I.cwiseProduct(w_B))).cwiseQuotient(I);
@@ -1065,8 +1052,8 @@ TEST(QuadrotorStep, FollowsAnIndependentTextbookFormulation) {
         EXPECT_LT(worst, 1e-9) << "motor " << static_cast<int>(motor) << " layout " << static_cast<int>(layout)
                                << " substeps " << substeps;
         EXPECT_GT((a.p_W - Eigen::Vector3d(1.0, -2.0, 50.0)).norm(), 5.0);  // it flew (open loop: off and down)
-        EXPECT_GT(a.p_W.z(), 10.0);                                          // far from the ground
-        EXPECT_GT(a.q_WB.coeffs().head<3>().norm(), 0.01);  // and turned
+        EXPECT_GT(a.p_W.z(), 10.0);                                         // far from the ground
+        EXPECT_GT(a.q_WB.coeffs().head<3>().norm(), 0.01);                  // and turned
       }
     }
   }

@@ -27,8 +27,7 @@ using quadcosim::model::VehicleParams;
 constexpr double kDt = 0.01;  // [s] the plant tick (100 Hz)
 
 Eigen::Matrix3d rotation_zyx(double roll, double pitch, double yaw) {
-  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
@@ -116,11 +115,9 @@ TEST_P(TorqueFree, ConservesEnergyAndWorldAngularMomentum) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, TorqueFree,
                          ::testing::Values(TumbleCase{{0.3, 1.0, 0.2}, "w0 (0.3, 1.0, 0.2)"},
-                                           TumbleCase{{1e-3, 2.0, 1e-3},
-                                                      "w0 close to the intermediate axis"}),
+                                           TumbleCase{{1e-3, 2.0, 1e-3}, "w0 close to the intermediate axis"}),
                          [](const auto& info) {
-                           return info.index == 0 ? std::string("Generic")
-                                                  : std::string("NearIntermediateAxis");
+                           return info.index == 0 ? std::string("Generic") : std::string("NearIntermediateAxis");
                          });
 
 // Independent formulation: with no torque the world angular momentum L_W is a constant, so the
@@ -190,8 +187,7 @@ TEST(TorqueFreeRotation, SimplifiedGyroscopicModelKeepsBodyRateAndSpinsAboutIt) 
     quad.step(x, (k - 1) * kDt, Vector4::Zero(), kDt, 1);
     ASSERT_EQ(x.w_B, w0);
     // Constant body rate: q(t) = q0 (x) exp(t w / 2), a steady spin about the fixed axis w0.
-    const Eigen::Quaterniond q_exact =
-        q0 * Eigen::Quaterniond(Eigen::AngleAxisd(rate * k * kDt, w0 / rate));
+    const Eigen::Quaterniond q_exact = q0 * Eigen::Quaterniond(Eigen::AngleAxisd(rate * k * kDt, w0 / rate));
     worst = std::max(worst, x.q_WB.angularDistance(q_exact));
   }
   // RK4 on q' = 1/2 q (0, w): phase error per step (h |w| / 2)^5 / 120 * 2 = 6e-14 rad, 1e4 steps:
@@ -214,8 +210,8 @@ Vec12 euler_model(const Vec12& s, const VehicleParams& v, const Vector4& w) {
   const double m = v.mass_kg, g = v.gravity_m_s2;
   const double Ixx = v.Ixx_kg_m2, Iyy = v.Iyy_kg_m2, Izz = v.Izz_kg_m2;
   const double phi = s[6], th = s[7], psi = s[8], P = s[9], Q = s[10], R = s[11];
-  const double cf = std::cos(phi), sf = std::sin(phi), ct = std::cos(th), st = std::sin(th),
-               tt = std::tan(th), cp = std::cos(psi), sp = std::sin(psi);
+  const double cf = std::cos(phi), sf = std::sin(phi), ct = std::cos(th), st = std::sin(th), tt = std::tan(th),
+               cp = std::cos(psi), sp = std::sin(psi);
   Vec12 d;
   d.segment<3>(0) = s.segment<3>(3);
   d[3] = U1 / m * (cp * st * cf + sp * sf);
@@ -265,9 +261,8 @@ Errors fly_against_reference(int substeps) {
     EXPECT_LT(std::abs(s[7]), 1.2);  // the reference stays clear of its gimbal lock
     e.p = std::max(e.p, (x.p_W - s.segment<3>(0)).norm());
     e.v = std::max(e.v, (x.v_W - s.segment<3>(3)).norm());
-    e.att = std::max(e.att, Eigen::AngleAxisd(x.q_WB.toRotationMatrix().transpose() *
-                                              rotation_zyx(s[6], s[7], s[8]))
-                                .angle());
+    e.att = std::max(e.att,
+                     Eigen::AngleAxisd(x.q_WB.toRotationMatrix().transpose() * rotation_zyx(s[6], s[7], s[8])).angle());
     e.w = std::max(e.w, (x.w_B - s.segment<3>(9)).norm());
   }
   EXPECT_GT(x.p_W.z(), 0.0);  // stayed airborne: no ground contact in the comparison
@@ -281,8 +276,8 @@ TEST(EulerAngleCrossCheck, PlantMatchesEq7And10WithEulerKinematics) {
   // about N (h Omega)^5 / 120 |(p, q)|; the reference's own error (3/8 rule, h = 0.1 ms) is ~1e8
   // smaller.
   const VehicleParams v;
-  const double Omega = 4.0 * std::sqrt((v.Izz_kg_m2 - v.Iyy_kg_m2) * (v.Izz_kg_m2 - v.Ixx_kg_m2) /
-                                       (v.Ixx_kg_m2 * v.Iyy_kg_m2));
+  const double Omega =
+      4.0 * std::sqrt((v.Izz_kg_m2 - v.Iyy_kg_m2) * (v.Izz_kg_m2 - v.Ixx_kg_m2) / (v.Ixx_kg_m2 * v.Iyy_kg_m2));
   const double pq = std::hypot(0.5, 0.4);
   auto bound = [&](int substeps) {
     const double h = kDt / substeps;

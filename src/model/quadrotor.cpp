@@ -190,8 +190,7 @@ Quadrotor::RigidInputs Quadrotor::rigid_inputs(const Wrench& f) const {
           params_.gyroscopic == GyroscopicModel::kFull};
 }
 
-Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInput& cmd,
-                                                 const Environment* env) const {
+Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInput& cmd, const Environment* env) const {
   const bool ideal = params_.motor.model == MotorModel::kIdeal;
   if (!env) return rigid_inputs(ideal ? cmd.wrench : wrench(Vector4(y[13], y[14], y[15], y[16])));
   // The rotors turn at the command (ideal) or at the state's speeds (lag); the air's drag acts on the
@@ -227,7 +226,7 @@ void Quadrotor::stage_derivative(const double* __restrict y, const RotorInput& c
 
 template <bool kVaryingInputs, bool kRotorLag>
 [[gnu::always_inline]] inline void Quadrotor::integrate(State& x, const RotorInput& cmd, double h, int substeps,
-                          const Environment* env) const {
+                                                        const Environment* env) const {
   constexpr int n = kRotorLag ? kWithRotors : kRigid;  // ideal rotors: their speeds are the command
   Packed r;
   pack(x, kRotorLag, r);
@@ -288,7 +287,8 @@ Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const
 }
 
 template <bool kVaryingInputs>
-[[gnu::always_inline]] inline Eigen::Vector3d Quadrotor::specific_force_W(const State& x, const RotorInput& cmd, const Environment* env) const {
+[[gnu::always_inline]] inline Eigen::Vector3d Quadrotor::specific_force_W(const State& x, const RotorInput& cmd,
+                                                                          const Environment* env) const {
   Packed y;
   pack(x, params_.motor.model == MotorModel::kFirstOrder, y);
   bool held = false;
@@ -302,7 +302,8 @@ template <bool kVaryingInputs>
 Outputs Quadrotor::outputs(double /*t_s*/, const State& x, const RotorInput& cmd, const Environment* env) const {
   // As step(), compiled for what varies: nothing but the state for ideal motors without an Environment.
   const bool varying = env || params_.motor.model == MotorModel::kFirstOrder;
-  const Eigen::Vector3d a_minus_g_W = varying ? specific_force_W<true>(x, cmd, env) : specific_force_W<false>(x, cmd, env);
+  const Eigen::Vector3d a_minus_g_W =
+      varying ? specific_force_W<true>(x, cmd, env) : specific_force_W<false>(x, cmd, env);
   return {x.p_W, x.q_WB, x.v_W, x.w_B, rotate_by_inverse(x.q_WB, a_minus_g_W)};
 }
 

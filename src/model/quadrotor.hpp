@@ -12,11 +12,11 @@ namespace quadcosim::model {
 
 /// Full plant state. Plain data: the integrator owns it, the model never stores it.
 struct State {
-  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();               ///< position [m]
-  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();               ///< velocity [m/s]
-  Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();    ///< attitude, body -> world
-  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();               ///< body angular velocity [rad/s]
-  Vector4 omega_rad_s = Vector4::Zero();                       ///< rotor speeds [rad/s]
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();             ///< position [m]
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();             ///< velocity [m/s]
+  Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();  ///< attitude, body -> world
+  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();             ///< body angular velocity [rad/s]
+  Vector4 omega_rad_s = Vector4::Zero();                     ///< rotor speeds [rad/s]
 };
 
 /// Time derivative of State; the quaternion derivative is kept as 4 raw coefficients (w, x, y, z).
@@ -82,8 +82,7 @@ class Quadrotor {
 
   /// Sensor outputs at state x under the given command (the command sets the acceleration that the
   /// accelerometer measures).
-  Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
-                  const Environment* env = nullptr) const;
+  Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s, const Environment* env = nullptr) const;
   /// The same for a command already turned into its rotor input (rotor_input(omega_cmd_rad_s)): the same numbers.
   Outputs outputs(double t_s, const State& x, const RotorInput& cmd, const Environment* env = nullptr) const;
 
@@ -99,7 +98,7 @@ class Quadrotor {
   /// A state at rest at p_W with rotors stopped (or at hover speed when `hover` is true).
   State initial_state(const Eigen::Vector3d& p_W, double yaw_rad, bool hover) const;
 
- /// What one RK4 stage's rigid-body derivative takes besides the state (defined in quadrotor.cpp).
+  /// What one RK4 stage's rigid-body derivative takes besides the state (defined in quadrotor.cpp).
   struct RigidInputs;
 
  private:
@@ -112,8 +111,8 @@ class Quadrotor {
   RigidInputs varying_inputs(const double* y, const RotorInput& cmd, const Environment* env) const;
   /// dy/dt at the packed state y; `held_inputs` are used when kVaryingInputs is false.
   template <bool kVaryingInputs, bool kRotorLag>
-  void stage_derivative(const double* y, const RotorInput& cmd, const Environment* env,
-                        const RigidInputs& held_inputs, double* d) const;
+  void stage_derivative(const double* y, const RotorInput& cmd, const Environment* env, const RigidInputs& held_inputs,
+                        double* d) const;
   /// The RK4 integrator of step(): `substeps` steps of h on x packed into plain doubles.
   template <bool kVaryingInputs, bool kRotorLag>
   void integrate(State& x, const RotorInput& cmd, double h, int substeps, const Environment* env) const;

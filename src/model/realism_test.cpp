@@ -40,7 +40,7 @@ TEST(RandomTest, NormalDeviatesHaveZeroMeanUnitVarianceAndNormalTails) {
     beyond2 += std::abs(v) > 2.0;
   }
   const Moments m = moments(x);
-  EXPECT_NEAR(m.mean, 0.0, 5.0 / std::sqrt(n));   // 5 standard errors
+  EXPECT_NEAR(m.mean, 0.0, 5.0 / std::sqrt(n));  // 5 standard errors
   EXPECT_NEAR(m.std, 1.0, 5.0 / std::sqrt(2.0 * n));
   // P(|N| > 2) = erfc(2 / sqrt 2) = 0.0455
   EXPECT_NEAR(beyond2 / static_cast<double>(n), std::erfc(std::sqrt(2.0)), 0.001);
@@ -221,8 +221,7 @@ TEST_P(DrydenSpectrumTest, SeriesHasTheConfiguredMeanVarianceAndSpectrum) {
                         : dryden_autocorrelation_lateral(tau, c.sigma, c.L, c.V);
   };
   auto Phi = [&](double w) {
-    return c.order == 1 ? dryden_psd_longitudinal(w, c.sigma, c.L, c.V)
-                        : dryden_psd_lateral(w, c.sigma, c.L, c.V);
+    return c.order == 1 ? dryden_psd_longitudinal(w, c.sigma, c.L, c.V) : dryden_psd_lateral(w, c.sigma, c.L, c.V);
   };
   // Spectrum shape from 0.02 Hz (below the corner V / (2 π L) = 0.08 Hz) to 5 Hz: the Welch
   // estimate averaged over 7 neighbouring bins (255 segments each) has a relative standard error
@@ -345,8 +344,8 @@ TEST(WindDragTest, RotorDragOpposesInPlaneAirspeedInProportionToRotorSpeed) {
   VehicleParams p;
   p.aero.rotor_drag_N_s_m_per_rad_s = 1e-5;
   const Vector4 omega = Vector4::Constant(5000.0);
-  const Eigen::Vector3d F = aero_force_W(p.aero, Eigen::Matrix3d::Identity(), {2.0, -1.0, 3.0},
-                                         Eigen::Vector3d::Zero(), omega);
+  const Eigen::Vector3d F =
+      aero_force_W(p.aero, Eigen::Matrix3d::Identity(), {2.0, -1.0, 3.0}, Eigen::Vector3d::Zero(), omega);
   EXPECT_NEAR(F.x(), -1e-5 * 20000.0 * 2.0, 1e-12);
   EXPECT_NEAR(F.y(), 1e-5 * 20000.0 * 1.0, 1e-12);
   EXPECT_EQ(F.z(), 0.0);  // no rotor drag along the rotor axis
@@ -373,8 +372,8 @@ TEST(GroundEffectTest, CheesemanBennettFactor) {
   AeroParams a;
   EXPECT_EQ(ground_effect_factor(a, 0.1), 1.0);  // off
   a.ground_effect_rotor_radius_m = 0.2;
-  EXPECT_NEAR(ground_effect_factor(a, 0.2), 16.0 / 15.0, 1e-15);        // z = R
-  EXPECT_NEAR(ground_effect_factor(a, 0.0), 4.0 / 3.0, 1e-15);          // floored at z = R/2
+  EXPECT_NEAR(ground_effect_factor(a, 0.2), 16.0 / 15.0, 1e-15);  // z = R
+  EXPECT_NEAR(ground_effect_factor(a, 0.0), 4.0 / 3.0, 1e-15);    // floored at z = R/2
   EXPECT_NEAR(ground_effect_factor(a, 100.0), 1.0, 1e-6);
 }
 

@@ -22,9 +22,9 @@ inline double bias_step_sigma(double random_walk, double period_s) { return rand
 
 /// Discrete noise on a 3-vector: y = x + b + σ n, then b += σ_b n'.
 struct NoiseSpec {
-  double white_sigma = 0.0;          ///< per-sample standard deviation [unit]
-  double bias_step_sigma = 0.0;      ///< per-sample bias increment standard deviation [unit]
-  double bias_initial_sigma = 0.0;   ///< standard deviation of the turn-on bias [unit]
+  double white_sigma = 0.0;         ///< per-sample standard deviation [unit]
+  double bias_step_sigma = 0.0;     ///< per-sample bias increment standard deviation [unit]
+  double bias_initial_sigma = 0.0;  ///< standard deviation of the turn-on bias [unit]
   bool active() const { return white_sigma > 0.0 || bias_step_sigma > 0.0 || bias_initial_sigma > 0.0; }
 };
 

@@ -8,9 +8,7 @@
 
 namespace quadcosim::model {
 
-double VehicleParams::hover_omega_rad_s() const {
-  return std::sqrt(mass_kg * gravity_m_s2 / (4.0 * kt_N_per_rad2_s2));
-}
+double VehicleParams::hover_omega_rad_s() const { return std::sqrt(mass_kg * gravity_m_s2 / (4.0 * kt_N_per_rad2_s2)); }
 
 namespace {
 
@@ -27,19 +25,18 @@ std::string number_text(double v) {
 }
 
 // One numeric parameter bound to a double inside VehicleParams.
-#define QC_NUMBER(NAME, UNIT, RANGE, MEMBER, MEANING)                                        \
-  VehicleParameter {                                                                        \
-    NAME, UNIT, MEANING, VehicleParameter::Kind::kNumber, RANGE, {},                        \
-        [](VehicleParams& v) -> double& { return v.MEMBER; }, nullptr, nullptr, nullptr       \
+#define QC_NUMBER(NAME, UNIT, RANGE, MEMBER, MEANING)                                   \
+  VehicleParameter {                                                                    \
+    NAME, UNIT, MEANING, VehicleParameter::Kind::kNumber, RANGE, {},                    \
+        [](VehicleParams& v) -> double& { return v.MEMBER; }, nullptr, nullptr, nullptr \
   }
 
 // One named option bound to an enum member; `to_string` names its values.
-#define QC_CHOICE(NAME, MEMBER, TYPE, FIRST, SECOND, MEANING)                                  \
-  VehicleParameter {                                                                        \
-    NAME, "", MEANING, VehicleParameter::Kind::kChoice, {}, {to_string(FIRST), to_string(SECOND)}, \
-        nullptr, [](const VehicleParams& v) -> std::string_view { return to_string(v.MEMBER); }, \
-        [](VehicleParams& v, std::string_view c) { v.MEMBER = c == to_string(FIRST) ? FIRST : SECOND; }, \
-        nullptr                                                                             \
+#define QC_CHOICE(NAME, MEMBER, TYPE, FIRST, SECOND, MEANING)                                                    \
+  VehicleParameter {                                                                                             \
+    NAME, "", MEANING, VehicleParameter::Kind::kChoice, {}, {to_string(FIRST), to_string(SECOND)}, nullptr,      \
+        [](const VehicleParams& v) -> std::string_view { return to_string(v.MEMBER); },                          \
+        [](VehicleParams& v, std::string_view c) { v.MEMBER = c == to_string(FIRST) ? FIRST : SECOND; }, nullptr \
   }
 
 std::vector<VehicleParameter> make_table() {
@@ -57,14 +54,22 @@ std::vector<VehicleParameter> make_table() {
                 "drag-torque coefficient k_m, eq. (2)"),
       QC_CHOICE("layout", layout, RotorLayout, RotorLayout::kPlus, RotorLayout::kX,
                 "rotor arrangement: plus (rotor 1 on the nose, eq. (4)) or x (turned 45 deg)"),
-      VehicleParameter{"spin", "", "reaction-torque sign of rotors 1..4 (+1: clockwise from above); two of each, alternating",
-                       VehicleParameter::Kind::kSigns, {}, {}, nullptr, nullptr, nullptr,
+      VehicleParameter{"spin",
+                       "",
+                       "reaction-torque sign of rotors 1..4 (+1: clockwise from above); two of each, alternating",
+                       VehicleParameter::Kind::kSigns,
+                       {},
+                       {},
+                       nullptr,
+                       nullptr,
+                       nullptr,
                        [](VehicleParams& v) -> std::array<int, 4>& { return v.spin; }},
       QC_CHOICE("gyroscopic", gyroscopic, GyroscopicModel, GyroscopicModel::kFull, GyroscopicModel::kSimplified,
                 "rotational dynamics: full (eq. (10), with w x I w) or simplified (eq. (11))"),
       QC_CHOICE("motor.model", motor.model, MotorModel, MotorModel::kIdeal, MotorModel::kFirstOrder,
                 "motor speed response: ideal (instant) or first_order (lag)"),
-      QC_NUMBER("motor.tau_up_s", "s", closed(1e-6, 1e3), motor.tau_up_s, "first-order lag time constant when spinning up"),
+      QC_NUMBER("motor.tau_up_s", "s", closed(1e-6, 1e3), motor.tau_up_s,
+                "first-order lag time constant when spinning up"),
       QC_NUMBER("motor.tau_down_s", "s", closed(1e-6, 1e3), motor.tau_down_s,
                 "first-order lag time constant when spinning down"),
       QC_NUMBER("motor.omega_min_rad_s", "rad/s", closed(0.0, 1e7), motor.omega_min_rad_s,
@@ -116,12 +121,9 @@ double VehicleParameter::get(const VehicleParams& v) const {
 
 std::string VehicleParameter::text(const VehicleParams& v) const {
   switch (kind) {
-    case Kind::kNumber:
-      return number_text(get(v));
-    case Kind::kChoice:
-      return std::string(choice_of(v));
-    case Kind::kSigns:
-      return signs_text(signs(const_cast<VehicleParams&>(v)));
+    case Kind::kNumber: return number_text(get(v));
+    case Kind::kChoice: return std::string(choice_of(v));
+    case Kind::kSigns: return signs_text(signs(const_cast<VehicleParams&>(v)));
   }
   return {};
 }
@@ -203,18 +205,14 @@ std::string validate_step(const VehicleParams& p, double period_s, int substeps)
   const double h = period_s / substeps;
   if (h <= 2.0 * tau) return {};
   std::ostringstream s;
-  s << "motor time constant " << tau << " s is too short for an RK4 step of " << h
-    << " s (plant period " << period_s << " s / " << substeps << " substeps): use at least "
-    << static_cast<int>(std::ceil(period_s / (2.0 * tau))) << " substeps";
+  s << "motor time constant " << tau << " s is too short for an RK4 step of " << h << " s (plant period " << period_s
+    << " s / " << substeps << " substeps): use at least " << static_cast<int>(std::ceil(period_s / (2.0 * tau)))
+    << " substeps";
   return s.str();
 }
 
 const char* to_string(RotorLayout layout) { return layout == RotorLayout::kPlus ? "plus" : "x"; }
-const char* to_string(MotorModel model) {
-  return model == MotorModel::kIdeal ? "ideal" : "first_order";
-}
-const char* to_string(GyroscopicModel model) {
-  return model == GyroscopicModel::kFull ? "full" : "simplified";
-}
+const char* to_string(MotorModel model) { return model == MotorModel::kIdeal ? "ideal" : "first_order"; }
+const char* to_string(GyroscopicModel model) { return model == GyroscopicModel::kFull ? "full" : "simplified"; }
 
 }  // namespace quadcosim::model

@@ -21,8 +21,8 @@ enum class RotorLayout {
 
 /// How the motor speed follows the commanded speed.
 enum class MotorModel {
-  kIdeal,        ///< speed equals the (clamped) command instantly, as in the paper.
-  kFirstOrder,   ///< first-order lag with separate time constants for spinning up and down.
+  kIdeal,       ///< speed equals the (clamped) command instantly, as in the paper.
+  kFirstOrder,  ///< first-order lag with separate time constants for spinning up and down.
 };
 
 /// Which rotational dynamics the plant integrates.
@@ -33,9 +33,9 @@ enum class GyroscopicModel {
 
 struct MotorParams {
   MotorModel model = MotorModel::kIdeal;
-  double tau_up_s = 0.02;     ///< [s] time constant when the command is above the current speed.
-  double tau_down_s = 0.04;   ///< [s] time constant when the command is below the current speed.
-  double omega_min_rad_s = 0.0;      ///< [rad/s] lowest speed a motor turns at (0: may stop).
+  double tau_up_s = 0.02;        ///< [s] time constant when the command is above the current speed.
+  double tau_down_s = 0.04;      ///< [s] time constant when the command is below the current speed.
+  double omega_min_rad_s = 0.0;  ///< [rad/s] lowest speed a motor turns at (0: may stop).
   /// [rad/s] highest speed. 12000 rad/s gives a thrust-to-weight ratio of about 6.2 with Table 1's
   /// k_t, above the peak the paper's altitude step asks for (about 8400 rad/s).
   double omega_max_rad_s = 12000.0;
@@ -47,7 +47,7 @@ struct VehicleParams {
   double Ixx_kg_m2 = 0.0149;
   double Iyy_kg_m2 = 0.0153;
   double Izz_kg_m2 = 0.0532;
-  double arm_length_m = 0.59;   ///< [m] rotor axis to centre of mass (L).
+  double arm_length_m = 0.59;           ///< [m] rotor axis to centre of mass (L).
   double kt_N_per_rad2_s2 = 2.06e-7;    ///< thrust coefficient k_t [N/(rad/s)^2], eq. (1).
   double km_Nm_per_rad2_s2 = 1.01e-10;  ///< drag-torque coefficient k_m [N m/(rad/s)^2], eq. (2).
   RotorLayout layout = RotorLayout::kPlus;
@@ -90,12 +90,12 @@ struct VehicleParameter {
   std::string_view unit;  ///< SI unit; "" when dimensionless or not a number
   std::string_view meaning;
   Kind kind = Kind::kNumber;
-  Range range;                            ///< kNumber: the values accepted
-  std::vector<std::string_view> choices;  ///< kChoice: the values accepted
-  double& (*ref)(VehicleParams&) = nullptr;                          ///< kNumber: the member
-  std::string_view (*choice_of)(const VehicleParams&) = nullptr;     ///< kChoice: current value
-  void (*set_choice)(VehicleParams&, std::string_view) = nullptr;    ///< kChoice: one of `choices`
-  std::array<int, 4>& (*signs)(VehicleParams&) = nullptr;            ///< kSigns: the member
+  Range range;                                                     ///< kNumber: the values accepted
+  std::vector<std::string_view> choices;                           ///< kChoice: the values accepted
+  double& (*ref)(VehicleParams&) = nullptr;                        ///< kNumber: the member
+  std::string_view (*choice_of)(const VehicleParams&) = nullptr;   ///< kChoice: current value
+  void (*set_choice)(VehicleParams&, std::string_view) = nullptr;  ///< kChoice: one of `choices`
+  std::array<int, 4>& (*signs)(VehicleParams&) = nullptr;          ///< kSigns: the member
 
   /// kNumber: the value in `v`.
   double get(const VehicleParams& v) const;

@@ -99,8 +99,8 @@ WindField::WindField(const WindParams& p, double period_s, Rng rng) : p_(p), rng
   filters_[1] = DrydenFilter(2, scales_.sigma_v_m_s, scales_.L_v_m, V, period_s);
   filters_[2] = DrydenFilter(2, scales_.sigma_w_m_s, scales_.L_w_m, V, period_s);
   const double n = horizontal.norm();
-  const Eigen::Vector3d u = n > 0.0 ? Eigen::Vector3d(horizontal.x() / n, horizontal.y() / n, 0.0)
-                                    : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d u =
+      n > 0.0 ? Eigen::Vector3d(horizontal.x() / n, horizontal.y() / n, 0.0) : Eigen::Vector3d::UnitX();
   R_gust_to_W_.col(0) = u;
   R_gust_to_W_.col(1) = Eigen::Vector3d::UnitZ().cross(u);
   R_gust_to_W_.col(2) = Eigen::Vector3d::UnitZ();

@@ -35,9 +35,9 @@ namespace quadcosim::model {
 
 struct GustParams {
   bool enabled = false;
-  double w20_m_s = 7.7;         ///< mean wind at 20 ft (6.1 m) [m/s]; MIL-F-8785C: light 15 kt, moderate 30, severe 45
-  double altitude_m = 5.0;      ///< altitude for the scale lengths and intensities [m] (clamped to 3.048..304.8)
-  double airspeed_m_s = 0.0;    ///< V [m/s]; 0: the mean wind speed, floored at 1 m/s
+  double w20_m_s = 7.7;       ///< mean wind at 20 ft (6.1 m) [m/s]; MIL-F-8785C: light 15 kt, moderate 30, severe 45
+  double altitude_m = 5.0;    ///< altitude for the scale lengths and intensities [m] (clamped to 3.048..304.8)
+  double airspeed_m_s = 0.0;  ///< V [m/s]; 0: the mean wind speed, floored at 1 m/s
 };
 
 struct WindParams {
@@ -78,9 +78,9 @@ class DrydenFilter {
 
  private:
   int order_ = 1;
-  std::array<double, 4> Ad_{};   ///< row-major 2x2
-  std::array<double, 3> Lq_{};   ///< lower Cholesky factor of the step covariance: l11, l21, l22
-  std::array<double, 3> Lp_{};   ///< lower Cholesky factor of the stationary covariance
+  std::array<double, 4> Ad_{};  ///< row-major 2x2
+  std::array<double, 3> Lq_{};  ///< lower Cholesky factor of the step covariance: l11, l21, l22
+  std::array<double, 3> Lp_{};  ///< lower Cholesky factor of the stationary covariance
   std::array<double, 2> c_{};
   std::array<double, 2> x_{};
 };

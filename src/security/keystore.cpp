@@ -132,8 +132,8 @@ Own<X509> make_cert(const std::string& subject_cn, EVP_PKEY* key, bool ca, X509*
     fail("validity");
   }
   X509_NAME* name = X509_get_subject_name(c.get());
-  if (!X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_UTF8,
-                                  reinterpret_cast<const unsigned char*>(subject_cn.c_str()), -1, -1, 0)) {
+  if (!X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_UTF8, reinterpret_cast<const unsigned char*>(subject_cn.c_str()),
+                                  -1, -1, 0)) {
     fail("subject name '" + subject_cn + "'");
   }
   if (!X509_set_issuer_name(c.get(), issuer ? X509_get_subject_name(issuer) : name)) fail("issuer name");
@@ -141,8 +141,8 @@ Own<X509> make_cert(const std::string& subject_cn, EVP_PKEY* key, bool ca, X509*
   X509V3_CTX ctx;
   X509V3_set_ctx_nodb(&ctx);
   X509V3_set_ctx(&ctx, issuer ? issuer : c.get(), c.get(), nullptr, nullptr, 0);
-  Own<X509_EXTENSION> bc(X509V3_EXT_conf_nid(nullptr, &ctx, NID_basic_constraints,
-                                             ca ? "critical,CA:TRUE,pathlen:1" : "CA:FALSE"));
+  Own<X509_EXTENSION> bc(
+      X509V3_EXT_conf_nid(nullptr, &ctx, NID_basic_constraints, ca ? "critical,CA:TRUE,pathlen:1" : "CA:FALSE"));
   if (!bc || !X509_add_ext(c.get(), bc.get(), -1)) fail("basicConstraints");
   if (!X509_sign(c.get(), issuer_key, EVP_sha256())) fail("signing the certificate for '" + subject_cn + "'");
   return c;
@@ -245,7 +245,7 @@ fs::path enclave_dir(const fs::path& keystore, const std::string& enclave) {
 }
 
 const std::vector<std::string>& enclave_files() {
-  static const std::vector<std::string> files = {"identity_ca.cert.pem", "cert.pem", "key.pem",
+  static const std::vector<std::string> files = {"identity_ca.cert.pem",    "cert.pem",       "key.pem",
                                                  "permissions_ca.cert.pem", "governance.p7s", "permissions.p7s"};
   return files;
 }
@@ -256,7 +256,9 @@ std::string governance_xml(std::uint32_t domain_id) {
     << "  <domain_access_rules>\n"
        "    <domain_rule>\n"
        "      <domains>\n"
-       "        <id>" << domain_id << "</id>\n"
+       "        <id>"
+    << domain_id
+    << "</id>\n"
        "      </domains>\n"
        "      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>\n"
        "      <enable_join_access_control>true</enable_join_access_control>\n"
@@ -287,11 +289,17 @@ std::string permissions_xml(const std::string& enclave, const EnclavePolicy& pol
   }
   // SROS2's default policy (topics "/*", services "/*", actions "/*" all allowed), as its
   // permissions.xsl expands it: the same topic set is published and subscribed.
-  const std::set<std::string> all = {
-      "rq/*/_action/cancel_goalRequest", "rq/*/_action/get_resultRequest", "rq/*/_action/send_goalRequest",
-      "rq/*Request",                     "rr/*/_action/cancel_goalReply",  "rr/*/_action/get_resultReply",
-      "rr/*/_action/send_goalReply",     "rr/*Reply",                      "rt/*",
-      "rt/*/_action/feedback",           "rt/*/_action/status"};
+  const std::set<std::string> all = {"rq/*/_action/cancel_goalRequest",
+                                     "rq/*/_action/get_resultRequest",
+                                     "rq/*/_action/send_goalRequest",
+                                     "rq/*Request",
+                                     "rr/*/_action/cancel_goalReply",
+                                     "rr/*/_action/get_resultReply",
+                                     "rr/*/_action/send_goalReply",
+                                     "rr/*Reply",
+                                     "rt/*",
+                                     "rt/*/_action/feedback",
+                                     "rt/*/_action/status"};
   std::set<std::string> denied;
   for (const auto& topic : policy.deny_publish) {
     if (topic.empty() || topic[0] != '/') {
@@ -361,7 +369,8 @@ fs::path create_enclave(const fs::path& dir, const std::string& name, const Encl
   }
   if (name == "/") throw KeystoreError("enclave '/': its directory is the keystore's enclaves/ itself; choose a name");
   if (!is_keystore(dir)) {
-    throw KeystoreError(dir.string() + ": not a keystore (expected public/{identity,permissions}_ca.cert.pem, "
+    throw KeystoreError(dir.string() +
+                        ": not a keystore (expected public/{identity,permissions}_ca.cert.pem, "
                         "private/{identity,permissions}_ca.key.pem and enclaves/governance.p7s)");
   }
   const fs::path pub = dir / "public", priv = dir / "private";

@@ -57,8 +57,8 @@ std::string governance_xml(std::uint32_t domain_id);
 
 /// The permissions document for `enclave` under `policy`, with the grant valid over
 /// [not_before, not_after] (ISO 8601 UTC without zone, "2026-01-31T12:00:00", as sros2 writes them).
-std::string permissions_xml(const std::string& enclave, const EnclavePolicy& policy,
-                            const std::string& not_before, const std::string& not_after);
+std::string permissions_xml(const std::string& enclave, const EnclavePolicy& policy, const std::string& not_before,
+                            const std::string& not_after);
 
 /// True when `dir` holds the files sros2 calls a valid keystore (both CA certs and keys,
 /// enclaves/governance.p7s).

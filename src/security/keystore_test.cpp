@@ -107,7 +107,8 @@ TEST(EnclaveName, DirectoryAsRclResolvesIt) {
 
 TEST_F(KeystoreTest, LayoutAsSros2) {
   EXPECT_TRUE(is_keystore(ks()));
-  for (const char* f : {"public/ca.cert.pem", "private/ca.key.pem", "enclaves/governance.xml", "enclaves/governance.p7s"}) {
+  for (const char* f :
+       {"public/ca.cert.pem", "private/ca.key.pem", "enclaves/governance.xml", "enclaves/governance.p7s"}) {
     EXPECT_TRUE(fs::is_regular_file(ks() / f)) << f;
   }
   // One CA serves identity and permissions: links to ca.*.pem.
@@ -157,8 +158,8 @@ TEST_F(KeystoreTest, KeysAndNames) {
     EXPECT_EQ(r.status, 0) << r.out;
     EXPECT_NE(r.out.find("ASN1 OID: prime256v1"), std::string::npos) << r.out;
   }
-  const Result ca = openssl({"x509", "-in", (ks() / "public/ca.cert.pem").string(), "-noout", "-text",
-                             "-nameopt", "RFC2253"});
+  const Result ca =
+      openssl({"x509", "-in", (ks() / "public/ca.cert.pem").string(), "-noout", "-text", "-nameopt", "RFC2253"});
   EXPECT_NE(ca.out.find("Subject: CN=sros2CA"), std::string::npos) << ca.out;
   EXPECT_NE(ca.out.find("Issuer: CN=sros2CA"), std::string::npos) << ca.out;
   EXPECT_NE(ca.out.find("X509v3 Basic Constraints: critical"), std::string::npos) << ca.out;
@@ -188,7 +189,8 @@ TEST_F(KeystoreTest, SignedDocumentsVerifyWithOpensslSmime) {
   for (const auto& [p7s, xml] : {std::pair{ks() / "enclaves/governance.p7s", ks() / "enclaves/governance.xml"},
                                  std::pair{plant() / "permissions.p7s", plant() / "permissions.xml"},
                                  std::pair{rogue() / "permissions.p7s", rogue() / "permissions.xml"}}) {
-    const Result r = openssl({"smime", "-verify", "-in", p7s.string(), "-CAfile", perm_ca, "-text", "-out", out.string()});
+    const Result r =
+        openssl({"smime", "-verify", "-in", p7s.string(), "-CAfile", perm_ca, "-text", "-out", out.string()});
     EXPECT_EQ(r.status, 0) << p7s << ": " << r.out;
     // The signed text is the XML beside it (S/MIME text mode carries it with CRLF line ends).
     std::string signed_text = slurp(out);
@@ -285,7 +287,9 @@ TEST_F(KeystoreTest, CheckNamesWhatIsWrong) {
   p7s.replace(p7s.find("<default>DENY</default>"), 23, "<default>ALLOW</default>");
   std::ofstream(bad / "permissions.p7s", std::ios::trunc) << p7s;
   EXPECT_NE(openssl({"smime", "-verify", "-in", (bad / "permissions.p7s").string(), "-CAfile",
-                     (ks() / "public/ca.cert.pem").string(), "-out", "/dev/null"}).status, 0);
+                     (ks() / "public/ca.cert.pem").string(), "-out", "/dev/null"})
+                .status,
+            0);
   EXPECT_NE(joined().find("permissions.p7s: signature does not verify"), std::string::npos) << joined();
   // A missing file is named.
   fs::remove(bad / "governance.p7s");

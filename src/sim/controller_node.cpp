@@ -7,8 +7,7 @@
 
 namespace quadcosim::sim {
 
-ControllerNode::ControllerNode(Transport& transport, const Topics& topics,
-                               const control::ControllerConfig& config)
+ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config)
     : config_(config), controller_(config.params) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   status_pub_ = transport.advertise<msg::ControllerStatus>(topics.controller_status);
@@ -67,8 +66,8 @@ const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, doubl
     imu_pending_ = false;
   }
   const std::int64_t oldest = std::min({pose_ref_ns_, velocity_ref_ns_, imu_ref_ns_});
-  observation_.age_s = oldest == kNever ? std::numeric_limits<double>::infinity()
-                                     : static_cast<double>(now_ns - oldest) / 1e9;
+  observation_.age_s =
+      oldest == kNever ? std::numeric_limits<double>::infinity() : static_cast<double>(now_ns - oldest) / 1e9;
   output_ = controller_.step(observation_, config_.setpoint, dt_s);
 
   const auto& sp = config_.setpoint;

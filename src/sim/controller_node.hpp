@@ -8,8 +8,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <cstdint>
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string>

@@ -309,8 +309,11 @@ TEST(FaultInjectionTest, HoverHoldsUnderTenPercentLossAndATickOfDelay) {
     dev = std::max(dev, (r.applied[k].array() - hover_w).abs().maxCoeff());
     dev_clean = std::max(dev_clean, (clean.applied[k].array() - hover_w).abs().maxCoeff());
   }
-  std::printf("hover under 10 %% loss + 1 tick delay: max |z - 1| %.3f m from the start, from 10 s on: %.2e m, max xy %.2e m, max tilt %.2e rad, "
-              "max |omega - hover| %.1f rad/s (%.1f without faults)\n", start_dz, max_dz, max_xy, max_tilt, dev, dev_clean);
+  std::printf(
+      "hover under 10 %% loss + 1 tick delay: max |z - 1| %.3f m from the start, from 10 s on: %.2e m, max xy %.2e m, "
+      "max tilt %.2e rad, "
+      "max |omega - hover| %.1f rad/s (%.1f without faults)\n",
+      start_dz, max_dz, max_xy, max_tilt, dev, dev_clean);
   EXPECT_LT(dev, 0.01 * hover_w);
 }
 

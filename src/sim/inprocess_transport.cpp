@@ -17,14 +17,13 @@ InProcessTransport::Channel& InProcessTransport::channel(const std::string& topi
       c.stream.emplace(faults_.seed, topic);
     }
   } else if (c.cpp_type != type.cpp_type) {
-    throw std::logic_error("topic '" + topic + "' is already used with type " +
-                           std::string(c.ros_type) + ", not " + std::string(type.ros_type));
+    throw std::logic_error("topic '" + topic + "' is already used with type " + std::string(c.ros_type) + ", not " +
+                           std::string(type.ros_type));
   }
   return c;
 }
 
-std::function<void(const void*)> InProcessTransport::make_sink(const std::string& topic,
-                                                                const TopicType& type) {
+std::function<void(const void*)> InProcessTransport::make_sink(const std::string& topic, const TopicType& type) {
   Channel* c = &channel(topic, type);
   return [this, c](const void* message) {
     if (!c->stream) return deliver(*c, message);

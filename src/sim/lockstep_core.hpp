@@ -264,11 +264,11 @@ class LockstepCore {
   Host& host_;
   // Shared by the host's thread and the delivering thread (never at once: see Threading).
   Phase phase_ = Phase::kAwaiting;
-  Tick k_ = 0;                ///< the tick in progress
-  bool published_ = false;    ///< k_'s outputs are out
-  bool advancing_ = false;    ///< inside advance (a plant's own publications may be delivered to it)
-  bool waiting_ = true;       ///< answers awaited (off while holding)
-  std::size_t answered_ = 0;  ///< plants [0, answered_) have answered k_
+  Tick k_ = 0;                                   ///< the tick in progress
+  bool published_ = false;                       ///< k_'s outputs are out
+  bool advancing_ = false;                       ///< inside advance (a plant's own publications may be delivered to it)
+  bool waiting_ = true;                          ///< answers awaited (off while holding)
+  std::size_t answered_ = 0;                     ///< plants [0, answered_) have answered k_
   std::int64_t asked_ns_ = 0, last_ask_ns_ = 0;  ///< k_ first / last published [wall ns]
   std::vector<std::int64_t> round_trips_ns_;
 };

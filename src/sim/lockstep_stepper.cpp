@@ -1,10 +1,9 @@
 #include "sim/lockstep_stepper.hpp"
 
-
 namespace quadcosim::sim {
 
-LockstepStepper::LockstepStepper(ControllerNode& node, std::vector<ScheduledParameter> schedule,
-                                 const TickClock& clock, int controller_divider)
+LockstepStepper::LockstepStepper(ControllerNode& node, std::vector<ScheduledParameter> schedule, const TickClock& clock,
+                                 int controller_divider)
     : node_(node),
       schedule_(std::move(schedule), clock),
       control_period_ns_(clock.period_ns * controller_divider),

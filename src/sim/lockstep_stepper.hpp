@@ -17,8 +17,8 @@ namespace quadcosim::sim {
 class LockstepStepper {
  public:
   /// Hooks itself to `node` (not copyable or movable: the hook holds `this`).
-  LockstepStepper(ControllerNode& node, std::vector<ScheduledParameter> schedule,
-                  const TickClock& clock, int controller_divider);
+  LockstepStepper(ControllerNode& node, std::vector<ScheduledParameter> schedule, const TickClock& clock,
+                  int controller_divider);
   ~LockstepStepper();
   LockstepStepper(const LockstepStepper&) = delete;
   LockstepStepper& operator=(const LockstepStepper&) = delete;

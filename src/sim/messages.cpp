@@ -83,10 +83,10 @@ std::int64_t eight_digits(const char* p) {
       ((w & 0x0F0F0F0F0F0F0F0FULL) + 0x0606060606060606ULL) & 0xF0F0F0F0F0F0F0F0ULL) {
     return -1;
   }
-  w &= 0x0F0F0F0F0F0F0F0FULL;                                    // digits d0 (first, lowest byte) .. d7
-  w = (w * 10 + (w >> 8)) & 0x00FF00FF00FF00FFULL;               // pairs: 10 d0 + d1, ...
-  w = (w * 100 + (w >> 16)) & 0x0000FFFF0000FFFFULL;             // quads
-  w = (w * 10000 + (w >> 32)) & 0x00000000FFFFFFFFULL;           // all eight
+  w &= 0x0F0F0F0F0F0F0F0FULL;                           // digits d0 (first, lowest byte) .. d7
+  w = (w * 10 + (w >> 8)) & 0x00FF00FF00FF00FFULL;      // pairs: 10 d0 + d1, ...
+  w = (w * 100 + (w >> 16)) & 0x0000FFFF0000FFFFULL;    // quads
+  w = (w * 10000 + (w >> 32)) & 0x00000000FFFFFFFFULL;  // all eight
   return static_cast<std::int64_t>(w);
 }
 }  // namespace

@@ -189,14 +189,14 @@ std::int64_t command_stamp_ns(const Float64MultiArray& m);
 /// monitoring). Published by the controller after every step, before its motor command.
 struct ControllerStatus {
   static constexpr std::string_view kRosType = "quadcosim_msgs/msg/ControllerStatus";
-  Header header;                    ///< stamp: the (simulated) time of the step
-  std::string mode;                 ///< "attitude" | "position"
+  Header header;                     ///< stamp: the (simulated) time of the step
+  std::string mode;                  ///< "attitude" | "position"
   std::array<double, 6> setpoint{};  ///< x, y, z [m], roll, pitch, yaw [rad] actually tracked
-  std::array<double, 4> u{};        ///< U1 [N], U2..U4 [N m] requested
-  std::array<double, 4> error{};    ///< e_z [m], e_roll, e_pitch, e_yaw [rad]
+  std::array<double, 4> u{};         ///< U1 [N], U2..U4 [N m] requested
+  std::array<double, 4> error{};     ///< e_z [m], e_roll, e_pitch, e_yaw [rad]
   std::array<bool, 4> rotor_saturated{};
   bool tilt_saturated = false;
-  bool safety = false;              ///< the stale-data safety command was sent
+  bool safety = false;  ///< the stale-data safety command was sent
   /// Sensor messages refused so far, by reason (sim/validation.hpp, docs/reliability.md); a refused
   /// message leaves the observation as it was, so its age grows until the safety command takes over.
   std::uint64_t rejected_non_finite = 0;       ///< NaN/Inf in a field
@@ -231,7 +231,7 @@ struct PlantStatus {
   std::uint64_t commands_clamped = 0;              ///< a speed < 0 or > omega_max: used clamped
   std::uint64_t commands_rejected_length = 0;      ///< not exactly 4 values (empty included): ignored
   std::uint64_t commands_rejected_non_finite = 0;  ///< a NaN/Inf speed: ignored
-  std::string last_problem;  ///< why the newest rejected or clamped command was ("" for none yet)
+  std::string last_problem;                        ///< why the newest rejected or clamped command was ("" for none yet)
   bool watchdog_active = false;      ///< the watchdog's policy sets the motors (no valid command for its limit)
   std::uint64_t watchdog_trips = 0;  ///< times the watchdog took over
   std::uint64_t watchdog_ticks = 0;  ///< ticks latched under the watchdog's policy

@@ -34,11 +34,10 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   pose_.header.frame_id = options.frame_id;
   twist_.header.frame_id = options.frame_id;
   imu_.header.frame_id = "base_link";
-  status_period_ticks_ = options.status_period_ticks > 0
-                             ? options.status_period_ticks
-                             : std::max<Tick>(1, 1'000'000'000 / options.clock.period_ns);
-  transport.subscribe<msg::Float64MultiArray>(
-      topics.motor_commands, [this](const msg::Float64MultiArray& m) { on_command(m); });
+  status_period_ticks_ = options.status_period_ticks > 0 ? options.status_period_ticks
+                                                         : std::max<Tick>(1, 1'000'000'000 / options.clock.period_ns);
+  transport.subscribe<msg::Float64MultiArray>(topics.motor_commands,
+                                              [this](const msg::Float64MultiArray& m) { on_command(m); });
 }
 
 void PlantNode::on_command(const msg::Float64MultiArray& m) {
@@ -108,8 +107,8 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const model::Outputs y = model_.outputs(options_.clock.seconds(k), state_, rotor_input_,
-                                          realism_ ? &realism_->environment(k) : nullptr);
+  const model::Outputs y =
+      model_.outputs(options_.clock.seconds(k), state_, rotor_input_, realism_ ? &realism_->environment(k) : nullptr);
 
   if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
   publish_status(k);

@@ -3,8 +3,8 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,8 +28,8 @@ std::string to_string(WatchdogPolicy p);
 
 struct PlantOptions {
   TickClock clock;
-  int substeps = 1;              ///< RK4 steps per plant tick
-  int command_delay_ticks = 0;   ///< a command received during tick k takes effect at tick k + delay
+  int substeps = 1;             ///< RK4 steps per plant tick
+  int command_delay_ticks = 0;  ///< a command received during tick k takes effect at tick k + delay
   std::string frame_id = "world";
   /// Lockstep: a command labelled with a stamp older than the current tick answers an earlier tick,
   /// and a second command with the label already received is a copy of it (the controller answers
@@ -54,15 +54,16 @@ struct PlantOptions {
 /// What became of the motor commands (sim/validation.hpp check_command).
 struct PlantStats {
   std::uint64_t commands_received = 0;
-  std::uint64_t commands_accepted = 0;  ///< used, clamped ones included (not repeats)
-  std::uint64_t commands_rejected = 0;  ///< wrong length or non-finite: ignored, last good one held
+  std::uint64_t commands_accepted = 0;             ///< used, clamped ones included (not repeats)
+  std::uint64_t commands_rejected = 0;             ///< wrong length or non-finite: ignored, last good one held
   std::uint64_t commands_rejected_length = 0;      ///< of those: not exactly 4 values
   std::uint64_t commands_rejected_non_finite = 0;  ///< of those: a NaN/Inf speed
-  std::uint64_t commands_clamped = 0;   ///< a speed < 0 or > omega_max: used clamped to [0, omega_max]
-  std::uint64_t commands_stale = 0;     ///< lockstep repeats (an earlier tick's command, or a second copy of this one), dropped
-  std::uint64_t watchdog_trips = 0;     ///< times the watchdog took over (no valid command for its limit)
-  std::uint64_t watchdog_ticks = 0;     ///< ticks latched under the watchdog's policy
-  std::string last_problem;             ///< the reason given for the newest rejected/clamped command
+  std::uint64_t commands_clamped = 0;              ///< a speed < 0 or > omega_max: used clamped to [0, omega_max]
+  std::uint64_t commands_stale =
+      0;  ///< lockstep repeats (an earlier tick's command, or a second copy of this one), dropped
+  std::uint64_t watchdog_trips = 0;  ///< times the watchdog took over (no valid command for its limit)
+  std::uint64_t watchdog_ticks = 0;  ///< ticks latched under the watchdog's policy
+  std::string last_problem;          ///< the reason given for the newest rejected/clamped command
 };
 
 /// The native plant behind the steppable-plant seam (sim/steppable_plant.hpp).
@@ -128,7 +129,7 @@ class PlantNode final : public SteppablePlant {
   std::size_t pending_head_ = 0;
   PlantStats stats_;
   std::function<std::int64_t()> receipt_clock_;
-  Tick last_valid_tick_ = 0;           ///< tick during which the newest valid command arrived
+  Tick last_valid_tick_ = 0;                 ///< tick during which the newest valid command arrived
   std::int64_t last_valid_receipt_ns_ = -1;  ///< receipt clock: its arrival (-1: none, from the first latch)
   std::int64_t command_age_ns_ = 0;
   bool watchdog_active_ = false;
@@ -138,7 +139,7 @@ class PlantNode final : public SteppablePlant {
   LogThrottle rejected_log_, clamped_log_;
   msg::PlantStatus status_;
   Tick status_period_ticks_ = 1;  ///< ticks between periodic statuses (options or one simulated second)
-  msg::PoseStamped pose_;  ///< the outgoing sensor messages, reused from tick to tick
+  msg::PoseStamped pose_;         ///< the outgoing sensor messages, reused from tick to tick
   msg::TwistStamped twist_;
   msg::Imu imu_;
   Tick last_status_tick_ = -1;

@@ -22,12 +22,11 @@ bool RealismConfig::active() const {
          i.accel_noise_density > 0.0 || i.accel_bias_random_walk > 0.0 || i.accel_bias_initial > 0.0 ||
          i.orientation_sigma_rad > 0.0 || timing_active(i.timing) || pose.position_sigma_m > 0.0 ||
          pose.orientation_sigma_rad > 0.0 || timing_active(pose.timing) || velocity.linear_sigma_m_s > 0.0 ||
-         velocity.angular_sigma_rad_s > 0.0 || timing_active(velocity.timing) || wind.active() ||
-         !faults.empty();
+         velocity.angular_sigma_rad_s > 0.0 || timing_active(velocity.timing) || wind.active() || !faults.empty();
 }
 
-PlantRealism::PlantRealism(const RealismConfig& c, const model::VehicleParams& /*vehicle*/,
-                           const std::string& ns, const TickClock& clock)
+PlantRealism::PlantRealism(const RealismConfig& c, const model::VehicleParams& /*vehicle*/, const std::string& ns,
+                           const TickClock& clock)
     : config_(c) {
   auto rng = [&](const char* source) { return model::Rng(model::stream_seed(c.seed, ns, source)); };
   const double T = clock.period_s();
@@ -46,8 +45,8 @@ PlantRealism::PlantRealism(const RealismConfig& c, const model::VehicleParams& /
   linear_noise_ = model::Vector3Noise({c.velocity.linear_sigma_m_s, 0.0, 0.0}, rng("velocity.linear"));
   angular_noise_ = model::Vector3Noise({c.velocity.angular_sigma_rad_s, 0.0, 0.0}, rng("velocity.angular"));
 
-  const int depth = 1 + std::max({c.imu.timing.latency_ticks, c.pose.timing.latency_ticks,
-                                  c.velocity.timing.latency_ticks});
+  const int depth =
+      1 + std::max({c.imu.timing.latency_ticks, c.pose.timing.latency_ticks, c.velocity.timing.latency_ticks});
   history_.resize(static_cast<std::size_t>(depth));
 
   // The covariances the messages carry: the white-noise variance of each published quantity (the
@@ -96,8 +95,7 @@ PlantRealism::Due PlantRealism::measure(Tick k, const model::Outputs& truth, msg
     }
     if (due_.imu) {
       const model::Outputs& y = sample_of(config_.imu.timing);
-      imu_.orientation =
-          to_msg(model::perturb_attitude(y.q_WB, config_.imu.orientation_sigma_rad, imu_attitude_rng_));
+      imu_.orientation = to_msg(model::perturb_attitude(y.q_WB, config_.imu.orientation_sigma_rad, imu_attitude_rng_));
       imu_.angular_velocity = to_msg(gyro_noise_.sample(y.w_B));
       imu_.linear_acceleration = to_msg(accel_noise_.sample(y.specific_force_B));
     }

@@ -30,13 +30,13 @@ struct SensorTiming {
 
 struct ImuConfig {
   SensorTiming timing;
-  double gyro_noise_density = 0.0;        ///< [rad/s/√Hz]
-  double gyro_bias_random_walk = 0.0;     ///< [rad/s²/√Hz] (= rad/s/√s)
-  double gyro_bias_initial = 0.0;         ///< turn-on bias sigma [rad/s]
-  double accel_noise_density = 0.0;       ///< [m/s²/√Hz]
-  double accel_bias_random_walk = 0.0;    ///< [m/s³/√Hz]
-  double accel_bias_initial = 0.0;        ///< turn-on bias sigma [m/s²]
-  double orientation_sigma_rad = 0.0;     ///< attitude estimate noise per axis [rad]
+  double gyro_noise_density = 0.0;      ///< [rad/s/√Hz]
+  double gyro_bias_random_walk = 0.0;   ///< [rad/s²/√Hz] (= rad/s/√s)
+  double gyro_bias_initial = 0.0;       ///< turn-on bias sigma [rad/s]
+  double accel_noise_density = 0.0;     ///< [m/s²/√Hz]
+  double accel_bias_random_walk = 0.0;  ///< [m/s³/√Hz]
+  double accel_bias_initial = 0.0;      ///< turn-on bias sigma [m/s²]
+  double orientation_sigma_rad = 0.0;   ///< attitude estimate noise per axis [rad]
 };
 
 struct PoseConfig {
@@ -47,8 +47,8 @@ struct PoseConfig {
 
 struct VelocityConfig {
   SensorTiming timing;
-  double linear_sigma_m_s = 0.0;      ///< per axis [m/s]
-  double angular_sigma_rad_s = 0.0;   ///< per axis [rad/s]
+  double linear_sigma_m_s = 0.0;     ///< per axis [m/s]
+  double angular_sigma_rad_s = 0.0;  ///< per axis [rad/s]
 };
 
 /// From tick `tick` on, rotor `rotor` (0-based) gives `efficiency` times its nominal thrust and drag
@@ -85,8 +85,7 @@ class PlantRealism {
   /// Records the true outputs of tick k and fills the sensor fields of the three messages (headers
   /// untouched) with the sample each sensor publishes at tick k; says which are due. Called again for
   /// the same tick, it returns the same sample (nothing new is drawn).
-  Due measure(Tick k, const model::Outputs& truth, msg::PoseStamped& pose, msg::TwistStamped& twist,
-              msg::Imu& imu);
+  Due measure(Tick k, const model::Outputs& truth, msg::PoseStamped& pose, msg::TwistStamped& twist, msg::Imu& imu);
 
   const RealismConfig& config() const { return config_; }
   /// The discrete per-sample standard deviations the IMU uses (for the message covariances).

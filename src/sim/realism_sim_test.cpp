@@ -46,9 +46,7 @@ struct Rig {
   }
 };
 
-model::State hover_state() {
-  return model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 5}, 0.0, true);
-}
+model::State hover_state() { return model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 5}, 0.0, true); }
 
 RealismConfig noisy() {
   RealismConfig r;
@@ -118,9 +116,9 @@ TEST(PlantRealismTest, AddingASourceDoesNotShiftAnotherSourcesNumbers) {
 
 TEST(PlantRealismTest, ImuCovariancesCarryTheDiscreteNoiseVariance) {
   RealismConfig r;
-  r.imu.gyro_noise_density = 0.001;   // at 100 Hz: sigma 0.01 rad/s
-  r.imu.accel_noise_density = 0.02;   // sigma 0.2 m/s^2
-  r.imu.timing.divider = 2;           // 50 Hz: sigma = density * sqrt(50)
+  r.imu.gyro_noise_density = 0.001;  // at 100 Hz: sigma 0.01 rad/s
+  r.imu.accel_noise_density = 0.02;  // sigma 0.2 m/s^2
+  r.imu.timing.divider = 2;          // 50 Hz: sigma = density * sqrt(50)
   r.imu.orientation_sigma_rad = 0.003;
   Rig rig(r, hover_state());
   rig.run(4);
@@ -188,7 +186,7 @@ TEST(PlantRealismTest, MotorFailureAtItsTickAndTheIdealPlantWhenAllIsOff) {
   failing.run(100);
   ideal.run(100);
   EXPECT_EQ(failing.plant.state().p_W, ideal.plant.state().p_W);  // nothing happened before the fault
-  const double z_before = failing.plant.state().p_W.z();  // at t = 1 s
+  const double z_before = failing.plant.state().p_W.z();          // at t = 1 s
   for (Tick k = 100; k < 149; ++k) {
     failing.plant.publish_outputs(k);
     failing.plant.latch_command(k);

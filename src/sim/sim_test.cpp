@@ -80,9 +80,11 @@ struct PlantRig {
     cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
     plant = std::make_unique<PlantNode>(bus, topics, vehicle, opt, x0);
   }
-  void send(std::vector<double> w) { msg::Float64MultiArray m;
+  void send(std::vector<double> w) {
+    msg::Float64MultiArray m;
     m.data = std::move(w);
-    cmd.publish(m); }
+    cmd.publish(m);
+  }
 };
 
 TEST(PlantNodeTest, PublishesStampedOutputsOfTheState) {
@@ -104,10 +106,10 @@ TEST(PlantNodeTest, RejectsMalformedCommandsAndHoldsTheLastGoodOne) {
   PlantRig rig;
   rig.plant->publish_outputs(0);
   rig.send({100, 200, 300, 400});
-  rig.send({1, 2, 3});                    // wrong length
-  rig.send({});                           // empty
-  rig.send({1, std::nan(""), 3, 4});      // NaN
-  rig.send({1, 2, INFINITY, 4});          // Inf
+  rig.send({1, 2, 3});                // wrong length
+  rig.send({});                       // empty
+  rig.send({1, std::nan(""), 3, 4});  // NaN
+  rig.send({1, 2, INFINITY, 4});      // Inf
   rig.plant->latch_command(0);
   EXPECT_EQ(rig.plant->stats().commands_received, 5u);
   EXPECT_EQ(rig.plant->stats().commands_rejected, 4u);
@@ -173,7 +175,7 @@ TEST(ControllerNodeTest, GoesToSafetyWhenDataGetsStaleAndRecovers) {
   EXPECT_FALSE(node.step(0, 0.02).safety);
   EXPECT_FALSE(node.step(100'000'000, 0.02).safety);  // exactly at the limit: still fresh
   EXPECT_TRUE(node.step(120'000'000, 0.02).safety);   // 0.12 s old
-  plant.publish_outputs(12);                            // fresh data at t = 0.12 s
+  plant.publish_outputs(12);                          // fresh data at t = 0.12 s
   EXPECT_FALSE(node.step(120'000'000, 0.02).safety);
 }
 
@@ -289,8 +291,8 @@ TEST(CommandLabelTest, WritesAndReadsTheStamp) {
   EXPECT_EQ(m.dim[0].label, "rotors@123456789012");
   EXPECT_EQ(command_stamp_ns(m), 123'456'789'012);
   EXPECT_EQ(command_label(0), "rotors@0");
-  for (const char* bad : {"rotors@", "rotors@-5", "rotors@+5", "rotors@12x", "rotors@99999999999999999999",
-                          "rotor@5", "", "rotors@ 5"}) {
+  for (const char* bad :
+       {"rotors@", "rotors@-5", "rotors@+5", "rotors@12x", "rotors@99999999999999999999", "rotor@5", "", "rotors@ 5"}) {
     m.dim[0].label = bad;
     EXPECT_EQ(command_stamp_ns(m), -1) << bad;
   }

@@ -18,9 +18,8 @@ struct ClearOnTick {
 };
 }  // namespace
 
-Simulation::Simulation(const SimulationConfig& config, const model::VehicleParams& vehicle,
-                       const model::State& initial, const control::ControllerConfig& controller,
-                       std::vector<ScheduledParameter> schedule)
+Simulation::Simulation(const SimulationConfig& config, const model::VehicleParams& vehicle, const model::State& initial,
+                       const control::ControllerConfig& controller, std::vector<ScheduledParameter> schedule)
     : config_(config),
       plant_(transport_, Topics::for_namespace(config.ns), vehicle, config.plant, initial),
       controller_(transport_, Topics::for_namespace(config.ns), controller),

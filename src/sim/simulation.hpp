@@ -53,9 +53,8 @@ struct TickRecord {
 class Simulation {
  public:
   /// Throws std::invalid_argument when a scheduled parameter is refused by the controller.
-  Simulation(const SimulationConfig& config, const model::VehicleParams& vehicle,
-             const model::State& initial, const control::ControllerConfig& controller,
-             std::vector<ScheduledParameter> schedule);
+  Simulation(const SimulationConfig& config, const model::VehicleParams& vehicle, const model::State& initial,
+             const control::ControllerConfig& controller, std::vector<ScheduledParameter> schedule);
 
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -108,7 +107,7 @@ class Simulation {
   ParameterSchedule schedule_;
   double control_dt_s_;
   msg::ControllerStatus status_;  ///< the last status delivered, when faults may lose or delay statuses
-  const msg::ControllerStatus* delivered_status_ = nullptr;  ///< status_, or the controller's own
+  const msg::ControllerStatus* delivered_status_ = nullptr;          ///< status_, or the controller's own
   const std::function<void(const TickRecord&)>* on_tick_ = nullptr;  ///< while run() or tick(k, f)
   SynchronousHost host_;
   LockstepCore<PlantNode, Hooks, SynchronousHost, true> loop_;

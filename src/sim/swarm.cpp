@@ -24,9 +24,8 @@ Eigen::Vector3d vehicle_offset_W(const SwarmLayout& layout, int index) {
 }
 
 SwarmVehicle swarm_vehicle(const SimulationConfig& simulation, const model::State& initial,
-                           const control::ControllerConfig& controller,
-                           const std::vector<ScheduledParameter>& schedule, const SwarmLayout& layout,
-                           int index) {
+                           const control::ControllerConfig& controller, const std::vector<ScheduledParameter>& schedule,
+                           const SwarmLayout& layout, int index) {
   const Eigen::Vector3d o = vehicle_offset_W(layout, index);
   SwarmVehicle v{simulation, initial, controller, schedule};
   v.simulation.ns = vehicle_namespace(layout.ns_prefix, index, layout.vehicles);

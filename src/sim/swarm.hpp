@@ -23,11 +23,11 @@
 namespace quadcosim::sim {
 
 struct SwarmLayout {
-  int vehicles = 16;              ///< N >= 1
-  double spacing_m = 2.0;         ///< grid spacing in x and y [m], > 0
-  int altitude_layers = 1;        ///< z_des cycles through this many layers, >= 1
-  double layer_spacing_m = 1.0;   ///< height between layers [m], >= 0
-  std::string ns_prefix = "/uav"; ///< namespaces are <prefix><index>
+  int vehicles = 16;               ///< N >= 1
+  double spacing_m = 2.0;          ///< grid spacing in x and y [m], > 0
+  int altitude_layers = 1;         ///< z_des cycles through this many layers, >= 1
+  double layer_spacing_m = 1.0;    ///< height between layers [m], >= 0
+  std::string ns_prefix = "/uav";  ///< namespaces are <prefix><index>
 };
 
 /// Namespace of vehicle `index` of `vehicles`: "/uav0007" (prefix + zero-padded index).
@@ -44,9 +44,8 @@ struct SwarmVehicle {
   std::vector<ScheduledParameter> schedule;
 };
 SwarmVehicle swarm_vehicle(const SimulationConfig& simulation, const model::State& initial,
-                           const control::ControllerConfig& controller,
-                           const std::vector<ScheduledParameter>& schedule, const SwarmLayout& layout,
-                           int index);
+                           const control::ControllerConfig& controller, const std::vector<ScheduledParameter>& schedule,
+                           const SwarmLayout& layout, int index);
 
 class Swarm {
  public:
@@ -61,8 +60,9 @@ class Swarm {
   /// Runs ticks 0..duration_ticks of every vehicle on `threads` threads (vehicles split in
   /// contiguous ranges). Each thread takes its vehicles through the run in blocks of `block_ticks`:
   /// within a block each vehicle runs its ticks back to back (its data stays in the cache), and at
-  /// the end of a block all of the thread's vehicles are at the same tick. `recorded[i]` (when not empty) selects vehicles whose ticks go to `recorder`.
-  /// Rethrows the first exception a vehicle raised (e.g. a refused scheduled parameter).
+  /// the end of a block all of the thread's vehicles are at the same tick. `recorded[i]` (when not empty) selects
+  /// vehicles whose ticks go to `recorder`. Rethrows the first exception a vehicle raised (e.g. a refused scheduled
+  /// parameter).
   void run(int threads, Tick block_ticks, const std::vector<bool>& recorded = {}, const Recorder& recorder = {});
 
   /// The same for ticks first..last only (0 <= first, last <= duration_ticks); successive calls

@@ -67,7 +67,8 @@ TEST(SwarmTest, EachVehicleFliesWhatItsOwnSimulationFlies) {
   l.layer_spacing_m = 1.5;
   Swarm swarm(config(), model::VehicleParams{}, model::State{}, position_mode(), schedule(), l);
   std::vector<Trace> got(5);
-  swarm.run(2, 100, std::vector<bool>(5, true), [&](int i, const TickRecord& r) { got[static_cast<std::size_t>(i)].add(r); });
+  swarm.run(2, 100, std::vector<bool>(5, true),
+            [&](int i, const TickRecord& r) { got[static_cast<std::size_t>(i)].add(r); });
 
   // Vehicle 4: column 1, row 1, layer 0, set up by hand.
   for (int i : {0, 4}) {
@@ -78,7 +79,8 @@ TEST(SwarmTest, EachVehicleFliesWhatItsOwnSimulationFlies) {
     c.setpoint.p_des_W = {ox, oy, oz};
     SimulationConfig cfg = config();
     cfg.ns = i == 0 ? "/uav0000" : "/uav0004";
-    Simulation alone(cfg, model::VehicleParams{}, x0, c, {{0, "z_des", 3.0 + oz}, {150, "x_des", 0.5 + ox}, {301, "y_des", -0.5 + oy}});
+    Simulation alone(cfg, model::VehicleParams{}, x0, c,
+                     {{0, "z_des", 3.0 + oz}, {150, "x_des", 0.5 + ox}, {301, "y_des", -0.5 + oy}});
     Trace want;
     alone.run([&](const TickRecord& r) { want.add(r); });
     EXPECT_EQ(swarm.vehicle_ns(i), cfg.ns);

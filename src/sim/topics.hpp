@@ -6,11 +6,11 @@
 namespace quadcosim::sim {
 
 struct Topics {
-  std::string motor_commands;  ///< controller -> plant, std_msgs/Float64MultiArray
-  std::string pose;            ///< plant ->, geometry_msgs/PoseStamped
-  std::string velocity;        ///< plant ->, geometry_msgs/TwistStamped
-  std::string imu;             ///< plant ->, sensor_msgs/Imu
-  std::string clock;           ///< plant ->, rosgraph_msgs/Clock (global, not namespaced)
+  std::string motor_commands;     ///< controller -> plant, std_msgs/Float64MultiArray
+  std::string pose;               ///< plant ->, geometry_msgs/PoseStamped
+  std::string velocity;           ///< plant ->, geometry_msgs/TwistStamped
+  std::string imu;                ///< plant ->, sensor_msgs/Imu
+  std::string clock;              ///< plant ->, rosgraph_msgs/Clock (global, not namespaced)
   std::string controller_status;  ///< controller ->, quadcosim_msgs/ControllerStatus
   std::string plant_status;       ///< plant ->, quadcosim_msgs/PlantStatus
 

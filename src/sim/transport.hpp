@@ -20,8 +20,7 @@ struct TopicType {
 
 template <class T>
 TopicType topic_type() {
-  return {T::kRosType, std::type_index(typeid(T)),
-          [](const void* m) -> std::shared_ptr<const void> {
+  return {T::kRosType, std::type_index(typeid(T)), [](const void* m) -> std::shared_ptr<const void> {
             return std::make_shared<const T>(*static_cast<const T*>(m));
           }};
 }
@@ -56,9 +55,8 @@ class Transport {
   /// `callback` is any callable taking const T& (stored as it is: one indirect call per delivery).
   template <class T, class F>
   void subscribe(const std::string& topic, F callback) {
-    add_subscription(topic, topic_type<T>(), [cb = std::move(callback)](const void* m) {
-      cb(*static_cast<const T*>(m));
-    });
+    add_subscription(topic, topic_type<T>(),
+                     [cb = std::move(callback)](const void* m) { cb(*static_cast<const T*>(m)); });
   }
 
  protected:

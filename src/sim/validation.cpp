@@ -1,7 +1,7 @@
 #include "sim/validation.hpp"
 
-#include <cmath>
 #include <fmt/format.h>
+#include <cmath>
 
 namespace quadcosim::sim {
 
@@ -196,9 +196,8 @@ std::string SensorCheck::reason() const {
     case SensorFault::kNonFinite:
       return fmt::format("{} {}: expected finite values", to_string(field), shown(value, quaternion));
     case SensorFault::kBadQuaternion:
-      return fmt::format("orientation {} has norm {:g}: expected a unit quaternion (within {:g})",
-                         shown(value, true), std::sqrt(norm_squared(value[0], value[1], value[2], value[3])),
-                         kQuaternionNormTolerance);
+      return fmt::format("orientation {} has norm {:g}: expected a unit quaternion (within {:g})", shown(value, true),
+                         std::sqrt(norm_squared(value[0], value[1], value[2], value[3])), kQuaternionNormTolerance);
     case SensorFault::kBadStamp:
       return fmt::format("stamp sec {} nanosec {}: expected sec >= 0 and nanosec < 1e9", stamp.sec, stamp.nanosec);
     case SensorFault::kStampBackwards:

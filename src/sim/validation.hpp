@@ -37,7 +37,7 @@ enum class CommandFault : std::uint8_t {
 struct CommandCheck {
   CommandFault fault = CommandFault::kNone;
   model::Vector4 omega_rad_s = model::Vector4::Zero();  ///< the speeds to use (not kRejected) [rad/s]
-  std::size_t values = 4;        ///< how many values the message held
+  std::size_t values = 4;                               ///< how many values the message held
   int rotor = 0;                 ///< the rotor at fault, 0..3: the first non-finite one, or the first clamped one
   double value = 0.0;            ///< that rotor's speed as sent [rad/s] (kNonFinite, kOutOfRange)
   double omega_max_rad_s = 0.0;  ///< the upper end of the range checked against [rad/s]

@@ -171,12 +171,22 @@ TEST(CheckSensorTest, EachFaultNamesTheFieldAndValue) {
        "position (1, nan, 3): expected finite values");
   pose([](auto& m) { m.orientation.x = kInf; }, kNever, F::kNonFinite, S::kOrientation,
        "orientation (x inf, y 0, z 0, w 1): expected finite values");
-  pose([](auto& m) { m.orientation = {0, 0, 0, 0}; }, kNever, F::kBadQuaternion, S::kOrientation,
-       "orientation (x 0, y 0, z 0, w 0) has norm 0: expected a unit quaternion (within 0.001)");
-  pose([](auto& m) { m.header.stamp = {1, 1'000'000'000u}; }, kNever, F::kBadStamp, S::kStamp,
-       "stamp sec 1 nanosec 1000000000: expected sec >= 0 and nanosec < 1e9");
-  pose([](auto& m) { m.header.stamp = {-1, 0}; }, kNever, F::kBadStamp, S::kStamp,
-       "stamp sec -1 nanosec 0: expected sec >= 0 and nanosec < 1e9");
+  pose(
+      [](auto& m) {
+        m.orientation = {0, 0, 0, 0};
+      },
+      kNever, F::kBadQuaternion, S::kOrientation,
+      "orientation (x 0, y 0, z 0, w 0) has norm 0: expected a unit quaternion (within 0.001)");
+  pose(
+      [](auto& m) {
+        m.header.stamp = {1, 1'000'000'000u};
+      },
+      kNever, F::kBadStamp, S::kStamp, "stamp sec 1 nanosec 1000000000: expected sec >= 0 and nanosec < 1e9");
+  pose(
+      [](auto& m) {
+        m.header.stamp = {-1, 0};
+      },
+      kNever, F::kBadStamp, S::kStamp, "stamp sec -1 nanosec 0: expected sec >= 0 and nanosec < 1e9");
   pose([](auto&) {}, 40'000'000, F::kStampBackwards, S::kStamp,
        "stamp 30000000 ns is older than the newest accepted, 40000000 ns");
   velocity([](auto& m) { m.linear.x = -kInf; }, kNever, F::kNonFinite, S::kLinear,
@@ -189,17 +199,28 @@ TEST(CheckSensorTest, EachFaultNamesTheFieldAndValue) {
            "stamp 30000000 ns is older than the newest accepted, 30000001 ns");
   imu([](auto& m) { m.orientation.w = kNaN; }, kNever, F::kNonFinite, S::kOrientation,
       "orientation (x 0, y 0, z 0, w nan): expected finite values");
-  imu([](auto& m) { m.orientation = {0.6, 0, 0, 0.6}; }, kNever, F::kBadQuaternion, S::kOrientation,
+  imu(
+      [](auto& m) {
+        m.orientation = {0.6, 0, 0, 0.6};
+      },
+      kNever, F::kBadQuaternion, S::kOrientation,
       "orientation (x 0.6, y 0, z 0, w 0.6) has norm 0.848528: expected a unit quaternion (within 0.001)");
   // Finite, but |q|^2 overflows: not a unit quaternion (not a non-finite value).
-  imu([](auto& m) { m.orientation = {1e200, 0, 0, 1}; }, kNever, F::kBadQuaternion, S::kOrientation,
+  imu(
+      [](auto& m) {
+        m.orientation = {1e200, 0, 0, 1};
+      },
+      kNever, F::kBadQuaternion, S::kOrientation,
       "orientation (x 1e+200, y 0, z 0, w 1) has norm inf: expected a unit quaternion (within 0.001)");
   imu([](auto& m) { m.angular_velocity.y = kInf; }, kNever, F::kNonFinite, S::kAngularVelocity,
       "angular_velocity (0, inf, 0): expected finite values");
   imu([](auto& m) { m.linear_acceleration.z = kNaN; }, kNever, F::kNonFinite, S::kLinearAcceleration,
       "linear_acceleration (0, 0, nan): expected finite values");
-  imu([](auto& m) { m.header.stamp = {-5, 7}; }, kNever, F::kBadStamp, S::kStamp,
-      "stamp sec -5 nanosec 7: expected sec >= 0 and nanosec < 1e9");
+  imu(
+      [](auto& m) {
+        m.header.stamp = {-5, 7};
+      },
+      kNever, F::kBadStamp, S::kStamp, "stamp sec -5 nanosec 7: expected sec >= 0 and nanosec < 1e9");
   imu([](auto&) {}, 1'000'000'000, F::kStampBackwards, S::kStamp,
       "stamp 30000000 ns is older than the newest accepted, 1000000000 ns");
   ASSERT_EQ(cases.size(), 17u);
@@ -423,10 +444,9 @@ TEST(PlantValidationTest, LogIsRateLimitedAndSaysHowMany) {
 TEST(PlantValidationTest, HostileCommandStreamNeverMakesTheStateNonFinite) {
   Rig rig;
   const double big = std::numeric_limits<double>::max();
-  const std::vector<std::vector<double>> evil = {{big, big, big, big},       {-big, big, -big, big},
-                                                 {kNaN, kNaN, kNaN, kNaN},   {big, 0, big, 0},
-                                                 {1e-320, 0, 1e-320, 0},     {0, big, 0, big},
-                                                 {12000, 0, 12000, 0},       {}};
+  const std::vector<std::vector<double>> evil = {
+      {big, big, big, big},   {-big, big, -big, big}, {kNaN, kNaN, kNaN, kNaN}, {big, 0, big, 0},
+      {1e-320, 0, 1e-320, 0}, {0, big, 0, big},       {12000, 0, 12000, 0},     {}};
   for (Tick k = 0; k < 400; ++k) {
     rig.cmd.publish(command(evil[static_cast<std::size_t>(k) % evil.size()]));
     rig.tick(k);

@@ -76,9 +76,7 @@ int index_of(const std::string& part) {
   return std::stoi(part);
 }
 
-bool digits(const std::string& part) {
-  return !part.empty() && std::all_of(part.begin(), part.end(), ::isdigit);
-}
+bool digits(const std::string& part) { return !part.empty() && std::all_of(part.begin(), part.end(), ::isdigit); }
 
 std::string join(const std::vector<std::string>& parts, std::size_t from, std::size_t to) {
   std::string s;
@@ -110,14 +108,13 @@ const model::VehicleParameter* find_vehicle_field(const std::string& name) {
 }
 
 void set_at(YAML::Node node, const std::vector<std::string>& parts, std::size_t pos, double value,
-            const std::string& path, const std::string& here,
-            const std::map<std::string, std::vector<double>>& lists) {
+            const std::string& path, const std::string& here, const std::map<std::string, std::vector<double>>& lists) {
   const auto at = [&](const std::string& k) { return here.empty() ? k : here + "." + k; };
   if (node.IsSequence()) {
     const int i = index_of(parts[pos]);
     if (i < 0 || i >= static_cast<int>(node.size())) {
-      throw PlanError(fmt::format("{}: {} is a list of {}; expected an index 0..{} (or x, y, z), got '{}'", path,
-                                  here, node.size(), node.size() - 1, parts[pos]));
+      throw PlanError(fmt::format("{}: {} is a list of {}; expected an index 0..{} (or x, y, z), got '{}'", path, here,
+                                  node.size(), node.size() - 1, parts[pos]));
     }
     if (pos + 1 == parts.size()) {
       if (node[i].IsMap() || node[i].IsSequence()) throw PlanError(path + ": is a list or mapping, not a number");
@@ -153,7 +150,8 @@ void set_at(YAML::Node node, const std::vector<std::string>& parts, std::size_t 
     for (double x : l->second) list.push_back(x);
     node[key] = list;
   } else if (digits(parts[pos + 1])) {
-    throw PlanError(path + ": " + at(key) + " is not in the scenario file; write the whole list there to vary one entry");
+    throw PlanError(path + ": " + at(key) +
+                    " is not in the scenario file; write the whole list there to vary one entry");
   } else {
     node[key] = YAML::Node(YAML::NodeType::Map);
   }
@@ -362,8 +360,7 @@ Vary parse_vary(const std::string& spec) {
     for (int i = 0; i < count; ++i) {
       // Ends exact: a at i = 0, b at i = n - 1.
       v.values.push_back(count == 1 ? args[0]
-                                    : (i == count - 1 ? args[1]
-                                                      : args[0] + (args[1] - args[0]) * i / (count - 1)));
+                                    : (i == count - 1 ? args[1] : args[0] + (args[1] - args[0]) * i / (count - 1)));
     }
   } else {
     throw PlanError("--vary " + spec + ": unknown distribution '" + fn + "'; " + expected);
@@ -428,9 +425,7 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
         try_load(v, v.a, "value");
         try_load(v, v.b, "value");
         break;
-      case Distribution::kNormal:
-        try_load(v, v.a, "mean");
-        break;
+      case Distribution::kNormal: try_load(v, v.a, "mean"); break;
       case Distribution::kGrid:
         for (double x : v.values) try_load(v, x, "grid value");
         p.grid_sizes.push_back(static_cast<int>(v.values.size()));

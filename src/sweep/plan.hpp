@@ -43,9 +43,9 @@ struct DeclaredRange {
 
 /// One scenario key a spec sets.
 struct Key {
-  std::string path;    ///< YAML path, e.g. "vehicle.mass_kg"
-  std::string stream;  ///< name of its random stream (a vehicle field's own name, else the path)
-  std::optional<double> nominal;         ///< value in the scenario (file or default), when known
+  std::string path;               ///< YAML path, e.g. "vehicle.mass_kg"
+  std::string stream;             ///< name of its random stream (a vehicle field's own name, else the path)
+  std::optional<double> nominal;  ///< value in the scenario (file or default), when known
   std::optional<DeclaredRange> declared;
   bool is_vehicle = false;  ///< the plant flies it; the controller keeps the nominal value
 };
@@ -65,14 +65,14 @@ Vary parse_vary(const std::string& spec);
 
 struct Plan {
   std::string scenario_file;
-  YAML::Node root;        ///< the scenario file as parsed (never modified)
+  YAML::Node root;  ///< the scenario file as parsed (never modified)
   io::Scenario nominal;
   std::uint64_t seed = 1;
   Sampler sampler = Sampler::kRandom;
   std::vector<Vary> vary;
-  int repeats = 1;               ///< runs per grid point
-  std::vector<int> grid_sizes;   ///< one per grid spec, in order (the first varies slowest)
-  int runs = 0;                  ///< product of grid_sizes times repeats
+  int repeats = 1;                                     ///< runs per grid point
+  std::vector<int> grid_sizes;                         ///< one per grid spec, in order (the first varies slowest)
+  int runs = 0;                                        ///< product of grid_sizes times repeats
   std::map<std::string, std::vector<int>> lhs_strata;  ///< per random key: run -> stratum
 };
 
@@ -86,7 +86,7 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
 /// The draws of one run.
 struct Sample {
   int index = 0;
-  std::uint64_t seed = 0;  ///< the run's seed (noise, gusts)
+  std::uint64_t seed = 0;                              ///< the run's seed (noise, gusts)
   std::vector<std::pair<std::string, double>> values;  ///< key path -> value, in spec order
   std::map<std::string, double> factors;               ///< KEY=P% keys: stream name -> factor
 };

@@ -76,8 +76,8 @@ std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunR
     const int n = ++seen[ch];
     const std::string prefix = n == 1 ? ch : fmt::format("{}#{}", ch, n);
     for (const auto& name : analysis::figure_names()) {
-      out.emplace_back(prefix + "." + name, ok && i < r.steps.size() ? analysis::figure(r.steps[i].figures, name)
-                                                                     : std::nullopt);
+      out.emplace_back(prefix + "." + name,
+                       ok && i < r.steps.size() ? analysis::figure(r.steps[i].figures, name) : std::nullopt);
     }
   }
   if (sc.hold) {
@@ -168,8 +168,8 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
     io::SeriesRecorder series;  // one per thread, reused run after run
     for (std::size_t i; (i = next.fetch_add(1)) < indices.size();) {
       const int index = indices[i];
-      results[i] = run_into(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep,
-                          series);
+      results[i] =
+          run_into(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep, series);
     }
   };
   std::vector<std::thread> pool;
@@ -239,12 +239,21 @@ nlohmann::json header_json(const Plan& plan) {
       keys.push_back(kj);
       fields.push_back(k.stream);
     }
-    nlohmann::json vj = {{"spec", v.spec}, {"key", v.name}, {"distribution", to_string(v.distribution)},
-                         {"keys", keys}, {"fields", fields}};
+    nlohmann::json vj = {{"spec", v.spec},
+                         {"key", v.name},
+                         {"distribution", to_string(v.distribution)},
+                         {"keys", keys},
+                         {"fields", fields}};
     switch (v.distribution) {
       case Distribution::kPercent: vj["percent"] = v.a * 100.0; break;
-      case Distribution::kUniform: vj["min"] = v.a; vj["max"] = v.b; break;
-      case Distribution::kNormal: vj["mean"] = v.a; vj["sigma"] = v.b; break;
+      case Distribution::kUniform:
+        vj["min"] = v.a;
+        vj["max"] = v.b;
+        break;
+      case Distribution::kNormal:
+        vj["mean"] = v.a;
+        vj["sigma"] = v.b;
+        break;
       case Distribution::kGrid: vj["values"] = v.values; break;
     }
     j["vary"].push_back(vj);
@@ -265,8 +274,9 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r) {
 
 nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run) {
   const int runs = header.at("runs").get<int>();
-  std::sort(per_run.begin(), per_run.end(),
-            [](const auto& a, const auto& b) { return a.at("index").template get<int>() < b.at("index").template get<int>(); });
+  std::sort(per_run.begin(), per_run.end(), [](const auto& a, const auto& b) {
+    return a.at("index").template get<int>() < b.at("index").template get<int>();
+  });
   for (std::size_t i = 0; i < per_run.size(); ++i) {
     const int index = per_run[i].at("index").get<int>();
     if (index != static_cast<int>(i)) {
@@ -280,7 +290,8 @@ nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::
                                     : fmt::format("{} runs for a sweep of {}", per_run.size(), runs));
   }
   nlohmann::json j = header;
-  const auto passed = std::count_if(per_run.begin(), per_run.end(), [](const auto& r) { return r.at("passed").template get<bool>(); });
+  const auto passed =
+      std::count_if(per_run.begin(), per_run.end(), [](const auto& r) { return r.at("passed").template get<bool>(); });
   j["passed"] = passed;
   j["pass_rate"] = runs > 0 ? static_cast<double>(passed) / runs : 0.0;
   std::map<std::string, std::vector<std::optional<double>>> values;
@@ -294,8 +305,15 @@ nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::
     const FigureStats d = figure_stats(list);
     nlohmann::json f = {{"count", d.count}, {"missing", d.missing}};
     if (d.count > 0) {
-      f.update({{"min", d.min}, {"max", d.max}, {"mean", d.mean}, {"std", d.std}, {"p5", d.p5}, {"p25", d.p25},
-                {"p50", d.p50}, {"p75", d.p75}, {"p95", d.p95}});
+      f.update({{"min", d.min},
+                {"max", d.max},
+                {"mean", d.mean},
+                {"std", d.std},
+                {"p5", d.p5},
+                {"p25", d.p25},
+                {"p50", d.p50},
+                {"p75", d.p75},
+                {"p95", d.p95}});
     }
     dist[name] = f;
   }
@@ -353,7 +371,8 @@ Plan plan_of(const fs::path& dir) {
   fs::path file = dir / "summary.json";
   if (!fs::exists(file)) file = dir / "shard.json";
   std::ifstream in(file);
-  if (!in) throw std::runtime_error((dir / "summary.json").string() + ": not found (nor shard.json): not a sweep folder");
+  if (!in)
+    throw std::runtime_error((dir / "summary.json").string() + ": not found (nor shard.json): not a sweep folder");
   try {
     in >> h;
     if (h.contains("header")) h = h.at("header");

@@ -5,14 +5,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <set>
 #include <sstream>
-#include <unistd.h>
-#include <fmt/format.h>
 
 #include "control/parameters.hpp"
 #include "model/random.hpp"
@@ -162,13 +162,15 @@ TEST(Plan, RefusesUnknownKeysDoubleVariationAndValuesTheLoaderRefuses) {
     return std::string("accepted");
   };
   EXPECT_THAT(error_of({"wingspan=5%"}), HasSubstr("unknown parameter 'wingspan'"));
-  EXPECT_THAT(error_of({"controller.altitude.kpp=uniform(1,2)"}), HasSubstr("unknown controller parameter 'altitude.kpp'"));
+  EXPECT_THAT(error_of({"controller.altitude.kpp=uniform(1,2)"}),
+              HasSubstr("unknown controller parameter 'altitude.kpp'"));
   EXPECT_THAT(error_of({"controller.mode=grid(1)"}), HasSubstr("is a choice"));
   EXPECT_THAT(error_of({"inertia=5%", "Ixx=5%"}), HasSubstr("already varied"));
   EXPECT_THAT(error_of({"vehicle.mass_kg=5%", "mass=1%"}), HasSubstr("already varied"));
   EXPECT_THAT(error_of({"vehicle.mass_kg=grid(1, -2)"}),
               AllOf(HasSubstr("vehicle.mass_kg = -2"), HasSubstr("declared range [1e-06, 1e+12]")));
-  EXPECT_THAT(error_of({"initial.yaw_rad=grid(0, 12)"}), AllOf(HasSubstr("grid value 12"), HasSubstr("initial.yaw_rad")));
+  EXPECT_THAT(error_of({"initial.yaw_rad=grid(0, 12)"}),
+              AllOf(HasSubstr("grid value 12"), HasSubstr("initial.yaw_rad")));
   EXPECT_THAT(error_of({"simulation.wobble=uniform(1,2)"}), HasSubstr("wobble"));
   EXPECT_THAT(error_of({"environment.gusts.w20_m_s=10%"}), HasSubstr("has no value in"));
   // Outside the controller table's declared range: refused before any run.
@@ -194,9 +196,9 @@ TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
   EXPECT_EQ(error_of({"initial.position_m[0]=grid(1)", "initial.position_m.z=grid(2)"}), "accepted");
 
   // A vehicle list entry by its index is the vehicle key .x/.y/.z: the table's range, the plant's key.
-  const Plan p = make_plan(
-      f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
-      Sampler::kRandom);
+  const Plan p =
+      make_plan(f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
+                Sampler::kRandom);
   ASSERT_EQ(p.vary.size(), 2u);
   const Key& lin = p.vary[0].keys.at(0);
   EXPECT_EQ(lin.path, "vehicle.aero.linear_drag_N_s_m.x");
@@ -222,9 +224,9 @@ TEST(PassesNeeded, CeilOfRateTimesRunsWithoutTheProductsRoundingError) {
   // 0.55 * 100 is 55.000000000000007 in binary: exactly 55 of 100 passing meets --min-pass-rate 0.55.
   ASSERT_GT(0.55 * 100, 55.0);
   EXPECT_EQ(passes_needed(0.55, 100), 55);
-  EXPECT_EQ(passes_needed(0.07, 100), 7);  // 0.07 * 100 = 7.000000000000001
-  EXPECT_EQ(passes_needed(0.29, 100), 29);  // 0.29 * 100 = 28.999999999999996
-  EXPECT_EQ(passes_needed(0.57, 100), 57);  // 0.57 * 100 = 56.99999999999999
+  EXPECT_EQ(passes_needed(0.07, 100), 7);    // 0.07 * 100 = 7.000000000000001
+  EXPECT_EQ(passes_needed(0.29, 100), 29);   // 0.29 * 100 = 28.999999999999996
+  EXPECT_EQ(passes_needed(0.57, 100), 57);   // 0.57 * 100 = 56.99999999999999
   EXPECT_EQ(passes_needed(0.551, 100), 56);  // a fraction of a run more: the next whole run
   EXPECT_EQ(passes_needed(1.0 / 3.0, 3), 1);
   EXPECT_EQ(passes_needed(0.5, 3), 2);
@@ -246,7 +248,8 @@ TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
     const Sample s = sample(a, i);
     EXPECT_EQ(sample(a, i).values, s.values);  // same call, same numbers
     // A key's draw depends on (seed, run, key) only, not on the other keys or their order.
-    std::map<std::string, double> other(b.vary.empty() ? std::map<std::string, double>{} : std::map<std::string, double>{});
+    std::map<std::string, double> other(b.vary.empty() ? std::map<std::string, double>{}
+                                                       : std::map<std::string, double>{});
     for (const auto& [k, v] : sample(b, i).values) other[k] = v;
     for (const auto& [k, v] : s.values) EXPECT_EQ(other.at(k), v) << k;
     // KEY=P%: factor 1 + P (2u - 1) with u the run's "vary"/field stream, as sweeps always drew.
@@ -262,9 +265,9 @@ TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
 }
 
 TEST(Sample, GridIsFullFactorialWithTheFirstKeySlowest) {
-  const Plan p = make_plan(scenario_file().string(),
-                           {"controller.altitude.kp=grid(2,4)", "controller.altitude.kd=linspace(1,3,3)"}, 1, 2,
-                           Sampler::kRandom);
+  const Plan p =
+      make_plan(scenario_file().string(),
+                {"controller.altitude.kp=grid(2,4)", "controller.altitude.kd=linspace(1,3,3)"}, 1, 2, Sampler::kRandom);
   ASSERT_EQ(p.runs, 2 * 3 * 2);  // two repeats per point
   std::multiset<std::pair<double, double>> points;
   for (int i = 0; i < p.runs; ++i) {
@@ -282,9 +285,9 @@ TEST(Sample, GridIsFullFactorialWithTheFirstKeySlowest) {
 
 TEST(Sample, LatinHypercubePutsOneRunInEveryStratumOfEveryKey) {
   const int n = 50;
-  const Plan p = make_plan(scenario_file().string(),
-                           {"controller.altitude.kp=uniform(0,1)", "controller.altitude.kd=uniform(10,20)"}, 3, n,
-                           Sampler::kLhs);
+  const Plan p =
+      make_plan(scenario_file().string(),
+                {"controller.altitude.kp=uniform(0,1)", "controller.altitude.kd=uniform(10,20)"}, 3, n, Sampler::kLhs);
   std::set<int> kp_strata, kd_strata;
   for (int i = 0; i < n; ++i) {
     const Sample s = sample(p, i);
@@ -311,8 +314,8 @@ double truncated_mean(double mu, double sigma, double a, double b) {
 TEST(Sample, NormalTruncatedToTheDeclaredRangeHasTheClosedFormMean) {
   const int n = 4000;
   // altitude.min_cos_tilt is declared in [0.05, 1]: normal(0.1, 0.3) is cut hard at 0.05.
-  const Plan p = make_plan(scenario_file().string(), {"controller.altitude.min_cos_tilt=normal(0.1,0.3)",
-                                                      "controller.altitude.kd=normal(3,0.5)"},
+  const Plan p = make_plan(scenario_file().string(),
+                           {"controller.altitude.min_cos_tilt=normal(0.1,0.3)", "controller.altitude.kd=normal(3,0.5)"},
                            9, n, Sampler::kLhs);
   double sum = 0.0, sum_kd = 0.0, ss_kd = 0.0;
   for (int i = 0; i < n; ++i) {
@@ -325,13 +328,13 @@ TEST(Sample, NormalTruncatedToTheDeclaredRangeHasTheClosedFormMean) {
     ss_kd += (s.values[1].second - 3.0) * (s.values[1].second - 3.0);
   }
   EXPECT_NEAR(sum / n, truncated_mean(0.1, 0.3, 0.05, 1.0), 0.005);  // 0.3066; untruncated it would be 0.1
-  EXPECT_NEAR(sum_kd / n, 3.0, 0.01);  // kd's range [0, 1e9] cuts nothing
+  EXPECT_NEAR(sum_kd / n, 3.0, 0.01);                                // kd's range [0, 1e9] cuts nothing
   EXPECT_NEAR(std::sqrt(ss_kd / n), 0.5, 0.01);
 }
 
 TEST(ScenarioFor, PlantFliesTheDrawTheControllerKeepsTheNominalVehicle) {
-  const Plan p = make_plan(scenario_file().string(), {"vehicle.mass_kg=grid(1.5)", "controller.altitude.kp=grid(7)"},
-                           1, 1, Sampler::kRandom);
+  const Plan p = make_plan(scenario_file().string(), {"vehicle.mass_kg=grid(1.5)", "controller.altitude.kp=grid(7)"}, 1,
+                           1, Sampler::kRandom);
   const Sample s = sample(p, 0);
   const io::Scenario sc = scenario_for(p, s);
   EXPECT_EQ(sc.vehicle.mass_kg, 1.5);
@@ -418,8 +421,8 @@ TEST(RunOne, SaturationIsJudgedAsRunJudgesItFromTheCsv) {
 }
 
 TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {
-  const Plan p = make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 7, 6,
-                           Sampler::kRandom);
+  const Plan p =
+      make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 7, 6, Sampler::kRandom);
   std::vector<int> all = shard_indices(p.runs, 1, 1);
   ASSERT_EQ(all, (std::vector<int>{0, 1, 2, 3, 4, 5}));
   const auto one = run_many(p, all, 1, {});

@@ -22,11 +22,16 @@ int main(int argc, char** argv) {
   std::string ns = "/drone";
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
-    if (a == "--seconds") seconds = std::atof(v.c_str());
-    else if (a == "--count") count = std::atoll(v.c_str());
-    else if (a == "--omega") omega = std::atof(v.c_str());
-    else if (a == "--rate") rate = std::atof(v.c_str());
-    else if (a == "--namespace") ns = v;
+    if (a == "--seconds")
+      seconds = std::atof(v.c_str());
+    else if (a == "--count")
+      count = std::atoll(v.c_str());
+    else if (a == "--omega")
+      omega = std::atof(v.c_str());
+    else if (a == "--rate")
+      rate = std::atof(v.c_str());
+    else if (a == "--namespace")
+      ns = v;
     else {
       std::cerr << "command_flood: unknown option " << a << '\n';
       return 2;

@@ -16,8 +16,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -36,17 +36,16 @@ volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_signal(int) { g_stop = 1; }
 
 // The vehicle of the paper and the controller's gains.
-constexpr double kMass = 1.96;      // [kg]
-constexpr double kGravity = 9.81;   // [m/s^2]
-constexpr double kThrust = 2.06e-7; // k_t [N/(rad/s)^2]
-constexpr double kZDes = 2.0;       // [m]
-constexpr double kKp = 4.0;         // [N/m]
-constexpr double kKd = 2.7;         // [N s/m]
+constexpr double kMass = 1.96;                         // [kg]
+constexpr double kGravity = 9.81;                      // [m/s^2]
+constexpr double kThrust = 2.06e-7;                    // k_t [N/(rad/s)^2]
+constexpr double kZDes = 2.0;                          // [m]
+constexpr double kKp = 4.0;                            // [N/m]
+constexpr double kKd = 2.7;                            // [N s/m]
 constexpr std::int64_t kControlPeriodNs = 20'000'000;  // 50 Hz
 
 std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -226,10 +225,11 @@ std::string remote_discovery(dds_entity_t participant) {
         }
       }
       dds_free(reps);
-      ends += std::string(ends.empty() ? "" : ",") + "{\"topic\":" + json_string(topic.c_str()) +
-              ",\"kind\":\"" + (k == 0 ? "writer" : "reader") + "\",\"type\":" + json_string(e->type_name) +
+      ends += std::string(ends.empty() ? "" : ",") + "{\"topic\":" + json_string(topic.c_str()) + ",\"kind\":\"" +
+              (k == 0 ? "writer" : "reader") + "\",\"type\":" + json_string(e->type_name) +
               ",\"reliable\":" + (rel == DDS_RELIABILITY_RELIABLE ? "true" : "false") +
-              ",\"transient_local\":" + (dur == DDS_DURABILITY_VOLATILE ? "false" : "true") + ",\"xcdr\":[" + xcdr + "]}";
+              ",\"transient_local\":" + (dur == DDS_DURABILITY_VOLATILE ? "false" : "true") + ",\"xcdr\":[" + xcdr +
+              "]}";
     }
     if (n > 0) dds_return_loan(r, samples, n);
   }

@@ -51,8 +51,8 @@ struct Setup {
     const dds::NodeName node{"/", "attitude_controller"};
     server = std::make_unique<dds::ParameterServer>(participant->handle(), node, cb, options);
     for (dds::ParamService service : dds::kParamServices) {
-      const std::string name = "rq" + node.fully_qualified() + "/" + std::string(dds::service_suffix(service)) +
-                               "Request";
+      const std::string name =
+          "rq" + node.fully_qualified() + "/" + std::string(dds::service_suffix(service)) + "Request";
       requests.emplace_back(*participant, dds::wire::service_types(service).request, name);
     }
     g_node = &setup_node;

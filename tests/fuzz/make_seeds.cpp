@@ -49,8 +49,8 @@ void sensors(Bytes& out, std::int64_t ns, double z, double q_w = 1.0) {
 }
 
 void save(const std::string& dir, const std::string& name, const Bytes& b) {
-  std::ofstream(dir + "/" + name, std::ios::binary).write(reinterpret_cast<const char*>(b.data()),
-                                                           static_cast<std::streamsize>(b.size()));
+  std::ofstream(dir + "/" + name, std::ios::binary)
+      .write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
 }
 
 // One request per service as `ros2 param` would send it, and some the node must refuse.
@@ -60,7 +60,8 @@ void write_parameter_seeds(const std::string& dir) {
   auto participant = fuzz::isolated_participant();
   auto request = [&](ParamService service, auto fill) {
     const dds_topic_descriptor_t* desc = dds::wire::service_types(service).request;
-    const fuzz::LocalTopic topic(*participant, desc, "rq/seed/" + std::string(dds::service_suffix(service)) + "Request");
+    const fuzz::LocalTopic topic(*participant, desc,
+                                 "rq/seed/" + std::string(dds::service_suffix(service)) + "Request");
     auto sample = dds::wire::new_sample(desc);
     fill(sample.get());
     Bytes out;
@@ -101,15 +102,15 @@ void write_parameter_seeds(const std::string& dir) {
     rq.depth = 0;
   });
   const Bytes good_set = set(ParamService::kSet, {{"z_des", ParamValue::of_double(2.0)},
-                                                   {"lqr.pitch.r", ParamValue::of_integer(50)},
-                                                   {"mode", ParamValue::of_string("position")}});
+                                                  {"lqr.pitch.r", ParamValue::of_integer(50)},
+                                                  {"mode", ParamValue::of_string("position")}});
   const Bytes bad_set = set(ParamService::kSet, {{"z_des", ParamValue::of_double(1e300)},
-                                                  {"mode", ParamValue::of_string("hover")},
-                                                  {"safety_mode", ParamValue::of_bool(true)},
-                                                  {"lqr.roll.r", ParamValue::of_double(0.0)},
-                                                  {"no_such", ParamValue::of_double(1.0)}});
-  const Bytes atomic = set(ParamService::kSetAtomically, {{"altitude.kp", ParamValue::of_double(6.0)},
-                                                          {"altitude.kd", ParamValue::of_double(-1.0)}});
+                                                 {"mode", ParamValue::of_string("hover")},
+                                                 {"safety_mode", ParamValue::of_bool(true)},
+                                                 {"lqr.roll.r", ParamValue::of_double(0.0)},
+                                                 {"no_such", ParamValue::of_double(1.0)}});
+  const Bytes atomic = set(ParamService::kSetAtomically,
+                           {{"altitude.kp", ParamValue::of_double(6.0)}, {"altitude.kd", ParamValue::of_double(-1.0)}});
   save(dir, "queries", [&] {
     Bytes b = get;
     for (const Bytes* x : {&types, &describe, &list}) b.insert(b.end(), x->begin(), x->end());

@@ -61,8 +61,7 @@ TEST(PaperTest, AltitudeStepMatchesFig4) {
   EXPECT_LT(*f.steady_state_error_pct, 1.0);
 }
 
-void expect_attitude_step(const std::string& name, std::vector<double> Flight::*channel,
-                          double target) {
+void expect_attitude_step(const std::string& name, std::vector<double> Flight::*channel, double target) {
   SCOPED_TRACE(name);
   const Flight r = simulate(paper(name));
   ASSERT_TRUE(r.finite);
@@ -92,8 +91,8 @@ TEST(PaperTest, YawStepMatchesFig7) {
   EXPECT_FALSE(r.any_rotor_saturated);
   const auto f = analysis::step_figures(r.t, r.yaw, 0.0, 0.2);
   ASSERT_TRUE(f.overshoot_pct && f.settling_time_2pct_s && f.steady_state_error_pct);
-  EXPECT_LE(*f.overshoot_pct, 2.0);           // paper: no overshoot
-  EXPECT_GE(*f.settling_time_2pct_s, 7.0);    // paper: about 8 s
+  EXPECT_LE(*f.overshoot_pct, 2.0);         // paper: no overshoot
+  EXPECT_GE(*f.settling_time_2pct_s, 7.0);  // paper: about 8 s
   EXPECT_LE(*f.settling_time_2pct_s, 9.0);
   EXPECT_LT(*f.steady_state_error_pct, 1.0);
   // Pure yaw: the vehicle stays level and in place.
@@ -109,8 +108,11 @@ TEST(PaperTest, PositionModeFliesToAPointAndHolds) {
   sc.simulation.duration_ticks = 4500;  // 45 s: the default outer loop is slow
   sc.initial.p_W = {0.0, 0.0, 5.0};
   sc.initial.hover = true;
-  sc.schedule = {{0, "mode", std::string("position")}, {0, "z_des", 5.0}, {0, "x_des", 3.0},
-                 {0, "y_des", -2.0}, {0, "yaw_des", 0.5}};
+  sc.schedule = {{0, "mode", std::string("position")},
+                 {0, "z_des", 5.0},
+                 {0, "x_des", 3.0},
+                 {0, "y_des", -2.0},
+                 {0, "yaw_des", 0.5}};
   const Flight r = simulate(sc);
   ASSERT_TRUE(r.finite);
   const std::size_t n = r.t.size() - 1;
@@ -119,7 +121,8 @@ TEST(PaperTest, PositionModeFliesToAPointAndHolds) {
   EXPECT_NEAR(r.z[n], 5.0, 0.05);
   EXPECT_NEAR(r.yaw[n], 0.5, 0.01);
   double max_tilt = 0.0;
-  for (std::size_t i = 0; i <= n; ++i) max_tilt = std::max(max_tilt, std::max(std::abs(r.roll[i]), std::abs(r.pitch[i])));
+  for (std::size_t i = 0; i <= n; ++i)
+    max_tilt = std::max(max_tilt, std::max(std::abs(r.roll[i]), std::abs(r.pitch[i])));
   EXPECT_LE(max_tilt, sc.controller.params.position.max_tilt_rad + 0.02);  // tilt limit holds
 }
 
