@@ -13,6 +13,7 @@ packages=(
   slurm-wlm munge  # a private single-node Slurm cluster for the sweep job array test (tests/sweep/slurm_test.sh)
   iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)
+  clang-format  # the C++ style, checked by the test style.clang_format (scripts/format.sh)
   clang libclang-rt-dev  # sanitizer build and libFuzzer targets (scripts/sanitize.sh); clang-14 and
                          # libclang-rt-14-dev on Debian 12
 )
