@@ -3,14 +3,7 @@
 # naming it) unless --force, which removes exactly the files the previous command wrote; `plot` and
 # `compare` replace their own previous figures. One case per CTest test.
 #   usage: output_folder_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE
-set -euo pipefail
-QC=$1
-SRC=$2
-CASE=$3
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fail() { echo "FAIL [$CASE]: $*" >&2; exit 1; }
-PY=${QUADCOSIM_PYTHON:-/usr/bin/python3}
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/cli_case.sh" "$@"
 MANIFEST=.quadcosim-outputs.json
 
 # Short copies of a scenario (fewer rows to plot): altitude (step_z) and position (step_x, step_y).
