@@ -91,13 +91,8 @@ void TrajectoryWriter::close() {
   if (!ok || !closed) throw std::runtime_error(path_ + ": write failed");
 }
 
-SeriesRecorder::SeriesRecorder(std::size_t rows) {
-  series_.t_s.reserve(rows);
-  for (const std::string& name : series_columns()) {
-    std::vector<double>& column = series_.values[name];
-    column.reserve(rows);
-    columns_.push_back(&column);
-  }
+SeriesRecorder::SeriesRecorder() {
+  for (const std::string& name : series_columns()) columns_.push_back(&series_.values[name]);
 }
 
 void SeriesRecorder::clear(std::size_t rows) {

@@ -58,16 +58,13 @@ class TrajectoryWriter {
 /// same doubles bit for bit (the CSV holds shortest round-trip text), without writing the file.
 class SeriesRecorder {
  public:
-  /// `rows`: how many ticks to reserve room for (a hint).
-  explicit SeriesRecorder(std::size_t rows = 0);
+  SeriesRecorder();
   /// Adds the row TrajectoryWriter::write(t_s, x, ..., c) writes.
   void add(double t_s, const model::State& x, const ControlColumns& c);
   const Series& series() const { return series_; }
   /// Empties the series for another run of `rows` ticks, keeping its memory (a sweep's worker
   /// records every run it flies in one recorder instead of allocating the columns again per run).
   void clear(std::size_t rows);
-  /// Moves the series out; add() must not be called after it.
-  Series take() { return std::move(series_); }
 
  private:
   Series series_;
