@@ -1,0 +1,164 @@
+// The interface every flight controller implements (docs/controllers.md). A controller is a step
+// function with explicit state: from what the sensors observed and what the vehicle is asked to do
+// (the reference), over one control period, to four rotor speed commands and the figures it wants
+// recorded. It declares its parameters in a table (name, unit, range, meaning), which become the
+// ROS 2 parameters of the controller node, the keys of a scenario's `controller:` section and the
+// sweepable `controller.*` keys. The node around it (sim::ControllerNode) keeps the latest sensor
+// samples, applies the stale-data safety of Algorithm 1 for every controller, evaluates the reference
+// and publishes the command and status; a controller never sees stale or non-finite observations.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "control/parameters.hpp"
+
+namespace quadcosim::control {
+
+enum class Mode {
+  kAttitude,  ///< roll, pitch, yaw setpoints + altitude hold (the paper's tests)
+  kPosition,  ///< position, velocity, acceleration, jerk and yaw to follow (steps and trajectories)
+};
+
+/// What the controller observes: the latest measurements the node took from its sensor topics, as
+/// received (no filtering: not an estimate), and how old they are.
+struct Observation {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();                ///< [m], from Pose
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();                ///< [m/s], from Velocity
+  Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();     ///< attitude body -> world, from the Imu
+  double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;        ///< Z-Y-X angles of q_WB
+  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();                ///< body rates [rad/s], from the Imu
+  Eigen::Vector3d specific_force_B = Eigen::Vector3d::Zero();  ///< accelerometer [m/s^2], from the Imu
+  /// Header stamps [ns] (simulated time) of the samples above; -1 for a topic never received.
+  std::int64_t pose_stamp_ns = -1, velocity_stamp_ns = -1, imu_stamp_ns = -1;
+  /// Age of the oldest of the inputs above [s]; +inf when any input never arrived.
+  double age_s = std::numeric_limits<double>::infinity();
+};
+
+/// What the vehicle is asked to do at this step: a flat-output setpoint (position and its first three
+/// derivatives, yaw and yaw rate) for position mode, plus the paper's attitude setpoints for attitude
+/// mode (with z for its altitude hold). A step setpoint has zero derivatives; a trajectory fills them.
+struct Reference {
+  Mode mode = Mode::kAttitude;
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< [m]; in attitude mode only z is held
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();  ///< [m/s]
+  Eigen::Vector3d a_W = Eigen::Vector3d::Zero();  ///< [m/s^2]
+  Eigen::Vector3d j_W = Eigen::Vector3d::Zero();  ///< jerk [m/s^3]
+  double yaw_rad = 0.0;
+  double yaw_rate_rad_s = 0.0;
+  double roll_rad = 0.0;   ///< attitude mode
+  double pitch_rad = 0.0;  ///< attitude mode
+};
+
+/// Everything one step decided. The node publishes omega_rad_s as the motor command and the rest in
+/// the controller's status (quadcosim_msgs/ControllerStatus).
+struct ControllerOutput {
+  Eigen::Vector4d omega_rad_s = Eigen::Vector4d::Zero();  ///< rotor speed commands [rad/s]
+  Eigen::Vector4d U = Eigen::Vector4d::Zero();            ///< requested U1 [N], U2..U4 [N m]
+  /// The attitude actually tracked (Z-Y-X angles of the desired attitude R_d) [rad]. In attitude mode
+  /// a controller reports the reference's roll and pitch here.
+  double roll_des_rad = 0.0, pitch_des_rad = 0.0, yaw_des_rad = 0.0;
+  /// Psi = 1/2 tr(I - R_d^T R) in [0, 2], for a controller that has a desired attitude R_d; NaN if not.
+  double attitude_error = std::numeric_limits<double>::quiet_NaN();
+  std::array<bool, 4> rotor_saturated{};  ///< the allocation clamped rotor i at omega_min or omega_max
+  bool tilt_saturated = false;            ///< a tilt limit cut the commanded attitude
+  bool safety = false;                    ///< set by the node: the stale-data safety command was sent
+  /// The controller's own figures, in the order of Controller::output_names() (sized by the node).
+  std::vector<double> outputs;
+};
+
+/// One parameter assignment, as from a scenario file, a schedule or `ros2 param set`.
+struct Setting {
+  std::string name;
+  ParameterValue value;
+};
+
+class Controller {
+ public:
+  virtual ~Controller() = default;
+
+  /// The registry name of its type ("paper", "se3", ...).
+  virtual std::string_view type() const = 0;
+  /// A copy with the same parameters and state (each node flies its own copy of a configured one).
+  virtual std::unique_ptr<Controller> clone() const = 0;
+
+  /// The declared parameter table, in a stable documented order.
+  virtual std::span<const ParameterSpec> parameters() const = 0;
+  /// The current value of a declared parameter, or nothing for an unknown name.
+  virtual std::optional<ParameterValue> get_parameter(std::string_view name) const = 0;
+  /// Checks and applies the settings together (all or nothing: a gain change and the design it needs
+  /// happen once). Returns "" on success, else why the first refused one was refused, naming it; then
+  /// nothing changed. Internal state (integrators) is kept.
+  virtual std::string set_parameters(std::span<const Setting> settings) = 0;
+
+  /// Names of the figures step() writes into ControllerOutput::outputs ("error.z", ...).
+  virtual std::span<const std::string> output_names() const = 0;
+
+  /// Clears internal state (integrators, filters), as after a restart.
+  virtual void reset() = 0;
+
+  /// One control period of dt_s [s]. The observation is finite and fresh (the node checked it);
+  /// `out.outputs` has output_names().size() entries. Writes every field of `out` except safety.
+  virtual void step(const Observation& observation, const Reference& reference, double dt_s,
+                    ControllerOutput& out) = 0;
+};
+
+/// The parameter plumbing of a controller whose parameters live in one struct P, declared by a
+/// ParameterTable<P>: clone, parameters, get_parameter and set_parameters (all-or-nothing, one
+/// configure() per call). Derived implements table(), configure() and the rest of Controller.
+template <class Derived, class P>
+class ControllerWith : public Controller {
+ public:
+  std::unique_ptr<Controller> clone() const override {
+    return std::make_unique<Derived>(static_cast<const Derived&>(*this));
+  }
+  std::span<const ParameterSpec> parameters() const override { return table().specs(); }
+  std::optional<ParameterValue> get_parameter(std::string_view name) const override {
+    return table().get(params_, name);
+  }
+  std::string set_parameters(std::span<const Setting> settings) override {
+    P next = params_;
+    for (const Setting& s : settings) {
+      if (std::string err = table().set(next, s.name, s.value); !err.empty()) return err;
+    }
+    try {
+      configure(next);
+    } catch (const std::exception& e) {
+      std::string names;
+      for (const Setting& s : settings) names += (names.empty() ? "" : ", ") + s.name;
+      return names + ": " + e.what();
+    }
+    params_ = next;
+    return {};
+  }
+  const P& params() const { return params_; }
+
+ protected:
+  explicit ControllerWith(const P& params) : params_(params) {}
+  /// The declared table.
+  virtual const ParameterTable<P>& table() const = 0;
+  /// Takes parameters that passed the table's checks (designs gains from them); throws to refuse,
+  /// leaving the controller unchanged. params() still holds the previous values during the call.
+  virtual void configure(const P& next) = 0;
+
+ private:
+  P params_;
+};
+
+/// Psi = 1/2 tr(I - R_d^T R), the attitude error of Lee, Leok and McClamroch (2010), in [0, 2]:
+/// 1 - cos(angle of the rotation between them).
+double attitude_error(const Eigen::Quaterniond& q_des, const Eigen::Quaterniond& q);
+
+const char* to_string(Mode mode);
+
+}  // namespace quadcosim::control

@@ -1,0 +1,63 @@
+#include "controllers/registry.hpp"
+
+#include <array>
+
+#include "controllers/paper/paper_controller.hpp"
+
+namespace quadcosim::controllers {
+
+namespace {
+template <class C>
+std::unique_ptr<control::Controller> make(const model::VehicleParams& vehicle) {
+  return std::make_unique<C>(vehicle);
+}
+
+// One line per controller.
+const std::array kTypes = {
+    ControllerType{PaperController::kType,
+                   "the paper's Algorithm 1: LQR attitude, PD altitude, PID position, allocation",
+                   &make<PaperController>},
+};
+}  // namespace
+
+std::span<const ControllerType> controller_types() { return kTypes; }
+
+std::string controller_type_names() {
+  std::string names;
+  for (const auto& t : kTypes) names += (names.empty() ? "" : ", ") + std::string(t.name);
+  return names;
+}
+
+const ControllerType* find_controller_type(std::string_view name) {
+  for (const auto& t : kTypes) {
+    if (t.name == name) return &t;
+  }
+  return nullptr;
+}
+
+control::ControllerConfig make_config(std::string_view type, const model::VehicleParams& vehicle) {
+  const ControllerType* t = find_controller_type(type);
+  if (!t) {
+    throw std::invalid_argument("unknown controller type '" + std::string(type) + "' (known: " +
+                                controller_type_names() + ")");
+  }
+  control::ControllerConfig c;
+  c.vehicle = vehicle;
+  c.controller = t->make(vehicle);
+  return c;
+}
+
+control::ControllerConfig rebind_vehicle(const control::ControllerConfig& config, const model::VehicleParams& vehicle) {
+  control::ControllerConfig c = make_config(config.type(), vehicle);
+  c.node = config.node;
+  std::vector<control::Setting> settings;
+  for (const control::ParameterSpec& s : config.controller->parameters()) {
+    settings.push_back({std::string(s.name), *config.controller->get_parameter(s.name)});
+  }
+  std::unique_ptr<control::Controller> next = c.controller->clone();
+  if (std::string err = next->set_parameters(settings); !err.empty()) throw std::invalid_argument(err);
+  c.controller = std::move(next);
+  return c;
+}
+
+}  // namespace quadcosim::controllers
