@@ -9,7 +9,7 @@
 #include "baseline/baseline_setup.hpp"
 #include "control/allocation.hpp"
 #include "control/care.hpp"
-#include "control/flight_controller.hpp"
+#include "controllers/paper/paper_controller.hpp"
 #include "io/scenario.hpp"
 #include "model/quadrotor.hpp"
 #include "sim/simulation.hpp"
@@ -42,7 +42,7 @@ void BM_PlantStep(benchmark::State& st) {
 BENCHMARK(BM_PlantStep)->Arg(1)->Arg(2)->Arg(4)->Arg(8);
 
 void BM_ControllerStep(benchmark::State& st) {
-  qc::control::FlightController c{qc::control::ControllerParams{}};
+  qc::controllers::PaperController c{qc::model::VehicleParams{}};
   qc::control::Observation e;
   e.p_W = {0.1, -0.2, 4.9};
   e.v_W = {0.01, 0.02, -0.1};
@@ -51,10 +51,13 @@ void BM_ControllerStep(benchmark::State& st) {
   e.yaw_rad = 0.1;
   e.w_B = {0.01, -0.02, 0.005};
   e.age_s = 0.0;
-  qc::control::Setpoint sp;
-  sp.p_des_W = {0.0, 0.0, 5.0};
+  qc::control::Reference ref;
+  ref.p_W = {0.0, 0.0, 5.0};
+  qc::control::ControllerOutput out;
+  out.outputs.resize(c.output_names().size());
   for (auto _ : st) {
-    benchmark::DoNotOptimize(c.step(e, sp, 0.02));
+    c.step(e, ref, 0.02, out);
+    benchmark::DoNotOptimize(out);
   }
 }
 BENCHMARK(BM_ControllerStep);
@@ -72,7 +75,6 @@ void BM_CareSolve(benchmark::State& st) {
 BENCHMARK(BM_CareSolve);
 
 void BM_Allocation(benchmark::State& st) {
-  qc::control::FlightController c{qc::control::ControllerParams{}};
   const Eigen::Matrix4d Mi = qc::model::mixer_matrix(qc::model::VehicleParams{}).inverse();
   Eigen::Vector4d U(19.3, 0.01, -0.02, 0.001);
   for (auto _ : st) {
@@ -84,7 +86,7 @@ BENCHMARK(BM_Allocation);
 
 // One 100 Hz tick (plant step + half a controller step) of the BASELINE minimal loop.
 void BM_BaselineTick(benchmark::State& st) {
-  qc::baseline::BaselineLoop loop = qc::baseline::make_baseline(qc::control::ControllerParams{}, 10.0);
+  qc::baseline::BaselineLoop loop = qc::baseline::make_baseline(qc::model::VehicleParams{}, qc::controllers::PaperParams{}, 10.0);
   long k = 0;
   for (auto _ : st) {
     loop.tick(k++, 0.01);

@@ -157,24 +157,24 @@ std::string hover_trim_problem(const model::VehicleParams& p) {
   return s.str();
 }
 
-std::vector<HoverLoop> hover_loops(const model::VehicleParams& plant, const control::ControllerParams& params,
+std::vector<HoverLoop> hover_loops(const model::VehicleParams& plant, const controllers::PaperController& fc,
                                    control::Mode mode, const LoopTiming& t) {
   if (const std::string why = hover_trim_problem(plant); !why.empty()) throw std::invalid_argument(why);
   if (!t.continuous && (!(t.tick_s > 0.0) || t.controller_divider < 1 || t.command_delay_ticks < 0 ||
                         t.imu_latency_ticks < 0 || t.pose_latency_ticks < 0 || t.velocity_latency_ticks < 0))
     throw std::invalid_argument("loop timing: tick must be > 0, divider >= 1 and latencies >= 0");
-  const control::FlightController fc(params);  // the LQR gains, designed as the controller does
+  const controllers::PaperParams& params = fc.params();
 
   // The allocation hands the plant Omega^2 = M_c^-1 U (thrust is k_t omega^2), so the plant's
   // generalised input is M_p M_c^-1 U: the identity when controller and plant agree on the vehicle.
-  const Eigen::Matrix4d alloc = model::mixer_matrix(plant) * model::mixer_matrix(params.vehicle).inverse();
+  const Eigen::Matrix4d alloc = model::mixer_matrix(plant) * model::mixer_matrix(fc.vehicle()).inverse();
   const double tau = plant.motor.model == model::MotorModel::kFirstOrder
                          ? std::max(plant.motor.tau_up_s, plant.motor.tau_down_s)
                          : 0.0;
   const double inertia[3] = {plant.Ixx_kg_m2, plant.Iyy_kg_m2, plant.Izz_kg_m2};
   const char* names[3] = {"roll", "pitch", "yaw"};
   const char* breaks[3] = {"U2 roll torque [N m]", "U3 pitch torque [N m]", "U4 yaw torque [N m]"};
-  const double g_c = params.vehicle.gravity_m_s2;
+  const double g_c = fc.vehicle().gravity_m_s2;
   // In-plane drag at hover: linear body drag plus rotor drag k_rd * sum(omega) = 4 omega_h k_rd.
   const double rotor_drag = 4.0 * plant.hover_omega_rad_s() * plant.aero.rotor_drag_N_s_m_per_rad_s;
 

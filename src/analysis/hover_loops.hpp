@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "analysis/margins.hpp"
-#include "control/flight_controller.hpp"
+#include "controllers/paper/paper_controller.hpp"
 #include "model/vehicle_params.hpp"
 
 namespace quadcosim::analysis {
@@ -33,7 +33,8 @@ struct HoverLoop {
 /// linearisation point exists and the allocation is not saturated there), else why not.
 std::string hover_trim_problem(const model::VehicleParams& plant);
 
-/// The loops of the controller `params` (gains designed as FlightController designs them) on the
+/// The loops of the paper controller `controller` (its gains as designed for the vehicle it believes
+/// it flies) on the
 /// plant `plant` about level hover: roll, pitch, yaw (U2..U4), altitude (U1), and in position mode
 /// also position_x and position_y (broken at the tilt setpoint, heading frame). In position mode the
 /// roll and pitch loops, broken at the torque, include the position loop around them.
@@ -41,7 +42,7 @@ std::string hover_trim_problem(const model::VehicleParams& plant);
 /// Linear drag (body and rotor drag) damps the translational channels; quadratic drag, wind, ground
 /// effect and faults are not part of the linearisation. Throws std::invalid_argument when hover
 /// cannot be trimmed (hover_trim_problem) and control::CareError when an LQR design fails.
-std::vector<HoverLoop> hover_loops(const model::VehicleParams& plant, const control::ControllerParams& params,
+std::vector<HoverLoop> hover_loops(const model::VehicleParams& plant, const controllers::PaperController& controller,
                                    control::Mode mode, const LoopTiming& timing);
 
 }  // namespace quadcosim::analysis

@@ -60,7 +60,9 @@ double inproc_rtf(const io::Scenario& sc, double sim_s) {
 double baseline_rtf(const io::Scenario& sc, double sim_s) {
   const double dt = sc.simulation.plant.clock.period_s();
   const long ticks = static_cast<long>(sim_s / dt + 0.5);
-  baseline::BaselineLoop loop = baseline::make_baseline(sc.controller.params, 10.0);
+  const controllers::PaperController* paper = controllers::paper_controller(sc.controller);
+  if (!paper) throw std::invalid_argument("the BASELINE loop flies the paper controller (controller.type: paper)");
+  baseline::BaselineLoop loop = baseline::make_baseline(sc.controller.vehicle, paper->params(), 10.0);
   const auto t0 = std::chrono::steady_clock::now();
   for (long k = 0; k <= ticks; ++k) loop.tick(k, dt);
   const double rtf = sim_s / seconds_since(t0);

@@ -57,6 +57,8 @@ int lqr_command(const LqrOptions& options);
 CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& options);
 
 struct ParamsOptions {
+  std::string controller = "paper";  ///< the controller type whose parameters are listed
+  bool list = false;                 ///< list the controller types instead
   bool vehicle = false;   ///< the vehicle's parameters instead of the controller's
   bool markdown = false;  ///< the vehicle table as Markdown (docs/model.md)
 };

@@ -115,7 +115,7 @@ int controller_command(const ControllerCommandOptions& o) {
     h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
       std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
                                safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
-                               node.observation().age_s, node.config().params.stale_limit_s,
+                               node.observation().age_s, node.settings().stale_limit_s,
                                static_cast<double>(now) / 1e9);
     };
     DdsDriverHost host(transport, /*precise_deadlines=*/true);

@@ -7,9 +7,13 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "control/parameters.hpp"
+#include "controllers/paper/paper_controller.hpp"
+#include "controllers/registry.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {
+
+std::vector<std::string> registered_controller_types();
 
 namespace {
 std::string complex_str(const std::complex<double>& c) {
@@ -26,7 +30,13 @@ CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& lqr) {
 }
 
 CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
-  auto* params_cmd = app.add_subcommand("params", "list the controller's (or the vehicle's) parameters");
+  auto* params_cmd = app.add_subcommand(
+      "params", "list the controller node's and a controller's parameters (or the vehicle's), and the controllers");
+  params_cmd
+      ->add_option("--controller", params.controller,
+                   "the controller type whose parameters follow the node's (default paper; see --list)")
+      ->check(CLI::IsMember(registered_controller_types()));
+  params_cmd->add_flag("--list", params.list, "list the registered controller types instead");
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
       ->needs(params_cmd->get_option("--vehicle"));
@@ -36,10 +46,14 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
 int lqr_command(const LqrOptions& opt) {
   model::VehicleParams vehicle;
   if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
-  control::ControllerConfig cfg;
-  cfg.params.vehicle = vehicle;
-  if (!opt.params.empty()) cfg = io::load_controller(opt.params, vehicle);
-  const control::FlightController fc(cfg.params);
+  const control::ControllerConfig cfg =
+      opt.params.empty() ? controllers::make_config("paper", vehicle) : io::load_controller(opt.params, vehicle);
+  const controllers::PaperController* paper = controllers::paper_controller(cfg);
+  if (!paper) {
+    throw std::invalid_argument(opt.params + ": `quadcosim lqr` shows the paper controller's LQR designs; this file "
+                                "configures controller type '" + std::string(cfg.type()) + "'");
+  }
+  const controllers::PaperController& fc = *paper;
   const char* names[3] = {"roll", "pitch", "yaw"};
   const double inertia[3] = {vehicle.Ixx_kg_m2, vehicle.Iyy_kg_m2, vehicle.Izz_kg_m2};
   for (int i = 0; i < 3; ++i) {
@@ -93,11 +107,23 @@ int vehicle_params_table(bool markdown) {
 
 }  // namespace
 
+std::vector<std::string> registered_controller_types() {
+  std::vector<std::string> names;
+  for (const auto& t : controllers::controller_types()) names.emplace_back(t.name);
+  return names;
+}
+
 int params_command(const ParamsOptions& options) {
   if (options.vehicle) return vehicle_params_table(options.markdown);
-  const control::ControllerConfig defaults;
+  if (options.list) {
+    std::cout << fmt::format("{:<10} {}\n", "type", "controller");
+    for (const auto& t : controllers::controller_types()) std::cout << fmt::format("{:<10} {}\n", t.name, t.description);
+    return exit_code::kOk;
+  }
+  const control::ControllerConfig defaults = controllers::make_config(options.controller, model::VehicleParams{});
   std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", "name", "unit", "range", "default", "meaning");
-  for (const auto& p : control::controller_parameters()) {
+  for (const control::ParameterSpec* spec : control::all_parameters(defaults)) {
+    const control::ParameterSpec& p = *spec;
     std::string range;
     if (p.is_choice()) {
       for (auto c : p.choices) {
@@ -108,7 +134,7 @@ int params_command(const ParamsOptions& options) {
       range = fmt::format("[{:g}, {:g}]", p.min, p.max);
     }
     std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", p.name, p.is_choice() ? "" : p.unit, range,
-                             control::to_string(p.get(defaults)), p.description);
+                             control::to_string(*control::get_parameter(defaults, p.name)), p.description);
   }
   return exit_code::kOk;
 }

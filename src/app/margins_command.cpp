@@ -18,6 +18,7 @@
 #include "analysis/margins.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "controllers/registry.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "sim/topics.hpp"
@@ -48,20 +49,25 @@ Setup setup_from(const std::string& path) {
   Setup s;
   if (path.empty()) {
     s.source = "defaults (the paper's vehicle and controller, plant 100 Hz, controller 50 Hz)";
-    s.controller.params.vehicle = s.plant;
+    s.controller = controllers::make_config("paper", s.plant);
     return s;
   }
   const io::Scenario sc = io::load_scenario(path);
   s.source = path;
   s.plant = sc.vehicle;
   s.controller = sc.controller;
+  if (!controllers::paper_controller(s.controller)) {
+    throw std::invalid_argument(fmt::format(
+        "{}: margins analyses the paper controller's loops; this scenario flies controller type '{}'", path,
+        s.controller.type()));
+  }
   bool later_design_change = false;
   std::vector<sim::ScheduledParameter> schedule = sc.schedule;
   std::stable_sort(schedule.begin(), schedule.end(), [](const auto& a, const auto& b) { return a.tick < b.tick; });
   for (const sim::ScheduledParameter& p : schedule) {
     if (std::string why = control::set_parameter(s.controller, p.name, p.value); !why.empty())
       throw std::invalid_argument(fmt::format("{}: schedule: {}", path, why));
-    const control::ParameterSpec* spec = control::find_parameter(p.name);
+    const control::ParameterSpec* spec = control::find_parameter(s.controller, p.name);
     if (p.tick > 0 && spec != nullptr && (spec->affects_design || p.name == "mode")) later_design_change = true;
   }
   if (later_design_change)
@@ -101,11 +107,11 @@ Setup setup_from(const std::string& path) {
                                   std::max(s.plant.motor.tau_up_s, s.plant.motor.tau_down_s)));
   const double worst_age_s = s.timing.tick_s * std::max({s.timing.imu_latency_ticks, s.timing.pose_latency_ticks,
                                                          s.timing.velocity_latency_ticks});
-  if (worst_age_s > s.controller.params.stale_limit_s)
+  if (worst_age_s > s.controller.node.stale_limit_s)
     s.notes.push_back(
         fmt::format("sensor latency {:g} s exceeds stale_limit {:g} s: the controller would command "
                     "its safety mode, which these loops do not model",
-                    worst_age_s, s.controller.params.stale_limit_s));
+                    worst_age_s, s.controller.node.stale_limit_s));
   return s;
 }
 
@@ -186,7 +192,8 @@ int margins_command(const MarginsOptions& o) {
     s.notes.push_back(
         "the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
         "in them");
-    loops = analysis::hover_loops(s.plant, s.controller.params, s.controller.setpoint.mode, s.timing);
+    loops = analysis::hover_loops(s.plant, *controllers::paper_controller(s.controller), s.controller.node.setpoint.mode,
+                                  s.timing);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(
         fmt::format("{}cannot linearise about hover: {}", o.scenario.empty() ? "" : o.scenario + ": ", e.what()));
@@ -202,7 +209,7 @@ int margins_command(const MarginsOptions& o) {
   nlohmann::json doc;
   doc["scenario"] = s.source;
   doc["linearised_about"] = "level hover, still air";
-  doc["mode"] = control::to_string(s.controller.setpoint.mode);
+  doc["mode"] = control::to_string(s.controller.node.setpoint.mode);
   doc["plant_period_s"] = t.tick_s;
   doc["controller_period_s"] = T;
   doc["command_delay_ticks"] = t.command_delay_ticks;
@@ -260,7 +267,7 @@ int margins_command(const MarginsOptions& o) {
   table += fmt::format(
       "linearised about level hover ({} mode); controller {:g} Hz (T = {:g} s, zero-order hold), "
       "plant {:g} Hz; command delay {} ticks; sensor latency imu {}, pose {}, velocity {} ticks\n",
-      control::to_string(s.controller.setpoint.mode), 1.0 / T, T, 1.0 / t.tick_s, t.command_delay_ticks,
+      control::to_string(s.controller.node.setpoint.mode), 1.0 / T, T, 1.0 / t.tick_s, t.command_delay_ticks,
       t.imu_latency_ticks, t.pose_latency_ticks, t.velocity_latency_ticks);
   table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", "loop", "broken at", "GM [dB]",
                        "w_pc", "GMlo[dB]", "PM [deg]", "w_gc", "DM [s]", "DM [smp]", "closed loop");

@@ -38,8 +38,10 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
   } else {
     sc.name = "defaults";
   }
-  if (!vehicle.empty()) sc.vehicle = io::load_vehicle(vehicle);
-  sc.controller.params.vehicle = sc.vehicle;
+  if (!vehicle.empty()) {
+    sc.vehicle = io::load_vehicle(vehicle);
+    sc.controller = controllers::rebind_vehicle(sc.controller, sc.vehicle);
+  }
   if (!ns.empty()) sc.simulation.ns = ns;
   if (sc.simulation.faults.active()) {
     throw io::ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) +

@@ -26,21 +26,24 @@ control::ParameterValue from_ros(const dds::ParamValue& v) {
 
 dds::ParameterCallbacks controller_parameter_callbacks(sim::ControllerNode& node) {
   dds::ParameterCallbacks cb;
-  cb.names = [] {
+  cb.names = [&node] {
     std::vector<std::string> names;
-    for (const auto& p : control::controller_parameters()) names.emplace_back(p.name);
+    for (const auto* p : node.parameters()) names.emplace_back(p->name);
     return names;
   };
   cb.get = [&node](const std::string& name) -> std::optional<dds::ParamValue> {
-    const auto v = control::get_parameter(node.config(), name);
+    const auto v = node.get_parameter(name);
     if (!v) return std::nullopt;
     return to_ros(*v);
   };
   cb.set = [&node](const std::string& name, const dds::ParamValue& value) {
     return node.set_parameter(name, from_ros(value));
   };
-  cb.describe = [](const std::string& name) -> std::optional<dds::ParamDescriptor> {
-    const control::ParameterSpec* spec = control::find_parameter(name);
+  cb.describe = [&node](const std::string& name) -> std::optional<dds::ParamDescriptor> {
+    const control::ParameterSpec* spec = nullptr;
+    for (const auto* p : node.parameters()) {
+      if (p->name == name) spec = p;
+    }
     if (!spec) return std::nullopt;
     dds::ParamDescriptor d;
     d.name = std::string(spec->name);

@@ -292,7 +292,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         // The setpoint at the end: the vehicle's initial one with its whole schedule applied.
         control::ControllerConfig c = v.controller;
         for (const auto& e : v.schedule) control::set_parameter(c, e.name, e.value);
-        f.p_des_W = c.setpoint.p_des_W;
+        f.p_des_W = c.node.setpoint.p_des_W;
         rows[static_cast<std::size_t>(i)] = f;
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
       }

@@ -157,7 +157,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
       const sim::Simulation& v = swarm.vehicle(i);
       auto& r = rows[static_cast<std::size_t>(i)];
       r.p_W = v.plant().state().p_W;
-      r.p_des_W = v.controller().config().setpoint.p_des_W;
+      r.p_des_W = v.controller().reference().p_W;
       r.safety = v.controller().last_output().safety;
       r.rejected = v.plant().stats().commands_rejected;
       namespaces[static_cast<std::size_t>(i)] = swarm.vehicle_ns(i);

@@ -6,8 +6,7 @@
 
 namespace quadcosim::baseline {
 
-BaselineLoop make_baseline(const control::ControllerParams& p, double z_des_m) {
-  const auto& veh = p.vehicle;
+BaselineLoop make_baseline(const model::VehicleParams& veh, const controllers::PaperParams& p, double z_des_m) {
   BaselineVehicle v{};
   v.mass_kg = veh.mass_kg;
   v.gravity_m_s2 = veh.gravity_m_s2;

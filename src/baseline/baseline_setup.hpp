@@ -3,12 +3,13 @@
 #pragma once
 
 #include "baseline/baseline_loop.hpp"
-#include "control/flight_controller.hpp"
+#include "controllers/paper/paper_controller.hpp"
 
 namespace quadcosim::baseline {
 
-/// The BASELINE loop for the vehicle and gains of `p` (its vehicle, mixer, per-axis LQR designs,
-/// altitude PD), holding altitude `z_des_m` [m]. Throws control::CareError when an LQR design fails.
-BaselineLoop make_baseline(const control::ControllerParams& p, double z_des_m);
+/// The BASELINE loop for `vehicle` (its mass, inertia, mixer) and the paper controller's gains `p`
+/// (per-axis LQR designs, altitude PD), holding altitude `z_des_m` [m]. Throws control::CareError when
+/// an LQR design fails.
+BaselineLoop make_baseline(const model::VehicleParams& vehicle, const controllers::PaperParams& p, double z_des_m);
 
 }  // namespace quadcosim::baseline

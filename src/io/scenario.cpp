@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "analysis/step_metrics.hpp"
+#include "controllers/registry.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/yaml_reader.hpp"
 #include "sim/topics.hpp"
@@ -97,15 +98,19 @@ control::ParameterValue parameter_value(YamlSection& s, const std::string& key, 
   }
 }
 
-// Applies every leaf of a (possibly nested) mapping as a controller parameter: `altitude: {kp: 4}`
-// and `altitude.kp: 4` are the same.
+// Reads every leaf of a (possibly nested) mapping as a controller parameter: `altitude: {kp: 4}`
+// and `altitude.kp: 4` are the same. The node's parameters are applied as read; the controller's are
+// checked against its table as read (so an error names the key) and applied together at the end (one
+// design for all of them).
 // Parameter names have at most three parts (lqr.roll.q_angle); deeper nesting, as an alias that
 // contains itself (`a: &x {b: *x}`) makes, is refused instead of followed.
 constexpr int kMaxParameterDepth = 3;
 
-void read_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
-                     std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth = 1) {
+void collect_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
+                        std::vector<control::Setting>& controller_settings,
+                        std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth) {
   for (const std::string& key : s.keys()) {
+    if (depth == 1 && key == "type") continue;  // read by the caller
     const YAML::Node n = s.raw(key);
     const std::string name = prefix.empty() ? key : prefix + "." + key;
     if (n.IsMap()) {
@@ -113,15 +118,48 @@ void read_parameters(YamlSection& s, const std::string& prefix, control::Control
         s.fail(key, "unknown controller parameter '" + name + "' (nested too deeply; see `quadcosim params`)");
       }
       YamlSection child(n, s.file(), s.key_path(key));
-      read_parameters(child, name, c, out, depth + 1);
+      collect_parameters(child, name, c, controller_settings, out, depth + 1);
       continue;
     }
-    const control::ParameterSpec* spec = control::find_parameter(name);
-    if (!spec) s.fail(key, "unknown controller parameter '" + name + "' (see `quadcosim params`)");
+    const control::ParameterSpec* spec = control::find_parameter(c, name);
+    if (!spec) {
+      s.fail(key, "unknown parameter '" + name + "' of the node or of controller type '" + std::string(c.type()) +
+                      "' (see `quadcosim params --controller " + std::string(c.type()) + "`)");
+    }
     const control::ParameterValue value = parameter_value(s, key, *spec, n);
-    if (std::string err = control::set_parameter(c, name, value); !err.empty()) s.fail(key, err);
+    if (control::node_parameters().find(name)) {
+      if (std::string err = control::set_parameter(c, name, value); !err.empty()) s.fail(key, err);
+    } else {
+      if (std::string err = control::check_value(*spec, value); !err.empty()) s.fail(key, err);
+      controller_settings.push_back({name, value});
+    }
     if (out) out->emplace_back(name, value);
   }
+}
+
+void read_parameters(YamlSection& s, control::ControllerConfig& c,
+                     std::vector<std::pair<std::string, control::ParameterValue>>* out) {
+  std::vector<control::Setting> settings;
+  collect_parameters(s, "", c, settings, out, 1);
+  if (settings.empty()) return;
+  std::unique_ptr<control::Controller> next = c.controller->clone();
+  if (std::string err = next->set_parameters(settings); !err.empty()) s.fail(settings.front().name, err);
+  c.controller = std::move(next);
+}
+
+// A `controller:` section: `type` (default paper) and the parameters, for `vehicle`.
+control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle) {
+  std::vector<std::string> types;
+  for (const auto& t : controllers::controller_types()) types.emplace_back(t.name);
+  const std::string type = s.choice("type", "paper", types);
+  control::ControllerConfig c;
+  try {
+    c = controllers::make_config(type, vehicle);
+  } catch (const std::exception& e) {
+    s.fail("type", "controller '" + type + "' cannot be designed for this vehicle: " + e.what());
+  }
+  read_parameters(s, c, nullptr);
+  return c;
 }
 
 // A time in seconds that must fall on a whole plant tick.
@@ -271,7 +309,8 @@ void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
     // Validate against a scratch config, so errors name this entry.
     control::ControllerConfig scratch = sc.controller;
     std::vector<std::pair<std::string, control::ParameterValue>> values;
-    read_parameters(*set, "", scratch, &values);
+    if (set->has("type")) set->fail("type", "the controller's type cannot change during a run");
+    read_parameters(*set, scratch, &values);
     for (auto& [name, value] : values) sc.schedule.push_back({tick, name, value});
     s.reject_unknown_keys();
   }
@@ -307,7 +346,7 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
   s.reject_unknown_keys();
 }
 
-Scenario read_scenario(YamlSection root, const std::string& path);
+Scenario read_scenario(YamlSection root, const std::string& path, const model::VehicleParams* controller_vehicle);
 
 }  // namespace
 
@@ -321,21 +360,23 @@ model::State initial_state(const Scenario& sc) {
   return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
 }
 
-Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path); }
+Scenario load_scenario(const std::string& path) {
+  return read_scenario(YamlSection::load_file(path), path, nullptr);
+}
 
-Scenario load_scenario(const YAML::Node& node, const std::string& path) {
+Scenario load_scenario(const YAML::Node& node, const std::string& path,
+                       const model::VehicleParams* controller_vehicle) {
   if (!node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
-  return read_scenario(YamlSection(node, path, ""), path);
+  return read_scenario(YamlSection(node, path, ""), path, controller_vehicle);
 }
 
 namespace {
-Scenario read_scenario(YamlSection root, const std::string& path) {
+Scenario read_scenario(YamlSection root, const std::string& path, const model::VehicleParams* controller_vehicle) {
   Scenario sc;
   sc.path = path;
   sc.name = root.text("name", std::filesystem::path(path).stem().string());
   sc.description = root.text("description", "");
   if (auto v = root.section("vehicle")) read_vehicle(*v, sc.vehicle);
-  sc.controller.params.vehicle = sc.vehicle;
 
   double duration_s = 15.0;
   if (auto s = root.section("simulation")) {
@@ -360,7 +401,12 @@ Scenario read_scenario(YamlSection root, const std::string& path) {
     sc.initial.hover = i->boolean("hover", false);
     i->reject_unknown_keys();
   }
-  if (auto c = root.section("controller")) read_parameters(*c, "", sc.controller, nullptr);
+  const model::VehicleParams& believed = controller_vehicle ? *controller_vehicle : sc.vehicle;
+  if (auto c = root.section("controller")) {
+    sc.controller = read_controller(*c, believed);
+  } else {
+    sc.controller = controllers::make_config("paper", believed);
+  }
   read_schedule(root, sc, duration_s);
   read_realism(root, sc);
   if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
@@ -379,10 +425,7 @@ model::VehicleParams load_vehicle(const std::string& path) {
 
 control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle) {
   YamlSection root = YamlSection::load_file(path);
-  control::ControllerConfig c;
-  c.params.vehicle = vehicle;
-  read_parameters(root, "", c, nullptr);
-  return c;
+  return read_controller(root, vehicle);
 }
 
 }  // namespace quadcosim::io

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "control/parameters.hpp"
+#include "controllers/registry.hpp"
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
@@ -83,7 +84,8 @@ struct Scenario {
   std::string name;
   std::string description;
   model::VehicleParams vehicle;
-  control::ControllerConfig controller;  ///< initial parameters and setpoints
+  /// The controller, its parameters and the node's setpoints (the paper's controller by default).
+  control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
   sim::SimulationConfig simulation;
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;
@@ -103,7 +105,10 @@ Scenario load_scenario(const std::string& path);
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file
 /// and `path` is recorded as the scenario's path. A sweep sets keys in the parsed file and loads each
 /// run's scenario with this, so a run's value is checked exactly as the same value written in the file.
-Scenario load_scenario(const YAML::Node& root, const std::string& source);
+/// `controller_vehicle`, when given, is the vehicle the controller is designed for instead of the
+/// scenario's own (a sweep's runs fly a controller designed for the nominal vehicle).
+Scenario load_scenario(const YAML::Node& root, const std::string& source,
+                       const model::VehicleParams* controller_vehicle = nullptr);
 
 /// Loads a vehicle file: the keys of a scenario's `vehicle:` section at top level. Throws ConfigError.
 model::VehicleParams load_vehicle(const std::string& path);

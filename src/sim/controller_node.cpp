@@ -1,6 +1,7 @@
 #include "sim/controller_node.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 
 #include "model/attitude.hpp"
@@ -8,8 +9,12 @@
 namespace quadcosim::sim {
 
 ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config)
-    : config_(config), controller_(config.params) {
+    : vehicle_(config.vehicle), settings_(config.node), controller_(config.controller->clone()) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
+  output_.outputs.assign(controller_->output_names().size(), 0.0);
+  status_.controller = controller_->type();
+  status_.output_names.assign(controller_->output_names().begin(), controller_->output_names().end());
+  status_.outputs = output_.outputs;
   status_pub_ = transport.advertise<msg::ControllerStatus>(topics.controller_status);
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
@@ -32,9 +37,10 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
     if (!accept(check_imu(m, imu_stamp_ns_), topic, imu_backwards_)) return;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
-    imu_q_WB_ = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
+    observation_.q_WB = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
     imu_pending_ = true;
     observation_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
+    observation_.specific_force_B = {m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
     imu_ref_ns_ = reference(imu_stamp_ns_);
     if (on_sample_) on_sample_();
@@ -57,9 +63,47 @@ bool ControllerNode::accept_refused(const SensorCheck& check, const std::string&
   return false;
 }
 
+namespace {
+bool finite(const control::Observation& e) {
+  return e.p_W.allFinite() && e.v_W.allFinite() && e.w_B.allFinite() && std::isfinite(e.roll_rad) &&
+         std::isfinite(e.pitch_rad) && std::isfinite(e.yaw_rad);
+}
+}  // namespace
+
+void ControllerNode::safety_output() {
+  // Algorithm 1, lines 3-5: every rotor at one speed; nothing else is decided. The attitude shown as
+  // tracked is the reference's in attitude mode and level in position mode.
+  const double w =
+      settings_.safety == control::SafetyMode::kHover ? vehicle_.hover_omega_rad_s() : vehicle_.motor.omega_min_rad_s;
+  output_.omega_rad_s.setConstant(w);
+  output_.U.setZero();
+  const bool attitude = reference_.mode == control::Mode::kAttitude;
+  output_.roll_des_rad = attitude ? reference_.roll_rad : 0.0;
+  output_.pitch_des_rad = attitude ? reference_.pitch_rad : 0.0;
+  output_.yaw_des_rad = 0.0;
+  output_.attitude_error = std::numeric_limits<double>::quiet_NaN();
+  output_.rotor_saturated = {};
+  output_.tilt_saturated = false;
+  std::fill(output_.outputs.begin(), output_.outputs.end(), std::numeric_limits<double>::quiet_NaN());
+}
+
+void ControllerNode::update_reference(std::int64_t now_ns) {
+  const control::Setpoint& sp = settings_.setpoint;
+  reference_.mode = sp.mode;
+  reference_.p_W = sp.p_des_W;
+  reference_.v_W.setZero();
+  reference_.a_W.setZero();
+  reference_.j_W.setZero();
+  reference_.yaw_rad = sp.yaw_des_rad;
+  reference_.yaw_rate_rad_s = 0.0;
+  reference_.roll_rad = sp.roll_des_rad;
+  reference_.pitch_rad = sp.pitch_des_rad;
+  (void)now_ns;
+}
+
 const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, double dt_s) {
   if (imu_pending_) {
-    const model::Euler e = model::euler_from_quaternion(imu_q_WB_);
+    const model::Euler e = model::euler_from_quaternion(observation_.q_WB);
     observation_.roll_rad = e.roll_rad;
     observation_.pitch_rad = e.pitch_rad;
     observation_.yaw_rad = e.yaw_rad;
@@ -68,23 +112,32 @@ const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, doubl
   const std::int64_t oldest = std::min({pose_ref_ns_, velocity_ref_ns_, imu_ref_ns_});
   observation_.age_s =
       oldest == kNever ? std::numeric_limits<double>::infinity() : static_cast<double>(now_ns - oldest) / 1e9;
-  output_ = controller_.step(observation_, config_.setpoint, dt_s);
+  const auto stamp = [](std::int64_t ns) { return ns == kNever ? std::int64_t{-1} : ns; };
+  observation_.pose_stamp_ns = stamp(pose_stamp_ns_);
+  observation_.velocity_stamp_ns = stamp(velocity_stamp_ns_);
+  observation_.imu_stamp_ns = stamp(imu_stamp_ns_);
 
-  const auto& sp = config_.setpoint;
-  const bool position = sp.mode == control::Mode::kPosition;
   // The status is stamped with simulated time: the step's time, or the newest sample's in real time.
   const std::int64_t sim_now_ns = receipt_clock_ ? std::max<std::int64_t>(newest_stamp_ns(), 0) : now_ns;
+  update_reference(sim_now_ns);
+  // Algorithm 1, lines 3-5, for every controller.
+  output_.safety = !(observation_.age_s <= settings_.stale_limit_s) || !finite(observation_);
+  if (output_.safety) {
+    safety_output();
+  } else {
+    controller_->step(observation_, reference_, dt_s, output_);
+  }
+
+  const auto& ref = reference_;
   status_.header.stamp = msg::Time::from_ns(sim_now_ns);
-  if (const char* mode = control::to_string(sp.mode); status_.mode != mode) status_.mode = mode;
-  status_.setpoint = {sp.p_des_W.x(),
-                      sp.p_des_W.y(),
-                      sp.p_des_W.z(),
-                      position ? output_.roll_des_rad : sp.roll_des_rad,
-                      position ? output_.pitch_des_rad : sp.pitch_des_rad,
-                      sp.yaw_des_rad};
+  if (const char* mode = control::to_string(ref.mode); status_.mode != mode) status_.mode = mode;
+  status_.setpoint = {ref.p_W.x(),           ref.p_W.y(),            ref.p_W.z(),
+                      output_.roll_des_rad, output_.pitch_des_rad, ref.yaw_rad};
+  for (int i = 0; i < 3; ++i) status_.position_error[i] = ref.p_W[i] - observation_.p_W[i];
+  status_.yaw_error = model::wrap_pi(ref.yaw_rad - observation_.yaw_rad);
+  status_.attitude_error = output_.attitude_error;
   for (int i = 0; i < 4; ++i) {
     status_.u[i] = output_.U[i];
-    status_.error[i] = output_.error[i];
     status_.rotor_saturated[i] = output_.rotor_saturated[i];
   }
   status_.tilt_saturated = output_.tilt_saturated;
@@ -93,6 +146,7 @@ const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, doubl
   status_.rejected_bad_quaternion = fault_log_[static_cast<int>(SensorFault::kBadQuaternion)].total();
   status_.rejected_bad_stamp = fault_log_[static_cast<int>(SensorFault::kBadStamp)].total();
   status_.rejected_stamp_backwards = fault_log_[static_cast<int>(SensorFault::kStampBackwards)].total();
+  status_.outputs = output_.outputs;
   status_pub_.publish(status_);
 
   for (int i = 0; i < 4; ++i) command_msg_.data[i] = output_.omega_rad_s[i];
@@ -120,17 +174,21 @@ std::int64_t ControllerNode::synchronized_stamp_ns() const {
 }
 
 std::string ControllerNode::set_parameter(const std::string& name, const control::ParameterValue& value) {
-  control::ControllerConfig next = config_;
-  if (std::string err = control::set_parameter(next, name, value); !err.empty()) return err;
-  if (control::find_parameter(name)->affects_design) {
-    try {
-      controller_.set_params(next.params);
-    } catch (const std::exception& e) {
-      return name + ": " + e.what();
-    }
-  }
-  config_ = next;
-  return {};
+  if (control::node_parameters().find(name)) return control::node_parameters().set(settings_, name, value);
+  const control::Setting setting{name, value};
+  return controller_->set_parameters({&setting, 1});
+}
+
+std::optional<control::ParameterValue> ControllerNode::get_parameter(std::string_view name) const {
+  if (auto v = control::node_parameters().get(settings_, name)) return v;
+  return controller_->get_parameter(name);
+}
+
+std::vector<const control::ParameterSpec*> ControllerNode::parameters() const {
+  std::vector<const control::ParameterSpec*> out;
+  for (const auto& s : control::node_parameters().specs()) out.push_back(&s);
+  for (const auto& s : controller_->parameters()) out.push_back(&s);
+  return out;
 }
 
 }  // namespace quadcosim::sim

@@ -1,7 +1,11 @@
-// The flight controller as a node: keeps the latest Pose, Velocity and Imu (the IMU quaternion is
-// turned into Z-Y-X Euler angles, as the paper's imuCallback does), runs FlightController::step on
-// its period, and publishes the rotor speeds on /<ns>/motor_commands. Parameters (gains, setpoints)
-// change between steps through the declared parameter table. Sensor messages that fail the checks of
+// A flight controller (control::Controller, any registered type) as a node: keeps the latest Pose,
+// Velocity and Imu (the IMU quaternion is also turned into Z-Y-X Euler angles, as the paper's
+// imuCallback does), evaluates the reference (the step setpoints, or the scenario's trajectory) and
+// steps the controller on its period, and publishes the rotor speeds on /<ns>/motor_commands and its
+// status on /<ns>/controller_status. The stale-data safety of Algorithm 1 is the node's: when the
+// observation is older than stale_limit or not finite, the node commands the safety speeds and the
+// controller is not stepped. Parameters (the node's setpoints and safety, the controller's own table)
+// change between steps. Sensor messages that fail the checks of
 // sim/validation.hpp (NaN/Inf, non-unit quaternion, malformed or backward stamp) are dropped, counted
 // in the status and logged (1st of each reason, then every 100th): the observation keeps its last valid
 // values and ages, so the stale-data safety (Algorithm 1) takes over when nothing valid arrives.
@@ -14,8 +18,9 @@
 #include <limits>
 #include <string>
 
-#include "control/flight_controller.hpp"
-#include "control/parameters.hpp"
+#include "control/controller.hpp"
+#include "control/controller_config.hpp"
+#include <memory>
 #include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
@@ -25,7 +30,7 @@ namespace quadcosim::sim {
 
 class ControllerNode {
  public:
-  /// Throws control::CareError if the initial gains admit no LQR design.
+  /// Flies a clone of config.controller (which must be set).
   ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config);
 
   /// One control period ending now. `now_ns` is the node's current (simulated) time, `dt_s` its
@@ -47,12 +52,19 @@ class ControllerNode {
   /// Time [ns] of the last step, or INT64_MIN before the first.
   std::int64_t last_step_ns() const { return last_step_ns_; }
 
-  /// Sets one parameter; returns "" on success, else the reason it was refused (nothing changed).
+  /// Sets one parameter (the node's or the controller's); returns "" on success, else the reason it
+  /// was refused (nothing changed).
   std::string set_parameter(const std::string& name, const control::ParameterValue& value);
+  /// A parameter's value, or nothing for an unknown name.
+  std::optional<control::ParameterValue> get_parameter(std::string_view name) const;
+  /// Every parameter the node offers: its own, then its controller's.
+  std::vector<const control::ParameterSpec*> parameters() const;
 
-  const control::ControllerConfig& config() const { return config_; }
+  const control::NodeSettings& settings() const { return settings_; }
   const control::ControllerOutput& last_output() const { return output_; }
-  const control::FlightController& controller() const { return controller_; }
+  const control::Controller& controller() const { return *controller_; }
+  /// The reference the last step followed.
+  const control::Reference& reference() const { return reference_; }
   /// The observation the last step used.
   const control::Observation& observation() const { return observation_; }
   /// The stamp [ns] shared by the newest Pose, Velocity and Imu, when all three have arrived with the
@@ -85,8 +97,14 @@ class ControllerNode {
   }
   bool accept_refused(const SensorCheck& check, const std::string& topic, int& backwards);
 
-  control::ControllerConfig config_;
-  control::FlightController controller_;
+  void safety_output();
+  /// reference_ at simulated time now_ns: the step setpoints (or the trajectory).
+  void update_reference(std::int64_t now_ns);
+
+  model::VehicleParams vehicle_;
+  control::NodeSettings settings_;
+  std::unique_ptr<control::Controller> controller_;
+  control::Reference reference_;
   control::Observation observation_;
   control::ControllerOutput output_;
   /// Header stamps of the newest samples, and the times their age is measured from (the stamps, or
@@ -96,8 +114,7 @@ class ControllerNode {
   std::function<std::int64_t()> receipt_clock_;
   std::int64_t reference(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
   std::int64_t last_step_ns_ = kNever;
-  Eigen::Quaterniond imu_q_WB_ = Eigen::Quaterniond::Identity();  ///< newest Imu orientation
-  bool imu_pending_ = false;  ///< imu_q_WB_ not yet turned into observation_'s Euler angles
+  bool imu_pending_ = false;  ///< observation_.q_WB not yet turned into its Euler angles
   msg::ControllerStatus status_;
   std::function<void(const std::string&)> log_;
   std::function<void()> on_sample_;

@@ -186,14 +186,19 @@ void write_command_label(std::string& label, std::int64_t stamp_ns);
 std::int64_t command_stamp_ns(const Float64MultiArray& m);
 
 /// quadcosim_msgs/msg/ControllerStatus: what the controller decided in one step (for recording and
-/// monitoring). Published by the controller after every step, before its motor command.
+/// monitoring). Published by the controller node after every step, before its motor command. A generic
+/// part that every controller fills (through the node), then the controller's own named figures.
 struct ControllerStatus {
   static constexpr std::string_view kRosType = "quadcosim_msgs/msg/ControllerStatus";
   Header header;                     ///< stamp: the (simulated) time of the step
+  std::string controller;            ///< the controller's type ("paper", "se3", ...)
   std::string mode;                  ///< "attitude" | "position"
-  std::array<double, 6> setpoint{};  ///< x, y, z [m], roll, pitch, yaw [rad] actually tracked
+  std::array<double, 6> setpoint{};  ///< x, y, z [m] of the reference, roll, pitch, yaw [rad] actually tracked
   std::array<double, 4> u{};         ///< U1 [N], U2..U4 [N m] requested
-  std::array<double, 4> error{};     ///< e_z [m], e_roll, e_pitch, e_yaw [rad]
+  std::array<double, 3> position_error{};  ///< reference minus observed position [m] (world)
+  double yaw_error = 0.0;                  ///< reference minus observed yaw, wrapped to [-pi, pi] [rad]
+  /// Psi = 1/2 tr(I - R_d^T R) in [0, 2] for a controller with a desired attitude R_d, NaN otherwise.
+  double attitude_error = 0.0;
   std::array<bool, 4> rotor_saturated{};
   bool tilt_saturated = false;
   bool safety = false;  ///< the stale-data safety command was sent
@@ -203,13 +208,18 @@ struct ControllerStatus {
   std::uint64_t rejected_bad_quaternion = 0;   ///< orientation not a unit quaternion (zero included)
   std::uint64_t rejected_bad_stamp = 0;        ///< sec < 0 or nanosec >= 1e9
   std::uint64_t rejected_stamp_backwards = 0;  ///< older than the newest accepted on its topic
+  std::vector<std::string> output_names;       ///< the controller's own figures: names ...
+  std::vector<double> outputs;                 ///< ... and values (NaN under the safety command)
   template <class M, class V>
   static void fields(M& m, V& v) {
     v.field("header", m.header);
+    v.field("controller", m.controller);
     v.field("mode", m.mode);
     v.field("setpoint", m.setpoint);
     v.field("u", m.u);
-    v.field("error", m.error);
+    v.field("position_error", m.position_error);
+    v.field("yaw_error", m.yaw_error);
+    v.field("attitude_error", m.attitude_error);
     v.field("rotor_saturated", m.rotor_saturated);
     v.field("tilt_saturated", m.tilt_saturated);
     v.field("safety", m.safety);
@@ -217,6 +227,8 @@ struct ControllerStatus {
     v.field("rejected_bad_quaternion", m.rejected_bad_quaternion);
     v.field("rejected_bad_stamp", m.rejected_bad_stamp);
     v.field("rejected_stamp_backwards", m.rejected_stamp_backwards);
+    v.field("output_names", m.output_names);
+    v.field("outputs", m.outputs);
   }
 };
 

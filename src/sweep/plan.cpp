@@ -213,7 +213,7 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
   k.nominal = get_at(root, parts, 0);
   if (parts[0] == "controller" && parts.size() > 1) {
     const std::string name = join(parts, 1, parts.size());
-    const control::ParameterSpec* spec = control::find_parameter(name);
+    const control::ParameterSpec* spec = control::find_parameter(nominal.controller, name);
     if (!spec) {
       throw PlanError("--vary " + v.spec + ": unknown controller parameter '" + name + "' (see `quadcosim params`)");
     }
@@ -510,10 +510,9 @@ io::Scenario scenario_for(const Plan& plan, const Sample& s) {
     YAML::Node root = YAML::Clone(plan.root);
     const auto lists = default_lists(plan.nominal);
     for (const auto& [path, value] : s.values) set_key(root, path, value, lists);
-    sc = io::load_scenario(root, plan.scenario_file);
+    sc = io::load_scenario(root, plan.scenario_file, &plan.nominal.vehicle);  // designed for the nominal vehicle
   }
   sc.simulation.plant.realism.seed = s.seed;
-  sc.controller.params.vehicle = plan.nominal.vehicle;  // designed for the nominal vehicle
   return sc;
 }
 

@@ -117,4 +117,8 @@ void PaperController::step(const control::Observation& obs, const control::Refer
   c.rotor_saturated = a.saturated;
 }
 
+const PaperController* paper_controller(const control::ControllerConfig& config) {
+  return dynamic_cast<const PaperController*>(config.controller.get());
+}
+
 }  // namespace quadcosim::controllers

@@ -13,6 +13,7 @@
 #include "control/altitude_pd.hpp"
 #include "control/attitude_lqr.hpp"
 #include "control/controller.hpp"
+#include "control/controller_config.hpp"
 #include "control/position_pid.hpp"
 #include "model/vehicle_params.hpp"
 
@@ -54,5 +55,9 @@ class PaperController : public control::ControllerWith<PaperController, PaperPar
   Eigen::Matrix4d mixer_inverse_;
   control::PositionPidState position_state_;
 };
+
+/// The paper controller `config` flies, or nullptr when it flies another type (for the analyses that
+/// are the paper controller's own: `quadcosim lqr`, `margins`, the BASELINE loop).
+const PaperController* paper_controller(const control::ControllerConfig& config);
 
 }  // namespace quadcosim::controllers
