@@ -20,36 +20,44 @@ using Table = control::ParameterTable<GeometricParams>;
 
 Table make_table() {
   return Table({
-      Table::number("k_x.x", "N/m", 0, kBig, "position gain along world x", [](auto& p) -> auto& { return p.k_x[0]; }),
-      Table::number("k_x.y", "N/m", 0, kBig, "position gain along world y", [](auto& p) -> auto& { return p.k_x[1]; }),
-      Table::number("k_x.z", "N/m", 0, kBig, "position gain along world z (also the attitude mode's altitude loop)",
-                    [](auto& p) -> auto& { return p.k_x[2]; }),
-      Table::number("k_v.x", "N s/m", 0, kBig, "velocity gain along world x", [](auto& p) -> auto& { return p.k_v[0]; }),
-      Table::number("k_v.y", "N s/m", 0, kBig, "velocity gain along world y", [](auto& p) -> auto& { return p.k_v[1]; }),
-      Table::number("k_v.z", "N s/m", 0, kBig, "velocity gain along world z (also the attitude mode's altitude loop)",
-                    [](auto& p) -> auto& { return p.k_v[2]; }),
-      Table::number("k_R.x", "N m/rad", 0, kBig, "attitude gain about body x (roll)",
-                    [](auto& p) -> auto& { return p.k_R[0]; }),
-      Table::number("k_R.y", "N m/rad", 0, kBig, "attitude gain about body y (pitch)",
-                    [](auto& p) -> auto& { return p.k_R[1]; }),
-      Table::number("k_R.z", "N m/rad", 0, kBig, "attitude gain about body z (yaw)",
-                    [](auto& p) -> auto& { return p.k_R[2]; }),
-      Table::number("k_Omega.x", "N m s/rad", 0, kBig, "body rate gain about x",
-                    [](auto& p) -> auto& { return p.k_Omega[0]; }),
-      Table::number("k_Omega.y", "N m s/rad", 0, kBig, "body rate gain about y",
-                    [](auto& p) -> auto& { return p.k_Omega[1]; }),
-      Table::number("k_Omega.z", "N m s/rad", 0, kBig, "body rate gain about z",
-                    [](auto& p) -> auto& { return p.k_Omega[2]; }),
-      Table::number("max_tilt", "rad", 0.01, kPi, "position mode: largest angle of b3d from vertical (pi: no limit)",
-                    [](auto& p) -> auto& { return p.max_tilt_rad; }),
-      Table::number("min_cos_tilt", "", 0.05, 1, "attitude mode: floor on (R e3)_z in the thrust's tilt compensation",
-                    [](auto& p) -> auto& { return p.min_cos_tilt; }),
+      Table::number(
+          "k_x.x", "N/m", 0, kBig, "position gain along world x", [](auto& p) -> auto& { return p.k_x[0]; }),
+      Table::number(
+          "k_x.y", "N/m", 0, kBig, "position gain along world y", [](auto& p) -> auto& { return p.k_x[1]; }),
+      Table::number(
+          "k_x.z", "N/m", 0, kBig, "position gain along world z (also the attitude mode's altitude loop)",
+          [](auto& p) -> auto& { return p.k_x[2]; }),
+      Table::number(
+          "k_v.x", "N s/m", 0, kBig, "velocity gain along world x", [](auto& p) -> auto& { return p.k_v[0]; }),
+      Table::number(
+          "k_v.y", "N s/m", 0, kBig, "velocity gain along world y", [](auto& p) -> auto& { return p.k_v[1]; }),
+      Table::number(
+          "k_v.z", "N s/m", 0, kBig, "velocity gain along world z (also the attitude mode's altitude loop)",
+          [](auto& p) -> auto& { return p.k_v[2]; }),
+      Table::number(
+          "k_R.x", "N m/rad", 0, kBig, "attitude gain about body x (roll)", [](auto& p) -> auto& { return p.k_R[0]; }),
+      Table::number(
+          "k_R.y", "N m/rad", 0, kBig, "attitude gain about body y (pitch)", [](auto& p) -> auto& { return p.k_R[1]; }),
+      Table::number(
+          "k_R.z", "N m/rad", 0, kBig, "attitude gain about body z (yaw)", [](auto& p) -> auto& { return p.k_R[2]; }),
+      Table::number(
+          "k_Omega.x", "N m s/rad", 0, kBig, "body rate gain about x", [](auto& p) -> auto& { return p.k_Omega[0]; }),
+      Table::number(
+          "k_Omega.y", "N m s/rad", 0, kBig, "body rate gain about y", [](auto& p) -> auto& { return p.k_Omega[1]; }),
+      Table::number(
+          "k_Omega.z", "N m s/rad", 0, kBig, "body rate gain about z", [](auto& p) -> auto& { return p.k_Omega[2]; }),
+      Table::number(
+          "max_tilt", "rad", 0.01, kPi, "position mode: largest angle of b3d from vertical (pi: no limit)",
+          [](auto& p) -> auto& { return p.max_tilt_rad; }),
+      Table::number(
+          "min_cos_tilt", "", 0.05, 1, "attitude mode: floor on (R e3)_z in the thrust's tilt compensation",
+          [](auto& p) -> auto& { return p.min_cos_tilt; }),
   });
 }
 
-const std::array<std::string, 14> kOutputNames = {
-    "e_x.x",     "e_x.y",     "e_x.z",     "e_v.x",  "e_v.y",         "e_v.z",     "e_R.x",
-    "e_R.y",     "e_R.z",     "e_Omega.x", "e_Omega.y", "e_Omega.z", "thrust", "yaw_torque_cut"};
+const std::array<std::string, 14> kOutputNames = {"e_x.x",     "e_x.y",     "e_x.z",  "e_v.x",         "e_v.y",
+                                                  "e_v.z",     "e_R.x",     "e_R.y",  "e_R.z",         "e_Omega.x",
+                                                  "e_Omega.y", "e_Omega.z", "thrust", "yaw_torque_cut"};
 
 Eigen::Vector3d vee(const Eigen::Matrix3d& m) { return {m(2, 1), m(0, 2), m(1, 0)}; }
 
@@ -145,10 +153,10 @@ void GeometricController::step(const control::Observation& obs, const control::R
     const double horizontal = F.head<2>().norm();
     if (std::atan2(horizontal, F.z()) > k.max_tilt_rad) {
       // Straight down (no horizontal part): nothing to tilt towards, so b3 = e3 and F's upward part (none).
-      const Eigen::Vector3d b3 = horizontal > 0 ? Eigen::Vector3d(std::sin(k.max_tilt_rad) * F.x() / horizontal,
-                                                                  std::sin(k.max_tilt_rad) * F.y() / horizontal,
-                                                                  std::cos(k.max_tilt_rad))
-                                                : e3;
+      const Eigen::Vector3d b3 =
+          horizontal > 0 ? Eigen::Vector3d(std::sin(k.max_tilt_rad) * F.x() / horizontal,
+                                           std::sin(k.max_tilt_rad) * F.y() / horizontal, std::cos(k.max_tilt_rad))
+                         : e3;
       F = F.z() > 0 ? Eigen::Vector3d(b3 * (F.z() / b3.z())) : Eigen::Vector3d(b3 * std::max(0.0, F.dot(b3)));
       c.tilt_saturated = true;
     }
@@ -172,11 +180,12 @@ void GeometricController::step(const control::Observation& obs, const control::R
       const Eigen::Vector3d b3d_dot = (m / F_norm) * (ref.j_W - b3d.dot(ref.j_W) * b3d);
       const Eigen::Vector3d b1d = t.R_d.col(0), b2d = t.R_d.col(1);
       const Eigen::Vector3d b1c_dot =
-          heading_from_yaw ? Eigen::Vector3d(Eigen::Vector3d(-std::sin(ref.yaw_rad), std::cos(ref.yaw_rad), 0.0) * ref.yaw_rate_rad_s)
+          heading_from_yaw ? Eigen::Vector3d(Eigen::Vector3d(-std::sin(ref.yaw_rad), std::cos(ref.yaw_rad), 0.0) *
+                                             ref.yaw_rate_rad_s)
                            : Eigen::Vector3d(Eigen::Vector3d::Zero());
       const double n = b3d.cross(b1c).norm();
-      t.Omega_d_B = Eigen::Vector3d(-b2d.dot(b3d_dot), b1d.dot(b3d_dot),
-                                    (b1c_dot.dot(b2d) - b3d_dot.dot(b1c.cross(b1d))) / n);
+      t.Omega_d_B =
+          Eigen::Vector3d(-b2d.dot(b3d_dot), b1d.dot(b3d_dot), (b1c_dot.dot(b2d) - b3d_dot.dot(b1c.cross(b1d))) / n);
     }
     const model::Euler e = model::euler_from_quaternion(Eigen::Quaterniond(t.R_d));
     c.roll_des_rad = e.roll_rad;
@@ -209,9 +218,9 @@ void GeometricController::step(const control::Observation& obs, const control::R
   c.rotor_saturated = a.saturated;
   c.attitude_error = control::attitude_error(Eigen::Quaterniond(t.R_d), obs.q_WB.normalized());
 
-  const std::array<double, 14> values = {t.e_x_W.x(),     t.e_x_W.y(),     t.e_x_W.z(),     t.e_v_W.x(), t.e_v_W.y(),
-                                         t.e_v_W.z(),     t.e_R.x(),       t.e_R.y(),       t.e_R.z(),   t.e_Omega_B.x(),
-                                         t.e_Omega_B.y(), t.e_Omega_B.z(), f,               t.yaw_torque_cut_Nm};
+  const std::array<double, 14> values = {
+      t.e_x_W.x(), t.e_x_W.y(), t.e_x_W.z(),     t.e_v_W.x(),     t.e_v_W.y(),     t.e_v_W.z(), t.e_R.x(),
+      t.e_R.y(),   t.e_R.z(),   t.e_Omega_B.x(), t.e_Omega_B.y(), t.e_Omega_B.z(), f,           t.yaw_torque_cut_Nm};
   std::copy(values.begin(), values.end(), c.outputs.begin());
   terms_ = t;
 }

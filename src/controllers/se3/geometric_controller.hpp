@@ -21,8 +21,10 @@
 // design scaled by the inertia or mass:
 //   attitude roll/pitch: omega_n = 10 rad/s, zeta = 0.8: k_R = J omega_n^2, k_Omega = 2 zeta J omega_n
 //     (crossover ~14 rad/s, where the 0.04 s lag costs ~32 deg of the PD's ~65 deg of phase margin);
-//   yaw: omega_n = 3 rad/s, zeta = 1: the rotors' drag torque gives the Table 1 vehicle only about
-//     9e-3 N m of yaw torque at hover (0.18 rad/s^2), so a stiffer yaw loop would only saturate;
+//   yaw: omega_n = 1 rad/s, zeta = 1: the rotors' drag torque gives the Table 1 vehicle only about
+//     9e-3 N m of yaw torque at hover (0.18 rad/s^2 of yaw acceleration), so a stiffer yaw loop saturates
+//     and overshoots a large heading error (at omega_n = 3 rad/s a 170 deg yaw error still swung
+//     +-40 deg after 20 s; at 1 rad/s it settles in 12 s without saturating);
 //   position: omega_p = 2.5 rad/s horizontally and 3 rad/s vertically, zeta = 1 (a quarter or less of
 //     the attitude bandwidth, so the attitude loop follows b3d): k_x = m omega_p^2, k_v = 2 zeta m omega_p.
 // Other vehicles: scale k_R, k_Omega by their inertia and k_x, k_v by their mass.
@@ -37,9 +39,9 @@
 namespace quadcosim::controllers {
 
 struct GeometricParams {
-  Eigen::Vector3d k_x{12.25, 12.25, 17.64};    ///< position gains, world x, y, z [N/m]
-  Eigen::Vector3d k_v{9.8, 9.8, 11.76};        ///< velocity gains, world x, y, z [N s/m]
-  Eigen::Vector3d k_R{1.49, 1.53, 0.0532};     ///< attitude gains, body x, y, z [N m/rad]
+  Eigen::Vector3d k_x{12.25, 12.25, 17.64};         ///< position gains, world x, y, z [N/m]
+  Eigen::Vector3d k_v{9.8, 9.8, 11.76};             ///< velocity gains, world x, y, z [N s/m]
+  Eigen::Vector3d k_R{1.49, 1.53, 0.0532};          ///< attitude gains, body x, y, z [N m/rad]
   Eigen::Vector3d k_Omega{0.2384, 0.2448, 0.1064};  ///< body rate gains, body x, y, z [N m s/rad]
   /// Largest angle [rad] between b3d and e3 in position mode; beyond it the horizontal part of F is cut
   /// (tilt_saturated). pi: no limit.

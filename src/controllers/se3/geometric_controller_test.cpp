@@ -21,11 +21,11 @@ using control::Reference;
 using control::Setting;
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kControlDt = 0.02;  // 50 Hz
+constexpr double kControlDt = 0.02;       // 50 Hz
 constexpr int kPlantStepsPerControl = 2;  // 100 Hz
 
 model::VehicleParams lagged_vehicle() {
-  model::VehicleParams v;  // Table 1
+  model::VehicleParams v;                          // Table 1
   v.motor.model = model::MotorModel::kFirstOrder;  // tau 0.02 s up, 0.04 s down
   return v;
 }
@@ -70,10 +70,10 @@ Reference hold_position(const Eigen::Vector3d& p_W, double yaw_rad) {
 // --- 1. e_R and Psi against their closed forms -------------------------------------------------
 
 TEST(GeometricController, AttitudeErrorMatchesClosedForm) {
-  const Eigen::Matrix3d R_d = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
+  const Eigen::Matrix3d R_d =
+      (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   const std::vector<Eigen::Vector3d> axes = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
                                              Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, -2, 0.5).normalized(),
                                              Eigen::Vector3d(-0.3, 0.4, -1).normalized()};
@@ -96,10 +96,10 @@ TEST(GeometricController, AttitudeModeReportsErrorAgainstTheReferenceAttitude) {
   ref.pitch_rad = -0.2;
   ref.yaw_rad = 1.0;
   ref.p_W.z() = 3.0;
-  const Eigen::Matrix3d R_d = (Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
+  const Eigen::Matrix3d R_d =
+      (Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   const Eigen::Vector3d a = Eigen::Vector3d(0.3, -1, 0.2).normalized();
   const double theta = 0.8;
   Observation obs;
@@ -192,14 +192,19 @@ Recovery recover(const Eigen::Vector3d& axis, double angle_rad, double duration_
   model::State x = plant.initial_state(p_d, 0.0, /*hover=*/true);
   x.q_WB = Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, axis.normalized()));
   Recovery r;
-  fly(plant, ctl, x, duration_s, [&](double) { return hold_position(p_d, 0.0); },
+  fly(
+      plant, ctl, x, duration_s, [&](double) { return hold_position(p_d, 0.0); },
       [&](double t, const model::State& s, const ControllerOutput& out) {
         const double psi = control::attitude_error(Eigen::Quaterniond::Identity(), s.q_WB);
         const double e = (s.p_W - p_d).norm();
-        if (psi >= 1e-3) r.attitude_settled_s = -1;
-        else if (r.attitude_settled_s < 0) r.attitude_settled_s = t;
-        if (e >= 0.03) r.position_settled_s = -1;
-        else if (r.position_settled_s < 0) r.position_settled_s = t;
+        if (psi >= 1e-3)
+          r.attitude_settled_s = -1;
+        else if (r.attitude_settled_s < 0)
+          r.attitude_settled_s = t;
+        if (e >= 0.03)
+          r.position_settled_s = -1;
+        else if (r.position_settled_s < 0)
+          r.position_settled_s = t;
         r.min_altitude_m = std::min(r.min_altitude_m, s.p_W.z());
         r.finite = r.finite && s.p_W.allFinite() && s.q_WB.coeffs().allFinite() && out.omega_rad_s.allFinite();
       });
@@ -224,10 +229,11 @@ TEST(GeometricController, RecoversFromLargeAttitudeErrors) {
   const double duration_s = 20.0;
   for (const Case& c : cases) {
     const Recovery r = recover(c.axis, c.angle_deg * kPi / 180.0, duration_s);
-    std::printf("recovery axis (%g, %g, %g) %g deg: Psi < 1e-3 from %.2f s, |e_x| < 3 cm from %.2f s, "
-                "final |e_x| %.2e m, altitude lost %.2f m\n",
-                c.axis.x(), c.axis.y(), c.axis.z(), c.angle_deg, r.attitude_settled_s, r.position_settled_s,
-                r.final_position_error_m, 100.0 - r.min_altitude_m);
+    std::printf(
+        "recovery axis (%g, %g, %g) %g deg: Psi < 1e-3 from %.2f s, |e_x| < 3 cm from %.2f s, "
+        "final |e_x| %.2e m, altitude lost %.2f m\n",
+        c.axis.x(), c.axis.y(), c.axis.z(), c.angle_deg, r.attitude_settled_s, r.position_settled_s,
+        r.final_position_error_m, 100.0 - r.min_altitude_m);
     EXPECT_TRUE(r.finite);
     EXPECT_GE(r.attitude_settled_s, 0.0) << c.axis.transpose() << " " << c.angle_deg;
     EXPECT_LE(r.attitude_settled_s, c.attitude_bound_s) << c.axis.transpose() << " " << c.angle_deg;
@@ -318,7 +324,8 @@ CircleRun fly_circle(const Circle& circle, bool on_circle) {
   double sum_sq = 0.0;
   int n = 0;
   const double periods = 3.0;
-  fly(plant, ctl, x, periods * circle.period_s, [&](double t) { return circle.at(t); },
+  fly(
+      plant, ctl, x, periods * circle.period_s, [&](double t) { return circle.at(t); },
       [&](double t, const model::State& s, const ControllerOutput& out) {
         run.finite = run.finite && s.p_W.allFinite() && out.omega_rad_s.allFinite();
         if (t < circle.period_s) return;
@@ -328,10 +335,11 @@ CircleRun fly_circle(const Circle& circle, bool on_circle) {
         ++n;
       });
   run.rmse_m = std::sqrt(sum_sq / n);
-  std::printf("circle r %.1f m, period %.0f s, heading %s, start %s: position RMSE over periods 2-3 %.3g mm, "
-              "max %.3g mm\n",
-              circle.radius_m, circle.period_s, circle.heading_follows ? "along the velocity" : "fixed",
-              on_circle ? "on the circle" : "at rest", run.rmse_m * 1e3, run.max_m * 1e3);
+  std::printf(
+      "circle r %.1f m, period %.0f s, heading %s, start %s: position RMSE over periods 2-3 %.3g mm, "
+      "max %.3g mm\n",
+      circle.radius_m, circle.period_s, circle.heading_follows ? "along the velocity" : "fixed",
+      on_circle ? "on the circle" : "at rest", run.rmse_m * 1e3, run.max_m * 1e3);
   return run;
 }
 
