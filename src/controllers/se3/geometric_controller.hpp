@@ -20,11 +20,11 @@
 // and 0.02-0.04 s of motor lag, i.e. roughly 0.04 s of phase lag, so each loop is a damped second-order
 // design scaled by the inertia or mass:
 //   attitude roll/pitch: omega_n = 10 rad/s, zeta = 0.8: k_R = J omega_n^2, k_Omega = 2 zeta J omega_n
-//     (crossover ~14 rad/s, where the 0.04 s lag costs ~32 deg of the PD's ~65 deg of phase margin);
+//     (crossover ~17 rad/s, where the 0.04 s lag costs ~39 deg of the PD's ~70 deg of phase margin);
 //   yaw: omega_n = 1 rad/s, zeta = 1: the rotors' drag torque gives the Table 1 vehicle only about
 //     9e-3 N m of yaw torque at hover (0.18 rad/s^2 of yaw acceleration), so a stiffer yaw loop saturates
-//     and overshoots a large heading error (at omega_n = 3 rad/s a 170 deg yaw error still swung
-//     +-40 deg after 20 s; at 1 rad/s it settles in 12 s without saturating);
+//     and overshoots a large heading error (at omega_n = 3 rad/s a 170 deg yaw error overshot to
+//     -99 deg and still swung back to +42 deg at 17 s; at 1 rad/s it settles in 12 s without saturating);
 //   position: omega_p = 2.5 rad/s horizontally and 3 rad/s vertically, zeta = 1 (a quarter or less of
 //     the attitude bandwidth, so the attitude loop follows b3d): k_x = m omega_p^2, k_v = 2 zeta m omega_p.
 // Other vehicles: scale k_R, k_Omega by their inertia and k_x, k_v by their mass.
