@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "model/attitude.hpp"
+#include "model/mixer.hpp"
 #include "model/quadrotor.hpp"
 
 namespace quadcosim::controllers {
@@ -154,6 +155,31 @@ TEST(GeometricController, ExactHoverGivesHoverSpeedsAndZeroErrors) {
   EXPECT_NEAR(out.roll_des_rad, 0.0, 1e-12);
   EXPECT_NEAR(out.pitch_des_rad, 0.0, 1e-12);
   EXPECT_FALSE(out.tilt_saturated);
+}
+
+TEST(GeometricController, YawTorqueGivesWayToThrustAndRollPitch) {
+  // A 1 rad heading error with a stiff yaw gain asks for far more yaw torque than the rotors' drag can
+  // give; the allocation keeps the thrust and zero roll/pitch torque and gives the largest yaw torque
+  // left: two opposite rotors at 0, the other two carrying the weight, |M_z| = k_m 4 w_hover^2.
+  const model::VehicleParams v;
+  GeometricController ctl(v);
+  ASSERT_EQ(ctl.set_parameters(std::vector<Setting>{{"k_R.z", 10.0}}), "");
+  Reference ref;
+  ref.mode = Mode::kAttitude;
+  ref.yaw_rad = 1.0;
+  Observation obs;  // level, yaw 0, at the held altitude 0
+  ControllerOutput out = new_output(ctl);
+  ctl.step(obs, ref, kControlDt, out);
+  const double requested = 10.0 * std::sin(1.0);  // e_R.z = -sin(1): M_z = +10 sin(1)
+  const double w2_hover = v.mass_kg * v.gravity_m_s2 / (4.0 * v.kt_N_per_rad2_s2);
+  const double max_yaw = v.km_Nm_per_rad2_s2 * 4.0 * w2_hover;
+  EXPECT_NEAR(out.U[3], max_yaw, 1e-12);
+  EXPECT_NEAR(out.outputs[output_index(ctl, "yaw_torque_cut")], requested - max_yaw, 1e-9);
+  const Eigen::Vector4d realised = model::mixer_matrix(v) * out.omega_rad_s.cwiseAbs2();
+  EXPECT_NEAR(realised[0], v.mass_kg * v.gravity_m_s2, 1e-9);
+  EXPECT_NEAR(realised[1], 0.0, 1e-9);
+  EXPECT_NEAR(realised[2], 0.0, 1e-9);
+  EXPECT_NEAR(realised[3], max_yaw, 1e-12);
 }
 
 // --- Closed loop on the plant ---------------------------------------------------------------------
