@@ -3,6 +3,7 @@
 #include <array>
 
 #include "controllers/paper/paper_controller.hpp"
+#include "controllers/se3/geometric_controller.hpp"
 
 namespace quadcosim::controllers {
 
@@ -17,6 +18,8 @@ const std::array kTypes = {
     ControllerType{PaperController::kType,
                    "the paper's Algorithm 1: LQR attitude, PD altitude, PID position, allocation",
                    &make<PaperController>},
+    ControllerType{GeometricController::kType, "geometric tracking on SE(3) (Lee, Leok, McClamroch 2010)",
+                   &make<GeometricController>},
 };
 }  // namespace
 
