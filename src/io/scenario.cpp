@@ -10,6 +10,7 @@
 #include "analysis/step_metrics.hpp"
 #include "controllers/registry.hpp"
 #include "io/realism_yaml.hpp"
+#include "io/trajectory_yaml.hpp"
 #include "io/yaml_reader.hpp"
 #include "sim/topics.hpp"
 
@@ -411,6 +412,8 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   read_realism(root, sc);
   if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
   if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
+  if (auto t = root.section("trajectory"))
+    sc.trajectory = read_trajectory(*t, std::filesystem::path(path).parent_path());
   root.reject_unknown_keys();
   return sc;
 }

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -15,6 +16,7 @@
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
+#include "trajectory/trajectory.hpp"
 
 namespace YAML {
 class Node;
@@ -93,6 +95,9 @@ struct Scenario {
   std::optional<SwarmSpec> swarm;    ///< present when the file has a `swarm:` section
   std::optional<HoldSpec> hold;      ///< analysis.hold
   std::optional<LimitsSpec> limits;  ///< analysis.limits
+  /// `trajectory:` the reference to track (controller evaluates at(t) each tick); nullptr (kind steps,
+  /// the default): setpoints from the controller parameters and the schedule.
+  std::shared_ptr<const trajectory::Trajectory> trajectory;
 };
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).
