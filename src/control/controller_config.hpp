@@ -16,6 +16,7 @@
 #include "control/controller.hpp"
 #include "control/parameters.hpp"
 #include "model/vehicle_params.hpp"
+#include "trajectory/trajectory.hpp"
 
 namespace quadcosim::control {
 
@@ -52,6 +53,12 @@ struct ControllerConfig {
   /// The configured controller; every node flies its own clone. Never null once made by
   /// controllers::make_config.
   std::shared_ptr<const Controller> controller;
+
+  /// The reference to track: when set, the node follows it in position mode (its position,
+  /// derivatives and yaw at the step's time, shifted by trajectory_offset_W) and the setpoint
+  /// parameters (mode, x_des, ..., yaw_des) are not used. Unset: the step setpoints.
+  std::shared_ptr<const trajectory::Trajectory> trajectory;
+  Eigen::Vector3d trajectory_offset_W = Eigen::Vector3d::Zero();  ///< [m] (a swarm vehicle's grid offset)
 
   /// The registry name of the controller's type.
   std::string_view type() const { return controller->type(); }

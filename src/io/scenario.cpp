@@ -412,8 +412,9 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   read_realism(root, sc);
   if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
   if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
-  if (auto t = root.section("trajectory"))
-    sc.trajectory = read_trajectory(*t, std::filesystem::path(path).parent_path());
+  if (auto t = root.section("trajectory")) {
+    sc.controller.trajectory = read_trajectory(*t, std::filesystem::path(path).parent_path());
+  }
   root.reject_unknown_keys();
   return sc;
 }

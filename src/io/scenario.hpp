@@ -86,7 +86,8 @@ struct Scenario {
   std::string name;
   std::string description;
   model::VehicleParams vehicle;
-  /// The controller, its parameters and the node's setpoints (the paper's controller by default).
+  /// The controller, its parameters and the node's setpoints (the paper's controller by default), and
+  /// the `trajectory:` to track (controller.trajectory; none for kind steps, the default).
   control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
   sim::SimulationConfig simulation;
   InitialState initial;
@@ -95,9 +96,6 @@ struct Scenario {
   std::optional<SwarmSpec> swarm;    ///< present when the file has a `swarm:` section
   std::optional<HoldSpec> hold;      ///< analysis.hold
   std::optional<LimitsSpec> limits;  ///< analysis.limits
-  /// `trajectory:` the reference to track (controller evaluates at(t) each tick); nullptr (kind steps,
-  /// the default): setpoints from the controller parameters and the schedule.
-  std::shared_ptr<const trajectory::Trajectory> trajectory;
 };
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).

@@ -47,8 +47,8 @@ std::string error_of(const std::string& trajectory_yaml) {
 }
 
 TEST(TrajectoryYamlTest, AbsentOrStepsIsNoTrajectory) {
-  EXPECT_EQ(load("").trajectory, nullptr);
-  EXPECT_EQ(load("trajectory: {kind: steps}\n").trajectory, nullptr);
+  EXPECT_EQ(load("").controller.trajectory, nullptr);
+  EXPECT_EQ(load("trajectory: {kind: steps}\n").controller.trajectory, nullptr);
 }
 
 TEST(TrajectoryYamlTest, CircleKeysAreRead) {
@@ -64,11 +64,11 @@ TEST(TrajectoryYamlTest, CircleKeysAreRead) {
   ramp_s: 0
   yaw_mode: centre
 )");
-  ASSERT_NE(sc.trajectory, nullptr);
-  EXPECT_EQ(sc.trajectory->describe().rfind("circle r=2 m, period 10 s cw about (1, 2) at 5 m", 0), 0u)
-      << sc.trajectory->describe();
+  ASSERT_NE(sc.controller.trajectory, nullptr);
+  EXPECT_EQ(sc.controller.trajectory->describe().rfind("circle r=2 m, period 10 s cw about (1, 2) at 5 m", 0), 0u)
+      << sc.controller.trajectory->describe();
   // A quarter period after the abrupt start at (3, 2), clockwise: (1, 0), facing the centre (+y).
-  const auto o = sc.trajectory->at(1.0 + 2.5);
+  const auto o = sc.controller.trajectory->at(1.0 + 2.5);
   EXPECT_NEAR(o.p_W.x(), 1.0, 1e-12);
   EXPECT_NEAR(o.p_W.y(), 0.0, 1e-12);
   EXPECT_EQ(o.p_W.z(), 5.0);
@@ -79,9 +79,9 @@ TEST(TrajectoryYamlTest, LissajousAndFigure8AreRead) {
   const Scenario l = load(
       "trajectory: {kind: lissajous, amplitude_m: [2, 1], period_s: [8, 4], phase_rad: [0, 1], altitude_m: 2, "
       "ramp_s: 0, yaw_mode: tangent}\n");
-  ASSERT_NE(l.trajectory, nullptr);
-  EXPECT_NEAR(l.trajectory->at(2.0).p_W.x(), 2.0, 1e-12);  // sin(2 pi / 8 * 2)
-  EXPECT_NEAR(l.trajectory->at(2.0).p_W.y(), std::sin(std::numbers::pi + 1.0), 1e-12);
+  ASSERT_NE(l.controller.trajectory, nullptr);
+  EXPECT_NEAR(l.controller.trajectory->at(2.0).p_W.x(), 2.0, 1e-12);  // sin(2 pi / 8 * 2)
+  EXPECT_NEAR(l.controller.trajectory->at(2.0).p_W.y(), std::sin(std::numbers::pi + 1.0), 1e-12);
   const Scenario f = load("trajectory: {kind: figure8, amplitude_m: [3, 1], period_s: 12, ramp_s: 0}\n");
   ASSERT_NE(f.trajectory, nullptr);
   EXPECT_NEAR(f.trajectory->at(3.0).p_W.x(), 3.0, 1e-12);
@@ -97,12 +97,12 @@ TEST(TrajectoryYamlTest, WaypointsAreRead) {
     - {t_s: 1, position_m: [0, 0, 1]}
     - {t_s: 3, position_m: [2, 0, 1], yaw_rad: 1.5}
 )");
-  ASSERT_NE(sc.trajectory, nullptr);
-  EXPECT_EQ(sc.trajectory->end_s(), 3.0);
-  EXPECT_NEAR(sc.trajectory->at(2.0).p_W.x(), 1.0, 1e-12);
-  EXPECT_NEAR(sc.trajectory->at(1.5).p_W.x(), 2.0 * (10.0 / 64 - 15.0 / 256 + 6.0 / 1024), 1e-12);
-  EXPECT_NEAR(sc.trajectory->at(3.0).yaw_rad, 1.5, 1e-12);
-  EXPECT_EQ(sc.trajectory->describe().rfind("min_jerk through 2 waypoints", 0), 0u);
+  ASSERT_NE(sc.controller.trajectory, nullptr);
+  EXPECT_EQ(sc.controller.trajectory->end_s(), 3.0);
+  EXPECT_NEAR(sc.controller.trajectory->at(2.0).p_W.x(), 1.0, 1e-12);
+  EXPECT_NEAR(sc.controller.trajectory->at(1.5).p_W.x(), 2.0 * (10.0 / 64 - 15.0 / 256 + 6.0 / 1024), 1e-12);
+  EXPECT_NEAR(sc.controller.trajectory->at(3.0).yaw_rad, 1.5, 1e-12);
+  EXPECT_EQ(sc.controller.trajectory->describe().rfind("min_jerk through 2 waypoints", 0), 0u);
 }
 
 TEST(TrajectoryYamlTest, FilePathIsRelativeToTheScenario) {
@@ -116,11 +116,11 @@ TEST(TrajectoryYamlTest, FilePathIsRelativeToTheScenario) {
   for (int c = 0; c < 32; ++c) csv += c == 0 ? ",1" : (c == 1 ? ",0.5" : (c == 16 ? ",2" : ",0"));
   write(dir / "paths" / "line.csv", csv + "\n");
   const Scenario sc = load("trajectory: {kind: file, path: paths/line.csv, start_s: 1}\n");
-  ASSERT_NE(sc.trajectory, nullptr);
-  EXPECT_EQ(sc.trajectory->end_s(), 3.0);
-  EXPECT_DOUBLE_EQ(sc.trajectory->at(2.0).p_W.x(), 1.5);  // 1 + 0.5 tau at tau = 1
-  EXPECT_DOUBLE_EQ(sc.trajectory->at(2.0).v_W.x(), 0.5);
-  EXPECT_DOUBLE_EQ(sc.trajectory->at(2.0).p_W.z(), 2.0);
+  ASSERT_NE(sc.controller.trajectory, nullptr);
+  EXPECT_EQ(sc.controller.trajectory->end_s(), 3.0);
+  EXPECT_DOUBLE_EQ(sc.controller.trajectory->at(2.0).p_W.x(), 1.5);  // 1 + 0.5 tau at tau = 1
+  EXPECT_DOUBLE_EQ(sc.controller.trajectory->at(2.0).v_W.x(), 0.5);
+  EXPECT_DOUBLE_EQ(sc.controller.trajectory->at(2.0).p_W.z(), 2.0);
 }
 
 struct BadTrajectory {

@@ -9,7 +9,11 @@
 namespace quadcosim::sim {
 
 ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config)
-    : vehicle_(config.vehicle), settings_(config.node), controller_(config.controller->clone()) {
+    : vehicle_(config.vehicle),
+      trajectory_(config.trajectory),
+      trajectory_offset_W_(config.trajectory_offset_W),
+      settings_(config.node),
+      controller_(config.controller->clone()) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   output_.outputs.assign(controller_->output_names().size(), 0.0);
   status_.controller = controller_->type();
@@ -88,6 +92,19 @@ void ControllerNode::safety_output() {
 }
 
 void ControllerNode::update_reference(std::int64_t now_ns) {
+  if (trajectory_) {
+    const trajectory::FlatOutput f = trajectory_->at(static_cast<double>(now_ns) / 1e9);
+    reference_.mode = control::Mode::kPosition;
+    reference_.p_W = f.p_W + trajectory_offset_W_;
+    reference_.v_W = f.v_W;
+    reference_.a_W = f.a_W;
+    reference_.j_W = f.j_W;
+    reference_.yaw_rad = f.yaw_rad;
+    reference_.yaw_rate_rad_s = f.yaw_rate_rad_s;
+    reference_.roll_rad = 0.0;
+    reference_.pitch_rad = 0.0;
+    return;
+  }
   const control::Setpoint& sp = settings_.setpoint;
   reference_.mode = sp.mode;
   reference_.p_W = sp.p_des_W;
@@ -98,7 +115,6 @@ void ControllerNode::update_reference(std::int64_t now_ns) {
   reference_.yaw_rate_rad_s = 0.0;
   reference_.roll_rad = sp.roll_des_rad;
   reference_.pitch_rad = sp.pitch_des_rad;
-  (void)now_ns;
 }
 
 const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, double dt_s) {

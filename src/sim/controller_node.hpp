@@ -102,6 +102,8 @@ class ControllerNode {
   void update_reference(std::int64_t now_ns);
 
   model::VehicleParams vehicle_;
+  std::shared_ptr<const trajectory::Trajectory> trajectory_;
+  Eigen::Vector3d trajectory_offset_W_;
   control::NodeSettings settings_;
   std::unique_ptr<control::Controller> controller_;
   control::Reference reference_;

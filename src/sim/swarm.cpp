@@ -32,6 +32,7 @@ SwarmVehicle swarm_vehicle(const SimulationConfig& simulation, const model::Stat
   v.initial.p_W.x() += o.x();
   v.initial.p_W.y() += o.y();
   v.controller.node.setpoint.p_des_W += o;
+  v.controller.trajectory_offset_W += o;
   for (ScheduledParameter& p : v.schedule) {
     const int axis = p.name == "x_des" ? 0 : p.name == "y_des" ? 1 : p.name == "z_des" ? 2 : -1;
     if (axis >= 0 && std::holds_alternative<double>(p.value)) p.value = std::get<double>(p.value) + o[axis];
