@@ -86,7 +86,8 @@ BENCHMARK(BM_Allocation);
 
 // One 100 Hz tick (plant step + half a controller step) of the BASELINE minimal loop.
 void BM_BaselineTick(benchmark::State& st) {
-  qc::baseline::BaselineLoop loop = qc::baseline::make_baseline(qc::model::VehicleParams{}, qc::controllers::PaperParams{}, 10.0);
+  qc::baseline::BaselineLoop loop =
+      qc::baseline::make_baseline(qc::model::VehicleParams{}, qc::controllers::PaperParams{}, 10.0);
   long k = 0;
   for (auto _ : st) {
     loop.tick(k++, 0.01);

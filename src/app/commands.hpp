@@ -20,6 +20,7 @@ namespace quadcosim::app {
 
 struct RunOptions {
   std::string scenario;
+  std::string controller;  ///< --controller: replaces the scenario's controller.type ("" keeps it)
   std::string out_dir;
   bool force = false;  ///< replace a previous command's outputs in out_dir (io/output_folder.hpp)
   bool plots = true;
@@ -59,8 +60,8 @@ CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& options);
 struct ParamsOptions {
   std::string controller = "paper";  ///< the controller type whose parameters are listed
   bool list = false;                 ///< list the controller types instead
-  bool vehicle = false;   ///< the vehicle's parameters instead of the controller's
-  bool markdown = false;  ///< the vehicle table as Markdown (docs/model.md)
+  bool vehicle = false;              ///< the vehicle's parameters instead of the controller's
+  bool markdown = false;             ///< the vehicle table as Markdown (docs/model.md)
 };
 /// Lists the controller's (or with `vehicle`, the vehicle's) parameters: name, unit, range, default,
 /// meaning.
@@ -143,9 +144,10 @@ struct ControllerCommandOptions {
   using Swarm = NodeSwarmOptions;
 
   // Every mode.
-  std::string scenario;  ///< controller parameters, rates, schedule ("" for defaults)
-  std::string params;    ///< controller parameter file, applied over the scenario's
-  std::string vehicle;   ///< vehicle file (the controller's model of the vehicle)
+  std::string scenario;    ///< controller parameters, rates, schedule ("" for defaults)
+  std::string controller;  ///< --controller: replaces the scenario's controller.type ("" keeps it)
+  std::string params;      ///< controller parameter file, applied over the scenario's
+  std::string vehicle;     ///< vehicle file (the controller's model of the vehicle)
   std::string ns;
   bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
   std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)

@@ -25,7 +25,12 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
   auto* ctl_cmd = app.add_subcommand("controller", "the flight controller as a ROS 2 node over DDS");
   ctl_cmd->add_option("--scenario", ctl.scenario, "scenario YAML (controller parameters, rates, schedule)")
       ->check(CLI::ExistingFile);
-  ctl_cmd->add_option("--params", ctl.params, "controller parameter YAML")->check(CLI::ExistingFile);
+  add_controller_type_option(*ctl_cmd, ctl.controller);
+  ctl_cmd
+      ->add_option("--params", ctl.params,
+                   "controller parameter YAML (its keys on top of the controller type's "
+                   "and the node's defaults; `type:` included)")
+      ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
   add_node_host_options(ctl_cmd, ctl.ns, ctl.swarm, ctl.sensor_qos,
@@ -66,10 +71,16 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
 }
 
 int controller_command(const ControllerCommandOptions& o) {
-  std::optional<io::Scenario> started = start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns);
+  std::optional<io::Scenario> started =
+      start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns, o.controller);
   if (!started) return exit_code::kBadInput;
   io::Scenario& sc = *started;
-  if (!o.params.empty()) sc.controller = io::load_controller(o.params, sc.vehicle);
+  if (!o.params.empty()) {
+    // The file replaces the controller and the node's parameters; the scenario's trajectory stays.
+    const auto trajectory = sc.controller.trajectory;
+    sc.controller = io::load_controller(o.params, sc.vehicle);
+    sc.controller.trajectory = trajectory;
+  }
   if (o.swarm.vehicles > 0) return swarm_controller_command(o, std::move(sc));
   const sim::TickClock clock = sc.simulation.plant.clock;
   const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
@@ -115,8 +126,7 @@ int controller_command(const ControllerCommandOptions& o) {
     h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
       std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
                                safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
-                               node.observation().age_s, node.settings().stale_limit_s,
-                               static_cast<double>(now) / 1e9);
+                               node.observation().age_s, node.settings().stale_limit_s, static_cast<double>(now) / 1e9);
     };
     DdsDriverHost host(transport, /*precise_deadlines=*/true);
     drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,

@@ -50,8 +50,10 @@ int lqr_command(const LqrOptions& opt) {
       opt.params.empty() ? controllers::make_config("paper", vehicle) : io::load_controller(opt.params, vehicle);
   const controllers::PaperController* paper = controllers::paper_controller(cfg);
   if (!paper) {
-    throw std::invalid_argument(opt.params + ": `quadcosim lqr` shows the paper controller's LQR designs; this file "
-                                "configures controller type '" + std::string(cfg.type()) + "'");
+    throw std::invalid_argument(opt.params +
+                                ": `quadcosim lqr` shows the paper controller's LQR designs; this file "
+                                "configures controller type '" +
+                                std::string(cfg.type()) + "'");
   }
   const controllers::PaperController& fc = *paper;
   const char* names[3] = {"roll", "pitch", "yaw"};
@@ -117,7 +119,8 @@ int params_command(const ParamsOptions& options) {
   if (options.vehicle) return vehicle_params_table(options.markdown);
   if (options.list) {
     std::cout << fmt::format("{:<10} {}\n", "type", "controller");
-    for (const auto& t : controllers::controller_types()) std::cout << fmt::format("{:<10} {}\n", t.name, t.description);
+    for (const auto& t : controllers::controller_types())
+      std::cout << fmt::format("{:<10} {}\n", t.name, t.description);
     return exit_code::kOk;
   }
   const control::ControllerConfig defaults = controllers::make_config(options.controller, model::VehicleParams{});

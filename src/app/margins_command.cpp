@@ -57,9 +57,9 @@ Setup setup_from(const std::string& path) {
   s.plant = sc.vehicle;
   s.controller = sc.controller;
   if (!controllers::paper_controller(s.controller)) {
-    throw std::invalid_argument(fmt::format(
-        "{}: margins analyses the paper controller's loops; this scenario flies controller type '{}'", path,
-        s.controller.type()));
+    throw std::invalid_argument(
+        fmt::format("{}: margins analyses the paper controller's loops; this scenario flies controller type '{}'", path,
+                    s.controller.type()));
   }
   bool later_design_change = false;
   std::vector<sim::ScheduledParameter> schedule = sc.schedule;
@@ -192,8 +192,8 @@ int margins_command(const MarginsOptions& o) {
     s.notes.push_back(
         "the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
         "in them");
-    loops = analysis::hover_loops(s.plant, *controllers::paper_controller(s.controller), s.controller.node.setpoint.mode,
-                                  s.timing);
+    loops = analysis::hover_loops(s.plant, *controllers::paper_controller(s.controller),
+                                  s.controller.node.setpoint.mode, s.timing);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(
         fmt::format("{}cannot linearise about hover: {}", o.scenario.empty() ? "" : o.scenario + ": ", e.what()));

@@ -24,7 +24,7 @@ namespace quadcosim::app {
 
 std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
                                                const std::string& scenario, const std::string& vehicle,
-                                               const std::string& ns) {
+                                               const std::string& ns, const std::string& controller_type) {
   install_stop_handlers();
   if (std::string err = use_cpus(cpus); !err.empty()) {
     std::cerr << "error: " << who << ": --cpus: " << err << '\n';
@@ -34,9 +34,10 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
   if (!cpus.empty()) std::cerr << fmt::format("{}: on CPU(s) {} only\n", who, cpus);
   io::Scenario sc;
   if (!scenario.empty()) {
-    sc = io::load_scenario(scenario);
+    sc = io::load_scenario(scenario, controller_type);
   } else {
     sc.name = "defaults";
+    if (!controller_type.empty()) sc.controller = controllers::make_config(controller_type, sc.vehicle);
   }
   if (!vehicle.empty()) {
     sc.vehicle = io::load_vehicle(vehicle);
@@ -49,6 +50,14 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
                           "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
   }
   return sc;
+}
+
+void add_controller_type_option(CLI::App& cmd, std::string& type) {
+  std::vector<std::string> names;
+  for (const auto& t : controllers::controller_types()) names.emplace_back(t.name);
+  cmd.add_option("--controller", type,
+                 "the controller type to fly, replacing the scenario's controller.type (`quadcosim params --list`)")
+      ->check(CLI::IsMember(names));
 }
 
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {

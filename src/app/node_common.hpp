@@ -2,6 +2,8 @@
 // measure with, how they find their scenario, and the sensor-data QoS option.
 #pragma once
 
+#include <CLI/CLI.hpp>
+
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -32,9 +34,13 @@ using dds::steady_ns;
 /// (exit 2); throws io::ConfigError for a bad file or when the scenario asks for injected faults,
 /// which only the in-process transport can inject (over DDS, faults come from the network: tc netem,
 /// docs/reliability.md).
+/// `controller_type`, when not empty, replaces the scenario's controller.type (--controller).
 std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
                                                const std::string& scenario, const std::string& vehicle,
-                                               const std::string& ns);
+                                               const std::string& ns, const std::string& controller_type = "");
+
+/// Adds `--controller TYPE` (a registered controller type, checked) to `cmd`.
+void add_controller_type_option(CLI::App& cmd, std::string& type);
 
 /// Real-time loops: lets the DDS transport deliver messages until 1 ms before `deadline_ns`
 /// (steady_ns), then spins on the clock until the deadline (5 % of a core for a 20 ms period), so

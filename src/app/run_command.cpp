@@ -68,6 +68,10 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
   // The plant owns simulated time, so in lockstep it applies the schedule through the controller's
   // parameter services, each change before its tick; in real time the controller applies it itself.
   std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario};
+  if (!opt.controller.empty()) {
+    controller_args.push_back("--controller");
+    controller_args.push_back(opt.controller);
+  }
   const std::string mcap_path = (std::filesystem::path(csv_path).parent_path() / "run.mcap").string();
   std::vector<std::string> plant_args = {self,     "plant",  "--scenario", opt.scenario, "--record",
                                          csv_path, "--mcap", mcap_path,    "--timeout",  timeout};
@@ -108,6 +112,7 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
                     "--out holds a previous command's outputs or other files: remove exactly the outputs its "
                     "manifest lists first (files quadcosim did not write are kept)");
   run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots and report.html");
+  add_controller_type_option(*run_cmd, run.controller);
   run_cmd
       ->add_option("--transport", run.transport,
                    "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
@@ -145,7 +150,7 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
 }
 
 int run_command(const RunOptions& opt) {
-  const io::Scenario sc = io::load_scenario(opt.scenario);
+  const io::Scenario sc = io::load_scenario(opt.scenario, opt.controller);
 
   if (opt.transport == "dds" && sc.simulation.faults.active() && !(opt.vehicles > 0 || sc.swarm)) {
     std::cerr << "error: " << opt.scenario

@@ -130,6 +130,10 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
         "--swarm-out", out.string()};
     std::vector<std::string> controller_args = {self,         "controller", "--scenario",
                                                 opt.scenario, "--vehicles", std::to_string(n)};
+    if (!opt.controller.empty()) {
+      controller_args.push_back("--controller");
+      controller_args.push_back(opt.controller);
+    }
     if (opt.pin) pin_apart(plant_args, controller_args);
     install_stop_handlers();
     if (const int rc = run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;

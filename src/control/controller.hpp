@@ -33,11 +33,11 @@ enum class Mode {
 /// What the controller observes: the latest measurements the node took from its sensor topics, as
 /// received (no filtering: not an estimate), and how old they are.
 struct Observation {
-  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();                ///< [m], from Pose
-  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();                ///< [m/s], from Velocity
-  Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();     ///< attitude body -> world, from the Imu
-  double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;        ///< Z-Y-X angles of q_WB
-  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();                ///< body rates [rad/s], from the Imu
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();               ///< [m], from Pose
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();               ///< [m/s], from Velocity
+  Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();    ///< attitude body -> world, from the Imu
+  double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;       ///< Z-Y-X angles of q_WB
+  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();               ///< body rates [rad/s], from the Imu
   Eigen::Vector3d specific_force_B = Eigen::Vector3d::Zero();  ///< accelerometer [m/s^2], from the Imu
   /// Header stamps [ns] (simulated time) of the samples above; -1 for a topic never received.
   std::int64_t pose_stamp_ns = -1, velocity_stamp_ns = -1, imu_stamp_ns = -1;
@@ -109,8 +109,7 @@ class Controller {
 
   /// One control period of dt_s [s]. The observation is finite and fresh (the node checked it);
   /// `out.outputs` has output_names().size() entries. Writes every field of `out` except safety.
-  virtual void step(const Observation& observation, const Reference& reference, double dt_s,
-                    ControllerOutput& out) = 0;
+  virtual void step(const Observation& observation, const Reference& reference, double dt_s, ControllerOutput& out) = 0;
 };
 
 /// The parameter plumbing of a controller whose parameters live in one struct P, declared by a

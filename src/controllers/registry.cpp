@@ -2,24 +2,26 @@
 
 #include <array>
 
+#include "controllers/example_pd/example_pd_controller.hpp"
 #include "controllers/paper/paper_controller.hpp"
 #include "controllers/se3/geometric_controller.hpp"
 
 namespace quadcosim::controllers {
 
 namespace {
+// A controller class C with static kType and kDescription, constructible from the vehicle.
 template <class C>
-std::unique_ptr<control::Controller> make(const model::VehicleParams& vehicle) {
-  return std::make_unique<C>(vehicle);
+constexpr ControllerType entry() {
+  return {C::kType, C::kDescription, [](const model::VehicleParams& vehicle) -> std::unique_ptr<control::Controller> {
+            return std::make_unique<C>(vehicle);
+          }};
 }
 
-// One line per controller.
+// One line per controller; the first is the default.
 const std::array kTypes = {
-    ControllerType{PaperController::kType,
-                   "the paper's Algorithm 1: LQR attitude, PD altitude, PID position, allocation",
-                   &make<PaperController>},
-    ControllerType{GeometricController::kType, "geometric tracking on SE(3) (Lee, Leok, McClamroch 2010)",
-                   &make<GeometricController>},
+    entry<PaperController>(),
+    entry<GeometricController>(),
+    entry<ExamplePdController>(),
 };
 }  // namespace
 
@@ -41,8 +43,8 @@ const ControllerType* find_controller_type(std::string_view name) {
 control::ControllerConfig make_config(std::string_view type, const model::VehicleParams& vehicle) {
   const ControllerType* t = find_controller_type(type);
   if (!t) {
-    throw std::invalid_argument("unknown controller type '" + std::string(type) + "' (known: " +
-                                controller_type_names() + ")");
+    throw std::invalid_argument("unknown controller type '" + std::string(type) +
+                                "' (known: " + controller_type_names() + ")");
   }
   control::ControllerConfig c;
   c.vehicle = vehicle;

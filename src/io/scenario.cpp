@@ -361,8 +361,22 @@ model::State initial_state(const Scenario& sc) {
   return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
 }
 
-Scenario load_scenario(const std::string& path) {
-  return read_scenario(YamlSection::load_file(path), path, nullptr);
+Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path, nullptr); }
+
+void set_controller_type(YAML::Node root, const std::string& controller_type) {
+  if (!root["controller"] || !root["controller"].IsMap()) {
+    if (root["controller"] && !root["controller"].IsNull()) return;  // load_scenario refuses it, naming the key
+    root["controller"] = YAML::Node(YAML::NodeType::Map);
+  }
+  root["controller"]["type"] = controller_type;
+}
+
+Scenario load_scenario(const std::string& path, const std::string& controller_type) {
+  if (controller_type.empty()) return load_scenario(path);
+  YamlSection file = YamlSection::load_file(path);
+  YAML::Node root = YAML::Clone(file.node());
+  set_controller_type(root, controller_type);
+  return read_scenario(YamlSection(root, path, ""), path, nullptr);
 }
 
 Scenario load_scenario(const YAML::Node& node, const std::string& path,

@@ -105,6 +105,13 @@ model::State initial_state(const Scenario& scenario);
 /// wrong type, value out of range, a rate that is not a whole divisor, ...).
 Scenario load_scenario(const std::string& path);
 
+/// The same with `controller.type` set to `controller_type` when it is not empty (the CLI's
+/// --controller): the file's controller parameters are then checked against that type's table.
+Scenario load_scenario(const std::string& path, const std::string& controller_type);
+
+/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed.
+void set_controller_type(YAML::Node root, const std::string& controller_type);
+
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file
 /// and `path` is recorded as the scenario's path. A sweep sets keys in the parsed file and loads each
 /// run's scenario with this, so a run's value is checked exactly as the same value written in the file.

@@ -54,6 +54,7 @@ class YamlSection {
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
   std::string key_path(const std::string& key) const;
   const std::string& file() const { return file_; }
+  const YAML::Node& node() const { return node_; }
   /// How a value appears in messages: 'text' for a scalar, else "a list", "a mapping", "nothing".
   static std::string describe(const YAML::Node& n);
 

@@ -147,8 +147,7 @@ const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, doubl
   const auto& ref = reference_;
   status_.header.stamp = msg::Time::from_ns(sim_now_ns);
   if (const char* mode = control::to_string(ref.mode); status_.mode != mode) status_.mode = mode;
-  status_.setpoint = {ref.p_W.x(),           ref.p_W.y(),            ref.p_W.z(),
-                      output_.roll_des_rad, output_.pitch_des_rad, ref.yaw_rad};
+  status_.setpoint = {ref.p_W.x(), ref.p_W.y(), ref.p_W.z(), output_.roll_des_rad, output_.pitch_des_rad, ref.yaw_rad};
   for (int i = 0; i < 3; ++i) status_.position_error[i] = ref.p_W[i] - observation_.p_W[i];
   status_.yaw_error = model::wrap_pi(ref.yaw_rad - observation_.yaw_rad);
   status_.attitude_error = output_.attitude_error;

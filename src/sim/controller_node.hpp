@@ -18,9 +18,9 @@
 #include <limits>
 #include <string>
 
+#include <memory>
 #include "control/controller.hpp"
 #include "control/controller_config.hpp"
-#include <memory>
 #include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"

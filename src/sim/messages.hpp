@@ -190,11 +190,11 @@ std::int64_t command_stamp_ns(const Float64MultiArray& m);
 /// part that every controller fills (through the node), then the controller's own named figures.
 struct ControllerStatus {
   static constexpr std::string_view kRosType = "quadcosim_msgs/msg/ControllerStatus";
-  Header header;                     ///< stamp: the (simulated) time of the step
-  std::string controller;            ///< the controller's type ("paper", "se3", ...)
-  std::string mode;                  ///< "attitude" | "position"
-  std::array<double, 6> setpoint{};  ///< x, y, z [m] of the reference, roll, pitch, yaw [rad] actually tracked
-  std::array<double, 4> u{};         ///< U1 [N], U2..U4 [N m] requested
+  Header header;                           ///< stamp: the (simulated) time of the step
+  std::string controller;                  ///< the controller's type ("paper", "se3", ...)
+  std::string mode;                        ///< "attitude" | "position"
+  std::array<double, 6> setpoint{};        ///< x, y, z [m] of the reference, roll, pitch, yaw [rad] actually tracked
+  std::array<double, 4> u{};               ///< U1 [N], U2..U4 [N m] requested
   std::array<double, 3> position_error{};  ///< reference minus observed position [m] (world)
   double yaw_error = 0.0;                  ///< reference minus observed yaw, wrapped to [-pi, pi] [rad]
   /// Psi = 1/2 tr(I - R_d^T R) in [0, 2] for a controller with a desired attitude R_d, NaN otherwise.

@@ -14,38 +14,54 @@ using Table = control::ParameterTable<PaperParams>;
 
 Table make_table() {
   return Table({
-      Table::number("altitude.kp", "N/m", 0, kBig, "altitude P gain K_p,z, eq. (12)",
-                    [](auto& p) -> auto& { return p.altitude.kp; }),
-      Table::number("altitude.kd", "N s/m", 0, kBig, "altitude D gain K_d,z, eq. (12)",
-                    [](auto& p) -> auto& { return p.altitude.kd; }),
-      Table::number("altitude.min_cos_tilt", "", 0.05, 1, "floor on cos(roll) cos(pitch) in eq. (13)",
-                    [](auto& p) -> auto& { return p.altitude.min_cos_tilt; }),
-      Table::number("lqr.roll.q_angle", "1/rad^2", 0, kBig, "roll LQR weight on angle error",
-                    [](auto& p) -> auto& { return p.roll.q_angle; }),
-      Table::number("lqr.roll.q_rate", "s^2/rad^2", 0, kBig, "roll LQR weight on rate",
-                    [](auto& p) -> auto& { return p.roll.q_rate; }),
-      Table::number("lqr.roll.r", "1/(N m)^2", 1e-12, kBig, "roll LQR weight on torque",
-                    [](auto& p) -> auto& { return p.roll.r; }),
-      Table::number("lqr.pitch.q_angle", "1/rad^2", 0, kBig, "pitch LQR weight on angle error",
-                    [](auto& p) -> auto& { return p.pitch.q_angle; }),
-      Table::number("lqr.pitch.q_rate", "s^2/rad^2", 0, kBig, "pitch LQR weight on rate",
-                    [](auto& p) -> auto& { return p.pitch.q_rate; }),
-      Table::number("lqr.pitch.r", "1/(N m)^2", 1e-12, kBig, "pitch LQR weight on torque",
-                    [](auto& p) -> auto& { return p.pitch.r; }),
-      Table::number("lqr.yaw.q_angle", "1/rad^2", 0, kBig, "yaw LQR weight on angle error",
-                    [](auto& p) -> auto& { return p.yaw.q_angle; }),
-      Table::number("lqr.yaw.q_rate", "s^2/rad^2", 0, kBig, "yaw LQR weight on rate",
-                    [](auto& p) -> auto& { return p.yaw.q_rate; }),
-      Table::number("lqr.yaw.r", "1/(N m)^2", 1e-12, kBig, "yaw LQR weight on torque",
-                    [](auto& p) -> auto& { return p.yaw.r; }),
-      Table::number("position.kp", "1/s^2", 0, kBig, "position P gain", [](auto& p) -> auto& { return p.position.kp; }),
-      Table::number("position.ki", "1/s^3", 0, kBig, "position I gain", [](auto& p) -> auto& { return p.position.ki; }),
-      Table::number("position.kd", "1/s", 0, kBig, "position D gain (on velocity)",
-                    [](auto& p) -> auto& { return p.position.kd; }),
-      Table::number("position.integral_limit", "m s", 0, kBig, "anti-windup bound on each axis's error integral",
-                    [](auto& p) -> auto& { return p.position.integral_limit; }),
-      Table::number("position.max_tilt", "rad", 0.01, 1.2, "tilt limit on the roll/pitch the position loop commands",
-                    [](auto& p) -> auto& { return p.position.max_tilt_rad; }),
+      Table::number(
+          "altitude.kp", "N/m", 0, kBig, "altitude P gain K_p,z, eq. (12)",
+          [](auto& p) -> auto& { return p.altitude.kp; }),
+      Table::number(
+          "altitude.kd", "N s/m", 0, kBig, "altitude D gain K_d,z, eq. (12)",
+          [](auto& p) -> auto& { return p.altitude.kd; }),
+      Table::number(
+          "altitude.min_cos_tilt", "", 0.05, 1, "floor on cos(roll) cos(pitch) in eq. (13)",
+          [](auto& p) -> auto& { return p.altitude.min_cos_tilt; }),
+      Table::number(
+          "lqr.roll.q_angle", "1/rad^2", 0, kBig, "roll LQR weight on angle error",
+          [](auto& p) -> auto& { return p.roll.q_angle; }),
+      Table::number(
+          "lqr.roll.q_rate", "s^2/rad^2", 0, kBig, "roll LQR weight on rate",
+          [](auto& p) -> auto& { return p.roll.q_rate; }),
+      Table::number(
+          "lqr.roll.r", "1/(N m)^2", 1e-12, kBig, "roll LQR weight on torque",
+          [](auto& p) -> auto& { return p.roll.r; }),
+      Table::number(
+          "lqr.pitch.q_angle", "1/rad^2", 0, kBig, "pitch LQR weight on angle error",
+          [](auto& p) -> auto& { return p.pitch.q_angle; }),
+      Table::number(
+          "lqr.pitch.q_rate", "s^2/rad^2", 0, kBig, "pitch LQR weight on rate",
+          [](auto& p) -> auto& { return p.pitch.q_rate; }),
+      Table::number(
+          "lqr.pitch.r", "1/(N m)^2", 1e-12, kBig, "pitch LQR weight on torque",
+          [](auto& p) -> auto& { return p.pitch.r; }),
+      Table::number(
+          "lqr.yaw.q_angle", "1/rad^2", 0, kBig, "yaw LQR weight on angle error",
+          [](auto& p) -> auto& { return p.yaw.q_angle; }),
+      Table::number(
+          "lqr.yaw.q_rate", "s^2/rad^2", 0, kBig, "yaw LQR weight on rate",
+          [](auto& p) -> auto& { return p.yaw.q_rate; }),
+      Table::number(
+          "lqr.yaw.r", "1/(N m)^2", 1e-12, kBig, "yaw LQR weight on torque", [](auto& p) -> auto& { return p.yaw.r; }),
+      Table::number(
+          "position.kp", "1/s^2", 0, kBig, "position P gain", [](auto& p) -> auto& { return p.position.kp; }),
+      Table::number(
+          "position.ki", "1/s^3", 0, kBig, "position I gain", [](auto& p) -> auto& { return p.position.ki; }),
+      Table::number(
+          "position.kd", "1/s", 0, kBig, "position D gain (on velocity)",
+          [](auto& p) -> auto& { return p.position.kd; }),
+      Table::number(
+          "position.integral_limit", "m s", 0, kBig, "anti-windup bound on each axis's error integral",
+          [](auto& p) -> auto& { return p.position.integral_limit; }),
+      Table::number(
+          "position.max_tilt", "rad", 0.01, 1.2, "tilt limit on the roll/pitch the position loop commands",
+          [](auto& p) -> auto& { return p.position.max_tilt_rad; }),
   });
 }
 
@@ -82,8 +98,8 @@ void PaperController::step(const control::Observation& obs, const control::Refer
   c.tilt_saturated = false;
   if (ref.mode == control::Mode::kPosition) {
     const control::TiltSetpoint tilt =
-        control::position_pid(params.position, position_state_, ref.p_W.head<2>(), obs.p_W.head<2>(),
-                              obs.v_W.head<2>(), obs.yaw_rad, v.gravity_m_s2, dt_s);
+        control::position_pid(params.position, position_state_, ref.p_W.head<2>(), obs.p_W.head<2>(), obs.v_W.head<2>(),
+                              obs.yaw_rad, v.gravity_m_s2, dt_s);
     c.roll_des_rad = tilt.roll_rad;
     c.pitch_des_rad = tilt.pitch_rad;
     c.tilt_saturated = tilt.saturated;
@@ -101,14 +117,14 @@ void PaperController::step(const control::Observation& obs, const control::Refer
   c.U[3] = axes_[2].torque(e_yaw, obs.w_B.z());
 
   // Lines 12-14: altitude PD, eq. (13).
-  c.U[0] = control::collective_thrust(params.altitude, v.mass_kg, v.gravity_m_s2, ref.p_W.z(), obs.p_W.z(),
-                                      obs.v_W.z(), obs.roll_rad, obs.pitch_rad);
+  c.U[0] = control::collective_thrust(params.altitude, v.mass_kg, v.gravity_m_s2, ref.p_W.z(), obs.p_W.z(), obs.v_W.z(),
+                                      obs.roll_rad, obs.pitch_rad);
   c.outputs[0] = ref.p_W.z() - obs.p_W.z();
   c.outputs[1] = e_roll;
   c.outputs[2] = e_pitch;
   c.outputs[3] = e_yaw;
-  c.attitude_error = control::attitude_error(
-      model::quaternion_from_euler({c.roll_des_rad, c.pitch_des_rad, c.yaw_des_rad}), obs.q_WB);
+  c.attitude_error =
+      control::attitude_error(model::quaternion_from_euler({c.roll_des_rad, c.pitch_des_rad, c.yaw_des_rad}), obs.q_WB);
 
   // Lines 15-20.
   const control::Allocation a =

@@ -30,6 +30,8 @@ struct PaperParams {
 class PaperController : public control::ControllerWith<PaperController, PaperParams> {
  public:
   static constexpr std::string_view kType = "paper";
+  static constexpr std::string_view kDescription =
+      "the paper's Algorithm 1: LQR attitude, PD altitude, PID position, allocation";
 
   /// Designs the three LQR axes for `vehicle` (the controller's knowledge of it); throws
   /// control::CareError if a design has no solution.

@@ -64,6 +64,7 @@ struct GeometricTerms {
 class GeometricController : public control::ControllerWith<GeometricController, GeometricParams> {
  public:
   static constexpr std::string_view kType = "se3";
+  static constexpr std::string_view kDescription = "geometric tracking on SE(3) (Lee, Leok, McClamroch 2010)";
 
   /// The controller for `vehicle` (mass, gravity, inertia, mixer, motor speed limits). Throws
   /// std::invalid_argument when the vehicle's mixer is singular.
