@@ -289,10 +289,18 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         const sim::SwarmVehicle v =
             sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
         SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
-        // The setpoint at the end: the vehicle's initial one with its whole schedule applied.
-        control::ControllerConfig c = v.controller;
-        for (const auto& e : v.schedule) control::set_parameter(c, e.name, e.value);
-        f.p_des_W = c.node.setpoint.p_des_W;
+        // The reference of the last control step: the trajectory's then, or the vehicle's initial
+        // setpoint with its whole schedule applied.
+        control::NodeSettings node = v.controller.node;
+        for (const auto& e : v.schedule) {
+          if (control::node_parameters().find(e.name)) (void)control::node_parameters().set(node, e.name, e.value);
+        }
+        f.p_des_W = node.setpoint.p_des_W;
+        if (const auto& trajectory = v.controller.trajectory) {
+          const sim::Tick divider = sc.simulation.controller_divider;
+          const sim::Tick last_step = sc.simulation.duration_ticks / divider * divider;
+          f.p_des_W = trajectory->at(sc.simulation.plant.clock.seconds(last_step)).p_W + v.controller.trajectory_offset_W;
+        }
         rows[static_cast<std::size_t>(i)] = f;
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
       }
