@@ -21,6 +21,10 @@ printf 'simulation: {plant_rate_hz: -5}\n' > out_of_range.yaml
 printf 'controller:\n  roll_des: 5\n' > param_range.yaml
 printf 'altitude: {kq: 3}\n' > params_unknown.yaml
 printf 'mass_kg: 1.0\nlayout: h\n' > vehicle_bad.yaml
+printf 'controller: {type: lqg}\n' > controller_type.yaml
+printf 'controller:\n  type: se3\n  lqr: {roll: {r: 1}}\n' > controller_foreign_key.yaml
+printf 'controller:\n  type: se3\n  k_R: {x: -1}\n' > controller_gain_range.yaml
+printf 'controller: {z_des: 1}\nschedule:\n  - at_s: 1\n    set: {type: se3}\n' > controller_type_change.yaml
 printf 'mass_kg: .nan\n' > vehicle_nan.yaml
 printf '? [a, b]\n: 1\n' > list_key.yaml
 printf 't,w1,w2,w3,w4\n0,1,2,3\n' > short.csv
@@ -72,6 +76,14 @@ expect 2 "unknown_key.yaml: simulaton: unknown key" run unknown_key.yaml --out o
 expect 2 "out_of_range.yaml: simulation.plant_rate_hz: got '-5', expected a number in [0.001, 1e+06]" run out_of_range.yaml --out o --no-plots
 expect 2 "param_range.yaml: controller.roll_des: roll_des must be in [-1.5, 1.5] rad, got 5" run param_range.yaml --out o --no-plots
 expect 2 "list_key.yaml: got a list as a key, expected a plain name" run list_key.yaml --out o --no-plots
+expect 2 "controller_type.yaml: controller.type: got 'lqg', expected one of;;paper;;se3" run controller_type.yaml --out o --no-plots
+expect 2 "controller_foreign_key.yaml: controller.lqr.roll.r: unknown parameter 'lqr.roll.r' of the node or of controller type 'se3'" run controller_foreign_key.yaml --out o --no-plots
+expect 2 "controller_gain_range.yaml: controller.k_R.x: k_R.x must be in [0, 1e+09] N m/rad, got -1" run controller_gain_range.yaml --out o --no-plots
+expect 2 "controller_type_change.yaml: schedule[0].set.type: the controller's type cannot change during a run" run controller_type_change.yaml --out o --no-plots
+expect 2 "--controller: lqg not in {paper,se3,example_pd}" run "$ALT" --out o --controller lqg
+expect 2 "position_step.yaml: controller.lqr.roll.q_angle: unknown parameter 'lqr.roll.q_angle' of the node or of controller type 'se3'" run "$SRC/scenarios/examples/position_step.yaml" --out o --no-plots --controller se3
+expect 2 "--controller: lqg not in {paper,se3,example_pd}" params --controller lqg
+expect 2 "--controller: lqg not in {paper,se3,example_pd}" controller --controller lqg
 expect 2 "--transport: carrier not in {inproc,dds}" run "$ALT" --out o --transport carrier
 expect 2 "--timeout: Value abc not in range 0.01" run "$ALT" --out o --timeout abc
 expect 2 "--rate-factor: Value 0 not in range 0.001" run "$ALT" --out o --rate-factor 0
@@ -96,7 +108,7 @@ expect 2 "--namespace: a namespace must start with '/', got 'drone'" plant --nam
 expect 2 "--duration: Value -1 not in range 0" plant --duration -1
 expect 2 "--on-timeout: explode not in {abort,hold}" plant --on-timeout explode
 expect 2 "--params: File does not exist: missing.yaml" controller --params missing.yaml
-expect 2 "params_unknown.yaml: altitude.kq: unknown controller parameter 'altitude.kq'" controller --params params_unknown.yaml
+expect 2 "params_unknown.yaml: altitude.kq: unknown parameter 'altitude.kq' of the node or of controller type 'paper'" controller --params params_unknown.yaml
 expect 2 "--namespace: a namespace may not contain '//', got '/a//b'" controller --namespace /a//b
 expect 2 "--node-name: invalid ROS node name '1ctl'" controller --node-name 1ctl
 expect 2 "--rate-factor: Value -2 not in range" controller --rate-factor -2
@@ -128,7 +140,7 @@ expect 2 "not_a_run/metrics.json: cannot open" summary not_a_run
 expect 2 "run_dirs is required" summary
 
 # lqr, openloop, params
-expect 2 "param_range.yaml: controller.roll_des: unknown controller parameter 'controller.roll_des'" lqr --params param_range.yaml
+expect 2 "param_range.yaml: controller.roll_des: unknown parameter 'controller.roll_des' of the node or of controller type 'paper'" lqr --params param_range.yaml
 expect 2 "vehicle_bad.yaml: layout: got 'h'" lqr --vehicle vehicle_bad.yaml
 expect 2 "--commands: File does not exist: missing.csv" openloop --commands missing.csv --out t.csv
 expect 2 "short.csv:2: expected 5 values (t,w1,w2,w3,w4), got 4" openloop --commands short.csv --out t.csv
