@@ -57,17 +57,22 @@ json j(const msg::Float64MultiArray& m) {
 json j(const msg::Clock& m) { return {{"clock", j(m.clock)}}; }
 json j(const msg::ControllerStatus& m) {
   return {{"header", j(m.header)},
+          {"controller", m.controller},
           {"mode", m.mode},
           {"setpoint", m.setpoint},
           {"u", m.u},
-          {"error", m.error},
+          {"position_error", m.position_error},
+          {"yaw_error", m.yaw_error},
+          {"attitude_error", m.attitude_error},
           {"rotor_saturated", m.rotor_saturated},
           {"tilt_saturated", m.tilt_saturated},
           {"safety", m.safety},
           {"rejected_non_finite", std::to_string(m.rejected_non_finite)},
           {"rejected_bad_quaternion", std::to_string(m.rejected_bad_quaternion)},
           {"rejected_bad_stamp", std::to_string(m.rejected_bad_stamp)},
-          {"rejected_stamp_backwards", std::to_string(m.rejected_stamp_backwards)}};
+          {"rejected_stamp_backwards", std::to_string(m.rejected_stamp_backwards)},
+          {"output_names", m.output_names},
+          {"outputs", m.outputs}};
 }
 // uint64 fields as decimal strings: the reference reader decodes them as bigints, shown as strings.
 json j(const msg::PlantStatus& m) {
