@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "analysis/hover_loops.hpp"
 #include "analysis/margins.hpp"
+#include "controllers/paper/paper_controller.hpp"
+#include "controllers/registry.hpp"
 #include "model/attitude.hpp"
 #include "sim/simulation.hpp"
 
@@ -205,11 +208,12 @@ TEST(MarginsTest, OpenLoopUnstablePlantHasALowerGainMargin) {
 }
 
 TEST(HoverLoopsTest, ContinuousAttitudeLoopsHaveTheLqrClosedLoopPoles) {
-  const control::ControllerParams params;
-  const control::FlightController fc(params);
+  const controllers::PaperParams params;
+  const model::VehicleParams vehicle;
+  const controllers::PaperController fc(vehicle, params);
   LoopTiming t;
   t.continuous = true;
-  const std::vector<HoverLoop> loops = hover_loops(params.vehicle, params, control::Mode::kAttitude, t);
+  const std::vector<HoverLoop> loops = hover_loops(vehicle, fc, control::Mode::kAttitude, t);
   ASSERT_EQ(loops.size(), 4u);
   for (int i = 0; i < 3; ++i) {
     Eigen::VectorXcd got = closed_loop_poles(loops[static_cast<std::size_t>(i)].loop);
@@ -225,17 +229,17 @@ TEST(HoverLoopsTest, ContinuousAttitudeLoopsHaveTheLqrClosedLoopPoles) {
   const Eigen::VectorXcd alt = closed_loop_poles(loops[3].loop);
   for (Eigen::Index j = 0; j < alt.size(); ++j) {
     const std::complex<double> s = alt(j);
-    EXPECT_NEAR(std::abs(params.vehicle.mass_kg * s * s + params.altitude.kd * s + params.altitude.kp), 0.0, 1e-9);
+    EXPECT_NEAR(std::abs(vehicle.mass_kg * s * s + params.altitude.kd * s + params.altitude.kp), 0.0, 1e-9);
   }
 }
 
 TEST(HoverLoopsTest, FastSampledLoopsApproachTheContinuousPoles) {
-  const control::ControllerParams params;
-  const control::FlightController fc(params);
+  const model::VehicleParams vehicle;
+  const controllers::PaperController fc(vehicle);
   LoopTiming t;
   t.tick_s = 1e-4;
   t.controller_divider = 1;
-  const std::vector<HoverLoop> loops = hover_loops(params.vehicle, params, control::Mode::kAttitude, t);
+  const std::vector<HoverLoop> loops = hover_loops(vehicle, fc, control::Mode::kAttitude, t);
   for (int i = 0; i < 3; ++i) {
     const Eigen::VectorXcd z = closed_loop_poles(loops[static_cast<std::size_t>(i)].loop);
     for (Eigen::Index j = 0; j < z.size(); ++j) {
@@ -248,10 +252,12 @@ TEST(HoverLoopsTest, FastSampledLoopsApproachTheContinuousPoles) {
 }
 
 TEST(HoverLoopsTest, PositionModeAddsTwoLoopsAndAnIntegratorOnlyWithKi) {
-  control::ControllerParams params;
+  controllers::PaperParams params;
   params.position = {0.8, 0.005, 1.4, 2.0, 0.35};
   params.roll = params.pitch = {1.0, 0.02, 1.0};
-  const std::vector<HoverLoop> loops = hover_loops(params.vehicle, params, control::Mode::kPosition, {});
+  const model::VehicleParams vehicle;
+  const std::vector<HoverLoop> loops =
+      hover_loops(vehicle, controllers::PaperController(vehicle, params), control::Mode::kPosition, {});
   ASSERT_EQ(loops.size(), 6u);
   EXPECT_EQ(loops[4].name, "position_x");
   EXPECT_EQ(loops[5].name, "position_y");
@@ -268,15 +274,16 @@ TEST(HoverLoopsTest, PositionModeAddsTwoLoopsAndAnIntegratorOnlyWithKi) {
   ASSERT_EQ(a.size(), b.size());
   for (Eigen::Index j = 0; j < a.size(); ++j) EXPECT_NEAR(std::abs(a(j) - b(j)), 0.0, 1e-8);
   params.position.ki = 0.0;
-  EXPECT_EQ(hover_loops(params.vehicle, params, control::Mode::kPosition, {})[4].loop.controller.A.rows(), 0);
+  EXPECT_EQ(hover_loops(vehicle, controllers::PaperController(vehicle, params), control::Mode::kPosition, {})[4]
+                .loop.controller.A.rows(),
+            0);
 }
 
 TEST(HoverLoopsTest, AVehicleThatCannotHoverIsRefusedByName) {
   model::VehicleParams v;
   v.motor.omega_max_rad_s = 4000.0;
   EXPECT_NE(hover_trim_problem(v).find("omega_max"), std::string::npos) << hover_trim_problem(v);
-  control::ControllerParams params;
-  EXPECT_THROW(hover_loops(v, params, control::Mode::kAttitude, {}), std::invalid_argument);
+  EXPECT_THROW(hover_loops(v, controllers::PaperController(v), control::Mode::kAttitude, {}), std::invalid_argument);
   EXPECT_EQ(hover_trim_problem(model::VehicleParams{}), "");
 }
 
@@ -292,13 +299,13 @@ class SimulationCrossCheck : public ::testing::TestWithParam<CrossCheckCase> {};
 
 TEST_P(SimulationCrossCheck, LinearLoopsPredictTheSimulatedFreeResponse) {
   const CrossCheckCase c = GetParam();
-  control::ControllerConfig controller;
-  controller.setpoint.p_des_W.z() = 10.0;
-  model::VehicleParams& v = controller.params.vehicle;
+  model::VehicleParams v;
   if (c.motor_lag) {
     v.motor.model = model::MotorModel::kFirstOrder;
     v.motor.tau_up_s = v.motor.tau_down_s = 0.015;  // symmetric: linear about hover
   }
+  control::ControllerConfig controller = controllers::make_config("paper", v);
+  controller.node.setpoint.p_des_W.z() = 10.0;
   sim::SimulationConfig cfg;
   cfg.duration_ticks = 400;
   cfg.plant.command_delay_ticks = c.command_delay_ticks;
@@ -321,7 +328,8 @@ TEST_P(SimulationCrossCheck, LinearLoopsPredictTheSimulatedFreeResponse) {
   t.command_delay_ticks = c.command_delay_ticks;
   t.imu_latency_ticks = c.imu_latency_ticks;
   t.pose_latency_ticks = c.pose_latency_ticks;
-  const std::vector<HoverLoop> loops = hover_loops(v, controller.params, control::Mode::kAttitude, t);
+  const std::vector<HoverLoop> loops =
+      hover_loops(v, *controllers::paper_controller(controller), control::Mode::kAttitude, t);
   // Free response of each closed loop from x(0) = offset, delay lines holding the hover command
   // (deviation 0) and the measurements of tick 0 (the plant publishes max(k - L, 0)).
   auto predict = [&](const HoverLoop& l, double offset, int latency) {
@@ -358,12 +366,14 @@ TEST_P(SimulationCrossCheck, LinearLoopsPredictTheSimulatedFreeResponse) {
 // loops (broken at the tilt setpoint; the closed loop includes attitude and the PID's integrator),
 // which checks the signs and the gravity coupling of the horizontal channels against the plant.
 TEST(SimulationCrossCheckPosition, PositionLoopsPredictTheSimulatedFreeResponse) {
-  control::ControllerConfig controller;
-  controller.setpoint.mode = control::Mode::kPosition;
-  controller.setpoint.p_des_W = {0.0, 0.0, 5.0};
-  controller.params.roll = controller.params.pitch = {1.0, 0.02, 1.0};
-  controller.params.position = {0.8, 0.005, 1.4, 2.0, 0.35};
-  const model::VehicleParams& v = controller.params.vehicle;
+  controllers::PaperParams params;
+  params.roll = params.pitch = {1.0, 0.02, 1.0};
+  params.position = {0.8, 0.005, 1.4, 2.0, 0.35};
+  const model::VehicleParams v;
+  control::ControllerConfig controller = controllers::make_config("paper", v);
+  controller.controller = std::make_shared<controllers::PaperController>(v, params);
+  controller.node.setpoint.mode = control::Mode::kPosition;
+  controller.node.setpoint.p_des_W = {0.0, 0.0, 5.0};
   sim::SimulationConfig cfg;
   cfg.duration_ticks = 800;
   cfg.plant.command_delay_ticks = 1;
@@ -380,7 +390,8 @@ TEST(SimulationCrossCheckPosition, PositionLoopsPredictTheSimulatedFreeResponse)
   });
   LoopTiming t;
   t.command_delay_ticks = 1;
-  const std::vector<HoverLoop> loops = hover_loops(v, controller.params, control::Mode::kPosition, t);
+  const std::vector<HoverLoop> loops =
+      hover_loops(v, *controllers::paper_controller(controller), control::Mode::kPosition, t);
   ASSERT_EQ(loops[4].name, "position_x");
   auto predict = [&](const HoverLoop& l, double offset) {
     const Eigen::MatrixXd A = l.loop.closed_loop_matrix(1.0);

@@ -19,7 +19,8 @@
 
 #include "control/attitude_lqr.hpp"
 #include "control/care.hpp"
-#include "control/flight_controller.hpp"
+#include "controllers/paper/paper_controller.hpp"
+#include "model/vehicle_params.hpp"
 
 namespace {
 
@@ -27,7 +28,6 @@ using Eigen::MatrixXd;
 using quadcosim::control::AxisLqr;
 using quadcosim::control::care_residual;
 using quadcosim::control::CareError;
-using quadcosim::control::ControllerParams;
 using quadcosim::control::design_axis_lqr;
 using quadcosim::control::lqr_gain;
 using quadcosim::control::LqrWeights;
@@ -464,10 +464,9 @@ struct AxisCase {
 };
 
 std::vector<AxisCase> default_axes() {
-  const ControllerParams p;
-  return {{"roll", p.vehicle.Ixx_kg_m2, p.roll},
-          {"pitch", p.vehicle.Iyy_kg_m2, p.pitch},
-          {"yaw", p.vehicle.Izz_kg_m2, p.yaw}};
+  const quadcosim::model::VehicleParams v;
+  const quadcosim::controllers::PaperParams p;
+  return {{"roll", v.Ixx_kg_m2, p.roll}, {"pitch", v.Iyy_kg_m2, p.pitch}, {"yaw", v.Izz_kg_m2, p.yaw}};
 }
 
 // Poles of I s^2 + k2 s + k1, sorted by real part then imaginary part.

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -18,15 +19,20 @@
 #include "control/allocation.hpp"
 #include "control/altitude_pd.hpp"
 #include "control/care.hpp"
-#include "control/flight_controller.hpp"
+#include "control/controller.hpp"
+#include "control/controller_config.hpp"
 #include "control/parameters.hpp"
 #include "control/position_pid.hpp"
+#include "controllers/paper/paper_controller.hpp"
+#include "controllers/registry.hpp"
 #include "model/mixer.hpp"
 #include "model/vehicle_params.hpp"
 
 namespace {
 
 using namespace quadcosim::control;
+using quadcosim::controllers::PaperController;
+using quadcosim::controllers::PaperParams;
 using quadcosim::model::VehicleParams;
 
 constexpr double kPi = std::numbers::pi;
@@ -396,7 +402,8 @@ TEST(PositionPid, AntiWindupStopsTheIntegralWhileSaturated) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-// FlightController (Algorithm 1).
+// PaperController (Algorithm 1, lines 6-20; the stale-data safety of lines 3-5 is the controller
+// node's, tested in src/sim/sim_test.cpp).
 
 // sqrt(m g / (4 kt)) from Table 1, the number in docs/model.md (~4830.6 rad/s).
 double hover_speed() { return std::sqrt(kMass * kG / (4.0 * kKt)); }
@@ -408,101 +415,45 @@ Observation hover_observation(double z) {
   return e;
 }
 
-Setpoint hold(double z) {
-  Setpoint sp;
-  sp.p_des_W = {0.0, 0.0, z};
-  return sp;
+Reference hold(double z) {
+  Reference r;
+  r.p_W = {0.0, 0.0, z};
+  return r;
 }
 
-TEST(FlightController, HoverSpeedIsTable1Value) { EXPECT_NEAR(hover_speed(), 4830.6, 0.05); }
-
-TEST(FlightController, StaleOrMissingDataGivesTheSafetyCommand) {
-  ControllerParams p;
-  p.vehicle.motor.omega_min_rad_s = 350.0;
-  FlightController fc(p);
-  const Setpoint sp = hold(5.0);
-  for (double age : {0.1 + 1e-9, 0.2, 10.0, kInf, kNaN}) {
-    SCOPED_TRACE(testing::Message() << "age " << age);
-    Observation e = hover_observation(5.0);
-    e.age_s = age;
-    const ControllerOutput c = fc.step(e, sp, 0.02);
-    EXPECT_TRUE(c.safety);
-    EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Constant(350.0));
-  }
-  // A default-constructed estimate has never received anything.
-  EXPECT_TRUE(std::isinf(Observation{}.age_s));
-  EXPECT_TRUE(fc.step(Observation{}, sp, 0.02).safety);
-  // At the limit the data still counts as fresh.
-  Observation fresh = hover_observation(5.0);
-  fresh.age_s = 0.1;
-  EXPECT_FALSE(fc.step(fresh, sp, 0.02).safety);
+// One step, with `outputs` sized as the node sizes it.
+ControllerOutput step(Controller& c, const Observation& e, const Reference& r, double dt_s) {
+  ControllerOutput out;
+  out.outputs.assign(c.output_names().size(), kNaN);
+  c.step(e, r, dt_s, out);
+  return out;
 }
 
-TEST(FlightController, SafetyStopIsOmegaMinAndSafetyHoverIsHoverSpeed) {
-  ControllerParams p;
-  ASSERT_EQ(p.safety, SafetyMode::kStop);
-  ASSERT_EQ(p.vehicle.motor.omega_min_rad_s, 0.0);
-  Observation stale = hover_observation(5.0);
-  stale.age_s = 1.0;
-  {
-    FlightController fc(p);
-    const ControllerOutput c = fc.step(stale, hold(5.0), 0.02);
-    EXPECT_TRUE(c.safety);
-    EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Zero());
+// The output named `name` of `c`'s step.
+double output(const Controller& c, const ControllerOutput& out, const std::string& name) {
+  const auto names = c.output_names();
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) {
+    ADD_FAILURE() << "no output named " << name;
+    return kNaN;
   }
-  {
-    p.safety = SafetyMode::kHover;
-    FlightController fc(p);
-    const ControllerOutput c = fc.step(stale, hold(5.0), 0.02);
-    EXPECT_TRUE(c.safety);
-    for (int i = 0; i < 4; ++i) EXPECT_NEAR(c.omega_rad_s[i], hover_speed(), 1e-9 * hover_speed());
-  }
+  return out.outputs.at(static_cast<std::size_t>(it - names.begin()));
 }
 
-TEST(FlightController, NonFiniteObservationGivesSafetyAndLeavesTheIntegratorAlone) {
-  ControllerParams p;
-  FlightController fc(p);
-  Setpoint sp = hold(5.0);
-  sp.mode = Mode::kPosition;
-  sp.p_des_W.x() = 1.0;
-  // Build some integral first.
-  for (int i = 0; i < 10; ++i) ASSERT_FALSE(fc.step(hover_observation(5.0), sp, 0.02).safety);
-  const Eigen::Vector2d integral = fc.position_state().integral_m_s;
-  ASSERT_GT(integral.x(), 0.0);
+TEST(PaperController, HoverSpeedIsTable1Value) { EXPECT_NEAR(hover_speed(), 4830.6, 0.05); }
 
-  for (int field = 0; field < 12; ++field) {
-    for (double bad : {kNaN, kInf}) {
-      SCOPED_TRACE(testing::Message() << "field " << field << " value " << bad);
-      Observation e = hover_observation(5.0);
-      if (field < 3)
-        e.p_W[field] = bad;
-      else if (field < 6)
-        e.v_W[field - 3] = bad;
-      else if (field < 9)
-        e.w_B[field - 6] = bad;
-      else if (field == 9)
-        e.roll_rad = bad;
-      else if (field == 10)
-        e.pitch_rad = bad;
-      else
-        e.yaw_rad = bad;
-      const ControllerOutput c = fc.step(e, sp, 0.02);
-      EXPECT_TRUE(c.safety);
-      EXPECT_TRUE(c.omega_rad_s.allFinite());
-      EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Zero());
-      EXPECT_EQ(fc.position_state().integral_m_s, integral);
-    }
-  }
-  // And the next good sample is controlled normally.
-  const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
-  EXPECT_FALSE(c.safety);
-  EXPECT_TRUE(c.omega_rad_s.allFinite());
+TEST(PaperController, OutputsAreThePapersErrors) {
+  const PaperController pc{VehicleParams{}};
+  const auto names = pc.output_names();
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.end()),
+            (std::vector<std::string>{"error.z", "error.roll", "error.pitch", "error.yaw"}));
+  EXPECT_EQ(pc.type(), "paper");
 }
 
-TEST(FlightController, HoverCommandsHoverSpeedOnAllRotors) {
-  FlightController fc{ControllerParams{}};
+TEST(PaperController, HoverCommandsHoverSpeedOnAllRotors) {
+  PaperController fc{VehicleParams{}};
   for (double z : {0.0, 5.0, 100.0}) {
-    const ControllerOutput c = fc.step(hover_observation(z), hold(z), 0.02);
+    const ControllerOutput c = step(fc, hover_observation(z), hold(z), 0.02);
     EXPECT_FALSE(c.safety);
     EXPECT_EQ(c.U[0], kMass * kG);
     EXPECT_EQ(c.U.tail<3>(), Eigen::Vector3d::Zero());
@@ -513,18 +464,19 @@ TEST(FlightController, HoverCommandsHoverSpeedOnAllRotors) {
   }
 }
 
-TEST(FlightController, RollErrorGivesPositiveTorqueAndRotor4FasterThanRotor2) {
-  const ControllerParams p;
-  FlightController fc(p);
-  Setpoint sp = hold(5.0);
-  sp.roll_des_rad = 0.1;
-  const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
+TEST(PaperController, RollErrorGivesPositiveTorqueAndRotor4FasterThanRotor2) {
+  const PaperParams p;
+  const VehicleParams vehicle;
+  PaperController fc(vehicle, p);
+  Reference sp = hold(5.0);
+  sp.roll_rad = 0.1;
+  const ControllerOutput c = step(fc, hover_observation(5.0), sp, 0.02);
   ASSERT_FALSE(c.safety);
   // U2 = k1 e with k1 = sqrt(q_angle / r) (closed form, see care_test.cpp).
   const double k1 = std::sqrt(p.roll.q_angle / p.roll.r);
   EXPECT_GT(c.U[1], 0.0);
   EXPECT_NEAR(c.U[1], k1 * 0.1, 1e-10 * k1);
-  EXPECT_NEAR(c.error[1], 0.1, 0.0);
+  EXPECT_NEAR(output(fc, c, "error.roll"), 0.1, 0.0);
   const Eigen::Vector4d w2 = squared(c.omega_rad_s);
   // Eq. (4): U2 = L kt (w4^2 - w2^2): rotor 4 (left, +y) speeds up, rotor 2 (right) slows down.
   EXPECT_GT(c.omega_rad_s[3], c.omega_rad_s[1]);
@@ -537,13 +489,14 @@ TEST(FlightController, RollErrorGivesPositiveTorqueAndRotor4FasterThanRotor2) {
   EXPECT_NEAR(kKt * w2.sum(), kMass * kG, 1e-9 * kMass * kG);
 }
 
-TEST(FlightController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
-  const ControllerParams p;
-  FlightController fc(p);
+TEST(PaperController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
+  const PaperParams p;
+  const VehicleParams vehicle;
+  PaperController fc(vehicle, p);
   {
-    Setpoint sp = hold(5.0);
-    sp.pitch_des_rad = 0.15;
-    const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
+    Reference sp = hold(5.0);
+    sp.pitch_rad = 0.15;
+    const ControllerOutput c = step(fc, hover_observation(5.0), sp, 0.02);
     // U3 = L kt (w3^2 - w1^2) > 0: rotor 3 (tail) faster than rotor 1 (nose).
     EXPECT_NEAR(c.U[2], std::sqrt(p.pitch.q_angle / p.pitch.r) * 0.15, 1e-10);
     EXPECT_GT(c.omega_rad_s[2], c.omega_rad_s[0]);
@@ -552,9 +505,9 @@ TEST(FlightController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
   }
   {
     // Yaw authority is small (k_m / k_t ~ 5e-4 m): 0.01 rad keeps every rotor inside its range.
-    Setpoint sp = hold(5.0);
-    sp.yaw_des_rad = 0.01;
-    const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
+    Reference sp = hold(5.0);
+    sp.yaw_rad = 0.01;
+    const ControllerOutput c = step(fc, hover_observation(5.0), sp, 0.02);
     for (int i = 0; i < 4; ++i) ASSERT_FALSE(c.rotor_saturated[i]);
     // U4 = km (w1^2 - w2^2 + w3^2 - w4^2) > 0: rotors 1 and 3 faster than 2 and 4.
     EXPECT_NEAR(c.U[3], std::sqrt(p.yaw.q_angle / p.yaw.r) * 0.01, 1e-12);
@@ -567,16 +520,17 @@ TEST(FlightController, PitchAndYawErrorsDriveTheRotorsEq4Implies) {
     // A body rate is damped: positive roll rate, no error -> negative roll torque -k2 p.
     Observation e = hover_observation(5.0);
     e.w_B = {0.5, 0.0, 0.0};
-    const ControllerOutput c = fc.step(e, hold(5.0), 0.02);
+    const ControllerOutput c = step(fc, e, hold(5.0), 0.02);
     const double k1 = std::sqrt(p.roll.q_angle / p.roll.r);
-    const double k2 = std::sqrt(p.roll.q_rate / p.roll.r + 2.0 * p.vehicle.Ixx_kg_m2 * k1);
+    const double k2 = std::sqrt(p.roll.q_rate / p.roll.r + 2.0 * vehicle.Ixx_kg_m2 * k1);
     EXPECT_NEAR(c.U[1], -k2 * 0.5, 1e-10);
   }
 }
 
-TEST(FlightController, YawErrorIsWrapped) {
-  const ControllerParams p;
-  FlightController fc(p);
+TEST(PaperController, YawErrorIsWrapped) {
+  const PaperParams p;
+  const VehicleParams vehicle;
+  PaperController fc(vehicle, p);
   const double k1 = std::sqrt(p.yaw.q_angle / p.yaw.r);
   struct Case {
     double des, yaw, error;
@@ -584,78 +538,169 @@ TEST(FlightController, YawErrorIsWrapped) {
   for (const Case c : {Case{kPi - 0.1, -kPi + 0.1, -0.2}, Case{-kPi + 0.1, kPi - 0.1, 0.2},
                        Case{3.0, -3.0, 6.0 - 2 * kPi}, Case{0.3, 0.1, 0.2}, Case{2 * kPi - 0.05, 0.05, -0.1}}) {
     SCOPED_TRACE(testing::Message() << "des " << c.des << " yaw " << c.yaw);
-    Setpoint sp = hold(5.0);
-    sp.yaw_des_rad = c.des;
+    Reference sp = hold(5.0);
+    sp.yaw_rad = c.des;
     Observation e = hover_observation(5.0);
     e.yaw_rad = c.yaw;
-    const ControllerOutput cmd = fc.step(e, sp, 0.02);
-    EXPECT_NEAR(cmd.error[3], c.error, 1e-12);
+    const ControllerOutput cmd = step(fc, e, sp, 0.02);
+    EXPECT_NEAR(output(fc, cmd, "error.yaw"), c.error, 1e-12);
     EXPECT_NEAR(cmd.U[3], k1 * c.error, 1e-12);
   }
 }
 
-TEST(FlightController, PositionModeTiltsTowardsTheTarget) {
-  FlightController fc{ControllerParams{}};
-  Setpoint sp = hold(5.0);
+TEST(PaperController, PositionModeTiltsTowardsTheTarget) {
+  PaperController fc{VehicleParams{}};
+  Reference sp = hold(5.0);
   sp.mode = Mode::kPosition;
-  sp.p_des_W.x() = 0.5;
-  const ControllerOutput c = fc.step(hover_observation(5.0), sp, 0.02);
+  sp.p_W.x() = 0.5;
+  const ControllerOutput c = step(fc, hover_observation(5.0), sp, 0.02);
   EXPECT_GT(c.pitch_des_rad, 0.0);
   EXPECT_EQ(c.roll_des_rad, 0.0);
   EXPECT_GT(c.U[2], 0.0);
   EXPECT_GT(c.omega_rad_s[2], c.omega_rad_s[0]);  // tail up, nose down, thrust towards +x
-  // Attitude setpoints in the Setpoint struct are ignored in position mode.
-  sp.roll_des_rad = 1.0;
-  FlightController fc2{ControllerParams{}};
-  EXPECT_EQ(fc2.step(hover_observation(5.0), sp, 0.02).roll_des_rad, 0.0);
+  // The reference's attitude setpoints are ignored in position mode.
+  sp.roll_rad = 1.0;
+  PaperController fc2{VehicleParams{}};
+  EXPECT_EQ(step(fc2, hover_observation(5.0), sp, 0.02).roll_des_rad, 0.0);
 }
 
-TEST(FlightController, SetParamsWithInvalidDesignThrowsAndChangesNothing) {
-  const ControllerParams good;
-  FlightController fc(good);
-  Setpoint sp = hold(5.0);
+// Every parameter of a controller, by name, for before/after comparisons.
+std::vector<std::pair<std::string, ParameterValue>> snapshot(const Controller& c) {
+  std::vector<std::pair<std::string, ParameterValue>> out;
+  for (const auto& spec : c.parameters()) out.emplace_back(std::string(spec.name), *c.get_parameter(spec.name));
+  return out;
+}
+
+TEST(PaperController, RefusedSettingsChangeNothingAndTheConstructorThrows) {
+  const PaperParams good;
+  const VehicleParams vehicle;
+  PaperController fc(vehicle, good);
+  Reference sp = hold(5.0);
   sp.mode = Mode::kPosition;
-  sp.p_des_W.x() = 1.0;
+  sp.p_W.x() = 1.0;
   Observation e = hover_observation(4.8);
   e.roll_rad = 0.05;
   e.w_B = {0.1, -0.2, 0.3};
-  for (int i = 0; i < 5; ++i) fc.step(e, sp, 0.02);
+  for (int i = 0; i < 5; ++i) step(fc, e, sp, 0.02);
 
   const auto K_before = std::array<Eigen::RowVector2d, 3>{fc.axis(0).K, fc.axis(1).K, fc.axis(2).K};
   const PositionPidState state_before = fc.position_state();
-  FlightController reference = fc;  // an untouched copy to compare the next step with
+  const auto params_before = snapshot(fc);
+  PaperController reference = fc;  // an untouched copy to compare the next step with
 
-  std::vector<ControllerParams> bad(5, good);
-  bad[0].roll.r = 0.0;
-  bad[1].yaw.q_angle = 0.0;  // fails on the last axis, after roll and pitch designed fine
-  bad[2].pitch.q_rate = -1.0;
-  bad[3].vehicle.Izz_kg_m2 = 0.0;
-  bad[4].altitude.kp = 99.0;  // a good change bundled with a bad one
-  bad[4].yaw.r = -1.0;
+  struct Case {
+    std::vector<Setting> settings;
+    std::string needle;  // what the refusal must name
+  };
+  const std::vector<Case> bad = {
+      {{{"lqr.roll.r", 0.0}}, "lqr.roll.r"},
+      // Fails on the last axis, after roll and pitch designed fine.
+      {{{"lqr.yaw.q_angle", 0.0}}, "lqr.yaw.q_angle"},
+      {{{"lqr.pitch.q_rate", -1.0}}, "lqr.pitch.q_rate"},
+      // A good change bundled with a bad one.
+      {{{"altitude.kp", 99.0}, {"lqr.yaw.r", -1.0}}, "lqr.yaw.r"},
+  };
   for (std::size_t i = 0; i < bad.size(); ++i) {
     SCOPED_TRACE(i);
-    EXPECT_THROW(fc.set_params(bad[i]), CareError);
+    const std::string err = fc.set_parameters(bad[i].settings);
+    EXPECT_NE(err.find(bad[i].needle), std::string::npos) << err;
     EXPECT_EQ(fc.params().roll.r, good.roll.r);
     EXPECT_EQ(fc.params().yaw.q_angle, good.yaw.q_angle);
     EXPECT_EQ(fc.params().altitude.kp, good.altitude.kp);
-    EXPECT_EQ(fc.params().vehicle.Izz_kg_m2, good.vehicle.Izz_kg_m2);
+    EXPECT_EQ(snapshot(fc), params_before);
     for (int a = 0; a < 3; ++a) EXPECT_EQ(fc.axis(a).K, K_before[a]);
     EXPECT_EQ(fc.position_state().integral_m_s, state_before.integral_m_s);
   }
-  const ControllerOutput c1 = fc.step(e, sp, 0.02), c2 = reference.step(e, sp, 0.02);
+  const ControllerOutput c1 = step(fc, e, sp, 0.02), c2 = step(reference, e, sp, 0.02);
   EXPECT_EQ(c1.omega_rad_s, c2.omega_rad_s);
   EXPECT_EQ(c1.U, c2.U);
 
-  // The constructor throws too.
-  EXPECT_THROW(FlightController{bad[0]}, CareError);
+  // The constructor throws for a design with no solution, of the weights or of the vehicle.
+  PaperParams bad_roll = good;
+  bad_roll.roll.r = 0.0;
+  EXPECT_THROW(PaperController(vehicle, bad_roll), CareError);
+  VehicleParams no_inertia = vehicle;
+  no_inertia.Izz_kg_m2 = 0.0;
+  EXPECT_THROW(PaperController{no_inertia}, CareError);
 
   // A valid change applies (K follows the closed form) and keeps the integrator.
-  ControllerParams better = good;
-  better.roll = {4.0, 1.0, 25.0};
   const PositionPidState s = fc.position_state();
-  fc.set_params(better);
+  const std::vector<Setting> better = {{"lqr.roll.q_angle", 4.0}, {"lqr.roll.q_rate", 1.0}, {"lqr.roll.r", 25.0}};
+  EXPECT_EQ(fc.set_parameters(better), "");
   EXPECT_NEAR(-fc.axis(0).K(0), std::sqrt(4.0 / 25.0), 1e-10);
+  EXPECT_EQ(fc.params().roll.q_rate, 1.0);
   EXPECT_EQ(fc.position_state().integral_m_s, s.integral_m_s);
+}
+
+// ControllerWith::set_parameters applies a batch all together or not at all.
+TEST(ControllerWith, SetParametersIsAllOrNothing) {
+  PaperController pc{VehicleParams{}};
+  const auto before = snapshot(pc);
+  const auto K_before = std::array<Eigen::RowVector2d, 3>{pc.axis(0).K, pc.axis(1).K, pc.axis(2).K};
+  const auto unchanged = [&] {
+    EXPECT_EQ(snapshot(pc), before);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(pc.axis(a).K, K_before[a]);
+  };
+  // Valid values first, then one out of range: nothing of the batch is applied; the refusal names it.
+  {
+    const std::vector<Setting> batch = {
+        {"altitude.kp", 7.5}, {"lqr.pitch.q_angle", 3.0}, {"position.max_tilt", 5.0}, {"position.kd", 1.0}};
+    const std::string err = pc.set_parameters(batch);
+    EXPECT_NE(err.find("position.max_tilt"), std::string::npos) << err;
+    unchanged();
+  }
+  // An unknown name, a string for a number, NaN: each refused, nothing applied.
+  for (const Setting& wrong : {Setting{"lqr.roll.nope", 1.0}, Setting{"altitude.kd", std::string("3")},
+                               Setting{"altitude.kd", kNaN}}) {
+    SCOPED_TRACE(wrong.name);
+    const std::vector<Setting> batch = {{"altitude.kp", 7.5}, wrong};
+    const std::string err = pc.set_parameters(batch);
+    EXPECT_NE(err.find(wrong.name), std::string::npos) << err;
+    unchanged();
+  }
+  // Every value in range, but together they make the yaw CARE unsolvable (no weight on the angle:
+  // the angle mode is undetectable in the cost, see care_test.cpp): refused naming the settings.
+  {
+    const std::vector<Setting> batch = {{"altitude.kp", 7.5}, {"lqr.roll.q_angle", 2.0}, {"lqr.yaw.q_angle", 0.0}};
+    const std::string err = pc.set_parameters(batch);
+    for (const char* n : {"altitude.kp", "lqr.roll.q_angle", "lqr.yaw.q_angle", "stabilis"}) {
+      EXPECT_NE(err.find(n), std::string::npos) << "'" << err << "' lacks '" << n << "'";
+    }
+    unchanged();
+  }
+  // The same batch without the bad one applies every value, with one design.
+  const std::vector<Setting> ok = {{"altitude.kp", 7.5}, {"lqr.roll.q_angle", 2.0}};
+  EXPECT_EQ(pc.set_parameters(ok), "");
+  EXPECT_EQ(std::get<double>(*pc.get_parameter("altitude.kp")), 7.5);
+  EXPECT_EQ(std::get<double>(*pc.get_parameter("lqr.roll.q_angle")), 2.0);
+  EXPECT_NEAR(-pc.axis(0).K(0), std::sqrt(2.0 / PaperParams{}.roll.r), 1e-10);
+  EXPECT_EQ(pc.axis(2).K, K_before[2]);
+}
+
+// Psi = 1/2 tr(I - R_d^T R) = 1 - cos(theta) for attitudes a rotation by theta apart.
+TEST(AttitudeError, IsOneMinusCosineOfTheAngleBetween) {
+  const std::vector<Eigen::Vector3d> axes = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                             Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, -2, 0.5).normalized()};
+  const std::vector<Eigen::Quaterniond> bases = {
+      Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 1, -0.2).normalized())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(-2.5, Eigen::Vector3d::UnitZ()))};
+  for (const auto& q_des : bases) {
+    for (const auto& axis : axes) {
+      for (double theta : {0.0, 1e-3, 0.1, 0.5, kPi / 2, 2.0, 3.0, kPi}) {
+        SCOPED_TRACE(testing::Message() << "axis " << axis.transpose() << " theta " << theta);
+        const Eigen::Quaterniond q = q_des * Eigen::Quaterniond(Eigen::AngleAxisd(theta, axis));
+        EXPECT_NEAR(attitude_error(q_des, q), 1.0 - std::cos(theta), 1e-12);
+        EXPECT_NEAR(attitude_error(q, q_des), 1.0 - std::cos(theta), 1e-12);  // symmetric
+        // The sign of a quaternion does not matter: -q is the same attitude.
+        EXPECT_NEAR(attitude_error(q_des, Eigen::Quaterniond(-q.coeffs())), 1.0 - std::cos(theta), 1e-12);
+      }
+    }
+  }
+  // The range ends: 0 for equal attitudes, 2 for opposite ones (a half turn).
+  EXPECT_EQ(attitude_error(Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()), 0.0);
+  EXPECT_NEAR(attitude_error(Eigen::Quaterniond::Identity(),
+                             Eigen::Quaterniond(Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitY()))),
+              2.0, 1e-15);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -664,9 +709,18 @@ TEST(FlightController, SetParamsWithInvalidDesignThrowsAndChangesNothing) {
 // Every parameter's current value, by name, for before/after comparisons.
 std::vector<std::pair<std::string, ParameterValue>> snapshot(const ControllerConfig& c) {
   std::vector<std::pair<std::string, ParameterValue>> out;
-  for (const auto& spec : controller_parameters())
-    out.emplace_back(std::string(spec.name), *get_parameter(c, spec.name));
+  for (const ParameterSpec* spec : all_parameters(c))
+    out.emplace_back(std::string(spec->name), *get_parameter(c, spec->name));
   return out;
+}
+
+// The paper controller's configuration for the Table 1 vehicle.
+ControllerConfig paper_config() { return quadcosim::controllers::make_config("paper", VehicleParams{}); }
+
+const PaperParams& paper_params(const ControllerConfig& c) {
+  const PaperController* pc = quadcosim::controllers::paper_controller(c);
+  if (pc == nullptr) throw std::logic_error("not a paper controller");
+  return pc->params();
 }
 
 void expect_refused(ControllerConfig& config, const std::string& name, const ParameterValue& v,
@@ -679,14 +733,14 @@ void expect_refused(ControllerConfig& config, const std::string& name, const Par
   for (const auto& n : needles) EXPECT_NE(err.find(n), std::string::npos) << "'" << err << "' lacks '" << n << "'";
   EXPECT_EQ(snapshot(config), before);
   // Spot checks on the raw struct too.
-  EXPECT_EQ(config.setpoint.p_des_W, raw_before.setpoint.p_des_W);
-  EXPECT_EQ(config.setpoint.mode, raw_before.setpoint.mode);
-  EXPECT_EQ(config.params.roll.r, raw_before.params.roll.r);
-  EXPECT_EQ(config.params.safety, raw_before.params.safety);
+  EXPECT_EQ(config.node.setpoint.p_des_W, raw_before.node.setpoint.p_des_W);
+  EXPECT_EQ(config.node.setpoint.mode, raw_before.node.setpoint.mode);
+  EXPECT_EQ(paper_params(config).roll.r, paper_params(raw_before).roll.r);
+  EXPECT_EQ(config.node.safety, raw_before.node.safety);
 }
 
 TEST(Parameters, RefusesBadValuesNamingTheParameter) {
-  ControllerConfig c;
+  ControllerConfig c = paper_config();
   ASSERT_EQ(set_parameter(c, "z_des", 3.0), "");
   expect_refused(c, "z_dse", 1.0, {"unknown", "z_dse"});
   expect_refused(c, "", 1.0, {"unknown"});
@@ -705,33 +759,34 @@ TEST(Parameters, RefusesBadValuesNamingTheParameter) {
   expect_refused(c, "mode", 1.0, {"mode"});
   expect_refused(c, "safety_mode", std::string("land"), {"safety_mode", "stop", "hover"});
   expect_refused(c, "safety_mode", std::string(""), {"safety_mode"});
-  EXPECT_EQ(c.setpoint.p_des_W.z(), 3.0);
+  EXPECT_EQ(c.node.setpoint.p_des_W.z(), 3.0);
 }
 
 TEST(Parameters, GetAfterSetReturnsTheValueAndWritesTheField) {
-  ControllerConfig c;
+  ControllerConfig c = paper_config();
   EXPECT_EQ(set_parameter(c, "z_des", 10.0), "");
-  EXPECT_EQ(c.setpoint.p_des_W.z(), 10.0);
+  EXPECT_EQ(c.node.setpoint.p_des_W.z(), 10.0);
   EXPECT_EQ(std::get<double>(*get_parameter(c, "z_des")), 10.0);
   EXPECT_EQ(set_parameter(c, "x_des", -2.5), "");
-  EXPECT_EQ(c.setpoint.p_des_W.x(), -2.5);
+  EXPECT_EQ(c.node.setpoint.p_des_W.x(), -2.5);
   EXPECT_EQ(set_parameter(c, "lqr.pitch.r", 42.0), "");
-  EXPECT_EQ(c.params.pitch.r, 42.0);
+  EXPECT_EQ(paper_params(c).pitch.r, 42.0);
   EXPECT_EQ(set_parameter(c, "position.max_tilt", 0.2), "");
-  EXPECT_EQ(c.params.position.max_tilt_rad, 0.2);
+  EXPECT_EQ(paper_params(c).position.max_tilt_rad, 0.2);
   EXPECT_EQ(set_parameter(c, "mode", std::string("position")), "");
-  EXPECT_EQ(c.setpoint.mode, Mode::kPosition);
+  EXPECT_EQ(c.node.setpoint.mode, Mode::kPosition);
   EXPECT_EQ(std::get<std::string>(*get_parameter(c, "mode")), "position");
   EXPECT_EQ(set_parameter(c, "mode", std::string("attitude")), "");
-  EXPECT_EQ(c.setpoint.mode, Mode::kAttitude);
+  EXPECT_EQ(c.node.setpoint.mode, Mode::kAttitude);
   EXPECT_EQ(set_parameter(c, "safety_mode", std::string("hover")), "");
-  EXPECT_EQ(c.params.safety, SafetyMode::kHover);
+  EXPECT_EQ(c.node.safety, SafetyMode::kHover);
   EXPECT_EQ(std::get<std::string>(*get_parameter(c, "safety_mode")), "hover");
   EXPECT_FALSE(get_parameter(c, "nope").has_value());
 
   // Every numeric parameter: both ends of the range and a value inside round-trip exactly, and only
   // that parameter changes.
-  for (const auto& spec : controller_parameters()) {
+  for (const ParameterSpec* p : all_parameters(c)) {
+    const ParameterSpec& spec = *p;
     SCOPED_TRACE(std::string(spec.name));
     if (spec.is_choice()) {
       for (auto choice : spec.choices) {
@@ -756,17 +811,16 @@ TEST(Parameters, GetAfterSetReturnsTheValueAndWritesTheField) {
 }
 
 TEST(Parameters, TableIsWellFormedAndDefaultsAreInRange) {
-  const ControllerConfig defaults;
-  const auto& table = controller_parameters();
+  const ControllerConfig defaults = paper_config();
+  const auto table = all_parameters(defaults);
   ASSERT_FALSE(table.empty());
   std::vector<std::string> names;
-  for (const auto& spec : table) {
+  for (const ParameterSpec* p : table) {
+    const ParameterSpec& spec = *p;
     SCOPED_TRACE(std::string(spec.name));
     EXPECT_FALSE(spec.name.empty());
     EXPECT_FALSE(spec.description.empty());
-    ASSERT_NE(spec.get, nullptr);
-    ASSERT_NE(spec.set, nullptr);
-    EXPECT_EQ(find_parameter(spec.name), &spec);
+    EXPECT_EQ(find_parameter(defaults, spec.name), &spec);
     for (const auto& n : names) EXPECT_NE(n, spec.name) << "duplicate name";
     names.emplace_back(spec.name);
     const ParameterValue v = *get_parameter(defaults, spec.name);
@@ -782,16 +836,16 @@ TEST(Parameters, TableIsWellFormedAndDefaultsAreInRange) {
       EXPECT_GE(d, spec.min);
       EXPECT_LE(d, spec.max);
       // Setting the default back is accepted.
-      ControllerConfig c;
+      ControllerConfig c = paper_config();
       EXPECT_EQ(set_parameter(c, spec.name, d), "");
     }
   }
   // The documented names the rest of the project relies on exist.
   for (const char* n : {"mode", "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "altitude.kp",
                         "altitude.kd", "lqr.roll.q_angle", "lqr.yaw.r", "position.kp", "stale_limit", "safety_mode"}) {
-    EXPECT_NE(find_parameter(n), nullptr) << n;
+    EXPECT_NE(find_parameter(defaults, n), nullptr) << n;
   }
-  EXPECT_EQ(find_parameter("no_such"), nullptr);
+  EXPECT_EQ(find_parameter(defaults, "no_such"), nullptr);
 }
 
 }  // namespace

@@ -859,10 +859,15 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
   msg::ControllerStatus s;
   s.header.stamp = {3, 250000000};
   s.header.frame_id = "world";
+  s.controller = "paper";
   s.mode = "position";
   s.setpoint = {1.0, 2.0, -3.0, 0.1, 0.2, 3.5};
   s.u = {9.81, 0.01, -0.02, 0.0};
-  s.error = {-0.5, 0.25, -0.125, 1e-06};
+  s.position_error = {0.75, -1.5, -0.5};
+  s.yaw_error = 1e-06;
+  s.attitude_error = 0.0078125;
+  s.output_names = {"error.z", "error.roll", "error.pitch", "error.yaw"};
+  s.outputs = {-0.5, 0.25, -0.125, 1e-06};
   s.rotor_saturated = {true, false, false, true};
   s.tilt_saturated = true;
   s.safety = false;
@@ -876,13 +881,16 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "    sec: 3\n"
             "    nanosec: 250000000\n"
             "  frame_id: world\n"
+            "controller: paper\n"
             "mode: position\n"
             "setpoint:\n"
             "- 1.0\n- 2.0\n- -3.0\n- 0.1\n- 0.2\n- 3.5\n"
             "u:\n"
             "- 9.81\n- 0.01\n- -0.02\n- 0.0\n"
-            "error:\n"
-            "- -0.5\n- 0.25\n- -0.125\n- 1.0e-06\n"
+            "position_error:\n"
+            "- 0.75\n- -1.5\n- -0.5\n"
+            "yaw_error: 1.0e-06\n"
+            "attitude_error: 0.0078125\n"
             "rotor_saturated:\n"
             "- true\n- false\n- false\n- true\n"
             "tilt_saturated: true\n"
@@ -890,7 +898,11 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "rejected_non_finite: 1\n"
             "rejected_bad_quaternion: 22\n"
             "rejected_bad_stamp: 333\n"
-            "rejected_stamp_backwards: 18446744073709551615\n");
+            "rejected_stamp_backwards: 18446744073709551615\n"
+            "output_names:\n"
+            "- error.z\n- error.roll\n- error.pitch\n- error.yaw\n"
+            "outputs:\n"
+            "- -0.5\n- 0.25\n- -0.125\n- 1.0e-06\n");
 
   msg::PlantStatus ps;
   ps.header.stamp = {9, 1};

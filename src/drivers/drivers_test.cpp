@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "controllers/registry.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
 #include "drivers/realtime_plant_driver.hpp"
@@ -28,6 +29,9 @@ namespace {
 
 using sim::Tick;
 
+// The paper controller with its defaults, for the Table 1 vehicle.
+control::ControllerConfig paper() { return controllers::make_config("paper", model::VehicleParams{}); }
+
 bool same(const model::State& a, const model::State& b) {
   return a.p_W == b.p_W && a.v_W == b.v_W && a.q_WB.coeffs() == b.q_WB.coeffs() && a.w_B == b.w_B &&
          a.omega_rad_s == b.omega_rad_s;
@@ -38,7 +42,7 @@ std::vector<model::State> reference_run(const sim::SimulationConfig& sc, const m
                                         const std::vector<sim::ScheduledParameter>& schedule) {
   sim::InProcessTransport bus;
   const sim::Topics t = sim::Topics::for_namespace(sc.ns);
-  sim::PlantNode plant(bus, t, c.params.vehicle, sc.plant, x0);
+  sim::PlantNode plant(bus, t, c.vehicle, sc.plant, x0);
   sim::ControllerNode node(bus, t, c);
   sim::ParameterSchedule changes(schedule, sc.plant.clock);
   const double dt_s = sc.plant.clock.period_s() * sc.controller_divider;
@@ -105,7 +109,7 @@ struct Rig {
       bool drop_stale = true) {
     sim::SwarmLayout layout;
     layout.vehicles = n;
-    control::ControllerConfig cfg;
+    const control::ControllerConfig cfg = paper();
     std::vector<DrivenController> driven;
     status_stamp.assign(static_cast<std::size_t>(n), -1);
     poses.assign(static_cast<std::size_t>(n), 0);
@@ -116,7 +120,7 @@ struct Rig {
       const sim::Topics t = sim::Topics::for_namespace(v.simulation.ns);
       sim::PlantOptions po = v.simulation.plant;
       po.drop_stale_commands = drop_stale;
-      plants.push_back(std::make_unique<sim::PlantNode>(plant_bus, t, cfg.params.vehicle, po, v.initial));
+      plants.push_back(std::make_unique<sim::PlantNode>(plant_bus, t, cfg.vehicle, po, v.initial));
       controllers.push_back(std::make_unique<sim::ControllerNode>(controller_bus, t, v.controller));
       driven.push_back({controllers.back().get(), v.schedule});
       relay<msg::PoseStamped>(t.pose, i, false);
@@ -199,8 +203,8 @@ sim::SimulationConfig config(Tick ticks) {
 // The in-process Simulation (sim::LockstepCore over a synchronous host) against the same loop.
 TEST(SimulationOnTheLockstepCoreTest, FliesTheHandWrittenLoopsBits) {
   const sim::SimulationConfig sc = config(300);
-  const auto expected = reference_run(sc, {}, control::ControllerConfig{}, kSchedule);
-  sim::Simulation s(sc, control::ControllerConfig{}.params.vehicle, {}, control::ControllerConfig{}, kSchedule);
+  const auto expected = reference_run(sc, {}, paper(), kSchedule);
+  sim::Simulation s(sc, model::VehicleParams{}, {}, paper(), kSchedule);
   std::size_t i = 0, differ = 0;
   s.run([&](const sim::TickRecord& r) {
     if (i >= expected.size() || !same(r.state, expected[i])) ++differ;
@@ -213,7 +217,7 @@ TEST(SimulationOnTheLockstepCoreTest, FliesTheHandWrittenLoopsBits) {
 
 TEST(LockstepPlantDriverTest, OneVehicleFliesTheSimulationsBitsWithTicksRunOnDelivery) {
   const sim::SimulationConfig sc = config(300);
-  const auto expected = reference_run(sc, {}, control::ControllerConfig{}, kSchedule);
+  const auto expected = reference_run(sc, {}, paper(), kSchedule);
   Rig rig(sc, 1, kSchedule);
   const Flight f = fly(rig, options_of(sc));
   ASSERT_EQ(f.result, LockstepResult::kDone);
@@ -439,7 +443,7 @@ TEST(LockstepControllerDriverTest, StepsOnDeliveryUntilAStop) {
   sim::InProcessTransport bus;
   const sim::Topics t = sim::Topics::for_namespace("/drone");
   sim::PlantNode plant(bus, t, model::VehicleParams{}, sim::PlantOptions{}, model::State{});
-  sim::ControllerNode node(bus, t, control::ControllerConfig{});
+  sim::ControllerNode node(bus, t, paper());
   struct Host : DriverHost {
     sim::PlantNode& plant;
     Tick k = 0;
@@ -456,7 +460,7 @@ TEST(LockstepControllerDriverTest, StepsOnDeliveryUntilAStop) {
     EXPECT_FALSE(host.arrival);
   }
   EXPECT_EQ(node.last_step_ns(), 60'000'000);  // ticks 0, 2, 4, 6 stepped
-  EXPECT_EQ(node.config().setpoint.p_des_W.z(), 2.0);
+  EXPECT_EQ(node.settings().setpoint.p_des_W.z(), 2.0);
   plant.publish_outputs(8);  // the driver is gone: its hooks too
   EXPECT_EQ(node.last_step_ns(), 60'000'000);
 }
@@ -467,7 +471,7 @@ TEST(RealtimeControllerDriverTest, CommandsNothingBeforeTheFirstCompleteSample) 
   int commands = 0;
   bus.subscribe<msg::Float64MultiArray>(t.motor_commands, [&](const msg::Float64MultiArray&) { ++commands; });
   sim::PlantNode plant(bus, t, model::VehicleParams{}, sim::PlantOptions{}, model::State{});
-  sim::ControllerNode node(bus, t, control::ControllerConfig{});
+  sim::ControllerNode node(bus, t, paper());
   struct Host : DriverHost {
     std::int64_t ns = 0;
     int wakes = 0;

@@ -16,10 +16,12 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "controllers/paper/paper_controller.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
@@ -31,6 +33,16 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kSourceDir = QUADCOSIM_SOURCE_DIR;
+
+// The parameters of the paper controller a configuration flies (it must fly one).
+const controllers::PaperParams& paper_params(const control::ControllerConfig& c) {
+  const controllers::PaperController* pc = controllers::paper_controller(c);
+  if (pc == nullptr) throw std::logic_error("not a paper controller");
+  return pc->params();
+}
+
+// The defaults of the paper controller.
+const controllers::PaperParams kPaperDefaults{};
 
 /// A fresh directory under the system temp dir, removed with everything in it at the end of the test.
 class TempDir {
@@ -134,17 +146,18 @@ TEST_P(PaperScenarioTest, LoadsWithTheDocumentedValues) {
   const model::VehicleParams table1;
   EXPECT_EQ(sc.vehicle.mass_kg, table1.mass_kg);
   EXPECT_EQ(sc.vehicle.kt_N_per_rad2_s2, table1.kt_N_per_rad2_s2);
-  EXPECT_EQ(sc.controller.params.vehicle.mass_kg, table1.mass_kg);
+  EXPECT_EQ(sc.controller.vehicle.mass_kg, table1.mass_kg);
+  EXPECT_EQ(controllers::paper_controller(sc.controller)->vehicle().mass_kg, table1.mass_kg);
 
   EXPECT_EQ(sc.initial.p_W, Eigen::Vector3d(0.0, 0.0, e.z0));
   EXPECT_EQ(sc.initial.yaw_rad, 0.0);
   EXPECT_EQ(sc.initial.hover, e.hover);
 
-  EXPECT_EQ(sc.controller.setpoint.mode, control::Mode::kAttitude);
-  EXPECT_EQ(sc.controller.setpoint.p_des_W.z(), e.z_des);
-  EXPECT_EQ(sc.controller.setpoint.roll_des_rad, 0.0);
-  EXPECT_EQ(sc.controller.setpoint.pitch_des_rad, 0.0);
-  EXPECT_EQ(sc.controller.setpoint.yaw_des_rad, 0.0);
+  EXPECT_EQ(sc.controller.node.setpoint.mode, control::Mode::kAttitude);
+  EXPECT_EQ(sc.controller.node.setpoint.p_des_W.z(), e.z_des);
+  EXPECT_EQ(sc.controller.node.setpoint.roll_des_rad, 0.0);
+  EXPECT_EQ(sc.controller.node.setpoint.pitch_des_rad, 0.0);
+  EXPECT_EQ(sc.controller.node.setpoint.yaw_des_rad, 0.0);
 
   // One scheduled change at t = 0: <channel>_des to the step value.
   ASSERT_EQ(sc.schedule.size(), 1u);
@@ -221,8 +234,8 @@ schedule:
   EXPECT_EQ(sc.schedule[2].name, "mode");
   EXPECT_EQ(std::get<std::string>(sc.schedule[2].value), "position");
   // Scheduled values do not change the initial configuration.
-  EXPECT_EQ(sc.controller.setpoint.p_des_W.z(), 0.0);
-  EXPECT_EQ(sc.controller.params.altitude.kp, control::ControllerConfig{}.params.altitude.kp);
+  EXPECT_EQ(sc.controller.node.setpoint.p_des_W.z(), 0.0);
+  EXPECT_EQ(paper_params(sc.controller).altitude.kp, kPaperDefaults.altitude.kp);
 }
 
 TEST(ScenarioTest, NestedAndDottedControllerKeysAreEquivalent) {
@@ -263,15 +276,15 @@ schedule:
 )"));
   for (const Scenario* sc : {&nested, &dotted, &mixed}) {
     SCOPED_TRACE(sc->path);
-    const auto& p = sc->controller.params;
-    EXPECT_EQ(sc->controller.setpoint.mode, control::Mode::kPosition);
+    const auto& p = paper_params(sc->controller);
+    EXPECT_EQ(sc->controller.node.setpoint.mode, control::Mode::kPosition);
     EXPECT_EQ(p.altitude.kp, 5.5);
     EXPECT_EQ(p.altitude.kd, 3.25);
     EXPECT_EQ(p.roll.q_angle, 2.0);
     EXPECT_EQ(p.roll.r, 50.0);
     EXPECT_EQ(p.yaw.q_rate, 7.0);
     EXPECT_EQ(p.position.max_tilt_rad, 0.3);
-    EXPECT_EQ(p.pitch.q_angle, control::ControllerConfig{}.params.pitch.q_angle);
+    EXPECT_EQ(p.pitch.q_angle, kPaperDefaults.pitch.q_angle);
     ASSERT_EQ(sc->schedule.size(), 1u);
     EXPECT_EQ(sc->schedule[0].tick, 100);
     EXPECT_EQ(sc->schedule[0].name, "lqr.pitch.q_angle");
@@ -292,7 +305,8 @@ TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {
   EXPECT_EQ(sc.vehicle.spin, (std::array<int, 4>{-1, 1, -1, 1}));
   EXPECT_EQ(sc.vehicle.motor.model, model::MotorModel::kFirstOrder);
   EXPECT_EQ(sc.vehicle.motor.tau_up_s, 0.03);
-  EXPECT_EQ(sc.controller.params.vehicle.mass_kg, 2.5);
+  EXPECT_EQ(sc.controller.vehicle.mass_kg, 2.5);
+  EXPECT_EQ(controllers::paper_controller(sc.controller)->vehicle().mass_kg, 2.5);
 }
 
 // Every key of the vehicle parameter table, at its place in the file, reaches its member.
@@ -417,7 +431,7 @@ INSTANTIATE_TEST_SUITE_P(
                     {"schedule[0].set.z_dse: ", "z_dse"}},
         BadScenario{"unknown_controller_parameter",
                     "controller:\n  z_dse: 3\n",
-                    {"controller.z_dse: ", "unknown controller parameter 'z_dse'"}},
+                    {"controller.z_dse: ", "unknown parameter 'z_dse' of the node or of controller type 'paper'"}},
         BadScenario{"unknown_nested_controller_parameter",
                     "controller:\n  altitude: {kq: 3}\n",
                     {"controller.altitude.kq: ", "'altitude.kq'"}},
@@ -500,9 +514,10 @@ TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
   EXPECT_EQ(v.mass_kg, 3.0);
   EXPECT_EQ(v.Izz_kg_m2, 0.06);
   const control::ControllerConfig c = load_controller(dir.write("c.yaml", "lqr: {roll: {r: 20}}\nyaw_des: 0.5\n"), v);
-  EXPECT_EQ(c.params.roll.r, 20.0);
-  EXPECT_EQ(c.setpoint.yaw_des_rad, 0.5);
-  EXPECT_EQ(c.params.vehicle.mass_kg, 3.0);
+  EXPECT_EQ(paper_params(c).roll.r, 20.0);
+  EXPECT_EQ(c.node.setpoint.yaw_des_rad, 0.5);
+  EXPECT_EQ(c.vehicle.mass_kg, 3.0);
+  EXPECT_EQ(controllers::paper_controller(c)->vehicle().mass_kg, 3.0);
 
   const std::string bad_vehicle = dir.write("bad_v.yaml", "mass_kg: 0\n");
   try {

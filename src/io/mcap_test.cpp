@@ -253,9 +253,11 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
   const std::string& status = ros2msg_definition(msg::ControllerStatus::kRosType);
   EXPECT_EQ(msg_blocks(status), (V{"std_msgs/Header", "builtin_interfaces/Time"}));
   EXPECT_EQ(status.substr(0, status.find("====")),
-            "std_msgs/Header header\nstring mode\nfloat64[6] setpoint\nfloat64[4] u\nfloat64[4] error\n"
+            "std_msgs/Header header\nstring controller\nstring mode\nfloat64[6] setpoint\nfloat64[4] u\n"
+            "float64[3] position_error\nfloat64 yaw_error\nfloat64 attitude_error\n"
             "bool[4] rotor_saturated\nbool tilt_saturated\nbool safety\nuint64 rejected_non_finite\n"
-            "uint64 rejected_bad_quaternion\nuint64 rejected_bad_stamp\nuint64 rejected_stamp_backwards\n");
+            "uint64 rejected_bad_quaternion\nuint64 rejected_bad_stamp\nuint64 rejected_stamp_backwards\n"
+            "string[] output_names\nfloat64[] outputs\n");
   const std::string& plant = ros2msg_definition(msg::PlantStatus::kRosType);
   EXPECT_EQ(msg_blocks(plant), (V{"std_msgs/Header", "builtin_interfaces/Time"}));
   EXPECT_EQ(plant.substr(0, plant.find("====")),

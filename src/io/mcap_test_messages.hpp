@@ -59,10 +59,22 @@ inline msg::Float64MultiArray sample_command(int i) {
 inline msg::ControllerStatus sample_status(int i) {
   msg::ControllerStatus m;
   m.header = sample_header(i, "");
+  m.controller = i % 3 == 2 ? "se3" : "paper";
   m.mode = i < 100 ? "attitude" : "position";
   m.setpoint = {0.0, 0.0, 1.0 + 0.01 * i, 0.1, -0.1, i / 9.0};
   m.u = {19.2276 + 0.1 * i, 0.001 * i, -0.002 * i, 0.0};
-  m.error = {0.5 - 0.005 * i, 0.01, -0.01, 1e-5 * i};
+  m.position_error = {0.25 - 0.001 * i, -0.003 * i, 0.5 - 0.005 * i};
+  m.yaw_error = 1e-5 * i;
+  m.attitude_error = 1e-4 * i;
+  // The paper controller's figures; a different number of them for the other type (none at all for
+  // some), so the sequences' lengths vary.
+  if (m.controller == "paper") {
+    m.output_names = {"error.z", "error.roll", "error.pitch", "error.yaw"};
+    m.outputs = {0.5 - 0.005 * i, 0.01, -0.01, 1e-5 * i};
+  } else if (i % 2 == 0) {
+    m.output_names = {"thrust_axis.z"};
+    m.outputs = {0.99 - 1e-4 * i};
+  }
   m.rotor_saturated = {i % 2 == 0, i % 3 == 0, false, true};
   m.tilt_saturated = i % 5 == 0;
   m.safety = i % 7 == 0;

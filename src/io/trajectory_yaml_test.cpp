@@ -83,10 +83,10 @@ TEST(TrajectoryYamlTest, LissajousAndFigure8AreRead) {
   EXPECT_NEAR(l.controller.trajectory->at(2.0).p_W.x(), 2.0, 1e-12);  // sin(2 pi / 8 * 2)
   EXPECT_NEAR(l.controller.trajectory->at(2.0).p_W.y(), std::sin(std::numbers::pi + 1.0), 1e-12);
   const Scenario f = load("trajectory: {kind: figure8, amplitude_m: [3, 1], period_s: 12, ramp_s: 0}\n");
-  ASSERT_NE(f.trajectory, nullptr);
-  EXPECT_NEAR(f.trajectory->at(3.0).p_W.x(), 3.0, 1e-12);
-  EXPECT_NEAR(f.trajectory->at(3.0).p_W.y(), 0.0, 1e-12);
-  EXPECT_EQ(f.trajectory->at(3.0).p_W.z(), 1.0);  // default altitude
+  ASSERT_NE(f.controller.trajectory, nullptr);
+  EXPECT_NEAR(f.controller.trajectory->at(3.0).p_W.x(), 3.0, 1e-12);
+  EXPECT_NEAR(f.controller.trajectory->at(3.0).p_W.y(), 0.0, 1e-12);
+  EXPECT_EQ(f.controller.trajectory->at(3.0).p_W.z(), 1.0);  // default altitude
 }
 
 TEST(TrajectoryYamlTest, WaypointsAreRead) {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <vector>
 
+#include "controllers/registry.hpp"
 #include "model/quadrotor.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
@@ -247,10 +248,10 @@ HoverRun hover(const FaultConfig& faults, Tick ticks) {
   SimulationConfig cfg;
   cfg.duration_ticks = ticks;
   cfg.faults = faults;
-  control::ControllerConfig controller;
-  controller.setpoint.p_des_W.z() = 1.0;
-  const model::State x0 = model::Quadrotor(controller.params.vehicle).initial_state({0, 0, 1.0}, 0.0, true);
-  Simulation s(cfg, controller.params.vehicle, x0, controller, {});
+  control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  controller.node.setpoint.p_des_W.z() = 1.0;
+  const model::State x0 = model::Quadrotor(controller.vehicle).initial_state({0, 0, 1.0}, 0.0, true);
+  Simulation s(cfg, controller.vehicle, x0, controller, {});
   HoverRun r;
   s.transport().subscribe<msg::PlantStatus>(Topics::for_namespace(cfg.ns).plant_status,
                                             [&](const msg::PlantStatus& m) { r.plant_status.push_back(m); });
@@ -303,7 +304,7 @@ TEST(FaultInjectionTest, HoverHoldsUnderTenPercentLossAndATickOfDelay) {
   EXPECT_EQ(r.safety_ticks, 0);
   EXPECT_EQ(r.watchdog_trips, 0u);
   // Commands stay near the hover speed (4830.6 rad/s), as without faults.
-  const double hover_w = control::ControllerConfig{}.params.vehicle.hover_omega_rad_s();
+  const double hover_w = model::VehicleParams{}.hover_omega_rad_s();
   double dev = 0.0, dev_clean = 0.0;
   for (std::size_t k = kSettleTicks; k < r.applied.size(); ++k) {
     dev = std::max(dev, (r.applied[k].array() - hover_w).abs().maxCoeff());

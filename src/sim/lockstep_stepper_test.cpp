@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "controllers/registry.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/lockstep_stepper.hpp"
@@ -19,7 +20,7 @@ namespace {
 struct LockstepRig {
   InProcessTransport bus;
   Topics topics = Topics::for_namespace("/drone");
-  control::ControllerConfig cfg;
+  control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
   std::vector<msg::Float64MultiArray> commands;
   std::unique_ptr<PlantNode> plant;
   std::unique_ptr<ControllerNode> node;
@@ -28,7 +29,7 @@ struct LockstepRig {
   explicit LockstepRig(std::vector<ScheduledParameter> schedule = {}, model::State x0 = {}) {
     bus.subscribe<msg::Float64MultiArray>(topics.motor_commands,
                                           [this](const msg::Float64MultiArray& m) { commands.push_back(m); });
-    plant = std::make_unique<PlantNode>(bus, topics, cfg.params.vehicle, PlantOptions{}, x0);
+    plant = std::make_unique<PlantNode>(bus, topics, cfg.vehicle, PlantOptions{}, x0);
     node = std::make_unique<ControllerNode>(bus, topics, cfg);
     stepper = std::make_unique<LockstepStepper>(*node, std::move(schedule), TickClock{}, 2);
   }
@@ -76,11 +77,11 @@ TEST(LockstepStepperTest, ARepeatedTickIsAnsweredAgainWithTheSameCommand) {
 TEST(LockstepStepperTest, AppliesTheScheduleBySimulatedTime) {
   LockstepRig rig({{6, "z_des", 3.0}});  // at tick 6 = 60 ms
   for (Tick k = 0; k <= 4; ++k) rig.plant->publish_outputs(k);
-  EXPECT_EQ(rig.node->config().setpoint.p_des_W.z(), rig.cfg.setpoint.p_des_W.z());
+  EXPECT_EQ(rig.node->settings().setpoint.p_des_W.z(), rig.cfg.node.setpoint.p_des_W.z());
   rig.plant->publish_outputs(5);
-  EXPECT_EQ(rig.node->config().setpoint.p_des_W.z(), rig.cfg.setpoint.p_des_W.z());
+  EXPECT_EQ(rig.node->settings().setpoint.p_des_W.z(), rig.cfg.node.setpoint.p_des_W.z());
   rig.plant->publish_outputs(6);
-  EXPECT_EQ(rig.node->config().setpoint.p_des_W.z(), 3.0);
+  EXPECT_EQ(rig.node->settings().setpoint.p_des_W.z(), 3.0);
 }
 
 TEST(LockstepStepperTest, ARefusedScheduledParameterIsAnErrorNamingIt) {
@@ -105,8 +106,8 @@ TEST(LockstepStepperTest, FliesTheSameBitsAsTheInProcessSimulation) {
   const std::vector<ScheduledParameter> schedule = {{50, "z_des", 1.0}, {120, "yaw_des", 0.3}};
   SimulationConfig sc;
   sc.duration_ticks = 300;
-  control::ControllerConfig controller;
-  Simulation reference(sc, controller.params.vehicle, {}, controller, schedule);
+  const control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  Simulation reference(sc, controller.vehicle, {}, controller, schedule);
   std::vector<model::State> expected;
   reference.run([&](const TickRecord& r) { expected.push_back(r.state); });
 

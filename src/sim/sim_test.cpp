@@ -3,8 +3,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
 #include <vector>
 
+#include "controllers/paper/paper_controller.hpp"
+#include "controllers/registry.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
@@ -149,8 +154,8 @@ TEST(ControllerNodeTest, PublishesTheSafetyCommandUntilSensorsArrive) {
   std::vector<msg::Float64MultiArray> out;
   bus.subscribe<msg::Float64MultiArray>(topics.motor_commands,
                                         [&](const msg::Float64MultiArray& m) { out.push_back(m); });
-  control::ControllerConfig cfg;
-  cfg.params.safety = control::SafetyMode::kHover;
+  control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
+  cfg.node.safety = control::SafetyMode::kHover;
   ControllerNode node(bus, topics, cfg);
   const auto& c = node.step(0, 0.02);
   EXPECT_TRUE(c.safety);
@@ -163,13 +168,13 @@ TEST(ControllerNodeTest, PublishesTheSafetyCommandUntilSensorsArrive) {
 TEST(ControllerNodeTest, GoesToSafetyWhenDataGetsStaleAndRecovers) {
   InProcessTransport bus;
   const Topics topics = Topics::for_namespace("/drone");
-  control::ControllerConfig cfg;
-  cfg.params.stale_limit_s = 0.1;
-  cfg.setpoint.p_des_W.z() = 5.0;
+  control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
+  cfg.node.stale_limit_s = 0.1;
+  cfg.node.setpoint.p_des_W.z() = 5.0;
   ControllerNode node(bus, topics, cfg);
   model::State x0;
   x0.p_W.z() = 5.0;
-  PlantNode plant(bus, topics, cfg.params.vehicle, {}, x0);
+  PlantNode plant(bus, topics, cfg.vehicle, {}, x0);
 
   plant.publish_outputs(0);  // data stamped t = 0
   EXPECT_FALSE(node.step(0, 0.02).safety);
@@ -181,15 +186,177 @@ TEST(ControllerNodeTest, GoesToSafetyWhenDataGetsStaleAndRecovers) {
 
 TEST(ControllerNodeTest, ParameterChangesAreCheckedAndAppliedBetweenSteps) {
   InProcessTransport bus;
-  ControllerNode node(bus, Topics::for_namespace("/drone"), {});
+  ControllerNode node(bus, Topics::for_namespace("/drone"), controllers::make_config("paper", model::VehicleParams{}));
   EXPECT_EQ(node.set_parameter("z_des", 10.0), "");
-  EXPECT_EQ(node.config().setpoint.p_des_W.z(), 10.0);
+  EXPECT_EQ(node.settings().setpoint.p_des_W.z(), 10.0);
   EXPECT_NE(node.set_parameter("z_des", std::nan("")), "");
-  EXPECT_EQ(node.config().setpoint.p_des_W.z(), 10.0);
+  EXPECT_EQ(node.settings().setpoint.p_des_W.z(), 10.0);
   EXPECT_NE(node.set_parameter("no_such", 1.0), "");
-  const double k_before = node.controller().axis(0).K(0);
+  const auto& paper = dynamic_cast<const controllers::PaperController&>(node.controller());
+  const double k_before = paper.axis(0).K(0);
   EXPECT_EQ(node.set_parameter("lqr.roll.q_angle", 10.0), "");
-  EXPECT_NE(node.controller().axis(0).K(0), k_before);  // the LQR was re-solved
+  EXPECT_NE(paper.axis(0).K(0), k_before);  // the LQR was re-solved
+}
+
+// The stale-data safety of Algorithm 1 (lines 3-5) is the node's, for every controller: a controller
+// node fed by the test, which publishes Pose, Velocity and Imu samples itself.
+struct SensorFeed {
+  InProcessTransport bus;
+  Topics topics = Topics::for_namespace("/drone");
+  Publisher<msg::PoseStamped> pose = bus.advertise<msg::PoseStamped>(topics.pose);
+  Publisher<msg::TwistStamped> velocity = bus.advertise<msg::TwistStamped>(topics.velocity);
+  Publisher<msg::Imu> imu = bus.advertise<msg::Imu>(topics.imu);
+  std::unique_ptr<ControllerNode> node;
+
+  explicit SensorFeed(const control::ControllerConfig& cfg) {
+    node = std::make_unique<ControllerNode>(bus, topics, cfg);
+    node->set_log([](const std::string&) {});
+  }
+  // A level vehicle at rest at height z, stamped `ns`; `bad` (0..12) puts `value` in one field: 0-2
+  // position, 3-5 velocity, 6-8 body rates, 9-12 the Imu quaternion (w, x, y, z); -1: none.
+  void send(std::int64_t ns, double z, int bad = -1, double value = 0.0, bool with_imu = true) {
+    msg::PoseStamped p;
+    p.header.stamp = msg::Time::from_ns(ns);
+    p.position.z = z;
+    p.orientation.w = 1.0;
+    msg::TwistStamped v;
+    v.header.stamp = p.header.stamp;
+    msg::Imu i;
+    i.header.stamp = p.header.stamp;
+    i.orientation.w = 1.0;
+    i.linear_acceleration.z = 9.81;
+    double* fields[] = {&p.position.x,         &p.position.y,         &p.position.z,         &v.linear.x,
+                        &v.linear.y,           &v.linear.z,           &i.angular_velocity.x, &i.angular_velocity.y,
+                        &i.angular_velocity.z, &i.orientation.w,      &i.orientation.x,      &i.orientation.y,
+                        &i.orientation.z};
+    if (bad >= 0) *fields[bad] = value;
+    pose.publish(p);
+    velocity.publish(v);
+    if (with_imu) imu.publish(i);
+  }
+};
+
+// sqrt(m g / (4 kt)) from Table 1 (~4830.6 rad/s).
+const double kHoverSpeed = std::sqrt(1.96 * 9.81 / (4 * 2.06e-7));
+
+TEST(ControllerNodeSafetyTest, StaleOrMissingDataGivesTheSafetyCommand) {
+  model::VehicleParams vehicle;
+  vehicle.motor.omega_min_rad_s = 350.0;
+  control::ControllerConfig cfg = controllers::make_config("paper", vehicle);
+  cfg.node.setpoint.p_des_W.z() = 5.0;
+  ASSERT_EQ(cfg.node.stale_limit_s, 0.1);
+  ASSERT_EQ(cfg.node.safety, control::SafetyMode::kStop);
+  {
+    SensorFeed feed(cfg);
+    // Nothing received yet: infinitely old.
+    const control::ControllerOutput& c = feed.node->step(0, 0.02);
+    EXPECT_TRUE(c.safety);
+    EXPECT_TRUE(std::isinf(feed.node->observation().age_s));
+    EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Constant(350.0));
+  }
+  constexpr std::int64_t t0 = 1'000'000'000;
+  for (std::int64_t age_ns : {100'000'001LL, 200'000'000LL, 10'000'000'000LL}) {
+    SCOPED_TRACE(testing::Message() << "age " << age_ns << " ns");
+    SensorFeed feed(cfg);
+    feed.send(t0, 5.0);
+    ASSERT_FALSE(feed.node->step(t0, 0.02).safety);
+    const control::ControllerOutput& c = feed.node->step(t0 + age_ns, 0.02);
+    EXPECT_TRUE(c.safety);
+    EXPECT_TRUE(feed.node->status().safety);
+    EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Constant(350.0));
+  }
+  {
+    // At the limit the data still counts as fresh.
+    SensorFeed feed(cfg);
+    feed.send(t0, 5.0);
+    EXPECT_FALSE(feed.node->step(t0 + 100'000'000, 0.02).safety);
+    EXPECT_EQ(feed.node->observation().age_s, 0.1);
+  }
+  {
+    // One input that never arrived (no Imu) makes the whole observation infinitely old.
+    SensorFeed feed(cfg);
+    feed.send(t0, 5.0, -1, 0.0, /*with_imu=*/false);
+    const control::ControllerOutput& c = feed.node->step(t0, 0.02);
+    EXPECT_TRUE(c.safety);
+    EXPECT_TRUE(std::isinf(feed.node->observation().age_s));
+    EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Constant(350.0));
+  }
+}
+
+TEST(ControllerNodeSafetyTest, SafetyStopIsOmegaMinAndSafetyHoverIsHoverSpeed) {
+  control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
+  cfg.node.setpoint.p_des_W.z() = 5.0;
+  ASSERT_EQ(cfg.node.safety, control::SafetyMode::kStop);
+  ASSERT_EQ(cfg.vehicle.motor.omega_min_rad_s, 0.0);
+  {
+    SensorFeed feed(cfg);
+    feed.send(0, 5.0);
+    const control::ControllerOutput& c = feed.node->step(1'000'000'000, 0.02);  // 1 s old
+    EXPECT_TRUE(c.safety);
+    EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Zero());
+  }
+  {
+    SensorFeed feed(cfg);
+    ASSERT_EQ(feed.node->set_parameter("safety_mode", std::string("hover")), "");
+    feed.send(0, 5.0);
+    const control::ControllerOutput& c = feed.node->step(1'000'000'000, 0.02);
+    EXPECT_TRUE(c.safety);
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(c.omega_rad_s[i], kHoverSpeed, 1e-9 * kHoverSpeed);
+  }
+}
+
+// A non-finite sample never reaches the controller: the node refuses it, the observation keeps its
+// last valid values and ages, and once older than stale_limit the safety command goes out while the
+// controller (and its integrator) is left alone.
+TEST(ControllerNodeSafetyTest, NonFiniteSamplesGiveSafetyAndLeaveTheIntegratorAlone) {
+  control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
+  cfg.node.setpoint.mode = control::Mode::kPosition;
+  cfg.node.setpoint.p_des_W = {1.0, 0.0, 5.0};
+  SensorFeed feed(cfg);
+  const auto& paper = dynamic_cast<const controllers::PaperController&>(feed.node->controller());
+  std::int64_t t = 0;
+  constexpr std::int64_t kPeriod = 20'000'000;
+  // Build some integral first.
+  for (int i = 0; i < 10; ++i, t += kPeriod) {
+    feed.send(t, 5.0);
+    ASSERT_FALSE(feed.node->step(t, 0.02).safety);
+  }
+  ASSERT_GT(paper.position_state().integral_m_s.x(), 0.0);
+
+  std::uint64_t refused = 0;
+  for (int field = 0; field < 13; ++field) {
+    for (double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+      SCOPED_TRACE(testing::Message() << "field " << field << " value " << bad);
+      const std::int64_t last_good = t - kPeriod;
+      // Up to the limit the controller flies on the last valid sample.
+      for (; t - last_good <= 100'000'000; t += kPeriod) {
+        feed.send(t, 5.0, field, bad);
+        EXPECT_FALSE(feed.node->step(t, 0.02).safety) << "t - last good = " << t - last_good << " ns";
+      }
+      const Eigen::Vector2d integral = paper.position_state().integral_m_s;
+      for (int k = 0; k < 3; ++k, t += kPeriod) {
+        feed.send(t, 5.0, field, bad);
+        const control::ControllerOutput& c = feed.node->step(t, 0.02);
+        EXPECT_TRUE(c.safety);
+        EXPECT_TRUE(c.omega_rad_s.allFinite());
+        EXPECT_EQ(c.omega_rad_s, Eigen::Vector4d::Zero());
+        EXPECT_EQ(paper.position_state().integral_m_s, integral);
+        EXPECT_TRUE(feed.node->observation().p_W.allFinite());
+        EXPECT_TRUE(feed.node->observation().v_W.allFinite());
+        EXPECT_TRUE(feed.node->observation().w_B.allFinite());
+      }
+      refused += 8;  // one message (Pose, Velocity or Imu) per sample, 8 samples
+      const msg::ControllerStatus& s = feed.node->status();
+      // Every bad message was refused (counted as non-finite, or as a bad quaternion).
+      EXPECT_EQ(s.rejected_non_finite + s.rejected_bad_quaternion, refused);
+      // And the next good sample is controlled normally.
+      feed.send(t, 5.0);
+      const control::ControllerOutput& c = feed.node->step(t, 0.02);
+      EXPECT_FALSE(c.safety);
+      EXPECT_TRUE(c.omega_rad_s.allFinite());
+      t += kPeriod;
+    }
+  }
 }
 
 // A short run of the full loop with a recorder that keeps everything it saw.
@@ -200,8 +367,8 @@ struct Recorded {
 };
 
 Recorded run(const SimulationConfig& cfg, std::vector<ScheduledParameter> schedule, model::State x0 = {}) {
-  control::ControllerConfig controller;
-  Simulation s(cfg, controller.params.vehicle, x0, controller, std::move(schedule));
+  const control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  Simulation s(cfg, controller.vehicle, x0, controller, std::move(schedule));
   Recorded r;
   s.run([&](const TickRecord& rec) {
     r.t.push_back(rec.t_s);
@@ -247,8 +414,8 @@ TEST(SimulationTest, ScheduledSetpointMakesTheVehicleClimb) {
 TEST(SimulationTest, RefusedScheduledParameterIsAnError) {
   SimulationConfig cfg;
   cfg.duration_ticks = 10;
-  control::ControllerConfig controller;
-  Simulation s(cfg, controller.params.vehicle, {}, controller, {{5, "roll_des", 9.0}});
+  const control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  Simulation s(cfg, controller.vehicle, {}, controller, {{5, "roll_des", 9.0}});
   EXPECT_THROW(s.run(nullptr), std::invalid_argument);
 }
 

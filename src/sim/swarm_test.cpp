@@ -3,8 +3,11 @@
 // block length.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <vector>
 
+#include "controllers/paper/paper_controller.hpp"
+#include "controllers/registry.hpp"
 #include "sim/swarm.hpp"
 
 namespace quadcosim::sim {
@@ -48,12 +51,14 @@ SimulationConfig config() {
 }
 
 control::ControllerConfig position_mode() {
-  control::ControllerConfig c;
-  c.setpoint.mode = control::Mode::kPosition;
-  c.params.roll = {1.0, 0.02, 1.0};
-  c.params.pitch = {1.0, 0.02, 1.0};
-  c.params.position.kp = 0.8;
-  c.params.position.kd = 1.4;
+  controllers::PaperParams p;
+  p.roll = {1.0, 0.02, 1.0};
+  p.pitch = {1.0, 0.02, 1.0};
+  p.position.kp = 0.8;
+  p.position.kd = 1.4;
+  control::ControllerConfig c = controllers::make_config("paper", model::VehicleParams{});
+  c.controller = std::make_shared<controllers::PaperController>(c.vehicle, p);
+  c.node.setpoint.mode = control::Mode::kPosition;
   return c;
 }
 
@@ -76,7 +81,7 @@ TEST(SwarmTest, EachVehicleFliesWhatItsOwnSimulationFlies) {
     model::State x0;
     x0.p_W = {ox, oy, 0.0};
     control::ControllerConfig c = position_mode();
-    c.setpoint.p_des_W = {ox, oy, oz};
+    c.node.setpoint.p_des_W = {ox, oy, oz};
     SimulationConfig cfg = config();
     cfg.ns = i == 0 ? "/uav0000" : "/uav0004";
     Simulation alone(cfg, model::VehicleParams{}, x0, c,

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "controllers/registry.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
@@ -471,9 +472,9 @@ struct ControllerRig {
     pose = bus.advertise<msg::PoseStamped>(topics.pose);
     velocity = bus.advertise<msg::TwistStamped>(topics.velocity);
     imu = bus.advertise<msg::Imu>(topics.imu);
-    control::ControllerConfig cfg;
-    cfg.params.safety = control::SafetyMode::kHover;  // a safety command that is not all zeros
-    cfg.setpoint.p_des_W.z() = 5.0;
+    control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
+    cfg.node.safety = control::SafetyMode::kHover;  // a safety command that is not all zeros
+    cfg.node.setpoint.p_des_W.z() = 5.0;
     node = std::make_unique<ControllerNode>(bus, topics, cfg);
     node->set_log([this](const std::string& line) { log.push_back(line); });
   }

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "control/parameters.hpp"
+#include "controllers/paper/paper_controller.hpp"
 #include "model/random.hpp"
 #include "sweep/statistics.hpp"
 #include "sweep/sweep.hpp"
@@ -338,7 +339,8 @@ TEST(ScenarioFor, PlantFliesTheDrawTheControllerKeepsTheNominalVehicle) {
   const Sample s = sample(p, 0);
   const io::Scenario sc = scenario_for(p, s);
   EXPECT_EQ(sc.vehicle.mass_kg, 1.5);
-  EXPECT_EQ(sc.controller.params.vehicle.mass_kg, 1.2);
+  EXPECT_EQ(sc.controller.vehicle.mass_kg, 1.2);
+  EXPECT_EQ(controllers::paper_controller(sc.controller)->vehicle().mass_kg, 1.2);
   EXPECT_EQ(std::get<double>(*control::get_parameter(sc.controller, "altitude.kp")), 7.0);
   EXPECT_EQ(sc.simulation.plant.realism.seed, s.seed);
 }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "analysis/step_metrics.hpp"
+#include "controllers/paper/paper_controller.hpp"
 #include "io/scenario.hpp"
 #include "model/attitude.hpp"
 #include "sim/simulation.hpp"
@@ -123,7 +124,9 @@ TEST(PaperTest, PositionModeFliesToAPointAndHolds) {
   double max_tilt = 0.0;
   for (std::size_t i = 0; i <= n; ++i)
     max_tilt = std::max(max_tilt, std::max(std::abs(r.roll[i]), std::abs(r.pitch[i])));
-  EXPECT_LE(max_tilt, sc.controller.params.position.max_tilt_rad + 0.02);  // tilt limit holds
+  const controllers::PaperController* pc = controllers::paper_controller(sc.controller);
+  ASSERT_NE(pc, nullptr);
+  EXPECT_LE(max_tilt, pc->params().position.max_tilt_rad + 0.02);  // tilt limit holds
 }
 
 }  // namespace
