@@ -299,7 +299,8 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         if (const auto& trajectory = v.controller.trajectory) {
           const sim::Tick divider = sc.simulation.controller_divider;
           const sim::Tick last_step = sc.simulation.duration_ticks / divider * divider;
-          f.p_des_W = trajectory->at(sc.simulation.plant.clock.seconds(last_step)).p_W + v.controller.trajectory_offset_W;
+          f.p_des_W =
+              trajectory->at(sc.simulation.plant.clock.seconds(last_step)).p_W + v.controller.trajectory_offset_W;
         }
         rows[static_cast<std::size_t>(i)] = f;
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;

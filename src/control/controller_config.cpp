@@ -62,7 +62,9 @@ const ParameterTable<NodeSettings>& node_parameters() {
 }
 
 const ParameterSpec* find_parameter(const ControllerConfig& config, std::string_view name) {
-  if (const auto* e = node_parameters().find(name)) return &e->spec;
+  for (const ParameterSpec& s : node_parameters().specs()) {
+    if (s.name == name) return &s;
+  }
   for (const ParameterSpec& s : config.controller->parameters()) {
     if (s.name == name) return &s;
   }

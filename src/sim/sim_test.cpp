@@ -225,9 +225,9 @@ struct SensorFeed {
     i.header.stamp = p.header.stamp;
     i.orientation.w = 1.0;
     i.linear_acceleration.z = 9.81;
-    double* fields[] = {&p.position.x,         &p.position.y,         &p.position.z,         &v.linear.x,
-                        &v.linear.y,           &v.linear.z,           &i.angular_velocity.x, &i.angular_velocity.y,
-                        &i.angular_velocity.z, &i.orientation.w,      &i.orientation.x,      &i.orientation.y,
+    double* fields[] = {&p.position.x,         &p.position.y,    &p.position.z,         &v.linear.x,
+                        &v.linear.y,           &v.linear.z,      &i.angular_velocity.x, &i.angular_velocity.y,
+                        &i.angular_velocity.z, &i.orientation.w, &i.orientation.x,      &i.orientation.y,
                         &i.orientation.z};
     if (bad >= 0) *fields[bad] = value;
     pose.publish(p);

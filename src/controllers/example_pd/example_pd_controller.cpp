@@ -21,16 +21,21 @@ ExamplePdController::ExamplePdController(const model::VehicleParams& vehicle)
 
 const Table& ExamplePdController::table() const {
   static const Table table({
-      Table::number("position.kp", "1/s^2", 0, 1e3, "acceleration per metre of position error",
-                    [](auto& p) -> auto& { return p.position_kp; }),
-      Table::number("position.kd", "1/s", 0, 1e3, "acceleration per m/s of velocity error",
-                    [](auto& p) -> auto& { return p.position_kd; }),
-      Table::number("attitude.kp", "1/s^2", 0, 1e5, "angular acceleration per radian of attitude error",
-                    [](auto& p) -> auto& { return p.attitude_kp; }),
-      Table::number("attitude.kd", "1/s", 0, 1e4, "angular acceleration per rad/s of body rate",
-                    [](auto& p) -> auto& { return p.attitude_kd; }),
-      Table::number("max_tilt", "rad", 0.01, 1.2, "bound on the commanded roll and pitch",
-                    [](auto& p) -> auto& { return p.max_tilt; }),
+      Table::number(
+          "position.kp", "1/s^2", 0, 1e3, "acceleration per metre of position error",
+          [](auto& p) -> auto& { return p.position_kp; }),
+      Table::number(
+          "position.kd", "1/s", 0, 1e3, "acceleration per m/s of velocity error",
+          [](auto& p) -> auto& { return p.position_kd; }),
+      Table::number(
+          "attitude.kp", "1/s^2", 0, 1e5, "angular acceleration per radian of attitude error",
+          [](auto& p) -> auto& { return p.attitude_kp; }),
+      Table::number(
+          "attitude.kd", "1/s", 0, 1e4, "angular acceleration per rad/s of body rate",
+          [](auto& p) -> auto& { return p.attitude_kd; }),
+      Table::number(
+          "max_tilt", "rad", 0.01, 1.2, "bound on the commanded roll and pitch",
+          [](auto& p) -> auto& { return p.max_tilt; }),
   });
   return table;
 }
@@ -67,8 +72,7 @@ void ExamplePdController::step(const control::Observation& o, const control::Ref
   out.roll_des_rad = roll_des;
   out.pitch_des_rad = pitch_des;
   out.yaw_des_rad = r.yaw_rad;
-  out.attitude_error =
-      control::attitude_error(model::quaternion_from_euler({roll_des, pitch_des, r.yaw_rad}), o.q_WB);
+  out.attitude_error = control::attitude_error(model::quaternion_from_euler({roll_des, pitch_des, r.yaw_rad}), o.q_WB);
   out.outputs[0] = out.U[0];
 }
 

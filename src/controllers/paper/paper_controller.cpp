@@ -24,7 +24,7 @@ Table make_table() {
           "altitude.min_cos_tilt", "", 0.05, 1, "floor on cos(roll) cos(pitch) in eq. (13)",
           [](auto& p) -> auto& { return p.altitude.min_cos_tilt; }),
       Table::number(
-          "lqr.roll.q_angle", "1/rad^2", 0, kBig, "roll LQR weight on angle error",
+          "lqr.roll.q_angle", "1/rad^2", 1e-12, kBig, "roll LQR weight on angle error",
           [](auto& p) -> auto& { return p.roll.q_angle; }),
       Table::number(
           "lqr.roll.q_rate", "s^2/rad^2", 0, kBig, "roll LQR weight on rate",
@@ -33,7 +33,7 @@ Table make_table() {
           "lqr.roll.r", "1/(N m)^2", 1e-12, kBig, "roll LQR weight on torque",
           [](auto& p) -> auto& { return p.roll.r; }),
       Table::number(
-          "lqr.pitch.q_angle", "1/rad^2", 0, kBig, "pitch LQR weight on angle error",
+          "lqr.pitch.q_angle", "1/rad^2", 1e-12, kBig, "pitch LQR weight on angle error",
           [](auto& p) -> auto& { return p.pitch.q_angle; }),
       Table::number(
           "lqr.pitch.q_rate", "s^2/rad^2", 0, kBig, "pitch LQR weight on rate",
@@ -42,7 +42,7 @@ Table make_table() {
           "lqr.pitch.r", "1/(N m)^2", 1e-12, kBig, "pitch LQR weight on torque",
           [](auto& p) -> auto& { return p.pitch.r; }),
       Table::number(
-          "lqr.yaw.q_angle", "1/rad^2", 0, kBig, "yaw LQR weight on angle error",
+          "lqr.yaw.q_angle", "1/rad^2", 1e-12, kBig, "yaw LQR weight on angle error",
           [](auto& p) -> auto& { return p.yaw.q_angle; }),
       Table::number(
           "lqr.yaw.q_rate", "s^2/rad^2", 0, kBig, "yaw LQR weight on rate",
