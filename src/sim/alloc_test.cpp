@@ -3,6 +3,8 @@
 // ticks may: the scheduled parameter change, the command label's first buffer).
 #include <gtest/gtest.h>
 
+#include "controllers/registry.hpp"
+
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -67,7 +69,8 @@ TEST(AllocationTest, TheCounterSeesAllocations) {
 }
 
 TEST(AllocationTest, SingleVehicleLoopAllocatesNothingPerStep) {
-  Simulation s(config(3000), model::VehicleParams{}, model::State{}, control::ControllerConfig{}, altitude_step());
+  Simulation s(config(3000), model::VehicleParams{}, model::State{},
+               controllers::make_config("paper", model::VehicleParams{}), altitude_step());
   for (Tick k = 0; k < 100; ++k) s.tick(k);  // warm-up: the schedule, the first command label
   const long n = allocations_during([&] {
     for (Tick k = 100; k < 3000; ++k) s.tick(k);
@@ -78,7 +81,8 @@ TEST(AllocationTest, SingleVehicleLoopAllocatesNothingPerStep) {
 
 TEST(AllocationTest, RecordedRunAllocatesNothingPerStepBeyondTheRecorder) {
   // run() with an observer: the scheduler and TickRecord add nothing either.
-  Simulation s(config(2000), model::VehicleParams{}, model::State{}, control::ControllerConfig{}, altitude_step());
+  Simulation s(config(2000), model::VehicleParams{}, model::State{},
+               controllers::make_config("paper", model::VehicleParams{}), altitude_step());
   double z_sum = 0.0;
   long during = -1;
   s.run([&](const TickRecord& r) {
@@ -99,8 +103,8 @@ TEST(AllocationTest, RecordedRunAllocatesNothingPerStepBeyondTheRecorder) {
 TEST(AllocationTest, SwarmLoopAllocatesNothingPerStep) {
   SwarmLayout layout;
   layout.vehicles = 16;
-  Swarm swarm(config(2000), model::VehicleParams{}, model::State{}, control::ControllerConfig{}, altitude_step(),
-              layout);
+  Swarm swarm(config(2000), model::VehicleParams{}, model::State{},
+              controllers::make_config("paper", model::VehicleParams{}), altitude_step(), layout);
   swarm.run_ticks(0, 99, 1, 100);  // warm-up
   EXPECT_EQ(allocations_during([&] { swarm.run_ticks(100, 1999, 1, 100); }), 0);
   for (int i = 0; i < swarm.size(); ++i) EXPECT_GT(swarm.vehicle(i).plant().state().p_W.z(), 5.0) << i;
@@ -110,8 +114,8 @@ TEST(AllocationTest, SwarmOnTwoThreadsAllocatesOnlyToStartTheThread) {
   // Starting the second thread allocates its state; the count must not grow with ticks or vehicles.
   SwarmLayout layout;
   layout.vehicles = 16;
-  Swarm swarm(config(3000), model::VehicleParams{}, model::State{}, control::ControllerConfig{}, altitude_step(),
-              layout);
+  Swarm swarm(config(3000), model::VehicleParams{}, model::State{},
+              controllers::make_config("paper", model::VehicleParams{}), altitude_step(), layout);
   swarm.run_ticks(0, 99, 2, 100);
   const long short_run = allocations_during([&] { swarm.run_ticks(100, 109, 2, 100); });
   const long long_run = allocations_during([&] { swarm.run_ticks(110, 2999, 2, 100); });

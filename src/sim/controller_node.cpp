@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <stdexcept>
 
 #include "model/attitude.hpp"
 
@@ -13,7 +14,9 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
       trajectory_(config.trajectory),
       trajectory_offset_W_(config.trajectory_offset_W),
       settings_(config.node),
-      controller_(config.controller->clone()) {
+      controller_(config.controller ? config.controller->clone() : nullptr) {
+  if (!controller_)
+    throw std::invalid_argument("ControllerNode: the config has no controller (controllers::make_config)");
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   output_.outputs.assign(controller_->output_names().size(), 0.0);
   status_.controller = controller_->type();
