@@ -77,8 +77,9 @@ REQUIRED_COLUMNS = (
     "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
 )
 
-# Read when present (saturation flags, docs/outputs.md); older trajectories lack them.
-OPTIONAL_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat", "att_err")
+# Read when present (saturation flags, the attitude error Psi; docs/outputs.md); older trajectories lack them.
+SATURATION_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
+OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err",)
 # Angles are drawn unwrapped (no 2 pi jumps), their setpoints too.
 ANGLE_COLUMNS = ("roll", "pitch", "yaw", "roll_des", "pitch_des", "yaw_des")
 COLOR_SATURATED = "#d62728"
@@ -262,7 +263,7 @@ def shade_saturation(ax, traj, lo=None, hi=None):
     """Shades the intervals where a rotor was saturated (red) or the tilt limit acted (orange);
     returns legend handles for what was shaded."""
     handles = []
-    if not all(traj.has(c) for c in OPTIONAL_COLUMNS):
+    if not all(traj.has(c) for c in SATURATION_COLUMNS):
         return handles
     t = traj["t"]
     any_rotor = np.zeros(len(t), dtype=bool)
