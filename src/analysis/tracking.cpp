@@ -25,8 +25,9 @@ struct Accumulator {
 
 const std::vector<std::string>& tracking_figure_names() {
   static const std::vector<std::string> names = {
-      "position_rmse_m", "position_max_m", "x_rmse_m", "x_max_m",           "y_rmse_m",          "y_max_m",
-      "z_rmse_m",        "z_max_m",        "yaw_rmse_rad", "attitude_error_rmse", "attitude_error_max"};
+      "position_rmse_m",   "position_max_m", "x_rmse_m", "x_max_m",      "y_rmse_m",
+      "y_max_m",           "z_rmse_m",       "z_max_m",  "yaw_rmse_rad", "attitude_error_rmse",
+      "attitude_error_max"};
   return names;
 }
 

@@ -387,9 +387,7 @@ model::State initial_state(const Scenario& sc) {
   return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
 }
 
-Scenario load_scenario(const std::string& path) {
-  return read_scenario(YamlSection::load_file(path), path, nullptr);
-}
+Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path, nullptr); }
 
 Scenario load_scenario(const YAML::Node& node, const std::string& path,
                        const model::VehicleParams* controller_vehicle) {

@@ -103,9 +103,9 @@ struct Scenario {
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
-  std::optional<SwarmSpec> swarm;    ///< present when the file has a `swarm:` section
-  std::optional<HoldSpec> hold;      ///< analysis.hold
-  std::optional<LimitsSpec> limits;  ///< analysis.limits
+  std::optional<SwarmSpec> swarm;        ///< present when the file has a `swarm:` section
+  std::optional<HoldSpec> hold;          ///< analysis.hold
+  std::optional<LimitsSpec> limits;      ///< analysis.limits
   std::optional<TrackingSpec> tracking;  ///< analysis.tracking, or its defaults when a trajectory is tracked
 };
 

@@ -22,10 +22,9 @@ constexpr std::ptrdiff_t kJudgedColumns = 12;  // x .. yaw_des, the first of ser
 }  // namespace
 
 const std::vector<std::string>& series_columns() {
-  static const std::vector<std::string> names = {"x",     "y",     "z",     "roll",     "pitch",     "yaw",
-                                                 "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
-                                                 "sat1",  "sat2",  "sat3",  "sat4",     "tilt_sat",  "U1",
-                                                 "att_err"};
+  static const std::vector<std::string> names = {"x",     "y",     "z",        "roll",      "pitch",   "yaw",  "x_des",
+                                                 "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "sat1", "sat2",
+                                                 "sat3",  "sat4",  "tilt_sat", "U1",        "att_err"};
   return names;
 }
 
@@ -251,10 +250,12 @@ TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series)
     return it->second;
   };
   const auto psi = v.find("att_err");
-  const analysis::TrackingSeries s{series.t_s,      column("x_des"), column("y_des"), column("z_des"),
-                                   column("yaw_des"), column("x"),   column("y"),     column("z"),
-                                   column("yaw"),
-                                   psi == v.end() ? std::span<const double>() : std::span<const double>(psi->second)};
+  const analysis::TrackingSeries s{
+      series.t_s,        column("x_des"),
+      column("y_des"),   column("z_des"),
+      column("yaw_des"), column("x"),
+      column("y"),       column("z"),
+      column("yaw"),     psi == v.end() ? std::span<const double>() : std::span<const double>(psi->second)};
   const analysis::TrackingFigures f = analysis::tracking_figures(s, spec.after_s, spec.reference_period_s);
   r.samples = f.samples;
   r.figures = f.values;
@@ -395,8 +396,7 @@ CriterionCells cells(const std::vector<CriterionResult>& criteria, const std::st
 }  // namespace
 
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
-                              const std::optional<HoldResult>& hold,
-                              const std::optional<SaturationResult>& saturation,
+                              const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
                               const std::optional<TrackingResult>& tracking) {
   std::string s = fmt::format("scenario {}\n", scenario.name);
   for (const StepResult& r : results) {

@@ -41,11 +41,10 @@ std::array<int, 5> ControlColumns::saturation_columns() const {
 
 const std::vector<std::string>& TrajectoryWriter::columns() {
   static const std::vector<std::string> c = {
-      "t",    "x",     "y",      "z",        "vx",    "vy",    "vz",       "qw",        "qx",      "qy", "qz",
-      "roll", "pitch", "yaw",    "p",        "q",     "r",     "w1",       "w2",        "w3",      "w4", "cmd1",
-      "cmd2", "cmd3",  "cmd4",   "x_des",    "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "U1", "U2",
-      "U3",   "U4",    "safety", "watchdog", "sat1",  "sat2",  "sat3",     "sat4",      "tilt_sat",
-      "att_err"};
+      "t",    "x",     "y",      "z",        "vx",    "vy",    "vz",       "qw",        "qx",       "qy",     "qz",
+      "roll", "pitch", "yaw",    "p",        "q",     "r",     "w1",       "w2",        "w3",       "w4",     "cmd1",
+      "cmd2", "cmd3",  "cmd4",   "x_des",    "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",  "U1",     "U2",
+      "U3",   "U4",    "safety", "watchdog", "sat1",  "sat2",  "sat3",     "sat4",      "tilt_sat", "att_err"};
   return c;
 }
 
