@@ -22,6 +22,17 @@ writes PNG figures into RUN_DIR, printing the path of every file written:
                       at max(15 s, 2.5 x settling time) after the step.
   overview.png        2x3 grid: 3D path, position, attitude, body rates,
                       rotor speeds, vertical speed.
+  tracking_path.png   when metrics.json has "tracking" (the run tracked a
+                      trajectory): the 3D path against the reference, and
+                      the top view (x-y), side by side.
+  tracking_axes.png   x, y, z against their reference over time.
+  tracking_error.png  the position error (reference - measured) at the
+                      samples the figures count (the controller's steps, at
+                      the multiples of metrics.json's reference_period_s):
+                      its norm and each axis over time, and the attitude
+                      error Psi (column att_err) when the controller reports
+                      one; the samples before after_s are greyed and the
+                      y-axes fit the judged ones.
 
 Conventions assumed for metrics.json: the time figures (peak_time_s, rise_time_s,
 t95_s, settling_time_2pct_s) are measured from the step time t_step_s; the
@@ -66,8 +77,9 @@ REQUIRED_COLUMNS = (
     "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
 )
 
-# Read when present (saturation flags, docs/outputs.md); older trajectories lack them.
-OPTIONAL_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
+# Read when present (saturation flags, the attitude error Psi; docs/outputs.md); older trajectories lack them.
+SATURATION_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
+OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err",)
 # Angles are drawn unwrapped (no 2 pi jumps), their setpoints too.
 ANGLE_COLUMNS = ("roll", "pitch", "yaw", "roll_des", "pitch_des", "yaw_des")
 COLOR_SATURATED = "#d62728"
@@ -251,7 +263,7 @@ def shade_saturation(ax, traj, lo=None, hi=None):
     """Shades the intervals where a rotor was saturated (red) or the tilt limit acted (orange);
     returns legend handles for what was shaded."""
     handles = []
-    if not all(traj.has(c) for c in OPTIONAL_COLUMNS):
+    if not all(traj.has(c) for c in SATURATION_COLUMNS):
         return handles
     t = traj["t"]
     any_rotor = np.zeros(len(t), dtype=bool)
@@ -360,6 +372,8 @@ def load_metrics(path):
         "hold": obj.get("hold") if isinstance(obj.get("hold"), dict) else None,
         # Saturation figures and limits, passed through as written; None without them.
         "saturation": obj.get("saturation") if isinstance(obj.get("saturation"), dict) else None,
+        # Tracking figures (a trajectory or analysis.tracking), passed through; None without them.
+        "tracking": obj.get("tracking") if isinstance(obj.get("tracking"), dict) else None,
     }
 
 
@@ -801,6 +815,171 @@ def plot_overview(traj, out_path, metrics, run_dir):
     plt.close(fig)
 
 
+# --------------------------------------------------------------------------- tracking
+
+TRACKING_FIGURE_NAMES = ("tracking_path.png", "tracking_axes.png", "tracking_error.png")
+TRACKING_FIGSIZE = (13.0, 5.5)
+XYZ_COLORS = ("#d62728", "#2ca02c", "#1f4fd6")
+
+
+def _tracking_after_s(metrics):
+    v = (metrics.get("tracking") or {}).get("after_s")
+    return float(v) if _is_number(v) and math.isfinite(float(v)) else 0.0
+
+
+def _tracking_subtitle(metrics):
+    tr = metrics.get("tracking") or {}
+    figs = tr.get("figures") or {}
+    parts = [f"judged from t = {_tracking_after_s(metrics):g} s"]
+    if _is_number(figs.get("position_rmse_m")):
+        parts.append(f"position RMSE {float(figs['position_rmse_m']):.4g} m")
+    if _is_number(figs.get("position_max_m")):
+        parts.append(f"max {float(figs['position_max_m']):.4g} m")
+    if _is_number(figs.get("yaw_rmse_rad")):
+        parts.append(f"yaw RMSE {float(figs['yaw_rmse_rad']):.4g} rad")
+    if isinstance(tr.get("passed"), bool) and tr.get("criteria"):
+        parts.append("PASSED" if tr["passed"] else "FAILED")
+    return "  ·  ".join(parts)
+
+
+def _mark_after(ax, t, after_s):
+    """Greys the samples before after_s (not judged) and returns a legend handle, or [] when none."""
+    if after_s <= float(t[0]):
+        return []
+    ax.axvspan(float(t[0]), min(after_s, float(t[-1])), color="0.88", lw=0, zorder=0)
+    return [Patch(facecolor="0.88", label=f"not judged (t < {after_s:g} s)")]
+
+
+def plot_tracking_path(traj, out_path, metrics):
+    x, y, z = traj["x"], traj["y"], traj["z"]
+    xd, yd, zd = traj["x_des"], traj["y_des"], traj["z_des"]
+    fig = plt.figure(figsize=TRACKING_FIGSIZE, dpi=DPI)
+    gs = fig.add_gridspec(1, 2, left=0.03, right=0.98, bottom=0.1, top=0.86, wspace=0.15)
+    ax3 = fig.add_subplot(gs[0, 0], projection="3d")
+    ax3.plot(xd, yd, zd, color=COLOR_SETPOINT, lw=1.2, ls="--", label="reference")
+    ax3.plot(x, y, z, color=COLOR_VAR, lw=1.2, label="path")
+    ax3.scatter([x[0]], [y[0]], [z[0]], color="k", marker="o", s=18, label="start", depthshade=False)
+    lims = [_finite_minmax(a, b) or (0.0, 0.0) for a, b in ((x, xd), (y, yd), (z, zd))]
+    half = max(0.5, max((b - a) for a, b in lims) / 2.0) * 1.05
+    for setter, (a, b) in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), lims):
+        c = 0.5 * (a + b)
+        setter(c - half, c + half)
+    ax3.set_box_aspect((1, 1, 1))
+    ax3.set_xlabel("x [m]", fontsize=9)
+    ax3.set_ylabel("y [m]", fontsize=9)
+    ax3.set_zlabel("z [m]", fontsize=9)
+    ax3.tick_params(labelsize=8)
+    ax3.set_title("3D path (equal axes)", fontsize=11)
+    ax3.legend(fontsize=8, loc="upper left", framealpha=0.85)
+
+    ax = fig.add_subplot(gs[0, 1])
+    ax.plot(xd, yd, color=COLOR_SETPOINT, lw=1.2, ls="--", label="reference")
+    ax.plot(x, y, color=COLOR_VAR, lw=1.2, label="path")
+    ax.plot([x[0]], [y[0]], "ko", ms=4, label="start")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m]", fontsize=9)
+    ax.set_ylabel("y [m]", fontsize=9)
+    ax.set_title("Top view (x–y, equal axes)", fontsize=11)
+    ax.tick_params(labelsize=8)
+    ax.grid(True, color="0.88", lw=0.6)
+    ax.legend(fontsize=8, loc="upper right", framealpha=0.85)
+    fig.text(0.03, 0.955, "Trajectory tracking: path", fontsize=14, fontweight="bold", ha="left", va="center")
+    fig.text(0.03, 0.915, _tracking_subtitle(metrics), fontsize=9, color="0.3", ha="left", va="center")
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
+def plot_tracking_axes(traj, out_path, metrics):
+    t = traj["t"]
+    after_s = _tracking_after_s(metrics)
+    fig, axes = plt.subplots(3, 1, figsize=(10.0, 8.0), dpi=DPI, sharex=True)
+    fig.subplots_adjust(left=0.09, right=0.97, bottom=0.07, top=0.89, hspace=0.12)
+    for ax, ch, col in zip(axes, ("x", "y", "z"), XYZ_COLORS):
+        h_ref, = ax.plot(t, traj[ch + "_des"], color=COLOR_SETPOINT, lw=1.2, ls="--", label=f"{ch} reference")
+        h, = ax.plot(t, traj[ch], color=col, lw=1.2, label=ch)
+        handles = [h, h_ref] + _mark_after(ax, t, after_s)
+        ax.set_ylabel(f"{ch} [m]", fontsize=9)
+        ax.tick_params(labelsize=8)
+        ax.grid(True, color="0.88", lw=0.6)
+        ax.legend(handles=handles, fontsize=8, loc="upper right", framealpha=0.85)
+    axes[-1].set_xlabel("time t [s]", fontsize=9)
+    if t[-1] > t[0]:
+        axes[-1].set_xlim(float(t[0]), float(t[-1]))
+    fig.text(0.09, 0.96, "Trajectory tracking: position against the reference", fontsize=14,
+             fontweight="bold", ha="left", va="center")
+    fig.text(0.09, 0.925, _tracking_subtitle(metrics), fontsize=9, color="0.3", ha="left", va="center")
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
+def tracking_errors(traj, reference_period_s=0.0):
+    """Errors as metrics.json's tracking figures define them, at the samples they count: "t" the
+    samples at the multiples of reference_period_s (the controller's steps, where the recorded reference
+    is current; every sample for 0), reference minus measured for x, y, z [m], their Euclidean norm
+    "norm", and "psi" (None without an att_err column)."""
+    t = traj["t"]
+    keep = np.ones(len(t), dtype=bool)
+    if reference_period_s > 0:
+        k = t / reference_period_s
+        keep = np.abs(k - np.round(k)) <= 1e-6
+    e = {"t": t[keep]}
+    e.update({ch: (traj[ch + "_des"] - traj[ch])[keep] for ch in ("x", "y", "z")})
+    e["norm"] = np.sqrt(e["x"] ** 2 + e["y"] ** 2 + e["z"] ** 2)
+    e["psi"] = traj["att_err"][keep] if traj.has("att_err") else None
+    return e
+
+
+def _reference_period_s(metrics):
+    v = (metrics.get("tracking") or {}).get("reference_period_s")
+    return float(v) if _is_number(v) and math.isfinite(float(v)) and float(v) > 0 else 0.0
+
+
+def plot_tracking_error(traj, out_path, metrics):
+    t = traj["t"]
+    after_s = _tracking_after_s(metrics)
+    e = tracking_errors(traj, _reference_period_s(metrics))
+    te = e["t"]
+    psi = e["psi"]
+    has_psi = psi is not None and np.any(np.isfinite(psi))
+    rows = 3 if has_psi else 2
+    fig, axes = plt.subplots(rows, 1, figsize=(10.0, 2.7 * rows + 0.8), dpi=DPI, sharex=True)
+    fig.subplots_adjust(left=0.09, right=0.97, bottom=0.07, top=1.0 - 0.75 / (2.7 * rows + 0.8), hspace=0.14)
+
+    def finish(ax, handles, ylabel, values, from_zero=False):
+        handles = handles + _mark_after(ax, t, after_s)
+        ax.set_ylabel(ylabel, fontsize=9)
+        ax.tick_params(labelsize=8)
+        ax.grid(True, color="0.88", lw=0.6)
+        # Scaled to the judged interval: the start-up transient would hide the tracking error.
+        judged = te >= after_s
+        lo_hi = _finite_minmax(*(v[judged] for v in values)) if judged.any() else None
+        if lo_hi is not None:
+            lo, hi = lo_hi
+            pad = 0.1 * (hi - lo) if hi > lo else max(1e-3, abs(hi) * 0.1)
+            lo = 0.0 if from_zero else lo - pad
+            ax.set_ylim(lo, hi + pad + 0.35 * max(hi - lo, 2 * pad))
+        ax.legend(handles=handles, fontsize=8, loc="upper right", framealpha=0.85, ncol=len(handles))
+
+    h, = axes[0].plot(te, e["norm"], color="k", lw=1.2, label="|e| (3D)")
+    finish(axes[0], [h], "position error |e| [m]", [e["norm"]], from_zero=True)
+    hs = [axes[1].plot(te, e[ch], color=col, lw=1.2, label=f"e_{ch}")[0] for ch, col in zip(("x", "y", "z"), XYZ_COLORS)]
+    axes[1].axhline(0.0, color="0.5", lw=0.8)
+    finish(axes[1], hs, "error per axis [m]", [e["x"], e["y"], e["z"]])
+    if has_psi:
+        h, = axes[2].plot(te, psi, color="#8c564b", lw=1.2, label="Ψ = ½ tr(I − R_dᵀR)")
+        finish(axes[2], [h], "attitude error Ψ [-]", [psi], from_zero=True)
+    axes[-1].set_xlabel("time t [s]", fontsize=9)
+    if t[-1] > t[0]:
+        axes[-1].set_xlim(float(t[0]), float(t[-1]))
+    top = 1.0 - 0.75 / (2.7 * rows + 0.8)
+    fig.text(0.09, top + (1 - top) * 0.7, "Trajectory tracking: error (reference − measured, at the controller's steps)",
+             fontsize=14, fontweight="bold", ha="left", va="center")
+    fig.text(0.09, top + (1 - top) * 0.3, _tracking_subtitle(metrics), fontsize=9, color="0.3", ha="left",
+             va="center")
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
 # --------------------------------------------------------------------------- main
 
 
@@ -879,6 +1058,13 @@ def run(run_dir):
     plot_overview(traj, out, metrics, run_dir)
     written.append(out)
     print(out, flush=True)
+
+    if metrics is not None and metrics.get("tracking") is not None:
+        for name, plot in zip(TRACKING_FIGURE_NAMES, (plot_tracking_path, plot_tracking_axes, plot_tracking_error)):
+            out = os.path.join(run_dir, name)
+            plot(traj, out, metrics)
+            written.append(out)
+            print(out, flush=True)
     return written
 
 

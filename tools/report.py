@@ -11,8 +11,10 @@ embedded as base64 data URIs, no external URL) with
   - per analysed step a table of the step figures: our value, the criterion
     band, ok/FAIL, and the reference value and its source when metrics.json
     has a "reference",
-  - the step figure of each step of metrics.json and overview.png, when present
-    (other PNGs in RUN_DIR are not this run's and are left out),
+  - the tracking figures and their criteria when metrics.json has "tracking",
+  - the step figure of each step of metrics.json, overview.png and, for a
+    tracking run, tracking_path.png, tracking_axes.png and tracking_error.png,
+    when present (other PNGs in RUN_DIR are not this run's and are left out),
   - the scenario YAML (RUN_DIR/scenario.yaml) in a <pre>,
   - versions: quadcosim (the text given with --version-text, e.g. the output of
     `quadcosim --version`), Python, numpy, matplotlib.
@@ -137,10 +139,12 @@ def png_data_uri(path):
 
 
 def _figure_sort_key(path):
-    """step_z.png, step_z_2.png ... in channel order, overview.png last."""
+    """step_z.png, step_z_2.png ... in channel order, then overview.png, then the tracking figures."""
     name = os.path.basename(path)
     if name == "overview.png":
         return (2, 0, 0, name)
+    if name in plot_run.TRACKING_FIGURE_NAMES:
+        return (3, plot_run.TRACKING_FIGURE_NAMES.index(name), 0, name)
     m = re.fullmatch(r"step_([a-z]+)(?:_(\d+))?\.png", name)
     if m and m.group(1) in plot_run.CHANNEL_ORDER:
         return (0, plot_run.CHANNEL_ORDER.index(m.group(1)), int(m.group(2) or 1), name)
@@ -150,8 +154,10 @@ def _figure_sort_key(path):
 def figure_files(run_dir, metrics):
     """The figures of this run that are present: the step figures of metrics.json's steps (named as
     plot_run.py names them) and overview.png. Any other PNG in RUN_DIR (left by another run) is not
-    this run's and is left out."""
+    this run's and is left out. A tracking run (metrics.json has "tracking") adds its tracking figures."""
     names = plot_run.step_figure_names(metrics["steps"]) + ["overview.png"]
+    if metrics.get("tracking") is not None:
+        names += list(plot_run.TRACKING_FIGURE_NAMES)
     files = [os.path.join(run_dir, n) for n in names if os.path.isfile(os.path.join(run_dir, n))]
     return sorted(files, key=_figure_sort_key)
 
@@ -255,6 +261,30 @@ def build_html(run_dir, metrics, version_text):
             w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
               f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
         w("</table>")
+
+    tr = metrics.get("tracking")
+    if tr:
+        tp = tr.get("passed")
+        mark = "" if not tr.get("criteria") else (" — ok" if tp else " — FAIL")
+        after = tr.get("after_s")
+        after = f"{float(after):g}" if plot_run._is_number(after) else "?"
+        w(f'<h2 id="tracking">Trajectory tracking from t = {esc(after)} s{esc(mark)}</h2>')
+        crit = {c.get("figure"): c for c in tr.get("criteria", []) if isinstance(c, dict)}
+        w("<table>")
+        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
+        for key, value in (tr.get("figures") or {}).items():
+            c = crit.get(key)
+            band = _band(c) if c else "—"
+            status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
+            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+            unit = " m" if key.endswith("_m") else (" rad" if key.endswith("_rad") else "")
+            ours = "—" if not plot_run._is_number(value) else f"{float(value):.4g}{unit}"
+            w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
+              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
+        w("</table>")
+        notes = [c.get("note") for c in tr.get("criteria", []) if isinstance(c, dict) and c.get("note")]
+        for note in dict.fromkeys(notes):
+            w(f'<p class="note">{esc(note)}</p>')
 
     w("<h2>Figures</h2>")
     files = figure_files(run_dir, metrics)

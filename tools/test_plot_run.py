@@ -163,6 +163,39 @@ def make_run(run_dir, steps, n_rows=1501, dt=0.01, with_metrics=True, drop=(),
                        "steps": entries, "passed": all(e["passed"] for e in entries)}, f, indent=2)
 
 
+def make_tracking_run(run_dir, tracking=True, psi=True, n_rows=2001, dt=0.01, offset_x=0.03):
+    """A run tracking a 2 m circle at 5 m (10 s a lap): the reference held between 50 Hz controller
+    steps, the vehicle `offset_x` behind it in x; att_err a constant 1e-4 (nan when not psi).
+    metrics.json has "tracking" when `tracking` (after_s 5, reference_period_s 0.02)."""
+    make_run(run_dir, [], n_rows=n_rows, dt=dt, with_metrics=False, extra_columns=False)
+    t = np.arange(n_rows) * dt
+    held = t - np.remainder(np.round(t / dt).astype(int), 2) * dt  # the last controller step's time
+    ang, ang_held = 2 * math.pi * t / 10.0, 2 * math.pi * held / 10.0
+    with open(os.path.join(run_dir, "trajectory.csv")) as f:
+        names = f.readline().strip().split(",")
+    data = np.loadtxt(os.path.join(run_dir, "trajectory.csv"), delimiter=",", skiprows=1, ndmin=2)
+    col = {n: data[:, i] for i, n in enumerate(names)}
+    col["x"], col["y"], col["z"] = 2 * np.cos(ang) - offset_x, 2 * np.sin(ang), np.full(n_rows, 5.0)
+    col["x_des"], col["y_des"], col["z_des"] = 2 * np.cos(ang_held), 2 * np.sin(ang_held), np.full(n_rows, 5.0)
+    names = names + ["att_err"]
+    col["att_err"] = np.full(n_rows, 1e-4 if psi else math.nan)
+    with open(os.path.join(run_dir, "trajectory.csv"), "w") as f:
+        f.write(",".join(names) + "\n")
+        for row in np.column_stack([col[n] for n in names]):
+            f.write(",".join(repr(float(v)) for v in row) + "\n")
+    metrics = {"scenario": "circle", "description": "synthetic circle", "steps": [], "passed": True}
+    if tracking:
+        metrics["tracking"] = {
+            "after_s": 5.0, "reference_period_s": 0.02, "samples": 751,
+            "figures": {"position_rmse_m": offset_x, "position_max_m": offset_x, "x_rmse_m": offset_x,
+                        "yaw_rmse_rad": 0.0, "attitude_error_rmse": 1e-4 if psi else None},
+            "criteria": [{"figure": "position_rmse_m", "min": None, "max": 0.05, "value": offset_x,
+                          "passed": True, "note": None}],
+            "passed": True}
+    with open(os.path.join(run_dir, "metrics.json"), "w") as f:
+        json.dump(metrics, f, indent=2)
+
+
 def png_size(path):
     """(width, height) from the IHDR chunk; raises AssertionError if not a PNG."""
     with open(path, "rb") as f:
@@ -476,6 +509,77 @@ class StepOnTraceTest(unittest.TestCase):
                 json.dump(m, f)
             with self.assertRaisesRegex(self.pr.InputError, "settling_band_pct"):
                 self.pr.load_metrics(os.path.join(run, "metrics.json"))
+
+
+class TrackingPlotTest(unittest.TestCase):
+    """tracking_*.png for a run whose metrics.json has "tracking", and the errors they draw."""
+
+    TRACKING_PNGS = ("tracking_path.png", "tracking_axes.png", "tracking_error.png")
+
+    def setUp(self):
+        self._tmp = tempfile.TemporaryDirectory(prefix="plot_run_tracking_")
+        self.tmp = self._tmp.name
+        self.env = dict(os.environ, MPLCONFIGDIR=os.path.join(self.tmp, "mplconfig"))
+
+    def tearDown(self):
+        self._tmp.cleanup()
+
+    def run_script(self, run_dir):
+        return subprocess.run([plot_python(), SCRIPT, run_dir], capture_output=True, text=True,
+                              timeout=180, env=self.env)
+
+    def test_tracking_figures_are_written_for_a_tracking_run(self):
+        run = os.path.join(self.tmp, "run")
+        make_tracking_run(run)
+        res = self.run_script(run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        sizes = {"tracking_path.png": ((1500, 650), (2400, 1000)),  # 13 x 5.5 in at 150 dpi
+                 "tracking_axes.png": ((1300, 1000), (1700, 1400)),  # 10 x 8 in
+                 "tracking_error.png": ((1300, 1200), (1700, 1500))}  # 10 x 8.9 in with the Psi row
+        for name in self.TRACKING_PNGS:
+            path = os.path.join(run, name)
+            self.assertIn(path, res.stdout.splitlines())
+            w, h = png_size(path)
+            (w0, h0), (w1, h1) = sizes[name]
+            self.assertTrue(w0 <= w <= w1 and h0 <= h <= h1, f"{name}: implausible size {w}x{h}")
+            self.assertGreater(os.path.getsize(path), 20_000, name)
+
+    def test_without_psi_the_error_figure_has_two_rows(self):
+        run = os.path.join(self.tmp, "run")
+        make_tracking_run(run, psi=False)
+        res = self.run_script(run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        _, h = png_size(os.path.join(run, "tracking_error.png"))
+        self.assertLess(h, 1100)  # (2 x 2.7 + 0.8) in at 150 dpi = 930 px
+
+    def test_no_tracking_figures_without_tracking_in_metrics(self):
+        run = os.path.join(self.tmp, "run")
+        make_tracking_run(run, tracking=False)
+        res = self.run_script(run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        for name in self.TRACKING_PNGS:
+            self.assertFalse(os.path.exists(os.path.join(run, name)), name)
+
+    def test_errors_are_counted_at_the_controller_steps(self):
+        if importlib.util.find_spec("matplotlib") is None:
+            self.skipTest("matplotlib not importable in this interpreter")
+        spec = importlib.util.spec_from_file_location("plot_run", SCRIPT)
+        pr = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(pr)
+        run = os.path.join(self.tmp, "run")
+        make_tracking_run(run, offset_x=0.03)
+        traj = pr.load_trajectory(os.path.join(run, "trajectory.csv"))
+        e = pr.tracking_errors(traj, 0.02)
+        # Every other sample (t = 0, 0.02, ...): there the reference is current, the error the 3 cm in x.
+        self.assertEqual(len(e["t"]), 1001)
+        np.testing.assert_allclose(e["x"], 0.03, atol=1e-12)
+        np.testing.assert_allclose(e["y"], 0.0, atol=1e-12)
+        np.testing.assert_allclose(e["norm"], 0.03, atol=1e-12)
+        np.testing.assert_allclose(e["psi"], 1e-4)
+        # Every sample: the held reference lags the vehicle by up to v dt = 1.257 m/s x 10 ms.
+        every = pr.tracking_errors(traj, 0.0)
+        self.assertEqual(len(every["t"]), 2001)
+        self.assertGreater(every["norm"].max(), 0.03 + 0.005)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
-from test_plot_run import make_run, plot_python, png_size  # noqa: E402
+from test_plot_run import make_run, make_tracking_run, plot_python, png_size  # noqa: E402
 
 REPORT = os.path.join(HERE, "report.py")
 COMPARE = os.path.join(HERE, "compare_runs.py")
@@ -129,6 +129,38 @@ class ReportTest(ToolTestBase):
         self.assertEqual(page.count("data:image/png;base64,"), 2)
         self.assertIn(">step_z.png<", page)
         self.assertNotIn("step_x.png", page)
+
+    def test_tracking_table_and_figures(self):
+        run = os.path.join(self.tmp, "run")
+        make_tracking_run(run)
+        res = self.run_tool(PLOT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        res = self.run_tool(REPORT, run)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
+            page = f.read()
+        self.assertIn("Trajectory tracking from t = 5 s — ok", page)
+        self.assertIn(">position_rmse_m<", page)
+        self.assertIn(">0.03 m<", page)
+        self.assertIn("≤ 0.05", page)
+        # overview and the three tracking figures, in that order
+        self.assertEqual(page.count("data:image/png;base64,"), 4)
+        order = [page.index(f">{n}<") for n in ("overview.png", "tracking_path.png", "tracking_axes.png",
+                                               "tracking_error.png")]
+        self.assertEqual(order, sorted(order))
+
+    def test_failed_tracking_criterion_shows_fail(self):
+        def fail_tracking(m):
+            m["tracking"] = {"after_s": 10, "reference_period_s": 0.02, "samples": 0,
+                             "figures": {"position_rmse_m": 0.2},
+                             "criteria": [{"figure": "position_rmse_m", "min": None, "max": 0.05, "value": 0.2,
+                                           "passed": False, "note": None}],
+                             "passed": False}
+            m["passed"] = False
+        page = self.report_with_metrics(fail_tracking)
+        self.assertIn("Trajectory tracking from t = 10 s — FAIL", page)
+        self.assertIn(">0.2 m<", page)
+        self.assertIn(">FAILED<", page)
 
     def test_failed_verdict(self):
         def fail_roll(m):

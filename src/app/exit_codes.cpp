@@ -19,7 +19,7 @@ const std::vector<ExitCodeRow>& exit_code_table() {
   // README.md "Exit codes" shows these rows; tests/cli/exit_codes.py compares the two.
   static const std::vector<ExitCodeRow> table = {
       {kOk, "success", "*"},
-      {kFailed, "a step or hold criterion failed", "run summary"},
+      {kFailed, "a step, hold, limits or tracking criterion failed", "run summary"},
       {kFailed, "fewer runs passed than --min-pass-rate asks", "sweep"},
       {kFailed, "a loop is unstable closed-loop (its margins are undefined)", "margins"},
       {kFailed, "the enclave has problems (listed)", "security"},

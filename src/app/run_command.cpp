@@ -229,8 +229,9 @@ int run_command(const RunOptions& opt) {
     const auto results = io::evaluate_steps(sc.steps, series);
     const auto hold = sc.hold ? std::optional(io::evaluate_hold(*sc.hold, series)) : std::nullopt;
     const auto saturation = io::evaluate_saturation(sc, series);
-    io::write_metrics_json((out / "metrics.json").string(), sc, results, hold, saturation);
-    const std::string table = io::format_step_table(sc, results, hold, saturation);
+    const auto tracking = sc.tracking ? std::optional(io::evaluate_tracking(*sc.tracking, series)) : std::nullopt;
+    io::write_metrics_json((out / "metrics.json").string(), sc, results, hold, saturation, tracking);
+    const std::string table = io::format_step_table(sc, results, hold, saturation, tracking);
     std::ofstream((out / "metrics.txt").string()) << table;
     std::cout << table;
     if (saturation) {
@@ -239,7 +240,7 @@ int run_command(const RunOptions& opt) {
     std::cout << "wrote " << (out / "trajectory.csv").string()
               << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
-    return io::passed_overall(results, hold, saturation) ? exit_code::kOk : exit_code::kFailed;
+    return io::passed_overall(results, hold, saturation, tracking) ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {
     throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());
   } catch (const std::invalid_argument& e) {

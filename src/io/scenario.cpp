@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <string_view>
 
 #include "analysis/step_metrics.hpp"
+#include "analysis/tracking.hpp"
 #include "controllers/registry.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/trajectory_yaml.hpp"
@@ -255,10 +257,34 @@ LimitsSpec read_limits(YamlSection& l, double duration_s) {
   return spec;
 }
 
+// analysis.tracking: after_s and criteria on the tracking figures, as a step's criteria.
+TrackingSpec read_tracking(YamlSection& s, double duration_s) {
+  TrackingSpec spec;
+  spec.after_s = s.number("after_s", 0.0, 0.0, duration_s);
+  auto c = s.section("criteria");
+  if (!c) s.fail("criteria", "missing; expected e.g. {position_rmse_m: [null, 0.05]}");
+  const auto& names = analysis::tracking_figure_names();
+  for (const std::string& fig : c->keys()) {
+    if (std::find(names.begin(), names.end(), fig) == names.end()) {
+      std::string expected;
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+      }
+      c->fail(fig, "unknown tracking figure (expected " + expected + ")");
+    }
+    const auto [min, max] = c->bounds(fig);
+    spec.criteria.push_back(Criterion{fig, min, max});
+  }
+  if (spec.criteria.empty()) s.fail("criteria", "expected at least one figure");
+  s.reject_unknown_keys();
+  return spec;
+}
+
 void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
   std::vector<StepSpec>& steps = sc.steps;
   if (auto h = analysis.section("hold")) sc.hold = read_hold(*h, duration_s);
   if (auto l = analysis.section("limits")) sc.limits = read_limits(*l, duration_s);
+  if (auto t = analysis.section("tracking")) sc.tracking = read_tracking(*t, duration_s);
   const std::vector<std::string> channels = {"x", "y", "z", "roll", "pitch", "yaw"};
   int index = 0;
   for (const YAML::Node& n : analysis.sequence("steps")) {
@@ -428,6 +454,10 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
   if (auto t = root.section("trajectory")) {
     sc.controller.trajectory = read_trajectory(*t, std::filesystem::path(path).parent_path());
+  }
+  if (sc.controller.trajectory && !sc.tracking) sc.tracking.emplace();  // figures without criteria
+  if (sc.tracking) {
+    sc.tracking->reference_period_s = sc.simulation.plant.clock.period_s() * sc.simulation.controller_divider;
   }
   root.reject_unknown_keys();
   return sc;

@@ -73,6 +73,16 @@ struct HoldSpec {
 /// "max_horizontal_error_m", "rms_horizontal_error_m", "max_vertical_error_m".
 const std::vector<std::string>& hold_figure_names();
 
+/// analysis.tracking: how closely the run follows its reference trajectory (analysis/tracking.hpp), judged
+/// over t >= after_s. Present in a Scenario also without that key when the scenario has a `trajectory:`
+/// (after_s 0, no criteria), so every tracking run reports its figures.
+struct TrackingSpec {
+  double after_s = 0.0;
+  std::vector<Criterion> criteria;  ///< on analysis::tracking_figure_names()
+  /// The controller's period [s] (simulation.controller_rate_hz): only samples at its steps are judged.
+  double reference_period_s = 0.0;
+};
+
 /// analysis.limits: upper bounds on the run's saturation and control effort (io::SaturationResult).
 /// Keys max_saturated_s, max_rotor_saturated_s (each rotor), max_tilt_saturated_s and
 /// max_rms_u1_deviation_n become criteria {figure, max} on the figures saturated_s,
@@ -93,9 +103,10 @@ struct Scenario {
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;
   std::vector<StepSpec> steps;
-  std::optional<SwarmSpec> swarm;    ///< present when the file has a `swarm:` section
-  std::optional<HoldSpec> hold;      ///< analysis.hold
-  std::optional<LimitsSpec> limits;  ///< analysis.limits
+  std::optional<SwarmSpec> swarm;        ///< present when the file has a `swarm:` section
+  std::optional<HoldSpec> hold;          ///< analysis.hold
+  std::optional<LimitsSpec> limits;      ///< analysis.limits
+  std::optional<TrackingSpec> tracking;  ///< analysis.tracking, or its defaults when a trajectory is tracked
 };
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).

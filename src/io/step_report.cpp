@@ -13,6 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "analysis/tracking.hpp"
+
 namespace quadcosim::io {
 
 namespace {
@@ -20,9 +22,9 @@ constexpr std::ptrdiff_t kJudgedColumns = 12;  // x .. yaw_des, the first of ser
 }  // namespace
 
 const std::vector<std::string>& series_columns() {
-  static const std::vector<std::string> names = {"x",     "y",     "z",     "roll",     "pitch",     "yaw",
-                                                 "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
-                                                 "sat1",  "sat2",  "sat3",  "sat4",     "tilt_sat",  "U1"};
+  static const std::vector<std::string> names = {"x",     "y",     "z",        "roll",      "pitch",   "yaw",  "x_des",
+                                                 "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "sat1", "sat2",
+                                                 "sat3",  "sat4",  "tilt_sat", "U1",        "att_err"};
   return names;
 }
 
@@ -238,6 +240,41 @@ HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
   return r;
 }
 
+TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series) {
+  TrackingResult r;
+  r.spec = spec;
+  const auto& v = series.values;
+  auto column = [&](const std::string& name) -> std::span<const double> {
+    const auto it = v.find(name);
+    if (it == v.end()) throw std::logic_error("no recorded series for " + name);
+    return it->second;
+  };
+  const auto psi = v.find("att_err");
+  const analysis::TrackingSeries s{
+      series.t_s,        column("x_des"),
+      column("y_des"),   column("z_des"),
+      column("yaw_des"), column("x"),
+      column("y"),       column("z"),
+      column("yaw"),     psi == v.end() ? std::span<const double>() : std::span<const double>(psi->second)};
+  const analysis::TrackingFigures f = analysis::tracking_figures(s, spec.after_s, spec.reference_period_s);
+  r.samples = f.samples;
+  r.figures = f.values;
+  for (const Criterion& c : spec.criteria) {
+    const auto it = r.figures.find(c.figure);
+    std::string note;
+    if (it == r.figures.end()) {
+      const bool psi_figure = c.figure.rfind("attitude_error", 0) == 0;
+      note = f.samples == 0 ? fmt::format("no sample with a reference at or after t = {:g} s", spec.after_s)
+             : psi_figure   ? "the controller reports no attitude error (att_err is NaN)"
+                            : "no sample with a finite yaw and yaw_des";
+    }
+    const CriterionResult cr = judge(c, it == r.figures.end() ? std::nullopt : std::optional(it->second), note);
+    r.passed = r.passed && cr.passed;
+    r.criteria.push_back(cr);
+  }
+  return r;
+}
+
 namespace {
 nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 
@@ -256,12 +293,14 @@ nlohmann::json criteria_json(const std::vector<CriterionResult>& criteria) {
 }  // namespace
 
 bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
-                    const std::optional<SaturationResult>& saturation) {
-  return all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed);
+                    const std::optional<SaturationResult>& saturation, const std::optional<TrackingResult>& tracking) {
+  return all_passed(results) && (!hold || hold->passed) && (!saturation || saturation->passed) &&
+         (!tracking || tracking->passed);
 }
 
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
-                            const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation) {
+                            const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
+                            const std::optional<TrackingResult>& tracking) {
   nlohmann::json j;
   j["scenario"] = scenario.name;
   j["description"] = scenario.description;
@@ -312,14 +351,28 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
     j["saturation"] = {
         {"figures", figs}, {"criteria", criteria_json(saturation->criteria)}, {"passed", saturation->passed}};
   }
-  j["passed"] = passed_overall(results, hold, saturation);
+  if (tracking) {
+    nlohmann::json figs = nlohmann::json::object();
+    for (const auto& name : analysis::tracking_figure_names()) {
+      const auto it = tracking->figures.find(name);
+      figs[name] = it == tracking->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
+    }
+    j["tracking"] = {{"after_s", tracking->spec.after_s},
+                     {"reference_period_s", tracking->spec.reference_period_s},
+                     {"samples", tracking->samples},
+                     {"figures", figs},
+                     {"criteria", criteria_json(tracking->criteria)},
+                     {"passed", tracking->passed}};
+  }
+  j["passed"] = passed_overall(results, hold, saturation, tracking);
   return j;
 }
 
 void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
-                        const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation) {
+                        const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
+                        const std::optional<TrackingResult>& tracking) {
   std::ofstream out(path);
-  out << metrics_json(scenario, results, hold, saturation).dump(2) << '\n';
+  out << metrics_json(scenario, results, hold, saturation, tracking).dump(2) << '\n';
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
@@ -343,8 +396,8 @@ CriterionCells cells(const std::vector<CriterionResult>& criteria, const std::st
 }  // namespace
 
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
-                              const std::optional<HoldResult>& hold,
-                              const std::optional<SaturationResult>& saturation) {
+                              const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
+                              const std::optional<TrackingResult>& tracking) {
   std::string s = fmt::format("scenario {}\n", scenario.name);
   for (const StepResult& r : results) {
     const auto& f = r.figures;
@@ -389,6 +442,18 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
       const CriterionCells c = cells(saturation->criteria, name);
       s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
                        it != saturation->figures.end() ? fmt::format("{:.3f}", it->second) : "-", c.crit, c.verdict);
+    }
+  }
+  if (tracking) {
+    s += fmt::format("tracking from t = {:g} s ({} samples, at the controller's steps every {:g} s): {}\n",
+                     tracking->spec.after_s, tracking->samples, tracking->spec.reference_period_s,
+                     tracking->passed ? (tracking->criteria.empty() ? "no criteria" : "PASS") : "FAIL");
+    for (const auto& name : analysis::tracking_figure_names()) {
+      const auto it = tracking->figures.find(name);
+      const CriterionCells c = cells(tracking->criteria, name);
+      s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
+                       it != tracking->figures.end() ? fmt::format("{:.4g}", it->second) : "-", c.crit, c.verdict);
+      for (const auto& note : c.notes) s += fmt::format("    {}: {}\n", name, note);
     }
   }
   return s;

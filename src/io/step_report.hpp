@@ -45,6 +45,15 @@ struct HoldResult {
   bool passed = true;
 };
 
+/// The tracking figures of a run (analysis::tracking_figures over t >= spec.after_s) and their verdicts.
+struct TrackingResult {
+  TrackingSpec spec;
+  std::size_t samples = 0;                ///< samples the position figures count
+  std::map<std::string, double> figures;  ///< by analysis::tracking_figure_names(); absent when not computable
+  std::vector<CriterionResult> criteria;
+  bool passed = true;
+};
+
 /// What a run did against its motor and tilt limits (docs/outputs.md, "Saturation"), and the
 /// verdicts of the scenario's analysis.limits.
 struct SaturationResult {
@@ -61,12 +70,12 @@ struct SaturationResult {
 const std::vector<std::string>& saturation_figure_names();
 
 /// The columns a Series holds besides t, in this order: the judged channels and their setpoints (x .. yaw,
-/// x_des .. yaw_des), then the saturation flags sat1..sat4, tilt_sat and U1 (absent from a trajectory.csv
-/// written before they existed).
+/// x_des .. yaw_des), then the saturation flags sat1..sat4, tilt_sat, U1 and the attitude error att_err
+/// (absent from a trajectory.csv written before they existed).
 const std::vector<std::string>& series_columns();
 
 /// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des; the
-/// saturation columns and U1 when present). Throws std::runtime_error naming the file and the
+/// saturation columns, U1 and att_err when present). Throws std::runtime_error naming the file and the
 /// missing column or bad line.
 Series read_series(const std::string& trajectory_csv);
 
@@ -85,29 +94,38 @@ std::string saturation_warning(const SaturationResult& saturation);
 bool all_passed(const std::vector<StepResult>& results);
 
 /// The verdict of a run (metrics.json "passed", the exit code of `run`, a sweep run's "passed"):
-/// every step passed, and the hold and the saturation limits when judged.
+/// every step passed, and the hold, the saturation limits and the tracking when judged.
 bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
-                    const std::optional<SaturationResult>& saturation);
+                    const std::optional<SaturationResult>& saturation,
+                    const std::optional<TrackingResult>& tracking = {});
 
 /// Evaluates the hold criterion over the samples with t >= spec.after_s.
 HoldResult evaluate_hold(const HoldSpec& spec, const Series& series);
+
+/// Evaluates the tracking figures and criteria over the samples with t >= spec.after_s: reference the
+/// x_des, y_des, z_des, yaw_des columns, measured x, y, z, yaw, Psi the att_err column when present. A
+/// criterion on a figure that is absent fails, with a note saying why.
+TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series);
 
 /// The content of metrics.json (schema in docs/outputs.md), for callers that add to it (a sweep adds
 /// the run's seed and varied values).
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
                             const std::optional<HoldResult>& hold = {},
-                            const std::optional<SaturationResult>& saturation = {});
+                            const std::optional<SaturationResult>& saturation = {},
+                            const std::optional<TrackingResult>& tracking = {});
 
 /// Writes metrics.json (schema in docs/outputs.md). Throws std::runtime_error on I/O failure.
-/// `hold` and `saturation`, when given, are written under "hold" and "saturation" and count in "passed".
+/// `hold`, `saturation` and `tracking`, when given, are written under their names and count in "passed".
 void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
                         const std::optional<HoldResult>& hold = {},
-                        const std::optional<SaturationResult>& saturation = {});
+                        const std::optional<SaturationResult>& saturation = {},
+                        const std::optional<TrackingResult>& tracking = {});
 
 /// A fixed-width table: one line per figure with value, criterion, verdict and reference; a figure
 /// that could not be judged shows why under its line.
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
                               const std::optional<HoldResult>& hold = {},
-                              const std::optional<SaturationResult>& saturation = {});
+                              const std::optional<SaturationResult>& saturation = {},
+                              const std::optional<TrackingResult>& tracking = {});
 
 }  // namespace quadcosim::io

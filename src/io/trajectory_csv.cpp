@@ -16,7 +16,7 @@ namespace quadcosim::io {
 
 ControlColumns ControlColumns::none() {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  return {nan, nan, nan, nan, nan, nan, Eigen::Vector4d::Constant(nan), false};
+  return {nan, nan, nan, nan, nan, nan, Eigen::Vector4d::Constant(nan), false, {}, false, nan};
 }
 
 ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
@@ -30,7 +30,8 @@ ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
           Eigen::Vector4d(m.u[0], m.u[1], m.u[2], m.u[3]),
           m.safety,
           m.rotor_saturated,
-          m.tilt_saturated};
+          m.tilt_saturated,
+          m.attitude_error};
 }
 
 std::array<int, 5> ControlColumns::saturation_columns() const {
@@ -40,10 +41,10 @@ std::array<int, 5> ControlColumns::saturation_columns() const {
 
 const std::vector<std::string>& TrajectoryWriter::columns() {
   static const std::vector<std::string> c = {
-      "t",    "x",     "y",      "z",        "vx",    "vy",    "vz",       "qw",        "qx",      "qy", "qz",
-      "roll", "pitch", "yaw",    "p",        "q",     "r",     "w1",       "w2",        "w3",      "w4", "cmd1",
-      "cmd2", "cmd3",  "cmd4",   "x_des",    "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "U1", "U2",
-      "U3",   "U4",    "safety", "watchdog", "sat1",  "sat2",  "sat3",     "sat4",      "tilt_sat"};
+      "t",    "x",     "y",      "z",        "vx",    "vy",    "vz",       "qw",        "qx",       "qy",     "qz",
+      "roll", "pitch", "yaw",    "p",        "q",     "r",     "w1",       "w2",        "w3",       "w4",     "cmd1",
+      "cmd2", "cmd3",  "cmd4",   "x_des",    "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",  "U1",     "U2",
+      "U3",   "U4",    "safety", "watchdog", "sat1",  "sat2",  "sat3",     "sat4",      "tilt_sat", "att_err"};
   return c;
 }
 
@@ -75,7 +76,7 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des, c.pitch_des,
                  c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
   const auto sat = c.saturation_columns();
-  fmt::format_to(out, "{},{},{},{},{}\n", sat[0], sat[1], sat[2], sat[3], sat[4]);
+  fmt::format_to(out, "{},{},{},{},{},{}\n", sat[0], sat[1], sat[2], sat[3], sat[4], c.attitude_error);
   if (buffer_.size() > (1 << 16)) {
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     buffer_.clear();
@@ -125,8 +126,9 @@ void SeriesRecorder::add(double t_s, const model::State& x, const ControlColumns
                         static_cast<double>(sat[2]),
                         static_cast<double>(sat[3]),
                         static_cast<double>(sat[4]),
-                        c.U[0]};
-  static_assert(std::size(row) == 18);
+                        c.U[0],
+                        c.attitude_error};
+  static_assert(std::size(row) == 19);
   assert(columns_.size() == std::size(row));
   series_.t_s.push_back(t_s);
   for (std::size_t i = 0; i < columns_.size(); ++i) columns_[i]->push_back(row[i]);

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct ControlColumns {
   /// (ControllerStatus.rotor_saturated); the position loop's tilt limit acted (tilt_saturated).
   std::array<bool, 4> rotor_saturated{};
   bool tilt_saturated = false;
+  /// The controller's attitude error Psi = 1/2 tr(I - R_d^T R) (ControllerStatus.attitude_error; NaN
+  /// when it has no desired attitude, and in open loop): the column att_err.
+  double attitude_error = std::numeric_limits<double>::quiet_NaN();
   /// The columns sat1..sat4, tilt_sat: 1 where the flag is set, else 0.
   std::array<int, 5> saturation_columns() const;
   static ControlColumns none();
@@ -55,7 +59,7 @@ class TrajectoryWriter {
 
 /// Builds in memory the Series that read_series() gives for the trajectory.csv TrajectoryWriter writes from
 /// the same ticks: t, the judged channels and setpoints (series_columns()), the saturation flags and U1, the
-/// same doubles bit for bit (the CSV holds shortest round-trip text), without writing the file.
+/// same doubles bit for bit (the CSV holds shortest round-trip text), without writing the file; att_err too.
 class SeriesRecorder {
  public:
   SeriesRecorder();

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "analysis/step_metrics.hpp"
+#include "analysis/tracking.hpp"
 #include "control/care.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/trajectory_csv.hpp"
@@ -61,12 +62,14 @@ void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
   r.steps = io::evaluate_steps(sc.steps, series);
   if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
   r.saturation = io::evaluate_saturation(sc, series);
-  r.passed = io::passed_overall(r.steps, r.hold, r.saturation);
+  if (sc.tracking) r.tracking = io::evaluate_tracking(*sc.tracking, series);
+  r.passed = io::passed_overall(r.steps, r.hold, r.saturation, r.tracking);
 }
 
 // Figure name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct"; a second step
 // of the same channel gets "roll#2.overshoot_pct"), "hold.<figure>" for the hold, "saturation.<figure>" for
-// the rotor and tilt saturation (every run has them; null when the run could not be flown).
+// the rotor and tilt saturation (every run has them; null when the run could not be flown), "tracking.<figure>"
+// for the tracking figures of a scenario with a trajectory or analysis.tracking.
 std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunResult& r, const io::Scenario& sc) {
   std::vector<std::pair<std::string, std::optional<double>>> out;
   std::map<std::string, int> seen;
@@ -96,6 +99,15 @@ std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunR
     }
     out.emplace_back("saturation." + name, v);
   }
+  if (sc.tracking) {
+    for (const auto& name : analysis::tracking_figure_names()) {
+      std::optional<double> v;
+      if (ok && r.tracking) {
+        if (auto it = r.tracking->figures.find(name); it != r.tracking->figures.end()) v = it->second;
+      }
+      out.emplace_back("tracking." + name, v);
+    }
+  }
   return out;
 }
 
@@ -108,7 +120,7 @@ nlohmann::json values_json(const Sample& s) {
 }  // namespace
 
 nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r) {
-  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation);
+  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation, r.tracking);
   nlohmann::json s;
   s["index"] = r.sample.index;
   s["seed"] = r.sample.seed;
@@ -215,7 +227,7 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
   write_json(dir / "metrics.json", run_metrics_json(plan, sc, r));
   std::ofstream txt(dir / "metrics.txt");
-  txt << io::format_step_table(sc, r.steps, r.hold, r.saturation);
+  txt << io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking);
   if (!txt) throw std::runtime_error((dir / "metrics.txt").string() + ": write failed");
   return r;
 }

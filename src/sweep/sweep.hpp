@@ -21,6 +21,7 @@ struct RunResult {
   std::vector<io::StepResult> steps;
   std::optional<io::HoldResult> hold;
   std::optional<io::SaturationResult> saturation;  ///< rotor and tilt saturation, analysis.limits
+  std::optional<io::TrackingResult> tracking;      ///< analysis.tracking, or figures of a trajectory run
   bool passed = false;
   std::string error;  ///< non-empty when the run could not be done (a refused value, a failed design)
 };
