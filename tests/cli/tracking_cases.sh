@@ -2,7 +2,7 @@
 # Trajectory tracking judged end to end (analysis.tracking), one case per CTest test.
 #   usage: tracking_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/cli_case.sh" "$@"
-S="$SRC/scenarios/examples/circle_se3.yaml"
+S="$SRC/scenarios/tracking/circle_se3.yaml"
 
 case "$CASE" in
   circle_passes)  # figures, criteria and verdict in metrics.json and metrics.txt; att_err last in the CSV

@@ -54,7 +54,7 @@ TEST(ExamplePdController, FollowsACircleWithinTheErrorOfItsLinearLoop) {
     worst = std::max(worst, (r.state.p_W - ref).norm());
   });
   // With the acceleration feedforward the error is that of the attitude loop's lag: far below the
-  // radius (without feedforward a PD loop of these gains lags the circle by about 0.4 m).
+  // radius.
   EXPECT_LT(worst, 0.2);
   EXPECT_GT(worst, 0.0);
 }
