@@ -577,7 +577,7 @@ TEST(TrajectoryWriterTest, HeaderHasTheDocumentedColumns) {
       "t", "x", "y", "z",  "vx", "vy", "vz", "qw",    "qx",    "qy",    "qz",       "roll",      "pitch",  "yaw",
       "p", "q", "r", "w1", "w2", "w3", "w4", "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des"};
   // Appended after watchdog, so that readers by position of the older columns still work.
-  const std::vector<std::string> tail = {"watchdog", "sat1", "sat2", "sat3", "sat4", "tilt_sat"};
+  const std::vector<std::string> tail = {"watchdog", "sat1", "sat2", "sat3", "sat4", "tilt_sat", "att_err"};
   TempDir dir;
   const std::string path = dir.file("trajectory.csv");
   {
@@ -634,7 +634,8 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
                        Eigen::Vector4d(a(7), a(8), a(9), a(10)),
                        k % 2 == 1,
                        {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3},
-                       k % 3 == 1};
+                       k % 3 == 1,
+                       a(11) / 3.0};
       const double t = static_cast<double>(k) * 1e7 / 1e9;
       const bool watchdog = k % 3 == 0;
       w.write(t, x, cmd, c, watchdog);
@@ -680,7 +681,8 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
                           c.rotor_saturated[1] ? 1.0 : 0.0,
                           c.rotor_saturated[2] ? 1.0 : 0.0,
                           c.rotor_saturated[3] ? 1.0 : 0.0,
-                          c.tilt_saturated ? 1.0 : 0.0});
+                          c.tilt_saturated ? 1.0 : 0.0,
+                          c.attitude_error});
     }
     w.close();
   }
@@ -772,7 +774,7 @@ TEST(TrajectoryWriterTest, OpenLoopColumnsAreNan) {
   ASSERT_EQ(cells.size(), header.size());
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const double v = parse_cell(cells[i]);
-    const bool control = header[i].ends_with("_des") || header[i].starts_with("U");
+    const bool control = header[i].ends_with("_des") || header[i].starts_with("U") || header[i] == "att_err";
     if (control) {
       EXPECT_TRUE(std::isnan(v)) << header[i];
     } else {

@@ -7,7 +7,7 @@ S="$SRC/scenarios/tracking/circle_se3.yaml"
 case "$CASE" in
   circle_passes)  # figures, criteria and verdict in metrics.json and metrics.txt; att_err last in the CSV
     "$QC" run "$S" --out "$TMP/run" > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "circle_se3 failed its criteria"; }
-    grep -q "^tracking from t = 10 s (1001 samples, at the controller's steps every 0.02 s): PASS" "$TMP/run/metrics.txt" \
+    grep -q "^tracking from t = 12 s (901 samples, at the controller's steps every 0.02 s): PASS" "$TMP/run/metrics.txt" \
       || { cat "$TMP/run/metrics.txt"; fail "no tracking verdict in metrics.txt"; }
     for f in tracking_path.png tracking_axes.png tracking_error.png; do
       [ -s "$TMP/run/$f" ] || fail "$f not written"
@@ -18,19 +18,19 @@ import csv, json, math, sys
 run = sys.argv[1]
 m = json.load(open(run + "/metrics.json"))
 tr = m["tracking"]
-assert tr["after_s"] == 10 and tr["reference_period_s"] == 0.02 and tr["samples"] == 1001, tr
+assert tr["after_s"] == 12 and tr["reference_period_s"] == 0.02 and tr["samples"] == 901, tr
 names = ["position_rmse_m", "position_max_m", "x_rmse_m", "x_max_m", "y_rmse_m", "y_max_m", "z_rmse_m", "z_max_m",
          "yaw_rmse_rad", "attitude_error_rmse", "attitude_error_max"]
 assert sorted(tr["figures"]) == sorted(names), list(tr["figures"])
 assert all(isinstance(tr["figures"][n], float) for n in names), tr["figures"]
 assert [c["figure"] for c in tr["criteria"]] == ["position_rmse_m", "position_max_m"]
 assert all(c["passed"] for c in tr["criteria"]) and tr["passed"] is True and m["passed"] is True
-# Recompute the RMSE from trajectory.csv: rows at t >= 10 s on the controller's 50 Hz steps.
+# Recompute the RMSE from trajectory.csv: rows at t >= 12 s on the controller's 50 Hz steps.
 rows = list(csv.DictReader(open(run + "/trajectory.csv")))
 assert list(rows[0])[-1] == "att_err", "att_err is not the last column"
 sq = [sum((float(r[a + "_des"]) - float(r[a])) ** 2 for a in "xyz") for r in rows
-      if float(r["t"]) >= 10 and round(float(r["t"]) * 100) % 2 == 0]
-assert len(sq) == 1001
+      if float(r["t"]) >= 12 and round(float(r["t"]) * 100) % 2 == 0]
+assert len(sq) == 901
 rmse = math.sqrt(sum(sq) / len(sq))
 assert abs(rmse - tr["figures"]["position_rmse_m"]) <= 1e-12 * max(1.0, rmse), (rmse, tr["figures"])
 assert rmse < 0.05
@@ -45,7 +45,7 @@ PYEOF
     rc=$?
     set -e
     [ "$rc" -eq 1 ] || { cat "$TMP/log"; fail "exit $rc, expected 1 (a criterion failed)"; }
-    grep -q "^tracking from t = 10 s .*: FAIL" "$TMP/run/metrics.txt" || fail "no FAIL in metrics.txt"
+    grep -q "^tracking from t = 12 s .*: FAIL" "$TMP/run/metrics.txt" || fail "no FAIL in metrics.txt"
     grep -Eq "^  position_rmse_m +[0-9.e-]+ +\[-, 1e-06\] +FAIL" "$TMP/run/metrics.txt" \
       || { cat "$TMP/run/metrics.txt"; fail "the failed criterion is not shown"; }
     "$PY" - "$TMP/run/metrics.json" <<'PYEOF' || fail "metrics.json verdict"
@@ -71,10 +71,10 @@ PYEOF
     }
     check 's/position_max_m:/position_p99_m:/' "analysis.tracking.criteria.position_p99_m"
     check 's/position_max_m:/position_p99_m:/' "unknown tracking figure"
-    check 's/after_s: 10/after_s: 99/' "analysis.tracking.after_s"
+    check 's/after_s: 12 /after_s: 99 /' "analysis.tracking.after_s"
     check 's/position_max_m: \[null, 0.1\]/position_max_m: [0.2, 0.1]/' "min is above max"
     check 's/position_max_m: \[null, 0.1\]/position_max_m: [null, fast]/' "fast"
-    check 's/    after_s: 10/    after_s: 10\n    window_s: 3/' "window_s"
+    check 's/    after_s: 12 /    after_s: 12\n    window_s: 3 /' "window_s"
     ;;
 
   *) fail "unknown case $CASE" ;;
