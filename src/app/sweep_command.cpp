@@ -203,9 +203,9 @@ int sweep_command(const SweepOptions& o) {
   for (const auto& spec : o.vary) grid = grid || sweep::parse_vary(spec).distribution == sweep::Distribution::kGrid;
   const sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
                                             o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
-  if (plan.nominal.steps.empty() && !plan.nominal.hold) {
-    std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps and no hold criterion; "
-              << "a sweep needs something to judge\n";
+  if (plan.nominal.steps.empty() && !plan.nominal.hold && !plan.nominal.tracking) {
+    std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps, no hold criterion and no "
+              << "trajectory to track; a sweep needs something to judge\n";
     return exit_code::kBadInput;
   }
   const fs::path out(o.out_dir);

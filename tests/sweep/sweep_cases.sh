@@ -245,6 +245,25 @@ assert os.path.exists(sys.argv[1] + "/hist_saturation.saturated_s.png"), os.list
 PYEOF
     ;;
 
+  tracking)  # a tracking scenario sweeps like any other: the SE(3) controller designed for the nominal
+    # mass holds z low by (m - m_nominal) g / k_x.z on a heavier vehicle (no integral term), which the
+    # swept tracking figures show for each run.
+    "$QC" sweep "$SRC/scenarios/tracking/circle_se3.yaml" --vary "mass=grid(1.96,2.156)" --out "$TMP/s" --no-plots --min-pass-rate 0.5 \
+      > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "sweep failed"; }
+    "$PY" - "$TMP/s" <<'PYEOF' || fail "tracking figures of the runs"
+import json, sys
+out = sys.argv[1]
+s = json.load(open(out + "/summary.json"))
+runs = {r["values"]["vehicle.mass_kg"]: r for r in s["per_run"]}
+assert sorted(runs) == [1.96, 2.156], list(runs)
+z = {m: r["figures"]["tracking.z_rmse_m"] for m, r in runs.items()}
+expected = (2.156 - 1.96) * 9.81 / 17.64  # (m - m_nominal) g / k_x.z
+assert z[1.96] < 1e-3, z
+assert abs(z[2.156] - expected) < 0.05 * expected, (z, expected)
+assert runs[1.96]["passed"] and runs[2.156]["passed"] == (runs[2.156]["figures"]["tracking.position_rmse_m"] <= 0.05)
+PYEOF
+    ;;
+
   slurm_submit)  # scripts/slurm/submit.sh with relative paths, through a stand-in sbatch that runs the jobs
     # The stand-in runs each job at once in its --chdir folder, as Slurm does (array tasks in turn with
     # SLURM_ARRAY_TASK_ID, an afterok job only when its dependency succeeded), and records its arguments.
