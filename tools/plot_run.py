@@ -551,6 +551,16 @@ def _finite_minmax(*arrays):
 # --------------------------------------------------------------------------- step figure
 
 
+
+def _equal_axes_3d(ax3, *pairs):
+    """Equal scales on a 3D axes: one cube around both series of each (x, y, z) pair, at least 1 m."""
+    lims = [_finite_minmax(a, b) or (0.0, 0.0) for a, b in pairs]
+    half = max(0.5, max((b - a) for a, b in lims) / 2.0) * 1.05
+    for setter, (a, b) in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), lims):
+        c = 0.5 * (a + b)
+        setter(c - half, c + half)
+    ax3.set_box_aspect((1, 1, 1))
+
 def step_on_trace(traj, step):
     """The step in the values of the trace as drawn: {"initial", "target", "half_band", "band_pct",
     "turns"}. An angle is drawn unwrapped from the first row, while metrics.json gives its initial
@@ -749,12 +759,7 @@ def plot_overview(traj, out_path, metrics, run_dir):
     ax3.scatter([x[0]], [y[0]], [z[0]], color="k", marker="o", s=18, label="start", depthshade=False)
     ax3.scatter([x[-1]], [y[-1]], [z[-1]], color="#1f4fd6", marker="s", s=18, label="end",
                 depthshade=False)
-    lims = [_finite_minmax(a, b) or (0.0, 0.0) for a, b in ((x, xd), (y, yd), (z, zd))]
-    half = max(0.5, max((b - a) for a, b in lims) / 2.0) * 1.05
-    for setter, (a, b) in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), lims):
-        c = 0.5 * (a + b)
-        setter(c - half, c + half)
-    ax3.set_box_aspect((1, 1, 1))
+    _equal_axes_3d(ax3, (x, xd), (y, yd), (z, zd))
     ax3.set_xlabel("x [m]", fontsize=8, labelpad=-2)
     ax3.set_ylabel("y [m]", fontsize=8, labelpad=-2)
     ax3.set_zlabel("z [m]", fontsize=8, labelpad=-2)
@@ -859,12 +864,7 @@ def plot_tracking_path(traj, out_path, metrics):
     ax3.plot(xd, yd, zd, color=COLOR_SETPOINT, lw=1.2, ls="--", label="reference")
     ax3.plot(x, y, z, color=COLOR_VAR, lw=1.2, label="path")
     ax3.scatter([x[0]], [y[0]], [z[0]], color="k", marker="o", s=18, label="start", depthshade=False)
-    lims = [_finite_minmax(a, b) or (0.0, 0.0) for a, b in ((x, xd), (y, yd), (z, zd))]
-    half = max(0.5, max((b - a) for a, b in lims) / 2.0) * 1.05
-    for setter, (a, b) in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), lims):
-        c = 0.5 * (a + b)
-        setter(c - half, c + half)
-    ax3.set_box_aspect((1, 1, 1))
+    _equal_axes_3d(ax3, (x, xd), (y, yd), (z, zd))
     ax3.set_xlabel("x [m]", fontsize=9)
     ax3.set_ylabel("y [m]", fontsize=9)
     ax3.set_zlabel("z [m]", fontsize=9)

@@ -89,6 +89,23 @@ def _band(c):
     return "—"
 
 
+def figure_table(w, section, show):
+    """Writes a section's figures (hold, saturation, tracking) as a table against its criteria;
+    show(key, value) gives the value as text with its unit."""
+    crit = {c.get("figure"): c for c in section.get("criteria", []) if isinstance(c, dict)}
+    w("<table>")
+    w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
+    for key, value in (section.get("figures") or {}).items():
+        c = crit.get(key)
+        band = _band(c) if c else "—"
+        status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
+        cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+        ours = "—" if not plot_run._is_number(value) else show(key, float(value))
+        w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
+          f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
+    w("</table>")
+
+
 def step_rows(step):
     """Rows (figure key, ours, band, status, reference) of one step's table."""
     figs, ref = step["figures"], step["reference"]
@@ -227,40 +244,14 @@ def build_html(run_dir, metrics, version_text):
         hp = hold.get("passed")
         w(f"<h2>Position hold from t = {esc(str(hold.get('after_s')))} s"
           f"{esc('' if hp is None else (' — ok' if hp else ' — FAIL'))}</h2>")
-        crit = {c.get("figure"): c for c in hold.get("criteria", []) if isinstance(c, dict)}
-        w("<table>")
-        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
-        for key, value in (hold.get("figures") or {}).items():
-            c = crit.get(key)
-            band = _band(c) if c else "—"
-            status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
-            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
-            ours = "—" if not plot_run._is_number(value) else f"{float(value):.3f} m"
-            w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
-              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
-        w("</table>")
+        figure_table(w, hold, lambda key, v: f"{v:.3f} m")
 
     sat = metrics.get("saturation")
     if sat:
         sp = sat.get("passed")
         mark = "" if not sat.get("criteria") else (" — ok" if sp else " — FAIL")
         w(f'<h2 id="saturation">Saturation and control effort{esc(mark)}</h2>')
-        crit = {}
-        for c in sat.get("criteria", []):
-            if isinstance(c, dict):
-                crit[c.get("figure")] = c
-        w("<table>")
-        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
-        for key, value in (sat.get("figures") or {}).items():
-            c = crit.get(key)
-            band = _band(c) if c else "—"
-            status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
-            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
-            unit = "N" if key.endswith("_n") else "s"
-            ours = "—" if not plot_run._is_number(value) else f"{float(value):.3f} {unit}"
-            w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
-              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
-        w("</table>")
+        figure_table(w, sat, lambda key, v: f"{v:.3f} {'N' if key.endswith('_n') else 's'}")
 
     tr = metrics.get("tracking")
     if tr:
@@ -269,19 +260,8 @@ def build_html(run_dir, metrics, version_text):
         after = tr.get("after_s")
         after = f"{float(after):g}" if plot_run._is_number(after) else "?"
         w(f'<h2 id="tracking">Trajectory tracking from t = {esc(after)} s{esc(mark)}</h2>')
-        crit = {c.get("figure"): c for c in tr.get("criteria", []) if isinstance(c, dict)}
-        w("<table>")
-        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
-        for key, value in (tr.get("figures") or {}).items():
-            c = crit.get(key)
-            band = _band(c) if c else "—"
-            status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
-            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
-            unit = " m" if key.endswith("_m") else (" rad" if key.endswith("_rad") else "")
-            ours = "—" if not plot_run._is_number(value) else f"{float(value):.4g}{unit}"
-            w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
-              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
-        w("</table>")
+        figure_table(w, tr, lambda key, v: f"{v:.4g}" + (" m" if key.endswith("_m") else
+                                                          (" rad" if key.endswith("_rad") else "")))
         notes = [c.get("note") for c in tr.get("criteria", []) if isinstance(c, dict) and c.get("note")]
         for note in dict.fromkeys(notes):
             w(f'<p class="note">{esc(note)}</p>')

@@ -83,31 +83,20 @@ std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunR
                        ok && i < r.steps.size() ? analysis::figure(r.steps[i].figures, name) : std::nullopt);
     }
   }
-  if (sc.hold) {
-    for (const auto& name : io::hold_figure_names()) {
+  // Every figure of `names` as "<group>.<name>": the result's value, or null when the run was not
+  // flown or the result lacks it.
+  const auto add = [&](const char* group, const std::vector<std::string>& names, const auto& result) {
+    for (const auto& name : names) {
       std::optional<double> v;
-      if (ok && r.hold) {
-        if (auto it = r.hold->figures.find(name); it != r.hold->figures.end()) v = it->second;
+      if (ok && result) {
+        if (auto it = result->figures.find(name); it != result->figures.end()) v = it->second;
       }
-      out.emplace_back("hold." + name, v);
+      out.emplace_back(std::string(group) + "." + name, v);
     }
-  }
-  for (const auto& name : io::saturation_figure_names()) {
-    std::optional<double> v;
-    if (ok && r.saturation) {
-      if (auto it = r.saturation->figures.find(name); it != r.saturation->figures.end()) v = it->second;
-    }
-    out.emplace_back("saturation." + name, v);
-  }
-  if (sc.tracking) {
-    for (const auto& name : analysis::tracking_figure_names()) {
-      std::optional<double> v;
-      if (ok && r.tracking) {
-        if (auto it = r.tracking->figures.find(name); it != r.tracking->figures.end()) v = it->second;
-      }
-      out.emplace_back("tracking." + name, v);
-    }
-  }
+  };
+  if (sc.hold) add("hold", io::hold_figure_names(), r.hold);
+  add("saturation", io::saturation_figure_names(), r.saturation);
+  if (sc.tracking) add("tracking", analysis::tracking_figure_names(), r.tracking);
   return out;
 }
 
