@@ -548,10 +548,6 @@ def _finite_minmax(*arrays):
     return min(float(v.min()) for v in vals), max(float(v.max()) for v in vals)
 
 
-# --------------------------------------------------------------------------- step figure
-
-
-
 def _equal_axes_3d(ax3, *pairs):
     """Equal scales on a 3D axes: one cube around both series of each (x, y, z) pair, at least 1 m."""
     lims = [_finite_minmax(a, b) or (0.0, 0.0) for a, b in pairs]
@@ -560,6 +556,10 @@ def _equal_axes_3d(ax3, *pairs):
         c = 0.5 * (a + b)
         setter(c - half, c + half)
     ax3.set_box_aspect((1, 1, 1))
+
+
+# --------------------------------------------------------------------------- step figure
+
 
 def step_on_trace(traj, step):
     """The step in the values of the trace as drawn: {"initial", "target", "half_band", "band_pct",
