@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "controllers/registry.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
@@ -16,8 +17,8 @@
 namespace quadcosim::fuzz {
 
 inline control::ControllerConfig hold_one_metre() {
-  control::ControllerConfig c;
-  c.setpoint.p_des_W.z() = 1.0;
+  control::ControllerConfig c = controllers::make_config("paper", model::VehicleParams{});
+  c.node.setpoint.p_des_W.z() = 1.0;
   return c;
 }
 
@@ -34,7 +35,7 @@ class ClosedLoop {
 
   /// `target` names the fuzzer in abort messages; the rotors start at `omega0_rad_s`.
   ClosedLoop(const char* target, double omega0_rad_s)
-      : target_(target), plant_(bus_, topics_, config_.params.vehicle, {}, at_one_metre(omega0_rad_s)) {
+      : target_(target), plant_(bus_, topics_, config_.vehicle, {}, at_one_metre(omega0_rad_s)) {
     controller_.set_log([](const std::string&) {});
     plant_.set_log([](const std::string&) {});
   }
