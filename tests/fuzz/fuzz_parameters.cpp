@@ -60,7 +60,8 @@ struct Setup {
     g_node = nullptr;
   }
   sim::InProcessTransport setup_bus;
-  sim::ControllerNode setup_node{setup_bus, sim::Topics::for_namespace("/drone"), controllers::make_config("paper", model::VehicleParams{})};
+  sim::ControllerNode setup_node{setup_bus, sim::Topics::for_namespace("/drone"),
+                                 controllers::make_config("paper", model::VehicleParams{})};
 };
 
 Setup& setup() {
