@@ -87,6 +87,20 @@ CriterionResult judge(const Criterion& c, const std::optional<double>& value, st
       cr.note.empty() && cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
   return cr;
 }
+
+// Judges each criterion on the figure of r.figures it names, into r.criteria and r.passed; a figure
+// that is absent fails, with why(criterion) as the note.
+template <class Result, class Why>
+void judge_figures(const std::vector<Criterion>& criteria, Result& r, Why why) {
+  for (const Criterion& c : criteria) {
+    const auto it = r.figures.find(c.figure);
+    const CriterionResult cr =
+        it == r.figures.end() ? judge(c, std::nullopt, why(c)) : judge(c, std::optional<double>(it->second));
+    r.passed = r.passed && cr.passed;
+    r.criteria.push_back(cr);
+  }
+}
+std::string no_note(const Criterion&) { return {}; }
 }  // namespace
 
 std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series) {
@@ -171,14 +185,7 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
   for (int k = 0; k < 4; ++k) r.figures[SaturationResult::fmt_rotor(k + 1)] = rotor[k];
   r.figures["tilt_saturated_s"] = tilt;
   if (n_u > 0) r.figures["rms_u1_deviation_n"] = std::sqrt(sum_du2 / static_cast<double>(n_u));
-  if (sc.limits) {
-    for (const Criterion& c : sc.limits->criteria) {
-      const auto it = r.figures.find(c.figure);
-      const CriterionResult cr = judge(c, it == r.figures.end() ? std::nullopt : std::optional(it->second));
-      r.passed = r.passed && cr.passed;
-      r.criteria.push_back(cr);
-    }
-  }
+  if (sc.limits) judge_figures(sc.limits->criteria, r, no_note);
   return r;
 }
 
@@ -231,12 +238,7 @@ HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
     r.figures["rms_horizontal_error_m"] = std::sqrt(sum_h2 / static_cast<double>(count));
     r.figures["max_vertical_error_m"] = max_v;
   }
-  for (const Criterion& c : spec.criteria) {
-    const auto it = r.figures.find(c.figure);
-    const CriterionResult cr = judge(c, it == r.figures.end() ? std::nullopt : std::optional<double>(it->second));
-    r.passed = r.passed && cr.passed;
-    r.criteria.push_back(cr);
-  }
+  judge_figures(spec.criteria, r, no_note);
   return r;
 }
 
@@ -259,24 +261,26 @@ TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series)
   const analysis::TrackingFigures f = analysis::tracking_figures(s, spec.after_s, spec.reference_period_s);
   r.samples = f.samples;
   r.figures = f.values;
-  for (const Criterion& c : spec.criteria) {
-    const auto it = r.figures.find(c.figure);
-    std::string note;
-    if (it == r.figures.end()) {
-      const bool psi_figure = c.figure.rfind("attitude_error", 0) == 0;
-      note = f.samples == 0 ? fmt::format("no sample with a reference at or after t = {:g} s", spec.after_s)
-             : psi_figure   ? "the controller reports no attitude error (att_err is NaN)"
-                            : "no sample with a finite yaw and yaw_des";
-    }
-    const CriterionResult cr = judge(c, it == r.figures.end() ? std::nullopt : std::optional(it->second), note);
-    r.passed = r.passed && cr.passed;
-    r.criteria.push_back(cr);
-  }
+  judge_figures(spec.criteria, r, [&](const Criterion& c) -> std::string {
+    if (f.samples == 0) return fmt::format("no sample with a reference at or after t = {:g} s", spec.after_s);
+    if (c.figure.rfind("attitude_error", 0) == 0) return "the controller reports no attitude error (att_err is NaN)";
+    return "no sample with a finite yaw and yaw_des";
+  });
   return r;
 }
 
 namespace {
 nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
+
+// Every figure of `names` by name: its value, or null when absent.
+nlohmann::json figures_json(const std::vector<std::string>& names, const std::map<std::string, double>& figures) {
+  nlohmann::json figs = nlohmann::json::object();
+  for (const auto& name : names) {
+    const auto it = figures.find(name);
+    figs[name] = it == figures.end() ? nlohmann::json() : nlohmann::json(it->second);
+  }
+  return figs;
+}
 
 nlohmann::json criteria_json(const std::vector<CriterionResult>& criteria) {
   nlohmann::json a = nlohmann::json::array();
@@ -332,35 +336,21 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
   if (hold) {
     nlohmann::json h;
     h["after_s"] = hold->spec.after_s;
-    nlohmann::json figs = nlohmann::json::object();
-    for (const auto& name : hold_figure_names()) {
-      const auto it = hold->figures.find(name);
-      figs[name] = it == hold->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
-    }
-    h["figures"] = figs;
+    h["figures"] = figures_json(hold_figure_names(), hold->figures);
     h["criteria"] = criteria_json(hold->criteria);
     h["passed"] = hold->passed;
     j["hold"] = h;
   }
   if (saturation) {
-    nlohmann::json figs = nlohmann::json::object();
-    for (const auto& name : saturation_figure_names()) {
-      const auto it = saturation->figures.find(name);
-      figs[name] = it == saturation->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
-    }
-    j["saturation"] = {
-        {"figures", figs}, {"criteria", criteria_json(saturation->criteria)}, {"passed", saturation->passed}};
+    j["saturation"] = {{"figures", figures_json(saturation_figure_names(), saturation->figures)},
+                       {"criteria", criteria_json(saturation->criteria)},
+                       {"passed", saturation->passed}};
   }
   if (tracking) {
-    nlohmann::json figs = nlohmann::json::object();
-    for (const auto& name : analysis::tracking_figure_names()) {
-      const auto it = tracking->figures.find(name);
-      figs[name] = it == tracking->figures.end() ? nlohmann::json() : nlohmann::json(it->second);
-    }
     j["tracking"] = {{"after_s", tracking->spec.after_s},
                      {"reference_period_s", tracking->spec.reference_period_s},
                      {"samples", tracking->samples},
-                     {"figures", figs},
+                     {"figures", figures_json(analysis::tracking_figure_names(), tracking->figures)},
                      {"criteria", criteria_json(tracking->criteria)},
                      {"passed", tracking->passed}};
   }
@@ -393,6 +383,23 @@ CriterionCells cells(const std::vector<CriterionResult>& criteria, const std::st
   }
   return c;
 }
+
+// One table row per figure of `names` (value as `show` writes it, "-" when absent), each followed by
+// the notes of its criteria.
+template <class Show>
+std::string figure_rows(const std::vector<std::string>& names, const std::map<std::string, double>& figures,
+                        const std::vector<CriterionResult>& criteria, Show show) {
+  std::string s;
+  for (const auto& name : names) {
+    const auto it = figures.find(name);
+    const CriterionCells c = cells(criteria, name);
+    s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name, it != figures.end() ? show(it->second) : "-", c.crit,
+                     c.verdict);
+    for (const auto& note : c.notes) s += fmt::format("    {}: {}\n", name, note);
+  }
+  return s;
+}
+std::string fixed3(double v) { return fmt::format("{:.3f}", v); }
 }  // namespace
 
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
@@ -427,34 +434,19 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
   }
   if (hold) {
     s += fmt::format("hold from t = {:g} s: {}\n", hold->spec.after_s, hold->passed ? "PASS" : "FAIL");
-    for (const auto& name : hold_figure_names()) {
-      const auto it = hold->figures.find(name);
-      const CriterionCells c = cells(hold->criteria, name);
-      s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
-                       it != hold->figures.end() ? fmt::format("{:.3f}", it->second) : "-", c.crit, c.verdict);
-    }
+    s += figure_rows(hold_figure_names(), hold->figures, hold->criteria, fixed3);
   }
   if (saturation) {
     s += fmt::format("limits (rotor speed and tilt saturation, control effort): {}\n",
                      saturation->passed ? (saturation->criteria.empty() ? "no criteria" : "PASS") : "FAIL");
-    for (const auto& name : saturation_figure_names()) {
-      const auto it = saturation->figures.find(name);
-      const CriterionCells c = cells(saturation->criteria, name);
-      s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
-                       it != saturation->figures.end() ? fmt::format("{:.3f}", it->second) : "-", c.crit, c.verdict);
-    }
+    s += figure_rows(saturation_figure_names(), saturation->figures, saturation->criteria, fixed3);
   }
   if (tracking) {
     s += fmt::format("tracking from t = {:g} s ({} samples, at the controller's steps every {:g} s): {}\n",
                      tracking->spec.after_s, tracking->samples, tracking->spec.reference_period_s,
                      tracking->passed ? (tracking->criteria.empty() ? "no criteria" : "PASS") : "FAIL");
-    for (const auto& name : analysis::tracking_figure_names()) {
-      const auto it = tracking->figures.find(name);
-      const CriterionCells c = cells(tracking->criteria, name);
-      s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name,
-                       it != tracking->figures.end() ? fmt::format("{:.4g}", it->second) : "-", c.crit, c.verdict);
-      for (const auto& note : c.notes) s += fmt::format("    {}: {}\n", name, note);
-    }
+    s += figure_rows(analysis::tracking_figure_names(), tracking->figures, tracking->criteria,
+                     [](double v) { return fmt::format("{:.4g}", v); });
   }
   return s;
 }
