@@ -115,7 +115,9 @@ Eigen::Vector3d attitude_error_vector(const Eigen::Matrix3d& R_d, const Eigen::M
 GeometricController::GeometricController(const model::VehicleParams& vehicle, const GeometricParams& params)
     : ControllerWith(params), vehicle_(vehicle) {
   J_ = Eigen::Vector3d(vehicle.Ixx_kg_m2, vehicle.Iyy_kg_m2, vehicle.Izz_kg_m2).asDiagonal();
-  configure(params);
+  Eigen::FullPivLU<Eigen::Matrix4d> lu(model::mixer_matrix(vehicle_));
+  if (!lu.isInvertible()) throw std::invalid_argument("the vehicle's mixer matrix is singular");
+  mixer_inverse_ = lu.inverse();
 }
 
 const control::ParameterTable<GeometricParams>& GeometricController::table() const {
@@ -124,13 +126,6 @@ const control::ParameterTable<GeometricParams>& GeometricController::table() con
 }
 
 std::span<const std::string> GeometricController::output_names() const { return kOutputNames; }
-
-void GeometricController::configure(const GeometricParams& /*next*/) {
-  // The gains are used as given; only the mixer depends on the vehicle.
-  Eigen::FullPivLU<Eigen::Matrix4d> lu(model::mixer_matrix(vehicle_));
-  if (!lu.isInvertible()) throw std::invalid_argument("the vehicle's mixer matrix is singular");
-  mixer_inverse_ = lu.inverse();
-}
 
 void GeometricController::step(const control::Observation& obs, const control::Reference& ref, double /*dt_s*/,
                                control::ControllerOutput& c) {

@@ -84,7 +84,9 @@ class GeometricController : public control::ControllerWith<GeometricController, 
 
  protected:
   const control::ParameterTable<GeometricParams>& table() const override;
-  void configure(const GeometricParams& next) override;
+  /// The gains are used as given: nothing is designed from them (the mixer inverse, from the vehicle, is
+  /// made once by the constructor).
+  void configure(const GeometricParams&) override {}
 
  private:
   model::VehicleParams vehicle_;
