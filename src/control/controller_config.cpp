@@ -61,33 +61,46 @@ const ParameterTable<NodeSettings>& node_parameters() {
   return table;
 }
 
+std::vector<const ParameterSpec*> all_parameters(const Controller& controller) {
+  std::vector<const ParameterSpec*> out;
+  for (const ParameterSpec& s : node_parameters().specs()) out.push_back(&s);
+  for (const ParameterSpec& s : controller.parameters()) out.push_back(&s);
+  return out;
+}
+
+std::optional<ParameterValue> get_parameter(const NodeSettings& node, const Controller& controller,
+                                            std::string_view name) {
+  if (auto v = node_parameters().get(node, name)) return v;
+  return controller.get_parameter(name);
+}
+
+std::string set_parameter(NodeSettings& node, Controller& controller, std::string_view name,
+                          const ParameterValue& value) {
+  if (node_parameters().find(name)) return node_parameters().set(node, name, value);
+  const Setting setting{std::string(name), value};
+  return controller.set_parameters({&setting, 1});
+}
+
 const ParameterSpec* find_parameter(const ControllerConfig& config, std::string_view name) {
-  for (const ParameterSpec& s : node_parameters().specs()) {
-    if (s.name == name) return &s;
-  }
-  for (const ParameterSpec& s : config.controller->parameters()) {
-    if (s.name == name) return &s;
+  for (const ParameterSpec* s : all_parameters(*config.controller)) {
+    if (s->name == name) return s;
   }
   return nullptr;
 }
 
 std::vector<const ParameterSpec*> all_parameters(const ControllerConfig& config) {
-  std::vector<const ParameterSpec*> out;
-  for (const ParameterSpec& s : node_parameters().specs()) out.push_back(&s);
-  for (const ParameterSpec& s : config.controller->parameters()) out.push_back(&s);
-  return out;
+  return all_parameters(*config.controller);
 }
 
 std::optional<ParameterValue> get_parameter(const ControllerConfig& config, std::string_view name) {
-  if (auto v = node_parameters().get(config.node, name)) return v;
-  return config.controller->get_parameter(name);
+  return get_parameter(config.node, *config.controller, name);
 }
 
 std::string set_parameter(ControllerConfig& config, std::string_view name, const ParameterValue& value) {
   if (node_parameters().find(name)) return node_parameters().set(config.node, name, value);
+  // The configured controller may be shared (swarm vehicles, sweep runs): change a copy.
   std::unique_ptr<Controller> next = config.controller->clone();
-  const Setting setting{std::string(name), value};
-  if (std::string err = next->set_parameters({&setting, 1}); !err.empty()) return err;
+  if (std::string err = set_parameter(config.node, *next, name, value); !err.empty()) return err;
   config.controller = std::move(next);
   return {};
 }

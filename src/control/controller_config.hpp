@@ -64,6 +64,18 @@ struct ControllerConfig {
   std::string_view type() const { return controller->type(); }
 };
 
+/// The parameters of a node flying `controller`: the node's, then the controller's.
+std::vector<const ParameterSpec*> all_parameters(const Controller& controller);
+
+/// A node or controller parameter's value, or nothing for an unknown name.
+std::optional<ParameterValue> get_parameter(const NodeSettings& node, const Controller& controller,
+                                            std::string_view name);
+
+/// Checks and applies one value to the node's settings or its controller. Returns "" on success, else
+/// why it was refused; then nothing changed.
+std::string set_parameter(NodeSettings& node, Controller& controller, std::string_view name,
+                          const ParameterValue& value);
+
 /// The declaration of a node or controller parameter, or nullptr.
 const ParameterSpec* find_parameter(const ControllerConfig& config, std::string_view name);
 

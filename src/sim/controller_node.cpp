@@ -192,21 +192,15 @@ std::int64_t ControllerNode::synchronized_stamp_ns() const {
 }
 
 std::string ControllerNode::set_parameter(const std::string& name, const control::ParameterValue& value) {
-  if (control::node_parameters().find(name)) return control::node_parameters().set(settings_, name, value);
-  const control::Setting setting{name, value};
-  return controller_->set_parameters({&setting, 1});
+  return control::set_parameter(settings_, *controller_, name, value);
 }
 
 std::optional<control::ParameterValue> ControllerNode::get_parameter(std::string_view name) const {
-  if (auto v = control::node_parameters().get(settings_, name)) return v;
-  return controller_->get_parameter(name);
+  return control::get_parameter(settings_, *controller_, name);
 }
 
 std::vector<const control::ParameterSpec*> ControllerNode::parameters() const {
-  std::vector<const control::ParameterSpec*> out;
-  for (const auto& s : control::node_parameters().specs()) out.push_back(&s);
-  for (const auto& s : controller_->parameters()) out.push_back(&s);
-  return out;
+  return control::all_parameters(*controller_);
 }
 
 }  // namespace quadcosim::sim
