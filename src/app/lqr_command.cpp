@@ -13,8 +13,6 @@
 
 namespace quadcosim::app {
 
-std::vector<std::string> registered_controller_types();
-
 namespace {
 std::string complex_str(const std::complex<double>& c) {
   if (c.imag() == 0.0) return fmt::format("{:.6g}", c.real());
@@ -35,7 +33,7 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
   params_cmd
       ->add_option("--controller", params.controller,
                    "the controller type whose parameters follow the node's (default paper; see --list)")
-      ->check(CLI::IsMember(registered_controller_types()));
+      ->check(CLI::IsMember(controllers::controller_type_list()));
   params_cmd->add_flag("--list", params.list, "list the registered controller types instead");
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
@@ -108,12 +106,6 @@ int vehicle_params_table(bool markdown) {
 }
 
 }  // namespace
-
-std::vector<std::string> registered_controller_types() {
-  std::vector<std::string> names;
-  for (const auto& t : controllers::controller_types()) names.emplace_back(t.name);
-  return names;
-}
 
 int params_command(const ParamsOptions& options) {
   if (options.vehicle) return vehicle_params_table(options.markdown);

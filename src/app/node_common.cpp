@@ -53,11 +53,9 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
 }
 
 void add_controller_type_option(CLI::App& cmd, std::string& type) {
-  std::vector<std::string> names;
-  for (const auto& t : controllers::controller_types()) names.emplace_back(t.name);
   cmd.add_option("--controller", type,
                  "the controller type to fly, replacing the scenario's controller.type (`quadcosim params --list`)")
-      ->check(CLI::IsMember(names));
+      ->check(CLI::IsMember(controllers::controller_type_list()));
 }
 
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {

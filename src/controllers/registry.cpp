@@ -27,6 +27,12 @@ const std::array kTypes = {
 
 std::span<const ControllerType> controller_types() { return kTypes; }
 
+std::vector<std::string> controller_type_list() {
+  std::vector<std::string> names;
+  for (const auto& t : kTypes) names.emplace_back(t.name);
+  return names;
+}
+
 std::string controller_type_names() {
   std::string names;
   for (const auto& t : kTypes) names += (names.empty() ? "" : ", ") + std::string(t.name);

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "control/controller.hpp"
 #include "control/controller_config.hpp"
@@ -25,6 +26,9 @@ struct ControllerType {
 
 /// Every registered controller type, "paper" first (the default).
 std::span<const ControllerType> controller_types();
+
+/// The registered names, "paper" first (for choices and flag checks).
+std::vector<std::string> controller_type_list();
 
 /// "paper, se3, ...": the registered names, for messages.
 std::string controller_type_names();

@@ -152,9 +152,7 @@ void read_parameters(YamlSection& s, control::ControllerConfig& c,
 
 // A `controller:` section: `type` (default paper) and the parameters, for `vehicle`.
 control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle) {
-  std::vector<std::string> types;
-  for (const auto& t : controllers::controller_types()) types.emplace_back(t.name);
-  const std::string type = s.choice("type", "paper", types);
+  const std::string type = s.choice("type", "paper", controllers::controller_type_list());
   control::ControllerConfig c;
   try {
     c = controllers::make_config(type, vehicle);
