@@ -1,0 +1,49 @@
+// The names of a quadrotor's FMI variables: what `quadcosim fmu export` gives its plant and
+// controller FMUs, and what the master (fmi/fmu_plant.hpp, fmi/fmu_controller.hpp) maps by default
+// when a scenario's `plant: {fmu: ...}` or `controller: {fmu: ...}` names no variables. Vectors are
+// written as Modelica arrays, 1-based: p_W[1] is x. Frames and symbols are the code's own (docs/model.md):
+// W world (z up), B body; q_WB rotates body to world, listed w, x, y, z.
+#pragma once
+
+#include <array>
+#include <string_view>
+
+namespace quadcosim::fmi::names {
+
+// Plant FMU inputs, controller FMU outputs: the four rotor speed commands [rad/s].
+inline constexpr std::array<std::string_view, 4> kOmegaCmd = {"omega_cmd[1]", "omega_cmd[2]", "omega_cmd[3]",
+                                                              "omega_cmd[4]"};
+
+// Plant FMU outputs, controller FMU inputs.
+inline constexpr std::array<std::string_view, 3> kPosition = {"p_W[1]", "p_W[2]", "p_W[3]"};  ///< [m]
+inline constexpr std::array<std::string_view, 3> kVelocity = {"v_W[1]", "v_W[2]", "v_W[3]"};  ///< [m/s]
+/// Attitude quaternion, w x y z [1].
+inline constexpr std::array<std::string_view, 4> kAttitude = {"q_WB[1]", "q_WB[2]", "q_WB[3]", "q_WB[4]"};
+/// Body angular velocity [rad/s].
+inline constexpr std::array<std::string_view, 3> kRates = {"w_B[1]", "w_B[2]", "w_B[3]"};
+/// Specific force in the body frame, what an accelerometer reads [m/s2].
+inline constexpr std::array<std::string_view, 3> kSpecificForce = {"f_B[1]", "f_B[2]", "f_B[3]"};
+// Plant FMU outputs only.
+/// Roll, pitch, yaw (Z-Y-X Euler angles) [rad].
+inline constexpr std::array<std::string_view, 3> kEuler = {"euler[1]", "euler[2]", "euler[3]"};
+/// Rotor speeds reached (after the motors' lag) [rad/s].
+inline constexpr std::array<std::string_view, 4> kRotorSpeed = {"omega[1]", "omega[2]", "omega[3]", "omega[4]"};
+
+// Plant FMU parameters.
+/// The initial state: this prefix + an output's name ("initial.p_W[3]", "initial.q_WB[1]",
+/// "initial.omega[2]").
+inline constexpr std::string_view kInitialPrefix = "initial.";
+/// Vehicle parameters: this prefix + the parameter's name in model::vehicle_parameters()
+/// ("vehicle.mass_kg", "vehicle.motor.tau_up_s", "vehicle.aero.linear_drag_N_s_m.x").
+inline constexpr std::string_view kVehiclePrefix = "vehicle.";
+
+// Controller FMU inputs besides the sensor values: the reference (flat outputs).
+inline constexpr std::array<std::string_view, 3> kRefPosition = {"ref.p_W[1]", "ref.p_W[2]", "ref.p_W[3]"};  ///< [m]
+inline constexpr std::array<std::string_view, 3> kRefVelocity = {"ref.v_W[1]", "ref.v_W[2]", "ref.v_W[3]"};  ///< [m/s]
+inline constexpr std::array<std::string_view, 3> kRefAcceleration = {"ref.a_W[1]", "ref.a_W[2]",
+                                                                     "ref.a_W[3]"};  ///< [m/s2]
+inline constexpr std::string_view kRefYaw = "ref.yaw";  ///< [rad]
+// Controller FMU parameters: this prefix + the controller's parameter name ("controller.kp_z").
+inline constexpr std::string_view kControllerPrefix = "controller.";
+
+}  // namespace quadcosim::fmi::names
