@@ -50,8 +50,8 @@ class ControllerModel final : public Model {
       throw FmuError("controller parameter refused: " + err);
     }
     for (const control::ParameterSpec& s : controller_->parameters()) {
-      parameters_.push_back(
-          {find_vr(md, std::string(names::kControllerPrefix) + std::string(s.name)), std::string(s.name), s.is_choice()});
+      parameters_.push_back({find_vr(md, std::string(names::kControllerPrefix) + std::string(s.name)),
+                             std::string(s.name), s.is_choice()});
     }
     output_.outputs.assign(controller_->output_names().size(), 0.0);
   }

@@ -114,17 +114,17 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     if (!uri_to_path(fmuResourceLocation, dir, error)) return refuse(error);
     quadcosim::fmi::FmuConfig config = quadcosim::fmi::read_config(dir);
     if (config.fmi_version != quadcosim::fmi::FmiVersion::k2) {
-      return refuse("this FMU is an FMI 3.0 FMU (its resources say so); instantiate it with fmi3InstantiateCoSimulation");
+      return refuse(
+          "this FMU is an FMI 3.0 FMU (its resources say so); instantiate it with fmi3InstantiateCoSimulation");
     }
     if (!fmuGUID || config.guid != fmuGUID) {
       return refuse("GUID mismatch: the FMU's is '" + config.guid + "', the importer gave '" +
                     std::string(fmuGUID ? fmuGUID : "(null)") + "'");
     }
     Instance* raw = inst.get();
-    inst->slave = std::make_unique<Slave>(std::move(config), [raw](Status s, const char* category,
-                                                                   const std::string& message) {
-      raw->log(to_fmi2(s), category, message);
-    });
+    inst->slave = std::make_unique<Slave>(
+        std::move(config),
+        [raw](Status s, const char* category, const std::string& message) { raw->log(to_fmi2(s), category, message); });
   } catch (const std::exception& e) {
     return refuse(e.what());
   } catch (...) {
@@ -208,7 +208,8 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
   return fmi2OK;
 }
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate, size_t*) {
-  return unsupported(c, "fmi2SerializedFMUstateSize", "the FMU state cannot be serialized (canSerializeFMUstate false)");
+  return unsupported(c, "fmi2SerializedFMUstateSize",
+                     "the FMU state cannot be serialized (canSerializeFMUstate false)");
 }
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate, fmi2Byte[], size_t) {
   return unsupported(c, "fmi2SerializeFMUstate", "the FMU state cannot be serialized (canSerializeFMUstate false)");
@@ -219,7 +220,8 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte[], size_t, fm
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference[], size_t, const fmi2ValueReference[],
                                         size_t, const fmi2Real[], fmi2Real[]) {
-  return unsupported(c, "fmi2GetDirectionalDerivative", "no directional derivatives (providesDirectionalDerivative false)");
+  return unsupported(c, "fmi2GetDirectionalDerivative",
+                     "no directional derivatives (providesDirectionalDerivative false)");
 }
 
 // Model Exchange.

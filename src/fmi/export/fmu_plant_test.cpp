@@ -17,11 +17,10 @@ namespace {
 /// One FMI 2 plant instance, instantiated and (by default) initialised.
 class Plant {
  public:
-  explicit Plant(const FmuConfig& config, bool initialise = true)
-      : md_(describe(config)), resources_(config) {
+  explicit Plant(const FmuConfig& config, bool initialise = true) : md_(describe(config)), resources_(config) {
     callbacks_ = log_.fmi2_callbacks();
-    c_ = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, config.guid.c_str(), resources_.uri().c_str(),
-                                 &callbacks_, fmi2False, fmi2False);
+    c_ = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, config.guid.c_str(), resources_.uri().c_str(), &callbacks_,
+                                 fmi2False, fmi2False);
     if (!c_) throw std::runtime_error("instantiate failed: " + log_.last());
     if (initialise) init();
   }
@@ -68,7 +67,8 @@ void expect_outputs(Plant& p, const model::Outputs& y, const model::State& x, co
   auto same = [&](const auto& names, const auto& values) {
     for (std::size_t i = 0; i < names.size(); ++i) {
       const double got = p.get(names[i]), want = values[static_cast<Eigen::Index>(i)];
-      EXPECT_EQ(std::memcmp(&got, &want, sizeof got), 0) << names[i] << " at " << where << ": " << got << " vs " << want;
+      EXPECT_EQ(std::memcmp(&got, &want, sizeof got), 0)
+          << names[i] << " at " << where << ": " << got << " vs " << want;
     }
   };
   same(names::kPosition, y.p_W);
@@ -110,7 +110,8 @@ TEST(FmuPlant, HoverEqualsTheNativeModelBitForBit) {
   c.initial.p_W = {1.0, -2.0, 5.0};
   const double hover = c.vehicle.hover_omega_rad_s();
   c.initial.omega_rad_s.setConstant(hover);
-  const model::State x = fly_side_by_side(c, [&](int) { return model::Vector4::Constant(hover); }, 200);
+  const model::State x = fly_side_by_side(
+      c, [&](int) { return model::Vector4::Constant(hover); }, 200);
   EXPECT_NEAR(x.p_W.z(), 5.0, 1e-9);
 }
 
@@ -127,9 +128,9 @@ TEST(FmuPlant, SpinUpWithMotorLagAndTiltEqualsTheNativeModelBitForBit) {
         return model::Vector4(w * 1.0002, w, w, w);
       },
       100);
-  EXPECT_GT(x.p_W.z(), 0.1);                                                  // it took off
-  EXPECT_GT(std::abs(x.q_WB.x()) + std::abs(x.q_WB.y()), 1e-4);               // and tilted
-  EXPECT_NEAR(x.omega_rad_s[1], 1.2 * hover, 1e-6);  // the lag has settled on the command
+  EXPECT_GT(x.p_W.z(), 0.1);                                     // it took off
+  EXPECT_GT(std::abs(x.q_WB.x()) + std::abs(x.q_WB.y()), 1e-4);  // and tilted
+  EXPECT_NEAR(x.omega_rad_s[1], 1.2 * hover, 1e-6);              // the lag has settled on the command
 }
 
 TEST(FmuPlant, LongerStepsAreTheSameTicks) {

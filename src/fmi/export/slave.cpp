@@ -202,8 +202,7 @@ Status Slave::refresh_outputs() {
 Status Slave::get_numbers(const ValueReference* vr, std::size_t n, VariableType type,
                           const std::function<void(std::size_t, double)>& out) {
   if (state_ == State::kInstantiated) {
-    return refuse(std::string("get") + std::string(type_name(type)) +
-                  " is not allowed before enterInitializationMode");
+    return refuse(std::string("get") + std::string(type_name(type)) + " is not allowed before enterInitializationMode");
   }
   if (n > 0 && (!vr)) return refuse("get" + std::string(type_name(type)) + ": null value reference array");
   for (std::size_t i = 0; i < n; ++i) {
@@ -234,23 +233,23 @@ Status Slave::set_values(const ValueReference* vr, std::size_t n, VariableType t
       case Causality::kParameter:
         if (v.variability == Variability::kConstant) return refuse(call + ": " + v.name + " is a constant");
         if (v.variability == Variability::kFixed && state_ == State::kStepMode) {
-          return refuse(call + ": " + v.name + " is a fixed parameter: it can be set only before exitInitializationMode");
+          return refuse(call + ": " + v.name +
+                        " is a fixed parameter: it can be set only before exitInitializationMode");
         }
         if (v.variability == Variability::kTunable) tunables.push_back(vr[i]);
         break;
       case Causality::kIndependent:
         return refuse(call + ": " + v.name + " is the independent variable (time): it cannot be set");
       default:
-        return refuse(call + ": " + v.name + " is " +
-                      (v.causality == Causality::kOutput ? "an output" : "calculated") +
+        return refuse(call + ": " + v.name + " is " + (v.causality == Causality::kOutput ? "an output" : "calculated") +
                       " (computed by the FMU): it cannot be set");
     }
     if (std::string err = put(i, next); !err.empty()) return refuse(call + ": " + v.name + " " + err);
     if (type != VariableType::kString) {
       const double x = next.number[vr[i]];
       if ((v.min && x < *v.min) || (v.max && x > *v.max)) {
-        return refuse(call + ": " + v.name + " = " + number_text(x) + " is outside [" + number_text(v.min.value_or(-HUGE_VAL)) +
-                      ", " + number_text(v.max.value_or(HUGE_VAL)) + "]");
+        return refuse(call + ": " + v.name + " = " + number_text(x) + " is outside [" +
+                      number_text(v.min.value_or(-HUGE_VAL)) + ", " + number_text(v.max.value_or(HUGE_VAL)) + "]");
       }
     }
   }

@@ -51,8 +51,9 @@ class Model {
 
 /// The model of `config` over the variables of `md` (describe(config)). Throws FmuError.
 std::unique_ptr<Model> make_model(const FmuConfig& config, const ModelDescription& md);
-std::unique_ptr<Model> make_plant_model(const FmuConfig& config, const ModelDescription& md);       // plant_model.cpp
-std::unique_ptr<Model> make_controller_model(const FmuConfig& config, const ModelDescription& md);  // controller_model.cpp
+std::unique_ptr<Model> make_plant_model(const FmuConfig& config, const ModelDescription& md);  // plant_model.cpp
+std::unique_ptr<Model> make_controller_model(const FmuConfig& config,
+                                             const ModelDescription& md);  // controller_model.cpp
 
 /// The value reference of the variable `name` of `md`. Throws FmuError when there is none.
 ValueReference find_vr(const ModelDescription& md, std::string_view name);
