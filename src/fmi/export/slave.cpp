@@ -78,7 +78,8 @@ std::unique_ptr<Model> make_model(const FmuConfig& config, const ModelDescriptio
   return config.kind == FmuKind::kPlant ? make_plant_model(config, md) : make_controller_model(config, md);
 }
 
-Slave::Slave(FmuConfig config, Log log) : config_(std::move(config)), md_(describe(config_)), log_(std::move(log)) {
+Slave::Slave(FmuConfig config, Log log)
+    : config_(std::move(config)), md_(describe(config_)), log_(std::move(log)), time_vr_(find_vr(md_, "time")) {
   restart();
 }
 
@@ -212,6 +213,7 @@ Status Slave::get_numbers(const ValueReference* vr, std::size_t n, VariableType 
   if (state_ == State::kInitialization && outputs_stale_) {
     if (Status s = refresh_outputs(); s != Status::kOK) return s;
   }
+  values_.number[time_vr_] = time_s();
   for (std::size_t i = 0; i < n; ++i) values[i] = static_cast<Out>(values_.number[vr[i]]);
   return Status::kOK;
 }

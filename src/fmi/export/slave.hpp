@@ -126,6 +126,7 @@ class Slave {
   FmuConfig config_;
   ModelDescription md_;
   Log log_;
+  ValueReference time_vr_;  ///< the independent variable, read as the current communication point
   Values values_;
   std::unique_ptr<Model> model_;
   State state_ = State::kInstantiated;
