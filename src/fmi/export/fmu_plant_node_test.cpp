@@ -124,6 +124,61 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
   QC_FMI(fmi2FreeInstance)(fmu);
 }
 
+TEST(FmuPlantNode, SensorNoiseLeftToTheMasterKeepsTheTrueStateOfANoisyNode) {
+  // What a quadcosim run with the FMU as its plant does when the scenario has sensor noise: the node
+  // adds the noise, the FMU (realism.sensor_noise off) reports the truth, which must be the native
+  // node's state bit for bit.
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.realism.seed = 3;
+  c.realism.imu.gyro_noise_density = 0.01;
+  c.realism.pose.position_sigma_m = 0.1;
+  c.initial.p_W = {0.0, 0.0, 1.0};
+  c.initial.omega_rad_s.setConstant(c.vehicle.hover_omega_rad_s() * 1.01);
+  c.guid = make_guid(c);
+
+  sim::InProcessTransport transport;
+  const sim::Topics topics = sim::Topics::for_namespace(c.realism_namespace);
+  sim::PlantOptions o;
+  o.watchdog_ticks = 0;
+  o.realism = c.realism;
+  sim::PlantNode node(transport, topics, c.vehicle, o, c.initial);
+
+  Resources resources(c);
+  Log log;
+  fmi2CallbackFunctions cb = log.fmi2_callbacks();
+  fmi2Component fmu = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, c.guid.c_str(), resources.uri().c_str(), &cb,
+                                              fmi2False, fmi2False);
+  ASSERT_NE(fmu, nullptr) << log.last();
+  const fmi2ValueReference noise = vr_of(c, "realism.sensor_noise");
+  const fmi2Boolean off = fmi2False;
+  ASSERT_EQ(QC_FMI(fmi2SetBoolean)(fmu, &noise, 1, &off), fmi2OK) << log.last();
+  ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(fmu), fmi2OK);
+  ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(fmu), fmi2OK) << log.last();
+  std::vector<fmi2ValueReference> vrs;
+  for (auto names : {names::kPosition, names::kVelocity, names::kRates}) {
+    for (auto n : names) vrs.push_back(vr_of(c, n));
+  }
+  for (auto n : names::kAttitude) vrs.push_back(vr_of(c, n));
+  for (sim::Tick k = 0; k <= 200; ++k) {
+    node.publish_outputs(k);
+    if (k % 2 == 0) {
+      std::vector<double> got(vrs.size());
+      ASSERT_EQ(QC_FMI(fmi2GetReal)(fmu, vrs.data(), vrs.size(), got.data()), fmi2OK);
+      const model::State& x = node.state();
+      const std::vector<double> want = {x.p_W.x(), x.p_W.y(), x.p_W.z(),  x.v_W.x(),  x.v_W.y(),  x.v_W.z(), x.w_B.x(),
+                                        x.w_B.y(), x.w_B.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
+      for (std::size_t i = 0; i < want.size(); ++i) {
+        ASSERT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0) << "output " << i << " at tick " << k;
+      }
+      if (k < 200) ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+    }
+    node.latch_command(k);
+    node.integrate(k);
+  }
+  EXPECT_GT(node.state().p_W.z(), 1.1);  // it climbed on the initial speeds
+  QC_FMI(fmi2FreeInstance)(fmu);
+}
+
 TEST(FmuPlantNode, WindGustsFaultsAndDragGiveThePlantNodesNumbers) {
   FmuConfig c = config_for(FmuKind::kPlant);
   c.realism = rough_air();
