@@ -13,7 +13,8 @@
  * with -DPOINT_MASS_OMIT_DO_STEP (a binary the master must refuse).
  *
  * Besides the physics it has test hooks: fail_at_step (doStep number n answers Error and logs why),
- * log_steps (logs every step), label (a String parameter echoed in the log), resources_ok (1 when
+ * fatal_at_step (likewise Fatal), a rotor command above 2000 rad/s (Warning, the step is taken),
+ * log_steps (logs every step and the termination), label (a String parameter echoed in the log), resources_ok (1 when
  * resources/point_mass.txt was found through the resource location the master passed). */
 #include <math.h>
 #include <stdarg.h>
@@ -51,7 +52,8 @@ enum {
   VR_LOG_STEPS = 32,
   VR_LABEL = 33,
   VR_RESOURCES_OK = 34,
-  VR_TIME = 35 /* FMI 3's independent variable */
+  VR_TIME = 35, /* FMI 3's independent variable */
+  VR_FATAL_AT_STEP = 36
 };
 
 typedef enum { kInstantiated, kInitializing, kStepping, kTerminated, kBroken } Phase;
@@ -83,7 +85,7 @@ typedef struct {
   double omega[4];
   double mass, k_thrust, g, z0, vz0;
   double t, z, vz;
-  int steps, fail_at_step;
+  int steps, fail_at_step, fatal_at_step;
   bool log_steps;
   int resources_ok;
 } PointMass;
@@ -164,6 +166,7 @@ static void set_defaults(PointMass* m) {
   m->vz = 0.0;
   m->steps = 0;
   m->fail_at_step = -1;
+  m->fatal_at_step = -1;
   m->log_steps = false;
   m->label[0] = '\0';
   m->phase = kInstantiated;
@@ -217,8 +220,13 @@ static int get_real(PointMass* m, unsigned int vr, double* value) {
 }
 
 static int set_integer(PointMass* m, unsigned int vr, int value) {
-  if (vr != VR_FAIL_AT_STEP) return fail(m, "SetInteger: value reference %u is no Integer parameter", vr);
-  m->fail_at_step = value;
+  if (vr == VR_FAIL_AT_STEP) {
+    m->fail_at_step = value;
+  } else if (vr == VR_FATAL_AT_STEP) {
+    m->fatal_at_step = value;
+  } else {
+    return fail(m, "SetInteger: value reference %u is no Integer parameter", vr);
+  }
   return kOK;
 }
 
@@ -226,6 +234,7 @@ static int get_integer(PointMass* m, unsigned int vr, int* value) {
   switch (vr) {
     case VR_STEPS: *value = m->steps; return kOK;
     case VR_FAIL_AT_STEP: *value = m->fail_at_step; return kOK;
+    case VR_FATAL_AT_STEP: *value = m->fatal_at_step; return kOK;
     case VR_RESOURCES_OK: *value = m->resources_ok; return kOK;
     default: return fail(m, "GetInteger: value reference %u is no Integer variable", vr);
   }
@@ -273,19 +282,37 @@ __attribute__((unused)) static int do_step(PointMass* m, double t, double h) {
     return fail(m, "DoStep: communication point %.17g is not the FMU's time %.17g", t, m->t);
   }
   double sum = 0.0;
+  int status = kOK;
   for (int i = 0; i < 4; ++i) {
     if (!isfinite(m->omega[i])) return fail(m, "omega_cmd[%d] = %g is not finite", i + 1, m->omega[i]);
+    if (m->omega[i] > 2000.0) {
+      log_message(m, kWarning, "logStatusWarning", "omega_cmd[%d] = %g exceeds 2000 rad/s; stepping on", i + 1,
+                  m->omega[i]);
+      status = kWarning;
+    }
     sum += m->omega[i] * m->omega[i];
   }
   m->steps += 1;
   if (m->steps == m->fail_at_step) {
     return fail(m, "step %d fails as fail_at_step = %d asks (100%% on purpose)", m->steps, m->fail_at_step);
   }
+  if (m->steps == m->fatal_at_step) {
+    log_message(m, kFatal, "logStatusFatal", "step %d: fatal_at_step reached", m->steps);
+    m->phase = kBroken;
+    return kFatal;
+  }
   const double a = m->k_thrust * sum / m->mass - m->g;
   m->z += m->vz * h + a * h * h / 2.0;
   m->vz += a * h;
   m->t = t + h;
   if (m->log_steps) log_message(m, kOK, "logAll", "%s step %d to t = %g: z = %g", m->label, m->steps, m->t, m->z);
+  return status;
+}
+
+static int terminate(PointMass* m) {
+  if (m->phase == kBroken) return fail(m, "Terminate: the FMU is broken");
+  if (m->log_steps) log_message(m, kOK, "logAll", "%s terminated after %d steps", m->label, m->steps);
+  m->phase = kTerminated;
   return kOK;
 }
 
@@ -353,10 +380,7 @@ EXPORT int fmi2EnterInitializationMode(void* c) {
   return enter_initialization(m, m->t);
 }
 EXPORT int fmi2ExitInitializationMode(void* c) { return exit_initialization((PointMass*)c); }
-EXPORT int fmi2Terminate(void* c) {
-  ((PointMass*)c)->phase = kTerminated;
-  return kOK;
-}
+EXPORT int fmi2Terminate(void* c) { return terminate((PointMass*)c); }
 EXPORT int fmi2Reset(void* c) {
   set_defaults((PointMass*)c);
   return kOK;
@@ -451,10 +475,7 @@ EXPORT int fmi3EnterInitializationMode(void* c, bool tolerance_defined, double t
   return enter_initialization((PointMass*)c, start);
 }
 EXPORT int fmi3ExitInitializationMode(void* c) { return exit_initialization((PointMass*)c); }
-EXPORT int fmi3Terminate(void* c) {
-  ((PointMass*)c)->phase = kTerminated;
-  return kOK;
-}
+EXPORT int fmi3Terminate(void* c) { return terminate((PointMass*)c); }
 EXPORT int fmi3Reset(void* c) {
   set_defaults((PointMass*)c);
   return kOK;
