@@ -316,7 +316,8 @@ TEST_P(PointMass, AStepThatFailsNamesTheCallAndWhatTheFmuLogged) {
 }
 
 TEST_P(PointMass, ANonFiniteInputFailsTheStep) {
-  auto instance = Fmu::load(fmu_file())->instantiate("nan", Log().sink());
+  Log log;
+  auto instance = Fmu::load(fmu_file())->instantiate("nan", log.sink());
   instance->enter_initialization(0.0);
   instance->exit_initialization();
   set_omega(*instance, {100, std::numeric_limits<double>::quiet_NaN(), 100, 100});
