@@ -326,6 +326,14 @@ static int terminate(PointMass* m) {
     return kOK;                                  \
   } while (0)
 
+/* The rest of the API, which a master that resolves every symbol needs (fmusim does): Error. */
+static int unsupported(void* c, const char* function) {
+  if (c == NULL) return kError;
+  return fail((PointMass*)c, "%s is not supported by the point mass", function);
+}
+#define UNSUPPORTED(function, params) \
+  EXPORT int function params { return unsupported(c, #function); }
+
 #ifndef POINT_MASS_FMI3
 /* ---- FMI 2.0 -------------------------------------------------------------------------------------- */
 EXPORT const char* fmi2GetTypesPlatform(void) { return "default"; }
@@ -430,6 +438,23 @@ EXPORT int fmi2DoStep(void* c, double t, double h, int no_set_state_prior) {
 #endif
 EXPORT int fmi2CancelStep(void* c) { return fail((PointMass*)c, "fmi2CancelStep: steps are never asynchronous"); }
 
+UNSUPPORTED(fmi2GetFMUstate, (void* c, void** state))
+UNSUPPORTED(fmi2SetFMUstate, (void* c, void* state))
+UNSUPPORTED(fmi2FreeFMUstate, (void* c, void** state))
+UNSUPPORTED(fmi2SerializedFMUstateSize, (void* c, void* state, size_t* size))
+UNSUPPORTED(fmi2SerializeFMUstate, (void* c, void* state, char bytes[], size_t size))
+UNSUPPORTED(fmi2DeSerializeFMUstate, (void* c, const char bytes[], size_t size, void** state))
+UNSUPPORTED(fmi2GetDirectionalDerivative, (void* c, const unsigned int u[], size_t nu, const unsigned int k[],
+                                           size_t nk, const double dk[], double du[]))
+UNSUPPORTED(fmi2SetRealInputDerivatives, (void* c, const unsigned int vr[], size_t n, const int order[],
+                                          const double v[]))
+UNSUPPORTED(fmi2GetRealOutputDerivatives, (void* c, const unsigned int vr[], size_t n, const int order[], double v[]))
+UNSUPPORTED(fmi2GetStatus, (void* c, int kind, int* value))
+UNSUPPORTED(fmi2GetRealStatus, (void* c, int kind, double* value))
+UNSUPPORTED(fmi2GetIntegerStatus, (void* c, int kind, int* value))
+UNSUPPORTED(fmi2GetBooleanStatus, (void* c, int kind, int* value))
+UNSUPPORTED(fmi2GetStringStatus, (void* c, int kind, const char** value))
+
 #else
 /* ---- FMI 3.0 -------------------------------------------------------------------------------------- */
 EXPORT const char* fmi3GetVersion(void) { return "3.0"; }
@@ -530,4 +555,80 @@ EXPORT int fmi3DoStep(void* c, double t, double h, bool no_set_state_prior, bool
   *last_successful_time = m->t;
   return status;
 }
+
+EXPORT void* fmi3InstantiateModelExchange(const char* name, const char* token, const char* resources, bool visible,
+                                          bool logging_on, void* env, Fmi3Logger logger) {
+  (void)name, (void)token, (void)resources, (void)visible, (void)logging_on;
+  if (logger != NULL) logger(env, kError, "logStatusError", "the point mass is a co-simulation FMU only");
+  return NULL;
+}
+EXPORT void* fmi3InstantiateScheduledExecution(const char* name, const char* token, const char* resources,
+                                               bool visible, bool logging_on, void* env, Fmi3Logger logger,
+                                               void* clock_update, void* lock, void* unlock) {
+  (void)clock_update, (void)lock, (void)unlock;
+  return fmi3InstantiateModelExchange(name, token, resources, visible, logging_on, env, logger);
+}
+
+#define UNSUPPORTED_GET_SET(T, type)                                                                               \
+  UNSUPPORTED(fmi3Get##T, (void* c, const uint32_t vr[], size_t nvr, type v[], size_t nv))                        \
+  UNSUPPORTED(fmi3Set##T, (void* c, const uint32_t vr[], size_t nvr, const type v[], size_t nv))
+UNSUPPORTED_GET_SET(Float32, float)
+UNSUPPORTED_GET_SET(Int8, int8_t)
+UNSUPPORTED_GET_SET(UInt8, uint8_t)
+UNSUPPORTED_GET_SET(Int16, int16_t)
+UNSUPPORTED_GET_SET(UInt16, uint16_t)
+UNSUPPORTED_GET_SET(UInt32, uint32_t)
+UNSUPPORTED_GET_SET(Int64, int64_t)
+UNSUPPORTED_GET_SET(UInt64, uint64_t)
+UNSUPPORTED(fmi3GetBinary, (void* c, const uint32_t vr[], size_t nvr, size_t sizes[], const uint8_t* v[], size_t nv))
+UNSUPPORTED(fmi3SetBinary, (void* c, const uint32_t vr[], size_t nvr, const size_t sizes[], const uint8_t* const v[],
+                            size_t nv))
+UNSUPPORTED(fmi3GetClock, (void* c, const uint32_t vr[], size_t nvr, bool v[]))
+UNSUPPORTED(fmi3SetClock, (void* c, const uint32_t vr[], size_t nvr, const bool v[]))
+UNSUPPORTED(fmi3EnterEventMode, (void* c))
+UNSUPPORTED(fmi3GetNumberOfVariableDependencies, (void* c, uint32_t vr, size_t* n))
+UNSUPPORTED(fmi3GetVariableDependencies, (void* c, uint32_t dependent, size_t element_of_dependent[],
+                                          uint32_t independents[], size_t elements_of_independents[], int kinds[],
+                                          size_t n))
+UNSUPPORTED(fmi3GetFMUState, (void* c, void** state))
+UNSUPPORTED(fmi3SetFMUState, (void* c, void* state))
+UNSUPPORTED(fmi3FreeFMUState, (void* c, void** state))
+UNSUPPORTED(fmi3SerializedFMUStateSize, (void* c, void* state, size_t* size))
+UNSUPPORTED(fmi3SerializeFMUState, (void* c, void* state, uint8_t bytes[], size_t size))
+UNSUPPORTED(fmi3DeserializeFMUState, (void* c, const uint8_t bytes[], size_t size, void** state))
+UNSUPPORTED(fmi3GetDirectionalDerivative, (void* c, const uint32_t unknowns[], size_t nu, const uint32_t knowns[],
+                                           size_t nk, const double seed[], size_t ns, double sensitivity[],
+                                           size_t nsens))
+UNSUPPORTED(fmi3GetAdjointDerivative, (void* c, const uint32_t unknowns[], size_t nu, const uint32_t knowns[],
+                                       size_t nk, const double seed[], size_t ns, double sensitivity[], size_t nsens))
+UNSUPPORTED(fmi3EnterConfigurationMode, (void* c))
+UNSUPPORTED(fmi3ExitConfigurationMode, (void* c))
+UNSUPPORTED(fmi3GetIntervalDecimal, (void* c, const uint32_t vr[], size_t n, double intervals[], int qualifiers[]))
+UNSUPPORTED(fmi3GetIntervalFraction, (void* c, const uint32_t vr[], size_t n, uint64_t counters[],
+                                      uint64_t resolutions[], int qualifiers[]))
+UNSUPPORTED(fmi3GetShiftDecimal, (void* c, const uint32_t vr[], size_t n, double shifts[]))
+UNSUPPORTED(fmi3GetShiftFraction, (void* c, const uint32_t vr[], size_t n, uint64_t counters[], uint64_t resolutions[]))
+UNSUPPORTED(fmi3SetIntervalDecimal, (void* c, const uint32_t vr[], size_t n, const double intervals[]))
+UNSUPPORTED(fmi3SetIntervalFraction, (void* c, const uint32_t vr[], size_t n, const uint64_t counters[],
+                                      const uint64_t resolutions[]))
+UNSUPPORTED(fmi3SetShiftDecimal, (void* c, const uint32_t vr[], size_t n, const double shifts[]))
+UNSUPPORTED(fmi3SetShiftFraction, (void* c, const uint32_t vr[], size_t n, const uint64_t counters[],
+                                   const uint64_t resolutions[]))
+UNSUPPORTED(fmi3EvaluateDiscreteStates, (void* c))
+UNSUPPORTED(fmi3UpdateDiscreteStates, (void* c, bool* update, bool* terminate, bool* nominals_changed,
+                                       bool* values_changed, bool* next_event_defined, double* next_event))
+UNSUPPORTED(fmi3EnterContinuousTimeMode, (void* c))
+UNSUPPORTED(fmi3CompletedIntegratorStep, (void* c, bool no_set_state_prior, bool* enter_event_mode, bool* terminate))
+UNSUPPORTED(fmi3SetTime, (void* c, double time))
+UNSUPPORTED(fmi3SetContinuousStates, (void* c, const double x[], size_t n))
+UNSUPPORTED(fmi3GetContinuousStateDerivatives, (void* c, double dx[], size_t n))
+UNSUPPORTED(fmi3GetEventIndicators, (void* c, double indicators[], size_t n))
+UNSUPPORTED(fmi3GetContinuousStates, (void* c, double x[], size_t n))
+UNSUPPORTED(fmi3GetNominalsOfContinuousStates, (void* c, double nominals[], size_t n))
+UNSUPPORTED(fmi3GetNumberOfEventIndicators, (void* c, size_t* n))
+UNSUPPORTED(fmi3GetNumberOfContinuousStates, (void* c, size_t* n))
+UNSUPPORTED(fmi3EnterStepMode, (void* c))
+UNSUPPORTED(fmi3GetOutputDerivatives, (void* c, const uint32_t vr[], size_t nvr, const int32_t orders[], double v[],
+                                       size_t nv))
+UNSUPPORTED(fmi3ActivateModelPartition, (void* c, uint32_t clock, double activation_time))
 #endif
