@@ -1,5 +1,6 @@
 // The plant FMU through FMI 2.0, loaded with dlopen: its outputs against model::Quadrotor stepped
 // natively tick by tick (bit for bit), and every bad use refused with a message, the instance usable after.
+#include <clocale>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -325,6 +326,31 @@ TEST(FmuPlant, ParametersSetBeforeInitialisationTakeEffect) {
   EXPECT_NEAR(p.get("p_W[3]"), 7.0 - 0.5 * c.vehicle.gravity_m_s2 * 0.25, 1e-12);
   EXPECT_NEAR(p.get("p_W[1]"), 0.75, 1e-12);
   EXPECT_NEAR(p.get("f_B[3]"), 0.0, 1e-12);  // free fall: the accelerometer reads nothing
+}
+
+}  // namespace
+}  // namespace quadcosim::fmi::test
+
+namespace quadcosim::fmi::test {
+namespace {
+
+TEST(FmuPlant, NumbersAreReadTheSameUnderADecimalCommaLocale) {
+  // An importer (a GUI tool) may run with a locale whose decimal separator is a comma.
+  const char* locale = nullptr;
+  for (const char* l : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8"}) {
+    if (std::setlocale(LC_ALL, l)) {
+      locale = l;
+      break;
+    }
+  }
+  if (!locale) GTEST_SKIP() << "no decimal-comma locale is installed (de_DE, fr_FR)";
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.initial.p_W.z() = 2.5;
+  c.guid = make_guid(c);
+  Plant p(c);
+  EXPECT_EQ(p.get("vehicle.mass_kg"), 1.96);
+  EXPECT_EQ(p.get("p_W[3]"), 2.5);
+  std::setlocale(LC_ALL, "C");
 }
 
 }  // namespace

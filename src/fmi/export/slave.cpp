@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 
 namespace quadcosim::fmi::exported {
 
@@ -48,7 +47,8 @@ Values start_values(const ModelDescription& md) {
     } else if (var.type == VariableType::kBoolean) {
       v.number[var.vr] = *var.start == "true" ? 1.0 : 0.0;
     } else {
-      v.number[var.vr] = std::strtod(var.start->c_str(), nullptr);  // shortest round-trip text: exact
+      // Shortest round-trip text: exact. from_chars, unlike strtod, ignores the importer's locale.
+      std::from_chars(var.start->data(), var.start->data() + var.start->size(), v.number[var.vr]);
     }
   }
   return v;
