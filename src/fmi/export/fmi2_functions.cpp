@@ -3,10 +3,9 @@
 // Co-Simulation only: Model Exchange functions, directional and input/output derivatives, cancelStep
 // and the asynchronous status calls answer fmi2Error with a logged message. FMU states can be got,
 // set and freed (canGetAndSetFMUstate), not serialized. No exception leaves a function.
-#include <cstring>
+#include <cctype>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "fmi/api/fmi2.h"
 #include "fmi/export/fmu_config.hpp"
@@ -74,7 +73,7 @@ bool uri_to_path(const char* uri, std::string& path, std::string& error) {
   }
   path.clear();
   for (std::size_t i = 0; i < u.size(); ++i) {
-    if (u[i] == '%' && i + 2 < u.size() + 0 && std::isxdigit(static_cast<unsigned char>(u[i + 1])) &&
+    if (u[i] == '%' && i + 2 < u.size() && std::isxdigit(static_cast<unsigned char>(u[i + 1])) &&
         std::isxdigit(static_cast<unsigned char>(u[i + 2]))) {
       path += static_cast<char>(std::stoi(u.substr(i + 1, 2), nullptr, 16));
       i += 2;
