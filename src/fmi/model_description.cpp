@@ -172,8 +172,10 @@ class Reader {
                    Causality::kInput, Causality::kOutput, Causality::kLocal, Causality::kIndependent}) {
       if (*text == to_string(c)) return c;
     }
-    fail(n, "{}: causality=\"{}\" is none of parameter, calculatedParameter, structuralParameter, input, output, "
-         "local, independent", what, *text);
+    fail(n,
+         "{}: causality=\"{}\" is none of parameter, calculatedParameter, structuralParameter, input, output, "
+         "local, independent",
+         what, *text);
   }
 
   std::optional<Variability> variability(const xmlNode* n, const std::string& what) const {
@@ -267,8 +269,7 @@ void read_fmi2_variables(const Reader& r, const xmlNode* root, ModelDescription&
     } else if (is_element(typed, "Enumeration")) {
       v.type = VariableType::kEnumeration;
     } else {
-      r.fail(typed, "{} has a <{}>, none of Real, Integer, Boolean, String, Enumeration", what,
-             element_name(typed));
+      r.fail(typed, "{} has a <{}>, none of Real, Integer, Boolean, String, Enumeration", what, element_name(typed));
     }
     // FMI 2 defaults to continuous, which only a Real can be.
     v.variability = r.variability(n, what).value_or(v.type == VariableType::kReal ? Variability::kContinuous
@@ -282,15 +283,21 @@ void read_fmi3_variables(const Reader& r, const xmlNode* root, ModelDescription&
   const auto units = declared_units(root, FmiVersion::k3);
   const xmlNode* list = child(root, "ModelVariables");
   if (list == nullptr) return;
-  static const std::map<std::string_view, VariableType> kTypes = {
-      {"Float64", VariableType::kReal},    {"Int32", VariableType::kInteger},
-      {"Boolean", VariableType::kBoolean}, {"String", VariableType::kString},
-      {"Enumeration", VariableType::kEnumeration}, {"Float32", VariableType::kOther},
-      {"Int8", VariableType::kOther},      {"UInt8", VariableType::kOther},
-      {"Int16", VariableType::kOther},     {"UInt16", VariableType::kOther},
-      {"UInt32", VariableType::kOther},    {"Int64", VariableType::kOther},
-      {"UInt64", VariableType::kOther},    {"Binary", VariableType::kOther},
-      {"Clock", VariableType::kOther}};
+  static const std::map<std::string_view, VariableType> kTypes = {{"Float64", VariableType::kReal},
+                                                                  {"Int32", VariableType::kInteger},
+                                                                  {"Boolean", VariableType::kBoolean},
+                                                                  {"String", VariableType::kString},
+                                                                  {"Enumeration", VariableType::kEnumeration},
+                                                                  {"Float32", VariableType::kOther},
+                                                                  {"Int8", VariableType::kOther},
+                                                                  {"UInt8", VariableType::kOther},
+                                                                  {"Int16", VariableType::kOther},
+                                                                  {"UInt16", VariableType::kOther},
+                                                                  {"UInt32", VariableType::kOther},
+                                                                  {"Int64", VariableType::kOther},
+                                                                  {"UInt64", VariableType::kOther},
+                                                                  {"Binary", VariableType::kOther},
+                                                                  {"Clock", VariableType::kOther}};
   for (const xmlNode* n = list->children; n != nullptr; n = n->next) {
     if (n->type != XML_ELEMENT_NODE) continue;
     const auto type = kTypes.find(element_name(n));
@@ -306,8 +313,7 @@ void read_fmi3_variables(const Reader& r, const xmlNode* root, ModelDescription&
     v.causality = r.causality(n, what);
     v.initial = r.initial(n, what);
     const bool is_float = type->first == "Float64" || type->first == "Float32";
-    v.variability =
-        r.variability(n, what).value_or(is_float ? Variability::kContinuous : Variability::kDiscrete);
+    v.variability = r.variability(n, what).value_or(is_float ? Variability::kContinuous : Variability::kDiscrete);
     // An array (Dimension children) is not a scalar the master can exchange.
     if (child(n, "Dimension") != nullptr) v.type = VariableType::kOther;
     if (v.type != VariableType::kOther) read_value_attributes(r, n, what, units, v);
@@ -327,10 +333,8 @@ void read_outputs(const Reader& r, const xmlNode* root, ModelDescription& md) {
       const std::string_view s = trim(text);
       std::size_t index = 0;
       const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), index);
-      if (s.empty() || ec != std::errc() || end != s.data() + s.size() || index < 1 ||
-          index > md.variables.size()) {
-        r.fail(u, "ModelStructure/Outputs/Unknown: index=\"{}\" is no variable (1 to {})", text,
-               md.variables.size());
+      if (s.empty() || ec != std::errc() || end != s.data() + s.size() || index < 1 || index > md.variables.size()) {
+        r.fail(u, "ModelStructure/Outputs/Unknown: index=\"{}\" is no variable (1 to {})", text, md.variables.size());
       }
       md.outputs.push_back(index - 1);
     }
@@ -339,8 +343,8 @@ void read_outputs(const Reader& r, const xmlNode* root, ModelDescription& md) {
   for (const xmlNode* o = structure->children; o != nullptr; o = o->next) {
     if (!is_element(o, "Output")) continue;
     const ValueReference vr = r.value_reference(o, "ModelStructure/Output");
-    const auto it = std::find_if(md.variables.begin(), md.variables.end(),
-                                 [vr](const Variable& v) { return v.vr == vr; });
+    const auto it =
+        std::find_if(md.variables.begin(), md.variables.end(), [vr](const Variable& v) { return v.vr == vr; });
     if (it == md.variables.end()) r.fail(o, "ModelStructure/Output: valueReference {} is no variable's", vr);
     md.outputs.push_back(static_cast<std::size_t>(it - md.variables.begin()));
   }

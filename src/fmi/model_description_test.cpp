@@ -176,8 +176,8 @@ TEST(ModelDescription, RefusesMalformedXml) {
 }
 
 TEST(ModelDescription, RefusesModelExchangeOnly) {
-  const std::string xml = replace(kFmi2, R"(<CoSimulation modelIdentifier="point_mass")",
-                                  R"(<ModelExchange modelIdentifier="point_mass")");
+  const std::string xml =
+      replace(kFmi2, R"(<CoSimulation modelIdentifier="point_mass")", R"(<ModelExchange modelIdentifier="point_mass")");
   const std::string message = refusal(xml);
   EXPECT_NE(message.find("test.xml: model 'PointMass' has no CoSimulation element: quadcosim masters co-simulation "
                          "FMUs only (this one is for model exchange)"),
@@ -223,7 +223,8 @@ TEST(ModelDescription, NamesTheCulprit) {
     const std::string message = refusal(replace(kFmi2, c.from, c.to));
     EXPECT_NE(message.find(c.expected), std::string::npos) << "got: " << message << "\nwanted: " << c.expected;
   }
-  const std::string fmi3 = refusal(replace(kFmi3, R"(<Output valueReference="8"/>)", R"(<Output valueReference="99"/>)"));
+  const std::string fmi3 =
+      refusal(replace(kFmi3, R"(<Output valueReference="8"/>)", R"(<Output valueReference="99"/>)"));
   EXPECT_NE(fmi3.find("ModelStructure/Output: valueReference 99 is no variable's"), std::string::npos) << fmi3;
   const std::string token = refusal(replace(kFmi3, "instantiationToken", "guid"));
   EXPECT_NE(token.find("fmiModelDescription has no instantiationToken"), std::string::npos) << token;
@@ -234,7 +235,8 @@ TEST(ModelDescription, NamesTheCulprit) {
 TEST(ModelDescription, RefusesAnExternalEntity) {
   // An external entity (a classic XXE) is neither fetched nor substituted: libxml2 refuses it in an
   // attribute, and any DOCTYPE is refused anyway.
-  const std::string xml = R"(<?xml version="1.0"?><!DOCTYPE fmiModelDescription [<!ENTITY x SYSTEM "file:///etc/passwd">]>
+  const std::string xml =
+      R"(<?xml version="1.0"?><!DOCTYPE fmiModelDescription [<!ENTITY x SYSTEM "file:///etc/passwd">]>
 <fmiModelDescription fmiVersion="2.0" modelName="&x;" guid="g"><CoSimulation modelIdentifier="m"/></fmiModelDescription>)";
   const std::string message = refusal(xml);
   EXPECT_TRUE(message.find("has a DOCTYPE") != std::string::npos ||

@@ -80,8 +80,8 @@ std::vector<std::string> components(std::string name, std::string& why) {
 
 void make_directory(const std::string& path, const std::string& archive, const std::string& entry) {
   if (::mkdir(path.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw FmuError(fmt::format("{}: entry '{}': cannot make directory {}: {}", archive, entry, path,
-                               std::strerror(errno)));
+    throw FmuError(
+        fmt::format("{}: entry '{}': cannot make directory {}: {}", archive, entry, path, std::strerror(errno)));
   }
   struct stat st {};
   if (::lstat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
