@@ -12,6 +12,7 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <optional>
@@ -239,8 +240,8 @@ void check_text(std::string_view text, std::string_view what) {
   for (const char ch : text) {
     const auto c = static_cast<unsigned char>(ch);
     if (c < 0x20 && c != '\t' && c != '\n' && c != '\r')
-      throw FmuError("modelDescription.xml: " + std::string(what) + " holds control character " +
-                     std::to_string(c) + ", which XML cannot carry");
+      throw FmuError("modelDescription.xml: " + std::string(what) + " holds control character " + std::to_string(c) +
+                     ", which XML cannot carry");
   }
   const std::string copy(text);
   if (!copy.empty() && xmlCheckUTF8(reinterpret_cast<const xmlChar*>(copy.c_str())) == 0)
@@ -330,6 +331,7 @@ Checked check(const ModelDescription& md) {
     }
     if ((var.min || var.max) && var.type != VariableType::kReal && var.type != VariableType::kInteger)
       fail(who + ": min/max on a variable that is not a number");
+    if ((var.min && std::isnan(*var.min)) || (var.max && std::isnan(*var.max))) fail(who + ": min or max is NaN");
     if (var.min && var.max && *var.min > *var.max) fail(who + ": min > max");
   }
   if (v3 && independent != 1)
@@ -409,8 +411,9 @@ const char* element_name(VariableType t, bool v3) {
 void type_attributes(Writer& w, const Variable& var, bool v3) {
   if (var.start && !(v3 && var.type == VariableType::kString)) w.attribute("start", *var.start);
   if (!var.unit.empty()) w.attribute("unit", var.unit);
-  if (var.min) w.attribute("min", *var.min);
-  if (var.max) w.attribute("max", *var.max);
+  // An infinite bound is no bound (and "inf" is no xs:double): left out.
+  if (var.min && std::isfinite(*var.min)) w.attribute("min", *var.min);
+  if (var.max && std::isfinite(*var.max)) w.attribute("max", *var.max);
 }
 
 }  // namespace
@@ -450,6 +453,11 @@ std::string write_model_description(const ModelDescription& md) {
     w.end();
   }
 
+  for (const auto& [name, value] : {std::pair{"startTime", md.start_time}, std::pair{"stopTime", md.stop_time},
+                                    std::pair{"stepSize", md.step_size}}) {
+    if (value && !std::isfinite(*value))
+      throw FmuError(std::string("modelDescription.xml: DefaultExperiment ") + name + " is not finite");
+  }
   if (md.start_time || md.stop_time || md.step_size) {
     w.start("DefaultExperiment");
     if (md.start_time) w.attribute("startTime", *md.start_time);

@@ -56,8 +56,7 @@ ModelDescription sample(FmiVersion version) {
   md.variables.push_back(mass);
   md.variables.push_back(
       real("vehicle.km_Nm_per_rad2_s2", vr++, Causality::kParameter, Variability::kFixed, "1.5e-9", "N m/(rad/s)^2"));
-  md.variables.push_back(
-      real("controller.q", vr++, Causality::kParameter, Variability::kTunable, "0.25", "1/(N m)^2"));
+  md.variables.push_back(real("controller.q", vr++, Causality::kParameter, Variability::kTunable, "0.25", "1/(N m)^2"));
   md.variables.push_back(
       real("vehicle.drag", vr++, Causality::kParameter, Variability::kFixed, "0", "N/((m/s) (rad/s))"));
   Variable on = real("realism.noise", vr++, Causality::kParameter, Variability::kFixed, "true", "");
@@ -127,7 +126,8 @@ TEST_P(WriterVersions, DeclaresUnitsInSiBaseUnits) {
   // Worked out by hand: N = kg m s^-2.
   EXPECT_NE(xml.find("<Unit name=\"rad/s\">\n      <BaseUnit s=\"-1\" rad=\"1\"/>"), std::string::npos) << xml;
   EXPECT_NE(xml.find("<Unit name=\"m/s2\">\n      <BaseUnit m=\"1\" s=\"-2\"/>"), std::string::npos);
-  EXPECT_NE(xml.find("<Unit name=\"N m/(rad/s)^2\">\n      <BaseUnit kg=\"1\" m=\"2\" rad=\"-2\"/>"), std::string::npos);
+  EXPECT_NE(xml.find("<Unit name=\"N m/(rad/s)^2\">\n      <BaseUnit kg=\"1\" m=\"2\" rad=\"-2\"/>"),
+            std::string::npos);
   EXPECT_NE(xml.find("<Unit name=\"1/(N m)^2\">\n      <BaseUnit kg=\"-2\" m=\"-4\" s=\"4\"/>"), std::string::npos);
   EXPECT_NE(xml.find("<Unit name=\"N/((m/s) (rad/s))\">\n      <BaseUnit kg=\"1\" rad=\"-1\"/>"), std::string::npos);
   EXPECT_NE(xml.find("<Unit name=\"kg\">\n      <BaseUnit kg=\"1\"/>"), std::string::npos);

@@ -3,6 +3,9 @@
 #include <minizip/zip.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
+
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -43,8 +46,11 @@ std::string read_file(const std::filesystem::path& file, const std::string& arch
 class Archive {
  public:
   Archive(std::filesystem::path temp, std::string archive) : temp_(std::move(temp)), archive_(std::move(archive)) {
+    errno = 0;
     zip_ = zipOpen64(temp_.c_str(), APPEND_STATUS_CREATE);
-    if (zip_ == nullptr) throw ZipError(archive_ + ": cannot create " + temp_.string());
+    if (zip_ == nullptr)
+      throw ZipError(archive_ + ": cannot create " + temp_.string() +
+                     (errno != 0 ? ": " + std::string(std::strerror(errno)) : ""));
   }
   ~Archive() {
     if (zip_ != nullptr) zipClose(zip_, nullptr);
@@ -70,13 +76,15 @@ class Archive {
     if (rc == ZIP_OK && !bytes.empty())
       rc = zipWriteInFileInZip(zip_, bytes.data(), static_cast<unsigned>(bytes.size()));
     if (rc == ZIP_OK) rc = zipCloseFileInZip(zip_);
-    if (rc != ZIP_OK) throw ZipError(archive_ + ": cannot write entry " + name + " (minizip error " + std::to_string(rc) + ")");
+    if (rc != ZIP_OK)
+      throw ZipError(archive_ + ": cannot write entry " + name + " (minizip error " + std::to_string(rc) + ")");
   }
 
   void commit(const std::filesystem::path& archive) {
     const int rc = zipClose(zip_, nullptr);
     zip_ = nullptr;
-    if (rc != ZIP_OK) throw ZipError(archive_ + ": cannot finish the archive (minizip error " + std::to_string(rc) + ")");
+    if (rc != ZIP_OK)
+      throw ZipError(archive_ + ": cannot finish the archive (minizip error " + std::to_string(rc) + ")");
     std::error_code ec;
     std::filesystem::rename(temp_, archive, ec);
     if (ec) throw ZipError(archive_ + ": cannot move it into place: " + ec.message());
