@@ -13,7 +13,8 @@
  * with -DPOINT_MASS_OMIT_DO_STEP (a binary the master must refuse).
  *
  * Besides the physics it has test hooks: fail_at_step (doStep number n answers Error and logs why),
- * log_steps (logs every step), label (a String parameter echoed in the log), resources_ok (1 when
+ * fatal_at_step (likewise Fatal), a rotor command above 2000 rad/s (Warning, the step is taken),
+ * log_steps (logs every step and the termination), label (a String parameter echoed in the log), resources_ok (1 when
  * resources/point_mass.txt was found through the resource location the master passed). */
 #include <math.h>
 #include <stdarg.h>
@@ -51,7 +52,9 @@ enum {
   VR_LOG_STEPS = 32,
   VR_LABEL = 33,
   VR_RESOURCES_OK = 34,
-  VR_TIME = 35 /* FMI 3's independent variable */
+  VR_TIME = 35, /* FMI 3's independent variable */
+  VR_FATAL_AT_STEP = 36,
+  VR_MODE = 37 /* an Enumeration in FMI 2 (read and written as an Integer) */
 };
 
 typedef enum { kInstantiated, kInitializing, kStepping, kTerminated, kBroken } Phase;
@@ -83,7 +86,7 @@ typedef struct {
   double omega[4];
   double mass, k_thrust, g, z0, vz0;
   double t, z, vz;
-  int steps, fail_at_step;
+  int steps, fail_at_step, fatal_at_step, mode;
   bool log_steps;
   int resources_ok;
 } PointMass;
@@ -164,6 +167,8 @@ static void set_defaults(PointMass* m) {
   m->vz = 0.0;
   m->steps = 0;
   m->fail_at_step = -1;
+  m->fatal_at_step = -1;
+  m->mode = 1;
   m->log_steps = false;
   m->label[0] = '\0';
   m->phase = kInstantiated;
@@ -217,8 +222,15 @@ static int get_real(PointMass* m, unsigned int vr, double* value) {
 }
 
 static int set_integer(PointMass* m, unsigned int vr, int value) {
-  if (vr != VR_FAIL_AT_STEP) return fail(m, "SetInteger: value reference %u is no Integer parameter", vr);
-  m->fail_at_step = value;
+  if (vr == VR_FAIL_AT_STEP) {
+    m->fail_at_step = value;
+  } else if (vr == VR_FATAL_AT_STEP) {
+    m->fatal_at_step = value;
+  } else if (vr == VR_MODE) {
+    m->mode = value;
+  } else {
+    return fail(m, "SetInteger: value reference %u is no Integer parameter", vr);
+  }
   return kOK;
 }
 
@@ -226,6 +238,8 @@ static int get_integer(PointMass* m, unsigned int vr, int* value) {
   switch (vr) {
     case VR_STEPS: *value = m->steps; return kOK;
     case VR_FAIL_AT_STEP: *value = m->fail_at_step; return kOK;
+    case VR_FATAL_AT_STEP: *value = m->fatal_at_step; return kOK;
+    case VR_MODE: *value = m->mode; return kOK;
     case VR_RESOURCES_OK: *value = m->resources_ok; return kOK;
     default: return fail(m, "GetInteger: value reference %u is no Integer variable", vr);
   }
@@ -273,19 +287,37 @@ __attribute__((unused)) static int do_step(PointMass* m, double t, double h) {
     return fail(m, "DoStep: communication point %.17g is not the FMU's time %.17g", t, m->t);
   }
   double sum = 0.0;
+  int status = kOK;
   for (int i = 0; i < 4; ++i) {
     if (!isfinite(m->omega[i])) return fail(m, "omega_cmd[%d] = %g is not finite", i + 1, m->omega[i]);
+    if (m->omega[i] > 2000.0) {
+      log_message(m, kWarning, "logStatusWarning", "omega_cmd[%d] = %g exceeds 2000 rad/s; stepping on", i + 1,
+                  m->omega[i]);
+      status = kWarning;
+    }
     sum += m->omega[i] * m->omega[i];
   }
   m->steps += 1;
   if (m->steps == m->fail_at_step) {
     return fail(m, "step %d fails as fail_at_step = %d asks (100%% on purpose)", m->steps, m->fail_at_step);
   }
+  if (m->steps == m->fatal_at_step) {
+    log_message(m, kFatal, "logStatusFatal", "step %d: fatal_at_step reached", m->steps);
+    m->phase = kBroken;
+    return kFatal;
+  }
   const double a = m->k_thrust * sum / m->mass - m->g;
   m->z += m->vz * h + a * h * h / 2.0;
   m->vz += a * h;
   m->t = t + h;
   if (m->log_steps) log_message(m, kOK, "logAll", "%s step %d to t = %g: z = %g", m->label, m->steps, m->t, m->z);
+  return status;
+}
+
+static int terminate(PointMass* m) {
+  if (m->phase == kBroken) return fail(m, "Terminate: the FMU is broken");
+  if (m->log_steps) log_message(m, kOK, "logAll", "%s terminated after %d steps", m->label, m->steps);
+  m->phase = kTerminated;
   return kOK;
 }
 
@@ -298,6 +330,14 @@ __attribute__((unused)) static int do_step(PointMass* m, double t, double h) {
     }                                            \
     return kOK;                                  \
   } while (0)
+
+/* The rest of the API, which a master that resolves every symbol needs (fmusim does): Error. */
+static int unsupported(void* c, const char* function) {
+  if (c == NULL) return kError;
+  return fail((PointMass*)c, "%s is not supported by the point mass", function);
+}
+#define UNSUPPORTED(function, params) \
+  EXPORT int function params { return unsupported(c, #function); }
 
 #ifndef POINT_MASS_FMI3
 /* ---- FMI 2.0 -------------------------------------------------------------------------------------- */
@@ -353,10 +393,7 @@ EXPORT int fmi2EnterInitializationMode(void* c) {
   return enter_initialization(m, m->t);
 }
 EXPORT int fmi2ExitInitializationMode(void* c) { return exit_initialization((PointMass*)c); }
-EXPORT int fmi2Terminate(void* c) {
-  ((PointMass*)c)->phase = kTerminated;
-  return kOK;
-}
+EXPORT int fmi2Terminate(void* c) { return terminate((PointMass*)c); }
 EXPORT int fmi2Reset(void* c) {
   set_defaults((PointMass*)c);
   return kOK;
@@ -406,6 +443,23 @@ EXPORT int fmi2DoStep(void* c, double t, double h, int no_set_state_prior) {
 #endif
 EXPORT int fmi2CancelStep(void* c) { return fail((PointMass*)c, "fmi2CancelStep: steps are never asynchronous"); }
 
+UNSUPPORTED(fmi2GetFMUstate, (void* c, void** state))
+UNSUPPORTED(fmi2SetFMUstate, (void* c, void* state))
+UNSUPPORTED(fmi2FreeFMUstate, (void* c, void** state))
+UNSUPPORTED(fmi2SerializedFMUstateSize, (void* c, void* state, size_t* size))
+UNSUPPORTED(fmi2SerializeFMUstate, (void* c, void* state, char bytes[], size_t size))
+UNSUPPORTED(fmi2DeSerializeFMUstate, (void* c, const char bytes[], size_t size, void** state))
+UNSUPPORTED(fmi2GetDirectionalDerivative, (void* c, const unsigned int u[], size_t nu, const unsigned int k[],
+                                           size_t nk, const double dk[], double du[]))
+UNSUPPORTED(fmi2SetRealInputDerivatives, (void* c, const unsigned int vr[], size_t n, const int order[],
+                                          const double v[]))
+UNSUPPORTED(fmi2GetRealOutputDerivatives, (void* c, const unsigned int vr[], size_t n, const int order[], double v[]))
+UNSUPPORTED(fmi2GetStatus, (void* c, int kind, int* value))
+UNSUPPORTED(fmi2GetRealStatus, (void* c, int kind, double* value))
+UNSUPPORTED(fmi2GetIntegerStatus, (void* c, int kind, int* value))
+UNSUPPORTED(fmi2GetBooleanStatus, (void* c, int kind, int* value))
+UNSUPPORTED(fmi2GetStringStatus, (void* c, int kind, const char** value))
+
 #else
 /* ---- FMI 3.0 -------------------------------------------------------------------------------------- */
 EXPORT const char* fmi3GetVersion(void) { return "3.0"; }
@@ -451,10 +505,7 @@ EXPORT int fmi3EnterInitializationMode(void* c, bool tolerance_defined, double t
   return enter_initialization((PointMass*)c, start);
 }
 EXPORT int fmi3ExitInitializationMode(void* c) { return exit_initialization((PointMass*)c); }
-EXPORT int fmi3Terminate(void* c) {
-  ((PointMass*)c)->phase = kTerminated;
-  return kOK;
-}
+EXPORT int fmi3Terminate(void* c) { return terminate((PointMass*)c); }
 EXPORT int fmi3Reset(void* c) {
   set_defaults((PointMass*)c);
   return kOK;
@@ -509,4 +560,80 @@ EXPORT int fmi3DoStep(void* c, double t, double h, bool no_set_state_prior, bool
   *last_successful_time = m->t;
   return status;
 }
+
+EXPORT void* fmi3InstantiateModelExchange(const char* name, const char* token, const char* resources, bool visible,
+                                          bool logging_on, void* env, Fmi3Logger logger) {
+  (void)name, (void)token, (void)resources, (void)visible, (void)logging_on;
+  if (logger != NULL) logger(env, kError, "logStatusError", "the point mass is a co-simulation FMU only");
+  return NULL;
+}
+EXPORT void* fmi3InstantiateScheduledExecution(const char* name, const char* token, const char* resources,
+                                               bool visible, bool logging_on, void* env, Fmi3Logger logger,
+                                               void* clock_update, void* lock, void* unlock) {
+  (void)clock_update, (void)lock, (void)unlock;
+  return fmi3InstantiateModelExchange(name, token, resources, visible, logging_on, env, logger);
+}
+
+#define UNSUPPORTED_GET_SET(T, type)                                                                               \
+  UNSUPPORTED(fmi3Get##T, (void* c, const uint32_t vr[], size_t nvr, type v[], size_t nv))                        \
+  UNSUPPORTED(fmi3Set##T, (void* c, const uint32_t vr[], size_t nvr, const type v[], size_t nv))
+UNSUPPORTED_GET_SET(Float32, float)
+UNSUPPORTED_GET_SET(Int8, int8_t)
+UNSUPPORTED_GET_SET(UInt8, uint8_t)
+UNSUPPORTED_GET_SET(Int16, int16_t)
+UNSUPPORTED_GET_SET(UInt16, uint16_t)
+UNSUPPORTED_GET_SET(UInt32, uint32_t)
+UNSUPPORTED_GET_SET(Int64, int64_t)
+UNSUPPORTED_GET_SET(UInt64, uint64_t)
+UNSUPPORTED(fmi3GetBinary, (void* c, const uint32_t vr[], size_t nvr, size_t sizes[], const uint8_t* v[], size_t nv))
+UNSUPPORTED(fmi3SetBinary, (void* c, const uint32_t vr[], size_t nvr, const size_t sizes[], const uint8_t* const v[],
+                            size_t nv))
+UNSUPPORTED(fmi3GetClock, (void* c, const uint32_t vr[], size_t nvr, bool v[]))
+UNSUPPORTED(fmi3SetClock, (void* c, const uint32_t vr[], size_t nvr, const bool v[]))
+UNSUPPORTED(fmi3EnterEventMode, (void* c))
+UNSUPPORTED(fmi3GetNumberOfVariableDependencies, (void* c, uint32_t vr, size_t* n))
+UNSUPPORTED(fmi3GetVariableDependencies, (void* c, uint32_t dependent, size_t element_of_dependent[],
+                                          uint32_t independents[], size_t elements_of_independents[], int kinds[],
+                                          size_t n))
+UNSUPPORTED(fmi3GetFMUState, (void* c, void** state))
+UNSUPPORTED(fmi3SetFMUState, (void* c, void* state))
+UNSUPPORTED(fmi3FreeFMUState, (void* c, void** state))
+UNSUPPORTED(fmi3SerializedFMUStateSize, (void* c, void* state, size_t* size))
+UNSUPPORTED(fmi3SerializeFMUState, (void* c, void* state, uint8_t bytes[], size_t size))
+UNSUPPORTED(fmi3DeserializeFMUState, (void* c, const uint8_t bytes[], size_t size, void** state))
+UNSUPPORTED(fmi3GetDirectionalDerivative, (void* c, const uint32_t unknowns[], size_t nu, const uint32_t knowns[],
+                                           size_t nk, const double seed[], size_t ns, double sensitivity[],
+                                           size_t nsens))
+UNSUPPORTED(fmi3GetAdjointDerivative, (void* c, const uint32_t unknowns[], size_t nu, const uint32_t knowns[],
+                                       size_t nk, const double seed[], size_t ns, double sensitivity[], size_t nsens))
+UNSUPPORTED(fmi3EnterConfigurationMode, (void* c))
+UNSUPPORTED(fmi3ExitConfigurationMode, (void* c))
+UNSUPPORTED(fmi3GetIntervalDecimal, (void* c, const uint32_t vr[], size_t n, double intervals[], int qualifiers[]))
+UNSUPPORTED(fmi3GetIntervalFraction, (void* c, const uint32_t vr[], size_t n, uint64_t counters[],
+                                      uint64_t resolutions[], int qualifiers[]))
+UNSUPPORTED(fmi3GetShiftDecimal, (void* c, const uint32_t vr[], size_t n, double shifts[]))
+UNSUPPORTED(fmi3GetShiftFraction, (void* c, const uint32_t vr[], size_t n, uint64_t counters[], uint64_t resolutions[]))
+UNSUPPORTED(fmi3SetIntervalDecimal, (void* c, const uint32_t vr[], size_t n, const double intervals[]))
+UNSUPPORTED(fmi3SetIntervalFraction, (void* c, const uint32_t vr[], size_t n, const uint64_t counters[],
+                                      const uint64_t resolutions[]))
+UNSUPPORTED(fmi3SetShiftDecimal, (void* c, const uint32_t vr[], size_t n, const double shifts[]))
+UNSUPPORTED(fmi3SetShiftFraction, (void* c, const uint32_t vr[], size_t n, const uint64_t counters[],
+                                   const uint64_t resolutions[]))
+UNSUPPORTED(fmi3EvaluateDiscreteStates, (void* c))
+UNSUPPORTED(fmi3UpdateDiscreteStates, (void* c, bool* update, bool* terminate, bool* nominals_changed,
+                                       bool* values_changed, bool* next_event_defined, double* next_event))
+UNSUPPORTED(fmi3EnterContinuousTimeMode, (void* c))
+UNSUPPORTED(fmi3CompletedIntegratorStep, (void* c, bool no_set_state_prior, bool* enter_event_mode, bool* terminate))
+UNSUPPORTED(fmi3SetTime, (void* c, double time))
+UNSUPPORTED(fmi3SetContinuousStates, (void* c, const double x[], size_t n))
+UNSUPPORTED(fmi3GetContinuousStateDerivatives, (void* c, double dx[], size_t n))
+UNSUPPORTED(fmi3GetEventIndicators, (void* c, double indicators[], size_t n))
+UNSUPPORTED(fmi3GetContinuousStates, (void* c, double x[], size_t n))
+UNSUPPORTED(fmi3GetNominalsOfContinuousStates, (void* c, double nominals[], size_t n))
+UNSUPPORTED(fmi3GetNumberOfEventIndicators, (void* c, size_t* n))
+UNSUPPORTED(fmi3GetNumberOfContinuousStates, (void* c, size_t* n))
+UNSUPPORTED(fmi3EnterStepMode, (void* c))
+UNSUPPORTED(fmi3GetOutputDerivatives, (void* c, const uint32_t vr[], size_t nvr, const int32_t orders[], double v[],
+                                       size_t nv))
+UNSUPPORTED(fmi3ActivateModelPartition, (void* c, uint32_t clock, double activation_time))
 #endif
