@@ -130,9 +130,10 @@ fmi::FmuConfig config_from(const FmuOptions& o, std::vector<std::string>& notes)
 
   // What a scenario can say that an FMU does not carry.
   if (later > 0 && c.kind == fmi::FmuKind::kController)
-    notes.push_back(fmt::format("the scenario's schedule after t = 0 ({} change{}) is not part of the FMU: set the "
-                                "controller.* parameters or ref.* inputs from the importer instead",
-                                later, later == 1 ? "" : "s"));
+    notes.push_back(
+        fmt::format("the scenario's schedule after t = 0 ({} change{}) is not part of the FMU: set the "
+                    "controller.* parameters or ref.* inputs from the importer instead",
+                    later, later == 1 ? "" : "s"));
   if (cc.trajectory && c.kind == fmi::FmuKind::kController)
     notes.push_back("the scenario's trajectory is not part of the FMU: feed it through the ref.* inputs");
   if (sim.plant.command_delay_ticks > 0 && c.kind == fmi::FmuKind::kPlant)
@@ -162,13 +163,12 @@ int export_fmu(const FmuOptions& o) {
   const std::string xml = fmi::write_model_description(md);  // FmuError: a bug, not the user's input
   const fs::path library = find_fmu_library();
 
-  fmi::write_zip(o.out, {
-                            fmi::ZipEntry::from_bytes("modelDescription.xml", xml),
-                            fmi::ZipEntry::from_file(
-                                "binaries/" + platform + "/" + md.model_identifier + ".so", library, true),
-                            fmi::ZipEntry::from_bytes("resources/" + std::string(fmi::kConfigFileName),
-                                                      fmi::to_json(config)),
-                        });
+  fmi::write_zip(
+      o.out, {
+                 fmi::ZipEntry::from_bytes("modelDescription.xml", xml),
+                 fmi::ZipEntry::from_file("binaries/" + platform + "/" + md.model_identifier + ".so", library, true),
+                 fmi::ZipEntry::from_bytes("resources/" + std::string(fmi::kConfigFileName), fmi::to_json(config)),
+             });
 
   int inputs = 0, outputs = 0, parameters = 0;
   for (const fmi::Variable& v : md.variables) {
@@ -234,8 +234,8 @@ int info(const FmuOptions& o) {
   row("modelIdentifier", md.model_identifier);
   row("binaries", (binaries.empty() ? std::string("none") : binaries) +
                       (runs_here ? fmt::format(" (runs here: {}/{}.so)", here, md.model_identifier)
-                                 : fmt::format(" (no {}/{}.so: not for this machine)",
-                                               here.empty() ? "binary" : here, md.model_identifier)));
+                                 : fmt::format(" (no {}/{}.so: not for this machine)", here.empty() ? "binary" : here,
+                                               md.model_identifier)));
   row("variable step", md.can_handle_variable_step ? "yes (canHandleVariableCommunicationStepSize)" : "no");
   if (md.start_time || md.stop_time || md.step_size) {
     std::string e;
@@ -246,9 +246,9 @@ int info(const FmuOptions& o) {
   }
   std::map<fmi::Causality, int> count;
   for (const fmi::Variable& v : md.variables) ++count[v.causality];
-  row("variables", fmt::format("{} ({} inputs, {} outputs, {} parameters)", md.variables.size(),
-                               count[fmi::Causality::kInput], count[fmi::Causality::kOutput],
-                               count[fmi::Causality::kParameter]));
+  row("variables",
+      fmt::format("{} ({} inputs, {} outputs, {} parameters)", md.variables.size(), count[fmi::Causality::kInput],
+                  count[fmi::Causality::kOutput], count[fmi::Causality::kParameter]));
 
   std::size_t name_w = 4, unit_w = 4, start_w = 5;
   for (const fmi::Variable& v : md.variables) {
