@@ -220,6 +220,37 @@ case "$CASE" in
   export_controller_fmi2) export_and_check controller 2 "$P/altitude_step.yaml" ;;
   export_controller_fmi3) export_and_check controller 3 ;;
 
+  # The exported FMUs run by an importer written here (Python ctypes over the FMI C API, nothing of
+  # quadcosim but the .fmu), against closed forms: plant under constant rotor speeds, controller's first command.
+  run_plant_fmi2 | run_plant_fmi3 | run_controller_fmi2 | run_controller_fmi3)
+    kind=${CASE#run_}
+    kind=${kind%_fmi*}
+    version=${CASE##*fmi}
+    args=(fmu export "$kind" --fmi "$version" --out "$TMP/x.fmu")
+    [ "$kind" = controller ] && args+=(--scenario "$P/altitude_step.yaml")  # reference z = 10 m from t = 0
+    "$QC" "${args[@]}" > /dev/null || fail "fmu export exited $?"
+    "$PY" "$(dirname "${BASH_SOURCE[0]}")/run_exported_fmu.py" "$TMP/x.fmu" "$kind" || fail "the FMU did not run as expected"
+    ;;
+
+  info_third_party)  # an FMU quadcosim did not write: the point mass test FMU of tests/fmi (FMI 2 and 3)
+    build_fmus=${5:?the build folder of tests/fmi}
+    for f in point_mass point_mass3; do
+      [ -f "$build_fmus/$f.fmu" ] || { echo "SKIPPED: $build_fmus/$f.fmu is not built (target fmi_test_fmus)"; exit 77; }
+      "$QC" fmu info "$build_fmus/$f.fmu" > "$TMP/$f.txt" || fail "fmu info $f.fmu exited $?"
+    done
+    grep -Eq "^FMI version +2.0 co-simulation$" "$TMP/point_mass.txt" || fail "point_mass: FMI version"
+    grep -Eq "^FMI version +3.0 co-simulation$" "$TMP/point_mass3.txt" || fail "point_mass3: FMI version"
+    grep -Eq "^binaries +linux64 \(runs here: linux64/point_mass.so\)$" "$TMP/point_mass.txt" || fail "point_mass: binaries"
+    grep -Eq "^binaries +x86_64-linux \(runs here" "$TMP/point_mass3.txt" || fail "point_mass3: binaries"
+    "$PY" - "$build_fmus/point_mass/modelDescription.xml" "$TMP/point_mass.txt" <<'PYEOF' || fail "info lacks a variable"
+import re, sys, xml.etree.ElementTree as ET
+info = open(sys.argv[2]).read()
+for sv in ET.parse(sys.argv[1]).getroot().iter("ScalarVariable"):
+    row = re.search(r"^" + re.escape(sv.get("name")) + r" +(\d+) +(\w+) ", info, re.M)
+    assert row and row.groups() == (sv.get("valueReference"), sv.get("causality", "local")), sv.get("name")
+PYEOF
+    ;;
+
   info)  # `fmu info` prints what the XML declares
     export_and_check plant 2
     "$QC" fmu info "$TMP/plant2.fmu" > "$TMP/info.txt" || fail "fmu info exited $?"
