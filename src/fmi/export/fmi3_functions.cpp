@@ -143,8 +143,7 @@ void fmi3FreeInstance(fmi3Instance instance) { delete static_cast<Instance*>(ins
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean, fmi3Float64, fmi3Float64 startTime,
                                        fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
   return call(instance, "fmi3EnterInitializationMode", [&](Slave& s) {
-    const Status st =
-        s.setup_experiment(startTime, stopTimeDefined ? std::optional<double>(stopTime) : std::nullopt);
+    const Status st = s.setup_experiment(startTime, stopTimeDefined ? std::optional<double>(stopTime) : std::nullopt);
     return st == Status::kOK ? s.enter_initialization() : st;
   });
 }
@@ -196,13 +195,13 @@ fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], s
   return scalars(instance, "fmi3SetString", nvr, nValues, [&](Slave& s) { return s.set_string(vr, nvr, values); });
 }
 
-#define QC_NO_SUCH_TYPE(TYPE)                                                                                       \
-  fmi3Status fmi3Get##TYPE(fmi3Instance instance, const fmi3ValueReference[], size_t nvr, fmi3##TYPE[], size_t) {   \
-    return no_such_type(instance, "fmi3Get" #TYPE, #TYPE, nvr);                                                     \
-  }                                                                                                                 \
-  fmi3Status fmi3Set##TYPE(fmi3Instance instance, const fmi3ValueReference[], size_t nvr, const fmi3##TYPE[],       \
-                           size_t) {                                                                                \
-    return no_such_type(instance, "fmi3Set" #TYPE, #TYPE, nvr);                                                     \
+#define QC_NO_SUCH_TYPE(TYPE)                                                                                     \
+  fmi3Status fmi3Get##TYPE(fmi3Instance instance, const fmi3ValueReference[], size_t nvr, fmi3##TYPE[], size_t) { \
+    return no_such_type(instance, "fmi3Get" #TYPE, #TYPE, nvr);                                                   \
+  }                                                                                                               \
+  fmi3Status fmi3Set##TYPE(fmi3Instance instance, const fmi3ValueReference[], size_t nvr, const fmi3##TYPE[],     \
+                           size_t) {                                                                              \
+    return no_such_type(instance, "fmi3Set" #TYPE, #TYPE, nvr);                                                   \
   }
 QC_NO_SUCH_TYPE(Float32)
 QC_NO_SUCH_TYPE(Int8)
@@ -294,8 +293,7 @@ fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReferen
 fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference[], size_t, fmi3Float64[]) {
   return unsupported(instance, "fmi3GetShiftDecimal", kNoClocks);
 }
-fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference[], size_t, fmi3UInt64[],
-                                fmi3UInt64[]) {
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference[], size_t, fmi3UInt64[], fmi3UInt64[]) {
   return unsupported(instance, "fmi3GetShiftFraction", kNoClocks);
 }
 fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference[], size_t, const fmi3Float64[]) {

@@ -67,7 +67,8 @@ class Instance3 {
 
 template <int N>
 void expect_bits(const Eigen::Matrix<double, N, 1>& got, const Eigen::Matrix<double, N, 1>& want, const char* what) {
-  for (int i = 0; i < N; ++i) EXPECT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0) << what << "[" << i + 1 << "]";
+  for (int i = 0; i < N; ++i)
+    EXPECT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0) << what << "[" << i + 1 << "]";
 }
 
 TEST(FmuFmi3, PlantStepsAsTheNativeModel) {
@@ -146,9 +147,9 @@ TEST(FmuFmi3, RefusalsAreLoggedAndTheInstanceStaysUsable) {
             nullptr);
   EXPECT_TRUE(log.contains("co-simulation only")) << log.last();
   // No logger: refused, no crash.
-  EXPECT_EQ(instantiate("x", "{wrong}", r.path().c_str(), false, false, false, false, nullptr, 0, nullptr, nullptr,
-                        nullptr),
-            nullptr);
+  EXPECT_EQ(
+      instantiate("x", "{wrong}", r.path().c_str(), false, false, false, false, nullptr, 0, nullptr, nullptr, nullptr),
+      nullptr);
   // An FMI 2 configuration instantiated through FMI 3.
   const FmuConfig c2 = config_for(FmuKind::kPlant, FmiVersion::k2);
   Resources r2(c2);

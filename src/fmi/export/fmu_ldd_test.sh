@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # The FMU binary is self-contained: at load time it needs nothing but the C library, the maths
 # library and the loader (the C++ runtime is linked in), and it exports the FMI functions only.
-# Usage: fmu_ldd_test.sh <quadcosim_fmu.so>
+# Usage: fmu_ldd_test.sh <quadcosim_fmu.so> [ON: a sanitizer build]
 set -euo pipefail
 so="$1"
+if [ "${2:-OFF}" = "ON" ]; then
+  echo "fmu_ldd_test: a sanitizer build links the sanitizer runtimes into every library" >&2
+  exit 77
+fi
 if ! command -v ldd > /dev/null; then
   echo "fmu_ldd_test: ldd is not installed (Debian package libc-bin)" >&2
   exit 77

@@ -205,6 +205,7 @@ TEST(FmuPlantBadUse, BadStepSizesAndTimesAreRefusedAndTheInstanceGoesOn) {
   double t = 0.0;
   EXPECT_EQ(QC_FMI(fmi2GetRealStatus)(p.c_, fmi2LastSuccessfulTime, &t), fmi2OK);
   EXPECT_DOUBLE_EQ(t, 0.04);
+  EXPECT_DOUBLE_EQ(p.get("time"), 0.04);
 }
 
 TEST(FmuPlantBadUse, UnknownValueReferencesAndWrongTypesAreNamed) {

@@ -88,8 +88,10 @@ class PlantModel final : public Model {
     quad_.emplace(vehicle);
     state_ = x;
     rotor_input_ = quad_->rotor_input(x.omega_rad_s);  // PlantNode latches the initial speeds first
+    // Present whenever the plant node would have one (the configured realism, not what the switches
+    // left of it): the model then takes the same path through an Environment, whatever it holds.
     realism_.reset();
-    if (realism.active() || vehicle.aero.active()) {
+    if (config_.realism.active() || vehicle.aero.active()) {
       realism_.emplace(realism, vehicle, config_.realism_namespace, clock_);
     }
     sensor_noise_ = sensor_noise_ && realism_;

@@ -78,7 +78,8 @@ std::unique_ptr<Model> make_model(const FmuConfig& config, const ModelDescriptio
   return config.kind == FmuKind::kPlant ? make_plant_model(config, md) : make_controller_model(config, md);
 }
 
-Slave::Slave(FmuConfig config, Log log) : config_(std::move(config)), md_(describe(config_)), log_(std::move(log)) {
+Slave::Slave(FmuConfig config, Log log)
+    : config_(std::move(config)), md_(describe(config_)), log_(std::move(log)), time_vr_(find_vr(md_, "time")) {
   restart();
 }
 
@@ -181,6 +182,7 @@ Status Slave::reset() {
 }
 
 std::string Slave::check_vr(ValueReference vr, VariableType type) const {
+  if (vr < md_.variables.size() && md_.variables[vr].type == type) return {};  // the usual case, no text
   if (vr >= md_.variables.size()) return "unknown value reference " + std::to_string(vr);
   const Variable& v = md_.variables[vr];
   if (v.type != type) {
@@ -199,119 +201,126 @@ Status Slave::refresh_outputs() {
   return Status::kOK;
 }
 
-Status Slave::get_numbers(const ValueReference* vr, std::size_t n, VariableType type,
-                          const std::function<void(std::size_t, double)>& out) {
+template <class Out>
+Status Slave::get_numbers(const ValueReference* vr, std::size_t n, VariableType type, Out* values) {
   if (state_ == State::kInstantiated) {
     return refuse(std::string("get") + std::string(type_name(type)) + " is not allowed before enterInitializationMode");
   }
   if (n > 0 && (!vr)) return refuse("get" + std::string(type_name(type)) + ": null value reference array");
   for (std::size_t i = 0; i < n; ++i) {
-    if (std::string err = check_vr(vr[i], type); !err.empty()) return refuse(err);
+    if (!valid(vr[i], type)) return refuse(check_vr(vr[i], type));
   }
   if (state_ == State::kInitialization && outputs_stale_) {
     if (Status s = refresh_outputs(); s != Status::kOK) return s;
   }
-  for (std::size_t i = 0; i < n; ++i) out(i, values_.number[vr[i]]);
+  values_.number[time_vr_] = time_s();
+  for (std::size_t i = 0; i < n; ++i) values[i] = static_cast<Out>(values_.number[vr[i]]);
   return Status::kOK;
 }
 
-Status Slave::set_values(const ValueReference* vr, std::size_t n, VariableType type,
-                         const std::function<std::string(std::size_t, Values&)>& put) {
-  const std::string call = "set" + std::string(type_name(type));
+Status Slave::set_values(const ValueReference* vr, std::size_t n, VariableType type, const double* numbers,
+                         const char* const* strings) {
+  const std::string_view call_type = type_name(type);
+  const auto refuse_set = [&](const std::string& why) { return refuse("set" + std::string(call_type) + ": " + why); };
   if (state_ == State::kTerminated || state_ == State::kError) {
-    return refuse(call + " is not allowed in " + state_name(state_));
+    return refuse_set(std::string("not allowed in ") + state_name(state_));
   }
-  if (n > 0 && !vr) return refuse(call + ": null value reference array");
+  if (n > 0 && (!vr || (!numbers && !strings))) return refuse_set("null value reference or value array");
   // Every value is checked before any is applied: a refused call changes nothing.
-  Values next = values_;
-  std::vector<ValueReference> tunables;
+  bool tunable = false;
   for (std::size_t i = 0; i < n; ++i) {
-    if (std::string err = check_vr(vr[i], type); !err.empty()) return refuse(call + ": " + err);
+    if (!valid(vr[i], type)) return refuse_set(check_vr(vr[i], type));
     const Variable& v = md_.variables[vr[i]];
     switch (v.causality) {
       case Causality::kInput: break;
       case Causality::kParameter:
-        if (v.variability == Variability::kConstant) return refuse(call + ": " + v.name + " is a constant");
+        if (v.variability == Variability::kConstant) return refuse_set(v.name + " is a constant");
         if (v.variability == Variability::kFixed && state_ == State::kStepMode) {
-          return refuse(call + ": " + v.name +
-                        " is a fixed parameter: it can be set only before exitInitializationMode");
+          return refuse_set(v.name + " is a fixed parameter: it can be set only before exitInitializationMode");
         }
-        if (v.variability == Variability::kTunable) tunables.push_back(vr[i]);
+        tunable = tunable || v.variability == Variability::kTunable;
         break;
-      case Causality::kIndependent:
-        return refuse(call + ": " + v.name + " is the independent variable (time): it cannot be set");
+      case Causality::kIndependent: return refuse_set(v.name + " is the independent variable (time): it cannot be set");
       default:
-        return refuse(call + ": " + v.name + " is " + (v.causality == Causality::kOutput ? "an output" : "calculated") +
-                      " (computed by the FMU): it cannot be set");
+        return refuse_set(v.name + " is " + (v.causality == Causality::kOutput ? "an output" : "calculated") +
+                          " (computed by the FMU): it cannot be set");
     }
-    if (std::string err = put(i, next); !err.empty()) return refuse(call + ": " + v.name + " " + err);
-    if (type != VariableType::kString) {
-      const double x = next.number[vr[i]];
-      if ((v.min && x < *v.min) || (v.max && x > *v.max)) {
-        return refuse(call + ": " + v.name + " = " + number_text(x) + " is outside [" +
-                      number_text(v.min.value_or(-HUGE_VAL)) + ", " + number_text(v.max.value_or(HUGE_VAL)) + "]");
+    if (strings) {
+      if (!strings[i]) return refuse_set(v.name + ": a null string refused");
+      continue;
+    }
+    const double x = numbers[i];
+    if (!std::isfinite(x)) return refuse_set(v.name + " = " + number_text(x) + " refused: not a finite number");
+    if ((v.min && x < *v.min) || (v.max && x > *v.max)) {
+      return refuse_set(v.name + " = " + number_text(x) + " is outside [" + number_text(v.min.value_or(-HUGE_VAL)) +
+                        ", " + number_text(v.max.value_or(HUGE_VAL)) + "]");
+    }
+  }
+  const auto apply = [&](Values& to) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (strings) {
+        to.text[vr[i]] = strings[i];
+      } else {
+        to.number[vr[i]] = numbers[i];
       }
     }
+  };
+  if (tunable) {  // the model takes them all or none
+    Values next = values_;
+    apply(next);
+    std::vector<ValueReference> tunables;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (md_.variables[vr[i]].variability == Variability::kTunable) tunables.push_back(vr[i]);
+    }
+    if (std::string err = model_->set_tunable(tunables, next); !err.empty()) return refuse_set(err);
+    values_ = std::move(next);
+  } else {
+    apply(values_);
   }
-  if (!tunables.empty()) {
-    if (std::string err = model_->set_tunable(tunables, next); !err.empty()) return refuse(call + ": " + err);
-  }
-  values_ = std::move(next);
   if (state_ == State::kInitialization) outputs_stale_ = true;
   return Status::kOK;
 }
 
 Status Slave::get_real(const ValueReference* vr, std::size_t n, double* values) {
-  return get_numbers(vr, n, VariableType::kReal, [&](std::size_t i, double x) { values[i] = x; });
+  return get_numbers(vr, n, VariableType::kReal, values);
 }
 
 Status Slave::get_integer(const ValueReference* vr, std::size_t n, std::int32_t* values) {
-  return get_numbers(vr, n, VariableType::kInteger,
-                     [&](std::size_t i, double x) { values[i] = static_cast<std::int32_t>(x); });
+  return get_numbers(vr, n, VariableType::kInteger, values);
 }
 
 Status Slave::get_boolean(const ValueReference* vr, std::size_t n, bool* values) {
-  return get_numbers(vr, n, VariableType::kBoolean, [&](std::size_t i, double x) { values[i] = x != 0.0; });
+  return get_numbers(vr, n, VariableType::kBoolean, values);  // stored as 0 or 1
 }
 
 Status Slave::get_string(const ValueReference* vr, std::size_t n, const char** values) {
   if (state_ == State::kInstantiated) return refuse("getString is not allowed before enterInitializationMode");
   if (n > 0 && !vr) return refuse("getString: null value reference array");
   for (std::size_t i = 0; i < n; ++i) {
-    if (std::string err = check_vr(vr[i], VariableType::kString); !err.empty()) return refuse(err);
+    if (!valid(vr[i], VariableType::kString)) return refuse(check_vr(vr[i], VariableType::kString));
   }
   for (std::size_t i = 0; i < n; ++i) values[i] = values_.text[vr[i]].c_str();
   return Status::kOK;
 }
 
 Status Slave::set_real(const ValueReference* vr, std::size_t n, const double* values) {
-  return set_values(vr, n, VariableType::kReal, [&](std::size_t i, Values& next) -> std::string {
-    if (!std::isfinite(values[i])) return "= " + number_text(values[i]) + " refused: not a finite number";
-    next.number[vr[i]] = values[i];
-    return {};
-  });
+  return set_values(vr, n, VariableType::kReal, values, nullptr);
 }
 
 Status Slave::set_integer(const ValueReference* vr, std::size_t n, const std::int32_t* values) {
-  return set_values(vr, n, VariableType::kInteger, [&](std::size_t i, Values& next) -> std::string {
-    next.number[vr[i]] = values[i];
-    return {};
-  });
+  std::vector<double> numbers(n);
+  for (std::size_t i = 0; i < n && values; ++i) numbers[i] = values[i];
+  return set_values(vr, n, VariableType::kInteger, values ? numbers.data() : nullptr, nullptr);
 }
 
 Status Slave::set_boolean(const ValueReference* vr, std::size_t n, const bool* values) {
-  return set_values(vr, n, VariableType::kBoolean, [&](std::size_t i, Values& next) -> std::string {
-    next.number[vr[i]] = values[i] ? 1.0 : 0.0;
-    return {};
-  });
+  std::vector<double> numbers(n);
+  for (std::size_t i = 0; i < n && values; ++i) numbers[i] = values[i] ? 1.0 : 0.0;
+  return set_values(vr, n, VariableType::kBoolean, values ? numbers.data() : nullptr, nullptr);
 }
 
 Status Slave::set_string(const ValueReference* vr, std::size_t n, const char* const* values) {
-  return set_values(vr, n, VariableType::kString, [&](std::size_t i, Values& next) -> std::string {
-    if (!values[i]) return "refused: a null string";
-    next.text[vr[i]] = values[i];
-    return {};
-  });
+  return set_values(vr, n, VariableType::kString, nullptr, values);
 }
 
 Status Slave::get_state(Snapshot** out) {

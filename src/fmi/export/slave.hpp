@@ -107,12 +107,18 @@ class Slave {
   double time_s() const;
 
  private:
+  /// True when variable `vr` exists and is of `type`.
+  bool valid(ValueReference vr, VariableType type) const {
+    return vr < md_.variables.size() && md_.variables[vr].type == type;
+  }
   /// "" when variable `vr` exists and is of `type`, else why not.
   std::string check_vr(ValueReference vr, VariableType type) const;
-  Status get_numbers(const ValueReference* vr, std::size_t n, VariableType type,
-                     const std::function<void(std::size_t, double)>& out);
-  Status set_values(const ValueReference* vr, std::size_t n, VariableType type,
-                    const std::function<std::string(std::size_t, Values&)>& put);
+  /// Reads Real, Integer or Boolean values (stored as doubles) into `values`.
+  template <class Out>
+  Status get_numbers(const ValueReference* vr, std::size_t n, VariableType type, Out* values);
+  /// Checks and sets `n` values: `numbers` for Real, Integer and Boolean variables, else `strings`.
+  Status set_values(const ValueReference* vr, std::size_t n, VariableType type, const double* numbers,
+                    const char* const* strings);
   /// Outputs read in initialization mode: the model built from the parameters as they are now.
   Status refresh_outputs();
   void restart();
@@ -120,6 +126,7 @@ class Slave {
   FmuConfig config_;
   ModelDescription md_;
   Log log_;
+  ValueReference time_vr_;  ///< the independent variable, read as the current communication point
   Values values_;
   std::unique_ptr<Model> model_;
   State state_ = State::kInstantiated;
