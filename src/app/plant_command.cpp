@@ -337,6 +337,10 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
                    "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
       ->check(CLI::IsMember({"hold", "stop"}));
 
+  plant_cmd->add_flag("--clock-after-sensors", plant.clock_after_sensors,
+                      "publish /clock after each tick's Pose, Velocity and Imu (for a peer that steps on "
+                      "/clock and reads the newest samples: Simulink's ROS 2 time model; docs/simulink.md)");
+
   add_enclave_option(plant_cmd, plant.enclave);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   plant_cmd->parse_complete_callback([plant_cmd, &plant] {
@@ -379,6 +383,7 @@ int plant_command(const PlantCommandOptions& o) {
     sc.simulation.plant.watchdog_policy =
         o.watchdog_policy == "hold" ? sim::WatchdogPolicy::kHold : sim::WatchdogPolicy::kStop;
   }
+  sc.simulation.plant.clock_after_sensors = o.clock_after_sensors;
   if (o.duration_s >= 0.0) {
     sc.simulation.duration_ticks = static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
   }
