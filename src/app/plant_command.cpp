@@ -63,6 +63,24 @@ class PlantProcess {
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));
     }
     next_event_ = sc_.schedule.begin();
+    if (o_.lockstep && sc_.simulation.plant.clock_after_sensors) {
+      // A peer that steps on /clock reads whatever samples it holds then. Matched on our side does not
+      // mean it has discovered our writers: its readers may still drop tick 0's samples while a
+      // /clock gets through. So tick 0's /clock waits until the samples are acknowledged (on the main
+      // thread, where tick 0 is published; deliveries go on meanwhile). Later ticks rely on
+      // in-order delivery (docs/simulink.md).
+      plant_.before_clock([this](sim::Tick k) {
+        if (k != 0 || samples_acknowledged_) return;
+        samples_acknowledged_ = host_.unlocked([this] {
+          return transport_.wait_for_acks(topics_.pose, timeout_ns()) &&
+                 transport_.wait_for_acks(topics_.velocity, timeout_ns()) &&
+                 transport_.wait_for_acks(topics_.imu, timeout_ns());
+        });
+        if (!samples_acknowledged_) {
+          std::cerr << fmt::format("plant: warning: tick 0's samples not acknowledged within {} s\n", o_.timeout_s);
+        }
+      });
+    }
     // Real time: the watchdog measures how long ago a command arrived on the wall clock, so a
     // controller that dies is noticed within its limit however the ticks are paced.
     if (!o_.lockstep) plant_.use_receipt_clock(steady_ns);
@@ -289,6 +307,7 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool watchdog_logged_ = false;
+  bool samples_acknowledged_ = false;  ///< --clock-after-sensors: tick 0's samples reached the peer
   std::int64_t loop_start_ns_ = 0;
   // Last: the drivers and their host (with delivery on arrival) go first.
   DdsDriverHost host_{transport_};

@@ -138,7 +138,10 @@ void PlantNode::publish_outputs(Tick k) {
     velocity_pub_.publish(twist_);
     imu_pub_.publish(imu_);
   }
-  if (clock_pub_ && !clock_first) clock_pub_.publish(msg::Clock{stamp});
+  if (clock_pub_ && !clock_first) {
+    if (before_clock_) before_clock_(k);
+    clock_pub_.publish(msg::Clock{stamp});
+  }
 }
 
 void PlantNode::latch_command(Tick k) {

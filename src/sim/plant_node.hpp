@@ -81,6 +81,10 @@ class PlantNode final : public SteppablePlant {
   /// every 100th, each line with the count so far). Default: stderr.
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
+  /// With clock_after_sensors: runs after tick k's Pose, Velocity and Imu went out, before its /clock
+  /// (a lockstep plant over DDS waits there at tick 0 until the peer has the samples).
+  void before_clock(std::function<void(Tick)> f) { before_clock_ = std::move(f); }
+
   /// Publishes /clock, Pose, Velocity and Imu for the state at tick k (/clock last with
   /// clock_after_sensors), and the plant status when due.
   void publish_outputs(Tick k) override;
@@ -151,6 +155,7 @@ class PlantNode final : public SteppablePlant {
   Tick last_status_tick_ = -1;
   Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;
+  std::function<void(Tick)> before_clock_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
   Publisher<msg::Imu> imu_pub_;
