@@ -10,9 +10,10 @@
 #   clock_stepped_controller  `quadcosim plant --clock-after-sensors` drives the /clock-stepped
 #       controller: no timeout, every one of the 751 steps on samples stamped with its own /clock
 #       time, the reference trajectory, and 5 runs with byte-identical trajectory CSVs.
-#   clock_first_is_stale  the same without --clock-after-sensors (/clock before the samples): each
-#       step sees the previous tick's samples (and step 0 none), so the flight differs from the
-#       reference. Measures that DDS delivered /clock and the samples in publication order.
+#   clock_first_is_stale  the same without --clock-after-sensors (/clock before the samples): no step
+#       sees its own tick's samples, each sees the previous tick's (the first ones, before the node
+#       has discovered the plant's writers, none), so the flight differs from the reference.
+#       Measures that DDS delivered /clock and the samples in publication order.
 #   waiting_plant  `quadcosim controller` drives a plant that publishes /clock and the samples at
 #       100 Hz and blocks each control step until a command arrives: every command answers its own
 #       step (its label), the reference trajectory, 5 runs byte-identical.
@@ -71,10 +72,17 @@ import json, sys
 r = json.loads(open(sys.argv[1]).read())
 rows = [list(map(int, l.split(","))) for l in open(sys.argv[2])]
 assert r["steps"] == 751 and len(rows) == 751, (r, len(rows))
-assert rows[0] == [0, -1, -1, -1], rows[0]  # step 0 before any sample
-prev = [row for row in rows[1:] if row[1] == row[2] == row[3] == row[0] - 10_000_000]
-assert len(prev) == 750, f"{len(prev)} of 750 steps on the previous tick's samples"
-print(r, "every step after 0 on the samples of 10 ms before")
+assert r["stale_steps"] >= 750, r  # not one step after t = 0 on its own tick's samples
+# Step 0 may see its own samples: while discovery settles the plant publishes tick 0 again after
+# 50 ms, and the samples of the first round may be in when the second /clock comes. Until the node
+# has discovered the plant's three writers a step lacks samples of some topic; from then on every
+# step has those of 10 ms before.
+blank = 1
+while blank < len(rows) and -1 in rows[blank][1:]:
+    blank += 1
+prev = [row for row in rows[blank:] if row[1] == row[2] == row[3] == row[0] - 10_000_000]
+assert blank <= 25 and len(prev) == 751 - blank, (blank, len(prev), [row for row in rows[blank:] if row not in prev][:6])
+print(r, f"step 0 on {rows[0][1:]}, {blank - 1} more lacking samples, then {len(prev)} on the samples of 10 ms before")
 PY
     if same_flight "$tmp/plant_1.csv"; then fail "stale samples flew the reference trajectory"; fi
     ;;

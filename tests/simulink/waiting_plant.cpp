@@ -43,9 +43,14 @@ int main(int argc, char** argv) try {
   sim::PlantOptions po = sc.simulation.plant;
   po.drop_stale_commands = false;  // the layout is not read
   sim::PlantNode plant(transport, topics, sc.vehicle, po, io::initial_state(sc));
+  // The test's own reader of the commands (a second DDS reader: it may take a command a moment after
+  // the plant's reader did, so each step waits for both).
   std::int64_t newest_label_ns = -1;
-  transport.subscribe<msg::Float64MultiArray>(
-      topics.motor_commands, [&](const msg::Float64MultiArray& m) { newest_label_ns = msg::command_stamp_ns(m); });
+  std::uint64_t labels_seen = 0;
+  transport.subscribe<msg::Float64MultiArray>(topics.motor_commands, [&](const msg::Float64MultiArray& m) {
+    newest_label_ns = msg::command_stamp_ns(m);
+    ++labels_seen;
+  });
 
   const bool matched = transport.spin_until(
       [&] {
@@ -62,12 +67,12 @@ int main(int argc, char** argv) try {
   long commands = 0, mismatched = 0;
   const sim::Tick last = sc.simulation.duration_ticks;
   for (sim::Tick k = 0; k <= last; ++k) {
-    const std::uint64_t before = plant.command_receipt().received;
+    const std::uint64_t before = plant.command_receipt().received, labels_before = labels_seen;
     plant.publish_outputs(k);
     if (k % sc.simulation.controller_divider == 0) {
       const auto asked = std::chrono::steady_clock::now();
       auto last_ask = asked;
-      while (plant.command_receipt().received <= before) {
+      while (plant.command_receipt().received <= before || labels_seen <= labels_before) {
         transport.spin_once(10'000'000);
         const auto now = std::chrono::steady_clock::now();
         if (now - asked > std::chrono::nanoseconds(timeout_ns)) {
