@@ -119,6 +119,8 @@ struct PlantCommandOptions {
   std::string watchdog_policy;  ///< overrides simulation.watchdog_policy when set: "hold" or "stop"
   std::string stats;            ///< write run figures (real-time factor, round trip) as JSON here ("" none)
   std::string enclave = "/";    ///< DDS Security enclave (rcl --enclave)
+  /// Publish /clock after each tick's Pose, Velocity and Imu (a peer stepping on /clock).
+  bool clock_after_sensors = false;
 
   Lockstep lockstep_only;
   Realtime realtime;
