@@ -408,6 +408,21 @@ const char* element_name(VariableType t, bool v3) {
 
 /// The type-specific attributes of a variable (FMI 2: on its Real/Integer/... child; FMI 3: on the
 /// typed element itself); String start values are FMI 3 <Start value=""> children, written by the caller.
+/// An output's `dependencies` attribute: FMI 2 lists 1-based variable indices, FMI 3 value references.
+void write_dependencies(Writer& w, const ModelDescription& md, std::size_t output, bool v3) {
+  const auto& deps = md.variables[output].dependencies;
+  if (!deps) return;
+  std::string list;
+  for (const std::size_t j : *deps) {
+    if (j >= md.variables.size() || md.variables[j].causality != Causality::kInput) {
+      throw FmuError("modelDescription.xml: output '" + md.variables[output].name + "' depends on variable " +
+                     std::to_string(j) + ", which is no input");
+    }
+    list += (list.empty() ? "" : " ") + std::to_string(v3 ? md.variables[j].vr : j + 1);
+  }
+  w.attribute("dependencies", std::string_view(list));
+}
+
 void type_attributes(Writer& w, const Variable& var, bool v3) {
   if (var.start && !(v3 && var.type == VariableType::kString)) w.attribute("start", *var.start);
   if (!var.unit.empty()) w.attribute("unit", var.unit);
@@ -435,6 +450,7 @@ std::string write_model_description(const ModelDescription& md) {
   w.attribute("modelIdentifier", md.model_identifier);
   if (md.can_handle_variable_step) w.attribute("canHandleVariableCommunicationStepSize", true);
   if (md.can_be_instantiated_only_once_per_process) w.attribute("canBeInstantiatedOnlyOncePerProcess", true);
+  if (md.can_get_and_set_fmu_state) w.attribute(v3 ? "canGetAndSetFMUState" : "canGetAndSetFMUstate", true);
   w.end();
 
   if (!checked.units.empty()) {
@@ -509,6 +525,7 @@ std::string write_model_description(const ModelDescription& md) {
     for (const std::size_t i : md.outputs) {
       w.start("Output");
       w.attribute("valueReference", std::string_view(std::to_string(md.variables[i].vr)));
+      write_dependencies(w, md, i, v3);
       w.end();
     }
     for (const std::size_t i : initial_unknowns) {
@@ -522,6 +539,7 @@ std::string write_model_description(const ModelDescription& md) {
       for (const std::size_t i : md.outputs) {
         w.start("Unknown");
         w.attribute("index", i + 1);
+        write_dependencies(w, md, i, v3);
         w.end();
       }
       w.end();

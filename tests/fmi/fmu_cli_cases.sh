@@ -53,6 +53,8 @@ check(cs is not None and cs.get("modelIdentifier") == ident, "CoSimulation model
 # A step must be a whole number of periods: the FMU cannot take any step, so it must not say it can.
 check(cs is not None and cs.get("canHandleVariableCommunicationStepSize", "false") == "false",
       "canHandleVariableCommunicationStepSize should be false")
+check(cs is not None and cs.get("canGetAndSetFMUState" if v3 else "canGetAndSetFMUstate") == "true",
+      "the FMU saves and restores its state: canGetAndSetFMUstate should be true")
 period = 0.01 if kind == "plant" else 0.02  # the paper's rates: plant 100 Hz, controller 50 Hz
 exp = root.find("DefaultExperiment")
 check(exp is not None and float(exp.get("stepSize")) == period, "DefaultExperiment stepSize")
@@ -168,6 +170,8 @@ outputs = [v for v in variables if v[4].get("causality") == "output"]
 ms = root.find("ModelStructure")
 if v3:
     listed = [int(e.get("valueReference")) for e in ms.findall("Output")]
+    check(all(e.get("dependencies") == "" for e in ms.findall("Output")),
+          "every Output should declare dependencies=\"\" (no direct feedthrough)")
     check(sorted(listed) == sorted(v[2] for v in outputs), "ModelStructure Output valueReferences != the outputs")
     init = [int(e.get("valueReference")) for e in ms.findall("InitialUnknown")]
     check(sorted(init) == sorted(v[2] for v in outputs if v[4].get("initial", "calculated") != "exact"),
@@ -177,6 +181,8 @@ if v3:
     check(len(set(vrs)) == len(vrs), "FMI 3 value references are not unique")
 else:
     listed = [int(u.get("index")) for u in ms.find("Outputs").findall("Unknown")]
+    check(all(u.get("dependencies") == "" for u in ms.find("Outputs").findall("Unknown")),
+          "every Outputs/Unknown should declare dependencies=\"\" (no direct feedthrough)")
     check(sorted(listed) == sorted(v[0] for v in outputs), "ModelStructure Outputs indices != the outputs")
     iu = ms.find("InitialUnknowns")
     init = [int(u.get("index")) for u in iu.findall("Unknown")] if iu is not None else []

@@ -370,7 +370,12 @@ struct Builder {
     v.unit = std::string(unit);
     v.description = std::move(description);
     md.variables.push_back(std::move(v));
-    if (causality == Causality::kOutput) md.outputs.push_back(md.variables.size() - 1);
+    if (causality == Causality::kOutput) {
+      // No direct feedthrough: outputs are computed at the end of doStep, from the inputs held over
+      // the step, so a plant and a controller FMU coupled both ways form no algebraic loop.
+      md.variables.back().dependencies.emplace();
+      md.outputs.push_back(md.variables.size() - 1);
+    }
     return md.variables.back();
   }
   void input(std::string_view name, std::string_view unit, std::string description, double start) {
@@ -520,6 +525,7 @@ ModelDescription describe(const FmuConfig& c) {
   md.model_identifier = std::string(model_identifier(c.kind));
   md.can_handle_variable_step = false;
   md.can_be_instantiated_only_once_per_process = false;
+  md.can_get_and_set_fmu_state = true;  // fmi2GetFMUstate/SetFMUstate/FreeFMUstate (not serialisation)
   const std::int64_t period_ns = plant ? c.plant_period_ns : c.plant_period_ns * c.controller_divider;
   md.start_time = 0.0;
   md.stop_time = c.stop_time_s;
