@@ -202,6 +202,7 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
   app::RunJudgement judged;
   std::vector<std::pair<std::string, std::vector<double>>> columns;
   std::string metrics;
+  bool interrupted = false;
   {
     py::gil_scoped_release release;
     if (out) {
@@ -219,16 +220,30 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
         e << s.root;
         std::ofstream(dir / "scenario.yaml") << e.c_str() << '\n';
       }
-      app::fly_inprocess(s.scenario, dir, info, warn);
-      judged = app::judge_run(s.scenario, dir);
+      // Ctrl-C (or any pending Python signal handler's exception) ends the run as it ends the CLI's:
+      // what ran stays recorded. Checked every 4096 ticks (~50 µs of simulation).
+      sim::Tick ticks = 0;
+      const auto on_tick = [&](double) {
+        if (++ticks % 4096 != 0) return false;
+        py::gil_scoped_acquire acquire;
+        return PyErr_CheckSignals() != 0;  // the exception stays set for the caller
+      };
+      if (!app::fly_inprocess(s.scenario, dir, info, warn, on_tick)) {
+        interrupted = true;
+      } else {
+        judged = app::judge_run(s.scenario, dir);
+      }
     } catch (const control::CareError& e) {
       throw io::ConfigError(s.source + ": controller design failed: " + e.what());
     } catch (const std::invalid_argument& e) {
       throw io::ConfigError(s.source + ": " + e.what());
     }
-    columns = read_csv_columns(dir / "trajectory.csv");
-    metrics = read_text(dir / "metrics.json");
+    if (!interrupted) {
+      columns = read_csv_columns(dir / "trajectory.csv");
+      metrics = read_text(dir / "metrics.json");
+    }
   }
+  if (interrupted) throw py::error_already_set();
   py::dict trajectory;
   for (auto& [name, values] : columns) {
     py::array_t<double> a(static_cast<py::ssize_t>(values.size()));

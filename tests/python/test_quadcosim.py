@@ -148,6 +148,27 @@ def test_run_refuses_a_folder_holding_other_outputs(tmp_path):
     quadcosim.run(ALTITUDE_STEP, out=tmp_path / "r", force=True)
 
 
+def test_ctrl_c_ends_a_run_keeping_what_ran(tmp_path):
+    """An hour simulated (360,001 ticks, seconds of wall time): a SIGINT 0.2 s in ends it promptly with
+    KeyboardInterrupt, and trajectory.csv holds the ticks that ran, whole rows."""
+    import _thread
+    import threading
+    import time
+    long = hover_scenario(duration_s=3600.0)
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    start = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            quadcosim.run(long, out=tmp_path / "long")
+    finally:
+        timer.cancel()
+    lines = (tmp_path / "long" / "trajectory.csv").read_text().splitlines()
+    assert 2 < len(lines) < 360_002
+    assert all(len(line.split(",")) == len(lines[0].split(",")) for line in lines)
+    assert time.perf_counter() - start < 30.0
+
+
 # --- stepping -------------------------------------------------------------------------------------------
 
 

@@ -98,6 +98,9 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
         run is recorded in a temporary folder that is removed.
     controller: a controller type replacing the scenario's (as --controller).
 
+    Ctrl-C raises KeyboardInterrupt within a few thousand plant ticks; out then holds what ran, as
+    after an interrupted `quadcosim run`.
+
     Returns a RunResult (trajectory, figures, passed, ...). Raises ConfigError for a bad scenario,
     ValueError when out cannot be used (it holds other outputs), RuntimeError on an I/O error.
     """
