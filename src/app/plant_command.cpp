@@ -63,6 +63,24 @@ class PlantProcess {
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));
     }
     next_event_ = sc_.schedule.begin();
+    if (o_.lockstep && sc_.simulation.plant.clock_after_sensors) {
+      // A peer that steps on /clock reads whatever samples it holds then. Matched on our side does not
+      // mean it has discovered our writers: its readers may still drop tick 0's samples while a
+      // /clock gets through. So tick 0's /clock waits until the samples are acknowledged (on the main
+      // thread, where tick 0 is published; deliveries go on meanwhile). Later ticks rely on
+      // in-order delivery (docs/simulink.md).
+      plant_.before_clock([this](sim::Tick k) {
+        if (k != 0 || samples_acknowledged_) return;
+        samples_acknowledged_ = host_.unlocked([this] {
+          return transport_.wait_for_acks(topics_.pose, timeout_ns()) &&
+                 transport_.wait_for_acks(topics_.velocity, timeout_ns()) &&
+                 transport_.wait_for_acks(topics_.imu, timeout_ns());
+        });
+        if (!samples_acknowledged_) {
+          std::cerr << fmt::format("plant: warning: tick 0's samples not acknowledged within {} s\n", o_.timeout_s);
+        }
+      });
+    }
     // Real time: the watchdog measures how long ago a command arrived on the wall clock, so a
     // controller that dies is noticed within its limit however the ticks are paced.
     if (!o_.lockstep) plant_.use_receipt_clock(steady_ns);
@@ -289,6 +307,7 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool watchdog_logged_ = false;
+  bool samples_acknowledged_ = false;  ///< --clock-after-sensors: tick 0's samples reached the peer
   std::int64_t loop_start_ns_ = 0;
   // Last: the drivers and their host (with delivery on arrival) go first.
   DdsDriverHost host_{transport_};
@@ -337,6 +356,10 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
                    "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
       ->check(CLI::IsMember({"hold", "stop"}));
 
+  plant_cmd->add_flag("--clock-after-sensors", plant.clock_after_sensors,
+                      "publish /clock after each tick's Pose, Velocity and Imu (for a peer that steps on "
+                      "/clock and reads the newest samples: Simulink's ROS 2 time model; docs/simulink.md)");
+
   add_enclave_option(plant_cmd, plant.enclave);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   plant_cmd->parse_complete_callback([plant_cmd, &plant] {
@@ -379,6 +402,7 @@ int plant_command(const PlantCommandOptions& o) {
     sc.simulation.plant.watchdog_policy =
         o.watchdog_policy == "hold" ? sim::WatchdogPolicy::kHold : sim::WatchdogPolicy::kStop;
   }
+  sc.simulation.plant.clock_after_sensors = o.clock_after_sensors;
   if (o.duration_s >= 0.0) {
     sc.simulation.duration_ticks = static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
   }

@@ -233,6 +233,15 @@ int DdsTransport::matched_writers(const std::string& ros_topic) const {
   return n;
 }
 
+bool DdsTransport::wait_for_acks(const std::string& ros_topic, std::int64_t timeout_ns) {
+  const auto it = writers_.find(ros_topic);
+  if (it == writers_.end()) return true;
+  for (dds_entity_t w : it->second) {
+    if (dds_wait_for_acks(w, timeout_ns) != DDS_RETCODE_OK) return false;
+  }
+  return true;
+}
+
 int DdsTransport::matched_readers(const std::string& ros_topic) const {
   int n = 0;
   const auto it = writers_.find(ros_topic);

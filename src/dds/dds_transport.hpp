@@ -51,6 +51,12 @@ class DdsTransport final : public sim::Transport {
   int matched_writers(const std::string& ros_topic) const;
   int matched_readers(const std::string& ros_topic) const;
 
+  /// Waits until every reliable reader matched by our writers of `ros_topic` has acknowledged what
+  /// they wrote (dds_wait_for_acks), at most timeout_ns; true when they all have. A reader that has
+  /// not discovered the writer yet acknowledges only after it has (and has the samples): what a
+  /// writer's own matched count cannot tell.
+  bool wait_for_acks(const std::string& ros_topic, std::int64_t timeout_ns);
+
   const Participant& participant() const { return participant_; }
 
   /// Extra DDS work served by spin_once beside the subscriptions, e.g. ROS 2 services on this

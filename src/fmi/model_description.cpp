@@ -414,6 +414,8 @@ ModelDescription parse_model_description(std::string_view xml, const std::string
   md.can_handle_variable_step = r.boolean(cs, "CoSimulation", "canHandleVariableCommunicationStepSize", false);
   md.can_be_instantiated_only_once_per_process =
       r.boolean(cs, "CoSimulation", "canBeInstantiatedOnlyOncePerProcess", false);
+  md.can_get_and_set_fmu_state = r.boolean(
+      cs, "CoSimulation", md.version == FmiVersion::k3 ? "canGetAndSetFMUState" : "canGetAndSetFMUstate", false);
 
   if (const xmlNode* experiment = child(root, "DefaultExperiment")) {
     md.start_time = r.number(experiment, "DefaultExperiment", "startTime");

@@ -46,6 +46,11 @@ struct Variable {
   std::string unit;                  ///< "" when none is declared
   std::string description;
   std::optional<double> min, max;  ///< declared bounds (numbers only)
+  /// Outputs: the inputs (indices into ModelDescription::variables) its value depends on directly,
+  /// within the same communication point; empty: on none (no direct feedthrough, so a master may
+  /// close a loop through it without an algebraic loop). Absent: on every input, as the standard
+  /// reads a missing `dependencies` attribute.
+  std::optional<std::vector<std::size_t>> dependencies;
 };
 
 struct ModelDescription {
@@ -59,6 +64,7 @@ struct ModelDescription {
   std::string model_identifier;
   bool can_handle_variable_step = false;  ///< canHandleVariableCommunicationStepSize
   bool can_be_instantiated_only_once_per_process = false;
+  bool can_get_and_set_fmu_state = false;  ///< canGetAndSetFMUstate: rollback by saving the state
   // DefaultExperiment, when given.
   std::optional<double> start_time, stop_time, step_size;
   std::vector<Variable> variables;

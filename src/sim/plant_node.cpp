@@ -110,7 +110,8 @@ void PlantNode::publish_outputs(Tick k) {
   const model::Outputs y =
       model_.outputs(options_.clock.seconds(k), state_, rotor_input_, realism_ ? &realism_->environment(k) : nullptr);
 
-  if (clock_pub_) clock_pub_.publish(msg::Clock{stamp});
+  const bool clock_first = !options_.clock_after_sensors;
+  if (clock_pub_ && clock_first) clock_pub_.publish(msg::Clock{stamp});
   publish_status(k);
 
   // The messages are kept between ticks (their frame ids are set once); every field that changes
@@ -132,11 +133,15 @@ void PlantNode::publish_outputs(Tick k) {
     if (due.pose) pose_pub_.publish(pose_);
     if (due.velocity) velocity_pub_.publish(twist_);
     if (due.imu) imu_pub_.publish(imu_);
-    return;
+  } else {
+    pose_pub_.publish(pose_);
+    velocity_pub_.publish(twist_);
+    imu_pub_.publish(imu_);
   }
-  pose_pub_.publish(pose_);
-  velocity_pub_.publish(twist_);
-  imu_pub_.publish(imu_);
+  if (clock_pub_ && !clock_first) {
+    if (before_clock_) before_clock_(k);
+    clock_pub_.publish(msg::Clock{stamp});
+  }
 }
 
 void PlantNode::latch_command(Tick k) {

@@ -49,6 +49,11 @@ struct PlantOptions {
   /// Publish /clock. It is global, not namespaced: when one process hosts many plants, one of them
   /// publishes it.
   bool publish_clock = true;
+  /// Publish /clock after Pose, Velocity and Imu of the tick instead of before them. For a peer that
+  /// steps when /clock reaches its next sample hit and then reads the newest sample of each topic (a
+  /// Simulink node with ROS 2 time model stepping, docs/simulink.md): delivered in publication order,
+  /// the tick's samples are in before the time that steps it.
+  bool clock_after_sensors = false;
 };
 
 /// What became of the motor commands (sim/validation.hpp check_command).
@@ -76,7 +81,12 @@ class PlantNode final : public SteppablePlant {
   /// every 100th, each line with the count so far). Default: stderr.
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
-  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k, and the plant status when due.
+  /// With clock_after_sensors: runs after tick k's Pose, Velocity and Imu went out, before its /clock
+  /// (a lockstep plant over DDS waits there at tick 0 until the peer has the samples).
+  void before_clock(std::function<void(Tick)> f) { before_clock_ = std::move(f); }
+
+  /// Publishes /clock, Pose, Velocity and Imu for the state at tick k (/clock last with
+  /// clock_after_sensors), and the plant status when due.
   void publish_outputs(Tick k) override;
   /// Fixes the command that acts over [t_k, t_k+1): the newest one whose delay has elapsed.
   void latch_command(Tick k) override;
@@ -145,6 +155,7 @@ class PlantNode final : public SteppablePlant {
   Tick last_status_tick_ = -1;
   Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;
+  std::function<void(Tick)> before_clock_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
   Publisher<msg::Imu> imu_pub_;

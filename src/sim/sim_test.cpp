@@ -107,6 +107,27 @@ TEST(PlantNodeTest, PublishesStampedOutputsOfTheState) {
   EXPECT_NEAR(rig.imus[0].linear_acceleration.z, 0.0, 1e-12);
 }
 
+// The order of a tick's messages: /clock first by default; last with clock_after_sensors, so a peer
+// that steps when /clock arrives holds the tick's samples by then (docs/simulink.md).
+TEST(PlantNodeTest, PublishesClockBeforeOrAfterTheSensors) {
+  for (const bool after : {false, true}) {
+    InProcessTransport bus;
+    const Topics topics = Topics::for_namespace("/drone");
+    std::vector<std::string> order;
+    bus.subscribe<msg::Clock>(topics.clock, [&](const msg::Clock&) { order.push_back("clock"); });
+    bus.subscribe<msg::PoseStamped>(topics.pose, [&](const msg::PoseStamped&) { order.push_back("pose"); });
+    bus.subscribe<msg::TwistStamped>(topics.velocity, [&](const msg::TwistStamped&) { order.push_back("velocity"); });
+    bus.subscribe<msg::Imu>(topics.imu, [&](const msg::Imu&) { order.push_back("imu"); });
+    PlantOptions opt;
+    opt.clock_after_sensors = after;
+    PlantNode plant(bus, topics, model::VehicleParams{}, opt, model::State{});
+    plant.publish_outputs(2);
+    const std::vector<std::string> expected = after ? std::vector<std::string>{"pose", "velocity", "imu", "clock"}
+                                                    : std::vector<std::string>{"clock", "pose", "velocity", "imu"};
+    EXPECT_EQ(order, expected) << "clock_after_sensors = " << after;
+  }
+}
+
 TEST(PlantNodeTest, RejectsMalformedCommandsAndHoldsTheLastGoodOne) {
   PlantRig rig;
   rig.plant->publish_outputs(0);

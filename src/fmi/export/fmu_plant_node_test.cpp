@@ -1,0 +1,195 @@
+// The plant FMU against sim::PlantNode itself, the plant of every quadcosim run: with drag, wind,
+// gusts, a rotor fault and sensor noise, rates and latencies, the FMU's outputs after each 0.02 s
+// step are the node's published sensor messages of that tick, bit for bit.
+#include <cstring>
+
+#include "fmi/export/fmu_test_support.hpp"
+#include "fmi/quadrotor_variables.hpp"
+#include "sim/inprocess_transport.hpp"
+#include "sim/plant_node.hpp"
+
+namespace quadcosim::fmi::test {
+namespace {
+
+sim::RealismConfig rough_air() {
+  sim::RealismConfig r;
+  r.seed = 42;
+  r.imu.timing = {2, 1};
+  r.imu.gyro_noise_density = 0.002;
+  r.imu.gyro_bias_random_walk = 1e-4;
+  r.imu.accel_noise_density = 0.02;
+  r.imu.accel_bias_initial = 0.05;
+  r.imu.orientation_sigma_rad = 0.01;
+  r.pose.timing = {5, 3};
+  r.pose.position_sigma_m = 0.02;
+  r.pose.orientation_sigma_rad = 0.01;
+  r.velocity.linear_sigma_m_s = 0.05;
+  r.velocity.angular_sigma_rad_s = 0.01;
+  r.wind.mean_W_m_s = {2.0, -1.0, 0.0};
+  r.wind.gusts.enabled = true;
+  r.faults.push_back({150, 2, 0.8});
+  return r;
+}
+
+/// Runs the FMU and a PlantNode side by side for 3 s under the same commands and compares, after
+/// every FMU step, its outputs with what the node last published.
+void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
+  c.vehicle.aero.linear_drag_N_s_m = {0.1, 0.1, 0.2};
+  c.vehicle.motor.model = model::MotorModel::kFirstOrder;
+  c.initial.p_W = {0.0, 0.0, 2.0};
+  c.initial.omega_rad_s.setConstant(c.vehicle.hover_omega_rad_s());
+  c.guid = make_guid(c);
+
+  sim::InProcessTransport transport;
+  const sim::Topics topics = sim::Topics::for_namespace(c.realism_namespace);
+  sim::PlantOptions o;
+  o.clock = {c.plant_period_ns};
+  o.substeps = c.substeps;
+  o.watchdog_ticks = 0;
+  o.realism = c.realism;
+  if (!sensor_noise) o.realism.imu = {}, o.realism.pose = {}, o.realism.velocity = {};
+  sim::PlantNode node(transport, topics, c.vehicle, o, c.initial);
+  node.set_log([](const std::string&) {});
+  msg::PoseStamped pose;
+  msg::TwistStamped twist;
+  msg::Imu imu;
+  transport.subscribe<msg::PoseStamped>(topics.pose, [&](const msg::PoseStamped& m) { pose = m; });
+  transport.subscribe<msg::TwistStamped>(topics.velocity, [&](const msg::TwistStamped& m) { twist = m; });
+  transport.subscribe<msg::Imu>(topics.imu, [&](const msg::Imu& m) { imu = m; });
+  auto commands = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
+
+  Resources resources(c);
+  Log log;
+  fmi2CallbackFunctions cb = log.fmi2_callbacks();
+  fmi2Component fmu = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, c.guid.c_str(), resources.uri().c_str(), &cb,
+                                              fmi2False, fmi2False);
+  ASSERT_NE(fmu, nullptr) << log.last();
+  const fmi2ValueReference noise = vr_of(c, "realism.sensor_noise");
+  const fmi2Boolean noise_on = sensor_noise ? fmi2True : fmi2False;
+  ASSERT_EQ(QC_FMI(fmi2SetBoolean)(fmu, &noise, 1, &noise_on), fmi2OK) << log.last();
+  ASSERT_EQ(QC_FMI(fmi2SetupExperiment)(fmu, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+  ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(fmu), fmi2OK);
+  ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(fmu), fmi2OK) << log.last();
+
+  std::vector<fmi2ValueReference> outputs, cmd_vrs;
+  for (auto names : {names::kPosition, names::kVelocity, names::kRates, names::kSpecificForce}) {
+    for (auto n : names) outputs.push_back(vr_of(c, n));
+  }
+  for (auto n : names::kAttitude) outputs.push_back(vr_of(c, n));
+  for (auto n : names::kRotorSpeed) outputs.push_back(vr_of(c, n));
+  for (auto n : names::kOmegaCmd) cmd_vrs.push_back(vr_of(c, n));
+
+  const double hover = c.vehicle.hover_omega_rad_s();
+  for (sim::Tick k = 0; k <= 300; ++k) {
+    node.publish_outputs(k);
+    if (k % 2 == 0) {
+      std::vector<double> got(outputs.size());
+      ASSERT_EQ(QC_FMI(fmi2GetReal)(fmu, outputs.data(), outputs.size(), got.data()), fmi2OK) << log.last();
+      const auto& s = node.state().omega_rad_s;
+      const std::vector<double> want = {pose.position.x,
+                                        pose.position.y,
+                                        pose.position.z,
+                                        twist.linear.x,
+                                        twist.linear.y,
+                                        twist.linear.z,
+                                        imu.angular_velocity.x,
+                                        imu.angular_velocity.y,
+                                        imu.angular_velocity.z,
+                                        imu.linear_acceleration.x,
+                                        imu.linear_acceleration.y,
+                                        imu.linear_acceleration.z,
+                                        imu.orientation.w,
+                                        imu.orientation.x,
+                                        imu.orientation.y,
+                                        imu.orientation.z,
+                                        s[0],
+                                        s[1],
+                                        s[2],
+                                        s[3]};
+      for (std::size_t i = 0; i < want.size(); ++i) {
+        ASSERT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0)
+            << "output " << i << " at tick " << k << ": " << got[i] << " vs " << want[i];
+      }
+      // The next command, to both: a slow wobble around hover.
+      const double w = hover * (1.0 + 0.01 * std::sin(0.05 * static_cast<double>(k)));
+      const std::vector<double> cmd = {w, hover, w, hover};
+      commands.publish(msg::Float64MultiArray{cmd, {}, 0});
+      ASSERT_EQ(QC_FMI(fmi2SetReal)(fmu, cmd_vrs.data(), 4, cmd.data()), fmi2OK);
+      if (k < 300) ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+    }
+    node.latch_command(k);
+    node.integrate(k);
+  }
+  EXPECT_GT(std::abs(node.state().p_W.x()), 0.01);  // the wind moved it
+  QC_FMI(fmi2FreeInstance)(fmu);
+}
+
+TEST(FmuPlantNode, SensorNoiseLeftToTheMasterKeepsTheTrueStateOfANoisyNode) {
+  // What a quadcosim run with the FMU as its plant does when the scenario has sensor noise: the node
+  // adds the noise, the FMU (realism.sensor_noise off) reports the truth, which must be the native
+  // node's state bit for bit.
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.realism.seed = 3;
+  c.realism.imu.gyro_noise_density = 0.01;
+  c.realism.pose.position_sigma_m = 0.1;
+  c.initial.p_W = {0.0, 0.0, 1.0};
+  c.initial.omega_rad_s.setConstant(c.vehicle.hover_omega_rad_s() * 1.01);
+  c.guid = make_guid(c);
+
+  sim::InProcessTransport transport;
+  const sim::Topics topics = sim::Topics::for_namespace(c.realism_namespace);
+  sim::PlantOptions o;
+  o.watchdog_ticks = 0;
+  o.realism = c.realism;
+  sim::PlantNode node(transport, topics, c.vehicle, o, c.initial);
+
+  Resources resources(c);
+  Log log;
+  fmi2CallbackFunctions cb = log.fmi2_callbacks();
+  fmi2Component fmu = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, c.guid.c_str(), resources.uri().c_str(), &cb,
+                                              fmi2False, fmi2False);
+  ASSERT_NE(fmu, nullptr) << log.last();
+  const fmi2ValueReference noise = vr_of(c, "realism.sensor_noise");
+  const fmi2Boolean off = fmi2False;
+  ASSERT_EQ(QC_FMI(fmi2SetBoolean)(fmu, &noise, 1, &off), fmi2OK) << log.last();
+  ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(fmu), fmi2OK);
+  ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(fmu), fmi2OK) << log.last();
+  std::vector<fmi2ValueReference> vrs;
+  for (auto names : {names::kPosition, names::kVelocity, names::kRates}) {
+    for (auto n : names) vrs.push_back(vr_of(c, n));
+  }
+  for (auto n : names::kAttitude) vrs.push_back(vr_of(c, n));
+  for (sim::Tick k = 0; k <= 200; ++k) {
+    node.publish_outputs(k);
+    if (k % 2 == 0) {
+      std::vector<double> got(vrs.size());
+      ASSERT_EQ(QC_FMI(fmi2GetReal)(fmu, vrs.data(), vrs.size(), got.data()), fmi2OK);
+      const model::State& x = node.state();
+      const std::vector<double> want = {x.p_W.x(), x.p_W.y(), x.p_W.z(),  x.v_W.x(),  x.v_W.y(),  x.v_W.z(), x.w_B.x(),
+                                        x.w_B.y(), x.w_B.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
+      for (std::size_t i = 0; i < want.size(); ++i) {
+        ASSERT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0) << "output " << i << " at tick " << k;
+      }
+      if (k < 200) ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+    }
+    node.latch_command(k);
+    node.integrate(k);
+  }
+  EXPECT_GT(node.state().p_W.z(), 1.1);  // it climbed on the initial speeds
+  QC_FMI(fmi2FreeInstance)(fmu);
+}
+
+TEST(FmuPlantNode, WindGustsFaultsAndDragGiveThePlantNodesNumbers) {
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.realism = rough_air();
+  compare_with_plant_node(c, /*sensor_noise=*/false);
+}
+
+TEST(FmuPlantNode, WithSensorNoiseTheOutputsAreThePublishedSamples) {
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.realism = rough_air();
+  compare_with_plant_node(c, /*sensor_noise=*/true);
+}
+
+}  // namespace
+}  // namespace quadcosim::fmi::test
