@@ -176,7 +176,7 @@ def test_hover_holds_its_altitude():
     """From a trimmed hover the vehicle is in equilibrium: thrust k * omega_h^2 equals m g up to the
     rounding of a few floating-point operations (relative error <= 16 eps, eps = 2.2e-16), a vertical
     acceleration bias |a| <= 16 eps g. Even uncorrected, such a bias moves the vehicle at most
-    1/2 |a| T^2 in T seconds (3.5e-13 m over 10 s); the altitude loop only holds it closer."""
+    1/2 |a| T^2 in T seconds (1.7e-12 m over 10 s); the altitude loop only holds it closer."""
     sim = quadcosim.Simulation(quadcosim.load_scenario(hover_scenario(z0=1.0)))
     T = 10.0
     bias = 16 * np.finfo(float).eps * G
