@@ -11,6 +11,7 @@ packages=(
   libssl-dev openssl  # DDS Security keystores (libcrypto); openssl checks them in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
+  pybind11-dev python3-dev python3-pytest  # the Python module (src/python) and its tests (tests/python)
   slurm-wlm munge  # a private single-node Slurm cluster for the sweep job array test (tests/sweep/slurm_test.sh)
   iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)

@@ -14,6 +14,7 @@
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/inprocess_run.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
@@ -30,8 +31,6 @@ namespace quadcosim::app {
 namespace fs = std::filesystem;
 
 namespace {
-
-struct Interrupted {};
 
 // A progress line on stderr for runs that take a while, only when stderr is a terminal.
 class Progress {
@@ -170,77 +169,31 @@ int run_command(const RunOptions& opt) {
     if (opt.transport == "dds") {
       if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
     } else {
-      sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
-      io::TrajectoryWriter csv(csv_path);
-      io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
-                            sim::Topics::for_namespace(sc.simulation.ns));
       install_stop_handlers();
       Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
-      bool watchdog = false;
-      try {
-        simulation.run([&](const sim::TickRecord& r) {
-          const io::ControlColumns c = io::ControlColumns::from(r.status);
-          const sim::PlantNode& plant = simulation.plant();
-          if (plant.watchdog_active() != watchdog) {
-            watchdog = plant.watchdog_active();
-            std::cerr << (watchdog
-                              ? fmt::format("run: plant watchdog: no valid motor command for {:g} s at t = {:g} s; "
-                                            "policy {}\n",
-                                            static_cast<double>(plant.command_age_ns()) / 1e9, r.t_s,
-                                            sim::to_string(plant.options().watchdog_policy))
-                              : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
-          }
-          csv.write(r.t_s, r.state, r.latched_command, c, watchdog);
-          mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
-          progress.update(r.t_s);
-          if (stop_requested()) throw Interrupted{};
-        });
-      } catch (const Interrupted&) {
+      const auto on_tick = [&](double t_s) {
+        progress.update(t_s);
+        return stop_requested();
+      };
+      if (!fly_inprocess(sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); })) {
         // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.
-        csv.close();
-        mcap.close();
-        mcap.write_bag_metadata(out.string(), "run.mcap");
         std::cerr << "\nrun: interrupted; " << csv_path << " and run.mcap hold what ran\n";
         return exit_code::kInterrupted;
-      }
-      progress.done();
-      csv.close();
-      mcap.close();
-      mcap.write_bag_metadata(out.string(), "run.mcap");
-      const auto& st = simulation.plant().stats();
-      if (st.watchdog_trips > 0) {
-        std::cout << fmt::format("plant watchdog took over {} times, for {} ticks\n", st.watchdog_trips,
-                                 st.watchdog_ticks);
-      }
-      const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
-      if (sc.simulation.faults.active()) {
-        std::cout << fmt::format("injected faults dropped: {} motor commands, {} Pose, {} Velocity, {} Imu\n",
-                                 simulation.dropped(topics.motor_commands), simulation.dropped(topics.pose),
-                                 simulation.dropped(topics.velocity), simulation.dropped(topics.imu));
-      }
-      if (st.commands_rejected > 0 || st.commands_clamped > 0) {
-        std::cout << fmt::format("plant rejected {} and clamped {} of {} motor commands (last: {})\n",
-                                 st.commands_rejected, st.commands_clamped, st.commands_received, st.last_problem);
       }
     }
 
     // Both transports are judged from what was recorded: the exact doubles of trajectory.csv.
-    const io::Series series = io::read_series(csv_path);
-    const auto results = io::evaluate_steps(sc.steps, series);
-    const auto hold = sc.hold ? std::optional(io::evaluate_hold(*sc.hold, series)) : std::nullopt;
-    const auto saturation = io::evaluate_saturation(sc, series);
-    const auto tracking = sc.tracking ? std::optional(io::evaluate_tracking(*sc.tracking, series)) : std::nullopt;
-    io::write_metrics_json((out / "metrics.json").string(), sc, results, hold, saturation, tracking);
-    const std::string table = io::format_step_table(sc, results, hold, saturation, tracking);
-    std::ofstream((out / "metrics.txt").string()) << table;
-    std::cout << table;
-    if (saturation) {
-      if (const std::string w = io::saturation_warning(*saturation); !w.empty()) std::cerr << "run: " << w << '\n';
+    const RunJudgement judged = judge_run(sc, out);
+    std::cout << judged.table;
+    if (judged.saturation) {
+      if (const std::string w = io::saturation_warning(*judged.saturation); !w.empty()) {
+        std::cerr << "run: " << w << '\n';
+      }
     }
     std::cout << "wrote " << (out / "trajectory.csv").string()
               << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
-    return io::passed_overall(results, hold, saturation, tracking) ? exit_code::kOk : exit_code::kFailed;
+    return judged.passed ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {
     throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());
   } catch (const std::invalid_argument& e) {

@@ -432,6 +432,27 @@ TEST(SimulationTest, ScheduledSetpointMakesTheVehicleClimb) {
   EXPECT_GT(r.z.back(), 2.5);
 }
 
+TEST(SimulationTest, OverriddenCommandsReachThePlantInsteadOfTheController) {
+  SimulationConfig cfg;
+  cfg.duration_ticks = 100;
+  const control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  Simulation s(cfg, controller.vehicle, {}, controller, {{0, "z_des", 1.0}});
+  for (Tick k = 0; k < 10; ++k) s.tick(k);
+  const std::int64_t last_step = s.controller().last_step_ns();
+  EXPECT_EQ(last_step, cfg.plant.clock.ns(8));
+  const model::Vector4 omega(100.0, 200.0, 300.0, 400.0);
+  s.override_command(omega);
+  for (Tick k = 10; k < 14; ++k) {
+    s.tick(k);
+    EXPECT_EQ(s.plant().latched_command(), omega) << "tick " << k;
+  }
+  EXPECT_EQ(s.controller().last_step_ns(), last_step);  // the controller did not step
+  s.override_command(std::nullopt);
+  s.tick(14);
+  EXPECT_EQ(s.controller().last_step_ns(), cfg.plant.clock.ns(14));
+  EXPECT_NE(s.plant().latched_command(), omega);
+}
+
 TEST(SimulationTest, RefusedScheduledParameterIsAnError) {
   SimulationConfig cfg;
   cfg.duration_ticks = 10;

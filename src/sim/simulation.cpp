@@ -55,4 +55,19 @@ void Simulation::tick(Tick k, const std::function<void(const TickRecord&)>& on_t
   loop_.tick(k);
 }
 
+void Simulation::override_command(const std::optional<model::Vector4>& omega_rad_s) {
+  override_ = omega_rad_s.has_value();
+  if (!override_) return;
+  if (!override_pub_) {
+    override_pub_ = transport_.advertise<msg::Float64MultiArray>(Topics::for_namespace(config_.ns).motor_commands);
+    override_msg_.dim = {{"", 4, 4}};
+  }
+  override_msg_.data.assign(omega_rad_s->data(), omega_rad_s->data() + 4);
+}
+
+void Simulation::publish_override(Tick k) {
+  msg::write_command_label(override_msg_.dim[0].label, config_.plant.clock.ns(k));
+  override_pub_.publish(override_msg_);
+}
+
 }  // namespace quadcosim::sim

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,14 @@ class Simulation {
   /// Messages lost to injected faults on `topic` so far.
   std::uint64_t dropped(const std::string& topic) const { return transport_.dropped(topic); }
   const ControllerNode& controller() const { return controller_; }
+  /// The controller node, to set its parameters (setpoints, gains) between ticks.
+  ControllerNode& controller() { return controller_; }
+
+  /// Rotor speeds [rad/s] published on the motor command topic on every control tick instead of
+  /// stepping the controller (which then neither runs nor publishes a status), until cleared with
+  /// nullopt. The plant checks and latches them as any command (a stepping front end flying its own
+  /// commands).
+  void override_command(const std::optional<model::Vector4>& omega_rad_s);
 
  private:
   /// The lockstep loop's hooks for this run (inlined: the loop's type names them).
@@ -89,7 +98,12 @@ class Simulation {
       return true;
     }
     void after_outputs(Tick k) const {
-      if (k % s->config_.controller_divider == 0) s->controller_.step(s->config_.plant.clock.ns(k), s->control_dt_s_);
+      if (k % s->config_.controller_divider != 0) return;
+      if (s->override_) {
+        s->publish_override(k);
+      } else {
+        s->controller_.step(s->config_.plant.clock.ns(k), s->control_dt_s_);
+      }
     }
     void after_latch(std::size_t /*i*/, Tick k) const {
       if (s->on_tick_) (*s->on_tick_)(s->record(k));
@@ -100,6 +114,8 @@ class Simulation {
     static std::int64_t status_stamp_ns(std::size_t /*i*/) { return -1; }
   };
 
+  void publish_override(Tick k);
+
   SimulationConfig config_;
   InProcessTransport transport_;
   PlantNode plant_;
@@ -109,6 +125,9 @@ class Simulation {
   msg::ControllerStatus status_;  ///< the last status delivered, when faults may lose or delay statuses
   const msg::ControllerStatus* delivered_status_ = nullptr;          ///< status_, or the controller's own
   const std::function<void(const TickRecord&)>* on_tick_ = nullptr;  ///< while run() or tick(k, f)
+  bool override_ = false;                                            ///< override_command() is in force
+  Publisher<msg::Float64MultiArray> override_pub_;                   ///< advertised on first use
+  msg::Float64MultiArray override_msg_;
   SynchronousHost host_;
   LockstepCore<PlantNode, Hooks, SynchronousHost, true> loop_;
 };

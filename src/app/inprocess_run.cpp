@@ -1,0 +1,81 @@
+#include "app/inprocess_run.hpp"
+
+#include <fmt/format.h>
+
+#include <fstream>
+
+#include "io/mcap_recorder.hpp"
+#include "io/trajectory_csv.hpp"
+#include "sim/simulation.hpp"
+
+namespace quadcosim::app {
+
+namespace fs = std::filesystem;
+
+bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& info, std::ostream& warn,
+                   const std::function<bool(double t_s)>& on_tick, const std::function<void()>& on_end) {
+  struct Stopped {};
+  const std::string csv_path = (out / "trajectory.csv").string();
+  sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
+  io::TrajectoryWriter csv(csv_path);
+  io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
+                        sim::Topics::for_namespace(sc.simulation.ns));
+  bool watchdog = false;
+  bool completed = true;
+  try {
+    simulation.run([&](const sim::TickRecord& r) {
+      const io::ControlColumns c = io::ControlColumns::from(r.status);
+      const sim::PlantNode& plant = simulation.plant();
+      if (plant.watchdog_active() != watchdog) {
+        watchdog = plant.watchdog_active();
+        warn << (watchdog ? fmt::format("run: plant watchdog: no valid motor command for {:g} s at t = {:g} s; "
+                                        "policy {}\n",
+                                        static_cast<double>(plant.command_age_ns()) / 1e9, r.t_s,
+                                        sim::to_string(plant.options().watchdog_policy))
+                          : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
+      }
+      csv.write(r.t_s, r.state, r.latched_command, c, watchdog);
+      mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
+      if (on_tick && on_tick(r.t_s)) throw Stopped{};
+    });
+  } catch (const Stopped&) {
+    completed = false;
+  }
+  if (completed && on_end) on_end();
+  csv.close();
+  mcap.close();
+  mcap.write_bag_metadata(out.string(), "run.mcap");
+  if (!completed) return false;
+
+  const auto& st = simulation.plant().stats();
+  if (st.watchdog_trips > 0) {
+    info << fmt::format("plant watchdog took over {} times, for {} ticks\n", st.watchdog_trips, st.watchdog_ticks);
+  }
+  const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
+  if (sc.simulation.faults.active()) {
+    info << fmt::format("injected faults dropped: {} motor commands, {} Pose, {} Velocity, {} Imu\n",
+                        simulation.dropped(topics.motor_commands), simulation.dropped(topics.pose),
+                        simulation.dropped(topics.velocity), simulation.dropped(topics.imu));
+  }
+  if (st.commands_rejected > 0 || st.commands_clamped > 0) {
+    info << fmt::format("plant rejected {} and clamped {} of {} motor commands (last: {})\n", st.commands_rejected,
+                        st.commands_clamped, st.commands_received, st.last_problem);
+  }
+  return true;
+}
+
+RunJudgement judge_run(const io::Scenario& sc, const fs::path& out) {
+  RunJudgement j;
+  const io::Series series = io::read_series((out / "trajectory.csv").string());
+  j.steps = io::evaluate_steps(sc.steps, series);
+  if (sc.hold) j.hold = io::evaluate_hold(*sc.hold, series);
+  j.saturation = io::evaluate_saturation(sc, series);
+  if (sc.tracking) j.tracking = io::evaluate_tracking(*sc.tracking, series);
+  io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking);
+  j.table = io::format_step_table(sc, j.steps, j.hold, j.saturation, j.tracking);
+  std::ofstream((out / "metrics.txt").string()) << j.table;
+  j.passed = io::passed_overall(j.steps, j.hold, j.saturation, j.tracking);
+  return j;
+}
+
+}  // namespace quadcosim::app

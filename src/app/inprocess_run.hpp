@@ -1,0 +1,43 @@
+// The in-process part of `quadcosim run` as library functions, so that every front end that runs a
+// scenario in one process (the CLI, the Python module) records and judges it with the same code and
+// writes the same bytes.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "io/scenario.hpp"
+#include "io/step_report.hpp"
+
+namespace quadcosim::app {
+
+/// Flies `scenario` in one process (sim::Simulation) and records it into `out`: trajectory.csv,
+/// run.mcap and metadata.yaml. Notes on the plant's watchdog go to `warn` as they happen; the run's
+/// watchdog, injected-fault and command-rejection counts to `info` at the end. `on_tick`, when set, is
+/// called with each recorded tick's time [s]; when it returns true the run stops there (what ran stays
+/// recorded: the CSV flushed, the MCAP file finished) and fly_inprocess returns false. `on_end`, when set,
+/// is called after the last tick of a completed run, before the counts are written. Throws
+/// std::invalid_argument when the controller refuses a scheduled parameter, std::runtime_error on I/O.
+bool fly_inprocess(const io::Scenario& scenario, const std::filesystem::path& out, std::ostream& info,
+                   std::ostream& warn, const std::function<bool(double t_s)>& on_tick = {},
+                   const std::function<void()>& on_end = {});
+
+/// A run's figures and verdicts, judged from its recorded trajectory.csv.
+struct RunJudgement {
+  std::vector<io::StepResult> steps;
+  std::optional<io::HoldResult> hold;
+  std::optional<io::SaturationResult> saturation;
+  std::optional<io::TrackingResult> tracking;
+  std::string table;  ///< metrics.txt
+  bool passed = false;
+};
+
+/// Judges `out`/trajectory.csv (the exact doubles recorded) against the scenario's steps, hold, limits
+/// and tracking, and writes `out`/metrics.json and `out`/metrics.txt. Throws std::runtime_error on I/O.
+RunJudgement judge_run(const io::Scenario& scenario, const std::filesystem::path& out);
+
+}  // namespace quadcosim::app
