@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config libzstd-dev
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   cyclonedds-dev cyclonedds-tools
+  libxml2-dev libminizip-dev  # FMI: modelDescription.xml and .fmu archives (src/fmi)
   libssl-dev openssl  # DDS Security keystores (libcrypto); openssl checks them in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy

@@ -51,6 +51,13 @@ class Fmu : public std::enable_shared_from_this<Fmu> {
 /// One co-simulation instance. Every call throws FmuError (naming the call, the variables and what
 /// the FMU logged) when the FMU answers Error or Fatal, and after Fatal every further call does too;
 /// Warning is passed to the log and goes on; Discard from do_step throws as well.
+///
+/// Calls out of FMI's order (do_step before exit_initialization, a second enter_initialization) and
+/// value references that are not variables of the call's type are refused before the FMU sees them.
+/// After Error or Discard the destructor only frees; after Fatal nothing but free is called.
+/// Instances are created with logging off (FMI's "debug logging"): FMUs still log their errors.
+/// Thread-safety: one instance is used by one thread at a time; instances of one FMU may run on
+/// different threads as far as the FMU itself allows (FMI requires it, not every FMU honours it).
 class Instance {
  public:
   virtual ~Instance() = default;  ///< terminates (when initialised) and frees the instance

@@ -45,7 +45,7 @@ struct Variable {
   std::optional<std::string> start;  ///< as written in the XML
   std::string unit;                  ///< "" when none is declared
   std::string description;
-  std::optional<double> min, max;    ///< declared bounds (numbers only)
+  std::optional<double> min, max;  ///< declared bounds (numbers only)
 };
 
 struct ModelDescription {

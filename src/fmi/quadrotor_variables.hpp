@@ -42,7 +42,7 @@ inline constexpr std::array<std::string_view, 3> kRefPosition = {"ref.p_W[1]", "
 inline constexpr std::array<std::string_view, 3> kRefVelocity = {"ref.v_W[1]", "ref.v_W[2]", "ref.v_W[3]"};  ///< [m/s]
 inline constexpr std::array<std::string_view, 3> kRefAcceleration = {"ref.a_W[1]", "ref.a_W[2]",
                                                                      "ref.a_W[3]"};  ///< [m/s2]
-inline constexpr std::string_view kRefYaw = "ref.yaw";  ///< [rad]
+inline constexpr std::string_view kRefYaw = "ref.yaw";                               ///< [rad]
 // Controller FMU parameters: this prefix + the controller's parameter name ("controller.kp_z").
 inline constexpr std::string_view kControllerPrefix = "controller.";
 

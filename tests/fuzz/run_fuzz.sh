@@ -15,7 +15,7 @@ export ROS_DOMAIN_ID=$((165 + ${QUADCOSIM_TEST_DOMAIN_OFFSET:-0})) ROS_AUTOMATIC
 unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
 export ASAN_OPTIONS="${ASAN_OPTIONS:-abort_on_error=1}" UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
 
-for target in fuzz_config fuzz_messages fuzz_parameters; do
+for target in fuzz_config fuzz_messages fuzz_parameters fuzz_model_description; do
   corpus="$src/tests/fuzz/corpus/$target"
   mkdir -p "$work/$target"
   dict=()

@@ -1,0 +1,138 @@
+// What fmu.cpp, fmi2_instance.cpp and fmi3_instance.cpp share: the FMU's binary (dlopen), the loaded
+// FMU's files, the log an instance keeps of what its FMU said, and the instance's state. Not part of
+// the library's interface.
+#pragma once
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+
+#include "fmi/fmu.hpp"
+#include "fmi/unzip.hpp"
+
+namespace quadcosim::fmi::detail {
+
+/// An FMU's shared library, dlopen'ed with RTLD_NOW | RTLD_LOCAL and closed on destruction.
+class Library {
+ public:
+  /// Throws FmuError with dlerror()'s text.
+  explicit Library(const std::string& file);
+  ~Library();
+  Library(const Library&) = delete;
+  Library& operator=(const Library&) = delete;
+
+  /// The function `name` (an FMI function type such as fmi2DoStepTYPE). Throws FmuError naming the
+  /// symbol and the file when the library lacks it.
+  template <typename FunctionType>
+  FunctionType* function(const char* name) const {
+    return reinterpret_cast<FunctionType*>(symbol(name));
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  void* symbol(const char* name) const;
+  void* handle_ = nullptr;
+  std::string file_;
+};
+
+/// Where a loaded FMU's files are: `root` is the directory with modelDescription.xml (the unpacked
+/// archive, or the directory given), `unpacked` owns it when it was unpacked here.
+struct FmuFiles {
+  std::string root;
+  std::unique_ptr<TempDir> unpacked;
+};
+
+/// The binary of `md` below `root` for this platform (FMI 2: binaries/linux64, FMI 3:
+/// binaries/x86_64-linux), checked to exist; FmuError naming the path and the platforms present.
+std::string binary_path(const ModelDescription& md, const std::string& root, const std::string& fmu_path);
+
+std::shared_ptr<Fmu> make_fmi2_fmu(ModelDescription md, std::string path, FmuFiles files);
+std::shared_ptr<Fmu> make_fmi3_fmu(ModelDescription md, std::string path, FmuFiles files);
+
+/// file:///... URI of an absolute path, percent-encoding every byte but unreserved characters and '/'.
+std::string file_uri(const std::string& absolute_path);
+
+/// Status codes as FMI 2 and 3 both number them.
+enum class Status { kOk = 0, kWarning = 1, kDiscard = 2, kError = 3, kFatal = 4, kPending = 5 };
+std::string_view to_string(Status s);
+
+/// What every instance does besides its calls: keeps what its FMU logged, forwards it to the sink,
+/// looks up variables' names for messages and checks a call's status.
+class InstanceCore {
+ public:
+  InstanceCore(const Fmu& fmu, std::string instance_name, LogSink sink);
+
+  /// The FMU's logger callbacks land here.
+  void on_log(Status status, const char* category, const char* message);
+
+  /// Before an FMI call: remembers where the log stood, and throws if the instance is broken (a call
+  /// answered Fatal before).
+  void begin(std::string_view call);
+  /// After it: OK passes, Warning is logged and passes, anything else throws FmuError naming the call
+  /// (`call()` makes its text with the arguments, e.g. "fmi2DoStep(t = 1, h = 0.01)", only when
+  /// needed) and what the FMU logged during it. Fatal breaks the instance for good.
+  template <typename Call>
+  void check(Status status, Call&& call) {
+    if (status != Status::kOk) handle(status, std::string(call()));
+  }
+  void handle(Status status, const std::string& call);
+  /// FmuError text for a failed call (also used when instantiation returns null).
+  std::string failure(const std::string& call, std::string_view what) const;
+
+  /// "mass_kg = 2, g = 9.81" for a call's message: names by value reference and type.
+  std::string name(ValueReference vr, VariableType type) const;
+  /// Throws FmuError unless every `vr` is a variable of `type` in the description.
+  void check_known(std::string_view call, std::span<const ValueReference> vrs, VariableType type) const;
+
+  const std::string& instance_name() const { return instance_name_; }
+  bool broken() const { return broken_; }
+  /// Where the instance is in FMI's state machine, as far as the master's calls go.
+  enum class Phase { kInstantiated, kInitializing, kStepping, kTerminated };
+  Phase phase = Phase::kInstantiated;
+  /// Throws FmuError naming `call` unless the instance is in `wanted` (the FMU is not asked then:
+  /// not every FMU survives a call out of order).
+  void expect(Phase wanted, std::string_view call) const;
+  /// Set when a call answered Error or Discard (cleared by reset): no terminate at destruction then.
+  bool errored = false;
+
+ private:
+  struct Message {
+    Status status;
+    std::string category, text;
+  };
+  const ModelDescription& md_;
+  std::string instance_name_;
+  LogSink sink_;
+  std::deque<Message> recent_;  ///< the last messages, for errors
+  std::size_t logged_ = 0;      ///< messages logged so far
+  std::size_t call_start_ = 0;  ///< logged_ when the current call began
+  bool broken_ = false;
+  std::string broken_by_;
+  std::unordered_map<std::uint64_t, std::size_t> by_vr_;  ///< (type, vr) -> index into variables
+};
+
+/// The variables of a call for its message: "p_W[3], v_W[3]", or with `values` "mass_kg = 2, g = 9.81"
+/// (the first eight, then how many more).
+template <typename T = double>
+std::string describe(const InstanceCore& core, std::span<const ValueReference> vrs, VariableType type,
+                     std::span<const T> values = {}) {
+  std::string text;
+  const std::size_t shown = std::min<std::size_t>(vrs.size(), 8);
+  for (std::size_t i = 0; i < shown; ++i) {
+    if (i > 0) text += ", ";
+    text += core.name(vrs[i], type);
+    if (i < values.size()) text += fmt::format(" = {}", values[i]);
+  }
+  if (shown < vrs.size()) text += fmt::format(" and {} more", vrs.size() - shown);
+  return text;
+}
+
+}  // namespace quadcosim::fmi::detail
