@@ -4,7 +4,9 @@
 // tests/fmi (the point mass in C) and the round trips of tests/fmi/round_trip_cases.sh.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -306,6 +308,219 @@ TEST(FmuPlant, LoadedPointMassErrorNamesTheTickAndWhatItLogged) {
     EXPECT_NE(std::string(e.what()).find("at tick 6 (t = 0.06 s)"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("fail_at_step = 7"), std::string::npos) << e.what();
   }
+}
+
+/// A proportional altitude controller FMU: omega_cmd[i] = base + gain (ref.p_W[3] - p_W[3]) (NaN
+/// when gain is negative), its error as the output "error.z".
+ModelDescription altitude_controller_description() {
+  ModelDescription md;
+  md.fmi_version = "2.0";
+  md.model_name = "Altitude";
+  md.model_identifier = "altitude";
+  ValueReference vr = 1;
+  for (auto n : names::kPosition) md.variables.push_back(var(std::string(n), vr++, Causality::kInput, "m"));
+  for (auto n : names::kRefPosition) md.variables.push_back(var(std::string(n), vr++, Causality::kInput, "m"));
+  for (auto n : names::kOmegaCmd) md.variables.push_back(var(std::string(n), vr++, Causality::kOutput, "rad/s"));
+  md.variables.push_back(var("error.z", vr++, Causality::kOutput, "m"));
+  Variable gain = var("controller.gain", vr++, Causality::kParameter, "rad/s/m", Variability::kTunable, "100");
+  gain.min = -10.0;
+  gain.max = 1000.0;
+  md.variables.push_back(gain);
+  md.variables.push_back(var("base", vr++, Causality::kParameter, "rad/s", Variability::kFixed, "400"));
+  return md;
+}
+
+class AltitudeInstance final : public Instance {
+ public:
+  AltitudeInstance(std::shared_ptr<Fmu> fmu, Journal& j) : Instance(std::move(fmu)), j_(j) { ++j_.instances; }
+  void enter_initialization(double, std::optional<double>) override { j_.calls.push_back("enter"); }
+  void exit_initialization() override { j_.calls.push_back("exit"); }
+  void do_step(double t, double h) override {
+    j_.calls.push_back(fmt("step {:g} {:g}", t, h));
+    if (v("controller.gain") > 500.0) throw FmuError("fmi2DoStep: Error: gain too high");
+    const double e = v("ref.p_W[3]") - v("p_W[3]");
+    const double w = v("controller.gain") < 0.0 ? NAN : v("base") + v("controller.gain") * e;
+    out_ = {w, w, w, w, e};
+  }
+  void terminate() override {}
+  void reset() override { values_.clear(); }
+  void get_real(std::span<const ValueReference> vr, std::span<double> out) override {
+    for (std::size_t i = 0; i < vr.size(); ++i) {
+      const std::string& n = name(vr[i]);
+      out[i] = n == "error.z" ? out_[4] : n.rfind("omega_cmd", 0) == 0 ? out_[0] : v(n);
+    }
+  }
+  void set_real(std::span<const ValueReference> vr, std::span<const double> x) override {
+    for (std::size_t i = 0; i < vr.size(); ++i) {
+      if (name(vr[i]) == "controller.gain" && x[i] == 13.0) throw FmuError("fmi2SetReal: Error: 13 is unlucky");
+      values_[name(vr[i])] = j_.set[name(vr[i])] = x[i];
+    }
+  }
+  void get_integer(std::span<const ValueReference>, std::span<std::int32_t>) override {}
+  void set_integer(std::span<const ValueReference>, std::span<const std::int32_t>) override {}
+  void get_boolean(std::span<const ValueReference>, std::span<bool>) override {}
+  void set_boolean(std::span<const ValueReference>, std::span<const bool>) override {}
+  void set_string(std::span<const ValueReference>, std::span<const std::string>) override {}
+
+ private:
+  static std::string fmt(const char* f, double a, double b) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "step %g %g", a, b);
+    (void)f;
+    return buf;
+  }
+  const std::string& name(ValueReference vr) const {
+    for (const Variable& x : description().variables) {
+      if (x.vr == vr) return x.name;
+    }
+    throw FmuError("unknown value reference");
+  }
+  double v(const std::string& n) const {
+    if (auto it = values_.find(n); it != values_.end()) return it->second;
+    const Variable* x = description().find(n);
+    return x && x->start ? std::stod(*x->start) : 0.0;
+  }
+  Journal& j_;
+  std::map<std::string, double> values_;
+  std::array<double, 5> out_{};
+};
+
+class ControllerFmu final : public Fmu {
+ public:
+  explicit ControllerFmu(Journal& j) : j_(j) {
+    description_ = altitude_controller_description();
+    path_ = "/nowhere/altitude.fmu";
+  }
+  std::unique_ptr<Instance> instantiate(const std::string& name, LogSink) override {
+    j_.calls.push_back("instantiate " + name);
+    return std::make_unique<AltitudeInstance>(shared_from_this(), j_);
+  }
+
+ private:
+  Journal& j_;
+};
+
+TEST(FmuController, StepsSetsInputsAndReadsTheCommand) {
+  Journal j;
+  auto fmu = std::make_shared<ControllerFmu>(j);
+  FmuController c(fmu, {}, model::VehicleParams{});
+  EXPECT_EQ(c.type(), "fmu");
+  ASSERT_EQ(c.output_names().size(), 1u);
+  EXPECT_EQ(c.output_names()[0], "error.z");
+  ASSERT_EQ(c.parameters().size(), 2u);
+  EXPECT_EQ(c.parameters()[0].name, "gain");  // controller. prefix dropped
+  EXPECT_EQ(c.parameters()[0].unit, "rad/s/m");
+  EXPECT_EQ(c.parameters()[0].min, -10.0);
+  EXPECT_EQ(c.parameters()[0].max, 1000.0);
+  EXPECT_EQ(std::get<double>(*c.get_parameter("base")), 400.0);
+
+  control::Observation o;
+  o.p_W = {0.0, 0.0, 1.0};
+  control::Reference r;
+  r.p_W = {0.0, 0.0, 3.0};
+  r.roll_rad = 0.1;
+  control::ControllerOutput out;
+  out.outputs.resize(1);
+  c.step(o, r, 0.02, out);
+  c.step(o, r, 0.02, out);
+  EXPECT_EQ(out.omega_rad_s, Eigen::Vector4d::Constant(400.0 + 100.0 * 2.0));
+  EXPECT_EQ(out.outputs[0], 2.0);
+  EXPECT_EQ(out.roll_des_rad, 0.1);
+  const model::Wrench u = model::Quadrotor(model::VehicleParams{}).wrench(out.omega_rad_s);
+  EXPECT_EQ(out.U[0], u.thrust_N);
+  EXPECT_TRUE(std::isnan(out.attitude_error));
+  // Instantiated once, initialised at the first step, stepped on n dt.
+  const std::vector<std::string> expected = {"instantiate altitude_0", "enter", "exit", "step 0 0.02",
+                                             "step 0.02 0.02"};
+  EXPECT_EQ(std::vector<std::string>(j.calls.end() - 5, j.calls.end()),
+            std::vector<std::string>(expected.begin(), expected.end()));
+}
+
+TEST(FmuController, ParametersAllOrNothingFixedOnesUntilTheFirstStepCloneAfresh) {
+  Journal j;
+  auto fmu = std::make_shared<ControllerFmu>(j);
+  FmuController c(fmu, {}, model::VehicleParams{});
+  const std::vector<control::Setting> both = {{"gain", 50.0}, {"base", 300.0}};
+  EXPECT_EQ(c.set_parameters(both), "");
+  const std::vector<control::Setting> out_of_range = {{"gain", 60.0}, {"base", 1.0}, {"gain", 2000.0}};
+  EXPECT_NE(c.set_parameters(out_of_range).find("gain"), std::string::npos);
+  EXPECT_EQ(std::get<double>(*c.get_parameter("gain")), 50.0);  // nothing changed
+  const std::vector<control::Setting> unknown = {{"gian", 1.0}};
+  EXPECT_NE(c.set_parameters(unknown).find("gian"), std::string::npos);
+
+  control::ControllerOutput out;
+  out.outputs.resize(1);
+  c.step({}, {}, 0.02, out);
+  EXPECT_EQ(j.set.at("base"), 300.0);  // applied at initialisation
+  EXPECT_EQ(j.set.at("controller.gain"), 50.0);
+  const std::vector<control::Setting> fixed = {{"base", 350.0}};
+  EXPECT_NE(c.set_parameters(fixed).find("base: the FMU declares it fixed"), std::string::npos);
+  // Tunable, through the FMU; a refusal by the FMU undoes the others and names the parameter.
+  const std::vector<control::Setting> tunable = {{"gain", 70.0}};
+  EXPECT_EQ(c.set_parameters(tunable), "");
+  EXPECT_EQ(j.set.at("controller.gain"), 70.0);
+  const std::vector<control::Setting> unlucky = {{"gain", 13.0}};
+  EXPECT_NE(c.set_parameters(unlucky).find("gain: refused by FMU altitude.fmu"), std::string::npos);
+  EXPECT_EQ(std::get<double>(*c.get_parameter("gain")), 70.0);
+
+  const int before = j.instances;
+  std::unique_ptr<control::Controller> copy = c.clone();
+  EXPECT_EQ(j.instances, before + 1);
+  EXPECT_EQ(std::get<double>(*copy->get_parameter("gain")), 70.0);
+  EXPECT_EQ(std::get<double>(*copy->get_parameter("base")), 300.0);
+}
+
+TEST(FmuController, AFailedStepOrANanCommandThrowsNamingTheFmuAndTheStep) {
+  Journal j;
+  auto fmu = std::make_shared<ControllerFmu>(j);
+  FmuController c(fmu, {}, model::VehicleParams{});
+  control::ControllerOutput out;
+  out.outputs.resize(1);
+  c.step({}, {}, 0.02, out);
+  const std::vector<control::Setting> high = {{"gain", 600.0}};
+  ASSERT_EQ(c.set_parameters(high), "");
+  try {
+    c.step({}, {}, 0.02, out);
+    ADD_FAILURE() << "a failed doStep went unnoticed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("FMU altitude.fmu"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("control step 1 (t = 0.02 s)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("gain too high"), std::string::npos) << e.what();
+  }
+  FmuController nan(fmu, {}, model::VehicleParams{});
+  const std::vector<control::Setting> negative = {{"gain", -1.0}};
+  ASSERT_EQ(nan.set_parameters(negative), "");
+  out.omega_rad_s.setConstant(7.0);
+  try {
+    nan.step({}, {}, 0.02, out);
+    ADD_FAILURE() << "a NaN command went unnoticed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("output 'omega_cmd[1]' is nan"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(out.omega_rad_s, Eigen::Vector4d::Constant(7.0));  // nothing written
+}
+
+TEST(FmuController, MappingRefusals) {
+  Journal j;
+  auto fmu = std::make_shared<ControllerFmu>(j);
+  auto refused = [&](FmuMapping m, const std::string& key, const std::string& words) {
+    try {
+      FmuController c(fmu, m, model::VehicleParams{});
+      ADD_FAILURE() << "not refused: " << key;
+    } catch (const MappingError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  FmuMapping m;
+  m.outputs["omega_cmd"] = {"error.z", "error.z", "error.z", "nope"};
+  refused(m, "outputs.omega_cmd", "unit 'm', expected 'rad/s'");
+  FmuMapping in;
+  in.inputs["ref.yaw"] = {"yaw"};
+  refused(in, "inputs.ref.yaw", "no variable 'yaw'");
+  FmuMapping p;
+  p.parameters = {{"controller.gain", "5000"}};
+  refused(p, "parameters.controller.gain", "[-10, 1000]");
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 # quadcosim's runs with FMUs in them: an FMU as the plant (fmu_plant, behind sim::ExternalDynamics)
 # and as the controller (fmu_controller, a control::Controller), mapped by fmu_mapping. Included
 # from CMakeLists.txt beside it.
-add_library(quadcosim_fmi_master STATIC fmu_mapping.cpp fmu_plant.cpp)
+add_library(quadcosim_fmi_master STATIC fmu_mapping.cpp fmu_plant.cpp fmu_controller.cpp)
 target_include_directories(quadcosim_fmi_master PUBLIC ${PROJECT_SOURCE_DIR}/src)
 target_link_libraries(quadcosim_fmi_master PUBLIC quadcosim_fmi quadcosim_sim quadcosim_control quadcosim_model
                       fmt::fmt)
