@@ -284,6 +284,21 @@ struct MarginsOptions {
 CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& options);
 int margins_command(const MarginsOptions& options);
 
+/// `quadcosim fmu export|info` (fmu_command.cpp): quadcosim's plant or controller as an FMI co-simulation
+/// FMU, and what any FMU declares. Exit 0 on success, 2 on bad input (a flag, the scenario, a file
+/// that is not an FMU), 3 when the FMU cannot be written or the FMU library is not found.
+struct FmuOptions {
+  std::string verb;        ///< "export" or "info" (set by the subcommand parsed)
+  std::string kind;        ///< export: "plant" or "controller"
+  std::string scenario;    ///< export: "" for the defaults (the paper's vehicle and controller)
+  std::string controller;  ///< export --controller: replaces the scenario's controller.type ("" keeps it)
+  int fmi = 2;             ///< export: FMI version, 2 or 3
+  std::string out;         ///< export: the .fmu to write
+  std::string fmu;         ///< info: the .fmu to read
+};
+CLI::App* add_fmu_subcommand(CLI::App& app, FmuOptions& options);
+int fmu_command(const FmuOptions& options);
+
 /// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
 /// override); returns false (after printing why) when it fails.
 bool run_tool(const std::string& script, const std::vector<std::string>& args);

@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   SweepOptions sweep;
   MarginsOptions margins;
   BenchOptions bench;
+  FmuOptions fmu;
   struct Subcommand {
     CLI::App* cli;
     std::function<int()> run;
@@ -70,6 +71,7 @@ int main(int argc, char** argv) {
       {add_sweep_subcommand(app, sweep), [&] { return sweep_command(sweep); }},
       {add_margins_subcommand(app, margins), [&] { return margins_command(margins); }},
       {add_bench_subcommand(app, bench), [&] { return bench_command(bench); }},
+      {add_fmu_subcommand(app, fmu), [&] { return fmu_command(fmu); }},
   };
   add_exit_code_footers(app);
 

@@ -91,7 +91,12 @@ std::uint64_t key(VariableType type, ValueReference vr) {
 InstanceCore::InstanceCore(const Fmu& fmu, std::string instance_name, LogSink sink)
     : md_(fmu.description()), instance_name_(std::move(instance_name)), sink_(std::move(sink)) {
   for (std::size_t i = 0; i < md_.variables.size(); ++i) {
-    by_vr_.emplace(key(md_.variables[i].type, md_.variables[i].vr), i);  // the first of aliases names it
+    const Variable& v = md_.variables[i];
+    by_vr_.emplace(key(v.type, v.vr), i);  // the first of aliases names it
+    // FMI 2 gets and sets an Enumeration with fmi2GetInteger / fmi2SetInteger.
+    if (md_.version == FmiVersion::k2 && v.type == VariableType::kEnumeration) {
+      by_vr_.emplace(key(VariableType::kInteger, v.vr), i);
+    }
   }
 }
 

@@ -72,8 +72,8 @@ class Instance {
   virtual void terminate() = 0;
   virtual void reset() = 0;
 
-  /// Real (FMI 3: Float64), Integer (Int32), Boolean and String values by value reference; the
-  /// spans have equal lengths.
+  /// Real (FMI 3: Float64), Integer (Int32; FMI 2: also Enumeration), Boolean and String values by
+  /// value reference; the spans have equal lengths.
   virtual void get_real(std::span<const ValueReference> vr, std::span<double> values) = 0;
   virtual void set_real(std::span<const ValueReference> vr, std::span<const double> values) = 0;
   virtual void get_integer(std::span<const ValueReference> vr, std::span<std::int32_t> values) = 0;

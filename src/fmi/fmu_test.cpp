@@ -442,6 +442,14 @@ TEST_P(PointMass, HonoursInstantiationOnlyOncePerProcess) {
   EXPECT_NE(fmu->instantiate("third"), nullptr);
 }
 
+TEST(Fmu, Fmi2ReadsAndWritesAnEnumerationAsAnInteger) {
+  auto instance = Fmu::load(kFmuDir + "/point_mass.fmu")->instantiate("enum");
+  EXPECT_EQ(instance->description().find("mode")->type, VariableType::kEnumeration);
+  EXPECT_EQ(get_int(*instance, "mode"), 1);
+  set_int(*instance, "mode", 2);
+  EXPECT_EQ(get_int(*instance, "mode"), 2);
+}
+
 TEST(Fmu, RefusesABinaryThatLacksAFunction) {
   const std::string dir = kFmuDir + "/no_do_step";
   EXPECT_CONTAINS(error_of([&] { Fmu::load(dir); }),

@@ -226,6 +226,10 @@ std::map<std::string, std::string> declared_units(const xmlNode* root, FmiVersio
 void read_value_attributes(const Reader& r, const xmlNode* typed, const std::string& what,
                            const std::map<std::string, std::string>& units, Variable& v) {
   v.start = Reader::attr(typed, "start");
+  // FMI 3 writes a String's start value as a child: <String ...><Start value="..."/></String>.
+  if (!v.start && v.type == VariableType::kString) {
+    if (const xmlNode* start = child(typed, "Start")) v.start = Reader::attr(start, "value");
+  }
   if (auto unit = Reader::attr(typed, "unit")) {
     v.unit = *unit;
   } else if (auto declared = Reader::attr(typed, "declaredType")) {

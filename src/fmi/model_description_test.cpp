@@ -56,6 +56,7 @@ const char* const kFmi3 = R"(<?xml version="1.0" encoding="UTF-8"?>
     <Float32 name="small" valueReference="9" causality="local"/>
     <Float64 name="vec" valueReference="10" causality="local"><Dimension start="3"/></Float64>
     <Boolean name="on" valueReference="11" causality="parameter" variability="fixed" start="false"/>
+    <String name="text" valueReference="12" causality="parameter" variability="fixed"><Start value="a b"/></String>
   </ModelVariables>
   <ModelStructure>
     <Output valueReference="7"/>
@@ -142,7 +143,9 @@ TEST(ModelDescription, ReadsFmi3) {
   EXPECT_EQ(md.guid, "{token-3}");
   EXPECT_EQ(md.model_identifier, "point_mass3");
   EXPECT_FALSE(md.step_size.has_value());
-  ASSERT_EQ(md.variables.size(), 7u);
+  ASSERT_EQ(md.variables.size(), 8u);
+  EXPECT_EQ(md.find("text")->type, VariableType::kString);
+  EXPECT_EQ(md.find("text")->start, "a b");
   EXPECT_EQ(md.find("time")->causality, Causality::kIndependent);
   EXPECT_EQ(md.find("omega_cmd[1]")->vr, 1u);
   EXPECT_EQ(md.find("omega_cmd[1]")->unit, "rad/s");

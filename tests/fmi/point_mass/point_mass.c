@@ -53,7 +53,8 @@ enum {
   VR_LABEL = 33,
   VR_RESOURCES_OK = 34,
   VR_TIME = 35, /* FMI 3's independent variable */
-  VR_FATAL_AT_STEP = 36
+  VR_FATAL_AT_STEP = 36,
+  VR_MODE = 37 /* an Enumeration in FMI 2 (read and written as an Integer) */
 };
 
 typedef enum { kInstantiated, kInitializing, kStepping, kTerminated, kBroken } Phase;
@@ -85,7 +86,7 @@ typedef struct {
   double omega[4];
   double mass, k_thrust, g, z0, vz0;
   double t, z, vz;
-  int steps, fail_at_step, fatal_at_step;
+  int steps, fail_at_step, fatal_at_step, mode;
   bool log_steps;
   int resources_ok;
 } PointMass;
@@ -167,6 +168,7 @@ static void set_defaults(PointMass* m) {
   m->steps = 0;
   m->fail_at_step = -1;
   m->fatal_at_step = -1;
+  m->mode = 1;
   m->log_steps = false;
   m->label[0] = '\0';
   m->phase = kInstantiated;
@@ -224,6 +226,8 @@ static int set_integer(PointMass* m, unsigned int vr, int value) {
     m->fail_at_step = value;
   } else if (vr == VR_FATAL_AT_STEP) {
     m->fatal_at_step = value;
+  } else if (vr == VR_MODE) {
+    m->mode = value;
   } else {
     return fail(m, "SetInteger: value reference %u is no Integer parameter", vr);
   }
@@ -235,6 +239,7 @@ static int get_integer(PointMass* m, unsigned int vr, int* value) {
     case VR_STEPS: *value = m->steps; return kOK;
     case VR_FAIL_AT_STEP: *value = m->fail_at_step; return kOK;
     case VR_FATAL_AT_STEP: *value = m->fatal_at_step; return kOK;
+    case VR_MODE: *value = m->mode; return kOK;
     case VR_RESOURCES_OK: *value = m->resources_ok; return kOK;
     default: return fail(m, "GetInteger: value reference %u is no Integer variable", vr);
   }
