@@ -153,7 +153,9 @@ class FmuDynamics final : public sim::ExternalDynamics {
   void step(sim::Tick k, const model::Vector4& omega_rad_s) override {
     const double cmd[4] = {omega_rad_s[0], omega_rad_s[1], omega_rad_s[2], omega_rad_s[3]};
     try {
-      instance_->set_real(omega_cmd_, cmd);
+      // Inputs hold their value: the command is set when it changed (every control period, not
+      // every plant tick); command_ is the one the FMU holds (the initial speeds at first).
+      if (omega_rad_s != command_) instance_->set_real(omega_cmd_, cmd);
       instance_->do_step(clock_.seconds(k), clock_.period_s());
     } catch (const std::exception& e) {
       throw std::runtime_error(
@@ -249,6 +251,11 @@ std::unique_ptr<sim::ExternalDynamics> FmuPlant::make(const model::VehicleParams
     set_initial(*instance, md, mapping_, initial);
     for (const ParameterSetting& p : parameters_) set_value(*instance, *p.variable, p.number);
     instance->enter_initialization(0.0);
+    // The command acting before the first one arrives is the initial rotor speeds (as the native
+    // plant latches them): the outputs at t = 0 (the specific force) are computed under it.
+    const double omega0[4] = {initial.omega_rad_s[0], initial.omega_rad_s[1], initial.omega_rad_s[2],
+                              initial.omega_rad_s[3]};
+    instance->set_real(refs_.omega_cmd, omega0);
     instance->exit_initialization();
   } catch (const std::exception& e) {
     throw FmuError(fmt::format("{}: initialisation failed: {}", describe(), e.what()));

@@ -4,7 +4,9 @@
 //   1. instantiate; set `vehicle.<name>` for every vehicle parameter (model::vehicle_parameters())
 //      the FMU declares under that name, `initial.<output variable>` for the initial state
 //      (position, velocity, attitude, rates, rotor speeds), then the scenario's `parameters:` by FMU
-//      variable name (last, so they win); enter and exit initialisation at start time 0;
+//      variable name (last, so they win); enter initialisation at start time 0, set omega_cmd to
+//      the initial rotor speeds (the command acting until the first one arrives, as the native
+//      plant latches them), exit initialisation;
 //   2. per plant tick k: set the four rotor speed commands, do_step(t_k, period), get the outputs.
 // Signals (default FMU names in fmi/quadrotor_variables.hpp, a scenario may name its own):
 //   inputs  omega_cmd [rad/s] x4, required;

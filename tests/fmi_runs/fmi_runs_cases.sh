@@ -64,16 +64,25 @@ case "$case_name" in
   node_fmu_flags)  # `plant --fmu` and `controller --fmu` over DDS lockstep: the native trajectory again
     need_export
     export_fmu "$paper/altitude_step.yaml" plant "$tmp/plant.fmu"
+    export_fmu "$paper/altitude_step.yaml" controller "$tmp/controller.fmu"
     "$bin" run "$paper/altitude_step.yaml" --out "$tmp/native" --no-plots > "$tmp/native.log" 2>&1 \
       || fail "native run failed"
     "$bin" controller --scenario "$paper/altitude_step.yaml" > "$tmp/controller.log" 2>&1 &
     pids+=($!)
     "$bin" plant --scenario "$paper/altitude_step.yaml" --fmu "$tmp/plant.fmu" --record "$tmp/plant.csv" \
       > "$tmp/plant.log" 2>&1 || fail "plant --fmu failed"
-    wait "${pids[0]}" || true
     grep -q "plant: FMU plant.fmu" "$tmp/plant.log" || fail "the plant did not say it flies the FMU"
     cmp "$tmp/native/trajectory.csv" "$tmp/plant.csv" || fail "plant --fmu: trajectory differs"
-    echo "plant --fmu over DDS lockstep: trajectory byte-identical"
+    kill "${pids[0]}" 2>/dev/null || true
+    # Both FMUs, each in its own process: the state columns as natively (see controller_round_trip).
+    "$bin" controller --scenario "$paper/altitude_step.yaml" --fmu "$tmp/controller.fmu" > "$tmp/controller2.log" 2>&1 &
+    pids+=($!)
+    "$bin" plant --scenario "$paper/altitude_step.yaml" --fmu "$tmp/plant.fmu" --record "$tmp/both.csv" \
+      > "$tmp/plant2.log" 2>&1 || fail "plant --fmu with controller --fmu failed"
+    grep -q "controller fmu " "$tmp/controller2.log" || fail "the controller did not say it flies the FMU"
+    cmp <(cut -d, -f1-28 "$tmp/native/trajectory.csv") <(cut -d, -f1-28 "$tmp/both.csv") \
+      || fail "plant --fmu with controller --fmu: state columns differ"
+    echo "plant --fmu (and controller --fmu) over DDS lockstep: trajectory (state columns) byte-identical"
     ;;
   swarm_and_sweep)  # one FMU instance per vehicle; a sweep pushes each run's vehicle into the FMU
     need_export
