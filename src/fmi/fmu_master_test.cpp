@@ -136,7 +136,7 @@ class MemoryFmu final : public Fmu {
   Journal& j_;
 };
 
-TEST(FmuPlant, StepsThePointMassAndSetsVehicleAndInitialState) {
+TEST(FmuPlantAsPlant, StepsThePointMassAndSetsVehicleAndInitialState) {
   Journal j;
   auto fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
   const FmuPlant plant(fmu, {});
@@ -173,7 +173,7 @@ TEST(FmuPlant, StepsThePointMassAndSetsVehicleAndInitialState) {
   EXPECT_EQ(x.omega_rad_s, model::Vector4::Constant(w));
 }
 
-TEST(FmuPlant, ScenarioParametersWinAndAreChecked) {
+TEST(FmuPlantAsPlant, ScenarioParametersWinAndAreChecked) {
   Journal j;
   auto fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
   FmuMapping m;
@@ -201,7 +201,7 @@ TEST(FmuPlant, ScenarioParametersWinAndAreChecked) {
   refused(bad, "parameters.p_W[1]", "causality output");
 }
 
-TEST(FmuPlant, MappingRefusalsNameTheKeyTheVariableAndTheUnit) {
+TEST(FmuPlantAsPlant, MappingRefusalsNameTheKeyTheVariableAndTheUnit) {
   Journal j;
   auto refused = [&](ModelDescription md, FmuMapping m, const std::string& key, const std::string& words) {
     auto fmu = std::make_shared<MemoryFmu>(std::move(md), j);
@@ -243,7 +243,7 @@ TEST(FmuPlant, MappingRefusalsNameTheKeyTheVariableAndTheUnit) {
   refused(integer, {}, "inputs.omega_cmd", "expected Real");
 }
 
-TEST(FmuPlant, FailuresNameTheTickAndNothingNonFiniteGetsThrough) {
+TEST(FmuPlantAsPlant, FailuresNameTheTickAndNothingNonFiniteGetsThrough) {
   Journal j;
   auto fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
   fmu->fail_at = 0.05;
@@ -269,7 +269,7 @@ TEST(FmuPlant, FailuresNameTheTickAndNothingNonFiniteGetsThrough) {
 
 // The point mass in C (tests/fmi/point_mass), loaded from its .fmu, as the plant under constant
 // commands: z(t) = z0 + v0 t + a t^2 / 2 with a = k sum(w^2) / m - g, against the closed form.
-TEST(FmuPlant, LoadedPointMassFollowsItsClosedForm) {
+TEST(FmuPlantAsPlant, LoadedPointMassFollowsItsClosedForm) {
   for (const char* file : {"point_mass.fmu", "point_mass3.fmu"}) {
     FmuMapping m;
     const double mass = 1.5, k = 2e-6, g = 9.81, z0 = 3.0, v0 = 0.5;
@@ -295,7 +295,7 @@ TEST(FmuPlant, LoadedPointMassFollowsItsClosedForm) {
   }
 }
 
-TEST(FmuPlant, LoadedPointMassErrorNamesTheTickAndWhatItLogged) {
+TEST(FmuPlantAsPlant, LoadedPointMassErrorNamesTheTickAndWhatItLogged) {
   FmuMapping m;
   m.parameters = {{"fail_at_step", "7"}};
   const FmuPlant plant(Fmu::load(std::string(QUADCOSIM_TEST_FMU_DIR) + "/point_mass.fmu"), m);
@@ -400,7 +400,7 @@ class ControllerFmu final : public Fmu {
   Journal& j_;
 };
 
-TEST(FmuController, StepsSetsInputsAndReadsTheCommand) {
+TEST(FmuControllerAsController, StepsSetsInputsAndReadsTheCommand) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
   FmuController c(fmu, {}, model::VehicleParams{});
@@ -436,7 +436,7 @@ TEST(FmuController, StepsSetsInputsAndReadsTheCommand) {
             std::vector<std::string>(expected.begin(), expected.end()));
 }
 
-TEST(FmuController, ParametersAllOrNothingFixedOnesUntilTheFirstStepCloneAfresh) {
+TEST(FmuControllerAsController, ParametersAllOrNothingFixedOnesUntilTheFirstStepCloneAfresh) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
   FmuController c(fmu, {}, model::VehicleParams{});
@@ -470,7 +470,7 @@ TEST(FmuController, ParametersAllOrNothingFixedOnesUntilTheFirstStepCloneAfresh)
   EXPECT_EQ(std::get<double>(*copy->get_parameter("base")), 300.0);
 }
 
-TEST(FmuController, AFailedStepOrANanCommandThrowsNamingTheFmuAndTheStep) {
+TEST(FmuControllerAsController, AFailedStepOrANanCommandThrowsNamingTheFmuAndTheStep) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
   FmuController c(fmu, {}, model::VehicleParams{});
@@ -500,7 +500,7 @@ TEST(FmuController, AFailedStepOrANanCommandThrowsNamingTheFmuAndTheStep) {
   EXPECT_EQ(out.omega_rad_s, Eigen::Vector4d::Constant(7.0));  // nothing written
 }
 
-TEST(FmuController, MappingRefusals) {
+TEST(FmuControllerAsController, MappingRefusals) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
   auto refused = [&](FmuMapping m, const std::string& key, const std::string& words) {
