@@ -109,6 +109,7 @@ struct PlantCommandOptions {
   // Every mode.
   std::string scenario;         ///< vehicle, rates, duration, initial state ("" for defaults)
   std::string vehicle;          ///< vehicle file, replaces the scenario's vehicle when set
+  std::string fmu;              ///< --fmu: a co-simulation FMU flown as the plant (default variable names)
   std::string ns;               ///< overrides the scenario's namespace when set
   bool sensor_qos = false;      ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
   std::string cpus;             ///< run on these CPUs only ("0", "0-1"; "" for any)
@@ -150,6 +151,7 @@ struct ControllerCommandOptions {
   std::string controller;  ///< --controller: replaces the scenario's controller.type ("" keeps it)
   std::string params;      ///< controller parameter file, applied over the scenario's
   std::string vehicle;     ///< vehicle file (the controller's model of the vehicle)
+  std::string fmu;         ///< --fmu: a co-simulation FMU flown as the controller (default variable names)
   std::string ns;
   bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
   std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)

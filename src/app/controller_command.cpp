@@ -33,6 +33,13 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
       ->check(CLI::ExistingFile);
   ctl_cmd->add_option("--vehicle", ctl.vehicle, "vehicle YAML (the controller's model of the vehicle)")
       ->check(CLI::ExistingFile);
+  ctl_cmd
+      ->add_option("--fmu", ctl.fmu,
+                   "fly this co-simulation FMU as the controller, its variables by their default names "
+                   "(replaces the scenario's controller, keeps its setpoints; docs/fmi.md)")
+      ->check(CLI::ExistingPath)
+      ->excludes("--controller")
+      ->excludes("--params");
   add_node_host_options(ctl_cmd, ctl.ns, ctl.swarm, ctl.sensor_qos,
                         "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)", ctl.cpus);
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep (one vehicle)");
@@ -81,6 +88,7 @@ int controller_command(const ControllerCommandOptions& o) {
     sc.controller = io::load_controller(o.params, sc.vehicle);
     sc.controller.trajectory = trajectory;
   }
+  if (!o.fmu.empty()) io::use_controller_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu");
   if (o.swarm.vehicles > 0) return swarm_controller_command(o, std::move(sc));
   const sim::TickClock clock = sc.simulation.plant.clock;
   const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
@@ -96,9 +104,10 @@ int controller_command(const ControllerCommandOptions& o) {
   if (!o.apply_schedule) sc.schedule.clear();
   dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
   announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
-  std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s\n",
+  std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s, controller {}\n",
                            transport.participant().domain_id(), sc.simulation.ns, o.lockstep ? "lockstep" : "real-time",
-                           dt_s);
+                           dt_s,
+                           sc.controller_fmu ? "fmu " + sc.controller_fmu->path : std::string(sc.controller.type()));
 
   if (o.lockstep) {
     // Steps where the samples are delivered: on Cyclone's receive thread with delivery on

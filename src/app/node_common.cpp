@@ -41,7 +41,11 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
   }
   if (!vehicle.empty()) {
     sc.vehicle = io::load_vehicle(vehicle);
-    sc.controller = controllers::rebind_vehicle(sc.controller, sc.vehicle);
+    if (sc.controller_fmu) {
+      sc.controller.vehicle = sc.vehicle;  // an FMU controller brings its own design (the status's U uses this)
+    } else {
+      sc.controller = controllers::rebind_vehicle(sc.controller, sc.vehicle);
+    }
   }
   if (!ns.empty()) sc.simulation.ns = ns;
   if (sc.simulation.faults.active()) {

@@ -85,9 +85,10 @@ class PlantProcess {
     // controller that dies is noticed within its limit however the ticks are paced.
     if (!o_.lockstep) plant_.use_receipt_clock(steady_ns);
     announcer_.announce();  // `ros2 node list` shows /quadrotor_plant
-    std::cerr << fmt::format("plant: domain {}, namespace {}, {} mode, {} ticks of {} s\n",
-                             transport_.participant().domain_id(), sc_.simulation.ns,
-                             o_.lockstep ? "lockstep" : "real-time", sc_.simulation.duration_ticks, clock_.period_s());
+    std::cerr << fmt::format(
+        "plant: domain {}, namespace {}, {} mode, {} ticks of {} s{}\n", transport_.participant().domain_id(),
+        sc_.simulation.ns, o_.lockstep ? "lockstep" : "real-time", sc_.simulation.duration_ticks, clock_.period_s(),
+        sc_.simulation.plant.external ? "; plant: " + sc_.simulation.plant.external->describe() : std::string());
   }
 
   /// Runs every tick; returns the process's exit code.
@@ -323,6 +324,11 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->check(CLI::ExistingFile);
   plant_cmd->add_option("--vehicle", plant.vehicle, "vehicle YAML (replaces the scenario's vehicle)")
       ->check(CLI::ExistingFile);
+  plant_cmd
+      ->add_option("--fmu", plant.fmu,
+                   "fly this co-simulation FMU as the plant, its variables by their default names "
+                   "(replaces the scenario's plant; docs/fmi.md)")
+      ->check(CLI::ExistingPath);
   add_node_host_options(plant_cmd, plant.ns, plant.swarm, plant.sensor_qos,
                         "publish Pose/Velocity/Imu best effort (ROS sensor data QoS)", plant.cpus);
   plant_cmd->add_flag("!--realtime", plant.lockstep, "pace by the wall clock instead of lockstep (one vehicle)");
@@ -389,6 +395,7 @@ int plant_command(const PlantCommandOptions& o) {
   std::optional<io::Scenario> started = start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns);
   if (!started) return exit_code::kBadInput;
   io::Scenario& sc = *started;
+  if (!o.fmu.empty()) io::use_plant_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu");
   if (o.watchdog_s >= 0.0) {
     const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
     if (std::abs(ticks - std::round(ticks)) > 1e-6) {

@@ -6,11 +6,14 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <string_view>
 
 #include "analysis/step_metrics.hpp"
 #include "analysis/tracking.hpp"
 #include "controllers/registry.hpp"
+#include "fmi/fmu_controller.hpp"
+#include "fmi/fmu_plant.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/trajectory_yaml.hpp"
 #include "io/yaml_reader.hpp"
@@ -109,11 +112,16 @@ control::ParameterValue parameter_value(YamlSection& s, const std::string& key, 
 // contains itself (`a: &x {b: *x}`) makes, is refused instead of followed.
 constexpr int kMaxParameterDepth = 3;
 
+// The keys of a `controller:` section that are not parameters: read by read_controller.
+bool controller_section_key(const std::string& key) {
+  return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters";
+}
+
 void collect_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
                         std::vector<control::Setting>& controller_settings,
                         std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth) {
   for (const std::string& key : s.keys()) {
-    if (depth == 1 && key == "type") continue;  // read by the caller
+    if (depth == 1 && controller_section_key(key)) continue;  // read by the caller
     const YAML::Node n = s.raw(key);
     const std::string name = prefix.empty() ? key : prefix + "." + key;
     if (n.IsMap()) {
@@ -150,8 +158,107 @@ void read_parameters(YamlSection& s, control::ControllerConfig& c,
   c.controller = std::move(next);
 }
 
-// A `controller:` section: `type` (default paper) and the parameters, for `vehicle`.
-control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle) {
+// One FMU's loaded description and binary per file, shared by every scenario that names it while any
+// of them lives (a sweep loads its scenario once per run).
+std::shared_ptr<fmi::Fmu> load_fmu(const std::string& path) {
+  static std::mutex mutex;
+  static std::map<std::string, std::pair<std::filesystem::file_time_type, std::weak_ptr<fmi::Fmu>>> cache;
+  std::error_code ec;
+  const auto mtime = std::filesystem::last_write_time(path, ec);
+  const std::lock_guard lock(mutex);
+  auto& entry = cache[path];
+  if (auto fmu = entry.second.lock(); fmu && !ec && entry.first == mtime) return fmu;
+  std::shared_ptr<fmi::Fmu> fmu = fmi::Fmu::load(path);
+  entry = {mtime, fmu};
+  return fmu;
+}
+
+// A list of FMU variable names under `key` of `s` (one per component of a signal).
+std::vector<std::string> variable_names(YamlSection& s, const std::string& key) {
+  const YAML::Node n = s.raw(key);
+  if (!n.IsSequence()) s.fail(key, "got " + YamlSection::describe(n) + ", expected a list of FMU variable names");
+  std::vector<std::string> names;
+  for (const YAML::Node& e : n) {
+    if (!e.IsScalar() || e.Scalar().empty()) {
+      s.fail(key, "got an entry " + YamlSection::describe(e) + ", expected FMU variable names");
+    }
+    names.push_back(e.Scalar());
+  }
+  return names;
+}
+
+// The `fmu`, `inputs`, `outputs` and `parameters` keys of a `plant:` or `controller:` section; a
+// relative path is taken from `folder` (the scenario file's).
+FmuSpec read_fmu_spec(YamlSection& s, const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  FmuSpec spec;
+  const std::string given = s.text("fmu", "");
+  if (given.empty()) s.fail("fmu", "missing; expected the path of a co-simulation FMU (.fmu file or unpacked folder)");
+  const fs::path full = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
+  if (!fs::exists(full)) s.fail("fmu", "got '" + given + "': no such file (" + full.string() + ")");
+  spec.path = full.lexically_normal().string();
+  for (const char* side : {"inputs", "outputs"}) {
+    auto m = s.section(side);
+    if (!m) continue;
+    auto& target = std::string_view(side) == "inputs" ? spec.mapping.inputs : spec.mapping.outputs;
+    for (const std::string& key : m->keys()) target[key] = variable_names(*m, key);
+  }
+  if (auto p = s.section("parameters")) {
+    for (const std::string& key : p->keys()) {
+      const YAML::Node n = p->raw(key);
+      if (!n.IsScalar()) {
+        p->fail(key, "got " + YamlSection::describe(n) +
+                         ", expected a single value (an FMU variable's whole name is the key: 'vehicle.mass_kg: 2')");
+      }
+      spec.mapping.parameters.emplace_back(key, n.Scalar());
+    }
+  }
+  return spec;
+}
+
+// Runs `make` (which loads and checks an FMU), turning its refusals into ConfigErrors at the key they
+// name under `s` (the FMU file itself at `fmu`).
+template <class F>
+auto checked_fmu(YamlSection& s, F make) -> decltype(make()) {
+  try {
+    return make();
+  } catch (const fmi::MappingError& e) {
+    s.fail(e.key(), e.what());
+  } catch (const fmi::FmuError& e) {
+    s.fail("fmu", e.what());
+  }
+}
+
+std::shared_ptr<const sim::ExternalDynamicsFactory> make_plant_fmu(YamlSection& s, const FmuSpec& spec) {
+  return checked_fmu(s, [&] { return std::make_shared<const fmi::FmuPlant>(load_fmu(spec.path), spec.mapping); });
+}
+
+std::shared_ptr<const control::Controller> make_controller_fmu(YamlSection& s, const FmuSpec& spec,
+                                                               const model::VehicleParams& vehicle) {
+  return checked_fmu(s, [&]() -> std::shared_ptr<const control::Controller> {
+    return std::make_shared<fmi::FmuController>(load_fmu(spec.path), spec.mapping, vehicle);
+  });
+}
+
+// A `controller:` section: `type` (default paper) and the parameters, for `vehicle`; or `fmu` (with
+// its inputs, outputs and parameters) and the node's and the FMU's parameters.
+control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle,
+                                          const std::filesystem::path& folder, std::optional<FmuSpec>* fmu_spec) {
+  if (s.has("fmu")) {
+    if (s.has("type") && s.text("type", "") != "fmu") {
+      s.fail("type", "got '" + s.text("type", "") + "' beside fmu; the FMU is the controller (leave type out)");
+    }
+    const FmuSpec spec = read_fmu_spec(s, folder);
+    control::ControllerConfig c;
+    c.vehicle = vehicle;
+    c.controller = make_controller_fmu(s, spec, vehicle);
+    read_parameters(s, c, nullptr);
+    if (fmu_spec) *fmu_spec = spec;
+    return c;
+  }
+  for (const char* key : {"inputs", "outputs", "parameters"}) {
+    if (s.has(key)) s.fail(key, "belongs to an FMU controller; expected fmu: beside it");
+  }
   const std::string type = s.choice("type", "paper", controllers::controller_type_list());
   control::ControllerConfig c;
   try {
@@ -442,12 +549,20 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   }
   const model::VehicleParams& believed = controller_vehicle ? *controller_vehicle : sc.vehicle;
   if (auto c = root.section("controller")) {
-    sc.controller = read_controller(*c, believed);
+    sc.controller = read_controller(*c, believed, std::filesystem::path(path).parent_path(), &sc.controller_fmu);
   } else {
     sc.controller = controllers::make_config("paper", believed);
   }
   read_schedule(root, sc, duration_s);
   read_realism(root, sc);
+  if (auto p = root.section("plant")) {
+    sc.plant_fmu = read_fmu_spec(*p, std::filesystem::path(path).parent_path());
+    p->reject_unknown_keys();
+    sc.simulation.plant.external = make_plant_fmu(*p, *sc.plant_fmu);
+    if (std::string key = sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle); !key.empty()) {
+      root.fail(key, "acts inside quadcosim's own plant model only, not with plant: {fmu: ...}");
+    }
+  }
   if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
   if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
   if (auto t = root.section("trajectory")) {
@@ -471,7 +586,38 @@ model::VehicleParams load_vehicle(const std::string& path) {
 
 control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle) {
   YamlSection root = YamlSection::load_file(path);
-  return read_controller(root, vehicle);
+  return read_controller(root, vehicle, std::filesystem::path(path).parent_path(), nullptr);
+}
+
+namespace {
+// A section holding only `fmu: <path>`, for the CLI's --fmu (its errors then read "<source>: fmu: ...").
+YAML::Node fmu_node(const FmuSpec& spec) {
+  YAML::Node n(YAML::NodeType::Map);
+  n["fmu"] = spec.path;
+  return n;
+}
+}  // namespace
+
+void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source) {
+  YamlSection s(fmu_node(spec), source, "");
+  sc.simulation.plant.external = make_plant_fmu(s, spec);
+  sc.plant_fmu = spec;
+  if (std::string key = sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle); !key.empty()) {
+    throw ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) + ": " + key +
+                      ": acts inside quadcosim's own plant model only, not with " + source + " " + spec.path);
+  }
+}
+
+void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source) {
+  YamlSection s(fmu_node(spec), source, "");
+  control::ControllerConfig c;
+  c.vehicle = sc.controller.vehicle;
+  c.node = sc.controller.node;
+  c.trajectory = sc.controller.trajectory;
+  c.trajectory_offset_W = sc.controller.trajectory_offset_W;
+  c.controller = make_controller_fmu(s, spec, c.vehicle);
+  sc.controller = std::move(c);
+  sc.controller_fmu = spec;
 }
 
 }  // namespace quadcosim::io

@@ -12,6 +12,7 @@
 
 #include "control/parameters.hpp"
 #include "controllers/registry.hpp"
+#include "fmi/fmu_mapping.hpp"
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
@@ -91,6 +92,13 @@ struct LimitsSpec {
   std::vector<Criterion> criteria;
 };
 
+/// A scenario's `plant: {fmu: ...}` or `controller: {fmu: ...}` (or the CLI's --fmu): the FMU and how
+/// its variables map to quadcosim's signals (fmi/fmu_mapping.hpp; empty: the default names).
+struct FmuSpec {
+  std::string path;  ///< resolved against the scenario file's folder
+  fmi::FmuMapping mapping;
+};
+
 struct Scenario {
   std::string path;  ///< file it was read from ("" for built-in defaults)
   std::string name;
@@ -107,7 +115,20 @@ struct Scenario {
   std::optional<HoldSpec> hold;          ///< analysis.hold
   std::optional<LimitsSpec> limits;      ///< analysis.limits
   std::optional<TrackingSpec> tracking;  ///< analysis.tracking, or its defaults when a trajectory is tracked
+  /// `plant: {fmu: ...}`: the FMU flown as the plant (simulation.plant.external is its factory).
+  std::optional<FmuSpec> plant_fmu;
+  /// `controller: {fmu: ...}`: the FMU flown as the controller (controller.controller is it).
+  std::optional<FmuSpec> controller_fmu;
 };
+
+/// Makes `sc` fly `spec` as its plant (`quadcosim plant --fmu`): loads the FMU, checks the mapping,
+/// sets simulation.plant.external. Throws ConfigError naming `source` (the flag or file) and what
+/// does not fit, also when the scenario uses what only the native plant has (wind, faults, drag).
+void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source);
+
+/// Makes `sc` fly `spec` as its controller (`quadcosim controller --fmu`), keeping the node's
+/// settings (setpoints, safety) and the trajectory. Throws ConfigError naming `source`.
+void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source);
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).
 model::State initial_state(const Scenario& scenario);

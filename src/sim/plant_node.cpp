@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <stdexcept>
 
 namespace quadcosim::sim {
 
@@ -13,6 +14,20 @@ msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(
 
 std::string to_string(WatchdogPolicy p) { return p == WatchdogPolicy::kHold ? "hold" : "stop"; }
 
+std::string external_plant_conflict(const RealismConfig& realism, const model::VehicleParams& vehicle) {
+  if (realism.wind.active()) return "environment";
+  if (!realism.faults.empty()) return "faults";
+  if (vehicle.aero.active()) {
+    for (const model::VehicleParameter& p : model::vehicle_parameters()) {
+      if (p.section() == "aero" && p.kind == model::VehicleParameter::Kind::kNumber && p.get(vehicle) != 0.0) {
+        return "vehicle." + std::string(p.name);
+      }
+    }
+    return "vehicle.aero";
+  }
+  return {};
+}
+
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
     : model_(vehicle),
@@ -21,6 +36,13 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
       latched_(initial.omega_rad_s),
       rotor_input_(model_.rotor_input(latched_)) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
+  if (options.external) {
+    if (std::string key = external_plant_conflict(options.realism, vehicle); !key.empty()) {
+      throw std::invalid_argument(key + ": acts inside quadcosim's own plant model only, not with " +
+                                  options.external->describe() + " as the plant");
+    }
+    external_ = options.external->make(vehicle, initial, options.clock);
+  }
   status_pub_ = transport.advertise<msg::PlantStatus>(topics.plant_status);
   if (options.realism.active() || vehicle.aero.active()) {
     // The vehicle's namespace names its noise streams: /drone/Pose -> /drone.
@@ -107,8 +129,9 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const model::Outputs y =
-      model_.outputs(options_.clock.seconds(k), state_, rotor_input_, realism_ ? &realism_->environment(k) : nullptr);
+  const model::Outputs y = external_ ? external_outputs(k)
+                                     : model_.outputs(options_.clock.seconds(k), state_, rotor_input_,
+                                                      realism_ ? &realism_->environment(k) : nullptr);
 
   const bool clock_first = !options_.clock_after_sensors;
   if (clock_pub_ && clock_first) clock_pub_.publish(msg::Clock{stamp});
@@ -142,6 +165,12 @@ void PlantNode::publish_outputs(Tick k) {
     if (before_clock_) before_clock_(k);
     clock_pub_.publish(msg::Clock{stamp});
   }
+}
+
+model::Outputs PlantNode::external_outputs(Tick k) {
+  model::Outputs y;
+  external_->outputs(k, y, state_);
+  return y;
 }
 
 void PlantNode::latch_command(Tick k) {
@@ -179,6 +208,10 @@ void PlantNode::set_latched(const model::Vector4& omega_rad_s) {
 }
 
 void PlantNode::integrate(Tick k) {
+  if (external_) {
+    external_->step(k, latched_);
+    return;
+  }
   model_.step(state_, options_.clock.seconds(k), rotor_input_, options_.clock.period_s(), options_.substeps,
               realism_ ? &realism_->environment(k) : nullptr);
 }

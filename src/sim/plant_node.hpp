@@ -10,6 +10,7 @@
 
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
+#include "sim/external_dynamics.hpp"
 #include "sim/messages.hpp"
 #include "sim/realism.hpp"
 #include "sim/steppable_plant.hpp"
@@ -54,7 +55,17 @@ struct PlantOptions {
   /// Simulink node with ROS 2 time model stepping, docs/simulink.md): delivered in publication order,
   /// the tick's samples are in before the time that steps it.
   bool clock_after_sensors = false;
+  /// Dynamics computed elsewhere (an FMU, sim/external_dynamics.hpp), one instance made per plant;
+  /// null: the native 6-DOF model. Commands, delay, watchdog, status, topics and the sensor realism
+  /// (noise, rates, latency) are the node's either way; wind, rotor faults and aerodynamic drag act
+  /// inside the native model only (external_plant_conflict refuses them).
+  std::shared_ptr<const ExternalDynamicsFactory> external;
 };
+
+/// "" when the native-only features (wind, rotor faults, the vehicle's aerodynamics) are all off,
+/// else the scenario key of the first one that is on ("environment", "faults",
+/// "vehicle.aero.linear_drag_N_s_m.x"): a plant with PlantOptions::external cannot honour it.
+std::string external_plant_conflict(const RealismConfig& realism, const model::VehicleParams& vehicle);
 
 /// What became of the motor commands (sim/validation.hpp check_command).
 struct PlantStats {
@@ -74,6 +85,8 @@ struct PlantStats {
 /// The native plant behind the steppable-plant seam (sim/steppable_plant.hpp).
 class PlantNode final : public SteppablePlant {
  public:
+  /// With options.external, makes its ExternalDynamics (what the factory throws goes through) and
+  /// throws std::invalid_argument naming the key when external_plant_conflict finds one.
   PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
             const PlantOptions& options, const model::State& initial);
 
@@ -97,9 +110,11 @@ class PlantNode final : public SteppablePlant {
   bool watchdog_active() const { return watchdog_active_; }
   /// Time [ns] without a valid command at the last latch_command (ticks * period, or receipt clock).
   std::int64_t command_age_ns() const { return command_age_ns_; }
-  /// Integrates the state from t_k to t_k+1 under the latched command.
+  /// Integrates the state from t_k to t_k+1 under the latched command (external dynamics: steps them).
   void integrate(Tick k) override;
 
+  /// The state at the current tick (external dynamics: as they reported it at the last
+  /// publish_outputs).
   const model::State& state() const { return state_; }
   const model::Quadrotor& model() const { return model_; }
   /// The command latched for the current interval, as received after check_command (speeds within
@@ -117,11 +132,14 @@ class PlantNode final : public SteppablePlant {
   /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
   void accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
+  /// The external dynamics' outputs at tick k; state_ becomes the state they report.
+  model::Outputs external_outputs(Tick k);
   /// Latches a command: latched_ and, formed once here, rotor_input_.
   void set_latched(const model::Vector4& omega_rad_s);
 
   model::Quadrotor model_;
   PlantOptions options_;
+  std::unique_ptr<ExternalDynamics> external_;  ///< options.external's dynamics; null: model_
   model::State state_;
   Tick current_tick_ = 0;
   std::int64_t last_command_stamp_ns_ = -1;

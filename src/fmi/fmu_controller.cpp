@@ -1,0 +1,348 @@
+#include "fmi/fmu_controller.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <deque>
+#include <iostream>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+
+#include "control/controller_config.hpp"
+#include "fmi/quadrotor_variables.hpp"
+
+namespace quadcosim::fmi {
+
+namespace {
+
+constexpr std::array<std::string_view, 3> kRefJerk = {"ref.j_W[1]", "ref.j_W[2]", "ref.j_W[3]"};
+constexpr std::array<std::string_view, 1> kRefYaw = {names::kRefYaw};
+constexpr std::array<std::string_view, 1> kRefYawRate = {"ref.yaw_rate"};
+constexpr std::array<std::string_view, 1> kRefRoll = {"ref.roll"};
+constexpr std::array<std::string_view, 1> kRefPitch = {"ref.pitch"};
+
+// The controller FMU's inputs, in the order they are set (the first five: the observation).
+enum Input {
+  kP,
+  kV,
+  kQ,
+  kW,
+  kF,
+  kRefP,
+  kRefV,
+  kRefA,
+  kRefJ,
+  kRefYawIn,
+  kRefYawRateIn,
+  kRefRollIn,
+  kRefPitchIn,
+  kCount
+};
+const std::array<Signal, kCount> kInputs = {
+    Signal{"p_W", names::kPosition, "m", false},          Signal{"v_W", names::kVelocity, "m/s", false},
+    Signal{"q_WB", names::kAttitude, "1", false},         Signal{"w_B", names::kRates, "rad/s", false},
+    Signal{"f_B", names::kSpecificForce, "m/s2", false},  Signal{"ref.p_W", names::kRefPosition, "m", false},
+    Signal{"ref.v_W", names::kRefVelocity, "m/s", false}, Signal{"ref.a_W", names::kRefAcceleration, "m/s2", false},
+    Signal{"ref.j_W", kRefJerk, "m/s3", false},           Signal{"ref.yaw", kRefYaw, "rad", false},
+    Signal{"ref.yaw_rate", kRefYawRate, "rad/s", false},  Signal{"ref.roll", kRefRoll, "rad", false},
+    Signal{"ref.pitch", kRefPitch, "rad", false},
+};
+const std::array<Signal, 1> kOutputs = {Signal{"omega_cmd", names::kOmegaCmd, "rad/s", true}};
+
+const std::vector<std::string>* given(const std::map<std::string, std::vector<std::string>, std::less<>>& m,
+                                      std::string_view name) {
+  const auto it = m.find(name);
+  return it == m.end() ? nullptr : &it->second;
+}
+
+std::optional<double> number(const std::optional<std::string>& text) {
+  if (!text) return std::nullopt;
+  try {
+    std::size_t used = 0;
+    const double d = std::stod(*text, &used);
+    if (used == text->size()) return d;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+std::atomic<int> instances_made{0};
+
+}  // namespace
+
+/// What an instance logged lately (the last few lines), for error messages; warnings and errors go
+/// to stderr as they come.
+struct FmuController::LogTail {
+  std::mutex mutex;
+  std::deque<std::string> lines;
+  void add(const std::string& category, const std::string& status, const std::string& message) {
+    const std::string line = status + (category.empty() ? "" : " [" + category + "]") + ": " + message;
+    if (status != "OK") std::cerr << "fmu: " << line << '\n';
+    const std::lock_guard lock(mutex);
+    lines.push_back(line);
+    if (lines.size() > 4) lines.pop_front();
+  }
+  std::string text() {
+    const std::lock_guard lock(mutex);
+    std::string out;
+    for (const auto& l : lines) out += (out.empty() ? "" : "; ") + l;
+    return out;
+  }
+};
+
+struct FmuController::Shared {
+  std::shared_ptr<Fmu> fmu;
+  std::string description;
+  std::array<int, kCount> in_at{};  ///< offset of each input signal in in_vrs, -1 when absent
+  std::vector<ValueReference> in_vrs;
+  std::vector<ValueReference> out_vrs;  ///< omega_cmd[1..4], then the figures
+  std::vector<std::string> out_names;   ///< the FMU variable of each out_vrs entry
+  std::vector<std::string> figure_names;
+  std::vector<ParameterSetting> fixed_settings;  ///< the scenario's `parameters:` that are not in the table
+  std::deque<std::string> strings;               ///< owns what the specs' string_views show
+  std::vector<control::ParameterSpec> specs;
+  std::vector<const Variable*> parameter_vars;
+  std::vector<double> defaults;
+};
+
+std::span<const Signal> controller_inputs() { return kInputs; }
+std::span<const Signal> controller_outputs() { return kOutputs; }
+
+FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping, const model::VehicleParams& vehicle)
+    : model_(vehicle) {
+  auto sh = std::make_shared<Shared>();
+  sh->fmu = std::move(fmu);
+  sh->description = describe_fmu(*sh->fmu);
+  const ModelDescription& md = sh->fmu->description();
+  const std::string name = fmu_name(*sh->fmu);
+  check_signal_keys(mapping.inputs, kInputs, "inputs");
+  check_signal_keys(mapping.outputs, kOutputs, "outputs");
+  bool observes = false;
+  for (std::size_t i = 0; i < kInputs.size(); ++i) {
+    const SignalRefs r = resolve_signal(md, name, kInputs[i], Side::kInput, given(mapping.inputs, kInputs[i].name));
+    sh->in_at[i] = r.empty() ? -1 : static_cast<int>(sh->in_vrs.size());
+    sh->in_vrs.insert(sh->in_vrs.end(), r.begin(), r.end());
+    if (i < kRefP && !r.empty()) observes = true;
+  }
+  if (!observes) {
+    throw MappingError("inputs", fmt::format("{} has none of the sensor inputs p_W, v_W, q_WB, w_B, f_B by their "
+                                             "default names (p_W[1], ...); name the FMU's variables, e.g. inputs: "
+                                             "{{p_W: [x, y, z]}}",
+                                             name));
+  }
+  sh->out_vrs = resolve_signal(md, name, kOutputs[0], Side::kOutput, given(mapping.outputs, "omega_cmd"));
+  const std::vector<std::string> omega_names =
+      given(mapping.outputs, "omega_cmd") ? *given(mapping.outputs, "omega_cmd")
+                                          : std::vector<std::string>(names::kOmegaCmd.begin(), names::kOmegaCmd.end());
+  sh->out_names = omega_names;
+  // The controller's own figures: the FMU's other Real outputs.
+  for (const Variable& v : md.variables) {
+    if (v.causality != Causality::kOutput || v.type != VariableType::kReal) continue;
+    if (std::find(omega_names.begin(), omega_names.end(), v.name) != omega_names.end()) continue;
+    sh->out_vrs.push_back(v.vr);
+    sh->out_names.push_back(v.name);
+    sh->figure_names.push_back(v.name);
+  }
+  // The parameter table: Real parameters that may be set (tunable, or fixed until initialisation).
+  const std::string prefix(names::kControllerPrefix);
+  for (const Variable& v : md.variables) {
+    if (v.causality != Causality::kParameter || v.type != VariableType::kReal) continue;
+    if (v.variability != Variability::kTunable && v.variability != Variability::kFixed) continue;
+    const std::optional<double> start = number(v.start);
+    if (!start) continue;  // a parameter without a start value is not offered
+    std::string shown = v.name.rfind(prefix, 0) == 0 ? v.name.substr(prefix.size()) : v.name;
+    if (control::node_parameters().find(shown)) shown = v.name;  // the node's own names stay the node's
+    const std::string& n = sh->strings.emplace_back(shown);
+    const std::string& u = sh->strings.emplace_back(v.unit);
+    const std::string& d = sh->strings.emplace_back(
+        v.description.empty()
+            ? fmt::format("FMU parameter {}{}", v.name,
+                          v.variability == Variability::kFixed ? " (fixed: until the first step)" : "")
+            : v.description + (v.variability == Variability::kFixed ? " (fixed: until the first step)" : ""));
+    control::ParameterSpec spec{n,
+                                u,
+                                d,
+                                v.min.value_or(std::numeric_limits<double>::lowest()),
+                                v.max.value_or(std::numeric_limits<double>::max()),
+                                {},
+                                true};
+    sh->specs.push_back(spec);
+    sh->parameter_vars.push_back(&v);
+    sh->defaults.push_back(*start);
+  }
+  values_ = sh->defaults;
+  changed_.assign(values_.size(), false);
+  for (const ParameterSetting& p : check_parameters(md, name, mapping)) {
+    bool in_table = false;
+    for (std::size_t i = 0; i < sh->parameter_vars.size(); ++i) {
+      if (sh->parameter_vars[i] == p.variable) {
+        values_[i] = p.number;
+        changed_[i] = true;
+        in_table = true;
+      }
+    }
+    if (!in_table) sh->fixed_settings.push_back(p);
+  }
+  shared_ = std::move(sh);
+  instantiate();
+}
+
+FmuController::FmuController(std::shared_ptr<const Shared> shared, std::vector<double> values,
+                             const model::Quadrotor& model)
+    : shared_(std::move(shared)), values_(std::move(values)), model_(model) {
+  changed_.assign(values_.size(), false);
+  for (std::size_t i = 0; i < values_.size(); ++i) changed_[i] = values_[i] != shared_->defaults[i];
+  instantiate();
+}
+
+FmuController::~FmuController() = default;
+
+void FmuController::instantiate() {
+  auto log = std::make_shared<LogTail>();
+  log_ = log;
+  instance_ = shared_->fmu->instantiate(
+      fmt::format("{}_{}", shared_->fmu->description().model_identifier, instances_made++),
+      [log](const std::string& c, const std::string& s, const std::string& m) { log->add(c, s, m); });
+  initialised_ = false;
+  steps_ = 0;
+  in_.assign(shared_->in_vrs.size(), 0.0);
+  out_.assign(shared_->out_vrs.size(), 0.0);
+}
+
+void FmuController::initialise() {
+  try {
+    for (const ParameterSetting& p : shared_->fixed_settings) set_value(*instance_, *p.variable, p.number);
+    for (std::size_t i = 0; i < values_.size(); ++i) {
+      if (changed_[i]) set_value(*instance_, *shared_->parameter_vars[i], values_[i]);
+    }
+    instance_->enter_initialization(0.0);
+    instance_->exit_initialization();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("{}: initialisation failed: {}", describe(), e.what()));
+  }
+  initialised_ = true;
+}
+
+std::unique_ptr<control::Controller> FmuController::clone() const {
+  return std::unique_ptr<FmuController>(new FmuController(shared_, values_, model_));
+}
+
+std::span<const control::ParameterSpec> FmuController::parameters() const { return shared_->specs; }
+
+std::optional<control::ParameterValue> FmuController::get_parameter(std::string_view name) const {
+  for (std::size_t i = 0; i < shared_->specs.size(); ++i) {
+    if (shared_->specs[i].name == name) return values_[i];
+  }
+  return std::nullopt;
+}
+
+std::string FmuController::set_parameters(std::span<const control::Setting> settings) {
+  std::vector<std::pair<std::size_t, double>> next;
+  for (const control::Setting& s : settings) {
+    std::size_t i = 0;
+    while (i < shared_->specs.size() && shared_->specs[i].name != s.name) ++i;
+    if (i == shared_->specs.size()) return control::unknown_parameter(s.name);
+    if (std::string err = control::check_value(shared_->specs[i], s.value); !err.empty()) return err;
+    if (initialised_ && shared_->parameter_vars[i]->variability == Variability::kFixed) {
+      return fmt::format("{}: the FMU declares it fixed: it can be set before the first step only", s.name);
+    }
+    next.emplace_back(i, std::get<double>(s.value));
+  }
+  if (initialised_) {
+    // Through the FMU, one at a time; a refusal undoes the ones already set.
+    std::vector<std::pair<std::size_t, double>> done;
+    for (const auto& [i, value] : next) {
+      try {
+        set_value(*instance_, *shared_->parameter_vars[i], value);
+      } catch (const std::exception& e) {
+        for (const auto& [j, old] : done) {
+          try {
+            set_value(*instance_, *shared_->parameter_vars[j], old);
+          } catch (const std::exception&) {
+          }
+        }
+        return fmt::format("{}: refused by {}: {}", shared_->specs[i].name, describe(), e.what());
+      }
+      done.emplace_back(i, values_[i]);
+    }
+  }
+  for (const auto& [i, value] : next) {
+    values_[i] = value;
+    if (!initialised_) changed_[i] = true;
+  }
+  return {};
+}
+
+std::span<const std::string> FmuController::output_names() const { return shared_->figure_names; }
+
+void FmuController::reset() {
+  if (initialised_) {
+    instance_->reset();
+    changed_.assign(values_.size(), true);  // the reset instance has its start values again
+  }
+  initialised_ = false;
+  steps_ = 0;
+}
+
+void FmuController::step(const control::Observation& o, const control::Reference& r, double dt_s,
+                         control::ControllerOutput& out) {
+  const double t = static_cast<double>(steps_) * dt_s;
+  auto put = [&](Input in, std::initializer_list<double> values) {
+    const int at = shared_->in_at[in];
+    if (at < 0) return;
+    std::size_t i = static_cast<std::size_t>(at);
+    for (double v : values) in_[i++] = v;
+  };
+  put(kP, {o.p_W.x(), o.p_W.y(), o.p_W.z()});
+  put(kV, {o.v_W.x(), o.v_W.y(), o.v_W.z()});
+  put(kQ, {o.q_WB.w(), o.q_WB.x(), o.q_WB.y(), o.q_WB.z()});
+  put(kW, {o.w_B.x(), o.w_B.y(), o.w_B.z()});
+  put(kF, {o.specific_force_B.x(), o.specific_force_B.y(), o.specific_force_B.z()});
+  put(kRefP, {r.p_W.x(), r.p_W.y(), r.p_W.z()});
+  put(kRefV, {r.v_W.x(), r.v_W.y(), r.v_W.z()});
+  put(kRefA, {r.a_W.x(), r.a_W.y(), r.a_W.z()});
+  put(kRefJ, {r.j_W.x(), r.j_W.y(), r.j_W.z()});
+  put(kRefYawIn, {r.yaw_rad});
+  put(kRefYawRateIn, {r.yaw_rate_rad_s});
+  put(kRefRollIn, {r.roll_rad});
+  put(kRefPitchIn, {r.pitch_rad});
+  try {
+    if (!initialised_) initialise();
+    instance_->set_real(shared_->in_vrs, in_);
+    instance_->do_step(t, dt_s);
+    instance_->get_real(shared_->out_vrs, out_);
+  } catch (const std::exception& e) {
+    const std::string logged = log_ ? log_->text() : "";
+    throw std::runtime_error(fmt::format("{}: control step {} (t = {:g} s) failed: {}{}", describe(), steps_, t,
+                                         e.what(), logged.empty() ? "" : " (the FMU logged: " + logged + ")"));
+  }
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (!std::isfinite(out_[i])) {
+      throw std::runtime_error(fmt::format("{}: control step {} (t = {:g} s): output '{}' is {}; not commanded",
+                                           describe(), steps_, t, shared_->out_names[i], out_[i]));
+    }
+  }
+  ++steps_;
+  out.omega_rad_s = {out_[0], out_[1], out_[2], out_[3]};
+  const model::Wrench u = model_.wrench(out.omega_rad_s);
+  out.U = {u.thrust_N, u.torque_B_Nm.x(), u.torque_B_Nm.y(), u.torque_B_Nm.z()};
+  out.roll_des_rad = r.roll_rad;
+  out.pitch_des_rad = r.pitch_rad;
+  out.yaw_des_rad = r.yaw_rad;
+  out.attitude_error = std::numeric_limits<double>::quiet_NaN();
+  out.rotor_saturated = {};
+  out.tilt_saturated = false;
+  for (std::size_t i = 0; i < shared_->figure_names.size() && i < out.outputs.size(); ++i) out.outputs[i] = out_[4 + i];
+}
+
+const std::shared_ptr<Fmu>& FmuController::fmu() const { return shared_->fmu; }
+
+std::string FmuController::describe() const { return shared_->description; }
+
+const FmuController* fmu_controller(const control::Controller& c) { return dynamic_cast<const FmuController*>(&c); }
+
+}  // namespace quadcosim::fmi
