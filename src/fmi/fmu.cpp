@@ -86,6 +86,7 @@ constexpr std::size_t kRecentMessages = 16;
 std::uint64_t key(VariableType type, ValueReference vr) {
   return (static_cast<std::uint64_t>(type) << 32) | static_cast<std::uint64_t>(vr);
 }
+std::uint8_t type_bit(VariableType type) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(type)); }
 }  // namespace
 
 InstanceCore::InstanceCore(const Fmu& fmu, std::string instance_name, LogSink sink)
@@ -97,6 +98,12 @@ InstanceCore::InstanceCore(const Fmu& fmu, std::string instance_name, LogSink si
     if (md_.version == FmiVersion::k2 && v.type == VariableType::kEnumeration) {
       by_vr_.emplace(key(VariableType::kInteger, v.vr), i);
     }
+  }
+  for (const auto& [k, i] : by_vr_) {
+    const auto vr = static_cast<ValueReference>(k & 0xffffffffu);
+    if (vr >= kDenseLimit) continue;
+    if (vr >= known_.size()) known_.resize(vr + 1, 0);
+    known_[vr] |= type_bit(static_cast<VariableType>(k >> 32));
   }
 }
 
@@ -177,7 +184,9 @@ std::string InstanceCore::name(ValueReference vr, VariableType type) const {
 }
 
 void InstanceCore::check_known(std::string_view call, std::span<const ValueReference> vrs, VariableType type) const {
+  const std::uint8_t bit = type_bit(type);
   for (const ValueReference vr : vrs) {
+    if (vr < known_.size() && (known_[vr] & bit) != 0) continue;
     if (!by_vr_.contains(key(type, vr))) {
       throw FmuError(
           fmt::format("{} of FMU '{}' instance '{}': value reference {} is no {} variable of its "

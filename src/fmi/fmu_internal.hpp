@@ -117,6 +117,10 @@ class InstanceCore {
   bool broken_ = false;
   std::string broken_by_;
   std::unordered_map<std::uint64_t, std::size_t> by_vr_;  ///< (type, vr) -> index into variables
+  /// Per value reference below kDenseLimit, one bit per VariableType it is known as: the check every
+  /// get and set makes, without a hash lookup per value (value references above it use by_vr_).
+  static constexpr ValueReference kDenseLimit = 1u << 16;
+  std::vector<std::uint8_t> known_;
 };
 
 /// The variables of a call for its message: "p_W[3], v_W[3]", or with `values` "mass_kg = 2, g = 9.81"
