@@ -53,6 +53,18 @@ class PlantModel final : public Model {
 
   std::unique_ptr<Model> clone() const override { return std::make_unique<PlantModel>(*this); }
   std::int64_t period_ns() const override { return clock_.period_ns; }
+
+  // The Euler angles are computed when they are read (from the attitude outputs as they are then),
+  // not on every step: a master that maps only the quaternion pays nothing for them.
+  void complete_outputs(const ValueReference* vr, std::size_t n, Values& v) const override {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (vr[i] < euler_.front() || vr[i] > euler_.back()) continue;
+      const Eigen::Quaterniond q(v.number[q_[0]], v.number[q_[1]], v.number[q_[2]], v.number[q_[3]]);
+      const model::Euler e = model::euler_from_quaternion(q);
+      put(v, euler_, Eigen::Vector3d(e.roll_rad, e.pitch_rad, e.yaw_rad));
+      return;
+    }
+  }
   std::string set_tunable(const std::vector<ValueReference>&, const Values&) override { return {}; }
   std::string check_inputs(const Values&) const override { return {}; }  // checked when set
 
@@ -159,8 +171,6 @@ class PlantModel final : public Model {
     put(v, p_, y.p_W);
     put(v, v_, y.v_W);
     put(v, q_, Eigen::Vector4d(y.q_WB.w(), y.q_WB.x(), y.q_WB.y(), y.q_WB.z()));
-    const model::Euler e = model::euler_from_quaternion(y.q_WB);
-    put(v, euler_, Eigen::Vector3d(e.roll_rad, e.pitch_rad, e.yaw_rad));
     put(v, w_, y.w_B);
     put(v, f_, y.specific_force_B);
     put(v, omega_, state_.omega_rad_s);

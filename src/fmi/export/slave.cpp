@@ -80,6 +80,7 @@ std::unique_ptr<Model> make_model(const FmuConfig& config, const ModelDescriptio
 
 Slave::Slave(FmuConfig config, Log log)
     : config_(std::move(config)), md_(describe(config_)), log_(std::move(log)), time_vr_(find_vr(md_, "time")) {
+  for (const Variable& v : md_.variables) type_of_.push_back(v.type);  // describe() numbers them 0, 1, ...
   restart();
 }
 
@@ -214,6 +215,7 @@ Status Slave::get_numbers(const ValueReference* vr, std::size_t n, VariableType 
     if (Status s = refresh_outputs(); s != Status::kOK) return s;
   }
   values_.number[time_vr_] = time_s();
+  model_->complete_outputs(vr, n, values_);
   for (std::size_t i = 0; i < n; ++i) values[i] = static_cast<Out>(values_.number[vr[i]]);
   return Status::kOK;
 }

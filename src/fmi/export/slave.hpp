@@ -47,6 +47,9 @@ class Model {
   virtual std::string set_tunable(const std::vector<ValueReference>& vrs, const Values& next) = 0;
   /// The model's period [ns]: a communication step is a whole number of them.
   virtual std::int64_t period_ns() const = 0;
+  /// Outputs computed only when read (the plant's Euler angles, from its attitude outputs): called
+  /// with the value references about to be read, before they are.
+  virtual void complete_outputs(const ValueReference* /*vr*/, std::size_t /*n*/, Values& /*v*/) const {}
 };
 
 /// The model of `config` over the variables of `md` (describe(config)). Throws FmuError.
@@ -108,9 +111,7 @@ class Slave {
 
  private:
   /// True when variable `vr` exists and is of `type`.
-  bool valid(ValueReference vr, VariableType type) const {
-    return vr < md_.variables.size() && md_.variables[vr].type == type;
-  }
+  bool valid(ValueReference vr, VariableType type) const { return vr < type_of_.size() && type_of_[vr] == type; }
   /// "" when variable `vr` exists and is of `type`, else why not.
   std::string check_vr(ValueReference vr, VariableType type) const;
   /// Reads Real, Integer or Boolean values (stored as doubles) into `values`.
@@ -126,7 +127,8 @@ class Slave {
   FmuConfig config_;
   ModelDescription md_;
   Log log_;
-  ValueReference time_vr_;  ///< the independent variable, read as the current communication point
+  ValueReference time_vr_;             ///< the independent variable, read as the current communication point
+  std::vector<VariableType> type_of_;  ///< by value reference (the variables' index): each get and set checks it
   Values values_;
   std::unique_ptr<Model> model_;
   State state_ = State::kInstantiated;
