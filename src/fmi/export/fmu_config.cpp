@@ -538,6 +538,10 @@ ModelDescription describe(const FmuConfig& c) {
   } else {
     controller_variables(c, b);
   }
+  Variable& period = b.add("period", Causality::kLocal, Variability::kConstant, "s",
+                           "the FMU's period: every communication step is a whole number of them");
+  period.initial = Initial::kExact;
+  period.start = number_text(static_cast<double>(period_ns) / 1e9);
   return md;
 }
 

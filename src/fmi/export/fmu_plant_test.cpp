@@ -233,6 +233,9 @@ TEST(FmuPlantBadUse, SettingWhatCannotBeSetIsRefusedNamingIt) {
   EXPECT_TRUE(p.log_.contains("p_W[3] is an output (computed by the FMU): it cannot be set")) << p.log_.last();
   EXPECT_EQ(p.set("time", 3.0), fmi2Error);
   EXPECT_TRUE(p.log_.contains("time is the independent variable")) << p.log_.last();
+  EXPECT_EQ(p.set("period", 0.02), fmi2Error);
+  EXPECT_TRUE(p.log_.contains("period is a constant: it cannot be set")) << p.log_.last();
+  EXPECT_EQ(p.get("period"), 0.01);  // the plant period, unchanged
   EXPECT_EQ(p.set("vehicle.mass_kg", 3.0), fmi2Error);
   EXPECT_TRUE(p.log_.contains("vehicle.mass_kg is a fixed parameter: it can be set only before exitInitializationMode"))
       << p.log_.last();

@@ -233,10 +233,10 @@ Status Slave::set_values(const ValueReference* vr, std::size_t n, VariableType t
   for (std::size_t i = 0; i < n; ++i) {
     if (!valid(vr[i], type)) return refuse_set(check_vr(vr[i], type));
     const Variable& v = md_.variables[vr[i]];
+    if (v.variability == Variability::kConstant) return refuse_set(v.name + " is a constant: it cannot be set");
     switch (v.causality) {
       case Causality::kInput: break;
       case Causality::kParameter:
-        if (v.variability == Variability::kConstant) return refuse_set(v.name + " is a constant");
         if (v.variability == Variability::kFixed && state_ == State::kStepMode) {
           return refuse_set(v.name + " is a fixed parameter: it can be set only before exitInitializationMode");
         }
