@@ -11,9 +11,9 @@ need_export() {
   "$bin" fmu export --help > /dev/null 2>&1 || { echo "SKIP: this build has no 'quadcosim fmu export'"; exit 77; }
 }
 
-# $1 scenario file, $2 plant|controller, $3 output .fmu
+# $1 scenario file, $2 plant|controller, $3 output .fmu, then further export flags (--fmi 3)
 export_fmu() {
-  "$bin" fmu export "$2" --scenario "$1" --out "$3" > "$tmp/export_$2.log" 2>&1 || fail "fmu export $2 failed"
+  "$bin" fmu export "$2" --scenario "$1" --out "$3" "${@:4}" > "$tmp/export_$2.log" 2>&1 || fail "fmu export $2 failed"
 }
 
 # The scenario $1 with `$2` (a YAML mapping line) appended, written to $3.
@@ -24,7 +24,7 @@ with_key() { { cat "$1"; echo; echo "$2"; } > "$3"; }
 plant_round_trip() {
   local s="$1"; shift
   need_export
-  export_fmu "$paper/$s.yaml" plant "$tmp/plant.fmu"
+  export_fmu "$paper/$s.yaml" plant "$tmp/plant.fmu" ${QUADCOSIM_EXPORT_FLAGS:-}
   with_key "$paper/$s.yaml" "plant: {fmu: plant.fmu}" "$tmp/fmu_$s.yaml"
   "$bin" run "$paper/$s.yaml" --out "$tmp/native" --no-plots > "$tmp/native.log" 2>&1 || fail "native run failed"
   "$bin" run "$tmp/fmu_$s.yaml" --out "$tmp/fmu" --no-plots "$@" > "$tmp/fmu.log" 2>&1 || fail "FMU plant run failed"
@@ -60,6 +60,7 @@ case "$case_name" in
   plant_round_trip_pitch) plant_round_trip pitch_step ;;
   plant_round_trip_yaw) plant_round_trip yaw_step ;;
   plant_round_trip_dds) plant_round_trip altitude_step --transport dds ;;
+  plant_round_trip_fmi3) QUADCOSIM_EXPORT_FLAGS="--fmi 3" plant_round_trip pitch_step ;;  # FMI 3.0 through the master
   controller_round_trip) controller_round_trip ;;
   node_fmu_flags)  # `plant --fmu` and `controller --fmu` over DDS lockstep: the native trajectory again
     need_export
