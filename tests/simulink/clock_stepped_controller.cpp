@@ -74,7 +74,7 @@ int main(int argc, char** argv) try {
 
   std::int64_t pose_ns = -1, velocity_ns = -1, imu_ns = -1;
   std::int64_t last_step_ns = -1;
-  long clocks = 0, steps = 0, stale = 0, non_hits = 0;
+  long clocks = 0, steps = 0, stale = 0, non_hits = 0, unmatched = 0;
   std::int64_t first_stale_ns = -1;
   auto last_clock = std::chrono::steady_clock::now();
   transport.subscribe<msg::PoseStamped>(topics.pose, [&](const msg::PoseStamped& m) {
@@ -98,6 +98,14 @@ int main(int argc, char** argv) try {
       return;
     }
     if (t_ns <= last_step_ns) return;  // that time again: stepped already
+    // No step before the command publisher has matched the plant's reader: a command published
+    // earlier would go nowhere, and the plant would wait for tick 0 in vain (it asks again, with
+    // /clock, every 50 ms, so the first step comes with the first /clock after the match). Discovery
+    // is asynchronous: the plant's readers may be known after its writers, under load by many ms.
+    if (transport.matched_readers(topics.motor_commands) == 0) {
+      ++unmatched;
+      return;
+    }
     last_step_ns = t_ns;
     ++steps;
     if (pose_ns != t_ns || velocity_ns != t_ns || imu_ns != t_ns) {
@@ -121,6 +129,8 @@ int main(int argc, char** argv) try {
     }
   }
   std::fclose(steps_csv);
+  std::fprintf(stderr, "clock_stepped_controller: %ld /clock sample hits skipped before the command writer matched\n",
+               unmatched);
   std::printf(
       "{\"clock_messages\": %ld, \"steps\": %ld, \"stale_steps\": %ld, \"first_stale_s\": %g, \"non_hits\": %ld, "
       "\"last_step_s\": %g}\n",
