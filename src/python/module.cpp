@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "app/inprocess_run.hpp"
+#include "batch.hpp"
 #include "control/care.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -556,4 +557,6 @@ imu: q (4), w (3) [rad/s], a (3) specific force in body [m/s^2]. Empty before th
       .def_property_readonly("setpoint", &PySimulation::setpoint,
                              "The controller node's setpoints: mode, x, y, z [m], roll, pitch, yaw [rad].")
       .def("__repr__", &PySimulation::repr);
+
+  bind_batch(m);
 }
