@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -39,12 +40,15 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// Threads that run one job on shares of the vehicles, kept between steps: a step of 1,000 vehicles
-/// takes a fraction of a millisecond, of which starting threads every time would be a visible part.
+/// Threads that run one job over the vehicles in chunks, kept between steps: a step of 1,000
+/// vehicles takes a fraction of a millisecond, of which starting threads every time would be a
+/// visible part. Chunks are taken from a shared counter, so a thread the OS does not run for a while
+/// (the machine is shared) delays a step by one chunk at most: the others take the rest, the calling
+/// thread too. Which thread steps which vehicle changes nothing (the vehicles do not interact).
 class WorkerPool {
  public:
   explicit WorkerPool(int threads) : threads_(std::max(threads, 1)) {
-    for (int t = 1; t < threads_; ++t) workers_.emplace_back([this, t] { work(t); });
+    for (int t = 1; t < threads_; ++t) workers_.emplace_back([this] { work(); });
   }
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -59,55 +63,68 @@ class WorkerPool {
 
   int size() const { return threads_; }
 
-  /// Runs job(t) for every t in [0, size()), t = 0 on the calling thread, and returns when all are
-  /// done. Rethrows the first exception a share raised (the others still ran to their end).
-  void run(const std::function<void(int)>& job) {
-    if (threads_ == 1) {
-      job(0);
+  /// Runs job(c) for every chunk c in [0, chunks) on the pool and the calling thread, and returns
+  /// when all are done. Rethrows the first exception a chunk raised (the other chunks still ran).
+  void run(std::uint32_t chunks, const std::function<void(std::uint32_t)>& job) {
+    if (threads_ == 1 || chunks <= 1) {
+      for (std::uint32_t c = 0; c < chunks; ++c) job(c);
       return;
     }
+    std::uint64_t generation = 0;
     {
       std::lock_guard lock(mutex_);
       job_ = &job;
-      pending_ = threads_ - 1;
+      chunks_ = chunks;
+      done_chunks_ = 0;
       failure_ = nullptr;
-      ++generation_;
+      generation = ++generation_;
+      next_.store(generation << 32, std::memory_order_release);
     }
     start_.notify_all();
-    std::exception_ptr mine;
-    try {
-      job(0);
-    } catch (...) {
-      mine = std::current_exception();
-    }
+    take_chunks(generation, job, chunks);
     std::unique_lock lock(mutex_);
-    done_.wait(lock, [this] { return pending_ == 0; });
+    done_.wait(lock, [&] { return done_chunks_ == chunks_; });
     job_ = nullptr;
-    if (mine) std::rethrow_exception(mine);
     if (failure_) std::rethrow_exception(failure_);
   }
 
  private:
-  void work(int t) {
+  /// Takes chunks of `generation` until none is left (the counter holds the generation in its high
+  /// half, so a thread that wakes late never takes a chunk of a later job with an earlier one).
+  void take_chunks(std::uint64_t generation, const std::function<void(std::uint32_t)>& job, std::uint32_t chunks) {
+    for (;;) {
+      std::uint64_t v = next_.load(std::memory_order_acquire);
+      std::uint32_t c = 0;
+      do {
+        if ((v >> 32) != generation || static_cast<std::uint32_t>(v) >= chunks) return;
+        c = static_cast<std::uint32_t>(v);
+      } while (!next_.compare_exchange_weak(v, v + 1, std::memory_order_acq_rel));
+      std::exception_ptr failure;
+      try {
+        job(c);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      std::lock_guard lock(mutex_);
+      if (failure && !failure_) failure_ = failure;
+      if (++done_chunks_ == chunks_) done_.notify_all();
+    }
+  }
+
+  void work() {
     std::uint64_t seen = 0;
     for (;;) {
-      const std::function<void(int)>* job = nullptr;
+      const std::function<void(std::uint32_t)>* job = nullptr;
+      std::uint32_t chunks = 0;
       {
         std::unique_lock lock(mutex_);
         start_.wait(lock, [&] { return stop_ || generation_ != seen; });
         if (stop_) return;
         seen = generation_;
         job = job_;
+        chunks = chunks_;
       }
-      std::exception_ptr failure;
-      try {
-        (*job)(t);
-      } catch (...) {
-        failure = std::current_exception();
-      }
-      std::lock_guard lock(mutex_);
-      if (failure && !failure_) failure_ = failure;
-      if (--pending_ == 0) done_.notify_one();
+      if (job) take_chunks(seen, *job, chunks);
     }
   }
 
@@ -115,9 +132,10 @@ class WorkerPool {
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable start_, done_;
-  const std::function<void(int)>* job_ = nullptr;
+  const std::function<void(std::uint32_t)>* job_ = nullptr;
   std::uint64_t generation_ = 0;
-  int pending_ = 0;
+  std::uint32_t chunks_ = 0, done_chunks_ = 0;
+  std::atomic<std::uint64_t> next_{0};  ///< generation << 32 | the next chunk to take
   bool stop_ = false;
   std::exception_ptr failure_;
 };
@@ -194,9 +212,14 @@ class Batch {
   std::size_t size() const { return n_; }
   int threads() const { return pool_.size(); }
 
-  /// Advances every vehicle one control period; with omega_cmd ((N, 4) rotor speeds [rad/s]) the
-  /// controllers are bypassed for that period, as Simulation.step(omega_cmd=).
-  void step(const std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>& omega_cmd) {
+  /// Advances every vehicle `periods` control periods (back to back, each vehicle's data staying in
+  /// the cache); with omega_cmd ((N, 4) rotor speeds [rad/s]) the controllers are bypassed and the
+  /// command held for them, as Simulation.step(omega_cmd=).
+  void step(const std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>& omega_cmd,
+            int periods) {
+    if (periods < 1) {
+      throw py::value_error("Batch.step: periods = " + std::to_string(periods) + ": expected at least 1");
+    }
     if (omega_cmd) {
       if (omega_cmd->ndim() != 2 || omega_cmd->shape(0) != static_cast<py::ssize_t>(n_) || omega_cmd->shape(1) != 4) {
         throw py::value_error("Batch.step: omega_cmd: expected an array of shape (" + std::to_string(n_) +
@@ -217,9 +240,9 @@ class Batch {
     py::gil_scoped_release release;
     std::lock_guard lock(mutex_);
     if (bypass) std::copy(c, c + 4 * n_, omega_cmd_.begin());
-    pool_.run([&](int t) {
-      const auto [first, last] = share(t);
-      for (std::size_t i = first; i < last; ++i) step_vehicle(i, bypass);
+    pool_.run(chunks(), [&](std::uint32_t c) {
+      const std::size_t last = std::min(n_, (c + 1) * kChunk);
+      for (std::size_t i = c * kChunk; i < last; ++i) step_vehicle(i, bypass, periods);
     });
   }
 
@@ -492,12 +515,9 @@ class Batch {
     sim::Tick next_tick = 0;  ///< the next plant tick to run
   };
 
-  /// Thread t's vehicles [first, last).
-  std::pair<std::size_t, std::size_t> share(int t) const {
-    const auto threads = static_cast<std::size_t>(pool_.size());
-    const auto u = static_cast<std::size_t>(t);
-    return {n_ * u / threads, n_ * (u + 1) / threads};
-  }
+  /// Vehicles per chunk of work (a few microseconds of stepping).
+  static constexpr std::size_t kChunk = 16;
+  std::uint32_t chunks() const { return static_cast<std::uint32_t>((n_ + kChunk - 1) / kChunk); }
 
   /// The scenario with `keys` set in its vehicle section, validated as the file would be (the same
   /// keys give the same shared scenario).
@@ -600,14 +620,14 @@ class Batch {
       it = used.count(it->second.get()) ? std::next(it) : loaded_.erase(it);
   }
 
-  void step_vehicle(std::size_t i, bool bypass) {
+  void step_vehicle(std::size_t i, bool bypass, int periods) {
     Vehicle& v = vehicles_[i];
     if (bypass) {
       const double* c = &omega_cmd_[4 * i];
       v.sim->override_command(model::Vector4(c[0], c[1], c[2], c[3]));
     }
-    const int divider = v.scenario->simulation.controller_divider;
-    for (int k = 0; k < divider; ++k) v.sim->tick(v.next_tick++);
+    const int ticks = v.scenario->simulation.controller_divider * periods;
+    for (int k = 0; k < ticks; ++k) v.sim->tick(v.next_tick++);
     if (bypass) v.sim->override_command(std::nullopt);
     fill_state(i);
   }
@@ -689,7 +709,7 @@ void bind_batch(py::module_& m) {
       .def(py::init<const std::string&, const std::string&, const std::vector<std::string>&,
                     const std::vector<std::uint64_t>&, int>(),
            py::arg("yaml"), py::arg("source"), py::arg("vehicle_keys"), py::arg("seeds"), py::arg("threads"))
-      .def("step", &Batch::step, py::arg("omega_cmd") = py::none())
+      .def("step", &Batch::step, py::arg("omega_cmd") = py::none(), py::arg("periods") = 1)
       .def("reset", &Batch::reset, py::arg("indices") = py::none(), py::arg("seeds") = py::none(),
            py::arg("vehicle_keys") = py::none())
       .def("set_setpoints", &Batch::set_setpoints, py::arg("indices") = py::none())

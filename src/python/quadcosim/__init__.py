@@ -25,6 +25,7 @@ import numpy  # noqa: F401  (the arrays the module returns; fail here, clearly, 
 from ._quadcosim import ConfigError, Scenario, Simulation
 from . import _quadcosim
 from .batch import Batch  # noqa: E402  (N vehicles stepped together; docs/python.md)
+from . import envs  # noqa: E402  (Gymnasium-style environments: HoverEnv, TrackingEnv, VectorHoverEnv, ...)
 
 __all__ = ["ConfigError", "Scenario", "Simulation", "RunResult", "load_scenario", "run"]
 

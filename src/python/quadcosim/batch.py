@@ -194,14 +194,17 @@ class Batch:
 
     # --- stepping ----------------------------------------------------------------------------------
 
-    def step(self, omega_cmd: Optional[np.ndarray] = None) -> None:
+    def step(self, omega_cmd: Optional[np.ndarray] = None, periods: int = 1) -> None:
         """Advances every vehicle one control period (dt seconds, ticks_per_step plant ticks).
 
         omega_cmd: None (each vehicle's controller flies) or an (n, 4) array of rotor speeds [rad/s]
         for this period, the controllers bypassed (as Simulation.step(omega_cmd=)). A wrong shape or a
         value that is not finite raises ValueError and steps nothing.
+        periods: control periods to advance in this call (the command, if given, held over all of
+        them). The numbers equal `periods` calls of step(); each vehicle runs them back to back while
+        its data is in the CPU's cache, which is faster for many vehicles (docs/performance.md).
         """
-        self._b.step(omega_cmd)
+        self._b.step(omega_cmd, int(periods))
 
     def reset(self, indices: Optional[Sequence[int]] = None, seeds: Any = None, vehicles: Any = None) -> None:
         """Back to t = 0 for the vehicles `indices` (None: all), with their scenario's initial state and

@@ -1,0 +1,548 @@
+"""Gymnasium-style environments over quadcosim.Batch, with no dependency on gymnasium.
+
+    env = quadcosim.envs.HoverEnv()
+    obs, info = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+
+HoverEnv holds a position; TrackingEnv follows a trajectory (the scenario's `trajectory:` or one
+given). VectorHoverEnv(n) and VectorTrackingEnv(n) run n of them on one Batch with Gymnasium's
+vector-env contract and auto-reset. The API follows Gymnasium 1.x (reset(seed, options) -> (obs,
+info); step(action) -> (obs, reward, terminated, truncated, info); observation_space, action_space,
+np_random); nothing is registered with gymnasium even when it is installed. See docs/python.md,
+"Gymnasium-style environments".
+
+Spaces (float32):
+  action (4,): normalised rotor commands in [-1, 1] (values outside are clipped), rotor i's speed
+      omega_i = omega_min + (a_i + 1) / 2 * (omega_max - omega_min) [rad/s] with the vehicle's
+      motor.omega_min_rad_s and motor.omega_max_rad_s; the controller is bypassed.
+  observation (18,): [0:3] position error p - p_ref [m, world]; [3:6] velocity error v - v_ref
+      [m/s, world] (v_ref = 0 for hovering); [6:15] attitude as the rotation matrix body -> world, row
+      by row (R[0,0], R[0,1], ..., R[2,2]); [15:18] body rates [rad/s]. Clipped to the space's bounds
+      (+-max_position_error_m, +-max_speed_m_s, +-1, +-max_rate_rad_s).
+Reward per step: 1 - (w_p |e_p|^2 + w_v |e_v|^2 + w_w |w|^2 + w_a |a - a_hover|^2), a_hover the action
+  that commands the vehicle's hover speed sqrt(m g / (4 k_t)); minus termination_penalty on the step
+  that terminates. Weights default to w_p 1, w_v 0.1, w_w 0.01, w_a 0.01.
+Terminated: a crash (z below crash_altitude_m, or tilted more than max_tilt_rad) or leaving the box
+  |e_p| <= max_position_error_m on every axis. Truncated: after max_episode_steps steps.
+"""
+
+import math
+import numbers
+from typing import Any, Dict, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .batch import Batch
+
+__all__ = ["Box", "HoverEnv", "TrackingEnv", "VectorHoverEnv", "VectorTrackingEnv"]
+
+
+class Box:
+    """A box in R^shape: every entry between low and high (gymnasium.spaces.Box's contract, a small version).
+
+    low, high: numbers or arrays (broadcast to shape; -inf/inf for unbounded); shape: taken from them
+    when None; dtype: of the samples and of the bounds. sample() draws with the space's numpy
+    Generator (np_random; seed() reseeds it): uniform where both bounds are finite, a normal draw where
+    neither is, an exponential one beyond a single finite bound.
+    """
+
+    def __init__(self, low: Any, high: Any, shape: Optional[Sequence[int]] = None, dtype: Any = np.float32,
+                 seed: Optional[int] = None):
+        self.dtype = np.dtype(dtype)
+        if shape is None:
+            shape = np.broadcast(np.asarray(low), np.asarray(high)).shape
+        self.shape: Tuple[int, ...] = tuple(int(s) for s in shape)
+        self.low = np.broadcast_to(np.asarray(low, dtype=self.dtype), self.shape).copy()
+        self.high = np.broadcast_to(np.asarray(high, dtype=self.dtype), self.shape).copy()
+        if np.any(self.low > self.high) or np.any(np.isnan(self.low)) or np.any(np.isnan(self.high)):
+            raise ValueError("Box: low must not exceed high (and neither be NaN)")
+        self._np_random: Optional[np.random.Generator] = None
+        if seed is not None:
+            self.seed(seed)
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        if self._np_random is None:
+            self._np_random = np.random.default_rng()
+        return self._np_random
+
+    def seed(self, seed: Optional[int] = None) -> list:
+        """Reseeds the space's Generator (None: fresh entropy)."""
+        self._np_random = np.random.default_rng(seed)
+        return [seed]
+
+    def is_bounded(self, manner: str = "both") -> bool:
+        below, above = bool(np.all(np.isfinite(self.low))), bool(np.all(np.isfinite(self.high)))
+        return {"both": below and above, "below": below, "above": above}[manner]
+
+    def sample(self) -> np.ndarray:
+        rng = self.np_random
+        low, high = self.low.astype(np.float64), self.high.astype(np.float64)
+        out = np.empty(self.shape, dtype=np.float64)
+        fl, fh = np.isfinite(low), np.isfinite(high)
+        both, none_, lo_only, hi_only = fl & fh, ~fl & ~fh, fl & ~fh, ~fl & fh
+        out[both] = rng.uniform(low[both], high[both])
+        out[none_] = rng.normal(size=int(none_.sum()))
+        out[lo_only] = low[lo_only] + rng.exponential(size=int(lo_only.sum()))
+        out[hi_only] = high[hi_only] - rng.exponential(size=int(hi_only.sum()))
+        if np.issubdtype(self.dtype, np.integer):
+            out = np.floor(out)
+        return np.clip(out.astype(self.dtype), self.low, self.high)
+
+    def contains(self, x: Any) -> bool:
+        """x has the space's shape, a dtype that casts to its dtype, and every entry within the bounds."""
+        if not isinstance(x, np.ndarray):
+            try:
+                x = np.asarray(x, dtype=self.dtype)
+            except (ValueError, TypeError):
+                return False
+        if x.shape != self.shape or not np.can_cast(x.dtype, self.dtype):
+            return False
+        return bool(np.all(x >= self.low) and np.all(x <= self.high))
+
+    def __contains__(self, x: Any) -> bool:
+        return self.contains(x)
+
+    def __eq__(self, other: Any) -> bool:
+        return (isinstance(other, Box) and self.shape == other.shape and self.dtype == other.dtype
+                and np.array_equal(self.low, other.low) and np.array_equal(self.high, other.high))
+
+    def __repr__(self) -> str:
+        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
+
+
+OBS_SIZE = 18
+ACTION_SIZE = 4
+
+# A trimmed hover 1 m above the ground with the paper's vehicle, no noise (the default of HoverEnv).
+HOVER_SCENARIO: Dict[str, Any] = {
+    "name": "hover_env",
+    "description": "HoverEnv: trimmed hover at (0, 0, 1) m",
+    "simulation": {"plant_rate_hz": 100, "controller_rate_hz": 50, "duration_s": 10},
+    "initial": {"position_m": [0.0, 0.0, 1.0], "hover": True},
+    "controller": {"mode": "attitude", "z_des": 1.0},
+}
+
+# A circle of radius 1 m at 1 m, 10 s per lap, spun up over 2 s, started trimmed in hover at its start
+# point (the default of TrackingEnv).
+TRACKING_SCENARIO: Dict[str, Any] = {
+    "name": "tracking_env",
+    "description": "TrackingEnv: circle r = 1 m, period 10 s at 1 m",
+    "simulation": {"plant_rate_hz": 100, "controller_rate_hz": 50, "duration_s": 20},
+    "initial": {"position_m": [1.0, 0.0, 1.0], "hover": True},
+    "controller": {"type": "paper", "mode": "position"},
+    "trajectory": {"kind": "circle", "centre_m": [0, 0], "altitude_m": 1, "radius_m": 1, "period_s": 10,
+                   "ramp_s": 2, "yaw_mode": "fixed"},
+}
+
+_REWARD_WEIGHTS = {"position": 1.0, "velocity": 0.1, "rate": 0.01, "action": 0.01}
+
+
+def _rotation_rows(q: np.ndarray) -> np.ndarray:
+    """(n, 4) quaternions w, x, y, z -> (n, 9) rotation matrices body -> world, row by row."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack([
+        1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+        2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+        2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+    ], axis=1)
+
+
+class _Episodes:
+    """n episodes on one Batch: actions, observations, rewards, termination (shared by the envs)."""
+
+    def __init__(self, n: int, tracking: bool, scenario: Any, trajectory: Optional[Dict[str, Any]],
+                 target: Any, max_episode_steps: int, max_position_error_m: float, crash_altitude_m: float,
+                 max_tilt_rad: float, max_speed_m_s: float, max_rate_rad_s: float,
+                 reward_weights: Optional[Dict[str, float]], termination_penalty: float,
+                 randomize: Optional[Dict[str, Any]], threads: Optional[int]):
+        if scenario is None:
+            scenario = TRACKING_SCENARIO if tracking else HOVER_SCENARIO
+        sections = {"trajectory": trajectory} if trajectory is not None else None
+        self.batch = Batch(scenario, n, seeds=0, threads=1 if threads is None and n < 64 else threads,
+                           _sections=sections)
+        if tracking and not self.batch.tracks_trajectory:
+            raise ValueError(f"TrackingEnv: scenario '{self.batch.scenario.name}' has no trajectory: section; give "
+                             "one with trajectory={...} (the keys of a scenario's trajectory:, docs/scenarios.md)")
+        self.n = n
+        self.tracking = tracking
+        if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, numbers.Integral) \
+                or max_episode_steps < 1:
+            raise ValueError(f"max_episode_steps = {max_episode_steps!r}: expected an integer >= 1")
+        self.max_episode_steps = int(max_episode_steps)
+        self.max_position_error_m = float(max_position_error_m)
+        self.crash_altitude_m = float(crash_altitude_m)
+        self.cos_max_tilt = math.cos(float(max_tilt_rad))
+        self.termination_penalty = float(termination_penalty)
+        unknown = set(reward_weights or {}) - set(_REWARD_WEIGHTS)
+        if unknown:
+            raise ValueError(f"reward_weights: unknown {sorted(unknown)}; expected {sorted(_REWARD_WEIGHTS)}")
+        self.weights = dict(_REWARD_WEIGHTS, **(reward_weights or {}))
+        self.randomize = self._check_randomize(randomize)
+        self.default_target = None if target is None else np.broadcast_to(np.asarray(target, float), (3,)).copy()
+        # The position each hover episode holds: the target given, else the scenario's initial position.
+        self.target = self.batch.p if self.default_target is None else np.repeat(self.default_target[None], n, 0)
+        self.steps = np.zeros(n, dtype=np.int64)
+        self.ended = np.ones(n, dtype=bool)  # before the first reset
+        self._refresh_vehicles()
+        bound = np.concatenate([np.full(3, self.max_position_error_m), np.full(3, float(max_speed_m_s)),
+                                np.ones(9), np.full(3, float(max_rate_rad_s))])
+        self.observation_space = Box(-bound, bound, dtype=np.float32)
+        self.action_space = Box(-1.0, 1.0, (ACTION_SIZE,), dtype=np.float32)
+
+    @staticmethod
+    def _check_randomize(randomize: Optional[Dict[str, Any]]) -> Optional[Dict[str, Tuple[np.ndarray, np.ndarray]]]:
+        if not randomize:
+            return None
+        out = {}
+        for key, bounds in randomize.items():
+            try:
+                low, high = bounds
+                low, high = np.asarray(low, dtype=float), np.asarray(high, dtype=float)
+            except (TypeError, ValueError):
+                raise ValueError(f"randomize[{key!r}]: expected (low, high), got {bounds!r}") from None
+            if low.shape != high.shape or not np.all(np.isfinite(low)) or not np.all(np.isfinite(high)) \
+                    or np.any(low > high):
+                raise ValueError(f"randomize[{key!r}]: expected finite low <= high of one shape, got {bounds!r}")
+            out[key] = (low, high)
+        return out
+
+    def _refresh_vehicles(self) -> None:
+        vp = self.batch.vehicle_params
+        self.omega_min = vp["motor.omega_min_rad_s"]
+        self.omega_max = vp["motor.omega_max_rad_s"]
+        self.hover_action = 2 * (vp["hover_omega_rad_s"] - self.omega_min) / (self.omega_max - self.omega_min) - 1
+
+    def draw(self, rng: np.random.Generator) -> Tuple[int, Optional[Dict[str, Any]]]:
+        """An episode's noise seed and vehicle keys (uniform within the randomisation ranges)."""
+        seed = int(rng.integers(0, 2**63))
+        if self.randomize is None:
+            return seed, None
+        keys = {}
+        for k, (low, high) in self.randomize.items():
+            v = rng.uniform(low, high)
+            keys[k] = v.tolist() if isinstance(v, np.ndarray) else float(v)
+        return seed, keys
+
+    def reset(self, indices: np.ndarray, rngs: Sequence[np.random.Generator], targets: Optional[np.ndarray]) -> None:
+        seeds, vehicles = [], []
+        for i in indices:
+            s, v = self.draw(rngs[i])
+            seeds.append(s)
+            vehicles.append(v)
+        self.batch.reset(list(indices), seeds=seeds, vehicles=vehicles if self.randomize else None)
+        if self.randomize:
+            self._refresh_vehicles()
+        if targets is not None:
+            self.target[indices] = targets
+        elif self.default_target is None and not self.tracking:
+            self.target[indices] = self.batch.p[indices]  # the scenario's initial position
+        self.steps[indices] = 0
+        self.ended[indices] = False
+
+    def omega_cmd(self, action: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (self.n, ACTION_SIZE):
+            raise ValueError(f"action: expected shape {(ACTION_SIZE,) if self.n == 1 else (self.n, ACTION_SIZE)}, "
+                             f"got {np.shape(action)}")
+        if not np.all(np.isfinite(a)):
+            bad = np.argwhere(~np.isfinite(a))[0]
+            raise ValueError(f"action{tuple(bad.tolist()) if self.n > 1 else (int(bad[1]),)} = "
+                             f"{a[tuple(bad)]}: expected finite numbers in [-1, 1]")
+        a = np.clip(a, -1.0, 1.0)
+        omega = self.omega_min[:, None] + (a + 1.0) * 0.5 * (self.omega_max - self.omega_min)[:, None]
+        return a, omega
+
+    def observe(self) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:
+        """Observations of all n vehicles and the parts the reward and termination use."""
+        b = self.batch
+        p, v, q, w = b.p, b.v, b.q, b.w
+        if self.tracking:
+            ref = b.reference
+            p_ref, v_ref = ref["p"], ref["v"]
+        else:
+            p_ref, v_ref = self.target, 0.0
+        e_p, e_v = p - p_ref, v - v_ref
+        rot = _rotation_rows(q)
+        obs = np.concatenate([e_p, e_v, rot, w], axis=1)
+        obs = np.clip(obs, self.observation_space.low, self.observation_space.high).astype(np.float32)
+        return obs, {"e_p": e_p, "e_v": e_v, "w": w, "z": p[:, 2], "r22": rot[:, 8]}
+
+    def evaluate(self, parts: Dict[str, np.ndarray], a: np.ndarray):
+        w = self.weights
+        cost = (w["position"] * np.sum(parts["e_p"] ** 2, axis=1) + w["velocity"] * np.sum(parts["e_v"] ** 2, axis=1)
+                + w["rate"] * np.sum(parts["w"] ** 2, axis=1)
+                + w["action"] * np.sum((a - self.hover_action[:, None]) ** 2, axis=1))
+        crashed = (parts["z"] < self.crash_altitude_m) | (parts["r22"] < self.cos_max_tilt)
+        out = np.any(np.abs(parts["e_p"]) > self.max_position_error_m, axis=1)
+        terminated = crashed | out
+        reward = 1.0 - cost - self.termination_penalty * terminated
+        truncated = self.steps >= self.max_episode_steps
+        return reward, terminated, truncated, crashed, out
+
+
+def _env_kwargs(kind: str, scenario, trajectory, target, max_episode_steps, max_position_error_m, crash_altitude_m,
+                max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights, termination_penalty, randomize):
+    return dict(tracking=kind == "tracking", scenario=scenario, trajectory=trajectory, target=target,
+                max_episode_steps=max_episode_steps, max_position_error_m=max_position_error_m,
+                crash_altitude_m=crash_altitude_m, max_tilt_rad=max_tilt_rad, max_speed_m_s=max_speed_m_s,
+                max_rate_rad_s=max_rate_rad_s, reward_weights=reward_weights,
+                termination_penalty=termination_penalty, randomize=randomize)
+
+
+class _Env:
+    """One vehicle (a Batch of 1): Gymnasium's Env contract."""
+
+    metadata: Dict[str, Any] = {"render_modes": []}
+    render_mode = None
+    spec = None
+
+    def __init__(self, kind: str, **kw: Any):
+        self._e = _Episodes(1, threads=1, **kw)
+        self.observation_space = self._e.observation_space
+        self.action_space = self._e.action_space
+        self.np_random = np.random.default_rng()
+        self._target_option = None
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def batch(self) -> Batch:
+        """The Batch of one vehicle the env steps (its state, sensors, vehicle parameters)."""
+        return self._e.batch
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None):
+        """Starts an episode: the scenario's initial state, a fresh noise seed and (with randomize) new
+        vehicle parameters, both drawn from np_random (reseeded by seed: the same seed, the same episode).
+        options: {"target": [x, y, z]} the position to hold (HoverEnv; default the scenario's initial
+        position). Returns (obs, info)."""
+        if seed is not None:
+            self.np_random = np.random.default_rng(seed)
+        options = options or {}
+        unknown = set(options) - {"target"}
+        if unknown:
+            raise ValueError(f"reset: unknown options {sorted(unknown)}; expected 'target'")
+        target = None
+        if "target" in options:
+            if self._e.tracking:
+                raise ValueError("reset: options['target'] is for HoverEnv; TrackingEnv follows its trajectory")
+            target = np.broadcast_to(np.asarray(options["target"], dtype=float), (3,))[None]
+        self._e.reset(np.array([0]), [self.np_random], target)
+        obs, _ = self._e.observe()
+        return obs[0], self._info(np.zeros(1, bool), np.zeros(1, bool))
+
+    def step(self, action: Any):
+        """Flies one control period with the rotor speeds the action maps to. Returns (obs, reward,
+        terminated, truncated, info); info: t [s], crashed, out_of_bounds, omega_cmd [rad/s]."""
+        e = self._e
+        if e.ended[0]:
+            raise RuntimeError("step: the episode has ended (or never began): call reset() first")
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (ACTION_SIZE,):
+            raise ValueError(f"step: action: expected shape ({ACTION_SIZE},), got {a.shape}")
+        a, omega = e.omega_cmd(a[None])
+        e.batch.step(omega_cmd=omega)
+        e.steps += 1
+        obs, parts = e.observe()
+        reward, terminated, truncated, crashed, out = e.evaluate(parts, a)
+        e.ended[0] = bool(terminated[0] or truncated[0])
+        info = self._info(crashed, out)
+        info["omega_cmd"] = omega[0]
+        return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), info
+
+    def _info(self, crashed: np.ndarray, out: np.ndarray) -> Dict[str, Any]:
+        return {"t": float(self._e.batch.t[0]), "crashed": bool(crashed[0]), "out_of_bounds": bool(out[0])}
+
+    def render(self):
+        return None
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *args):
+        self.close()
+
+
+class HoverEnv(_Env):
+    """Hold a position with the four rotor speeds (see the module's docstring for spaces, reward, termination).
+
+    scenario: a Scenario, file or dict (default HOVER_SCENARIO: a trimmed hover at (0, 0, 1) m, no noise);
+    target: the position to hold [m] (default: the scenario's initial position; reset(options=
+    {"target": ...}) for one episode); max_episode_steps: truncation (default 500, 10 s at 50 Hz);
+    max_position_error_m: the box around the target (2 m); crash_altitude_m (0.05 m) and max_tilt_rad
+    (pi/2): what counts as a crash; max_speed_m_s (10), max_rate_rad_s (20): observation bounds;
+    reward_weights: {"position", "velocity", "rate", "action"}; termination_penalty (10);
+    randomize: domain randomisation on every reset, {vehicle key: (low, high)} drawn uniformly, e.g.
+    {"mass_kg": (0.4, 0.55), "motor.tau_up_s": (0.02, 0.05)} (vector keys take arrays of 3).
+    """
+
+    def __init__(self, scenario: Any = None, target: Any = None, max_episode_steps: int = 500,
+                 max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05, max_tilt_rad: float = math.pi / 2,
+                 max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
+                 reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
+                 randomize: Optional[Dict[str, Any]] = None):
+        super().__init__("hover", **_env_kwargs("hover", scenario, None, target, max_episode_steps,
+                                                max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
+                                                max_rate_rad_s, reward_weights, termination_penalty, randomize))
+
+
+class TrackingEnv(_Env):
+    """Follow a trajectory with the four rotor speeds: the observation's errors are to the trajectory's
+    position and velocity at the vehicle's time.
+
+    scenario: one with a `trajectory:` section (default TRACKING_SCENARIO: a 1 m circle at 1 m, see
+    scenarios/tracking/ for others); trajectory: the keys of a `trajectory:` section replacing the
+    scenario's (e.g. {"kind": "figure8", ...}, docs/scenarios.md). Other arguments as HoverEnv's
+    (max_episode_steps defaults to 1000: 20 s at 50 Hz).
+    """
+
+    def __init__(self, scenario: Any = None, trajectory: Optional[Dict[str, Any]] = None,
+                 max_episode_steps: int = 1000, max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05,
+                 max_tilt_rad: float = math.pi / 2, max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
+                 reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
+                 randomize: Optional[Dict[str, Any]] = None):
+        super().__init__("tracking", **_env_kwargs("tracking", scenario, trajectory, None, max_episode_steps,
+                                                   max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
+                                                   max_rate_rad_s, reward_weights, termination_penalty, randomize))
+
+
+class _VectorEnv:
+    """n sub-envs on one Batch: Gymnasium's VectorEnv contract, auto-reset included.
+
+    autoreset_mode "next_step" (Gymnasium 1.x's default, AutoresetMode.NEXT_STEP): the step after a
+    sub-env's episode ended resets it instead of stepping it (its action is ignored) and returns its
+    first observation with reward 0, terminated and truncated False. "same_step"
+    (AutoresetMode.SAME_STEP): the ending step resets it at once and returns the new episode's first
+    observation; the last one is in info["final_obs"] (rows of finished sub-envs; NaN elsewhere) with the
+    mask info["_final_obs"].
+    """
+
+    def __init__(self, kind: str, num_envs: int, autoreset_mode: str = "next_step", threads: Optional[int] = None,
+                 **kw: Any):
+        if autoreset_mode not in ("next_step", "same_step"):
+            raise ValueError(f"autoreset_mode = {autoreset_mode!r}: expected 'next_step' or 'same_step'")
+        if isinstance(num_envs, bool) or not isinstance(num_envs, numbers.Integral) or num_envs < 1:
+            raise ValueError(f"num_envs = {num_envs!r}: expected an integer >= 1")
+        self.num_envs = int(num_envs)
+        self.autoreset_mode = autoreset_mode
+        self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
+        self.render_mode = None
+        self._e = _Episodes(self.num_envs, threads=threads, **kw)
+        self.single_observation_space = self._e.observation_space
+        self.single_action_space = self._e.action_space
+        o, a = self.single_observation_space, self.single_action_space
+        self.observation_space = Box(np.broadcast_to(o.low, (self.num_envs,) + o.shape),
+                                     np.broadcast_to(o.high, (self.num_envs,) + o.shape), dtype=o.dtype)
+        self.action_space = Box(-1.0, 1.0, (self.num_envs, ACTION_SIZE), dtype=a.dtype)
+        self._rngs = [np.random.default_rng() for _ in range(self.num_envs)]
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def batch(self) -> Batch:
+        return self._e.batch
+
+    def reset(self, *, seed: Any = None, options: Optional[Dict[str, Any]] = None):
+        """Resets every sub-env (or those of options["reset_mask"]). seed: an int s seeds sub-env i with
+        s + i (as Gymnasium's vector envs; so sub-env i repeats HoverEnv().reset(seed=s + i)), or a list of
+        n seeds (None entries: fresh entropy). Returns (obs (n, 18), info)."""
+        n = self.num_envs
+        if seed is not None:
+            seeds = [seed + i for i in range(n)] if isinstance(seed, numbers.Integral) else list(seed)
+            if len(seeds) != n:
+                raise ValueError(f"reset: {len(seeds)} seeds for {n} sub-envs")
+            self._rngs = [np.random.default_rng(s) for s in seeds]
+        options = options or {}
+        unknown = set(options) - {"reset_mask"}
+        if unknown:
+            raise ValueError(f"reset: unknown options {sorted(unknown)}; expected 'reset_mask'")
+        mask = np.ones(n, dtype=bool) if "reset_mask" not in options else np.asarray(options["reset_mask"], dtype=bool)
+        if mask.shape != (n,):
+            raise ValueError(f"reset: options['reset_mask']: expected {n} booleans, got shape {mask.shape}")
+        self._e.reset(np.flatnonzero(mask), self._rngs, None)
+        self._autoreset[mask] = False
+        obs, _ = self._e.observe()
+        return obs, self._info(np.zeros(n, bool), np.zeros(n, bool))
+
+    def step(self, actions: Any):
+        """Steps every sub-env with its action ((n, 4) in [-1, 1]). Returns (obs (n, 18) float32,
+        rewards (n,) float64, terminated (n,) bool, truncated (n,) bool, info: dict of (n,) arrays t,
+        crashed, out_of_bounds)."""
+        e, n = self._e, self.num_envs
+        a, omega = e.omega_cmd(actions)
+        pending = self._autoreset.copy()
+        if np.any(e.ended & ~pending):
+            raise RuntimeError("step: call reset() first")
+        e.batch.step(omega_cmd=omega)
+        e.steps += 1
+        if self.autoreset_mode == "next_step" and np.any(pending):
+            e.reset(np.flatnonzero(pending), self._rngs, None)  # the step just made for them is discarded
+        obs, parts = e.observe()
+        reward, terminated, truncated, crashed, out = e.evaluate(parts, a)
+        if self.autoreset_mode == "next_step":
+            reward[pending] = 0.0
+            terminated[pending] = truncated[pending] = crashed[pending] = out[pending] = False
+        done = terminated | truncated
+        info = self._info(crashed, out)
+        if self.autoreset_mode == "same_step":
+            final = np.full_like(obs, np.nan)
+            final[done] = obs[done]
+            info["final_obs"], info["_final_obs"] = final, done.copy()
+            if np.any(done):
+                e.reset(np.flatnonzero(done), self._rngs, None)
+                obs, _ = e.observe()
+            self._autoreset[:] = False
+        else:
+            e.ended[done] = True
+            self._autoreset = done.copy()
+        return obs, reward, terminated, truncated, info
+
+    def _info(self, crashed: np.ndarray, out: np.ndarray) -> Dict[str, np.ndarray]:
+        return {"t": self._e.batch.t, "crashed": crashed, "out_of_bounds": out}
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *args):
+        self.close()
+
+
+class VectorHoverEnv(_VectorEnv):
+    """num_envs HoverEnvs on one Batch (arguments as HoverEnv's, plus autoreset_mode and threads)."""
+
+    def __init__(self, num_envs: int, scenario: Any = None, target: Any = None, max_episode_steps: int = 500,
+                 max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05, max_tilt_rad: float = math.pi / 2,
+                 max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
+                 reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
+                 randomize: Optional[Dict[str, Any]] = None, autoreset_mode: str = "next_step",
+                 threads: Optional[int] = None):
+        super().__init__("hover", num_envs, autoreset_mode, threads,
+                         **_env_kwargs("hover", scenario, None, target, max_episode_steps, max_position_error_m,
+                                       crash_altitude_m, max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights,
+                                       termination_penalty, randomize))
+
+
+class VectorTrackingEnv(_VectorEnv):
+    """num_envs TrackingEnvs on one Batch (arguments as TrackingEnv's, plus autoreset_mode and threads)."""
+
+    def __init__(self, num_envs: int, scenario: Any = None, trajectory: Optional[Dict[str, Any]] = None,
+                 max_episode_steps: int = 1000, max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05,
+                 max_tilt_rad: float = math.pi / 2, max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
+                 reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
+                 randomize: Optional[Dict[str, Any]] = None, autoreset_mode: str = "next_step",
+                 threads: Optional[int] = None):
+        super().__init__("tracking", num_envs, autoreset_mode, threads,
+                         **_env_kwargs("tracking", scenario, trajectory, None, max_episode_steps,
+                                       max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
+                                       max_rate_rad_s, reward_weights, termination_penalty, randomize))
