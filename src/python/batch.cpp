@@ -178,12 +178,17 @@ class Batch {
   /// yaml, source: the scenario's document and where it came from (relative paths in it resolve
   /// against source's folder, as for the file itself). vehicle_keys[i]: vehicle i's keys of the
   /// `vehicle:` section as a JSON/YAML mapping ("" for none). seeds[i]: its seed.
+  /// nominal_controller: every controller is designed for the scenario's own vehicle (as a sweep's
+  /// runs are) instead of for its vehicle's parameters.
   Batch(const std::string& yaml, const std::string& source, const std::vector<std::string>& vehicle_keys,
-        const std::vector<std::uint64_t>& seeds, int threads)
-      : source_(source), pool_(std::max(1, std::min<int>(threads, static_cast<int>(vehicle_keys.size())))) {
+        const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller)
+      : source_(source),
+        nominal_controller_(nominal_controller),
+        pool_(std::max(1, std::min<int>(threads, static_cast<int>(vehicle_keys.size())))) {
     if (vehicle_keys.empty()) throw py::value_error("Batch: n must be at least 1");
     if (seeds.size() != vehicle_keys.size()) throw py::value_error("Batch: one seed per vehicle expected");
     root_ = YAML::Load(yaml);
+    base_ = load_checked(root_, "");
     n_ = vehicle_keys.size();
     vehicles_.resize(n_);
     p_.assign(3 * n_, 0.0);
@@ -525,6 +530,7 @@ class Batch {
   /// The scenario with `keys` set in its vehicle section, validated as the file would be (the same
   /// keys give the same shared scenario).
   std::shared_ptr<const io::Scenario> load(const std::string& keys, std::size_t index) {
+    if (keys.empty()) return base_;
     if (const auto it = loaded_.find(keys); it != loaded_.end()) return it->second;
     const std::string who = "vehicle " + std::to_string(index) + ": ";
     YAML::Node root = YAML::Clone(root_);
@@ -539,9 +545,16 @@ class Batch {
       if (!root["vehicle"].IsMap()) root["vehicle"] = YAML::Node(YAML::NodeType::Map);
       merge(root["vehicle"], given);
     }
-    std::shared_ptr<const io::Scenario> sc;
+    const std::shared_ptr<const io::Scenario> sc = load_checked(root, who);
+    loaded_.emplace(keys, sc);
+    return sc;
+  }
+
+  /// io::load_scenario on `root`, its errors prefixed by `who`.
+  std::shared_ptr<const io::Scenario> load_checked(const YAML::Node& root, const std::string& who) const {
     try {
-      sc = std::make_shared<const io::Scenario>(io::load_scenario(root, source_));
+      return std::make_shared<const io::Scenario>(
+          io::load_scenario(root, source_, nominal_controller_ && base_ ? &base_->vehicle : nullptr));
     } catch (const control::CareError& e) {
       throw io::ConfigError(who + source_ + ": controller design failed: " + e.what());
     } catch (const io::ConfigError& e) {
@@ -549,8 +562,6 @@ class Batch {
     } catch (const std::invalid_argument& e) {
       throw io::ConfigError(who + source_ + ": " + e.what());
     }
-    loaded_.emplace(keys, sc);
-    return sc;
   }
 
   /// Vehicle i's simulation as quadcosim.Simulation builds it (sim/simulation.hpp), its seed for
@@ -671,6 +682,8 @@ class Batch {
   }
 
   std::string source_;
+  bool nominal_controller_ = false;
+  std::shared_ptr<const io::Scenario> base_;  ///< the scenario itself (vehicles without keys fly it)
   YAML::Node root_;
   std::size_t n_ = 0;
   std::map<std::string, std::shared_ptr<const io::Scenario>> loaded_;
@@ -718,8 +731,9 @@ std::string replace_sections(const std::string& yaml, const std::string& section
 void bind_batch(py::module_& m) {
   py::class_<Batch>(m, "_Batch", "N vehicles of one scenario; use quadcosim.Batch.")
       .def(py::init<const std::string&, const std::string&, const std::vector<std::string>&,
-                    const std::vector<std::uint64_t>&, int>(),
-           py::arg("yaml"), py::arg("source"), py::arg("vehicle_keys"), py::arg("seeds"), py::arg("threads"))
+                    const std::vector<std::uint64_t>&, int, bool>(),
+           py::arg("yaml"), py::arg("source"), py::arg("vehicle_keys"), py::arg("seeds"), py::arg("threads"),
+           py::arg("nominal_controller"))
       .def("step", &Batch::step, py::arg("omega_cmd") = py::none(), py::arg("periods") = 1)
       .def("reset", &Batch::reset, py::arg("indices") = py::none(), py::arg("seeds") = py::none(),
            py::arg("vehicle_keys") = py::none())

@@ -507,3 +507,16 @@ def test_vector_tracking_env_runs():
     check_obs(venv.observation_space, obs)
     with pytest.raises(ValueError, match="shape"):
         venv.step(np.zeros((3, 4)))
+
+
+def test_nominal_controller_sags_by_the_closed_form():
+    """controller_vehicle="nominal": the paper's altitude PD (u = m_nom g + K_p,z e - K_d,z v_z, no
+    integral) holds a vehicle of mass m below its setpoint by e = (m - m_nom) g / K_p,z; designed for the
+    vehicle's own mass ("own") it holds it on the setpoint."""
+    masses = np.array([1.7, 1.96, 2.2])
+    kp, g, m_nom = 4.0, 9.81, 1.96  # altitude.kp's default [N/m] and the paper's vehicle (docs/controllers.md)
+    for mode, expected in (("nominal", (masses - m_nom) * g / kp), ("own", np.zeros(3))):
+        b = quadcosim.Batch("scenarios/paper/altitude_step.yaml", 3, vehicles={"mass_kg": masses},
+                            controller_vehicle=mode, threads=1)
+        b.step(periods=2000)  # 40 s: long settled
+        np.testing.assert_allclose(10.0 - b.p[:, 2], expected, atol=1e-6, err_msg=mode)

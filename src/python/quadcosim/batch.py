@@ -160,9 +160,12 @@ class Batch:
         a list of n dicts ({"mass_kg": 0.5, "motor": {"tau_up_s": 0.03}}; None or {} keeps the
         scenario's), or a dict of arrays of length n ({"mass_kg": masses, "motor.tau_up_s": taus};
         an (n, 3) array for a 3-vector such as aero.linear_drag_N_s_m; a scalar applies to all).
-        Each vehicle's scenario is validated as the file with those keys would be (its controller is
-        designed for its own vehicle); a bad key or value raises ConfigError naming the vehicle, the key
-        and the value.
+        Each vehicle's scenario is validated as the file with those keys would be; a bad key or value
+        raises ConfigError naming the vehicle, the key and the value.
+    controller_vehicle: "own" (default): each vehicle's controller is designed for its own parameters,
+        as a scenario file with those keys would be (vehicle i then equals that Simulation bit for
+        bit); "nominal": every controller is designed for the scenario's vehicle, which the vehicles
+        only approximate (as the runs of a sweep; what robustness checks and domain randomisation want).
     threads: worker threads that step the vehicles (default: the CPUs this process may use); the
         numbers do not depend on it.
 
@@ -171,7 +174,8 @@ class Batch:
     """
 
     def __init__(self, scenario: Union[Scenario, dict, str, "os.PathLike[str]"], n: int, seeds: Any = None,
-                 vehicles: Any = None, threads: Optional[int] = None, _sections: Optional[Dict[str, Any]] = None):
+                 vehicles: Any = None, threads: Optional[int] = None, controller_vehicle: str = "own",
+                 _sections: Optional[Dict[str, Any]] = None):
         from . import load_scenario  # the package's loader (a file, a dict or a Scenario)
 
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
@@ -188,8 +192,10 @@ class Batch:
             # Top-level sections replaced (a TrackingEnv's trajectory): merged into the document.
             yaml = _quadcosim._replace_sections(yaml, _yaml_text(_sections, "sections"))
         self.scenario = sc
+        if controller_vehicle not in ("own", "nominal"):
+            raise ValueError(f"Batch: controller_vehicle = {controller_vehicle!r}: expected 'own' or 'nominal'")
         self._b = _quadcosim._Batch(yaml, sc.source, _vehicle_keys(vehicles, n), _seeds(seeds, n, "__init__"),
-                                    int(threads))
+                                    int(threads), controller_vehicle == "nominal")
         self.n = n
 
     # --- stepping ----------------------------------------------------------------------------------
