@@ -439,6 +439,12 @@ def test_tracking_env_follows_the_circle():
     env.reset(seed=0)
     with pytest.raises(ValueError, match="no trajectory"):
         TrackingEnv(scenario=noisy_hover())
+    # A scenario file of scenarios/tracking: its trajectory, from its start point.
+    env = TrackingEnv(scenario="scenarios/tracking/figure8_paper.yaml")
+    obs, _ = env.reset(seed=0)
+    np.testing.assert_allclose(obs[:6], 0.0, atol=1e-9)
+    obs, *_ = env.step(np.full(4, hover_action(env.batch)))
+    check_obs(env.observation_space, obs)
 
 
 def test_vector_env_equals_single_envs():
