@@ -27,9 +27,9 @@ constexpr int kUnboundedSequence = 144;
 const std::map<std::string, int, std::less<>>& primitive_ids() {
   // .msg names; char is uint8 and byte is octet (rosidl_adapter), float32/64 are float/double.
   static const std::map<std::string, int, std::less<>> ids = {
-      {"int8", 2},     {"uint8", 3},    {"char", 3},     {"int16", 4},  {"uint16", 5},
-      {"int32", 6},    {"uint32", 7},   {"int64", 8},    {"uint64", 9}, {"float32", 10},
-      {"float64", 11}, {"bool", 15},    {"byte", 16},    {"string", 17}, {"wstring", 18},
+      {"int8", 2},     {"uint8", 3},  {"char", 3},  {"int16", 4},   {"uint16", 5},
+      {"int32", 6},    {"uint32", 7}, {"int64", 8}, {"uint64", 9},  {"float32", 10},
+      {"float64", 11}, {"bool", 15},  {"byte", 16}, {"string", 17}, {"wstring", 18},
   };
   return ids;
 }
@@ -49,8 +49,8 @@ struct Field {
 bool is_name(std::string_view s, bool slashes) {
   if (s.empty()) return false;
   for (char c : s) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-                    (slashes && c == '/');
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || (slashes && c == '/');
     if (!ok) return false;
   }
   return true;
@@ -148,9 +148,8 @@ const Types& all_types() {
                            "_Response[<=1] response",
                        n + "_Event"));
       add(t, n,
-          parse_fields(n + "_Request request_message\n" + n + "_Response response_message\n" + n +
-                           "_Event event_message",
-                       n));
+          parse_fields(
+              n + "_Request request_message\n" + n + "_Response response_message\n" + n + "_Event event_message", n));
     }
     return t;
   }();
