@@ -123,6 +123,118 @@ netns_identical() {
   echo "plant and controller in two network namespaces ($*): identical to in-process"
 }
 
+# --- nftables on the veth: loss, bursts and cuts on real UDP ------------------------------------------
+# One table in nsA (the plant's side) filters both directions on its end of the veth pair: the input
+# hook sees every datagram from the controller's namespace (commands, status, acknowledgements), the
+# output hook every datagram to it (sensors, clock, heartbeats, retransmissions). Each datagram is
+# counted (`seen`), dropped while chain `cut` holds a drop rule (counted as `cut`; empty unless the
+# test fills it), and else dropped with LOSS % probability (chain `loss`, counted as `lost`).
+nft_setup() {  # nft_setup LOSS_PERCENT: (re)creates the table; SKIPPED (77) when nftables cannot be used
+  local loss="$1" rule="" why=""
+  [ "$loss" -gt 0 ] && rule="numgen random mod 100 < $loss counter name \"lost\" drop;"
+  if ! command -v nft > /dev/null; then
+    why="needs nft (Debian package nftables, scripts/install-deps.sh), not installed"
+  else
+    ip netns exec "$nsA" nft delete table inet qcsfault 2>/dev/null || true
+    if ! ip netns exec "$nsA" nft -f - > "$tmp/nft.log" 2>&1 <<EOF
+table inet qcsfault {
+  counter seen { }
+  counter lost { }
+  counter cut { }
+  chain cut { }
+  chain loss { $rule }
+  chain input {
+    type filter hook input priority filter; policy accept;
+    iifname "$nsA" counter name "seen" jump cut
+    iifname "$nsA" jump loss
+  }
+  chain output {
+    type filter hook output priority filter; policy accept;
+    oifname "$nsA" counter name "seen" jump cut
+    oifname "$nsA" jump loss
+  }
+}
+EOF
+    then
+      why="nftables refused the rules in a network namespace: $(tr '\n' ' ' < "$tmp/nft.log")"
+    fi
+  fi
+  if [ -n "$why" ]; then
+    echo "SKIPPED [$case_name]: $why"
+    exit 77
+  fi
+}
+nft_a() { ip netns exec "$nsA" nft "$@"; }
+nft_count() { nft_a list counter inet qcsfault "$1" | grep -o 'packets [0-9]*' | grep -o '[0-9]*$'; }
+# cut_timed on|off: fills or empties chain `cut`, printing the monotonic times just before and after.
+cut_timed() {
+  local args=(flush chain inet qcsfault cut)
+  [ "$1" = on ] && args=(add rule inet qcsfault cut counter name '"cut"' drop)
+  "$py" -c 'import subprocess, sys, time
+t0 = time.monotonic(); subprocess.run(sys.argv[1:], check=True); t1 = time.monotonic()
+print(f"{t0:.6f} {t1:.6f}")' ip netns exec "$nsA" nft "${args[@]}"
+}
+# altitude_scenario SECONDS: the paper altitude step, run for SECONDS, without its step criteria (made
+# for 15 s); prints the file's path.
+altitude_scenario() {
+  local f="$tmp/altitude_$1.yaml"
+  sed -e "s/^  duration_s: 15\$/  duration_s: $1/" -e '/^analysis:/,$d' "$src/scenarios/paper/altitude_step.yaml" > "$f"
+  grep -q "^  duration_s: $1\$" "$f" || fail "could not set the duration in $f"
+  echo "$f"
+}
+# nft_lockstep SCENARIO LOSS [FAULT]: lockstep across the namespaces (multicast discovery) through the
+# rules above with LOSS % loss each way; FAULT, a function given the plant's pid, runs beside the
+# plant. The trajectory must be byte-identical to the in-process run of the same scenario. Sets rtf
+# (the plant's simulated/wall), rt_max_ms (its largest lockstep round trip) and the counters.
+nft_lockstep() {
+  local s="$1" loss="$2" fault="${3:-}" name
+  name="$(basename "$s" .yaml)"
+  if [ ! -f "$tmp/in_$name/trajectory.csv" ]; then
+    "$bin" run "$s" --out "$tmp/in_$name" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process run failed"
+  fi
+  [ "${#namespaces[@]}" -gt 0 ] || make_namespaces
+  nft_setup "$loss"
+  local env_ns=(ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET)
+  rm -f "$tmp/ns.csv"
+  in_ns "$nsB" "${env_ns[@]}" "$bin" controller --scenario "$s" --no-schedule > "$tmp/controller.log" 2>&1 &
+  local ctl=$!; pids+=("$ctl")
+  in_ns "$nsA" "${env_ns[@]}" timeout 250 "$bin" plant --scenario "$s" --record "$tmp/ns.csv" --timeout 20 \
+    --schedule-via /attitude_controller > "$tmp/plant.log" 2>&1 &
+  local plant=$!; pids+=("$plant")
+  [ -z "$fault" ] || "$fault" "$plant"
+  set +e
+  wait "$plant"; local rc=$?
+  kill -TERM "$ctl" 2>/dev/null; wait "$ctl" 2>/dev/null
+  set -e
+  [ "$rc" -eq 0 ] || fail "plant across namespaces with $loss % loss exited with $rc"
+  if ! cmp "$tmp/in_$name/trajectory.csv" "$tmp/ns.csv"; then
+    first_difference "$tmp/in_$name/trajectory.csv" "$tmp/ns.csv"
+    fail "trajectory with $loss % loss differs from the in-process run"
+  fi
+  rtf=$(sed -nE 's/.* simulated in [0-9.]+ s \(([0-9.]+)x real time\).*/\1/p' "$tmp/plant.log")
+  rt_max_ms=$(sed -nE 's/.*lockstep round trip .* max ([0-9.]+) us.*/\1/p' "$tmp/plant.log")
+  rt_max_ms=$("$py" -c "print(f'{$rt_max_ms / 1000:.1f}')")
+  seen=$(nft_count seen); lost=$(nft_count lost); cut=$(nft_count cut)
+  echo "lockstep $name, $loss % loss each way: identical to in-process; ${rtf}x real time, largest round trip" \
+    "$rt_max_ms ms; datagrams on the veth $seen, lost $lost, cut $cut"
+}
+first_difference() {  # first_difference A.csv B.csv: the first rows that differ, column by column
+  "$py" - "$1" "$2" <<'PY'
+import csv, sys
+a, b = list(csv.reader(open(sys.argv[1]))), list(csv.reader(open(sys.argv[2])))
+print(f"rows: {len(a)} and {len(b)}")
+shown = 0
+for i, (x, y) in enumerate(zip(a, b)):
+    if x != y and shown < 3:
+        print(f"row {i}: " + ", ".join(f"{h} {u} / {v}" for h, u, v in zip(a[0], x, y) if u != v))
+        shown += 1
+PY
+}
+# Waits until the plant has recorded SIZE bytes of trajectory: lockstep is under way.
+wait_recording() { wait_for 60 bash -c "[ \$(stat -c %s '$tmp/ns.csv' 2>/dev/null || echo 0) -ge $1 ]"; }
+# In real time: samples of the plant's 'watchdog' log lines and the controller's 'safety' lines.
+monotonic_of() { sed -nE 's/.*monotonic ([0-9.]+) s.*/\1/p' <<< "$1"; }
+
 case "$case_name" in
   controller_killed)  # real time: kill -9 the controller mid-hover, then start a new one
     limit=0.3  # tests/faults/hover.yaml: simulation.watchdog_s (policy hold)
@@ -305,6 +417,204 @@ PY
     rc=$?
     set -e
     [ "$rc" -eq 4 ] || fail "without static peers the plant should find no controller (exit 4), got $rc"
+    ;;
+
+  netns_nft_loss10)  # lockstep through 0 %, then 10 % loss each way (nftables): identical; the speed lost
+    s=$(altitude_scenario 15)
+    nft_lockstep "$s" 0
+    rtf0=$rtf
+    [ "$lost" -eq 0 ] && [ "$cut" -eq 0 ] || fail "datagrams dropped without loss: lost $lost, cut $cut"
+    nft_lockstep "$s" 10
+    "$py" - "$seen" "$lost" "$rtf0" "$rtf" <<'PY' || fail "loss rate (see above)"
+import sys
+seen, lost, rtf0, rtf = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+# Binomial: with n >= 3000 datagrams the standard deviation of the loss fraction is <= 0.55 %.
+print(f"10 % loss: {lost} of {seen} datagrams dropped ({100 * lost / seen:.1f} %); "
+      f"{rtf0}x real time without loss, {rtf}x with it")
+assert seen >= 3000, seen
+assert 0.07 <= lost / seen <= 0.13, lost / seen
+PY
+    ;;
+
+  netns_nft_loss30)  # lockstep through 30 % loss each way: identical (5 s of the step: it runs below real time)
+    nft_lockstep "$(altitude_scenario 5)" 30
+    "$py" - "$seen" "$lost" <<'PY' || fail "loss rate (see above)"
+import sys
+seen, lost = int(sys.argv[1]), int(sys.argv[2])
+print(f"30 % loss: {lost} of {seen} datagrams dropped ({100 * lost / seen:.1f} %)")
+assert seen >= 1000, seen
+assert 0.25 <= lost / seen <= 0.35, lost / seen
+PY
+    ;;
+
+  netns_nft_bursts)  # lockstep while the link drops everything for 200 ms of every second
+    bursts() {  # from when lockstep is under way until the plant ends
+      local plant="$1" n=0
+      wait_recording 100000 || fail "lockstep did not start"
+      while kill -0 "$plant" 2>/dev/null; do
+        cut_timed on > /dev/null
+        sleep 0.2
+        cut_timed off > /dev/null
+        n=$((n + 1))
+        sleep 0.8
+      done
+      echo "$n" > "$tmp/bursts"
+    }
+    nft_lockstep "$(altitude_scenario 600)" 0 bursts
+    n=$(cat "$tmp/bursts")
+    echo "$n bursts of 200 ms during the run"
+    [ "$n" -ge 3 ] || fail "only $n bursts while lockstep ran"
+    [ "$cut" -gt 0 ] || fail "the bursts dropped nothing"
+    ;;
+
+  netns_nft_cut)  # lockstep while the link is cut for 2 s, then healed
+    cut_2s() {
+      wait_recording 100000 || fail "lockstep did not start"
+      cut_timed on > "$tmp/cut_on"
+      sleep 2
+      cut_timed off > "$tmp/cut_off"
+      kill -0 "$1" 2>/dev/null || fail "the plant ended before the link was healed: cut too late"
+    }
+    nft_lockstep "$(altitude_scenario 600)" 0 cut_2s
+    ! grep -q "lockstep timeout" "$tmp/plant.log" || fail "a lockstep timeout during a 2 s cut (--timeout 20)"
+    "$py" - "$rt_max_ms" "$cut" <<'PY' || fail "the cut was not felt (see above)"
+import sys
+rt_max_ms, cut = float(sys.argv[1]), int(sys.argv[2])
+print(f"2 s cut: {cut} datagrams dropped; the longest lockstep round trip {rt_max_ms:.0f} ms")
+assert cut > 0, cut
+assert rt_max_ms >= 1900, rt_max_ms  # a round trip spanned the cut: lockstep waited it out
+PY
+    ;;
+
+  netns_nft_hover_rt)  # real time, position hold in gusts through 10 % loss each way: within the bounds
+    s="$tmp/hover_gusts_15.yaml"
+    sed 's/^  duration_s: 30$/  duration_s: 15/' "$src/tests/faults/hover_gusts.yaml" > "$s"
+    "$bin" run "$s" --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process run failed"
+    make_namespaces
+    nft_setup 10
+    env_ns=(ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET)
+    in_ns "$nsB" "${env_ns[@]}" "$bin" controller --realtime --scenario "$s" > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    set +e
+    in_ns "$nsA" "${env_ns[@]}" timeout 60 "$bin" plant --realtime --wait-for-controller --timeout 20 \
+      --scenario "$s" --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 0 ] || fail "plant exited with $rc"
+    "$py" - "$tmp/t.csv" "$tmp/in/trajectory.csv" "$(nft_count seen)" "$(nft_count lost)" <<'PY' || fail "hover under 10 % loss (see above)"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+ref = {r["t"]: float(r["z"]) for r in csv.DictReader(open(sys.argv[2]))}
+seen, lost = int(sys.argv[3]), int(sys.argv[4])
+e = [float(r["z"]) - 1.0 for r in rows]
+dev = [abs(float(r["z"]) - ref[r["t"]]) for r in rows]
+safety = sum(int(r["safety"]) for r in rows)
+wd = sum(int(r["watchdog"]) for r in rows)
+rms = math.sqrt(sum(v * v for v in e) / len(e))
+ref_e = [v - 1.0 for v in ref.values()]
+print(f"real-time hover in gusts, 10 % loss ({lost} of {seen} datagrams): |z - 1| max {max(map(abs, e)):.4f} m, "
+      f"RMS {rms:.4f} m (in-process: max {max(map(abs, ref_e)):.4f}, RMS "
+      f"{math.sqrt(sum(v * v for v in ref_e) / len(ref_e)):.4f}); |z - z_in-process| max {max(dev):.4f} m; "
+      f"safety ticks {safety}, watchdog ticks {wd}")
+assert len(rows) == 1501, len(rows)
+assert 0.07 <= lost / seen <= 0.13, lost / seen
+assert max(map(abs, e)) <= 0.35, max(map(abs, e))
+assert rms <= 0.15, rms
+assert max(dev) <= 0.15, max(dev)
+assert wd == 0, wd
+PY
+    ;;
+
+  netns_nft_cut_rt)  # real time: a 2 s cut; the watchdog and the stale-data safety act, both recover
+    wd_limit=0.3 stale_limit=0.1  # hover_gusts.yaml simulation.watchdog_s; the controller's default
+    s="$src/tests/faults/hover_gusts.yaml"
+    make_namespaces
+    nft_setup 0
+    env_ns=(ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET)
+    in_ns "$nsB" "${env_ns[@]}" "$bin" controller --realtime --scenario "$s" > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    in_ns "$nsA" "${env_ns[@]}" "$bin" plant --realtime --wait-for-controller --timeout 20 --scenario "$s" \
+      --duration 12 --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1 &
+    plant=$!; pids+=("$plant")
+    wait_for 25 grep -q "real-time mode" "$tmp/plant.log" || fail "plant did not start"
+    wait_for 15 grep -q "controlling" "$tmp/controller.log" || fail "controller did not start controlling"
+    sleep 3
+    read -r c0 c1 < <(cut_timed on)
+    sleep 2
+    read -r h0 h1 < <(cut_timed off)
+    set +e
+    timeout 60 tail --pid="$plant" -f /dev/null
+    wait "$plant"; rc=$?
+    set -e
+    end=$(mono)
+    [ "$rc" -eq 0 ] || fail "plant exited with $rc"
+    grep -q "took over 1 times" "$tmp/plant.log" || fail "expected exactly one watchdog event"
+    trip=$(grep "plant: watchdog: no valid motor command" "$tmp/plant.log") || fail "no watchdog event logged"
+    release=$(grep "plant: watchdog: valid motor commands again" "$tmp/plant.log") || fail "no release after the heal"
+    stale=$(grep "controller: stale sensor data" "$tmp/controller.log" | head -1) || fail "no safety event logged"
+    fresh=$(grep "controller: sensor data fresh again" "$tmp/controller.log" | head -1) || fail "no recovery logged"
+    "$py" - "$tmp/t.csv" "$trip" "$release" "$stale" "$fresh" "$c0" "$c1" "$h0" "$h1" "$wd_limit" "$stale_limit" \
+      "$(nft_count cut)" <<'PY' || fail "bounds (see above)"
+import csv, math, re, sys
+path, trip, release, stale, fresh = sys.argv[1:6]
+c0, c1, h0, h1, wd_limit, stale_limit = map(float, sys.argv[6:12])
+cut = int(sys.argv[12])
+mono = lambda line: float(re.search(r"monotonic ([0-9.]+) s", line).group(1))
+t_trip, t_release, t_stale, t_fresh = mono(trip), mono(release), mono(stale), mono(fresh)
+wd_age = float(re.search(r"command for ([0-9.]+) s", trip).group(1))
+stale_age = float(re.search(r"data age ([0-9.]+) s", stale).group(1))
+tick, period, sched = 0.01, 0.02, 0.06
+print(f"2 s cut ({cut} datagrams dropped) at monotonic {c0:.3f}..{c1:.3f}, healed {h0:.3f}..{h1:.3f}")
+print(f"plant watchdog: age at trip {wd_age:.3f} s (limit {wd_limit}), {t_trip - c1:.3f}..{t_trip - c0:.3f} s "
+      f"after the cut; released {t_release - h1:.3f}..{t_release - h0:.3f} s after the heal")
+print(f"controller safety: age {stale_age:.3f} s (limit {stale_limit}), {t_stale - c1:.3f}..{t_stale - c0:.3f} s "
+      f"after the cut; normal control {t_fresh - h1:.3f}..{t_fresh - h0:.3f} s after the heal")
+# Each acted within its limit: the age it saw, and the delay after the cut on the test's own clock
+# (the last datagram crossed at most a control period, for the plant, or a plant tick, for the
+# controller, before the cut; each checks its age once per own period, late by scheduling at most).
+assert wd_limit <= wd_age <= wd_limit + tick + sched, wd_age
+assert wd_limit - period - tick - 0.005 <= t_trip - c1 and t_trip - c0 <= wd_limit + tick + sched + 0.05, t_trip
+assert stale_limit <= stale_age <= stale_limit + period + sched, stale_age
+assert stale_limit - tick - 0.005 <= t_stale - c1 and t_stale - c0 <= stale_limit + period + sched + 0.05, t_stale
+# Both acted during the cut, and both recovered after the heal, within a second.
+assert c0 < t_trip < h0 and c0 < t_stale < h0, (t_trip, t_stale)
+assert h0 < t_release <= h1 + 1.0 and h0 < t_fresh <= h1 + 1.0, (t_release, t_fresh)
+rows = list(csv.DictReader(open(path)))
+wd = [int(r["watchdog"]) for r in rows]
+z = [float(r["z"]) for r in rows]
+cmd = [float(r["cmd1"]) for r in rows]
+k_rel = max(k for k in range(1, len(wd)) if wd[k - 1] == 1 and wd[k] == 0)
+held = sum(wd)
+assert 150 <= held <= 230, held  # about the 2 s cut less the 0.3 s limit, in 10 ms ticks
+assert not any(wd[k_rel:]), "the watchdog acted again after the release"
+# Flying under control afterwards: the last 3 s hold the setpoint as the in-flight bound of
+# netns_nft_hover_rt, with a new command on (nearly) every control tick.
+last = rows[-300:]
+e = [float(r["z"]) - 1.0 for r in last]
+distinct = len(set(float(r["cmd1"]) for r in last))
+print(f"released at t = {rows[k_rel]['t']} s after {held} held ticks; max |z - 1| {max(abs(v - 1) for v in z):.3f} m "
+      f"over the run, {max(map(abs, e)):.3f} m over the last 3 s; {distinct} distinct commands in its 150 control ticks")
+assert max(map(abs, e)) <= 0.35, max(map(abs, e))
+assert distinct >= 120, distinct
+PY
+    ;;
+
+  soak_rss)  # a long lockstep run: neither process's resident set grows after warm-up
+    # One simulated hour (30-100 s here at 40-130x real time), localhost in the test's namespace.
+    ROS_DOMAIN_ID="$domain" bash "$src/bench/soak.sh" "$bin" 3600 "$tmp/soak.json" > "$tmp/soak.log" 2>&1 ||
+      fail "soak run failed: $(cat "$tmp/soak.log")"
+    grep "^soak: " "$tmp/soak.log"
+    "$py" - "$tmp/soak.json" <<'PY' || fail "resident set growth (see above)"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["simulated_s"] == 3600, s["simulated_s"]
+assert s["samples"] >= 20, s["samples"]  # at least 5 samples per quarter
+for name in ("plant", "controller"):
+    p = s[name]
+    # After warm-up (the first quarter) nothing more than 2 MB: a leak of one 100-byte allocation per
+    # control tick would add 17 MB over the 180 000 ticks.
+    assert p["growth_kB"] <= 2048, (name, p["growth_kB"])
+PY
     ;;
 
   netns_netem)  # 10 % loss and 5 ms delay on the veth (tc netem), real-time hover across namespaces
