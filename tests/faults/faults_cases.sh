@@ -6,7 +6,8 @@
 # Times are compared on the monotonic clock (CLOCK_MONOTONIC: the nodes' steady clock and Python's
 # time.monotonic()). Bounds and why they are what they are: docs/reliability.md.
 # The netns cases need root and iproute2. When namespaces cannot be created they fail, unless
-# QUADCOSIM_SKIP_NETNS=1, which makes them report SKIPPED (exit 77).
+# QUADCOSIM_SKIP_NETNS=1, which makes them report SKIPPED (exit 77). The netns_nft cases also need
+# nftables (nft, and nf_tables in the kernel); without it they report SKIPPED with the reason.
 set -euo pipefail
 bin="$1"; src="$2"; case_name="$3"; domain="$4"; flood="${5:-}"
 export ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
@@ -512,33 +513,46 @@ safety = sum(int(r["safety"]) for r in rows)
 wd = sum(int(r["watchdog"]) for r in rows)
 rms = math.sqrt(sum(v * v for v in e) / len(e))
 ref_e = [v - 1.0 for v in ref.values()]
+ref_max = max(map(abs, ref_e))
+ref_rms = math.sqrt(sum(v * v for v in ref_e) / len(ref_e))
+n = safety // 2  # control periods on the stale-data safety command (2 plant ticks each)
 print(f"real-time hover in gusts, 10 % loss ({lost} of {seen} datagrams): |z - 1| max {max(map(abs, e)):.4f} m, "
-      f"RMS {rms:.4f} m (in-process: max {max(map(abs, ref_e)):.4f}, RMS "
-      f"{math.sqrt(sum(v * v for v in ref_e) / len(ref_e)):.4f}); |z - z_in-process| max {max(dev):.4f} m; "
-      f"safety ticks {safety}, watchdog ticks {wd}")
+      f"RMS {rms:.4f} m (in-process: max {ref_max:.4f}, RMS {ref_rms:.4f}); |z - z_in-process| max {max(dev):.4f} m; "
+      f"{n} control periods on the safety command, watchdog ticks {wd}")
 assert len(rows) == 1501, len(rows)
 assert 0.07 <= lost / seen <= 0.13, lost / seen
-assert max(map(abs, e)) <= 0.35, max(map(abs, e))
-assert rms <= 0.15, rms
-assert max(dev) <= 0.15, max(dev)
+# Measured (11 runs): without a safety period the flight is the in-process one to within 1 cm; a
+# retransmission later than stale_limit (0.1 s) puts the controller on its safety command (rotors
+# stopped) for a control period, which costs up to 8 cm (max) and 2.5 cm (RMS). 0-1 such periods per
+# run were seen; the bounds allow 3, each with a margin.
+assert n <= 3, n
+assert max(map(abs, e)) <= ref_max + 0.02 + 0.1 * n, max(map(abs, e))
+assert rms <= ref_rms + 0.01 + 0.03 * n, rms
+assert max(dev) <= 0.02 + 0.1 * n, max(dev)
 assert wd == 0, wd
 PY
     ;;
 
   netns_nft_cut_rt)  # real time: a 2 s cut; the watchdog and the stale-data safety act, both recover
-    wd_limit=0.3 stale_limit=0.1  # hover_gusts.yaml simulation.watchdog_s; the controller's default
-    s="$src/tests/faults/hover_gusts.yaml"
+    wd_limit=0.3 stale_limit=0.1  # hover.yaml simulation.watchdog_s (policy hold); the controller's default
+    # The trimmed hover, which the held command keeps (a held command of a vehicle in gusts or with
+    # noisy sensors tips it over within the 2 s: measured), and a step to 1.5 m at 8 s, after the
+    # heal, which only a controller in command flies.
+    s="$tmp/hover_step.yaml"
+    { sed 's/^  duration_s: 30$/  duration_s: 12/' "$src/tests/faults/hover.yaml"
+      printf 'schedule:\n  - at_s: 8\n    set: {z_des: 1.5}\n'; } > "$s"
+    "$bin" run "$s" --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process run failed"
     make_namespaces
     nft_setup 0
     env_ns=(ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET)
     in_ns "$nsB" "${env_ns[@]}" "$bin" controller --realtime --scenario "$s" > "$tmp/controller.log" 2>&1 &
     pids+=($!)
     in_ns "$nsA" "${env_ns[@]}" "$bin" plant --realtime --wait-for-controller --timeout 20 --scenario "$s" \
-      --duration 12 --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1 &
+      --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1 &
     plant=$!; pids+=("$plant")
     wait_for 25 grep -q "real-time mode" "$tmp/plant.log" || fail "plant did not start"
     wait_for 15 grep -q "controlling" "$tmp/controller.log" || fail "controller did not start controlling"
-    sleep 3
+    sleep 2
     read -r c0 c1 < <(cut_timed on)
     sleep 2
     read -r h0 h1 < <(cut_timed off)
@@ -546,56 +560,68 @@ PY
     timeout 60 tail --pid="$plant" -f /dev/null
     wait "$plant"; rc=$?
     set -e
-    end=$(mono)
     [ "$rc" -eq 0 ] || fail "plant exited with $rc"
     grep -q "took over 1 times" "$tmp/plant.log" || fail "expected exactly one watchdog event"
     trip=$(grep "plant: watchdog: no valid motor command" "$tmp/plant.log") || fail "no watchdog event logged"
     release=$(grep "plant: watchdog: valid motor commands again" "$tmp/plant.log") || fail "no release after the heal"
     stale=$(grep "controller: stale sensor data" "$tmp/controller.log" | head -1) || fail "no safety event logged"
     fresh=$(grep "controller: sensor data fresh again" "$tmp/controller.log" | head -1) || fail "no recovery logged"
-    "$py" - "$tmp/t.csv" "$trip" "$release" "$stale" "$fresh" "$c0" "$c1" "$h0" "$h1" "$wd_limit" "$stale_limit" \
-      "$(nft_count cut)" <<'PY' || fail "bounds (see above)"
-import csv, math, re, sys
-path, trip, release, stale, fresh = sys.argv[1:6]
-c0, c1, h0, h1, wd_limit, stale_limit = map(float, sys.argv[6:12])
-cut = int(sys.argv[12])
+    "$py" - "$tmp/t.csv" "$tmp/in/trajectory.csv" "$trip" "$release" "$stale" "$fresh" "$c0" "$c1" "$h0" "$h1" \
+      "$wd_limit" "$stale_limit" "$(nft_count cut)" <<'PY' || fail "bounds (see above)"
+import csv, re, sys
+path, ref_path, trip, release, stale, fresh = sys.argv[1:7]
+c0, c1, h0, h1, wd_limit, stale_limit = map(float, sys.argv[7:13])
+cut = int(sys.argv[13])
 mono = lambda line: float(re.search(r"monotonic ([0-9.]+) s", line).group(1))
 t_trip, t_release, t_stale, t_fresh = mono(trip), mono(release), mono(stale), mono(fresh)
 wd_age = float(re.search(r"command for ([0-9.]+) s", trip).group(1))
 stale_age = float(re.search(r"data age ([0-9.]+) s", stale).group(1))
 tick, period, sched = 0.01, 0.02, 0.06
-print(f"2 s cut ({cut} datagrams dropped) at monotonic {c0:.3f}..{c1:.3f}, healed {h0:.3f}..{h1:.3f}")
-print(f"plant watchdog: age at trip {wd_age:.3f} s (limit {wd_limit}), {t_trip - c1:.3f}..{t_trip - c0:.3f} s "
+print(f"2 s cut ({cut} datagrams dropped) set at monotonic {c0:.3f}..{c1:.3f} (nft ran in between), "
+      f"healed {h0:.3f}..{h1:.3f}")
+print(f"plant watchdog: age at trip {wd_age:.3f} s (limit {wd_limit} s), {t_trip - c1:.3f}..{t_trip - c0:.3f} s "
       f"after the cut; released {t_release - h1:.3f}..{t_release - h0:.3f} s after the heal")
-print(f"controller safety: age {stale_age:.3f} s (limit {stale_limit}), {t_stale - c1:.3f}..{t_stale - c0:.3f} s "
+print(f"controller safety: age {stale_age:.3f} s (limit {stale_limit} s), {t_stale - c1:.3f}..{t_stale - c0:.3f} s "
       f"after the cut; normal control {t_fresh - h1:.3f}..{t_fresh - h0:.3f} s after the heal")
-# Each acted within its limit: the age it saw, and the delay after the cut on the test's own clock
-# (the last datagram crossed at most a control period, for the plant, or a plant tick, for the
-# controller, before the cut; each checks its age once per own period, late by scheduling at most).
+# Each acted within its limit: the age it saw, and the time after the cut on the test's clock. The cut
+# took effect between c0 and c1; the last datagram before it crossed at most a control period (the
+# plant's commands) or a plant tick (the controller's samples) earlier; each checks the age once per
+# its own period, late by scheduling at most `sched`.
 assert wd_limit <= wd_age <= wd_limit + tick + sched, wd_age
-assert wd_limit - period - tick - 0.005 <= t_trip - c1 and t_trip - c0 <= wd_limit + tick + sched + 0.05, t_trip
+assert t_trip - c0 >= wd_limit - period - 0.005, t_trip - c0
+assert t_trip - c1 <= wd_limit + tick + sched, t_trip - c1
 assert stale_limit <= stale_age <= stale_limit + period + sched, stale_age
-assert stale_limit - tick - 0.005 <= t_stale - c1 and t_stale - c0 <= stale_limit + period + sched + 0.05, t_stale
-# Both acted during the cut, and both recovered after the heal, within a second.
-assert c0 < t_trip < h0 and c0 < t_stale < h0, (t_trip, t_stale)
+assert t_stale - c0 >= stale_limit - tick - 0.005, t_stale - c0
+assert t_stale - c1 <= stale_limit + period + sched, t_stale - c1
+# Both acted during the cut and let go after the heal, within a second.
+assert t_trip < h0 and t_stale < h0, (t_trip, t_stale)
 assert h0 < t_release <= h1 + 1.0 and h0 < t_fresh <= h1 + 1.0, (t_release, t_fresh)
 rows = list(csv.DictReader(open(path)))
+ref = list(csv.DictReader(open(ref_path)))
+assert len(rows) == len(ref) == 1201, (len(rows), len(ref))
 wd = [int(r["watchdog"]) for r in rows]
 z = [float(r["z"]) for r in rows]
-cmd = [float(r["cmd1"]) for r in rows]
+zr = [float(r["z"]) for r in ref]
 k_rel = max(k for k in range(1, len(wd)) if wd[k - 1] == 1 and wd[k] == 0)
 held = sum(wd)
-assert 150 <= held <= 230, held  # about the 2 s cut less the 0.3 s limit, in 10 ms ticks
+# The hold lasts the cut less the limit, to within the nft windows and a control period or two.
+assert h0 - c1 - wd_limit - 0.1 <= held * tick <= h1 - c0 - wd_limit + 0.2, held
 assert not any(wd[k_rel:]), "the watchdog acted again after the release"
-# Flying under control afterwards: the last 3 s hold the setpoint as the in-flight bound of
-# netns_nft_hover_rt, with a new command on (nearly) every control tick.
-last = rows[-300:]
-e = [float(r["z"]) - 1.0 for r in last]
-distinct = len(set(float(r["cmd1"]) for r in last))
-print(f"released at t = {rows[k_rel]['t']} s after {held} held ticks; max |z - 1| {max(abs(v - 1) for v in z):.3f} m "
-      f"over the run, {max(map(abs, e)):.3f} m over the last 3 s; {distinct} distinct commands in its 150 control ticks")
-assert max(map(abs, e)) <= 0.35, max(map(abs, e))
-assert distinct >= 120, distinct
+assert k_rel < 750, k_rel  # released before the step at 8 s
+# The first commands across the healed link are the controller's safety commands (safety: stop, the
+# default: rotors at 0), sent until fresh samples reach it; then its control resumes.
+stops = next(k for k in range(k_rel, len(rows)) if float(rows[k]["cmd1"]) > 0) - k_rel
+low = min(z[k_rel:800])
+k_low = k_rel + z[k_rel:800].index(low)
+print(f"released at t = {rows[k_rel]['t']} s after {held} held ticks; then {stops} ticks of the safety command "
+      f"(stopped rotors) and control again: lowest z {low:.3f} m at t = {rows[k_low]['t']} s, "
+      f"{z[799]:.3f} m at 8 s; step to 1.5 m at 8 s: z at 12 s {z[-1]:.3f} m (in-process {zr[-1]:.3f})")
+assert max(abs(v - 1.0) for v in z[:k_rel]) <= 0.005, "the held trim command kept the hover until the release"
+assert stops * tick <= 0.2, stops
+assert low >= 0.6, low  # a fall of g for 0.2 s (the stops) and the time the climb back takes
+if low < 0.98:
+    assert z[799] - low >= 0.05, z[799]  # climbing back under control before the step
+assert z[-1] - z[799] >= 0.3, z[-1]  # and flying the step: the in-process one climbs 0.5 m
 PY
     ;;
 
@@ -609,20 +635,26 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["simulated_s"] == 3600, s["simulated_s"]
 assert s["samples"] >= 20, s["samples"]  # at least 5 samples per quarter
-for name in ("plant", "controller"):
-    p = s[name]
-    # After warm-up (the first quarter) nothing more than 2 MB: a leak of one 100-byte allocation per
-    # control tick would add 17 MB over the 180 000 ticks.
-    assert p["growth_kB"] <= 2048, (name, p["growth_kB"])
+# The plant keeps every lockstep round trip (8 bytes per control period, for the p50/p99/max it prints
+# at the end): from the first quarter's end to the last's, 3/4 of the 180 000 control periods.
+series_kB = 0.75 * 3600 * 50 * 8 / 1024
+plant, controller = s["plant"], s["controller"]
+print(f"growth first -> last quarter: plant {plant['growth_kB']} kB (its round-trip series {series_kB:.0f} kB), "
+      f"controller {controller['growth_kB']} kB")
+# After warm-up (the first quarter) at most 2 MB in all, and nothing beyond the round-trip series but
+# 0.5 MB: a leak of one 100-byte allocation per control tick would add 13 MB.
+assert plant["growth_kB"] <= 2048 and controller["growth_kB"] <= 2048, (plant, controller)
+assert plant["growth_kB"] - series_kB <= 512, plant["growth_kB"]
+assert controller["growth_kB"] <= 512, controller["growth_kB"]
 PY
     ;;
 
   netns_netem)  # 10 % loss and 5 ms delay on the veth (tc netem), real-time hover across namespaces
     make_namespaces
     if ! ip netns exec "$nsA" tc qdisc add dev "$nsA" root netem loss 10% delay 5ms > "$tmp/tc.log" 2>&1; then
-      echo "SKIPPED [$case_name]: this kernel refuses tc netem ($(tr '\n' ' ' < "$tmp/tc.log")); message loss and"
-      echo "delay over the network are not tested here. The in-process fault injection is (sim_test"
-      echo "FaultInjectionTest.*), and two-namespace lockstep runs in faults.netns_multicast/static_peers."
+      echo "SKIPPED [$case_name]: this kernel refuses tc netem ($(tr '\n' ' ' < "$tmp/tc.log")); delay over the"
+      echo "network is not tested here. Loss, bursts and cuts on the same veth are, with nftables"
+      echo "(faults.netns_nft_*); the in-process fault injection delays too (sim_test FaultInjectionTest.*)."
       exit 77
     fi
     ip netns exec "$nsB" tc qdisc add dev "$nsB" root netem loss 10% delay 5ms || fail "netem on $nsB"
