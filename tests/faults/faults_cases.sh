@@ -205,8 +205,8 @@ nft_lockstep() {
   [ -z "$fault" ] || "$fault" "$plant"
   set +e
   wait "$plant"; local rc=$?
-  kill -TERM "$ctl" 2>/dev/null; wait "$ctl" 2>/dev/null
   set -e
+  stop_ns "$nsB"
   [ "$rc" -eq 0 ] || fail "plant across namespaces with $loss % loss exited with $rc"
   if ! cmp "$tmp/in_$name/trajectory.csv" "$tmp/ns.csv"; then
     first_difference "$tmp/in_$name/trajectory.csv" "$tmp/ns.csv"
@@ -231,10 +231,19 @@ for i, (x, y) in enumerate(zip(a, b)):
         shown += 1
 PY
 }
+# stop_ns NS: ends every process in NS and waits until they are gone. $! of `in_ns ... &` is the
+# subshell that runs the function, and ending it would leave its child running: a controller left
+# over from one run answers the next one's plant on the same domain.
+stop_ns() {
+  local p
+  for p in $(ip netns pids "$1"); do kill -TERM "$p" 2>/dev/null || true; done
+  wait_for 10 bash -c "[ -z \"\$(ip netns pids '$1')\" ]" || {
+    for p in $(ip netns pids "$1"); do kill -KILL "$p" 2>/dev/null || true; done
+    wait_for 5 bash -c "[ -z \"\$(ip netns pids '$1')\" ]" || fail "processes in $1 outlived SIGKILL"
+  }
+}
 # Waits until the plant has recorded SIZE bytes of trajectory: lockstep is under way.
 wait_recording() { wait_for 60 bash -c "[ \$(stat -c %s '$tmp/ns.csv' 2>/dev/null || echo 0) -ge $1 ]"; }
-# In real time: samples of the plant's 'watchdog' log lines and the controller's 'safety' lines.
-monotonic_of() { sed -nE 's/.*monotonic ([0-9.]+) s.*/\1/p' <<< "$1"; }
 
 case "$case_name" in
   controller_killed)  # real time: kill -9 the controller mid-hover, then start a new one
