@@ -530,14 +530,15 @@ print(f"real-time hover in gusts, 10 % loss ({lost} of {seen} datagrams): |z - 1
       f"{n} control periods on the safety command, watchdog ticks {wd}")
 assert len(rows) == 1501, len(rows)
 assert 0.07 <= lost / seen <= 0.13, lost / seen
-# Measured (11 runs): without a safety period the flight is the in-process one to within 1 cm; a
+# Measured (13 runs): without a safety period the flight is the in-process one to within 1 cm; a
 # retransmission later than stale_limit (0.1 s) puts the controller on its safety command (rotors
-# stopped) for a control period, which costs up to 8 cm (max) and 2.5 cm (RMS). 0-1 such periods per
-# run were seen; the bounds allow 3, each with a margin.
+# stopped) for a control period, which moved the vehicle up to 11.4 cm from the in-process flight
+# (|z - 1| max +8 cm, RMS +2.4 cm). 0-1 such periods per run were seen; the bounds allow 3, each with
+# a margin.
 assert n <= 3, n
-assert max(map(abs, e)) <= ref_max + 0.02 + 0.1 * n, max(map(abs, e))
-assert rms <= ref_rms + 0.01 + 0.03 * n, rms
-assert max(dev) <= 0.02 + 0.1 * n, max(dev)
+assert max(map(abs, e)) <= ref_max + 0.03 + 0.15 * n, max(map(abs, e))
+assert rms <= ref_rms + 0.01 + 0.04 * n, rms
+assert max(dev) <= 0.03 + 0.15 * n, max(dev)
 assert wd == 0, wd
 PY
     ;;
