@@ -198,7 +198,7 @@ nft_lockstep() {
   local env_ns=(ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET)
   rm -f "$tmp/ns.csv"
   in_ns "$nsB" "${env_ns[@]}" "$bin" controller --scenario "$s" --no-schedule > "$tmp/controller.log" 2>&1 &
-  local ctl=$!; pids+=("$ctl")
+  pids+=($!)
   in_ns "$nsA" "${env_ns[@]}" timeout 250 "$bin" plant --scenario "$s" --record "$tmp/ns.csv" --timeout 20 \
     --schedule-via /attitude_controller > "$tmp/plant.log" 2>&1 &
   local plant=$!; pids+=("$plant")
