@@ -629,8 +629,8 @@ print(f"released at t = {rows[k_rel]['t']} s after {held} held ticks; then {stop
 assert max(abs(v - 1.0) for v in z[:k_rel]) <= 0.005, "the held trim command kept the hover until the release"
 assert stops * tick <= 0.2, stops
 assert low >= 0.6, low  # a fall of g for 0.2 s (the stops) and the time the climb back takes
-if low < 0.98:
-    assert z[799] - low >= 0.05, z[799]  # climbing back under control before the step
+if low < 0.98:  # climbing back under control before the step: measured 58-100 % of the drop regained
+    assert z[799] - low >= 0.4 * (1.0 - low), z[799]
 assert z[-1] - z[799] >= 0.3, z[-1]  # and flying the step: the in-process one climbs 0.5 m
 PY
     ;;
