@@ -16,6 +16,7 @@ packages=(
   colcon python3-colcon-ros python3-colcon-cmake  # package.xml as a ROS 2 workspace reads it (tests/install)
   slurm-wlm munge  # a private single-node Slurm cluster for the sweep job array test (tests/sweep/slurm_test.sh)
   iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
+  nftables  # nft: packet loss, bursts and cuts on the veth between the namespaces (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)
   clang-format  # the C++ style, checked by the test style.clang_format (scripts/format.sh)
   clang libclang-rt-dev  # sanitizer build and libFuzzer targets (scripts/sanitize.sh); clang-14 and
