@@ -30,6 +30,7 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
+#include "app/resources.hpp"
 #include "app/swarm.hpp"
 #include "baseline/baseline_setup.hpp"
 #include "sim/simulation.hpp"
@@ -212,8 +213,8 @@ nlohmann::json number_or_null(double v) {
 }  // namespace
 
 CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& bench) {
-  bench.scenario = QUADCOSIM_SCENARIOS_DIR "/paper/altitude_step.yaml";
-  bench.swarm_scenario = QUADCOSIM_SCENARIOS_DIR "/swarm/grid_takeoff.yaml";
+  bench.scenario = (scenarios_dir() / "paper" / "altitude_step.yaml").string();
+  bench.swarm_scenario = (scenarios_dir() / "swarm" / "grid_takeoff.yaml").string();
   auto* bench_cmd = app.add_subcommand("bench", "measure speed: in-process, DDS lockstep, real-time jitter, swarms");
   bench_cmd->add_flag("--json", bench.json, "print one JSON object");
   bench_cmd->add_flag("--quick", bench.quick, "short runs (smoke test; the figures are not representative)");

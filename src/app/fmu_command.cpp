@@ -25,6 +25,7 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
+#include "app/resources.hpp"
 #include "controllers/registry.hpp"
 #include "fmi/export/fmu_config.hpp"
 #include "fmi/model_description.hpp"
@@ -49,12 +50,6 @@ std::string platform_folder(fmi::FmiVersion version) {
   (void)version;
   return "";
 #endif
-}
-
-fs::path executable_dir() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path{} : self.parent_path();
 }
 
 /// The FMU library to pack, or an error naming every place looked at.

@@ -10,6 +10,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/resources.hpp"
 #include "io/output_folder.hpp"
 
 namespace quadcosim::app {
@@ -29,7 +30,7 @@ std::string shell_quote(const std::string& s) {
 
 bool run_tool(const std::string& script, const std::vector<std::string>& args) {
   const std::string python = env_or("QUADCOSIM_PYTHON", "/usr/bin/python3");
-  const std::string tools = env_or("QUADCOSIM_TOOLS_DIR", QUADCOSIM_TOOLS_DIR);
+  const std::string tools = tools_dir().string();
   std::string cmd = shell_quote(python);
   cmd += ' ';
   cmd += shell_quote(tools + "/" + script);

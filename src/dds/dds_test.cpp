@@ -602,15 +602,15 @@ TEST(GraphTest, OnlyRtTopicsAreRosTopics) {
 
 TEST(GraphTest, ListsTopicsSortedUniqueWithTypes) {
   const std::vector<Endpoint> endpoints = {
-      {"rt/drone/Pose", "geometry_msgs::msg::dds_::PoseStamped_", true, true},
-      {"rt/clock", "rosgraph_msgs::msg::dds_::Clock_", true, false},
-      {"ros_discovery_info", "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_", true, true},
-      {"rt/drone/Pose", "geometry_msgs::msg::dds_::PoseStamped_", false, true},
-      {"rt/drone/Imu", "sensor_msgs::msg::dds_::Imu_", true, true},
-      {"rt/drone/_internal", "std_msgs::msg::dds_::Float64MultiArray_", true, true},
-      {"rt/mixed", "b::msg::dds_::B_", true, true},
-      {"rt/mixed", "a::msg::dds_::A_", false, true},
-      {"rq/x/get_parametersRequest", "rcl_interfaces::srv::dds_::GetParameters_Request_", true, true},
+      {"rt/drone/Pose", "geometry_msgs::msg::dds_::PoseStamped_", true, true, ""},
+      {"rt/clock", "rosgraph_msgs::msg::dds_::Clock_", true, false, ""},
+      {"ros_discovery_info", "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_", true, true, ""},
+      {"rt/drone/Pose", "geometry_msgs::msg::dds_::PoseStamped_", false, true, ""},
+      {"rt/drone/Imu", "sensor_msgs::msg::dds_::Imu_", true, true, ""},
+      {"rt/drone/_internal", "std_msgs::msg::dds_::Float64MultiArray_", true, true, ""},
+      {"rt/mixed", "b::msg::dds_::B_", true, true, ""},
+      {"rt/mixed", "a::msg::dds_::A_", false, true, ""},
+      {"rq/x/get_parametersRequest", "rcl_interfaces::srv::dds_::GetParameters_Request_", true, true, ""},
   };
   const auto topics = ros_topics(endpoints);
   ASSERT_EQ(topics.size(), 5u);

@@ -6,6 +6,8 @@
 #include <thread>
 #include <utility>
 
+#include "dds/type_hash.hpp"
+
 namespace quadcosim::dds {
 
 std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_topic; }
@@ -40,6 +42,7 @@ dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const s
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
   const QosProfile p = qos_for(ros_topic);
   dds_qos_t* qos = ros_qos(p.depth, p.reliable);
+  set_endpoint_user_data(qos, ops->descriptor->m_typename);
   const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos, nullptr)
                                 : dds_create_reader(participant_.handle(), topic, qos, nullptr);
   dds_delete_qos(qos);

@@ -113,6 +113,12 @@ void take_endpoints(dds_entity_t reader, bool writers, const Key& own, std::map<
       dds_reliability_kind_t kind = DDS_RELIABILITY_RELIABLE;
       dds_duration_t blocking = 0;
       if (s->qos && dds_qget_reliability(s->qos, &kind, &blocking)) e.reliable = kind == DDS_RELIABILITY_RELIABLE;
+      void* data = nullptr;
+      size_t size = 0;
+      if (s->qos && dds_qget_userdata(s->qos, &data, &size) && data != nullptr) {
+        e.user_data.assign(static_cast<const char*>(data), size);
+        dds_free(data);
+      }
       known[key] = std::move(e);
     }
     if (n > 0) dds_return_loan(reader, samples, n);

@@ -22,6 +22,7 @@ struct Endpoint {
   std::string dds_type;   ///< "geometry_msgs::msg::dds_::PoseStamped_"
   bool writer = false;    ///< a writer (publisher) or a reader (subscription)
   bool reliable = true;   ///< its reliability QoS
+  std::string user_data;  ///< its USER_DATA QoS as sent ("typehash=RIHS01_...;" from ROS 2 Jazzy), "" if none
 };
 
 /// A ROS topic with everything discovered on it.

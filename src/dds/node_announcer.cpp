@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "dds/participant.hpp"
+#include "dds/type_hash.hpp"
 #include "rmw_dds_common.h"
 
 namespace quadcosim::dds {
@@ -45,6 +46,7 @@ NodeAnnouncer::NodeAnnouncer(dds_entity_t participant, std::string name, std::st
             "dds_create_topic ros_discovery_info");
   dds_qos_t* qos = ros_qos(1, true);
   dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  set_endpoint_user_data(qos, rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc.m_typename);
   writer_ = dds_create_writer(participant_, topic, qos, nullptr);
   dds_delete_qos(qos);
   check(writer_, "dds_create_writer ros_discovery_info");

@@ -6,6 +6,7 @@
 
 #include "dds/parameter_wire.hpp"
 #include "dds/steady_clock.hpp"
+#include "dds/type_hash.hpp"
 
 namespace quadcosim::dds {
 
@@ -51,10 +52,12 @@ ParameterClient::Endpoints& ParameterClient::endpoints(ParamService service) {
   const dds_entity_t rr_topic = check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
                                       ("dds_create_topic " + rr).c_str());
   // rclpy's parameter client uses the parameter-service profile: KEEP_LAST 1000, RELIABLE, VOLATILE.
+  // One client id on both endpoints, each followed by the hash of its own message type (rmw_cyclonedds).
   dds_qos_t* qos = ros_qos(1000, true);
-  const std::string user_data = "clientid=" + wire::new_endpoint_id(participant_) + ";";
-  dds_qset_userdata(qos, user_data.data(), user_data.size());
+  const std::string client_id = "clientid=" + wire::new_endpoint_id(participant_) + ";";
+  set_endpoint_user_data(qos, types.request->m_typename, client_id);
   e.writer = dds_create_writer(participant_, rq_topic, qos, nullptr);
+  set_endpoint_user_data(qos, types.response->m_typename, client_id);
   e.reader = dds_create_reader(participant_, rr_topic, qos, nullptr);
   dds_delete_qos(qos);
   check(e.writer, ("dds_create_writer " + rq).c_str());

@@ -7,6 +7,7 @@
 #include "dds/parameter_wire.hpp"
 #include "dds/participant.hpp"
 #include "dds/steady_clock.hpp"
+#include "dds/type_hash.hpp"
 
 namespace quadcosim::dds {
 
@@ -40,11 +41,13 @@ ParameterServer::ParameterServer(dds_entity_t participant, NodeName node, Parame
                                         ("dds_create_topic " + rq).c_str());
     const dds_entity_t rr_topic = check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
                                         ("dds_create_topic " + rr).c_str());
+    // One service id on both endpoints, each followed by the hash of its own message type (rmw_cyclonedds).
     dds_qos_t* qos = ros_qos(options_.depth, true);
-    const std::string user_data = "serviceid=" + wire::new_endpoint_id(participant_) + ";";
-    dds_qset_userdata(qos, user_data.data(), user_data.size());
+    const std::string service_id = "serviceid=" + wire::new_endpoint_id(participant_) + ";";
     Endpoints& e = ep_[index(s)];
+    set_endpoint_user_data(qos, types.request->m_typename, service_id);
     e.reader = dds_create_reader(participant_, rq_topic, qos, nullptr);
+    set_endpoint_user_data(qos, types.response->m_typename, service_id);
     e.writer = dds_create_writer(participant_, rr_topic, qos, nullptr);
     dds_delete_qos(qos);
     check(e.reader, ("dds_create_reader " + rq).c_str());
@@ -58,6 +61,7 @@ ParameterServer::ParameterServer(dds_entity_t participant, NodeName node, Parame
                                                       "rt/parameter_events", nullptr, nullptr),
                                      "dds_create_topic rt/parameter_events");
     dds_qos_t* qos = ros_qos(1000, true);
+    set_endpoint_user_data(qos, rcl_interfaces_msg_dds__ParameterEvent__desc.m_typename);
     events_writer_ = dds_create_writer(participant_, topic, qos, nullptr);
     dds_delete_qos(qos);
     check(events_writer_, "dds_create_writer rt/parameter_events");
