@@ -28,6 +28,7 @@
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
+#include "io/yaml_reader.hpp"
 #include "python/py_controller.hpp"
 #include "sim/simulation.hpp"
 
@@ -215,6 +216,33 @@ PyScenario with_any_controller(const PyScenario& s, const py::object& controller
   return with_python_controller(s, controller, step_timeout_s);
 }
 
+/// A scenario source (a Scenario, a scenario file, a dict) flown by `controller` (None: its own; a str: a
+/// controller type; else a Python controller). A document given for a Python controller is checked only
+/// once the controller is known, so that its controller section may hold the class's parameters.
+PyScenario load_any(const py::object& source, const py::object& controller, std::optional<double> step_timeout_s) {
+  if (py::isinstance<PyScenario>(source)) {
+    return with_any_controller(source.cast<const PyScenario&>(), controller, step_timeout_s);
+  }
+  const bool dict = py::isinstance<py::dict>(source);
+  const std::string path = dict ? "" : py::module_::import("os").attr("fspath")(source).cast<std::string>();
+  if (controller.is_none() || py::isinstance<py::str>(controller)) {
+    const std::string type = controller.is_none() ? "" : controller.cast<std::string>();
+    const PyScenario s = dict ? load_dict(source.cast<py::dict>(), type) : load_file(path, type);
+    return step_timeout_s ? with_any_controller(s, py::none(), step_timeout_s) : s;
+  }
+  PyScenario raw;
+  if (dict) {
+    raw.root = to_yaml(source, "");
+    raw.source = "<dict>";
+  } else {
+    raw.root = YAML::Clone(io::YamlSection::load_file(path).node());
+    raw.source = path;
+    raw.from_file = true;
+  }
+  if (!raw.root.IsMap()) throw io::ConfigError(raw.source + ": expected a mapping of keys at the top level");
+  return with_python_controller(raw, controller, step_timeout_s);
+}
+
 // ---------------------------------------------------------------------------------------------------
 // Runs
 
@@ -355,9 +383,9 @@ double stamp_s(const msg::Header& h) { return h.stamp.sec + h.stamp.nanosec * 1e
 /// One vehicle of a scenario, advanced one control period at a time.
 class PySimulation {
  public:
-  PySimulation(const PyScenario& scenario, std::optional<std::uint64_t> seed, const py::object& controller,
+  PySimulation(const py::object& scenario, std::optional<std::uint64_t> seed, const py::object& controller,
                std::optional<double> step_timeout_s)
-      : scenario_(with_any_controller(scenario, controller, step_timeout_s).scenario) {
+      : scenario_(load_any(scenario, controller, step_timeout_s).scenario) {
     seed_ = seed ? *seed : scenario_.simulation.plant.realism.seed;
     build();
   }
@@ -612,6 +640,10 @@ Made by quadcosim.load_scenario(path_or_dict); pass it to quadcosim.run() or qua
       .def_property_readonly(
           "seed", [](const PyScenario& s) { return s.scenario.simulation.plant.realism.seed; },
           "The seed of its sensor noise, wind and other random sources (realism.seed).")
+      .def_property_readonly(
+          "vehicle", [](const PyScenario& s) { return vehicle_dict(s.scenario.vehicle); },
+          "The vehicle as the dict a Python controller's __init__ receives (keys of the vehicle: section, "
+          "hover_omega_rad_s, mixer_inverse).")
       .def(
           "yaml",
           [](const PyScenario& s) {
@@ -629,9 +661,10 @@ Made by quadcosim.load_scenario(path_or_dict); pass it to quadcosim.run() or qua
         "Validates a scenario given as a dict with the keys of a scenario file.");
   m.def("_with_controller", &with_controller, py::arg("scenario"), py::arg("controller"),
         "The same scenario flown by another controller type.");
-  m.def("_with_any_controller", &with_any_controller, py::arg("scenario"), py::arg("controller"),
+  m.def("_load", &load_any, py::arg("source"), py::arg("controller") = py::none(),
         py::arg("step_timeout_s") = py::none(),
-        "The same scenario flown by a controller type (str) or a Python controller (instance or class).");
+        "A scenario (a Scenario, file or dict) flown by its controller, a controller type (str) or a Python "
+        "controller (instance or class).");
   m.def("_run", &run, py::arg("scenario"), py::arg("out"), py::arg("force") = false,
         "Runs a scenario in process as `quadcosim run` does; the parts of a RunResult.");
 
@@ -651,11 +684,12 @@ period) of the run's trajectory, bit for bit.
 
 Scheduled parameter changes of the scenario apply at their times; a scenario with a trajectory
 follows it and ignores set_setpoint's position and yaw.)")
-      .def(py::init<const PyScenario&, std::optional<std::uint64_t>, const py::object&, std::optional<double>>(),
+      .def(py::init<const py::object&, std::optional<std::uint64_t>, const py::object&, std::optional<double>>(),
            py::arg("scenario"), py::arg("seed") = py::none(), py::kw_only(), py::arg("controller") = py::none(),
            py::arg("step_timeout_s") = py::none(),
            R"(Builds the vehicle and controller at t = 0.
 
+scenario: a Scenario, a scenario file or a dict (as quadcosim.load_scenario takes).
 controller: None keeps the scenario's; a str is a controller type (as --controller); anything else is a
 controller written in Python, an instance or a class (see docs/python.md, "Write a controller in
 Python"): each Simulation flies its own copy.deepcopy of the configured object.

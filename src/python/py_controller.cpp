@@ -5,6 +5,7 @@
 #include <pybind11/eval.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <Eigen/LU>
 
 #include <algorithm>
 #include <atomic>
@@ -18,6 +19,7 @@
 
 #include "control/controller_config.hpp"
 #include "io/scenario.hpp"
+#include "model/mixer.hpp"
 
 namespace py = pybind11;
 
@@ -689,6 +691,11 @@ py::dict vehicle_dict(const model::VehicleParams& vehicle) {
     }
   }
   d["hover_omega_rad_s"] = vehicle.hover_omega_rad_s();
+  // The inverse of the mixer (eq. (4)): rotor speeds squared from U, as the C++ controllers allocate.
+  const Eigen::Matrix4d inverse = model::mixer_matrix(vehicle).inverse();
+  py::list rows;
+  for (int r = 0; r < 4; ++r) rows.append(py::make_tuple(inverse(r, 0), inverse(r, 1), inverse(r, 2), inverse(r, 3)));
+  d["mixer_inverse"] = py::tuple(rows);
   return d;
 }
 

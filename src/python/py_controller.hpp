@@ -130,7 +130,8 @@ void install_python_controller_factory();
 
 /// The vehicle as the dict a Python controller's __init__ receives: every entry of
 /// model::vehicle_parameters() by its YAML path ("mass_kg", "motor.omega_max_rad_s", ...; a 3-vector
-/// as three entries .x, .y, .z; choices as strings, spin as a list) and hover_omega_rad_s.
+/// as three entries .x, .y, .z; choices as strings, spin as a tuple), hover_omega_rad_s and
+/// mixer_inverse (4 rows of 4: rotor speeds squared = mixer_inverse U, as the C++ controllers allocate).
 pybind11::dict vehicle_dict(const model::VehicleParams& vehicle);
 
 /// The Python exception type raised inside a step that overran step_timeout_s: quadcosim.StepTimeout, a
