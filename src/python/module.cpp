@@ -594,6 +594,8 @@ PYBIND11_MODULE(_quadcosim, m) {
                                 PyExc_RuntimeError, nullptr)));
   m.attr("ControllerError") = *controller_error;
   m.attr("StepTimeout") = step_timeout_type();
+  m.attr("Observation") = observation_class();
+  m.attr("Reference") = reference_class();
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -699,6 +699,9 @@ py::dict vehicle_dict(const model::VehicleParams& vehicle) {
   return d;
 }
 
+py::object observation_class() { return globals().observation_class; }
+py::object reference_class() { return globals().reference_class; }
+
 py::object step_timeout_type() {
   py::gil_scoped_acquire gil;
   return globals().step_timeout;

@@ -22,11 +22,11 @@ from typing import Any, Dict, Optional, Union
 
 import numpy  # noqa: F401  (the arrays the module returns; fail here, clearly, without it)
 
-from ._quadcosim import ConfigError, ControllerError, Scenario, Simulation, StepTimeout
+from ._quadcosim import ConfigError, ControllerError, Observation, Reference, Scenario, Simulation, StepTimeout
 from . import _quadcosim
 
-__all__ = ["ConfigError", "Controller", "ControllerError", "StepTimeout", "Scenario", "Simulation", "RunResult", "load_scenario",
-           "run"]
+__all__ = ["ConfigError", "Controller", "ControllerError", "Observation", "Reference", "StepTimeout", "Scenario",
+           "Simulation", "RunResult", "load_scenario", "run"]
 
 ScenarioLike = Union[Scenario, dict, str, "os.PathLike[str]"]
 
