@@ -484,6 +484,9 @@ void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
     control::ControllerConfig scratch = sc.controller;
     std::vector<std::pair<std::string, control::ParameterValue>> values;
     if (set->has("type")) set->fail("type", "the controller's type cannot change during a run");
+    for (const char* key : {"python", "fmu", "inputs", "outputs", "parameters"}) {
+      if (set->has(key)) set->fail(key, "the controller cannot change during a run (only its parameters)");
+    }
     read_parameters(*set, scratch, &values);
     for (auto& [name, value] : values) sc.schedule.push_back({tick, name, value});
     s.reject_unknown_keys();
