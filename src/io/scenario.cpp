@@ -545,6 +545,11 @@ void set_controller_type(YAML::Node root, const std::string& controller_type) {
     root["controller"] = YAML::Node(YAML::NodeType::Map);
   }
   root["controller"]["type"] = controller_type;
+  if (controller_type != "python") {
+    // Another type in place of a Python controller: its class and time limit go with it.
+    root["controller"].remove("python");
+    root["controller"].remove("step_timeout_s");
+  }
 }
 
 Scenario load_scenario(const std::string& path, const std::string& controller_type) {

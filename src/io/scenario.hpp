@@ -155,7 +155,8 @@ Scenario load_scenario(const std::string& path);
 /// --controller): the file's controller parameters are then checked against that type's table.
 Scenario load_scenario(const std::string& path, const std::string& controller_type);
 
-/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed.
+/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed; a type other
+/// than python drops the section's `python` and `step_timeout_s` (a Python controller's).
 void set_controller_type(YAML::Node root, const std::string& controller_type);
 
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file

@@ -95,6 +95,11 @@ std::string describe_value(const py::handle& v) {
 
 bool is_real_number(const py::handle& v) {
   if (PyFloat_Check(v.ptr()) || (PyLong_Check(v.ptr()) && !PyBool_Check(v.ptr()))) return true;
+  if (py::isinstance<py::array>(v)) {  // a 0-d numeric array (np.clip of a scalar, a reduction)
+    const auto a = py::reinterpret_borrow<py::array>(v);
+    const char kind = a.dtype().kind();
+    return a.ndim() == 0 && (kind == 'f' || kind == 'i' || kind == 'u');
+  }
   // numpy scalars and other numbers with __float__, but not strings, bools or complex numbers.
   return !PyBool_Check(v.ptr()) && !PyUnicode_Check(v.ptr()) && !PyBytes_Check(v.ptr()) && !PyComplex_Check(v.ptr()) &&
          py::hasattr(v, "__float__") && !py::hasattr(v, "__len__");
@@ -614,6 +619,9 @@ void PyController::step(const control::Observation& o, const control::Reference&
       const auto f = py::array_t<double, py::array::forcecast>::ensure(a);
       for (std::size_t i = 0; i < n; ++i) into[i] = f.at(static_cast<py::ssize_t>(i));
       return;
+    }
+    if (!PySequence_Check(values.ptr())) {  // not a dict, set or iterator: an order is needed
+      fail_step(fmt::format("returned {}, expected {}", describe_value(values), what), t);
     }
     PyObject* seq = PySequence_Fast(values.ptr(), "");
     if (!seq) {

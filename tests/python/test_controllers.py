@@ -419,8 +419,20 @@ def test_outputs_may_be_any_numbers_even_not_finite():
 
 def test_numbers_of_any_numeric_type_are_accepted():
     for value in [[400, 400, 400, 400], np.full(4, 400, dtype=np.int32), np.full(4, 400.0, dtype=np.float32),
-                  tuple(np.float64(400.0) for _ in range(4)), range(400, 404)]:
+                  tuple(np.float64(400.0) for _ in range(4)), range(400, 404), [np.array(400.0)] * 4,
+                  [np.float32(400.0)] * 4]:
         quadcosim.run(hover_scenario(duration_s=0.1), controller=failing(after=0, value=value))
+
+
+@pytest.mark.parametrize("value, message", [
+    ({1: 400.0, 2: 400.0, 3: 400.0, 4: 400.0}, r"returned dict"),
+    ({400.0, 401.0, 402.0, 403.0}, r"returned set"),
+    (iter([400.0] * 4), r"returned list_iterator"),
+    ([True, 400.0, 400.0, 400.0], r"returned bool \(True\) as entry 0"),
+])
+def test_unordered_or_non_numeric_containers_are_refused(value, message):
+    with pytest.raises(quadcosim.ControllerError, match=message):
+        quadcosim.run(hover_scenario(), controller=failing(after=0, value=value))
 
 
 def test_a_failing_init_or_deepcopy_is_named():
@@ -607,6 +619,37 @@ def test_a_controller_cannot_step_its_own_simulation():
     holder["sim"] = sim
     with pytest.raises(quadcosim.ControllerError, match=r"called from inside its own step"):
         sim.step()
+
+
+def test_runs_in_threads_serialise_on_the_gil_and_give_the_serial_numbers():
+    """Four runs in four Python threads at once (each step takes the GIL; the simulation between steps
+    runs without it): each gives exactly the trajectory of the same run alone."""
+    alone = quadcosim.run(ALTITUDE_STEP, controller=AltitudePD).trajectory
+    results = [None] * 4
+
+    def fly(i):
+        results[i] = quadcosim.run(ALTITUDE_STEP, controller=AltitudePD).trajectory
+
+    threads = [threading.Thread(target=fly, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        for name in STATE:
+            assert np.array_equal(r[name], alone[name]), name
+
+
+def test_a_string_keeps_meaning_a_controller_type(tmp_path):
+    """controller="paper" on a scenario that names a Python class flies the paper controller (the class
+    and its time limit go); the same scenario as written flies the class."""
+    write_controller_module(tmp_path)
+    (tmp_path / "s.yaml").write_text('simulation: {duration_s: 2}\n'
+                                     'controller: {python: "my_controllers:AltitudePD", step_timeout_s: 1, z_des: 1}\n')
+    assert quadcosim.load_scenario(tmp_path / "s.yaml").controller == "python"
+    assert quadcosim.load_scenario(tmp_path / "s.yaml", controller="paper").controller == "paper"
+    r = quadcosim.run(tmp_path / "s.yaml", controller="paper")
+    assert r.trajectory["z"][-1] > 0.5
 
 
 def test_two_runs_are_byte_identical(tmp_path):
