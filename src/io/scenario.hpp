@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -121,6 +123,18 @@ struct Scenario {
   std::optional<FmuSpec> controller_fmu;
 };
 
+/// What resolves a scenario's `controller: {python: "module:Class"}` (or `type: python`): from the
+/// target text, the scenario file's folder (imports look there first) and the vehicle the controller is
+/// designed for, the configured controller. Throws to refuse (the message becomes the ConfigError at
+/// controller.python). Installed by whatever hosts a Python interpreter: the Python module
+/// (python::install_python_controller_factory) or an executable that embeds one.
+using PythonControllerFactory = std::function<std::shared_ptr<const control::Controller>(
+    const std::string& target, const std::filesystem::path& folder, const model::VehicleParams& vehicle)>;
+
+/// Sets (or with an empty function, removes) the resolver of `controller: {python: ...}`. Without one,
+/// such a scenario is refused: "controller.python: this quadcosim was built without Python ...".
+void set_python_controller_factory(PythonControllerFactory factory);
+
 /// Makes `sc` fly `spec` as its plant (`quadcosim plant --fmu`): loads the FMU, checks the mapping,
 /// sets simulation.plant.external. Throws ConfigError naming `source` (the flag or file) and what
 /// does not fit, also when the scenario uses what only the native plant has (wind, faults, drag).
@@ -141,7 +155,8 @@ Scenario load_scenario(const std::string& path);
 /// --controller): the file's controller parameters are then checked against that type's table.
 Scenario load_scenario(const std::string& path, const std::string& controller_type);
 
-/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed.
+/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed; a type other
+/// than python drops the section's `python` and `step_timeout_s` (a Python controller's).
 void set_controller_type(YAML::Node root, const std::string& controller_type);
 
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file

@@ -22,34 +22,37 @@ from typing import Any, Dict, Optional, Union
 
 import numpy  # noqa: F401  (the arrays the module returns; fail here, clearly, without it)
 
-from ._quadcosim import ConfigError, Scenario, Simulation
+from ._quadcosim import ConfigError, ControllerError, Observation, Reference, Scenario, Simulation, StepTimeout
 from . import _quadcosim
 from .batch import Batch  # noqa: E402  (N vehicles stepped together; docs/python.md)
 from . import envs  # noqa: E402  (Gymnasium-style environments: HoverEnv, TrackingEnv, VectorHoverEnv, ...)
 
-__all__ = ["ConfigError", "Scenario", "Simulation", "RunResult", "load_scenario", "run"]
+__all__ = ["ConfigError", "Controller", "ControllerError", "Observation", "Reference", "StepTimeout", "Scenario",
+           "Simulation", "RunResult", "load_scenario", "run"]
 
 ScenarioLike = Union[Scenario, dict, str, "os.PathLike[str]"]
 
 
-def load_scenario(source: Union[dict, str, "os.PathLike[str]"], controller: Optional[str] = None) -> Scenario:
+def load_scenario(source: Union[Scenario, dict, str, "os.PathLike[str]"], controller: Any = None,
+                  step_timeout_s: Optional[float] = None) -> Scenario:
     """Loads and validates a scenario.
 
     source: a scenario file (YAML, docs/scenarios.md), or a dict with the same keys and values as the
-    file (nested dicts and lists; numbers, strings, bools, None; numpy scalars and arrays too).
-    controller: a controller type replacing the scenario's controller.type (as `quadcosim run
-    --controller`); the scenario's controller parameters are then checked against that type.
+    file (nested dicts and lists; numbers, strings, bools, None; numpy scalars and arrays too), or a
+    Scenario (to change its controller).
+    controller: a controller type replacing the scenario's controller.type (a str, as `quadcosim run
+    --controller`), or a controller written in Python (an instance or a class, see Controller); the
+    scenario's controller parameters and schedule are then checked against that controller's.
+    step_timeout_s: the per-step time limit of a Python controller [s] (0: none), as the scenario key
+    controller.step_timeout_s.
 
     Raises ConfigError (a ValueError) whose message names the file (or '<dict>'), the key and the
     value, e.g. "<dict>: simulation.plant_rate_hz: got 'fast', expected a number in [0.001, 1e+06]": the same
     checks and messages as the CLI.
     """
-    ctype = controller or ""
-    if isinstance(source, Scenario):
-        return _quadcosim._with_controller(source, ctype)
-    if isinstance(source, dict):
-        return _quadcosim._load_scenario_dict(source, ctype)
-    return _quadcosim._load_scenario_file(os.fspath(source), ctype)
+    if not isinstance(source, (Scenario, dict)):
+        source = os.fspath(source)
+    return _quadcosim._load(source, controller, step_timeout_s)
 
 
 @dataclass
@@ -84,12 +87,58 @@ class RunResult:
         return f"RunResult(passed={self.passed}, {n} ticks, figures={sorted(self.figures)}, out={self.out!r})"
 
 
+class Controller:
+    """A convenience base class for controllers written in Python (any object with step() flies).
+
+        class AltitudePD(quadcosim.Controller):
+            parameters = {"kp_z": dict(default=1.0, unit="1/s^2", min=0.0, max=100.0,
+                                       description="vertical acceleration per metre of altitude error")}
+            outputs = ("error.z",)
+
+            def step(self, obs, ref, dt):
+                e = ref.p[2] - obs.p[2]
+                ...
+                return omega, (e,)
+
+    parameters: name -> dict(default=, unit="", min=-inf, max=inf, description="") (numbers). They are
+        the keys of a scenario's controller: section (range-checked), can be changed by its schedule: and
+        are the controller node's ROS 2 parameters. The current value of each is an attribute of the
+        object (self.kp_z), set before the first step and after each accepted change.
+    outputs: names of the figures step() returns besides the rotor speeds.
+    step_timeout_s: the default per-step time limit [s] (0: none); a scenario's
+        controller.step_timeout_s or run(..., step_timeout_s=) overrides it.
+
+    __init__(vehicle) receives the vehicle as a dict (Scenario.vehicle: mass_kg, gravity_m_s2,
+    kt_N_per_rad2_s2, hover_omega_rad_s, mixer_inverse, ...) when quadcosim instantiates the class;
+    here it is kept as self.vehicle. reset() clears internal state (integrators); set_parameters(changes)
+    may refuse a change by raising ValueError (nothing changes then). step(obs, ref, dt) returns 4 rotor
+    speeds [rad/s], or (omega, outputs). See docs/python.md, "Write a controller in Python".
+    """
+
+    parameters: Dict[str, Any] = {}
+    outputs: tuple = ()
+
+    def __init__(self, vehicle: Optional[Dict[str, Any]] = None):
+        self.vehicle = vehicle
+
+    def reset(self) -> None:
+        """Clears internal state (integrators, filters), as after a restart."""
+
+    def set_parameters(self, changes: Dict[str, float]) -> None:
+        """Called with {name: new value} (already range-checked) before the attributes change; raise
+        ValueError to refuse."""
+
+    def step(self, obs, ref, dt: float):
+        """One control period of dt seconds: return 4 rotor speeds [rad/s] (or (omega, outputs))."""
+        raise NotImplementedError(f"{type(self).__name__}.step")
+
+
 # Keys of metrics.json that describe the run rather than judge it.
 _HEADER_KEYS = {"scenario", "description", "passed", "controller", "schema", "version"}
 
 
 def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = None,
-        controller: Optional[str] = None, force: bool = False) -> RunResult:
+        controller: Any = None, force: bool = False, step_timeout_s: Optional[float] = None) -> RunResult:
     """Runs a scenario in process, as `quadcosim run SCENARIO --out OUT --no-plots` does.
 
     scenario: a Scenario, a scenario file or a dict (see load_scenario).
@@ -98,7 +147,13 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
         metadata.yaml, metrics.json, metrics.txt and scenario.yaml, the same bytes as the CLI writes
         (the PNG plots and report.html are not made: `quadcosim plot OUT` makes them). Without out the
         run is recorded in a temporary folder that is removed.
-    controller: a controller type replacing the scenario's (as --controller).
+    controller: a controller type replacing the scenario's (a str, as --controller), or a controller
+        written in Python: an instance or a class with step(obs, ref, dt) (see Controller and
+        docs/python.md). The run flies a copy.deepcopy of the configured object (the object passed is
+        not stepped). A failing Python controller raises ControllerError naming the step.
+    step_timeout_s: the per-step time limit of a Python controller [s] (None keeps the scenario's or
+        the class's, default 0: no limit); a step that runs longer is stopped with StepTimeout and the
+        run raises ControllerError.
 
     Ctrl-C raises KeyboardInterrupt within a few thousand plant ticks; out then holds what ran, as
     after an interrupted `quadcosim run`.
@@ -106,10 +161,7 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
     Returns a RunResult (trajectory, figures, passed, ...). Raises ConfigError for a bad scenario,
     ValueError when out cannot be used (it holds other outputs), RuntimeError on an I/O error.
     """
-    if isinstance(scenario, Scenario):
-        sc = load_scenario(scenario, controller) if controller else scenario
-    else:
-        sc = load_scenario(scenario, controller)
+    sc = load_scenario(scenario, controller, step_timeout_s)
     r = _quadcosim._run(sc, None if out is None else os.fspath(out), force)
     metrics = json.loads(r["metrics_json"])
     figures = {k: v for k, v in metrics.items() if k not in _HEADER_KEYS}
