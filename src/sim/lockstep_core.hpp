@@ -46,9 +46,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <utility>
 #include <vector>
 
+#include "analysis/log_histogram.hpp"
 #include "sim/clock.hpp"
 #include "sim/steppable_plant.hpp"
 
@@ -83,9 +85,7 @@ class LockstepCore {
   /// `plants` and `host` must outlive the loop.
   LockstepCore(std::vector<Plant*> plants, const LockstepOptions& options, Hooks hooks, Host& host)
       : plants_(std::move(plants)), slots_(plants_.size()), o_(options), hooks_(std::move(hooks)), host_(host) {
-    if constexpr (!kSynchronous) {
-      round_trips_ns_.reserve(static_cast<std::size_t>(o_.duration_ticks / o_.controller_divider + 1));
-    }
+    if constexpr (!kSynchronous) round_trips_ns_ = std::make_unique<analysis::LogHistogram>();
   }
   LockstepCore(const LockstepCore&) = delete;
   LockstepCore& operator=(const LockstepCore&) = delete;
@@ -143,7 +143,12 @@ class LockstepCore {
   Tick ticks_run() const { return k_; }
   /// Outputs published -> every answer in, per awaited control tick [ns, wall clock]; none when
   /// synchronous.
-  const std::vector<std::int64_t>& round_trips_ns() const { return round_trips_ns_; }
+  /// Lockstep round trips [ns] (outputs published -> every command back), one per control period; in
+  /// fixed memory however long the run. Empty for a synchronous loop.
+  const analysis::LogHistogram& round_trips_ns() const {
+    static const analysis::LogHistogram kNone;
+    return round_trips_ns_ ? *round_trips_ns_ : kNone;
+  }
   /// False while holding after a timeout.
   bool awaiting_answers() const { return waiting_; }
   Hooks& hooks() { return hooks_; }
@@ -202,7 +207,7 @@ class LockstepCore {
       }
       if (waiting_ && control) {
         if (!all_answered(k)) return Phase::kAwaiting;
-        round_trips_ns_.push_back(host_.now_ns() - asked_ns_);
+        round_trips_ns_->record(host_.now_ns() - asked_ns_);
       }
       end_tick(k);
       ++k_;
@@ -270,7 +275,7 @@ class LockstepCore {
   bool waiting_ = true;                          ///< answers awaited (off while holding)
   std::size_t answered_ = 0;                     ///< plants [0, answered_) have answered k_
   std::int64_t asked_ns_ = 0, last_ask_ns_ = 0;  ///< k_ first / last published [wall ns]
-  std::vector<std::int64_t> round_trips_ns_;
+  std::unique_ptr<analysis::LogHistogram> round_trips_ns_;  ///< asynchronous loops only (30 kB)
 };
 
 }  // namespace quadcosim::sim
