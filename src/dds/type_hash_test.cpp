@@ -38,6 +38,9 @@ namespace {
 //  [Z1] ZettaScaleLabs/ros-z, an rmw_zenoh-compatible client that puts these hashes on the wire to
 //       ROS 2 Jazzy nodes: crates/ros-z-codegen/tests/hash_regression.rs (PoseStamped, TwistStamped,
 //       Imu) and crates/ros-z/src/parameter/wire_types.rs (the six parameter services, ParameterEvent)
+//  [B1] a ROS 2 Jazzy build from source (rosidl_generator_type_description of rosidl 4.6, the jazzy
+//       rcl_interfaces and common_interfaces), its install/share/<package>/{msg,srv}/<Type>.json
+//       "type_hashes"; every other value above agrees with that build too
 //  [E1] eclipse-zenoh/zenoh-plugin-ros2dds@f4990b12, zenoh-plugin-ros2dds/src/ros_discovery.rs:
 //       ROS_DISCOVERY_INFO_TYPE_HASH, "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_ in Iron and Jazzy"
 struct Expected {
@@ -96,6 +99,21 @@ const std::vector<Expected>& expected_hashes() {
        "Z1"},
       {"rcl_interfaces/srv/DescribeParameters",
        "RIHS01_845b484d71eb0673dae682f2e3ba3c4851a65a3dcfb97bddd82c5b57e91e4cff", "Z1"},
+      {"rcl_interfaces/srv/DescribeParameters_Request", "RIHS01_05dd1c2bc87dec2627105c8070d6f9725c781a4f2ab852975bf105462b82b644", "B1"},
+      {"rcl_interfaces/srv/DescribeParameters_Response", "RIHS01_ad6747319613c6131589e062e095b469a46cc764f7d0f12a001a49e6cd893995", "B1"},
+      {"rcl_interfaces/srv/DescribeParameters_Event", "RIHS01_3deba64c035093033c690184834441551a53128ea2539f71f2596fbc4ed9de43", "B1"},
+      {"rcl_interfaces/srv/GetParameterTypes_Request", "RIHS01_87d7ec5ef545d4daa289d500025d31fb2437bc8b8365ca367161c4dac4be33fd", "B1"},
+      {"rcl_interfaces/srv/GetParameterTypes_Response", "RIHS01_ac1335dce67c478e669434f6ac2fbff34fcd529580f272d3006785ba8b54e47f", "B1"},
+      {"rcl_interfaces/srv/GetParameterTypes_Event", "RIHS01_9516adca0cc885d46a59c2362fb8eb5f4906b046518266f8c645b454b0dddc60", "B1"},
+      {"rcl_interfaces/srv/GetParameters_Request", "RIHS01_135a9e1c3d7cebef792f6687d7ddf99949b21a0bd9a320d863a9110a3f5cf4d6", "B1"},
+      {"rcl_interfaces/srv/GetParameters_Response", "RIHS01_9fa773b46e39cc5d02db6224d8fd520bb9caeeffc2b27c96c1e59431baba9f2a", "B1"},
+      {"rcl_interfaces/srv/GetParameters_Event", "RIHS01_84eeb9247b09067c35bd8750d5c8555b700e394a616737c4624f15ae02e64c4d", "B1"},
+      {"rcl_interfaces/srv/ListParameters_Request", "RIHS01_a1b0b5d6b967a5b8ac5bc8563c3ea678f349e312a6a4967227c5a96bc5ce38df", "B1"},
+      {"rcl_interfaces/srv/ListParameters_Response", "RIHS01_31b937b82de3612426be79f231e386259f97e8dc843e3f2845288b4bfa296bdd", "B1"},
+      {"rcl_interfaces/srv/ListParameters_Event", "RIHS01_89c5b5aaf68ec925ae9bbc5569ee21de82959b4d1496dbd498792ad825b9b292", "B1"},
+      {"rcl_interfaces/srv/SetParametersAtomically_Request", "RIHS01_db0bd950ed5ed867a0e90b225e44dea382d762c0762ff3e0ee842190042a59e5", "B1"},
+      {"rcl_interfaces/srv/SetParametersAtomically_Response", "RIHS01_31b1a38c5b0b9d893ee24da45f69638f4561c78461d82d52750f429b534502b8", "B1"},
+      {"rcl_interfaces/srv/SetParametersAtomically_Event", "RIHS01_42fc0821e6e8fcff2b150cefc7d8269f0ce65139e1dc715b15267a4bcf63a189", "B1"},
   };
   return table;
 }

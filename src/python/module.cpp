@@ -583,6 +583,10 @@ PYBIND11_MODULE(_quadcosim, m) {
   using namespace quadcosim;
   using namespace quadcosim::python;
   m.doc() = "quadcosim's compiled core; use the package quadcosim (load_scenario, run, Simulation).";
+  // pybind11's numpy API is looked up once, in a function-local static whose initialiser imports numpy
+  // and lets the GIL go: done first by two Python threads whose controllers step at once, that would
+  // deadlock (one in the static's guard waiting for the GIL, the other holding it). Done here, once.
+  { const py::array_t<double> warm(1); }
 
   py::register_exception<io::ConfigError>(m, "ConfigError", PyExc_ValueError);
   // A Python controller's failure: quadcosim.ControllerError (a RuntimeError) with the controller's own

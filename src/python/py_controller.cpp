@@ -503,8 +503,11 @@ void PyController::prepare_call() {
   call_ = std::move(c);
 }
 
-void PyController::fail_step(const std::string& what, double t, py::object cause) const {
-  throw ControllerError(fmt::format("{}.step at step {} (t = {:g} s): {}", shared_->name, steps_, t, what),
+void PyController::fail_step(const std::string& what, double t, py::object cause) {
+  // A failed step counts too: a node that flies on (--on-controller-error safety) names each failure
+  // by its own step and time, and the next call is the next step.
+  const long long n = steps_++;
+  throw ControllerError(fmt::format("{}.step at step {} (t = {:g} s): {}", shared_->name, n, t, what),
                         std::move(cause));
 }
 

@@ -94,7 +94,7 @@ class PyController final : public control::Controller {
   struct Call;  ///< the step's Python objects (bound method, obs, ref, their arrays)
   PyController(std::shared_ptr<const Shared> shared, pybind11::object object, std::vector<double> values,
                double step_timeout_s, const model::Quadrotor& model);
-  [[noreturn]] void fail_step(const std::string& what, double t, pybind11::object cause = {}) const;
+  [[noreturn]] void fail_step(const std::string& what, double t, pybind11::object cause = {});
   void mirror_attributes(std::span<const std::size_t> which) const;
   void prepare_call();
 
