@@ -190,7 +190,7 @@ ControllerNode::~ControllerNode() {
 }
 
 void ControllerNode::run_controller_on_thread(ControllerThreading threading) {
-  auto on_thread = std::make_unique<ControllerThread>(std::move(controller_));
+  auto on_thread = std::make_unique<ControllerThread>(std::move(controller_), threading.thread_host);
   thread_ = on_thread.get();
   controller_ = std::move(on_thread);
   threading_ = std::move(threading);

@@ -58,6 +58,8 @@ struct ControllerThreading {
   /// Asynchronous steps with kStop: called once, on the controller's thread, with the failure's
   /// message after the node stopped answering (the host ends; controller_failure() has it).
   std::function<void(const std::string&)> on_failure;
+  /// What the controller's thread runs its loop in (ControllerThread::ThreadHost), when set.
+  std::function<void(const std::function<void()>&)> thread_host;
 };
 
 class ControllerNode {

@@ -36,7 +36,7 @@ struct ControllerThread::Shared {
   }
 };
 
-ControllerThread::ControllerThread(std::unique_ptr<control::Controller> controller)
+ControllerThread::ControllerThread(std::unique_ptr<control::Controller> controller, ThreadHost host)
     : shared_(std::make_shared<Shared>()) {
   if (!controller) throw std::invalid_argument("ControllerThread: no controller");
   type_ = std::string(controller->type());
@@ -52,7 +52,13 @@ ControllerThread::ControllerThread(std::unique_ptr<control::Controller> controll
   for (const std::string& n : controller->output_names()) output_names_.push_back(n);
   refresh_values(*controller);
   shared_->controller = std::move(controller);
-  std::thread([shared = shared_] { shared->loop(); }).detach();
+  std::thread([shared = shared_, host = std::move(host)] {
+    if (host) {
+      host([&shared] { shared->loop(); });
+    } else {
+      shared->loop();
+    }
+  }).detach();
 }
 
 ControllerThread::~ControllerThread() {
@@ -178,8 +184,8 @@ void ControllerThread::reset() {
   if (error) std::rethrow_exception(error);
 }
 
-void ControllerThread::step(const control::Observation& observation, const control::Reference& reference,
-                            double dt_s, control::ControllerOutput& out) {
+void ControllerThread::step(const control::Observation& observation, const control::Reference& reference, double dt_s,
+                            control::ControllerOutput& out) {
   auto s = std::make_shared<Step>();
   s->observation = observation;
   s->reference = reference;

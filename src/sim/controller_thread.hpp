@@ -13,9 +13,9 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <exception>
 #include <functional>
-#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -40,9 +40,13 @@ class ControllerThread final : public control::Controller {
     std::exception_ptr error;
   };
 
+  /// What the thread runs its loop in: `host(loop)` must call loop() once (e.g. holding a Python
+  /// thread state for the thread's life, so each call into a Python controller does not make one).
+  using ThreadHost = std::function<void(const std::function<void()>& loop)>;
+
   /// Takes `controller` over and starts the thread (the table, output names and parameter values are
-  /// read here, on the calling thread).
-  explicit ControllerThread(std::unique_ptr<control::Controller> controller);
+  /// read here, on the calling thread), its loop run by `host` when given.
+  explicit ControllerThread(std::unique_ptr<control::Controller> controller, ThreadHost host = {});
   /// Stops the thread. A call still running after 1 s (a controller that never returns) is left
   /// behind: the thread is detached with the controller, and the process may exit around it.
   ~ControllerThread() override;
