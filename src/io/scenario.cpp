@@ -114,7 +114,7 @@ constexpr int kMaxParameterDepth = 3;
 
 // The keys of a `controller:` section that are not parameters: read by read_controller.
 bool controller_section_key(const std::string& key) {
-  return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters";
+  return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters" || key == "python";
 }
 
 void collect_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
@@ -240,10 +240,52 @@ std::shared_ptr<const control::Controller> make_controller_fmu(YamlSection& s, c
   });
 }
 
+std::mutex python_factory_mutex;
+PythonControllerFactory python_factory;
+
+PythonControllerFactory python_controller_factory() {
+  const std::lock_guard lock(python_factory_mutex);
+  return python_factory;
+}
+
 // A `controller:` section: `type` (default paper) and the parameters, for `vehicle`; or `fmu` (with
-// its inputs, outputs and parameters) and the node's and the FMU's parameters.
+// its inputs, outputs and parameters) and the node's and the FMU's parameters; or `python` (type
+// python: a class written in Python, resolved by the installed PythonControllerFactory) and the node's
+// and the class's declared parameters.
 control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle,
                                           const std::filesystem::path& folder, std::optional<FmuSpec>* fmu_spec) {
+  if (s.has("python") || (s.has("type") && s.text("type", "") == "python")) {
+    if (s.has("type") && s.text("type", "") != "python") {
+      s.fail("type",
+             "got '" + s.text("type", "") + "' beside python; the Python class is the controller (type: python)");
+    }
+    if (s.has("fmu")) s.fail("fmu", "beside python; a controller is either an FMU or a Python class");
+    for (const char* key : {"inputs", "outputs", "parameters"}) {
+      if (s.has(key)) s.fail(key, "belongs to an FMU controller; expected fmu: beside it");
+    }
+    const std::string target = s.has("python") ? s.text("python", "") : "";
+    if (target.empty()) {
+      s.fail("python", "missing; expected the controller's class as module:Class (e.g. my_controllers:AltitudePD)");
+    }
+    const PythonControllerFactory factory = python_controller_factory();
+    if (!factory) {
+      s.fail("python",
+             "this quadcosim was built without Python (or runs without an interpreter), so a controller written in "
+             "Python cannot fly here; build with pybind11 and the Python headers (docs/python.md)");
+    }
+    control::ControllerConfig c;
+    c.vehicle = vehicle;
+    try {
+      c.controller = factory(target, folder, vehicle);
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const std::exception& e) {
+      s.fail("python", "got '" + target + "': " + e.what());
+    }
+    if (!c.controller) s.fail("python", "got '" + target + "': no controller was made");
+    read_parameters(s, c, nullptr);
+    return c;
+  }
   if (s.has("fmu")) {
     if (s.has("type") && s.text("type", "") != "fmu") {
       s.fail("type", "got '" + s.text("type", "") + "' beside fmu; the FMU is the controller (leave type out)");
@@ -597,6 +639,11 @@ YAML::Node fmu_node(const FmuSpec& spec) {
   return n;
 }
 }  // namespace
+
+void set_python_controller_factory(PythonControllerFactory factory) {
+  const std::lock_guard lock(python_factory_mutex);
+  python_factory = std::move(factory);
+}
 
 void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source) {
   YamlSection s(fmu_node(spec), source, "");

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -120,6 +122,18 @@ struct Scenario {
   /// `controller: {fmu: ...}`: the FMU flown as the controller (controller.controller is it).
   std::optional<FmuSpec> controller_fmu;
 };
+
+/// What resolves a scenario's `controller: {python: "module:Class"}` (or `type: python`): from the
+/// target text, the scenario file's folder (imports look there first) and the vehicle the controller is
+/// designed for, the configured controller. Throws to refuse (the message becomes the ConfigError at
+/// controller.python). Installed by whatever hosts a Python interpreter: the Python module
+/// (python::install_python_controller_factory) or an executable that embeds one.
+using PythonControllerFactory = std::function<std::shared_ptr<const control::Controller>(
+    const std::string& target, const std::filesystem::path& folder, const model::VehicleParams& vehicle)>;
+
+/// Sets (or with an empty function, removes) the resolver of `controller: {python: ...}`. Without one,
+/// such a scenario is refused: "controller.python: this quadcosim was built without Python ...".
+void set_python_controller_factory(PythonControllerFactory factory);
 
 /// Makes `sc` fly `spec` as its plant (`quadcosim plant --fmu`): loads the FMU, checks the mapping,
 /// sets simulation.plant.external. Throws ConfigError naming `source` (the flag or file) and what

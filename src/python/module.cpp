@@ -9,6 +9,7 @@
 
 #include <stdlib.h>
 
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -18,6 +19,8 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "app/inprocess_run.hpp"
@@ -25,6 +28,7 @@
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
+#include "python/py_controller.hpp"
 #include "sim/simulation.hpp"
 
 namespace py = pybind11;
@@ -132,6 +136,83 @@ PyScenario with_controller(const PyScenario& s, const std::string& controller) {
   io::set_controller_type(r.root, controller);
   r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
   return r;
+}
+
+/// Python controllers given as objects (quadcosim.run(..., controller=obj)) while a scenario naming them
+/// is loaded: the scenario's controller.python names the object's class ("module:Class") and the
+/// module's resolver of controller.python takes the object from here rather than importing it.
+thread_local std::unordered_map<std::string, py::object>* given_controllers = nullptr;
+
+/// The resolver of `controller: {python: ...}` the module installs: a given object, else an import.
+std::shared_ptr<const control::Controller> resolve_python_controller(const std::string& target,
+                                                                     const std::filesystem::path& folder,
+                                                                     const model::VehicleParams& vehicle) {
+  if (given_controllers) {
+    if (const auto it = given_controllers->find(target); it != given_controllers->end()) {
+      try {
+        return make_python_controller(it->second, vehicle);
+      } catch (const ControllerError& e) {
+        throw std::invalid_argument(e.what());
+      }
+    }
+  }
+  return load_python_controller(target, folder, vehicle);
+}
+
+/// "module:Class" of a controller object or class (its class's).
+std::string controller_target(const py::handle& controller) {
+  const py::handle cls = PyType_Check(controller.ptr()) ? controller : py::type::handle_of(controller);
+  return py::str(cls.attr("__module__")).cast<std::string>() + ":" +
+         py::str(cls.attr("__qualname__")).cast<std::string>();
+}
+
+/// The same scenario flown by a Python controller (an instance or a class): its controller section
+/// gets type python and the object's "module:Class", so that the section's and the schedule's
+/// parameters are checked against the object's declared ones. step_timeout_s, when given, is set too.
+PyScenario with_python_controller(const PyScenario& s, const py::object& controller,
+                                  std::optional<double> step_timeout_s) {
+  PyScenario r = s;
+  r.root = s.from_file ? YAML::LoadFile(s.source) : YAML::Clone(s.root);
+  io::set_controller_type(r.root, "python");
+  const std::string target = controller_target(controller);
+  if (r.root["controller"].IsMap()) {
+    r.root["controller"]["python"] = target;
+    if (step_timeout_s)
+      r.root["controller"]["step_timeout_s"] = py::repr(py::float_(*step_timeout_s)).cast<std::string>();
+  }
+  std::unordered_map<std::string, py::object> given = {{target, controller}};
+  given_controllers = &given;
+  try {
+    r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
+  } catch (...) {
+    given_controllers = nullptr;
+    throw;
+  }
+  given_controllers = nullptr;
+  return r;
+}
+
+/// `controller` of run() and Simulation(): None keeps the scenario's, a str is a controller type, anything
+/// else a Python controller (an instance or a class).
+PyScenario with_any_controller(const PyScenario& s, const py::object& controller,
+                               std::optional<double> step_timeout_s) {
+  if (controller.is_none()) {
+    if (!step_timeout_s) return s;
+    if (s.scenario.controller.type() != "python") {
+      throw py::value_error("step_timeout_s: applies to a controller written in Python; this scenario flies '" +
+                            std::string(s.scenario.controller.type()) + "'");
+    }
+    PyScenario r = s;
+    r.root = s.from_file ? YAML::LoadFile(s.source) : YAML::Clone(s.root);
+    r.root["controller"]["step_timeout_s"] = py::repr(py::float_(*step_timeout_s)).cast<std::string>();
+    r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
+    return r;
+  }
+  if (py::isinstance<py::str>(controller)) {
+    if (step_timeout_s) throw py::value_error("step_timeout_s: applies to a controller written in Python");
+    return with_controller(s, controller.cast<std::string>());
+  }
+  return with_python_controller(s, controller, step_timeout_s);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -274,13 +355,15 @@ double stamp_s(const msg::Header& h) { return h.stamp.sec + h.stamp.nanosec * 1e
 /// One vehicle of a scenario, advanced one control period at a time.
 class PySimulation {
  public:
-  PySimulation(const PyScenario& scenario, std::optional<std::uint64_t> seed) : scenario_(scenario.scenario) {
+  PySimulation(const PyScenario& scenario, std::optional<std::uint64_t> seed, const py::object& controller,
+               std::optional<double> step_timeout_s)
+      : scenario_(with_any_controller(scenario, controller, step_timeout_s).scenario) {
     seed_ = seed ? *seed : scenario_.simulation.plant.realism.seed;
     build();
   }
 
   void reset(std::optional<std::uint64_t> seed) {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     if (seed) seed_ = *seed;
     build();
   }
@@ -294,15 +377,22 @@ class PySimulation {
       }
       command = model::Vector4(omega_cmd->at(0), omega_cmd->at(1), omega_cmd->at(2), omega_cmd->at(3));
     }
+    auto lock = guard();
     py::gil_scoped_release release;
-    std::lock_guard lock(mutex_);
+    stepping_ = std::this_thread::get_id();
+    struct Done {
+      PySimulation& s;
+      ~Done() {
+        s.sim_->override_command(std::nullopt);
+        s.stepping_ = std::thread::id();
+      }
+    } done{*this};
     sim_->override_command(command);
     for (int i = 0; i < divider(); ++i) sim_->tick(next_tick_++);
-    sim_->override_command(std::nullopt);
   }
 
   void set_setpoint(const py::kwargs& values) {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     static const std::map<std::string, std::string> names = {
         {"x", "x_des"},         {"y", "y_des"},     {"z", "z_des"},  {"roll", "roll_des"},
         {"pitch", "pitch_des"}, {"yaw", "yaw_des"}, {"mode", "mode"}};
@@ -326,21 +416,21 @@ class PySimulation {
   }
 
   double t() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     return scenario_.simulation.plant.clock.seconds(next_tick_);
   }
   sim::Tick tick() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     return next_tick_;
   }
   double dt() const { return scenario_.simulation.plant.clock.period_s() * divider(); }
   std::uint64_t seed() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     return seed_;
   }
 
   py::dict state() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     const model::State& x = sim_->plant().state();
     py::dict d;
     d["p"] = array({x.p_W.x(), x.p_W.y(), x.p_W.z()});
@@ -352,13 +442,13 @@ class PySimulation {
   }
 
   py::array_t<double> command() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     const model::Vector4& c = sim_->plant().latched_command();
     return array({c[0], c[1], c[2], c[3]});
   }
 
   py::dict sensors() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     py::dict d;
     if (pose_) {
       d["pose"] =
@@ -385,7 +475,7 @@ class PySimulation {
   }
 
   py::dict setpoint() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     const control::Setpoint& s = sim_->controller().settings().setpoint;
     py::dict d;
     d["mode"] = s.mode == control::Mode::kPosition ? "position" : "attitude";
@@ -399,7 +489,7 @@ class PySimulation {
   }
 
   std::string repr() {
-    std::lock_guard lock(mutex_);
+    auto lock = guard();
     return "<quadcosim.Simulation '" + scenario_.name +
            "' t=" + py::repr(py::float_(scenario_.simulation.plant.clock.seconds(next_tick_))).cast<std::string>() +
            " s, seed " + std::to_string(seed_) + ">";
@@ -407,6 +497,18 @@ class PySimulation {
 
  private:
   int divider() const { return scenario_.simulation.controller_divider; }
+
+  /// The lock of this simulation, taken with the GIL released (a step holds the lock and takes the GIL
+  /// to call a Python controller). Refused from inside a step of this simulation on its own thread (a
+  /// Python controller calling back into the simulation that steps it).
+  std::unique_lock<std::mutex> guard() {
+    if (stepping_.load() == std::this_thread::get_id()) {
+      throw std::runtime_error(
+          "Simulation: called from inside its own step (a Python controller cannot use the simulation that flies it)");
+    }
+    py::gil_scoped_release release;
+    return std::unique_lock<std::mutex>(mutex_);
+  }
 
   void build() {
     io::Scenario sc = scenario_;
@@ -440,7 +542,8 @@ class PySimulation {
   std::optional<msg::PoseStamped> pose_;
   std::optional<msg::TwistStamped> velocity_;
   std::optional<msg::Imu> imu_;
-  std::mutex mutex_;  ///< one thread steps or reads at a time (stepping runs without the GIL)
+  std::mutex mutex_;                         ///< one thread steps or reads at a time (stepping runs without the GIL)
+  std::atomic<std::thread::id> stepping_{};  ///< the thread inside step(), if any
 };
 
 }  // namespace
@@ -453,6 +556,31 @@ PYBIND11_MODULE(_quadcosim, m) {
   m.doc() = "quadcosim's compiled core; use the package quadcosim (load_scenario, run, Simulation).";
 
   py::register_exception<io::ConfigError>(m, "ConfigError", PyExc_ValueError);
+  // A Python controller's failure: quadcosim.ControllerError (a RuntimeError) with the controller's own
+  // exception as __cause__; a KeyboardInterrupt (or SystemExit) inside a step passes as it is.
+  static auto* controller_error = new py::object(py::reinterpret_steal<py::object>(
+      PyErr_NewExceptionWithDoc("quadcosim.ControllerError",
+                                "A Python controller failed: its step raised, returned what cannot be commanded "
+                                "(wrong shape, not numbers, not finite) or overran step_timeout_s. The message "
+                                "names the controller, the step and its time; __cause__ is the Python exception.",
+                                PyExc_RuntimeError, nullptr)));
+  m.attr("ControllerError") = *controller_error;
+  m.attr("StepTimeout") = step_timeout_type();
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const ControllerError& e) {
+      py::object cause = e.python_error();
+      if (e.interrupt()) {
+        PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(cause.ptr())), cause.ptr());
+        return;
+      }
+      py::object error = (*controller_error)(e.what());
+      if (!cause.is_none()) PyException_SetCause(error.ptr(), cause.release().ptr());
+      PyErr_SetObject(controller_error->ptr(), error.ptr());
+    }
+  });
+  io::set_python_controller_factory(&resolve_python_controller);
 
   py::class_<PyScenario>(m, "Scenario", R"(A validated scenario (see docs/scenarios.md for every key).
 
@@ -501,6 +629,9 @@ Made by quadcosim.load_scenario(path_or_dict); pass it to quadcosim.run() or qua
         "Validates a scenario given as a dict with the keys of a scenario file.");
   m.def("_with_controller", &with_controller, py::arg("scenario"), py::arg("controller"),
         "The same scenario flown by another controller type.");
+  m.def("_with_any_controller", &with_any_controller, py::arg("scenario"), py::arg("controller"),
+        py::arg("step_timeout_s") = py::none(),
+        "The same scenario flown by a controller type (str) or a Python controller (instance or class).");
   m.def("_run", &run, py::arg("scenario"), py::arg("out"), py::arg("force") = false,
         "Runs a scenario in process as `quadcosim run` does; the parts of a RunResult.");
 
@@ -520,10 +651,16 @@ period) of the run's trajectory, bit for bit.
 
 Scheduled parameter changes of the scenario apply at their times; a scenario with a trajectory
 follows it and ignores set_setpoint's position and yaw.)")
-      .def(py::init<const PyScenario&, std::optional<std::uint64_t>>(), py::arg("scenario"),
-           py::arg("seed") = py::none(),
-           "Builds the vehicle and controller at t = 0. seed replaces the scenario's seed of sensor noise, wind "
-           "and injected message faults (None keeps realism.seed).")
+      .def(py::init<const PyScenario&, std::optional<std::uint64_t>, const py::object&, std::optional<double>>(),
+           py::arg("scenario"), py::arg("seed") = py::none(), py::kw_only(), py::arg("controller") = py::none(),
+           py::arg("step_timeout_s") = py::none(),
+           R"(Builds the vehicle and controller at t = 0.
+
+controller: None keeps the scenario's; a str is a controller type (as --controller); anything else is a
+controller written in Python, an instance or a class (see docs/python.md, "Write a controller in
+Python"): each Simulation flies its own copy.deepcopy of the configured object.
+seed replaces the scenario's seed of sensor noise, wind and injected message faults (None keeps
+realism.seed). step_timeout_s: the per-step time limit of a Python controller (0: none).)")
       .def("step", &PySimulation::step, py::arg("omega_cmd") = py::none(),
            R"(Advances one control period (sim.dt seconds, several plant ticks).
 

@@ -22,10 +22,11 @@ from typing import Any, Dict, Optional, Union
 
 import numpy  # noqa: F401  (the arrays the module returns; fail here, clearly, without it)
 
-from ._quadcosim import ConfigError, Scenario, Simulation
+from ._quadcosim import ConfigError, ControllerError, Scenario, Simulation, StepTimeout
 from . import _quadcosim
 
-__all__ = ["ConfigError", "Scenario", "Simulation", "RunResult", "load_scenario", "run"]
+__all__ = ["ConfigError", "ControllerError", "StepTimeout", "Scenario", "Simulation", "RunResult", "load_scenario",
+           "run"]
 
 ScenarioLike = Union[Scenario, dict, str, "os.PathLike[str]"]
 
@@ -87,7 +88,7 @@ _HEADER_KEYS = {"scenario", "description", "passed", "controller", "schema", "ve
 
 
 def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = None,
-        controller: Optional[str] = None, force: bool = False) -> RunResult:
+        controller: Any = None, force: bool = False, step_timeout_s: Optional[float] = None) -> RunResult:
     """Runs a scenario in process, as `quadcosim run SCENARIO --out OUT --no-plots` does.
 
     scenario: a Scenario, a scenario file or a dict (see load_scenario).
@@ -96,7 +97,13 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
         metadata.yaml, metrics.json, metrics.txt and scenario.yaml, the same bytes as the CLI writes
         (the PNG plots and report.html are not made: `quadcosim plot OUT` makes them). Without out the
         run is recorded in a temporary folder that is removed.
-    controller: a controller type replacing the scenario's (as --controller).
+    controller: a controller type replacing the scenario's (a str, as --controller), or a controller
+        written in Python: an instance or a class with step(obs, ref, dt) (see Controller and
+        docs/python.md). The run flies a copy.deepcopy of the configured object (the object passed is
+        not stepped). A failing Python controller raises ControllerError naming the step.
+    step_timeout_s: the per-step time limit of a Python controller [s] (None keeps the scenario's or
+        the class's, default 0: no limit); a step that runs longer is stopped with StepTimeout and the
+        run raises ControllerError.
 
     Ctrl-C raises KeyboardInterrupt within a few thousand plant ticks; out then holds what ran, as
     after an interrupted `quadcosim run`.
@@ -104,10 +111,9 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
     Returns a RunResult (trajectory, figures, passed, ...). Raises ConfigError for a bad scenario,
     ValueError when out cannot be used (it holds other outputs), RuntimeError on an I/O error.
     """
-    if isinstance(scenario, Scenario):
-        sc = load_scenario(scenario, controller) if controller else scenario
-    else:
-        sc = load_scenario(scenario, controller)
+    sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if controller is not None or step_timeout_s is not None:
+        sc = _quadcosim._with_any_controller(sc, controller, step_timeout_s)
     r = _quadcosim._run(sc, None if out is None else os.fspath(out), force)
     metrics = json.loads(r["metrics_json"])
     figures = {k: v for k, v in metrics.items() if k not in _HEADER_KEYS}
