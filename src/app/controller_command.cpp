@@ -110,6 +110,7 @@ int controller_command(const ControllerCommandOptions& o) {
     const std::filesystem::path folder =
         o.scenario.empty() ? std::filesystem::path() : std::filesystem::path(o.scenario).parent_path();
     sc.controller.controller = make_python_controller(o.python, folder, sc.controller.vehicle, "--python");
+    sc.controller_fmu.reset();
   }
   if (o.swarm.vehicles > 0) {
     if (sc.controller.type() == "python") {

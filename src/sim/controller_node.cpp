@@ -5,6 +5,8 @@
 #include <iostream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "model/attitude.hpp"
 #include "sim/controller_thread.hpp"
 
@@ -232,7 +234,7 @@ void ControllerNode::step_on_thread(std::int64_t now_ns, std::int64_t sim_now_ns
   job->reference = reference_;
   job->dt_s = dt_s;
   job->output.outputs.assign(output_.outputs.size(), 0.0);
-  const auto seconds = [](std::int64_t ns) { return std::to_string(static_cast<double>(ns) / 1e9); };
+  const auto seconds = [](std::int64_t ns) { return fmt::format("{:g}", static_cast<double>(ns) / 1e9); };
 
   if (threading_.asynchronous) {
     {

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <thread>
 
@@ -98,9 +99,19 @@ TEST(ControllerThread, ABlockedStepLeavesParametersReadableAndRefusesSets) {
   Instrumented* c = owned.get();
   c->block = true;
   ControllerThread thread(std::move(owned));
-  const std::string name(thread.parameters().front().name);
+  // A numeric parameter above its minimum: halfway down to the minimum is a valid change.
+  std::string name;
+  double lower = 0.0;
+  for (const control::ParameterSpec& spec : thread.parameters()) {
+    const auto v = thread.get_parameter(spec.name);
+    if (!spec.is_choice() && v && std::get<double>(*v) > spec.min && std::isfinite(spec.min)) {
+      name = std::string(spec.name);
+      lower = (std::get<double>(*v) + spec.min) / 2;
+      break;
+    }
+  }
+  ASSERT_FALSE(name.empty());
   const auto before = thread.get_parameter(name);
-  ASSERT_TRUE(before.has_value());
 
   auto step = std::make_shared<ControllerThread::Step>();
   step->observation = f.obs;
@@ -115,7 +126,7 @@ TEST(ControllerThread, ABlockedStepLeavesParametersReadableAndRefusesSets) {
   EXPECT_EQ(thread.get_parameter(name), before) << "read from the values as of the last return";
 
   const auto t0 = std::chrono::steady_clock::now();
-  const control::Setting s{name, std::get<double>(*before) * 1.01};
+  const control::Setting s{name, lower};
   const std::string refused = thread.set_parameters(std::span(&s, 1));
   const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_NE(refused.find("the controller is busy"), std::string::npos) << refused;
@@ -158,7 +169,8 @@ TEST(ControllerThread, AStepThatNeverReturnsIsLeftBehindAfterOneSecond) {
     ControllerThread thread(std::move(owned));
     auto step = std::make_shared<ControllerThread::Step>();
     step->output.outputs.assign(thread.output_names().size(), 0.0);
-    ASSERT_TRUE(thread.start(step, [](ControllerThread::Step&) { ADD_FAILURE() << "continuation after the owner left"; }));
+    ASSERT_TRUE(
+        thread.start(step, [](ControllerThread::Step&) { ADD_FAILURE() << "continuation after the owner left"; }));
   }
   const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_NEAR(waited, 1.0, 0.3);
