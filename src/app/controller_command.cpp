@@ -176,8 +176,13 @@ int controller_command(const ControllerCommandOptions& o) {
                                static_cast<double>(stamp_ns) / 1e9);
     };
     h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
+      // On a thread, the safety command also stands in for a late or failed step (counted and logged).
+      const bool stale = node.observation().age_s > node.settings().stale_limit_s;
       std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
-                               safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
+                               safety                ? (stale || !on_thread ? "stale sensor data: safety command"
+                                                                            : "no answer from the controller: safety command")
+                               : stale || !on_thread ? "sensor data fresh again: normal control"
+                                                     : "the controller answers again: normal control",
                                node.observation().age_s, node.settings().stale_limit_s, static_cast<double>(now) / 1e9);
     };
     DdsDriverHost host(transport, /*precise_deadlines=*/true);

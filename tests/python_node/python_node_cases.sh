@@ -166,7 +166,7 @@ case "$case_name" in
     grep -qx "Double value is: 4.0" "$tmp/get.log" || fail "param get: $(cat "$tmp/get.log")"
     set +e; wait "$ppid"; prc=$?; set -e
     [ "$prc" -eq 4 ] || fail "the plant exited $prc, expected 4 (lockstep timeout, --on-timeout abort)"
-    grep -q "lockstep timeout: no motor command on /drone/motor_commands for tick 10 " "$tmp/plant.log" \
+    grep -qE "lockstep timeout: no motor command on /drone/motor_commands for tick 1[01] " "$tmp/plant.log" \
       || fail "the plant did not time out on tick 10 (step 5's answer)"
     "$bin" param get /attitude_controller kp_z --timeout 2 > "$tmp/get2.log" 2>&1 || fail "param get failed after the plant"
     term_within "$cpid" 2
@@ -176,6 +176,8 @@ case "$case_name" in
   run_and_sweep)  # `run` and `sweep` of a scenario with controller: {python: ...}; sweep runs = single runs
     need_python
     scenario AltitudePD "" 6 "$tmp/pd.yaml"
+    # Something for the sweep to judge: the step's overshoot, loosely.
+    printf 'analysis:\n  steps:\n    - channel: z\n      at_s: 0\n      criteria:\n        overshoot_pct: [null, 50]\n' >> "$tmp/pd.yaml"
     export PYTHONPATH="$here"  # the sweep's copy of the scenario is in --out, without the module
     "$bin" sweep "$tmp/pd.yaml" --runs 3 --jobs 2 --seed 7 --vary mass=10% --keep all --min-pass-rate 0 \
       --out "$tmp/sweep" > "$tmp/sweep.log" 2>&1 || fail "sweep failed"
