@@ -221,9 +221,10 @@ bool ControllerNode::controller_failed(const std::exception_ptr& error, std::int
     return false;
   }
   if (failure_log_.count()) {
-    log_("controller: " + what +
-         "; the safety command was sent instead (t = " + std::to_string(static_cast<double>(sim_now_ns) / 1e9) +
-         " s); " + std::to_string(failure_log_.total()) + " failed steps so far (logged: 1st, then every 100th)");
+    log_(
+        fmt::format("controller: {}; the safety command was sent instead (t = {:g} s); {} failed steps so far "
+                    "(logged: 1st, then every 100th)",
+                    what, static_cast<double>(sim_now_ns) / 1e9, failure_log_.total()));
   }
   return true;
 }

@@ -1,5 +1,6 @@
 // The CLI's embedded Python (app/python_host.hpp), built when Python and pybind11 are found.
 #include <pybind11/embed.h>
+#include <pybind11/numpy.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -33,6 +34,11 @@ void start_python() {
       py::list path = py::module_::import("sys").attr("path");
       if (fs::exists(fs::path(QUADCOSIM_PYTHON_PACKAGE_DIR) / "quadcosim")) path.append(QUADCOSIM_PYTHON_PACKAGE_DIR);
     }
+    // pybind11's numpy API is looked up once, in a function-local static whose initialisation imports
+    // numpy (and so lets the GIL go): first done by two threads at once (a sweep's first steps), one
+    // waits for the GIL inside the static's guard while the other holds the GIL and waits for the
+    // guard. Done here, before any other thread can take the GIL.
+    { const py::array_t<double> warm(1); }
     g_running = true;
     PyEval_SaveThread();  // never restored: every later use takes the GIL with gil_scoped_acquire
   });
