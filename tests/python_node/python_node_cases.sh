@@ -70,7 +70,7 @@ case "$case_name" in
 
   param_set)  # a declared Python parameter changed with `quadcosim param set` mid-run takes effect
     need_python
-    # kp_z 0: thrust m g only, the vehicle stays on the ground; kp_z 4 from about 1.5 s on: it climbs.
+    # kp_z 0: thrust m g only, the vehicle stays on the ground; kp_z 4 from about 3 s on: it climbs.
     scenario AltitudePD ", kp_z: 0" 6 "$tmp/pd.yaml"
     "$bin" controller --scenario "$tmp/pd.yaml" --realtime > "$tmp/controller.log" 2>&1 &
     pids+=($!)
@@ -78,7 +78,7 @@ case "$case_name" in
     grep -qx "Double value is: 0.0" "$tmp/get0.log" || fail "kp_z does not start at 0: $(cat "$tmp/get0.log")"
     "$bin" plant --scenario "$tmp/pd.yaml" --realtime --record "$tmp/t.csv" > "$tmp/plant.log" 2>&1 &
     ppid=$!; pids+=("$ppid")
-    sleep 1.5
+    sleep 3  # the plant's simulated clock is well past 1 s by then, also on a loaded machine
     "$bin" param set /attitude_controller kp_z 4.0 > "$tmp/set.log" 2>&1 || fail "param set failed"
     grep -qx "Set parameter successful" "$tmp/set.log" || fail "param set: unexpected output"
     "$bin" param get /attitude_controller kp_z > "$tmp/get.log" 2>&1 || fail "param get failed"
