@@ -152,6 +152,8 @@ struct ControllerCommandOptions {
   std::string params;      ///< controller parameter file, applied over the scenario's
   std::string vehicle;     ///< vehicle file (the controller's model of the vehicle)
   std::string fmu;         ///< --fmu: a co-simulation FMU flown as the controller (default variable names)
+  std::string python;      ///< --python module:Class: a controller written in Python
+  std::string on_controller_error = "stop";  ///< a failed step: "stop" the node or send the "safety" command
   std::string ns;
   bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
   std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)

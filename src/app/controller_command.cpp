@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <iostream>
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
+#include "app/python_host.hpp"
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
@@ -40,6 +42,19 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
       ->check(CLI::ExistingPath)
       ->excludes("--controller")
       ->excludes("--params");
+  ctl_cmd
+      ->add_option("--python", ctl.python,
+                   "fly a controller written in Python, MODULE:CLASS (the module found in the scenario's folder, "
+                   "the current directory or PYTHONPATH; replaces the scenario's controller, keeps its setpoints; "
+                   "docs/python.md)")
+      ->excludes("--controller")
+      ->excludes("--params")
+      ->excludes("--fmu");
+  ctl_cmd
+      ->add_option("--on-controller-error", ctl.on_controller_error,
+                   "a Python controller's step that raises or returns garbage: stop the node (exit 5), or send the "
+                   "stale-data safety command for that step and keep flying (counted, logged)")
+      ->check(CLI::IsMember({"stop", "safety"}));
   add_node_host_options(ctl_cmd, ctl.ns, ctl.swarm, ctl.sensor_qos,
                         "subscribe Pose/Velocity/Imu best effort (ROS sensor data QoS)", ctl.cpus);
   ctl_cmd->add_flag("!--realtime", ctl.lockstep, "step on a wall-clock timer instead of lockstep (one vehicle)");
@@ -67,6 +82,7 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
             {"--realtime", !swarm, "--vehicles; a swarm runs in lockstep only"},
             {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
             {"--node-name", !swarm, "--vehicles; a swarm offers no parameter services"},
+            {"--python", !swarm, "--vehicles; a Python controller flies one vehicle"},
             {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
             {"--threads", swarm, "one vehicle; it needs --vehicles N"},
             {"--rate-factor", realtime, "lockstep; it needs --realtime"},
@@ -89,15 +105,42 @@ int controller_command(const ControllerCommandOptions& o) {
     sc.controller.trajectory = trajectory;
   }
   if (!o.fmu.empty()) io::use_controller_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu");
-  if (o.swarm.vehicles > 0) return swarm_controller_command(o, std::move(sc));
+  if (!o.python.empty()) {
+    // Replaces the controller only: the node's setpoints, safety and trajectory stay the scenario's.
+    const std::filesystem::path folder =
+        o.scenario.empty() ? std::filesystem::path() : std::filesystem::path(o.scenario).parent_path();
+    sc.controller.controller = make_python_controller(o.python, folder, sc.controller.vehicle, "--python");
+    sc.controller_fmu.reset();
+  }
+  if (o.swarm.vehicles > 0) {
+    if (sc.controller.type() == "python") {
+      throw io::ConfigError("controller: a Python controller flies one vehicle (no --vehicles)");
+    }
+    return swarm_controller_command(o, std::move(sc));
+  }
   const sim::TickClock clock = sc.simulation.plant.clock;
   const std::int64_t control_period_ns = clock.period_ns * sc.simulation.controller_divider;
   const double dt_s = static_cast<double>(control_period_ns) / 1e9;
+  const auto wall_period_ns =
+      static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.realtime.rate_factor);
   const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
 
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   if (o.sensor_qos) use_sensor_qos(transport, topics);
   sim::ControllerNode node(transport, topics, sc.controller);
+  // A controller written in Python runs on a thread of its own (docs/python.md): one that blocks holds
+  // up neither the DDS threads (discovery, parameter services) nor a stop.
+  const bool on_thread = sc.controller.type() == "python";
+  if (on_thread) {
+    sim::ControllerThreading threading;
+    threading.asynchronous = o.lockstep;
+    threading.wait_ns = wall_period_ns * 3 / 4;
+    threading.on_error = o.on_controller_error == "safety" ? sim::ControllerThreading::OnError::kSafety
+                                                           : sim::ControllerThreading::OnError::kStop;
+    threading.on_failure = [](const std::string&) { request_stop(); };
+    threading.thread_host = python_thread_host();
+    node.run_controller_on_thread(std::move(threading));
+  }
   const dds::NodeName ros_name = dds::parse_node_name(o.one_vehicle.node_name);
   // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
   dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
@@ -107,7 +150,9 @@ int controller_command(const ControllerCommandOptions& o) {
   std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s, controller {}\n",
                            transport.participant().domain_id(), sc.simulation.ns, o.lockstep ? "lockstep" : "real-time",
                            dt_s,
-                           sc.controller_fmu ? "fmu " + sc.controller_fmu->path : std::string(sc.controller.type()));
+                           sc.controller_fmu   ? "fmu " + sc.controller_fmu->path
+                           : !o.python.empty() ? "python " + o.python
+                                               : std::string(sc.controller.type()));
 
   if (o.lockstep) {
     // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
@@ -123,8 +168,6 @@ int controller_command(const ControllerCommandOptions& o) {
     if (std::string err = use_realtime_priority(o.realtime.rt_priority); !err.empty()) {
       std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
     }
-    const auto wall_period_ns =
-        static_cast<std::int64_t>(static_cast<double>(control_period_ns) / o.realtime.rate_factor);
     PeriodJitter jitter(wall_period_ns);
     drivers::RealtimeControllerHooks h;
     h.on_wake = [&](std::int64_t now) { jitter.add(now); };
@@ -133,8 +176,13 @@ int controller_command(const ControllerCommandOptions& o) {
                                static_cast<double>(stamp_ns) / 1e9);
     };
     h.on_safety = [&](std::size_t, bool safety, std::int64_t now) {
+      // On a thread, the safety command also stands in for a late or failed step (counted and logged).
+      const bool stale = node.observation().age_s > node.settings().stale_limit_s;
       std::cerr << fmt::format("controller: {} (sensor data age {:.3f} s, limit {:g} s; monotonic {:.6f} s)\n",
-                               safety ? "stale sensor data: safety command" : "sensor data fresh again: normal control",
+                               safety                ? (stale || !on_thread ? "stale sensor data: safety command"
+                                                                            : "no answer from the controller: safety command")
+                               : stale || !on_thread ? "sensor data fresh again: normal control"
+                                                     : "the controller answers again: normal control",
                                node.observation().age_s, node.settings().stale_limit_s, static_cast<double>(now) / 1e9);
     };
     DdsDriverHost host(transport, /*precise_deadlines=*/true);
@@ -142,6 +190,12 @@ int controller_command(const ControllerCommandOptions& o) {
                                              o.realtime.rate_factor, std::move(h), host);
     driver.run();
     if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
+  }
+  if (std::optional<std::string> failure = node.controller_failure()) throw sim::ControllerFailure(*failure);
+  if (on_thread && (node.controller_failures() > 0 || node.late_steps() > 0)) {
+    std::cerr << fmt::format(
+        "controller: {} failed steps (safety command sent instead), {} {}\n", node.controller_failures(),
+        node.late_steps(), o.lockstep ? "ticks not answered (controller busy)" : "late periods (safety command sent)");
   }
   std::cerr << "controller: stopped\n";
   return exit_code::kOk;

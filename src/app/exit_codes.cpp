@@ -11,6 +11,7 @@
 #include "dds/parameter_client.hpp"
 #include "io/scenario.hpp"
 #include "security/keystore.hpp"
+#include "sim/controller_node.hpp"
 
 namespace quadcosim::app {
 
@@ -29,6 +30,10 @@ const std::vector<ExitCodeRow>& exit_code_table() {
       {kOutput, "an output could not be written, or a tool or system call failed", "*"},
       {kNoPeer, "lockstep: the peer did not answer within --timeout, or the controller exited early", "run plant"},
       {kNoPeer, "the node was not found, or did not answer within --timeout", "param"},
+      {kControllerFailed,
+       "the controller's step failed: it raised or returned garbage (the message names the controller, the "
+       "step and its time)",
+       "controller"},
       {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant"},
   };
   return table;
@@ -72,6 +77,9 @@ int run_guarded(const std::string& command, const std::function<int()>& body) {
   } catch (const security::KeystoreError& e) {
     std::cerr << "error: " << command << ": " << e.what() << '\n';
     return exit_code::kBadInput;
+  } catch (const sim::ControllerFailure& e) {  // names the controller, the step and its time
+    std::cerr << "error: " << command << ": " << e.what() << '\n';
+    return exit_code::kControllerFailed;
   } catch (const dds::ParameterCallError& e) {
     std::cerr << "error: " << e.what() << '\n';
     return exit_code::kNoPeer;

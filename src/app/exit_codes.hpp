@@ -17,12 +17,13 @@ namespace quadcosim::app {
 /// The values a command returns (main() returns them as the process status).
 namespace exit_code {
 enum : int {
-  kOk = 0,            ///< done; every criterion passed
-  kFailed = 1,        ///< done, but the verdict is "no" (a criterion failed, a check found problems, ...)
-  kBadInput = 2,      ///< a file, flag or value was wrong (the message names it); nothing was run
-  kOutput = 3,        ///< an output could not be written, or a tool or system call failed
-  kNoPeer = 4,        ///< a DDS peer did not answer in time (lockstep timeout, no such node)
-  kInterrupted = 130  ///< SIGINT / SIGTERM (Ctrl-C) before the end; the outputs hold what ran
+  kOk = 0,                ///< done; every criterion passed
+  kFailed = 1,            ///< done, but the verdict is "no" (a criterion failed, a check found problems, ...)
+  kBadInput = 2,          ///< a file, flag or value was wrong (the message names it); nothing was run
+  kOutput = 3,            ///< an output could not be written, or a tool or system call failed
+  kNoPeer = 4,            ///< a DDS peer did not answer in time (lockstep timeout, no such node)
+  kControllerFailed = 5,  ///< the controller node's controller failed (raised, returned garbage)
+  kInterrupted = 130      ///< SIGINT / SIGTERM (Ctrl-C) before the end; the outputs hold what ran
 };
 }
 
@@ -45,8 +46,8 @@ void add_exit_code_footers(CLI::App& app);
 
 /// Runs `body` (a command), mapping what it throws to an exit code after printing it on stderr:
 /// io::ConfigError, std::invalid_argument, control::CareError, security::KeystoreError -> kBadInput;
-/// dds::ParameterCallError -> kNoPeer; any other std::exception -> kOutput. `command` names the
-/// command in messages that would not otherwise say where they come from.
+/// dds::ParameterCallError -> kNoPeer; sim::ControllerFailure -> kControllerFailed; any other std::exception ->
+/// kOutput. `command` names the command in messages that would not otherwise say where they come from.
 int run_guarded(const std::string& command, const std::function<int()>& body);
 
 }  // namespace quadcosim::app

@@ -10,6 +10,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/python_host.hpp"
 
 namespace {
 
@@ -89,8 +90,15 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? exit_code::kOk : exit_code::kBadInput;
   }
+  // A scenario's `controller: {python: ...}` resolves through the embedded Python (started on first
+  // use only).
+  install_python_controllers();
   for (const Subcommand& c : commands) {
-    if (*c.cli) return run_guarded(c.cli->get_name(), c.run);
+    if (*c.cli) {
+      const int code = run_guarded(c.cli->get_name(), c.run);
+      python_at_exit();
+      return code;
+    }
   }
   return exit_code::kBadInput;
 }

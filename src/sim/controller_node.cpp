@@ -5,7 +5,10 @@
 #include <iostream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "model/attitude.hpp"
+#include "sim/controller_thread.hpp"
 
 namespace quadcosim::sim {
 
@@ -77,21 +80,21 @@ bool finite(const control::Observation& e) {
 }
 }  // namespace
 
-void ControllerNode::safety_output() {
+void ControllerNode::safety_output(const control::Reference& ref, control::ControllerOutput& out) const {
   // Algorithm 1, lines 3-5: every rotor at one speed; nothing else is decided. The attitude shown as
   // tracked is the reference's in attitude mode and level in position mode.
   const double w =
       settings_.safety == control::SafetyMode::kHover ? vehicle_.hover_omega_rad_s() : vehicle_.motor.omega_min_rad_s;
-  output_.omega_rad_s.setConstant(w);
-  output_.U.setZero();
-  const bool attitude = reference_.mode == control::Mode::kAttitude;
-  output_.roll_des_rad = attitude ? reference_.roll_rad : 0.0;
-  output_.pitch_des_rad = attitude ? reference_.pitch_rad : 0.0;
-  output_.yaw_des_rad = 0.0;
-  output_.attitude_error = std::numeric_limits<double>::quiet_NaN();
-  output_.rotor_saturated = {};
-  output_.tilt_saturated = false;
-  std::fill(output_.outputs.begin(), output_.outputs.end(), std::numeric_limits<double>::quiet_NaN());
+  out.omega_rad_s.setConstant(w);
+  out.U.setZero();
+  const bool attitude = ref.mode == control::Mode::kAttitude;
+  out.roll_des_rad = attitude ? ref.roll_rad : 0.0;
+  out.pitch_des_rad = attitude ? ref.pitch_rad : 0.0;
+  out.yaw_des_rad = 0.0;
+  out.attitude_error = std::numeric_limits<double>::quiet_NaN();
+  out.rotor_saturated = {};
+  out.tilt_saturated = false;
+  std::fill(out.outputs.begin(), out.outputs.end(), std::numeric_limits<double>::quiet_NaN());
 }
 
 void ControllerNode::update_reference(std::int64_t now_ns) {
@@ -140,41 +143,158 @@ const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, doubl
   const std::int64_t sim_now_ns = receipt_clock_ ? std::max<std::int64_t>(newest_stamp_ns(), 0) : now_ns;
   update_reference(sim_now_ns);
   // Algorithm 1, lines 3-5, for every controller.
-  output_.safety = !(observation_.age_s <= settings_.stale_limit_s) || !finite(observation_);
+  const bool safety = !(observation_.age_s <= settings_.stale_limit_s) || !finite(observation_);
+  if (thread_ && !safety) {
+    step_on_thread(now_ns, sim_now_ns, dt_s);
+    return output_;
+  }
+  const std::lock_guard lock(publish_mutex_);
+  output_.safety = safety;
   if (output_.safety) {
     safety_output();
   } else {
     controller_->step(observation_, reference_, dt_s, output_);
   }
-
-  const auto& ref = reference_;
-  status_.header.stamp = msg::Time::from_ns(sim_now_ns);
-  if (const char* mode = control::to_string(ref.mode); status_.mode != mode) status_.mode = mode;
-  status_.setpoint = {ref.p_W.x(), ref.p_W.y(), ref.p_W.z(), output_.roll_des_rad, output_.pitch_des_rad, ref.yaw_rad};
-  for (int i = 0; i < 3; ++i) status_.position_error[i] = ref.p_W[i] - observation_.p_W[i];
-  status_.yaw_error = model::wrap_pi(ref.yaw_rad - observation_.yaw_rad);
-  status_.attitude_error = output_.attitude_error;
-  for (int i = 0; i < 4; ++i) {
-    status_.u[i] = output_.U[i];
-    status_.rotor_saturated[i] = output_.rotor_saturated[i];
-  }
-  status_.tilt_saturated = output_.tilt_saturated;
-  status_.safety = output_.safety;
-  status_.rejected_non_finite = fault_log_[static_cast<int>(SensorFault::kNonFinite)].total();
-  status_.rejected_bad_quaternion = fault_log_[static_cast<int>(SensorFault::kBadQuaternion)].total();
-  status_.rejected_bad_stamp = fault_log_[static_cast<int>(SensorFault::kBadStamp)].total();
-  status_.rejected_stamp_backwards = fault_log_[static_cast<int>(SensorFault::kStampBackwards)].total();
-  status_.outputs = output_.outputs;
-  status_pub_.publish(status_);
-
-  for (int i = 0; i < 4; ++i) command_msg_.data[i] = output_.omega_rad_s[i];
-  msg::write_command_label(command_msg_.dim[0].label, sim_now_ns);
-  command_pub_.publish(command_msg_);
+  publish(observation_, reference_, output_, sim_now_ns);
   last_step_ns_ = now_ns;
   return output_;
 }
 
+void ControllerNode::publish(const control::Observation& obs, const control::Reference& ref,
+                             const control::ControllerOutput& out, std::int64_t sim_now_ns) {
+  status_.header.stamp = msg::Time::from_ns(sim_now_ns);
+  if (const char* mode = control::to_string(ref.mode); status_.mode != mode) status_.mode = mode;
+  status_.setpoint = {ref.p_W.x(), ref.p_W.y(), ref.p_W.z(), out.roll_des_rad, out.pitch_des_rad, ref.yaw_rad};
+  for (int i = 0; i < 3; ++i) status_.position_error[i] = ref.p_W[i] - obs.p_W[i];
+  status_.yaw_error = model::wrap_pi(ref.yaw_rad - obs.yaw_rad);
+  status_.attitude_error = out.attitude_error;
+  for (int i = 0; i < 4; ++i) {
+    status_.u[i] = out.U[i];
+    status_.rotor_saturated[i] = out.rotor_saturated[i];
+  }
+  status_.tilt_saturated = out.tilt_saturated;
+  status_.safety = out.safety;
+  status_.rejected_non_finite = fault_log_[static_cast<int>(SensorFault::kNonFinite)].total();
+  status_.rejected_bad_quaternion = fault_log_[static_cast<int>(SensorFault::kBadQuaternion)].total();
+  status_.rejected_bad_stamp = fault_log_[static_cast<int>(SensorFault::kBadStamp)].total();
+  status_.rejected_stamp_backwards = fault_log_[static_cast<int>(SensorFault::kStampBackwards)].total();
+  status_.outputs = out.outputs;
+  status_pub_.publish(status_);
+
+  for (int i = 0; i < 4; ++i) command_msg_.data[i] = out.omega_rad_s[i];
+  msg::write_command_label(command_msg_.dim[0].label, sim_now_ns);
+  command_pub_.publish(command_msg_);
+}
+
+ControllerNode::~ControllerNode() {
+  // The controller's thread first: a step's continuation uses the members below.
+  controller_.reset();
+}
+
+void ControllerNode::run_controller_on_thread(ControllerThreading threading) {
+  auto on_thread = std::make_unique<ControllerThread>(std::move(controller_), threading.thread_host);
+  thread_ = on_thread.get();
+  controller_ = std::move(on_thread);
+  threading_ = std::move(threading);
+}
+
+std::optional<std::string> ControllerNode::controller_failure() const {
+  const std::lock_guard lock(publish_mutex_);
+  return failure_;
+}
+
+bool ControllerNode::controller_failed(const std::exception_ptr& error, std::int64_t sim_now_ns) {
+  std::string what;
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+    what = "the controller's step threw something that is not a std::exception";
+  }
+  if (threading_.on_error == ControllerThreading::OnError::kStop) {
+    if (!threading_.asynchronous) throw ControllerFailure(what);
+    if (!failure_) {
+      failure_ = what;
+      if (threading_.on_failure) threading_.on_failure(what);
+    }
+    return false;
+  }
+  if (failure_log_.count()) {
+    log_(
+        fmt::format("controller: {}; the safety command was sent instead (t = {:g} s); {} failed steps so far "
+                    "(logged: 1st, then every 100th)",
+                    what, static_cast<double>(sim_now_ns) / 1e9, failure_log_.total()));
+  }
+  return true;
+}
+
+void ControllerNode::step_on_thread(std::int64_t now_ns, std::int64_t sim_now_ns, double dt_s) {
+  auto job = std::make_shared<ControllerThread::Step>();
+  job->observation = observation_;
+  job->reference = reference_;
+  job->dt_s = dt_s;
+  job->output.outputs.assign(output_.outputs.size(), 0.0);
+  const auto seconds = [](std::int64_t ns) { return fmt::format("{:g}", static_cast<double>(ns) / 1e9); };
+
+  if (threading_.asynchronous) {
+    {
+      const std::lock_guard lock(publish_mutex_);
+      if (failure_) return;  // the node has stopped answering
+      step_in_flight_ = true;
+    }
+    const bool started = thread_->start(job, [this, sim_now_ns](ControllerThread::Step& s) {
+      const std::lock_guard lock(publish_mutex_);
+      step_in_flight_ = false;
+      s.output.safety = false;
+      if (s.error) {
+        if (!controller_failed(s.error, sim_now_ns)) return;  // ends the node: nothing published
+        s.output.safety = true;
+        safety_output(s.reference, s.output);
+      }
+      output_ = s.output;
+      publish(s.observation, s.reference, output_, sim_now_ns);
+    });
+    if (!started) {
+      const std::lock_guard lock(publish_mutex_);
+      step_in_flight_ = false;
+      if (late_log_.count()) {
+        log_("controller: tick of t = " + seconds(sim_now_ns) +
+             " s not answered: the controller has not returned from its previous step; " +
+             std::to_string(late_log_.total()) + " ticks not answered so far (logged: 1st, then every 100th)");
+      }
+      return;
+    }
+    last_step_ns_ = now_ns;
+    return;
+  }
+
+  // Real time: wait for the controller up to the limit; the safety command when it is late.
+  const bool returned = thread_->start(job) && thread_->wait_free(threading_.wait_ns);
+  const std::lock_guard lock(publish_mutex_);
+  if (!returned) {
+    output_.safety = true;
+    safety_output();
+    if (late_log_.count()) {
+      log_("controller: the controller did not return within " + seconds(threading_.wait_ns) +
+           " s; the safety command was sent for the period of t = " + seconds(sim_now_ns) + " s; " +
+           std::to_string(late_log_.total()) + " late periods so far (logged: 1st, then every 100th)");
+    }
+  } else if (job->error) {
+    controller_failed(job->error, sim_now_ns);  // throws unless the safety command replaces the step
+    output_.safety = true;
+    safety_output();
+  } else {
+    output_ = job->output;
+    output_.safety = false;
+  }
+  publish(observation_, reference_, output_, sim_now_ns);
+  last_step_ns_ = now_ns;
+}
+
 void ControllerNode::republish() {
+  const std::lock_guard lock(publish_mutex_);
+  if (step_in_flight_) return;  // its continuation publishes the answer
   status_pub_.publish(status_);
   command_pub_.publish(command_msg_);
 }

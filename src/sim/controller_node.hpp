@@ -19,6 +19,10 @@
 #include <string>
 
 #include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+
 #include "control/controller.hpp"
 #include "control/controller_config.hpp"
 #include "sim/messages.hpp"
@@ -28,10 +32,53 @@
 
 namespace quadcosim::sim {
 
+class ControllerThread;
+
+/// A controller's step failed (it threw: a Python controller that raised or returned garbage); the
+/// message is the controller's own (it names the controller, the step and its time).
+class ControllerFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// How a node runs its controller on a thread of its own (ControllerNode::run_controller_on_thread).
+struct ControllerThreading {
+  enum class OnError {
+    kStop,    ///< a failed step ends the node (ControllerFailure)
+    kSafety,  ///< a failed step sends the stale-data safety command; counted and logged
+  };
+  /// Lockstep: step() hands the controller its step and returns; the status and command are
+  /// published from the controller's thread when it returns. A tick that comes while the controller
+  /// is still busy is not answered (the plant's --timeout and --on-timeout apply).
+  bool asynchronous = false;
+  /// Real time: how long step() waits for the controller [ns]; when it has not returned by then, or
+  /// is still busy with an earlier step, the safety command is sent for this period (counted).
+  std::int64_t wait_ns = 0;
+  OnError on_error = OnError::kStop;
+  /// Asynchronous steps with kStop: called once, on the controller's thread, with the failure's
+  /// message after the node stopped answering (the host ends; controller_failure() has it).
+  std::function<void(const std::string&)> on_failure;
+  /// What the controller's thread runs its loop in (ControllerThread::ThreadHost), when set.
+  std::function<void(const std::function<void()>&)> thread_host;
+};
+
 class ControllerNode {
  public:
   /// Flies a clone of config.controller (which must be set).
   ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config);
+  ~ControllerNode();
+
+  /// From now on the controller runs on a thread of its own (sim/controller_thread.hpp): every call
+  /// into it there, one at a time, so one that is slow or blocks holds up neither the transport's
+  /// threads nor the parameter services. Call before the first step.
+  void run_controller_on_thread(ControllerThreading threading);
+  /// Steps whose controller failed (threw) and got the safety command instead (OnError::kSafety).
+  std::uint64_t controller_failures() const { return failure_log_.total(); }
+  /// Real time on a thread: periods whose controller had not returned in time (safety command sent);
+  /// lockstep on a thread: ticks not answered because the controller was still busy.
+  std::uint64_t late_steps() const { return late_log_.total(); }
+  /// The failure that ended an asynchronous node (OnError::kStop), or nothing.
+  std::optional<std::string> controller_failure() const;
 
   /// One control period ending now. `now_ns` is the node's current (simulated) time, `dt_s` its
   /// period; the age of the sensor data is measured against now_ns. Publishes the status, then the
@@ -97,7 +144,17 @@ class ControllerNode {
   }
   bool accept_refused(const SensorCheck& check, const std::string& topic, int& backwards);
 
-  void safety_output();
+  void safety_output() { safety_output(reference_, output_); }
+  /// The stale-data safety command for `ref` into `out`.
+  void safety_output(const control::Reference& ref, control::ControllerOutput& out) const;
+  /// Publishes the status and command of a step at now_ns (simulated sim_now_ns) that used `obs`
+  /// and `ref` and decided `out`.
+  void publish(const control::Observation& obs, const control::Reference& ref, const control::ControllerOutput& out,
+               std::int64_t sim_now_ns);
+  /// The controller's step on its thread (run_controller_on_thread).
+  void step_on_thread(std::int64_t now_ns, std::int64_t sim_now_ns, double dt_s);
+  /// A failed step on the thread: the error policy. Returns true when the safety command replaces it.
+  bool controller_failed(const std::exception_ptr& error, std::int64_t sim_now_ns);
   /// reference_ at simulated time now_ns: the step setpoints (or the trajectory).
   void update_reference(std::int64_t now_ns);
 
@@ -125,6 +182,15 @@ class ControllerNode {
   Publisher<msg::ControllerStatus> status_pub_;
   Publisher<msg::Float64MultiArray> command_pub_;
   msg::Float64MultiArray command_msg_;
+  // The controller on its own thread (run_controller_on_thread): controller_ is then its stand-in.
+  ControllerThread* thread_ = nullptr;
+  ControllerThreading threading_;
+  /// Held while status_, command_msg_ and output_ are written and published: an asynchronous step
+  /// publishes from the controller's thread.
+  mutable std::mutex publish_mutex_;
+  bool step_in_flight_ = false;  ///< an asynchronous step has been started and not yet published
+  std::optional<std::string> failure_;
+  LogThrottle failure_log_, late_log_;
 };
 
 }  // namespace quadcosim::sim

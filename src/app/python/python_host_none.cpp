@@ -1,0 +1,24 @@
+// The CLI built without Python (app/python_host.hpp): --python says so; a scenario's
+// `controller: {python: ...}` gets io's own error (no hook installed).
+#include "app/python_host.hpp"
+#include "io/scenario.hpp"
+
+namespace quadcosim::app {
+
+bool built_with_python() { return false; }
+
+void install_python_controllers() {}
+
+std::shared_ptr<const control::Controller> make_python_controller(const std::string&, const std::filesystem::path&,
+                                                                  const model::VehicleParams&,
+                                                                  const std::string& what) {
+  throw io::ConfigError(what +
+                        ": this quadcosim was built without Python (it needs pybind11 and the Python headers, "
+                        "Debian: pybind11-dev python3-dev, and QUADCOSIM_BUILD_PYTHON=ON; docs/python.md)");
+}
+
+std::function<void(const std::function<void()>&)> python_thread_host() { return {}; }
+
+void python_at_exit() {}
+
+}  // namespace quadcosim::app
