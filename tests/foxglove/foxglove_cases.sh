@@ -13,8 +13,8 @@
 #                  keeps receiving every message (a paced run)
 #   dds_plant      plant --foxglove (with its controller over DDS): Pose and Imu equal to the plant's
 #                  trajectory CSV; the server closes when the plant ends
-#   shutdown       SIGINT to a plant waiting for its controller and SIGTERM to a lingering run, each
-#                  with a client connected: both end within seconds
+#   shutdown       SIGINT to a running plant and SIGTERM to a lingering run, each with a client
+#                  connected: both end within seconds; a client arriving after the run gets the final Pose
 # Every process this script starts is killed by PID on exit (tests/lib/process_case.sh).
 bin="$1"; src="$2"
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
@@ -33,7 +33,8 @@ url_of() {  # url_of LOG
     [ -n "$u" ] && { echo "$u"; return; }
     sleep 0.1
   done
-  fail "no 'foxglove: serving ws://' line in $1"
+  # In a command substitution: fail's report goes to stderr, the exit ends the caller (set -e).
+  fail "no 'foxglove: serving ws://' line in $1" >&2
 }
 
 # Waits up to 20 s for TEXT in FILE.
@@ -203,19 +204,28 @@ PY
     echo "received $counts; $line"
     ;;
   shutdown)
-    "$bin" plant --scenario "$scenario" --foxglove 127.0.0.1:0 --timeout 60 > "$tmp/plant.log" 2>&1 &
+    # A long lockstep run (plant and controller), a client receiving, then SIGINT to the plant.
+    "$bin" plant --scenario "$scenario" --duration 100000 --foxglove 127.0.0.1:0 > "$tmp/plant.log" 2>&1 &
     pids+=($!); plant_pid=$!
     url="$(url_of "$tmp/plant.log")"
     client watch "$url" "$ns/Pose" --seconds 60 > "$tmp/c1.json" 2> "$tmp/c1.log" &
-    pids+=($!)
+    pids+=($!); c1=$!
     await "$tmp/c1.log" subscribed
+    "$bin" controller --scenario "$scenario" > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    sleep 2
     start=$(date +%s%N)
     kill -INT "$plant_pid"
     rc=0; wait "$plant_pid" || rc=$?
     ms=$((($(date +%s%N) - start) / 1000000))
+    [ "$rc" -eq 130 ] || fail "plant exit $rc after SIGINT, expected 130"
     [ "$ms" -lt 5000 ] || fail "plant took $ms ms to end after SIGINT"
     grep -q "plant: foxglove: 1 clients" "$tmp/plant.log" || fail "no summary after SIGINT"
-    echo "plant with a client ended $ms ms after SIGINT (exit $rc)"
+    wait "$c1" || fail "the client failed"
+    received=$(python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); print(len(j["messages"]["/drone/Pose"]), j["close"]["code"])' "$tmp/c1.json")
+    [ "${received#* }" = 1001 ] || fail "the client saw no close 1001: $received"
+    [ "${received% *}" -gt 100 ] || fail "the client received only ${received% *} Pose messages"
+    echo "plant with a client ended $ms ms after SIGINT (exit $rc, ${received% *} Pose received, close 1001)"
 
     "$bin" run "$scenario" --out "$tmp/linger" --no-plots --foxglove 0 --foxglove-linger 300 > "$tmp/run.log" 2>&1 &
     pids+=($!); run_pid=$!
