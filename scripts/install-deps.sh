@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   cyclonedds-dev cyclonedds-tools
   libxml2-dev libminizip-dev  # FMI: modelDescription.xml and .fmu archives (src/fmi)
+  libwebsocketpp-dev libasio-dev  # --foxglove: the Foxglove WebSocket server (src/foxglove)
   libssl-dev openssl  # DDS Security keystores (libcrypto); openssl checks them in the tests
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy

@@ -18,6 +18,16 @@ class OutputFolder;
 
 namespace quadcosim::app {
 
+/// `--foxglove [ADDR:]PORT` and its companions (run, plant, controller): serve the node's topics live
+/// over the Foxglove WebSocket protocol (app/foxglove_cli.hpp, docs/foxglove.md).
+struct FoxgloveCliOptions {
+  std::string listen;            ///< "PORT" (on 127.0.0.1) or "ADDR:PORT"; "" for no server
+  double linger_s = 0.0;         ///< keep serving the last state this long after the run [s]
+  double wait_s = 0.0;           ///< in-process run: wait this long for a client to subscribe first [s]
+  double pace = 0.0;             ///< in-process run: run at this many times real time (0: unpaced)
+  std::size_t queue_kib = 1024;  ///< per-client queue above which messages are dropped [KiB]
+};
+
 struct RunOptions {
   std::string scenario;
   std::string controller;  ///< --controller: replaces the scenario's controller.type ("" keeps it)
@@ -34,6 +44,7 @@ struct RunOptions {
   /// dds: run secured (Enforce) with this SROS2 keystore; created when missing, as are the enclaves
   /// /quadcosim/plant and /quadcosim/controller ("" = as the ROS_SECURITY_* environment says).
   std::string keystore;
+  FoxgloveCliOptions foxglove;
 };
 int run_command(const RunOptions& options);
 CLI::App* add_run_subcommand(CLI::App& app, RunOptions& options);
@@ -123,6 +134,8 @@ struct PlantCommandOptions {
   /// Publish /clock after each tick's Pose, Velocity and Imu (a peer stepping on /clock).
   bool clock_after_sensors = false;
 
+  FoxgloveCliOptions foxglove;  ///< one vehicle
+
   Lockstep lockstep_only;
   Realtime realtime;
   OneVehicle one_vehicle;
@@ -158,8 +171,9 @@ struct ControllerCommandOptions {
   bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
   std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)
   bool lockstep = true;
-  bool apply_schedule = true;  ///< apply the scenario's schedule itself (off when the plant does it)
-  std::string enclave = "/";   ///< DDS Security enclave (rcl --enclave)
+  bool apply_schedule = true;   ///< apply the scenario's schedule itself (off when the plant does it)
+  std::string enclave = "/";    ///< DDS Security enclave (rcl --enclave)
+  FoxgloveCliOptions foxglove;  ///< one vehicle
 
   Realtime realtime;
   OneVehicle one_vehicle;

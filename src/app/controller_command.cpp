@@ -8,6 +8,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/foxglove_cli.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/python_host.hpp"
@@ -72,6 +73,7 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
                    "one vehicle: ROS node name (parameter services /NAME/..., ros2 node list)")
       ->check(CLI::Validator(check_node_name, "NAME"));
 
+  add_foxglove_options(*ctl_cmd, ctl.foxglove, /*inprocess=*/false);
   add_enclave_option(ctl_cmd, ctl.enclave);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   ctl_cmd->parse_complete_callback([ctl_cmd, &ctl] {
@@ -83,6 +85,7 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
             {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
             {"--node-name", !swarm, "--vehicles; a swarm offers no parameter services"},
             {"--python", !swarm, "--vehicles; a Python controller flies one vehicle"},
+            {"--foxglove", !swarm, "--vehicles; one vehicle is served"},
             {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
             {"--threads", swarm, "one vehicle; it needs --vehicles N"},
             {"--rate-factor", realtime, "lockstep; it needs --realtime"},
@@ -145,6 +148,8 @@ int controller_command(const ControllerCommandOptions& o) {
   // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
   dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
   if (!o.apply_schedule) sc.schedule.clear();
+  // After the node's own readers, so a plant that counts this process's readers finds the node's first.
+  std::unique_ptr<foxglove::Server> fox = start_foxglove(o.foxglove, "controller", transport, topics);
   dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
   announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
   std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s, controller {}\n",
@@ -198,6 +203,7 @@ int controller_command(const ControllerCommandOptions& o) {
         node.late_steps(), o.lockstep ? "ticks not answered (controller busy)" : "late periods (safety command sent)");
   }
   std::cerr << "controller: stopped\n";
+  if (fox) finish_foxglove(o.foxglove, "controller", *fox);
   return exit_code::kOk;
 }
 

@@ -13,13 +13,15 @@ namespace quadcosim::app {
 namespace fs = std::filesystem;
 
 bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& info, std::ostream& warn,
-                   const std::function<bool(double t_s)>& on_tick, const std::function<void()>& on_end) {
+                   const std::function<bool(double t_s)>& on_tick, const std::function<void()>& on_end,
+                   const std::function<void(sim::Transport&, const sim::Topics&)>& attach) {
   struct Stopped {};
   const std::string csv_path = (out / "trajectory.csv").string();
   sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
   io::TrajectoryWriter csv(csv_path);
   io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
                         sim::Topics::for_namespace(sc.simulation.ns));
+  if (attach) attach(simulation.transport(), sim::Topics::for_namespace(sc.simulation.ns));
   bool watchdog = false;
   bool completed = true;
   try {

@@ -13,6 +13,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/foxglove_cli.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/signals.hpp"
@@ -57,6 +58,7 @@ class PlantProcess {
     if (!o_.one_vehicle.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.one_vehicle.record);
     if (!o_.one_vehicle.mcap.empty())
       mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
+    foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_);
     if (!o_.one_vehicle.schedule_node.empty()) {
       scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));
@@ -96,8 +98,9 @@ class PlantProcess {
     loop_start_ns_ = steady_ns();
     const int rc = o_.lockstep ? run_lockstep() : run_realtime();
     finish(rc);
+    if (rc == kExitOk) report();
+    if (foxglove_) finish_foxglove(o_.foxglove, "plant", *foxglove_);
     if (rc != kExitOk) return rc;
-    report();
     return stop_requested() ? kExitInterrupted : kExitOk;
   }
 
@@ -111,8 +114,8 @@ class PlantProcess {
 
   /// Waits until a controller is there to answer, so tick 0 is not published into the void.
   bool wait_for_controller() {
-    // The recorder's own readers (same participant) match too: look for one more.
-    const int own = mcap_ ? 1 : 0;
+    // The recorder's and the Foxglove server's own readers (same participant) match too: look for one more.
+    const int own = (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0);
     const bool found = transport_.spin_until(
         [&] {
           return stop_requested() ||
@@ -303,6 +306,8 @@ class PlantProcess {
   bool have_status_ = false;
   std::unique_ptr<io::TrajectoryWriter> csv_;
   std::unique_ptr<io::McapRecorder> mcap_;
+  // Served from the transport's deliveries, like the recorder; stopped at the end of run().
+  std::unique_ptr<foxglove::Server> foxglove_;
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool watchdog_logged_ = false;
@@ -364,6 +369,7 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
                       "publish /clock after each tick's Pose, Velocity and Imu (for a peer that steps on "
                       "/clock and reads the newest samples: Simulink's ROS 2 time model; docs/simulink.md)");
 
+  add_foxglove_options(*plant_cmd, plant.foxglove, /*inprocess=*/false);
   add_enclave_option(plant_cmd, plant.enclave);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   plant_cmd->parse_complete_callback([plant_cmd, &plant] {
@@ -375,6 +381,7 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
             {"--namespace", !swarm, "--vehicles; each vehicle's namespace is <--ns-prefix>0000, ..."},
             {"--record", !swarm, "--vehicles; a swarm records with --swarm-out"},
             {"--mcap", !swarm, "--vehicles; a swarm records with --swarm-out"},
+            {"--foxglove", !swarm, "--vehicles; one vehicle is served"},
             {"--schedule-via", !swarm, "--vehicles; each vehicle's controller applies the schedule"},
             {"--ns-prefix", swarm, "one vehicle; it needs --vehicles N"},
             {"--threads", swarm, "one vehicle; it needs --vehicles N"},

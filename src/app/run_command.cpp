@@ -10,10 +10,12 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/foxglove_cli.hpp"
 #include "app/inprocess_run.hpp"
 #include "app/node_common.hpp"
 #include "app/signals.hpp"
@@ -98,6 +100,12 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     plant_args.push_back(fmt::format("{}", opt.rate_factor));
   }
   if (opt.pin) pin_apart(plant_args, controller_args);
+  if (!opt.foxglove.listen.empty()) {  // the plant serves: it has every topic, and the simulated time
+    plant_args.insert(plant_args.end(), {"--foxglove", opt.foxglove.listen, "--foxglove-queue-kib",
+                                         fmt::format("{}", opt.foxglove.queue_kib)});
+    if (opt.foxglove.linger_s > 0)
+      plant_args.insert(plant_args.end(), {"--foxglove-linger", fmt::format("{}", opt.foxglove.linger_s)});
+  }
   return run_plant_and_controller(plant_args, controller_args);
 }
 
@@ -132,9 +140,11 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
       ->check(CLI::Range(1, 10'000'000));
   run_cmd->add_option("--threads", run.threads, "in-process swarm: worker threads (default: swarm.threads, 2)")
       ->check(CLI::Range(1, 64));
+  add_foxglove_options(*run_cmd, run.foxglove, /*inprocess=*/true);
   // Flags that do nothing in the chosen mode are refused (exit 2), naming the flag and the mode.
   run_cmd->parse_complete_callback([run_cmd, &run] {
     const bool dds = run.transport == "dds";
+    const bool swarm = run.vehicles > 0;
     refuse_idle_flags(*run_cmd,
                       {
                           {"--realtime", dds, "--transport inproc; it needs --transport dds"},
@@ -143,6 +153,9 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
                           {"--keystore", dds, "--transport inproc; it needs --transport dds"},
                           {"--rate-factor", dds && run.realtime, "lockstep; it needs --transport dds --realtime"},
                           {"--threads", !dds, "--transport dds; it sets the in-process swarm's threads"},
+                          {"--foxglove", !swarm, "--vehicles; one vehicle is served"},
+                          {"--foxglove-wait", !dds, "--transport dds; the plant waits for its controller"},
+                          {"--foxglove-pace", !dds, "--transport dds; use --realtime there"},
                       });
   });
   return run_cmd;
@@ -155,6 +168,10 @@ int run_command(const RunOptions& opt) {
     std::cerr << "error: " << opt.scenario
               << ": message_faults: message loss and delay are injected by the "
                  "in-process transport only; over DDS use tc netem (docs/reliability.md)\n";
+    return exit_code::kBadInput;
+  }
+  if ((opt.vehicles > 0 || sc.swarm) && !opt.foxglove.listen.empty()) {
+    std::cerr << "error: --foxglove serves one vehicle; " << opt.scenario << " flies a swarm\n";
     return exit_code::kBadInput;
   }
   // Refused (exit 2) when it holds anything, unless --force; every file written below is listed in
@@ -171,11 +188,28 @@ int run_command(const RunOptions& opt) {
     } else {
       install_stop_handlers();
       Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
+      // --foxglove: served from the simulation's transport; --foxglove-pace holds each tick back
+      // until its time on the wall clock (scaled), so a viewer sees the run as it would fly.
+      std::unique_ptr<foxglove::Server> fox;
+      std::chrono::steady_clock::time_point paced_from;
+      const auto attach = [&](sim::Transport& transport, const sim::Topics& topics) {
+        fox = start_foxglove(opt.foxglove, "run", transport, topics);
+        if (fox) wait_for_foxglove_client(opt.foxglove, "run", *fox);
+        paced_from = std::chrono::steady_clock::now();
+      };
       const auto on_tick = [&](double t_s) {
         progress.update(t_s);
+        if (opt.foxglove.pace > 0.0) {
+          std::this_thread::sleep_until(paced_from + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                         std::chrono::duration<double>(t_s / opt.foxglove.pace)));
+        }
         return stop_requested();
       };
-      if (!fly_inprocess(sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); })) {
+      const bool completed = fly_inprocess(
+          sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); },
+          opt.foxglove.listen.empty() ? nullptr : std::function(attach));
+      if (fox) finish_foxglove(opt.foxglove, "run", *fox);
+      if (!completed) {
         // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.
         std::cerr << "\nrun: interrupted; " << csv_path << " and run.mcap hold what ran\n";
         return exit_code::kInterrupted;

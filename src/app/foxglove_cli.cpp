@@ -1,0 +1,108 @@
+#include "app/foxglove_cli.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <chrono>
+#include <iostream>
+#include <thread>
+
+#include "app/signals.hpp"
+#include "foxglove/topic_tap.hpp"
+#include "io/scenario.hpp"
+
+namespace quadcosim::app {
+
+void add_foxglove_options(CLI::App& cmd, FoxgloveCliOptions& o, bool inprocess) {
+  cmd.add_option("--foxglove", o.listen,
+                 "serve the topics live to Foxglove (WebSocket, foxglove.websocket.v1) on [ADDR:]PORT "
+                 "(ADDR 127.0.0.1 by default; PORT 0: a free one, printed; docs/foxglove.md)");
+  auto* linger = cmd.add_option("--foxglove-linger", o.linger_s,
+                                "after the run, keep serving its last state this long [s] (Ctrl-C ends it)")
+                     ->check(CLI::Range(0.0, 1e6));
+  auto* queue = cmd.add_option("--foxglove-queue-kib", o.queue_kib,
+                               "per-client queue [KiB] above which a slow client's messages are dropped")
+                    ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 20));
+  linger->needs("--foxglove");
+  queue->needs("--foxglove");
+  if (inprocess) {
+    cmd.add_option("--foxglove-wait", o.wait_s, "in-process: wait up to this long for a client to subscribe first [s]")
+        ->check(CLI::Range(0.0, 1e6))
+        ->needs("--foxglove");
+    cmd.add_option("--foxglove-pace", o.pace,
+                   "in-process: run at this many times real time, to watch it live (0: as fast as it goes)")
+        ->check(CLI::Range(0.0, 1e6))
+        ->needs("--foxglove");
+  }
+}
+
+std::string parse_listen(const std::string& text, std::string& address, std::uint16_t& port) {
+  std::string port_text = text;
+  address = "127.0.0.1";
+  if (!text.empty() && text.front() == '[') {  // [IPv6]:PORT
+    const auto close = text.find("]:");
+    if (close == std::string::npos) return fmt::format("\"{}\": expected [ADDRESS]:PORT", text);
+    address = text.substr(1, close - 1);
+    port_text = text.substr(close + 2);
+  } else if (const auto colon = text.rfind(':'); colon != std::string::npos) {
+    address = text.substr(0, colon);
+    port_text = text.substr(colon + 1);
+    if (address.find(':') != std::string::npos)
+      return fmt::format("\"{}\": write an IPv6 address as [ADDRESS]:PORT", text);
+  }
+  unsigned value = 0;
+  const auto [end, ec] = std::from_chars(port_text.data(), port_text.data() + port_text.size(), value);
+  if (port_text.empty() || ec != std::errc() || end != port_text.data() + port_text.size() || value > 65535) {
+    return fmt::format("\"{}\": the port must be a number 0..65535", text);
+  }
+  if (address.empty()) return fmt::format("\"{}\": empty address", text);
+  port = static_cast<std::uint16_t>(value);
+  return "";
+}
+
+std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveCliOptions& o, const std::string& who,
+                                                 sim::Transport& transport, const sim::Topics& topics) {
+  if (o.listen.empty()) return nullptr;
+  foxglove::ServerOptions so;
+  if (std::string err = parse_listen(o.listen, so.address, so.port); !err.empty()) {
+    throw io::ConfigError("--foxglove " + err);
+  }
+  so.name = fmt::format("{}: foxglove", who);
+  so.client_queue_bytes = o.queue_kib * 1024;
+  so.keep_last = o.linger_s > 0.0;
+  auto server = std::make_unique<foxglove::Server>(so);
+  foxglove::serve_vehicle_topics(*server, transport, topics);
+  server->start();
+  const bool v6 = so.address.find(':') != std::string::npos;
+  std::cerr << fmt::format("{}: foxglove: serving ws://{}{}{}:{}\n", who, v6 ? "[" : "", so.address, v6 ? "]" : "",
+                           server->port())
+            << std::flush;
+  return server;
+}
+
+void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& who, foxglove::Server& server) {
+  if (o.wait_s <= 0.0) return;
+  std::cerr << fmt::format("{}: foxglove: waiting up to {:g} s for a client to subscribe\n", who, o.wait_s)
+            << std::flush;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.wait_s);
+  while (server.subscriptions() == 0 && !stop_requested() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (server.subscriptions() == 0) std::cerr << fmt::format("{}: foxglove: no client subscribed; running\n", who);
+}
+
+void finish_foxglove(const FoxgloveCliOptions& o, const std::string& who, foxglove::Server& server) {
+  if (o.linger_s > 0.0 && !stop_requested()) {
+    std::cerr << fmt::format("{}: foxglove: run ended; serving its last state for {:g} s (Ctrl-C ends)\n", who,
+                             o.linger_s)
+              << std::flush;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.linger_s);
+    while (!stop_requested() && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  server.stop();
+  std::cerr << fmt::format("{}: foxglove: {}\n", who, server.summary());
+}
+
+}  // namespace quadcosim::app

@@ -1,0 +1,477 @@
+#include "foxglove/server.hpp"
+
+// websocketpp on standalone asio (Debian's libwebsocketpp-dev and libasio-dev), without TLS.
+#define ASIO_STANDALONE
+#include <websocketpp/config/asio_no_tls.hpp>
+#include <websocketpp/server.hpp>
+
+#include <fmt/format.h>
+#include <pthread.h>
+#include <signal.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+namespace quadcosim::foxglove {
+
+namespace {
+
+using WsServer = websocketpp::server<websocketpp::config::asio>;
+using Hdl = websocketpp::connection_hdl;
+using nlohmann::json;
+
+// Binary opcodes (server to client) and status levels of the protocol.
+constexpr std::uint8_t kMessageData = 0x01, kTime = 0x02;
+constexpr int kStatusError = 2;
+// Per client: the first errors are logged, the rest only counted; this many close the connection.
+constexpr std::uint64_t kLoggedErrors = 5, kErrorsBeforeDisconnect = 100;
+
+void put_le(std::uint8_t* p, std::uint64_t v, int bytes) {
+  for (int i = 0; i < bytes; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+// A JSON number that is a whole number fitting a u32 (ids), else nullopt.
+std::optional<std::uint32_t> as_u32(const json& v) {
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() <= UINT32_MAX)
+    return static_cast<std::uint32_t>(v.get<std::uint64_t>());
+  if (v.is_number_integer() && v.get<std::int64_t>() >= 0 && v.get<std::int64_t>() <= UINT32_MAX)
+    return static_cast<std::uint32_t>(v.get<std::int64_t>());
+  return std::nullopt;
+}
+
+}  // namespace
+
+struct Server::Impl {
+  struct Channel {
+    std::string topic, schema_name, schema;
+    std::atomic<int> subscribers{0};
+    // Server thread only: the newest message, sent at once to a client that subscribes later.
+    std::vector<std::uint8_t> last;
+    std::int64_t last_t_ns = -1;
+  };
+  struct Client {
+    std::uint64_t id = 0;
+    std::string remote;
+    std::map<std::uint32_t, std::uint32_t> subscriptions;  // subscription id -> channel
+    std::vector<std::int64_t> subscription_of;             // channel -> subscription id, -1 for none
+    std::uint64_t dropped = 0, errors = 0;
+    bool dropping = false;  // its queue is full (logged once per episode)
+  };
+  struct Handed {
+    std::uint32_t channel;
+    std::int64_t t_ns;
+    std::vector<std::uint8_t> cdr;
+  };
+
+  explicit Impl(ServerOptions o) : options(std::move(o)) {}
+
+  ServerOptions options;
+  std::vector<std::unique_ptr<Channel>> channels;
+  asio::io_context io;
+  WsServer ws;
+  std::thread thread;
+  bool started = false, stopped = false;
+  std::string session_id;
+
+  // Hand-over from the publishing threads.
+  std::mutex handoff_mutex;
+  std::vector<Handed> handoff, batch;
+  bool drain_posted = false;
+
+  // Server thread only.
+  std::map<Hdl, Client, std::owner_less<Hdl>> clients;
+  std::uint64_t next_client_id = 1;
+  std::int64_t time_ns = -1;  // the newest time sent
+
+  std::atomic<std::size_t> open{0};
+  std::atomic<std::uint64_t> n_clients{0}, n_refused{0}, n_sent{0}, n_dropped{0}, n_handoff_dropped{0}, n_time{0},
+      n_bad{0}, n_disconnected{0};
+
+  void log(const std::string& line) const { std::cerr << fmt::format("{}: {}\n", options.name, line); }
+
+  WsServer::connection_ptr connection(const Hdl& h) {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr c = ws.get_con_from_hdl(h, ec);
+    return ec ? nullptr : c;
+  }
+
+  // --- handshake, open, close -------------------------------------------------------------------
+  bool validate(Hdl h) {
+    WsServer::connection_ptr c = connection(h);
+    if (!c) return false;
+    const auto& offered = c->get_requested_subprotocols();
+    if (std::find(offered.begin(), offered.end(), kSubprotocol) == offered.end()) {
+      ++n_refused;
+      log(fmt::format("refused {}: it does not offer the subprotocol {}", c->get_remote_endpoint(), kSubprotocol));
+      c->set_status(websocketpp::http::status_code::bad_request);
+      return false;
+    }
+    if (clients.size() >= options.max_clients) {
+      ++n_refused;
+      log(fmt::format("refused {}: {} clients already connected", c->get_remote_endpoint(), clients.size()));
+      c->set_status(websocketpp::http::status_code::service_unavailable);
+      return false;
+    }
+    websocketpp::lib::error_code ec;
+    c->select_subprotocol(kSubprotocol, ec);
+    return !ec;
+  }
+
+  void on_open(Hdl h) {
+    WsServer::connection_ptr c = connection(h);
+    if (!c) return;
+    Client& cl = clients[h];
+    cl.id = next_client_id++;
+    cl.remote = c->get_remote_endpoint();
+    cl.subscription_of.assign(channels.size(), -1);
+    c->set_close_handshake_timeout(1000);  // a client that does not answer a close is cut off after 1 s
+    ++n_clients;
+    ++open;
+    json info = {{"op", "serverInfo"},
+                 {"name", options.name},
+                 {"capabilities", json::array({"time"})},
+                 {"supportedEncodings", json::array({"cdr"})},
+                 {"metadata", json::object()},
+                 {"sessionId", session_id}};
+    send_text(h, info);
+    json list = json::array();
+    for (std::size_t i = 0; i < channels.size(); ++i) {
+      const Channel& ch = *channels[i];
+      list.push_back({{"id", i},
+                      {"topic", ch.topic},
+                      {"encoding", "cdr"},
+                      {"schemaName", ch.schema_name},
+                      {"schema", ch.schema},
+                      {"schemaEncoding", "ros2msg"}});
+    }
+    send_text(h, json{{"op", "advertise"}, {"channels", list}});
+    if (time_ns >= 0) send_time(h, cl);
+  }
+
+  void on_close(Hdl h) {
+    const auto it = clients.find(h);
+    if (it == clients.end()) return;
+    Client& cl = it->second;
+    if (WsServer::connection_ptr c = connection(h);
+        c && c->get_local_close_code() == websocketpp::close::status::message_too_big) {
+      ++n_bad;
+      ++n_disconnected;
+      log(fmt::format("client {} ({}): frame longer than {} bytes: disconnected", cl.id, cl.remote,
+                      options.max_client_frame_bytes));
+    }
+    for (const auto& [sub, channel] : cl.subscriptions) --channels[channel]->subscribers;
+    if (cl.dropped > 0)
+      log(fmt::format("client {} ({}) left; {} messages dropped for it", cl.id, cl.remote, cl.dropped));
+    clients.erase(it);
+    --open;
+  }
+
+  // --- client requests ---------------------------------------------------------------------------
+  void error(Hdl h, Client& cl, const std::string& what) {
+    ++n_bad;
+    ++cl.errors;
+    if (cl.errors <= kLoggedErrors) log(fmt::format("client {} ({}): {}", cl.id, cl.remote, what));
+    if (cl.errors == kLoggedErrors + 1)
+      log(fmt::format("client {} ({}): further errors are only counted", cl.id, cl.remote));
+    send_text(h, json{{"op", "status"}, {"level", kStatusError}, {"message", what}});
+    if (cl.errors >= kErrorsBeforeDisconnect) {
+      ++n_disconnected;
+      log(fmt::format("client {} ({}): {} errors: disconnected", cl.id, cl.remote, cl.errors));
+      websocketpp::lib::error_code ec;
+      ws.close(h, websocketpp::close::status::policy_violation, "too many errors", ec);
+    }
+  }
+
+  void on_message(Hdl h, WsServer::message_ptr m) {
+    const auto it = clients.find(h);
+    if (it == clients.end()) return;
+    Client& cl = it->second;
+    if (m->get_opcode() != websocketpp::frame::opcode::text) {
+      error(h, cl, "binary client messages need the clientPublish capability, which this server does not offer");
+      return;
+    }
+    const json j = json::parse(m->get_payload(), nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) {
+      error(h, cl, "malformed JSON");
+      return;
+    }
+    if (!j.is_object() || !j.contains("op") || !j["op"].is_string()) {
+      error(h, cl, "a JSON message must be an object with a string field \"op\"");
+      return;
+    }
+    const std::string op = j["op"].get<std::string>();
+    if (op == "subscribe") {
+      subscribe(h, cl, j);
+    } else if (op == "unsubscribe") {
+      unsubscribe(h, cl, j);
+    } else {
+      error(h, cl, fmt::format("op \"{}\" is not supported (capabilities: time)", op));
+    }
+  }
+
+  void subscribe(Hdl h, Client& cl, const json& j) {
+    if (!j.contains("subscriptions") || !j["subscriptions"].is_array()) {
+      error(h, cl, "subscribe: \"subscriptions\" must be an array");
+      return;
+    }
+    for (const json& s : j["subscriptions"]) {
+      const auto id = s.is_object() && s.contains("id") ? as_u32(s["id"]) : std::nullopt;
+      const auto channel = s.is_object() && s.contains("channelId") ? as_u32(s["channelId"]) : std::nullopt;
+      if (!id || !channel) {
+        error(h, cl, "subscribe: each subscription needs an \"id\" and a \"channelId\" (u32)");
+        continue;
+      }
+      if (*channel >= channels.size()) {
+        error(h, cl, fmt::format("subscribe: unknown channel id {}", *channel));
+        continue;
+      }
+      if (cl.subscriptions.count(*id) != 0) {
+        error(h, cl, fmt::format("subscribe: subscription id {} is in use", *id));
+        continue;
+      }
+      if (cl.subscription_of[*channel] >= 0) {
+        error(h, cl,
+              fmt::format("subscribe: channel {} is already subscribed (subscription {})", *channel,
+                          cl.subscription_of[*channel]));
+        continue;
+      }
+      cl.subscriptions[*id] = *channel;
+      cl.subscription_of[*channel] = *id;
+      Channel& ch = *channels[*channel];
+      ++ch.subscribers;
+      if (ch.last_t_ns >= 0) send_message(h, cl, *id, ch.last_t_ns, ch.last);
+    }
+  }
+
+  void unsubscribe(Hdl h, Client& cl, const json& j) {
+    if (!j.contains("subscriptionIds") || !j["subscriptionIds"].is_array()) {
+      error(h, cl, "unsubscribe: \"subscriptionIds\" must be an array");
+      return;
+    }
+    for (const json& v : j["subscriptionIds"]) {
+      const auto id = as_u32(v);
+      const auto it = id ? cl.subscriptions.find(*id) : cl.subscriptions.end();
+      if (it == cl.subscriptions.end()) {
+        error(h, cl, fmt::format("unsubscribe: unknown subscription id {}", v.dump()));
+        continue;
+      }
+      --channels[it->second]->subscribers;
+      cl.subscription_of[it->second] = -1;
+      cl.subscriptions.erase(it);
+    }
+  }
+
+  // --- sending -------------------------------------------------------------------------------------
+  void send_text(Hdl h, const json& j) {
+    websocketpp::lib::error_code ec;
+    ws.send(h, j.dump(), websocketpp::frame::opcode::text, ec);
+  }
+
+  // False when the client's queue is full (nothing sent).
+  bool room(Hdl h, Client& cl, WsServer::connection_ptr& c) {
+    c = connection(h);
+    if (!c) return false;
+    if (c->get_buffered_amount() <= options.client_queue_bytes) {
+      if (cl.dropping) {
+        cl.dropping = false;
+        log(fmt::format("client {} ({}) reads again; {} messages dropped for it so far", cl.id, cl.remote, cl.dropped));
+      }
+      return true;
+    }
+    if (!cl.dropping) {
+      cl.dropping = true;
+      log(fmt::format("client {} ({}) does not keep up: {} bytes queued; dropping its messages", cl.id, cl.remote,
+                      c->get_buffered_amount()));
+    }
+    return false;
+  }
+
+  void send_time(Hdl h, Client& cl) {
+    WsServer::connection_ptr c;
+    if (!room(h, cl, c)) return;
+    std::uint8_t frame[9];
+    frame[0] = kTime;
+    put_le(frame + 1, static_cast<std::uint64_t>(time_ns), 8);
+    websocketpp::lib::error_code ec;
+    c->send(frame, sizeof frame, websocketpp::frame::opcode::binary);
+    ++n_time;
+  }
+
+  void send_message(Hdl h, Client& cl, std::uint32_t subscription, std::int64_t t_ns,
+                    const std::vector<std::uint8_t>& cdr) {
+    WsServer::connection_ptr c;
+    if (!room(h, cl, c)) {
+      ++cl.dropped;
+      ++n_dropped;
+      return;
+    }
+    std::vector<std::uint8_t> frame(13 + cdr.size());
+    frame[0] = kMessageData;
+    put_le(frame.data() + 1, subscription, 4);
+    put_le(frame.data() + 5, static_cast<std::uint64_t>(std::max<std::int64_t>(t_ns, 0)), 8);
+    std::copy(cdr.begin(), cdr.end(), frame.begin() + 13);
+    c->send(frame.data(), frame.size(), websocketpp::frame::opcode::binary);
+    ++n_sent;
+  }
+
+  // Runs on the server thread: everything handed over so far, in the order it came.
+  void drain() {
+    {
+      std::lock_guard<std::mutex> lock(handoff_mutex);
+      batch.swap(handoff);
+      drain_posted = false;
+    }
+    for (Handed& m : batch) {
+      if (m.t_ns > time_ns) {
+        time_ns = m.t_ns;
+        for (auto& [h, cl] : clients) send_time(h, cl);
+      }
+      for (auto& [h, cl] : clients) {
+        const std::int64_t sub = cl.subscription_of[m.channel];
+        if (sub >= 0) send_message(h, cl, static_cast<std::uint32_t>(sub), m.t_ns, m.cdr);
+      }
+      Channel& ch = *channels[m.channel];
+      ch.last = std::move(m.cdr);
+      ch.last_t_ns = m.t_ns;
+    }
+    batch.clear();  // keeps its capacity for the next swap
+  }
+
+  void run() {
+    // Ctrl-C and SIGTERM go to the node's threads, which poll for them.
+    sigset_t block;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &block, nullptr);
+    for (;;) {
+      try {
+        io.run();
+        return;
+      } catch (const std::exception& e) {  // a handler's failure ends that handler, not the server
+        log(fmt::format("error: {}", e.what()));
+      }
+    }
+  }
+};
+
+Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+
+Server::~Server() { stop(); }
+
+std::uint32_t Server::add_channel(const std::string& topic, const std::string& schema_name, const std::string& schema) {
+  if (impl_->started) throw std::logic_error("foxglove::Server::add_channel after start()");
+  auto ch = std::make_unique<Impl::Channel>();
+  ch->topic = topic;
+  ch->schema_name = schema_name;
+  ch->schema = schema;
+  impl_->channels.push_back(std::move(ch));
+  return static_cast<std::uint32_t>(impl_->channels.size() - 1);
+}
+
+void Server::start() {
+  Impl& s = *impl_;
+  const std::string where = fmt::format("{}:{}", s.options.address, s.options.port);
+  asio::error_code aec;
+  const asio::ip::address address = asio::ip::make_address(s.options.address, aec);
+  if (aec) throw std::runtime_error(fmt::format("foxglove: {}: not an IP address", s.options.address));
+  s.ws.clear_access_channels(websocketpp::log::alevel::all);  // the server logs what matters itself
+  s.ws.clear_error_channels(websocketpp::log::elevel::all);
+  websocketpp::lib::error_code ec;
+  s.ws.init_asio(&s.io, ec);
+  if (ec) throw std::runtime_error(fmt::format("foxglove: {}: {}", where, ec.message()));
+  s.ws.set_reuse_addr(true);
+  s.ws.set_max_message_size(s.options.max_client_frame_bytes);
+  s.ws.set_validate_handler([&s](Hdl h) { return s.validate(h); });
+  s.ws.set_open_handler([&s](Hdl h) { s.on_open(h); });
+  s.ws.set_close_handler([&s](Hdl h) { s.on_close(h); });
+  s.ws.set_fail_handler([&s](Hdl h) { s.on_close(h); });
+  s.ws.set_message_handler([&s](Hdl h, WsServer::message_ptr m) { s.on_message(h, std::move(m)); });
+  s.ws.listen(asio::ip::tcp::endpoint(address, s.options.port), ec);
+  if (ec) throw std::runtime_error(fmt::format("foxglove: cannot listen on {}: {}", where, ec.message()));
+  const asio::ip::tcp::endpoint bound = s.ws.get_local_endpoint(ec);
+  if (ec) throw std::runtime_error(fmt::format("foxglove: {}: {}", where, ec.message()));
+  port_ = bound.port();
+  s.ws.start_accept(ec);
+  if (ec) throw std::runtime_error(fmt::format("foxglove: {}: {}", where, ec.message()));
+  s.session_id = std::to_string(std::chrono::system_clock::now().time_since_epoch().count());
+  s.handoff.reserve(1024);
+  s.batch.reserve(1024);
+  s.started = true;
+  s.thread = std::thread([&s] { s.run(); });
+}
+
+bool Server::wanted(std::uint32_t channel) const {
+  return impl_->options.keep_last || impl_->channels[channel]->subscribers.load(std::memory_order_relaxed) > 0;
+}
+
+void Server::publish(std::uint32_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr) {
+  Impl& s = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(s.handoff_mutex);
+    if (s.stopped) return;
+    if (s.handoff.size() >= s.options.handoff_messages) {
+      ++s.n_handoff_dropped;
+      return;
+    }
+    s.handoff.push_back({channel, t_ns, std::move(cdr)});
+    if (s.drain_posted) return;
+    s.drain_posted = true;
+  }
+  asio::post(s.io, [&s] { s.drain(); });
+}
+
+void Server::stop() {
+  Impl& s = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(s.handoff_mutex);
+    if (s.stopped) return;
+    s.stopped = true;
+  }
+  if (!s.started) return;
+  asio::post(s.io, [&s] {
+    websocketpp::lib::error_code ec;
+    s.ws.stop_listening(ec);
+    for (auto& [h, cl] : s.clients) s.ws.close(h, websocketpp::close::status::going_away, "server shutting down", ec);
+  });
+  // Clients that answer the close are gone within milliseconds; one that does not is cut off.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(1000);
+  while (s.open.load() > 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  s.io.stop();
+  s.thread.join();
+}
+
+ServerStats Server::stats() const {
+  const Impl& s = *impl_;
+  return {s.n_clients.load(),         s.n_refused.load(), s.n_sent.load(), s.n_dropped.load(),
+          s.n_handoff_dropped.load(), s.n_time.load(),    s.n_bad.load(),  s.n_disconnected.load()};
+}
+
+std::size_t Server::connected() const { return impl_->open.load(); }
+
+std::size_t Server::subscriptions() const {
+  std::size_t n = 0;
+  for (const auto& ch : impl_->channels) n += static_cast<std::size_t>(ch->subscribers.load());
+  return n;
+}
+
+std::string Server::summary() const {
+  const ServerStats st = stats();
+  return fmt::format(
+      "{} clients ({} refused), {} messages sent, {} dropped for slow clients, {} dropped before the "
+      "server thread, {} bad requests, {} clients disconnected",
+      st.clients, st.refused, st.messages_sent, st.messages_dropped, st.handoff_dropped, st.bad_requests,
+      st.disconnected);
+}
+
+}  // namespace quadcosim::foxglove

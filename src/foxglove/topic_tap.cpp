@@ -1,0 +1,58 @@
+#include "foxglove/topic_tap.hpp"
+
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "io/ros2_cdr.hpp"
+#include "sim/messages.hpp"
+
+namespace quadcosim::foxglove {
+
+namespace {
+
+// The newest header time seen [ns]: the time of motor commands without a stamp in their label.
+using Newest = std::shared_ptr<std::atomic<std::int64_t>>;
+
+template <class T>
+std::int64_t stamp_of(const T& m, const Newest& newest) {
+  if constexpr (std::is_same_v<T, msg::Clock>) {
+    return m.clock.to_ns();
+  } else if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
+    const std::int64_t s = msg::command_stamp_ns(m);
+    return s >= 0 ? s : newest->load(std::memory_order_relaxed);
+  } else {
+    return m.header.stamp.to_ns();
+  }
+}
+
+template <class T>
+void serve(Server& server, sim::Transport& transport, const std::string& topic, const Newest& newest) {
+  const std::string type(T::kRosType);
+  const std::uint32_t channel = server.add_channel(topic, type, io::ros2msg_definition(type));
+  transport.subscribe<T>(topic, [&server, channel, newest](const T& m) {
+    const std::int64_t t = stamp_of(m, newest);
+    if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) {
+      std::int64_t seen = newest->load(std::memory_order_relaxed);
+      while (t > seen && !newest->compare_exchange_weak(seen, t, std::memory_order_relaxed)) {
+      }
+    }
+    if (!server.wanted(channel)) return;
+    server.publish(channel, t, io::to_cdr(m));
+  });
+}
+
+}  // namespace
+
+void serve_vehicle_topics(Server& server, sim::Transport& transport, const sim::Topics& topics) {
+  auto newest = std::make_shared<std::atomic<std::int64_t>>(0);
+  serve<msg::Clock>(server, transport, topics.clock, newest);
+  serve<msg::PoseStamped>(server, transport, topics.pose, newest);
+  serve<msg::TwistStamped>(server, transport, topics.velocity, newest);
+  serve<msg::Imu>(server, transport, topics.imu, newest);
+  serve<msg::ControllerStatus>(server, transport, topics.controller_status, newest);
+  serve<msg::PlantStatus>(server, transport, topics.plant_status, newest);
+  serve<msg::Float64MultiArray>(server, transport, topics.motor_commands, newest);
+}
+
+}  // namespace quadcosim::foxglove
