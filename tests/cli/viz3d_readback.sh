@@ -34,3 +34,17 @@ for t in d["/tf_static"]["messages"][0]["message"]["transforms"]:
     assert abs(abs(tr["x"]) - 0.25 / math.sqrt(2)) < 1e-12 and abs(abs(tr["y"]) - 0.25 / math.sqrt(2)) < 1e-12, t
 print("ok: 'x' layout rotors on the diagonals")
 PY
+
+# simulation.tf: false switches all of it off: no /tf, /tf_static, robot_description or scene.
+sed -e 's/^simulation:/simulation:\n  tf: false/' "$src/scenarios/paper/roll_step.yaml" > "$tmp/off.yaml"
+"$bin" run "$tmp/off.yaml" --out "$tmp/off" --no-plots > /dev/null
+node "$verify/dump.mjs" "$tmp/off/run.mcap" /tf /tf_static /drone/robot_description /drone/scene /drone/Pose > "$tmp/off.json"
+/usr/bin/python3 - "$tmp/off.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["/drone/Pose"] and len(d["/drone/Pose"]["messages"]) == 1501, "Pose missing"
+# The recorder keeps its /tf channel (a plant elsewhere may publish it); nothing comes on it.
+assert d["/tf"] is None or d["/tf"]["messages"] == [], "messages on /tf"
+assert all(d[t] is None for t in ("/tf_static", "/drone/robot_description", "/drone/scene")), d
+print("ok: simulation.tf: false records none of the 3D topics")
+PY
