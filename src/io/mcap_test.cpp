@@ -292,10 +292,11 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
             std::string::npos);
   EXPECT_NE(tf.find("MSG: geometry_msgs/Transform\nVector3 translation\nQuaternion rotation\n"), std::string::npos);
   EXPECT_EQ(ros2msg_definition(msg::String::kRosType), "string data\n");
-  // foxglove_msgs/SceneUpdate as Foxglove's ROS 2 .msg files state it (field lines, in order).
+  // foxglove_msgs/SceneUpdate as Foxglove's ROS 2 .msg files state it (field lines, in order; a type
+  // of the same package named without it, as .msg files may).
   const std::string& scene = ros2msg_definition(msg::SceneUpdate::kRosType);
   EXPECT_EQ(scene.substr(0, scene.find("====")),
-            "foxglove_msgs/SceneEntityDeletion[] deletions\nfoxglove_msgs/SceneEntity[] entities\n");
+            "SceneEntityDeletion[] deletions\nSceneEntity[] entities\n");  // same package: bare names
   const std::string sep = std::string(80, '=') + "\n";
   for (const std::string block :
        {"MSG: foxglove_msgs/SceneEntityDeletion\nbuiltin_interfaces/Time timestamp\nuint8 type\nstring id\n",
