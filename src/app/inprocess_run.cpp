@@ -21,6 +21,8 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
   io::TrajectoryWriter csv(csv_path);
   io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
                         sim::Topics::for_namespace(sc.simulation.ns));
+  if (sc.simulation.plant.publish_tf)
+    mcap.record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
   if (attach) attach(simulation.transport(), sim::Topics::for_namespace(sc.simulation.ns));
   bool watchdog = false;
   bool completed = true;

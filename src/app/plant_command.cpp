@@ -56,8 +56,10 @@ class PlantProcess {
       have_status_ = true;
     });
     if (!o_.one_vehicle.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.one_vehicle.record);
-    if (!o_.one_vehicle.mcap.empty())
+    if (!o_.one_vehicle.mcap.empty()) {
       mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
+      if (sc_.simulation.plant.publish_tf) mcap_->record_vehicle(sc_.vehicle, sc_.simulation.ns, clock_.ns(0));
+    }
     foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_);
     if (!o_.one_vehicle.schedule_node.empty()) {
       scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),

@@ -35,8 +35,8 @@ int record_command(const RecordOptions& o) {
   }
   const sim::Topics topics = sim::Topics::for_namespace(o.ns);
   const std::vector<std::string> known = {
-      topics.clock,        topics.pose,          topics.velocity, topics.imu, topics.controller_status,
-      topics.plant_status, topics.motor_commands};
+      topics.clock,        topics.pose,           topics.velocity, topics.imu, topics.controller_status,
+      topics.plant_status, topics.motor_commands, topics.tf};
   for (const auto& t : o.topics) {
     if (std::find(known.begin(), known.end(), t) == known.end()) {
       std::string list;

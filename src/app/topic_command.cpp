@@ -42,10 +42,10 @@ std::pair<const std::string, Subscriber> entry() {
 }
 
 const std::map<std::string, Subscriber>& known_types() {
-  static const std::map<std::string, Subscriber> table = {entry<msg::PoseStamped>(), entry<msg::TwistStamped>(),
-                                                          entry<msg::Imu>(),         entry<msg::Float64MultiArray>(),
-                                                          entry<msg::Clock>(),       entry<msg::ControllerStatus>(),
-                                                          entry<msg::PlantStatus>()};
+  static const std::map<std::string, Subscriber> table = {
+      entry<msg::PoseStamped>(),       entry<msg::TwistStamped>(), entry<msg::Imu>(),
+      entry<msg::Float64MultiArray>(), entry<msg::Clock>(),        entry<msg::ControllerStatus>(),
+      entry<msg::PlantStatus>(),       entry<msg::TFMessage>(),    entry<msg::String>()};
   return table;
 }
 
@@ -88,8 +88,13 @@ dds::RosTopic find_topic(dds::DdsTransport& transport, const std::string& topic,
   return *found;
 }
 
-dds::QosProfile qos_named(const std::string& name) {
-  return name == "sensor" ? dds::QosProfile::sensor_data() : dds::QosProfile::ros_default();
+/// "default": what ROS 2 uses for `topic` (dds::QosProfile::for_topic: the ROS default, tf2's for /tf
+/// and /tf_static, transient local for robot_description); "sensor": best effort; "transient_local":
+/// reliable, transient local, depth 1 (gets the last sample a latching writer holds).
+dds::QosProfile qos_named(const std::string& name, const std::string& topic) {
+  if (name == "sensor") return dds::QosProfile::sensor_data();
+  if (name == "transient_local") return {1, true, true};
+  return dds::QosProfile::for_topic(topic);
 }
 
 std::string normalized(std::string topic) {
@@ -109,7 +114,7 @@ int topic_echo(const TopicOptions& o) {
   const std::string topic = normalized(o.topic);
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   const dds::RosTopic found = find_topic(transport, topic, o.wait_s);
-  const dds::QosProfile qos = qos_named(o.qos);
+  const dds::QosProfile qos = qos_named(o.qos, topic);
   if (qos.reliable && found.publishers > 0 && found.best_effort_publishers == found.publishers) {
     std::cerr << fmt::format(
         "note: every publisher of {} is best effort, which a reliable reader does not "
@@ -134,7 +139,7 @@ int topic_hz(const TopicOptions& o) {
   if (found.publishers == 0) {
     std::cerr << fmt::format("WARNING: topic [{}] does not appear to be published yet\n", topic);
   }
-  transport.set_qos(topic, qos_named(o.qos));
+  transport.set_qos(topic, qos_named(o.qos, topic));
   dds::RateWindow window(static_cast<std::size_t>(o.window));
   // Arrival times on the steady clock; decoding to YAML is wasted work here but keeps one path.
   known_types().at(found.types[0])(transport, topic, [&](const std::string&) { window.add(steady_ns()); });
@@ -189,8 +194,10 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
   echo->add_option("topic", o.topic, "ROS topic name, e.g. /drone/Pose")->required();
   echo->add_option("--count", o.count, "exit after this many messages (default: until Ctrl-C)")
       ->check(CLI::Range(1, 1 << 30));
-  echo->add_option("--qos", o.qos, "default: reliable (ROS default); sensor: best effort (matches any writer)")
-      ->check(CLI::IsMember({"default", "sensor"}));
+  echo->add_option("--qos", o.qos,
+                   "default: the topic's ROS 2 QoS (reliable; transient local for robot_description and "
+                   "/tf_static); sensor: best effort (matches any writer); transient_local: reliable, transient local")
+      ->check(CLI::IsMember({"default", "sensor", "transient_local"}));
   echo->add_option("--wait", o.wait_s, "how long to look for the topic [s] (default 5)")
       ->check(CLI::Range(0.0, 3600.0));
   add_enclave_option(echo, o.enclave);

@@ -12,6 +12,17 @@ namespace quadcosim::dds {
 
 std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_topic; }
 
+QosProfile QosProfile::for_topic(const std::string& ros_topic) {
+  static const std::string kDescription = "/robot_description";
+  if (ros_topic == "/tf") return {100, true, false};
+  if (ros_topic == "/tf_static") return {1, true, true};
+  if (ros_topic.size() >= kDescription.size() &&
+      ros_topic.compare(ros_topic.size() - kDescription.size(), kDescription.size(), kDescription) == 0) {
+    return {1, true, true};
+  }
+  return ros_default();
+}
+
 DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
   waitset_ = check(dds_create_waitset(participant_.handle()), "dds_create_waitset");
 }
@@ -22,7 +33,7 @@ DdsTransport::~DdsTransport() {
 
 QosProfile DdsTransport::qos_for(const std::string& ros_topic) const {
   const auto it = qos_.find(ros_topic);
-  return it == qos_.end() ? QosProfile::ros_default() : it->second;
+  return it == qos_.end() ? QosProfile::for_topic(ros_topic) : it->second;
 }
 
 dds_entity_t DdsTransport::topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops) {
@@ -41,7 +52,7 @@ dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const s
                                            const TypeOps*& ops) {
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
   const QosProfile p = qos_for(ros_topic);
-  dds_qos_t* qos = ros_qos(p.depth, p.reliable);
+  dds_qos_t* qos = ros_qos(p.depth, p.reliable, p.transient_local);
   set_endpoint_user_data(qos, ops->descriptor->m_typename);
   const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos, nullptr)
                                 : dds_create_reader(participant_.handle(), topic, qos, nullptr);

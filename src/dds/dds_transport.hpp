@@ -20,10 +20,16 @@
 namespace quadcosim::dds {
 
 struct QosProfile {
-  int depth = 10;        ///< KEEP_LAST depth
-  bool reliable = true;  ///< RELIABLE (ROS default) or BEST_EFFORT (ROS sensor data)
-  static QosProfile ros_default() { return {10, true}; }
-  static QosProfile sensor_data() { return {5, false}; }
+  int depth = 10;                ///< KEEP_LAST depth
+  bool reliable = true;          ///< RELIABLE (ROS default) or BEST_EFFORT (ROS sensor data)
+  bool transient_local = false;  ///< TRANSIENT_LOCAL (late joiners get the last `depth`) or VOLATILE
+  static QosProfile ros_default() { return {10, true, false}; }
+  static QosProfile sensor_data() { return {5, false, false}; }
+  /// What ROS 2 uses for `ros_topic` unless told otherwise: tf2's for /tf (reliable, volatile, depth
+  /// 100: tf2_ros::DynamicBroadcasterQoS and DynamicListenerQoS) and /tf_static (reliable, transient
+  /// local, depth 1: StaticBroadcasterQoS), robot_state_publisher's for any `.../robot_description`
+  /// (reliable, transient local, depth 1), the ROS default for every other topic.
+  static QosProfile for_topic(const std::string& ros_topic);
 };
 
 /// "/drone/Pose" -> "rt/drone/Pose".
@@ -34,7 +40,7 @@ class DdsTransport final : public sim::Transport {
   explicit DdsTransport(const RosEnvironment& env);
   ~DdsTransport() override;
 
-  /// QoS for endpoints created later on `ros_topic` (default: ROS default QoS).
+  /// QoS for endpoints created later on `ros_topic` (default: QosProfile::for_topic).
   void set_qos(const std::string& ros_topic, QosProfile qos) { qos_[ros_topic] = qos; }
 
   /// Waits up to timeout_ns for data on any subscription, then delivers the samples of every

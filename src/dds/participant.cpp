@@ -116,11 +116,11 @@ Participant::~Participant() {
   if (domain_ > 0) dds_delete(domain_);
 }
 
-dds_qos_t* ros_qos(int depth, bool reliable) {
+dds_qos_t* ros_qos(int depth, bool reliable, bool transient_local) {
   dds_qos_t* q = dds_create_qos();
   dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
   dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_INFINITY);
-  dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+  dds_qset_durability(q, transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_INFINITY);
   dds_qset_writer_data_lifecycle(q, false);
   const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};

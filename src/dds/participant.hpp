@@ -69,8 +69,9 @@ class Participant {
   bool secured_ = false;
 };
 
-/// The QoS rmw uses for `depth` KEEP_LAST, RELIABLE (or BEST_EFFORT), VOLATILE, XCDR1 only.
-/// Caller owns the result (dds_delete_qos).
-dds_qos_t* ros_qos(int depth, bool reliable);
+/// The QoS rmw uses for `depth` KEEP_LAST, RELIABLE (or BEST_EFFORT), VOLATILE (or TRANSIENT_LOCAL:
+/// a writer keeps its last `depth` samples for readers that join later, as robot_state_publisher's
+/// robot_description and tf2's /tf_static), XCDR1 only. Caller owns the result (dds_delete_qos).
+dds_qos_t* ros_qos(int depth, bool reliable, bool transient_local = false);
 
 }  // namespace quadcosim::dds

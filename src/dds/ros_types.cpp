@@ -14,6 +14,7 @@
 #include "sensor_msgs.h"
 #include "sim/messages.hpp"
 #include "std_msgs.h"
+#include "tf2_msgs.h"
 
 namespace quadcosim::dds {
 
@@ -60,6 +61,14 @@ template <>
 const dds_topic_descriptor_t& idl<msg::PlantStatus>() {
   return quadcosim_msgs_msg_dds__PlantStatus__desc;
 }
+template <>
+const dds_topic_descriptor_t& idl<msg::TFMessage>() {
+  return tf2_msgs_msg_dds__TFMessage__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::String>() {
+  return std_msgs_msg_dds__String__desc;
+}
 
 // Room for the C sample of any message type on the stack (checked per type by ops_for).
 constexpr std::size_t kMaxSample = 1024;
@@ -104,6 +113,8 @@ const TypeOps* type_ops(std::type_index type) {
       {typeid(msg::Clock), ops_for<msg::Clock>()},
       {typeid(msg::ControllerStatus), ops_for<msg::ControllerStatus>()},
       {typeid(msg::PlantStatus), ops_for<msg::PlantStatus>()},
+      {typeid(msg::TFMessage), ops_for<msg::TFMessage>()},
+      {typeid(msg::String), ops_for<msg::String>()},
   };
   const auto it = table.find(type);
   return it == table.end() ? nullptr : &it->second;

@@ -45,6 +45,15 @@ const std::vector<MessageDescription>& message_descriptions() {
        "float64 x\n"
        "float64 y\n"
        "float64 z"},
+      {"geometry_msgs/msg/Transform",
+       "geometry_msgs/msg/Vector3 translation\n"
+       "geometry_msgs/msg/Quaternion rotation"},
+      {"geometry_msgs/msg/TransformStamped",
+       "std_msgs/msg/Header header\n"
+       "string child_frame_id\n"
+       "geometry_msgs/msg/Transform transform"},
+      {"tf2_msgs/msg/TFMessage", "geometry_msgs/msg/TransformStamped[] transforms"},
+      {"std_msgs/msg/String", "string data"},
       {"geometry_msgs/msg/Twist",
        "geometry_msgs/msg/Vector3 linear\n"
        "geometry_msgs/msg/Vector3 angular"},

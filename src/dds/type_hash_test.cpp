@@ -41,6 +41,8 @@ namespace {
 //  [B1] a ROS 2 Jazzy build from source (rosidl_generator_type_description of rosidl 4.6, the jazzy
 //       rcl_interfaces and common_interfaces), its install/share/<package>/{msg,srv}/<Type>.json
 //       "type_hashes"; every other value above agrees with that build too
+//  [B2] the same build's rosidl_adapter and rosidl_generator_type_description run on tf2_msgs'
+//       TFMessage.msg (geometry_msgs/TransformStamped[] transforms) against its installed geometry_msgs
 //  [E1] eclipse-zenoh/zenoh-plugin-ros2dds@f4990b12, zenoh-plugin-ros2dds/src/ros_discovery.rs:
 //       ROS_DISCOVERY_INFO_TYPE_HASH, "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_ in Iron and Jazzy"
 struct Expected {
@@ -114,6 +116,11 @@ const std::vector<Expected>& expected_hashes() {
       {"rcl_interfaces/srv/SetParametersAtomically_Request", "RIHS01_db0bd950ed5ed867a0e90b225e44dea382d762c0762ff3e0ee842190042a59e5", "B1"},
       {"rcl_interfaces/srv/SetParametersAtomically_Response", "RIHS01_31b1a38c5b0b9d893ee24da45f69638f4561c78461d82d52750f429b534502b8", "B1"},
       {"rcl_interfaces/srv/SetParametersAtomically_Event", "RIHS01_42fc0821e6e8fcff2b150cefc7d8269f0ce65139e1dc715b15267a4bcf63a189", "B1"},
+      {"geometry_msgs/msg/Transform", "RIHS01_beb83fbe698636351461f6f35d1abb20010c43d55374d81bd041f1ba2581fddc", "B1"},
+      {"geometry_msgs/msg/TransformStamped", "RIHS01_0a241f87d04668d94099cbb5ba11691d5ad32c2f29682e4eb5653424bd275206",
+       "B1"},
+      {"std_msgs/msg/String", "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18", "B1"},
+      {"tf2_msgs/msg/TFMessage", "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087", "B2"},
   };
   return table;
 }

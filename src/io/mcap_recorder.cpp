@@ -6,6 +6,7 @@
 
 #include "io/ros2_cdr.hpp"
 #include "sim/messages.hpp"
+#include "sim/vehicle_description.hpp"
 
 namespace quadcosim::io {
 
@@ -15,6 +16,8 @@ template <class T>
 std::int64_t stamp_of(const T& m, std::int64_t fallback) {
   if constexpr (std::is_same_v<T, msg::Clock>) {
     return m.clock.to_ns();
+  } else if constexpr (std::is_same_v<T, msg::TFMessage>) {
+    return m.transforms.empty() ? fallback : m.transforms.front().header.stamp.to_ns();
   } else if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
     const std::int64_t s = msg::command_stamp_ns(m);
     return s >= 0 ? s : fallback;
@@ -27,14 +30,35 @@ std::int64_t stamp_of(const T& m, std::int64_t fallback) {
 
 McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics,
                            const std::vector<std::string>& only)
-    : writer_(path, McapOptions{"ros2", 64 * 1024, true}) {  // small chunks: little to lose on a crash
-  add<msg::Clock>(transport, topics.clock, only);
-  add<msg::PoseStamped>(transport, topics.pose, only);
-  add<msg::TwistStamped>(transport, topics.velocity, only);
-  add<msg::Imu>(transport, topics.imu, only);
-  add<msg::ControllerStatus>(transport, topics.controller_status, only);
-  add<msg::PlantStatus>(transport, topics.plant_status, only);
-  add<msg::Float64MultiArray>(transport, topics.motor_commands, only);
+    : writer_(path, McapOptions{"ros2", 64 * 1024, true}), only_(only) {  // small chunks: little to lose on a crash
+  add<msg::Clock>(transport, topics.clock);
+  add<msg::PoseStamped>(transport, topics.pose);
+  add<msg::TwistStamped>(transport, topics.velocity);
+  add<msg::Imu>(transport, topics.imu);
+  add<msg::ControllerStatus>(transport, topics.controller_status);
+  add<msg::PlantStatus>(transport, topics.plant_status);
+  add<msg::Float64MultiArray>(transport, topics.motor_commands);
+  add<msg::TFMessage>(transport, topics.tf, Qos{100, true, false});  // tf2's dynamic broadcaster QoS
+}
+
+bool McapRecorder::wanted(const std::string& topic) const {
+  return only_.empty() || std::find(only_.begin(), only_.end(), topic) != only_.end();
+}
+
+void McapRecorder::record_vehicle(const model::VehicleParams& vehicle, const std::string& ns, std::int64_t t_ns) {
+  const sim::Topics topics = sim::Topics::for_namespace(ns);
+  const sim::VehicleDescription d = sim::describe_vehicle(vehicle, ns, msg::Time::from_ns(t_ns));
+  const Qos latched{1, true, true};  // robot_state_publisher's and tf2's static broadcaster's
+  if (wanted(topics.robot_description)) {
+    push(static_cast<std::uint16_t>(open_channel<msg::String>(topics.robot_description, latched)), t_ns,
+         to_cdr(d.urdf));
+  }
+  if (wanted(topics.tf_static)) {
+    push(static_cast<std::uint16_t>(open_channel<msg::TFMessage>(topics.tf_static, latched)), t_ns, to_cdr(d.rotors));
+  }
+  if (wanted(topics.scene)) {
+    push(static_cast<std::uint16_t>(open_channel<msg::SceneUpdate>(topics.scene, latched)), t_ns, to_cdr(d.scene));
+  }
 }
 
 McapRecorder::~McapRecorder() {
@@ -45,14 +69,25 @@ McapRecorder::~McapRecorder() {
 }
 
 template <class T>
-void McapRecorder::add(sim::Transport& transport, const std::string& topic, const std::vector<std::string>& only) {
-  if (!only.empty() && std::find(only.begin(), only.end(), topic) == only.end()) return;
+std::size_t McapRecorder::open_channel(const std::string& topic, Qos qos) {
   const std::string type(T::kRosType);
   const std::uint16_t schema = writer_.add_schema(type, "ros2msg", ros2msg_definition(type));
-  const std::uint16_t id =
-      writer_.add_channel(topic, schema, "cdr", {{"offered_qos_profiles", ros2_offered_qos_profiles(10, true)}});
-  const std::size_t index = channels_.size();
-  channels_.push_back({topic, type, id});
+  const std::uint16_t id = writer_.add_channel(
+      topic, schema, "cdr",
+      {{"offered_qos_profiles", ros2_offered_qos_profiles(qos.depth, qos.reliable, qos.transient_local)}});
+  ChannelInfo c;
+  c.topic = topic;
+  c.type = type;
+  c.id = id;
+  c.qos = qos;
+  channels_.push_back(std::move(c));
+  return channels_.size() - 1;
+}
+
+template <class T>
+void McapRecorder::add(sim::Transport& transport, const std::string& topic, Qos qos) {
+  if (!wanted(topic)) return;
+  const std::size_t index = open_channel<T>(topic, qos);
   transport.subscribe<T>(topic, [this, index](const T& m) {
     const std::int64_t t = stamp_of(m, last_stamp_ns_);
     bool stamped = true;  // the message carries its own time (header, clock, or command label)
@@ -60,11 +95,22 @@ void McapRecorder::add(sim::Transport& transport, const std::string& topic, cons
     ChannelInfo& c = channels_[index];
     // Lockstep may repeat a tick (a republished sample or its repeated answer): one copy is recorded,
     // so the file does not depend on whether a repeat happened.
-    if (stamped && c.newest_ns >= 0 && t <= c.newest_ns) {
-      ++repeats_;
-      return;
+    if constexpr (std::is_same_v<T, msg::TFMessage>) {  // per child frame: one /tf carries many vehicles
+      if (!m.transforms.empty()) {
+        auto [it, first] = c.newest_by_frame.try_emplace(m.transforms.front().child_frame_id, t);
+        if (!first && t <= it->second) {
+          ++repeats_;
+          return;
+        }
+        it->second = t;
+      }
+    } else {
+      if (stamped && c.newest_ns >= 0 && t <= c.newest_ns) {
+        ++repeats_;
+        return;
+      }
+      if (stamped) c.newest_ns = t;
     }
-    if (stamped) c.newest_ns = t;
     if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) last_stamp_ns_ = std::max(last_stamp_ns_, t);
     push(static_cast<std::uint16_t>(index), t, to_cdr(m));
   });
@@ -118,7 +164,9 @@ void McapRecorder::write_bag_metadata(const std::string& dir, const std::string&
       << "        type: " << c.type << "\n"
       << "        serialization_format: cdr\n"
       << "        offered_qos_profiles: \"";
-    for (char ch : ros2_offered_qos_profiles(10, true)) y << (ch == '\n' ? std::string("\\n") : std::string(1, ch));
+    for (char ch : ros2_offered_qos_profiles(c.qos.depth, c.qos.reliable, c.qos.transient_local)) {
+      y << (ch == '\n' ? std::string("\\n") : std::string(1, ch));
+    }
     y << "\"\n"
       << "      message_count: " << c.count << "\n";
   }

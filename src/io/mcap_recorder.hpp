@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "io/mcap_writer.hpp"
+#include "model/vehicle_params.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
@@ -17,7 +18,8 @@ namespace quadcosim::io {
 class McapRecorder {
  public:
   /// Opens `path` and subscribes, through `transport`, to the vehicle's topics: /clock, Pose,
-  /// Velocity, Imu, motor_commands, controller_status and plant_status. Throws std::runtime_error naming the path.
+  /// Velocity, Imu, motor_commands, controller_status, plant_status and /tf. Throws
+  /// std::runtime_error naming the path.
   /// `only`, when not empty, limits the recording to those topic names.
   McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics,
                const std::vector<std::string>& only = {});
@@ -35,6 +37,14 @@ class McapRecorder {
   static constexpr std::int64_t kHoldNs = 100'000'000;
   /// flush_before(now_ns - kHoldNs): the call to make once per tick.
   void flush_settled(std::int64_t now_ns) { flush_before(now_ns - kHoldNs); }
+
+  /// Records, at `t_ns`, what describes the vehicle in namespace `ns` (sim/vehicle_description.hpp):
+  /// <ns>/robot_description and /tf_static as the plant publishes them once, and <ns>/scene, a
+  /// foxglove_msgs/msg/SceneUpdate drawing it frame-locked to <ns>/base_link. Written from the vehicle
+  /// parameters, not taken from the wire: the file does not depend on when a late (transient-local)
+  /// sample arrives, so in-process and DDS recordings stay identical. Call once, before the first
+  /// flush; topics outside `only` (constructor) are skipped.
+  void record_vehicle(const model::VehicleParams& vehicle, const std::string& ns, std::int64_t t_ns);
 
   /// Newest message time seen so far [ns] (0 before any).
   std::int64_t newest_ns() const { return last_stamp_ns_; }
@@ -55,18 +65,31 @@ class McapRecorder {
     std::uint64_t arrival;
     std::vector<std::uint8_t> cdr;
   };
+  struct Qos {
+    std::uint32_t depth = 10;
+    bool reliable = true;
+    bool transient_local = false;
+  };
   struct ChannelInfo {
     std::string topic, type;
     std::uint16_t id;
+    Qos qos;
     std::uint64_t count = 0;
     std::uint32_t sequence = 0;
     std::int64_t newest_ns = -1;  ///< newest own stamp accepted on this channel
+    /// tf2_msgs/TFMessage: newest stamp per child frame (many vehicles share /tf, each its own frame)
+    std::map<std::string, std::int64_t> newest_by_frame;
   };
+  /// The channel of `topic` with T's schema; its index in channels_.
   template <class T>
-  void add(sim::Transport& transport, const std::string& topic, const std::vector<std::string>& only);
+  std::size_t open_channel(const std::string& topic, Qos qos);
+  template <class T>
+  void add(sim::Transport& transport, const std::string& topic, Qos qos = {});
+  bool wanted(const std::string& topic) const;
   void push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr);
 
   McapWriter writer_;
+  std::vector<std::string> only_;
   std::vector<ChannelInfo> channels_;  // indexed by position, not by MCAP id
   std::vector<Pending> pending_;
   std::uint64_t arrivals_ = 0, written_ = 0, repeats_ = 0;

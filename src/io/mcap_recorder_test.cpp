@@ -50,5 +50,44 @@ TEST(McapRecorderTest, RecordsARepeatedTickOnceAndKeepsUnlabelledCommands) {
   std::filesystem::remove_all(dir);
 }
 
+// One /tf carries every vehicle of a swarm: a repeat is a transform no newer than the last of the same
+// child frame, not of the channel. The vehicle's description is written at the time given, tf2's and
+// robot_state_publisher's QoS in the bag metadata.
+TEST(McapRecorderTest, TfRepeatsArePerChildFrameAndTheVehicleIsDescribedOnce) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mcap_tf_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  sim::InProcessTransport bus;
+  const sim::Topics topics = sim::Topics::for_namespace("/uav0000");
+  McapRecorder rec((dir / "run.mcap").string(), bus, topics);
+  rec.record_vehicle(model::VehicleParams{}, "/uav0000", 0);
+  auto tf = bus.advertise<msg::TFMessage>(topics.tf);
+  auto one = [](const std::string& child, std::int64_t ns) {
+    msg::TFMessage m;
+    m.transforms.resize(1);
+    m.transforms[0].header = {msg::Time::from_ns(ns), "world"};
+    m.transforms[0].child_frame_id = child;
+    return m;
+  };
+  tf.publish(one("uav0000/base_link", 0));
+  tf.publish(one("uav0001/base_link", 0));  // same stamp, another vehicle: recorded
+  tf.publish(one("uav0000/base_link", 0));  // a repeated tick: not
+  tf.publish(one("uav0001/base_link", 10'000'000));
+  tf.publish(one("uav0000/base_link", 10'000'000));
+  rec.close();
+  EXPECT_EQ(rec.messages(), 4u + 3u);  // and robot_description, /tf_static, the scene
+  EXPECT_EQ(rec.repeats(), 1u);
+  rec.write_bag_metadata(dir.string(), "run.mcap");
+  std::ifstream y(dir / "metadata.yaml");
+  const std::string meta((std::istreambuf_iterator<char>(y)), std::istreambuf_iterator<char>());
+  for (const std::string want : {"name: /tf\n        type: tf2_msgs/msg/TFMessage",
+                                 "name: /uav0000/robot_description\n        type: std_msgs/msg/String",
+                                 "name: /tf_static\n        type: tf2_msgs/msg/TFMessage",
+                                 "name: /uav0000/scene\n        type: foxglove_msgs/msg/SceneUpdate", "depth: 100\\n",
+                                 "durability: transient_local"}) {
+    EXPECT_NE(meta.find(want), std::string::npos) << want << "\n" << meta;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace quadcosim::io

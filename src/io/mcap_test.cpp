@@ -203,6 +203,25 @@ TEST_F(CdrTest, PlantStatusMatchesCyclone) {
   }
 }
 
+TEST_F(CdrTest, TFMessageMatchesCyclone) {
+  check(msg::TFMessage{}, "empty");
+  msg::TFMessage m;
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {  // parent and child of every length mod 8
+    msg::TransformStamped t;
+    t.header = {{static_cast<std::int32_t>(k), static_cast<std::uint32_t>(k * 1000)}, kFrames[k]};
+    t.child_frame_id = kFrames[kFrames.size() - 1 - k] + "/base_link";
+    t.translation = {1.0 / 3.0 + static_cast<double>(k), -2.5, 1e-7};
+    t.rotation = {0.1, -0.2, 0.3, std::sqrt(1.0 - 0.14)};
+    m.transforms.push_back(t);
+    check(m, std::to_string(k + 1) + " transforms");
+  }
+}
+
+TEST_F(CdrTest, StringMatchesCyclone) {
+  for (const std::string& s : kFrames) check(msg::String{s}, "'" + s + "'");
+  check(msg::String{std::string(5000, 'u') + "<robot/>\n"}, "long");
+}
+
 TEST(CdrLayoutTest, ClockIsTheHeaderAndTwoIntegers) {
   const std::vector<std::uint8_t> want = {0x00, 0x01, 0x00, 0x00, 0x02, 0, 0, 0, 0x03, 0, 0, 0};
   EXPECT_EQ(to_cdr(msg::Clock{{2, 3}}), want);
@@ -264,6 +283,39 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
             "std_msgs/Header header\nuint64 commands_accepted\nuint64 commands_clamped\n"
             "uint64 commands_rejected_length\nuint64 commands_rejected_non_finite\nstring last_problem\n"
             "bool watchdog_active\nuint64 watchdog_trips\nuint64 watchdog_ticks\n");
+  const std::string& tf = ros2msg_definition(msg::TFMessage::kRosType);
+  EXPECT_EQ(msg_blocks(tf), (V{"geometry_msgs/TransformStamped", "std_msgs/Header", "builtin_interfaces/Time",
+                               "geometry_msgs/Transform", "geometry_msgs/Vector3", "geometry_msgs/Quaternion"}));
+  EXPECT_EQ(tf.substr(0, tf.find("====")), "geometry_msgs/TransformStamped[] transforms\n");
+  EXPECT_NE(tf.find("MSG: geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\n"
+                    "Transform transform\n"),
+            std::string::npos);
+  EXPECT_NE(tf.find("MSG: geometry_msgs/Transform\nVector3 translation\nQuaternion rotation\n"), std::string::npos);
+  EXPECT_EQ(ros2msg_definition(msg::String::kRosType), "string data\n");
+  // foxglove_msgs/SceneUpdate as Foxglove's ROS 2 .msg files state it (field lines, in order; a type
+  // of the same package named without it, as .msg files may).
+  const std::string& scene = ros2msg_definition(msg::SceneUpdate::kRosType);
+  EXPECT_EQ(scene.substr(0, scene.find("====")),
+            "SceneEntityDeletion[] deletions\nSceneEntity[] entities\n");  // same package: bare names
+  const std::string sep = std::string(80, '=') + "\n";
+  for (const std::string block :
+       {"MSG: foxglove_msgs/SceneEntityDeletion\nbuiltin_interfaces/Time timestamp\nuint8 type\nstring id\n",
+        "MSG: foxglove_msgs/SceneEntity\nbuiltin_interfaces/Time timestamp\nstring frame_id\nstring id\n"
+        "builtin_interfaces/Duration lifetime\nbool frame_locked\nKeyValuePair[] metadata\n"
+        "ArrowPrimitive[] arrows\nCubePrimitive[] cubes\nSpherePrimitive[] spheres\n"
+        "CylinderPrimitive[] cylinders\nLinePrimitive[] lines\nTriangleListPrimitive[] triangles\n"
+        "TextPrimitive[] texts\nModelPrimitive[] models\n",
+        "MSG: builtin_interfaces/Duration\nint32 sec\nuint32 nanosec\n",
+        "MSG: foxglove_msgs/CylinderPrimitive\ngeometry_msgs/Pose pose\ngeometry_msgs/Vector3 size\n"
+        "float64 bottom_scale\nfloat64 top_scale\nColor color\n",
+        "MSG: foxglove_msgs/LinePrimitive\nuint8 type\ngeometry_msgs/Pose pose\nfloat64 thickness\n"
+        "bool scale_invariant\ngeometry_msgs/Point[] points\nColor color\nColor[] colors\nuint32[] indices\n",
+        "MSG: foxglove_msgs/ModelPrimitive\ngeometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nColor color\n"
+        "bool override_color\nstring url\nstring media_type\nuint8[] data\n",
+        "MSG: foxglove_msgs/Color\nfloat64 r\nfloat64 g\nfloat64 b\nfloat64 a\n"}) {
+    EXPECT_NE(scene.find(sep + block), std::string::npos) << block;
+  }
+  EXPECT_EQ(msg_blocks(scene).size(), 18u) << scene;
   EXPECT_THROW(ros2msg_definition("geometry_msgs/msg/PoseWithCovariance"), std::invalid_argument);
   EXPECT_THROW(ros2msg_definition("geometry_msgs/PoseStamped"), std::invalid_argument);
 }

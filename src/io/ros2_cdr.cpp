@@ -67,6 +67,8 @@ struct CdrFields {
   void put(const T& v) {
     if constexpr (std::is_same_v<T, bool>) {
       w.boolean(v);
+    } else if constexpr (std::is_same_v<T, std::uint8_t>) {
+      w.u8(v);
     } else if constexpr (std::is_same_v<T, std::string>) {
       w.str(v);
     } else if constexpr (std::is_same_v<T, double>) {
@@ -143,6 +145,8 @@ struct MsgFields {
   std::string type_text(const T& v, std::string_view ros_type) {
     if constexpr (std::is_same_v<T, bool>) {
       return "bool";
+    } else if constexpr (std::is_same_v<T, std::uint8_t>) {
+      return "uint8";
     } else if constexpr (std::is_same_v<T, std::string>) {
       return "string";
     } else if constexpr (std::is_same_v<T, double>) {
@@ -190,6 +194,9 @@ const MsgTypes& msg_types() {
     add_type<msg::Clock>(t);
     add_type<msg::ControllerStatus>(t);
     add_type<msg::PlantStatus>(t);
+    add_type<msg::TFMessage>(t);
+    add_type<msg::String>(t);
+    add_type<msg::SceneUpdate>(t);
     return t;
   }();
   return types;
@@ -219,6 +226,9 @@ std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m) { return cdr_o
 std::vector<std::uint8_t> to_cdr(const msg::Clock& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::TFMessage& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::String& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::SceneUpdate& m) { return cdr_of(m); }
 
 const std::string& ros2msg_definition(std::string_view ros_type) {
   // "pkg/msg/Type" -> the full text, built once from the .msg table (immutable afterwards).
@@ -237,13 +247,13 @@ const std::string& ros2msg_definition(std::string_view ros_type) {
   return it->second;
 }
 
-std::string ros2_offered_qos_profiles(std::uint32_t depth, bool reliable) {
+std::string ros2_offered_qos_profiles(std::uint32_t depth, bool reliable, bool transient_local) {
   // RMW_DURATION_INFINITE as rosbag2 writes it.
   const std::string infinite = "\n    sec: 9223372036\n    nsec: 854775807";
   return "- history: keep_last\n  depth: " + std::to_string(depth) +
          "\n  reliability: " + (reliable ? "reliable" : "best_effort") +
-         "\n  durability: volatile\n  deadline:" + infinite + "\n  lifespan:" + infinite +
-         "\n  liveliness: automatic\n  liveliness_lease_duration:" + infinite +
+         "\n  durability: " + (transient_local ? "transient_local" : "volatile") + "\n  deadline:" + infinite +
+         "\n  lifespan:" + infinite + "\n  liveliness: automatic\n  liveliness_lease_duration:" + infinite +
          "\n  avoid_ros_namespace_conventions: false";
 }
 

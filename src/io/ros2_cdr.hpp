@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sim/messages.hpp"
+#include "sim/scene_messages.hpp"
 
 namespace quadcosim::io {
 
@@ -26,19 +27,24 @@ std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m);
 std::vector<std::uint8_t> to_cdr(const msg::Clock& m);
 std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m);
 std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m);
+std::vector<std::uint8_t> to_cdr(const msg::TFMessage& m);
+std::vector<std::uint8_t> to_cdr(const msg::String& m);
+std::vector<std::uint8_t> to_cdr(const msg::SceneUpdate& m);
 
 /// The full `ros2msg` schema text of a ROS 2 message type named "pkg/msg/Type" (e.g.
 /// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType): the type's own .msg fields,
 /// then every type it depends on, depth first in field order, each once, as a line of 80 '=', a line
 /// "MSG: pkg/Type" and that type's fields (the ros1msg/ros2msg convention of the MCAP registry and
-/// rosbag2). Known: the seven message types of sim/messages.hpp and the types they contain. Throws
+/// rosbag2). Known: the message types of sim/messages.hpp, foxglove_msgs/msg/SceneUpdate
+/// (sim/scene_messages.hpp) and the types they contain. Throws
 /// std::invalid_argument naming `ros_type` for any other.
 const std::string& ros2msg_definition(std::string_view ros_type);
 
 /// The `offered_qos_profiles` channel metadata the MCAP ros2 profile requires, in rosbag2's YAML
 /// (bag format version 9, Jazzy): one publisher offering KEEP_LAST `depth`, RELIABLE or BEST_EFFORT,
-/// VOLATILE, infinite deadline/lifespan/lease, AUTOMATIC liveliness — what quadcosim's nodes offer
-/// (dds/participant.hpp ros_qos). An empty string ("unknown, use defaults") is also valid for rosbag2.
-std::string ros2_offered_qos_profiles(std::uint32_t depth, bool reliable);
+/// VOLATILE or TRANSIENT_LOCAL, infinite deadline/lifespan/lease, AUTOMATIC liveliness — what
+/// quadcosim's nodes offer (dds/participant.hpp ros_qos). An empty string ("unknown, use defaults") is
+/// also valid for rosbag2.
+std::string ros2_offered_qos_profiles(std::uint32_t depth, bool reliable, bool transient_local = false);
 
 }  // namespace quadcosim::io

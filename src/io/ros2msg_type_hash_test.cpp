@@ -18,7 +18,7 @@
 namespace quadcosim::io {
 namespace {
 
-const std::set<std::string> kPrimitives = {"bool",  "byte",   "char",  "int8",   "uint8",   "int16",  "uint16",
+const std::set<std::string> kPrimitives = {"bool",  "byte",   "char",  "int8",   "uint8",   "int16",   "uint16",
                                            "int32", "uint32", "int64", "uint64", "float32", "float64", "string"};
 
 // "pkg/Type" (or bare "Type" within `package`) -> "pkg/msg/Type"; primitives stay as they are.
@@ -65,9 +65,9 @@ TEST(Ros2msgTypeHashTest, TypeDescriptionsMatchTheRecordedSchemas) {
   std::map<std::string, std::string> table;
   for (const dds::MessageDescription& d : dds::message_descriptions()) table[d.name] = d.fields;
   int compared = 0;
-  for (const std::string_view type : {msg::PoseStamped::kRosType, msg::TwistStamped::kRosType, msg::Imu::kRosType,
-                           msg::Float64MultiArray::kRosType, msg::Clock::kRosType, msg::ControllerStatus::kRosType,
-                           msg::PlantStatus::kRosType}) {
+  for (const std::string_view type :
+       {msg::PoseStamped::kRosType, msg::TwistStamped::kRosType, msg::Imu::kRosType, msg::Float64MultiArray::kRosType,
+        msg::Clock::kRosType, msg::ControllerStatus::kRosType, msg::PlantStatus::kRosType}) {
     for (const auto& [name, fields] : sections(std::string(type), ros2msg_definition(type))) {
       ASSERT_EQ(table.count(name), 1u) << name << " (in the schema of " << type << ") has no type description";
       EXPECT_EQ(lines(table[name]), fields) << name;

@@ -345,6 +345,8 @@ void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duratio
   cfg.duration_ticks = tick_at(s, "duration_s", duration_s, cfg.plant.clock.period_ns);
   cfg.ns = s.text("namespace", cfg.ns);
   if (std::string err = sim::validate_namespace(cfg.ns); !err.empty()) s.fail("namespace", err);
+  // The vehicle for 3D views: /tf, /tf_static, robot_description and the recorded scene.
+  cfg.plant.publish_tf = s.boolean("tf", true);
   const double watchdog_s = s.number("watchdog_s", 0.5, 0.0, 1e6);
   cfg.plant.watchdog_ticks = tick_at(s, "watchdog_s", watchdog_s, cfg.plant.clock.period_ns);
   cfg.plant.watchdog_policy = s.choice("watchdog_policy", "stop", {"hold", "stop"}) == "hold"

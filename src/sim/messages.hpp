@@ -261,6 +261,45 @@ struct PlantStatus {
   }
 };
 
+/// geometry_msgs/msg/TransformStamped: the pose of frame child_frame_id in frame header.frame_id
+/// (translation of its origin, rotation q_parent_child), as tf2 carries it.
+struct TransformStamped {
+  static constexpr std::string_view kRosType = "geometry_msgs/msg/TransformStamped";
+  Header header;
+  std::string child_frame_id;
+  Vector3 translation;  ///< transform.translation
+  Quaternion rotation;  ///< transform.rotation
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("child_frame_id", m.child_frame_id);
+    v.group("transform", "geometry_msgs/msg/Transform", [&](auto& g) {
+      g.field("translation", m.translation);
+      g.field("rotation", m.rotation);
+    });
+  }
+};
+
+/// tf2_msgs/msg/TFMessage: what /tf and /tf_static carry.
+struct TFMessage {
+  static constexpr std::string_view kRosType = "tf2_msgs/msg/TFMessage";
+  std::vector<TransformStamped> transforms;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("transforms", m.transforms);
+  }
+};
+
+/// std_msgs/msg/String (the robot description: a URDF).
+struct String {
+  static constexpr std::string_view kRosType = "std_msgs/msg/String";
+  std::string data;
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("data", m.data);
+  }
+};
+
 /// rosgraph_msgs/msg/Clock
 struct Clock {
   static constexpr std::string_view kRosType = "rosgraph_msgs/msg/Clock";

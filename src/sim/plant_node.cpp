@@ -5,6 +5,8 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "sim/vehicle_description.hpp"
+
 namespace quadcosim::sim {
 
 namespace {
@@ -56,6 +58,20 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   pose_.header.frame_id = options.frame_id;
   twist_.header.frame_id = options.frame_id;
   imu_.header.frame_id = "base_link";
+  if (options.publish_tf) {
+    // tf2 names frames without a leading '/', the vehicle's namespace as their prefix (/drone ->
+    // drone/base_link), so many vehicles share one /tf.
+    const std::string ns = topics.pose.substr(0, topics.pose.rfind('/'));
+    tf_.transforms.resize(1);
+    tf_.transforms[0].header.frame_id = options.frame_id;
+    tf_.transforms[0].child_frame_id = tf_prefix(ns) + "base_link";
+    VehicleDescription d = describe_vehicle(vehicle, ns, msg::Time::from_ns(options.clock.ns(0)));
+    tf_static_ = std::move(d.rotors);
+    description_ = std::move(d.urdf);
+    tf_pub_ = transport.advertise<msg::TFMessage>(topics.tf);
+    tf_static_pub_ = transport.advertise<msg::TFMessage>(topics.tf_static);
+    description_pub_ = transport.advertise<msg::String>(topics.robot_description);
+  }
   status_period_ticks_ = options.status_period_ticks > 0 ? options.status_period_ticks
                                                          : std::max<Tick>(1, 1'000'000'000 / options.clock.period_ns);
   transport.subscribe<msg::Float64MultiArray>(topics.motor_commands,
@@ -135,6 +151,11 @@ void PlantNode::publish_outputs(Tick k) {
 
   const bool clock_first = !options_.clock_after_sensors;
   if (clock_pub_ && clock_first) clock_pub_.publish(msg::Clock{stamp});
+  if (description_pub_ && !description_sent_) {
+    description_sent_ = true;
+    description_pub_.publish(description_);
+    tf_static_pub_.publish(tf_static_);
+  }
   publish_status(k);
 
   // The messages are kept between ticks (their frame ids are set once); every field that changes
@@ -160,6 +181,13 @@ void PlantNode::publish_outputs(Tick k) {
     pose_pub_.publish(pose_);
     velocity_pub_.publish(twist_);
     imu_pub_.publish(imu_);
+  }
+  if (tf_pub_) {  // the true pose, whatever the sensors made of it
+    msg::TransformStamped& t = tf_.transforms.front();
+    t.header.stamp = stamp;
+    t.translation = to_msg(y.p_W);
+    t.rotation = to_msg(y.q_WB);
+    tf_pub_.publish(tf_);
   }
   if (clock_pub_ && !clock_first) {
     if (before_clock_) before_clock_(k);

@@ -55,6 +55,10 @@ struct PlantOptions {
   /// Simulink node with ROS 2 time model stepping, docs/simulink.md): delivered in publication order,
   /// the tick's samples are in before the time that steps it.
   bool clock_after_sensors = false;
+  /// The vehicle for 3D views: /tf (frame_id -> <ns>/base_link, the true pose, every tick), and once,
+  /// at the first tick, /tf_static (base_link -> rotors) and <ns>/robot_description (a URDF of the
+  /// vehicle); sim/vehicle_description.hpp. Off: none of the three.
+  bool publish_tf = true;
   /// Dynamics computed elsewhere (an FMU, sim/external_dynamics.hpp), one instance made per plant;
   /// null: the native 6-DOF model. Commands, delay, watchdog, status, topics and the sensor realism
   /// (noise, rates, latency) are the node's either way; wind, rotor faults and aerodynamic drag act
@@ -177,6 +181,14 @@ class PlantNode final : public SteppablePlant {
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
   Publisher<msg::Imu> imu_pub_;
+  msg::TFMessage tf_;  ///< one transform, frame ids set once
+  Publisher<msg::TFMessage> tf_pub_;
+  // Published at the first publish_outputs (built in the constructor: no allocation on a tick).
+  msg::TFMessage tf_static_;
+  msg::String description_;
+  bool description_sent_ = false;
+  Publisher<msg::TFMessage> tf_static_pub_;
+  Publisher<msg::String> description_pub_;
 };
 
 }  // namespace quadcosim::sim

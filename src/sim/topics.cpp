@@ -8,8 +8,17 @@ Topics Topics::for_namespace(const std::string& ns) {
   std::string base = ns;
   while (base.size() > 1 && base.back() == '/') base.pop_back();
   if (base == "/") base.clear();
-  return {base + "/motor_commands",    base + "/Pose",        base + "/Velocity", base + "/Imu", "/clock",
-          base + "/controller_status", base + "/plant_status"};
+  return {base + "/motor_commands",
+          base + "/Pose",
+          base + "/Velocity",
+          base + "/Imu",
+          "/clock",
+          base + "/controller_status",
+          base + "/plant_status",
+          "/tf",
+          "/tf_static",
+          base + "/robot_description",
+          base + "/scene"};
 }
 
 std::string validate_namespace(const std::string& ns) {

@@ -13,6 +13,11 @@ struct Topics {
   std::string clock;              ///< plant ->, rosgraph_msgs/Clock (global, not namespaced)
   std::string controller_status;  ///< controller ->, quadcosim_msgs/ControllerStatus
   std::string plant_status;       ///< plant ->, quadcosim_msgs/PlantStatus
+  /// plant ->, tf2_msgs/TFMessage: world -> <ns>/base_link, every tick (global: all vehicles share it)
+  std::string tf;
+  std::string tf_static;          ///< plant ->, tf2_msgs/TFMessage: base_link -> rotors, once (global)
+  std::string robot_description;  ///< plant ->, std_msgs/String: the vehicle's URDF, once
+  std::string scene;              ///< recorded only, foxglove_msgs/SceneUpdate: the vehicle drawn
 
   /// Topics under `ns` ("/drone" gives "/drone/Pose", ...). `ns` must start with '/'.
   static Topics for_namespace(const std::string& ns = "/drone");

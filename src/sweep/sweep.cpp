@@ -38,6 +38,8 @@ const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, c
   if (mcap_dir) {
     mcap.emplace((*mcap_dir / "run.mcap").string(), simulation.transport(),
                  sim::Topics::for_namespace(sc.simulation.ns));
+    if (sc.simulation.plant.publish_tf)
+      mcap->record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
   }
   series.clear(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
   bool watchdog = false;

@@ -120,7 +120,7 @@ expect 2 "value is required" param set /attitude_controller z_des
 expect 2 "--timeout: Value -1 not in range" param get /attitude_controller z_des --timeout -1
 expect 2 "topic is required" topic echo
 expect 2 "--count: Value -3 not in range 1" topic echo /drone/Pose --count -3
-expect 2 "--qos: fancy not in {default,sensor}" topic echo /drone/Pose --qos fancy
+expect 2 "--qos: fancy not in {default,sensor,transient_local}" topic echo /drone/Pose --qos fancy
 expect 2 "--window: Value 0 not in range 1" topic hz /drone/Pose --window 0
 expect 2 "--wait: Value soon not in range" topic list --wait soon
 

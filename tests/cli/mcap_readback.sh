@@ -21,9 +21,11 @@ if summary["profile"] != "ros2": fail("profile is %r" % summary["profile"])
 ch = summary["channels"]
 # 15 s at 100 Hz plant (ticks 0..1500) and 50 Hz controller (steps at even ticks):
 # 4 x 1501 + 2 x 751 = 7506 messages, and the plant status once per simulated second (no command
-# was refused): 16, 7522 in all.
+# was refused): 16; /tf at every tick: 1501; the robot description, /tf_static and the scene once:
+# 9026 in all.
 expected = {"/clock": 1501, "/drone/Pose": 1501, "/drone/Velocity": 1501, "/drone/Imu": 1501,
-            "/drone/controller_status": 751, "/drone/motor_commands": 751, "/drone/plant_status": 16}
+            "/drone/controller_status": 751, "/drone/motor_commands": 751, "/drone/plant_status": 16,
+            "/tf": 1501, "/drone/robot_description": 1, "/tf_static": 1, "/drone/scene": 1}
 for topic, n in expected.items():
     got = ch[topic]["last"]["sequence"]
     if got != n: fail("%s: %d messages, expected %d" % (topic, got, n))
@@ -45,7 +47,7 @@ if cs["rejected_non_finite"] != "0" or cs["rejected_stamp_backwards"] != "0":
 cmd = ch["/drone/motor_commands"]["last"]["message"]["data"]
 if [float(rows[-2]["cmd%d" % i]) for i in range(1, 5)] != cmd and [float(rows[-1]["cmd%d" % i]) for i in range(1, 5)] != cmd:
     fail("last motor command %r not in the CSV" % cmd)
-for needle in ("storage_identifier: mcap", "relative_file_paths:", "- run.mcap", "message_count: 7522",
+for needle in ("storage_identifier: mcap", "relative_file_paths:", "- run.mcap", "message_count: 9026",
                "name: /drone/Pose", "type: geometry_msgs/msg/PoseStamped"):
     if needle not in meta: fail("metadata.yaml lacks %r" % needle)
 print("ok: counts match the rates, values match trajectory.csv, metadata.yaml describes the bag")
