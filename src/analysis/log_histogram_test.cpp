@@ -16,8 +16,8 @@ namespace {
 
 TEST(LogHistogram, BucketsCoverEveryValueInOrderWithinOneSixtyFourth) {
   // Each value falls in the bucket whose lower edge is the largest edge not above it.
-  for (std::uint64_t u : {0ull, 1ull, 63ull, 64ull, 65ull, 127ull, 128ull, 1000ull, 123456789ull, (1ull << 40) + 12345ull,
-                          ~0ull >> 1}) {
+  for (std::uint64_t u :
+       {0ull, 1ull, 63ull, 64ull, 65ull, 127ull, 128ull, 1000ull, 123456789ull, (1ull << 40) + 12345ull, ~0ull >> 1}) {
     const std::size_t i = LogHistogram::index(u);
     ASSERT_LT(i, LogHistogram::kBuckets) << u;
     EXPECT_LE(LogHistogram::lower_edge(i), u) << u;

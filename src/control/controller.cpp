@@ -1,8 +1,24 @@
 #include "control/controller.hpp"
 
+#include "model/quadrotor.hpp"
+
 #include <algorithm>
+#include <limits>
 
 namespace quadcosim::control {
+
+void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference, const Eigen::Vector4d& omega_rad_s,
+                         ControllerOutput& out) {
+  out.omega_rad_s = omega_rad_s;
+  const model::Wrench u = model.wrench(omega_rad_s);
+  out.U = {u.thrust_N, u.torque_B_Nm.x(), u.torque_B_Nm.y(), u.torque_B_Nm.z()};
+  out.roll_des_rad = reference.roll_rad;
+  out.pitch_des_rad = reference.pitch_rad;
+  out.yaw_des_rad = reference.yaw_rad;
+  out.attitude_error = std::numeric_limits<double>::quiet_NaN();
+  out.rotor_saturated = {};
+  out.tilt_saturated = false;
+}
 
 double attitude_error(const Eigen::Quaterniond& q_des, const Eigen::Quaterniond& q) {
   // 1/2 tr(I - R_d^T R) = 1 - cos(theta) for the rotation R_d^T R by theta; with the unit quaternion

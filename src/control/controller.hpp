@@ -23,6 +23,10 @@
 
 #include "control/parameters.hpp"
 
+namespace quadcosim::model {
+class Quadrotor;
+}
+
 namespace quadcosim::control {
 
 enum class Mode {
@@ -153,6 +157,12 @@ class ControllerWith : public Controller {
  private:
   P params_;
 };
+
+/// The output of a controller that decides only rotor speeds (an FMU, a Python class): `omega_rad_s`, U
+/// = the wrench those speeds make on `model` (eq. (4)), the reference's attitude as the tracked one,
+/// attitude_error NaN, no saturation flags. Leaves `out.outputs` as it is.
+void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference, const Eigen::Vector4d& omega_rad_s,
+                         ControllerOutput& out);
 
 /// Psi = 1/2 tr(I - R_d^T R), the attitude error of Lee, Leok and McClamroch (2010), in [0, 2]:
 /// 1 - cos(angle of the rotation between them).

@@ -327,15 +327,7 @@ void FmuController::step(const control::Observation& o, const control::Reference
     }
   }
   ++steps_;
-  out.omega_rad_s = {out_[0], out_[1], out_[2], out_[3]};
-  const model::Wrench u = model_.wrench(out.omega_rad_s);
-  out.U = {u.thrust_N, u.torque_B_Nm.x(), u.torque_B_Nm.y(), u.torque_B_Nm.z()};
-  out.roll_des_rad = r.roll_rad;
-  out.pitch_des_rad = r.pitch_rad;
-  out.yaw_des_rad = r.yaw_rad;
-  out.attitude_error = std::numeric_limits<double>::quiet_NaN();
-  out.rotor_saturated = {};
-  out.tilt_saturated = false;
+  control::rotor_speeds_output(model_, r, Eigen::Vector4d(out_[0], out_[1], out_[2], out_[3]), out);
   for (std::size_t i = 0; i < shared_->figure_names.size() && i < out.outputs.size(); ++i) out.outputs[i] = out_[4 + i];
 }
 

@@ -672,15 +672,8 @@ void PyController::step(const control::Observation& o, const control::Reference&
               t);
   }
   ++steps_;
-  out.omega_rad_s = {omega_values[0], omega_values[1], omega_values[2], omega_values[3]};
-  const model::Wrench u = model_.wrench(out.omega_rad_s);
-  out.U = {u.thrust_N, u.torque_B_Nm.x(), u.torque_B_Nm.y(), u.torque_B_Nm.z()};
-  out.roll_des_rad = r.roll_rad;
-  out.pitch_des_rad = r.pitch_rad;
-  out.yaw_des_rad = r.yaw_rad;
-  out.attitude_error = std::numeric_limits<double>::quiet_NaN();
-  out.rotor_saturated = {};
-  out.tilt_saturated = false;
+  control::rotor_speeds_output(
+      model_, r, Eigen::Vector4d(omega_values[0], omega_values[1], omega_values[2], omega_values[3]), out);
 }
 
 // ---------------------------------------------------------------------------------------------------
