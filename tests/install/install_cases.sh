@@ -75,7 +75,8 @@ r = quadcosim.run(sys.argv[1])
 assert r.passed, r.table
 print("pip-installed module:", quadcosim.__file__, r)
 PYEOF
-    venv/bin/python -m pip show quadcosim | grep -q "^Version: " || fail "pip does not list quadcosim"
+    venv/bin/python -m pip show quadcosim > show.log 2>&1 || fail "pip show quadcosim failed: $(cat show.log)"
+    grep -q "^Version: " show.log || fail "pip does not list quadcosim: $(cat show.log)"
     ;;
   colcon)
     command -v colcon > /dev/null || { echo "SKIP: colcon is not installed (Debian: colcon python3-colcon-ros)"; exit 77; }

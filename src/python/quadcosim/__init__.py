@@ -134,7 +134,7 @@ class Controller:
 
 
 # Keys of metrics.json that describe the run rather than judge it.
-_HEADER_KEYS = {"scenario", "description", "passed", "controller", "schema", "version"}
+_HEADER_KEYS = {"scenario", "scenario_file", "description", "passed", "controller", "schema", "version"}
 
 
 def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = None,
