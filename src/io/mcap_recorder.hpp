@@ -65,15 +65,17 @@ class McapRecorder {
     std::uint64_t arrival;
     std::vector<std::uint8_t> cdr;
   };
+  /// A channel's offered QoS (no member initialisers: clang refuses one of those in the default
+  /// argument of add() below, inside the class).
   struct Qos {
-    std::uint32_t depth = 10;
-    bool reliable = true;
-    bool transient_local = false;
+    std::uint32_t depth;
+    bool reliable;
+    bool transient_local;
   };
   struct ChannelInfo {
     std::string topic, type;
     std::uint16_t id;
-    Qos qos;
+    Qos qos{10, true, false};
     std::uint64_t count = 0;
     std::uint32_t sequence = 0;
     std::int64_t newest_ns = -1;  ///< newest own stamp accepted on this channel
@@ -84,7 +86,7 @@ class McapRecorder {
   template <class T>
   std::size_t open_channel(const std::string& topic, Qos qos);
   template <class T>
-  void add(sim::Transport& transport, const std::string& topic, Qos qos = {});
+  void add(sim::Transport& transport, const std::string& topic, Qos qos = {10, true, false});
   bool wanted(const std::string& topic) const;
   void push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr);
 
