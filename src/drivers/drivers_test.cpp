@@ -256,13 +256,14 @@ struct PlainController {
   sim::Publisher<msg::Float64MultiArray> pub = bus.advertise<msg::Float64MultiArray>(t.motor_commands);
   bool stale_first = false;
   bool answer = true;
+  std::int64_t first_answer_ns = 0;  ///< answers no sample stamped earlier (a timer on ROS time: one period)
   int answered = 0;
   explicit PlainController(bool drop_stale) {
     sim::PlantOptions po;
     po.drop_stale_commands = drop_stale;
     bus.subscribe<msg::Imu>(t.imu, [this](const msg::Imu& m) {
       const std::int64_t s = m.header.stamp.to_ns();
-      if (!answer || s % 20'000'000 != 0) return;
+      if (!answer || s % 20'000'000 != 0 || s < first_answer_ns) return;
       msg::Float64MultiArray c;
       if (stale_first) {  // tick 0's command, labelled, and for every later tick that one again
         c.dim.push_back({msg::command_label(0), 4, 1});
@@ -289,6 +290,40 @@ TEST(LockstepPlantDriverTest, AnUnlabelledCommandAnswersTheTickItArrivesAfter) {
   EXPECT_EQ(c.answered, 6);                       // ticks 0, 2, ..., 10
   EXPECT_EQ(c.plant->latched_command()[0], 105);  // tick 10's own command acts at tick 10
   EXPECT_EQ(host.clock_ns, 0) << "the driver waited for an answer that was there";
+}
+
+TEST(LockstepPlantDriverTest, AControllerOnATimerIsFirstAwaitedOnePeriodIn) {
+  // A timer on ROS time first fires one control period after it starts: no answer to tick 0.
+  PlainController c(true);
+  c.first_answer_ns = 20'000'000;
+  QueuedHost host;
+  LockstepOptions o;
+  o.duration_ticks = 10;
+  o.timeout_ns = 200'000'000;
+  o.first_control_tick = 2;
+  std::vector<double> latched;
+  LockstepHooks h;
+  h.after_latch = [&](std::size_t, Tick) { latched.push_back(c.plant->latched_command()[0]); };
+  LockstepPlantDriver driver({DrivenPlant{c.plant.get(), {}, {}}}, o, h, host);
+  host.driver = &driver;
+  ASSERT_EQ(driver.run(), LockstepResult::kDone);
+  EXPECT_EQ(c.answered, 5);  // ticks 2, 4, ..., 10
+  EXPECT_EQ(host.clock_ns, 0) << "the driver waited for an answer to a tick before the first";
+  ASSERT_EQ(latched.size(), 11u);
+  EXPECT_EQ(latched[0], 0);  // no command yet: the plant's initial one
+  EXPECT_EQ(latched[1], 0);
+  EXPECT_EQ(latched[2], 101);  // tick 2's own command acts at tick 2
+  EXPECT_EQ(latched[10], 105);
+
+  // Awaited from tick 0 (the default), the same controller leaves tick 0 unanswered.
+  PlainController late(true);
+  late.first_answer_ns = 20'000'000;
+  QueuedHost host2;
+  o.first_control_tick = 0;
+  LockstepPlantDriver waiting({DrivenPlant{late.plant.get(), {}, {}}}, o, {}, host2);
+  host2.driver = &waiting;
+  EXPECT_EQ(waiting.run(), LockstepResult::kTimedOut);
+  EXPECT_EQ(waiting.ticks_run(), 0);
 }
 
 TEST(LockstepPlantDriverTest, ALabelledRepeatOfAnEarlierTickIsNoAnswer) {

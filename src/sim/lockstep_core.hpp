@@ -7,9 +7,9 @@
 //
 // Per tick k: hooks.before_outputs(k) (a scheduled change), every plant publishes its outputs,
 // hooks.after_outputs(k) (a controller stepped on the tick); on control ticks
-// (k % controller_divider == 0) the loop waits for the answer of every plant; then each plant latches
-// its command, hooks.after_latch(i, k) records it, and the plant integrates to t_k+1 (not after the
-// last tick).
+// (k % controller_divider == 0, from first_control_tick on) the loop waits for the answer of every plant; then each
+// plant latches its command, hooks.after_latch(i, k) records it, and the plant integrates to t_k+1 (not after the last
+// tick).
 //
 // The answer to tick k (one rule, for every plant and host):
 //   - a command labelled with t_k (msg::command_stamp_ns), or, when the newest command taken carries
@@ -65,7 +65,10 @@ enum class TimeoutPolicy {
 struct LockstepOptions {
   TickClock clock;
   Tick duration_ticks = 1500;  ///< last tick
-  int controller_divider = 2;  ///< control ticks: k % divider == 0
+  int controller_divider = 2;  ///< control ticks: k % divider == 0 and k >= first_control_tick
+  /// The first tick answered: 0 for a controller that steps on each control tick's samples; one
+  /// control period for a timer on ROS time, which first fires one period after it starts.
+  Tick first_control_tick = 0;
   std::int64_t timeout_ns = 10'000'000'000;
   TimeoutPolicy on_timeout = TimeoutPolicy::kAbort;
   std::int64_t retry_ns = 50'000'000;  ///< ask again after this long without the answer
@@ -192,7 +195,7 @@ class LockstepCore {
   Phase advance_ticks(bool on_delivery) {
     for (;;) {
       const Tick k = k_;
-      const bool control = k % o_.controller_divider == 0;
+      const bool control = k % o_.controller_divider == 0 && k >= o_.first_control_tick;
       if (!published_) {
         if (k > o_.duration_ticks || host_.stop_requested()) return Phase::kDone;
         if (on_delivery && (!waiting_ || hooks_.main_thread_due(k))) return Phase::kMainThread;

@@ -1,0 +1,203 @@
+#!/usr/bin/env bash
+# quadcosim against real ROS 2 (Jazzy, rmw_cyclonedds_cpp): the rclcpp and rclpy controllers of this
+# folder, unmodified ROS 2 nodes that step from a timer on ROS time, flown by `quadcosim plant` in
+# lockstep; and the ros2 command line on quadcosim's nodes.
+#
+#   ros2_cases.sh QUADCOSIM SOURCE_DIR CASE DOMAIN_ID WORK_DIR
+#   CASE: rclcpp_lockstep | rclcpp_no_clock_thread | rclpy_lockstep | cli
+#
+# Needs a ROS 2 installation: one already sourced (ROS_DISTRO set, `ros2` on PATH), or the setup
+# file named by QUADCOSIM_ROS2_SETUP (e.g. /opt/ros/jazzy/setup.bash), with rclcpp, rclpy, ros2cli
+# and rmw_cyclonedds_cpp. Without it the case reports SKIPPED (exit 77) and says why. The rclcpp
+# controller is built in WORK_DIR/rclcpp_controller with the installation's CMake packages (once,
+# under a lock, for every case).
+#
+# What each case checks, with numbers it did not produce:
+#  - every control step of the controller (its log: now, and the stamps of the Pose, Velocity and
+#    Imu it used) used the samples of its own tick: the three stamps equal the ROS time of the step;
+#    steps come every 20 ms from t = 0.02 s on, 750 in the 15 s of the paper's altitude step;
+#  - repeated runs give byte-identical trajectory.csv (20 for rclcpp), and the rclcpp and rclpy
+#    controllers, which compute the same law in the same order, give the same bytes as each other;
+#  - the flight is the altitude step: z(15 s) within 1 % of z_des = 10 m (PD: wn 1.43 rad/s, zeta
+#    0.48, settled to 2 % by ~6 s);
+#  - nothing in the ROS 2 processes' output is a warning or an error (rclcpp's INFO line on SIGTERM
+#    is not).
+set -euo pipefail
+QC="$1" SRC="$2" case_arg="$3" DOMAIN="$4" WORK="$5"
+
+skip() { echo "SKIPPED: $*"; exit 77; }
+if [ -n "${QUADCOSIM_ROS2_SETUP:-}" ]; then
+  [ -f "$QUADCOSIM_ROS2_SETUP" ] || skip "QUADCOSIM_ROS2_SETUP=$QUADCOSIM_ROS2_SETUP is not a file"
+  set +u
+  # shellcheck disable=SC1090
+  source "$QUADCOSIM_ROS2_SETUP"
+  set -u
+fi
+command -v ros2 > /dev/null 2>&1 && [ -n "${AMENT_PREFIX_PATH:-}" ] ||
+  skip "no ROS 2 installation: source one (e.g. /opt/ros/jazzy/setup.bash) or set QUADCOSIM_ROS2_SETUP"
+has_package() {
+  local p
+  for p in ${AMENT_PREFIX_PATH//:/ }; do
+    [ -e "$p/share/ament_index/resource_index/packages/$1" ] && return 0
+  done
+  return 1
+}
+for p in rclcpp rclpy rmw_cyclonedds_cpp ros2topic ros2param ros2node; do
+  has_package "$p" || skip "the ROS 2 installation has no $p"
+done
+export RMW_IMPLEMENTATION=rmw_cyclonedds_cpp
+# The Python the installation's tools run on (a python3 earlier on PATH may lack its modules).
+ROS_PY=$(head -1 "$(command -v ros2)" | sed -n 's/^#! *//p')
+[ -x "${ROS_PY%% *}" ] || ROS_PY=python3
+# shellcheck source=../lib/process_case.sh
+source "$SRC/tests/lib/process_case.sh" "ros2.$case_arg" "$DOMAIN"
+
+# The rclcpp controller, built once for all cases (they may run in parallel).
+CTL_CPP="$WORK/rclcpp_controller/attitude_controller"
+build_rclcpp_controller() {
+  mkdir -p "$WORK"
+  (
+    flock 9
+    if [ ! -x "$CTL_CPP" ] || [ "$SRC/tests/ros2/rclcpp_controller/src/attitude_controller.cpp" -nt "$CTL_CPP" ]; then
+      cmake -S "$SRC/tests/ros2/rclcpp_controller" -B "$WORK/rclcpp_controller" -DCMAKE_BUILD_TYPE=Release > "$WORK/build.log" 2>&1 &&
+        cmake --build "$WORK/rclcpp_controller" -j2 >> "$WORK/build.log" 2>&1 || { cat "$WORK/build.log"; exit 1; }
+    fi
+  ) 9> "$WORK/build.lock" || fail "building tests/ros2/rclcpp_controller failed"
+}
+CTL_PY="$SRC/tests/ros2/rclpy_controller/attitude_controller.py"
+SCENARIO="$SRC/scenarios/paper/altitude_step.yaml"
+
+# No warnings or errors in a ROS 2 process's output (FILE): rclcpp's and rclpy's log lines and
+# Python tracebacks.
+no_warnings() {
+  if grep -E "\[(WARN|ERROR|FATAL)\]|Traceback|[Ff]ailed|INVALID" "$1"; then fail "$2 printed warnings or errors (above)"; fi
+}
+
+# lockstep_run N CONTROLLER... : one paper altitude step (15 s) in lockstep; leaves run N's
+# trajectory.csv, the controller's step log, both outputs and the plant's stats in $tmp/runN/.
+lockstep_run() {
+  local n="$1"
+  shift
+  local d="$tmp/run$n"
+  mkdir -p "$d"
+  "$@" --ros-args -p use_sim_time:=true -p log_file:="$d/steps.log" > "$d/controller.out" 2>&1 &
+  local ctl=$!
+  pids+=("$ctl")
+  local rc=0
+  "$QC" plant --scenario "$SCENARIO" --schedule-via /attitude_controller --record "$d/trajectory.csv" \
+    --stats "$d/stats.json" --timeout 30 > "$d/plant.out" 2>&1 || rc=$?
+  kill -TERM "$ctl" 2>/dev/null || true
+  wait "$ctl" 2>/dev/null || true
+  [ "$rc" = 0 ] || { cat "$d/plant.out"; fail "run $n: plant exited with $rc"; }
+  grep -q "lockstep with /attitude_controller on ROS time" "$d/plant.out" ||
+    { cat "$d/plant.out"; fail "run $n: the plant did not choose the ROS-time protocol"; }
+  if grep -i "warning" "$d/plant.out"; then fail "run $n: the plant warned (above)"; fi
+  no_warnings "$d/controller.out" "run $n's controller"
+  # Every step used its own tick's samples; a step every 20 ms from 0.02 s to 15 s.
+  awk -v run="$n" '
+    { if ($1 != $2 || $1 != $3 || $1 != $4) { printf "run %s: the step at %d ns used samples of %d/%d/%d ns\n", run, $1, $2, $3, $4; bad++ }
+      if ($1 != NR * 20000000) { printf "run %s: step %d at %d ns, expected %d\n", run, NR, $1, NR * 20000000; bad++ } }
+    END { if (NR != 750) { printf "run %s: %d steps, expected 750\n", run, NR; bad++ } exit bad > 0 }' "$d/steps.log" ||
+    fail "run $n: the controller's steps did not see their own ticks' samples"
+  # The altitude step reached 10 m (z is column 4 of trajectory.csv).
+  tail -1 "$d/trajectory.csv" | awk -F, '{ exit !($4 > 9.9 && $4 < 10.1) }' ||
+    fail "run $n: z(15 s) = $(tail -1 "$d/trajectory.csv" | cut -d, -f4), expected 10 m within 1 %"
+  "$ROS_PY" -c 'import json,sys; print("run %s: %.1fx real time" % (sys.argv[2], json.load(open(sys.argv[1]))["real_time_factor"]))' \
+    "$d/stats.json" "$n"
+}
+
+# same_bytes FIRST LAST [REFERENCE]: runs FIRST..LAST gave the same trajectory.csv (as REFERENCE's).
+same_bytes() {
+  local ref="${3:-$tmp/run$1/trajectory.csv}" i
+  for ((i = $1; i <= $2; i++)); do
+    cmp -s "$ref" "$tmp/run$i/trajectory.csv" || {
+      cmp "$ref" "$tmp/run$i/trajectory.csv" || true
+      fail "run $i's trajectory.csv differs from $ref"
+    }
+  done
+}
+
+case "$case_arg" in
+  rclcpp_lockstep)
+    build_rclcpp_controller
+    for i in $(seq 1 20); do lockstep_run "$i" "$CTL_CPP"; done
+    same_bytes 1 20
+    cp "$tmp/run1/trajectory.csv" "$WORK/rclcpp_trajectory.csv"
+    echo "20 runs with the rclcpp controller: byte-identical trajectory.csv, every step on its own tick's samples"
+    ;;
+  rclcpp_no_clock_thread)
+    # /clock in the node's own executor (NodeOptions::use_clock_thread(false)): the same bytes.
+    build_rclcpp_controller
+    for i in 1 2 3; do lockstep_run "$i" "$CTL_CPP" --no-clock-thread; done
+    same_bytes 1 3
+    lockstep_run 4 "$CTL_CPP"
+    same_bytes 1 4
+    echo "use_clock_thread false and true: the same bytes"
+    ;;
+  rclpy_lockstep)
+    build_rclcpp_controller
+    for i in 1 2 3 4 5; do lockstep_run "$i" "$ROS_PY" "$CTL_PY"; done
+    same_bytes 1 5
+    lockstep_run 6 "$CTL_CPP"
+    same_bytes 1 6
+    echo "5 runs with the rclpy controller: byte-identical, and the same bytes as the rclcpp controller"
+    ;;
+  cli)
+    # A real-time run: ros2 sees quadcosim's nodes and topics, the type hash is valid, and a
+    # parameter set from the command line mid-run moves the vehicle.
+    build_rclcpp_controller
+    "$CTL_CPP" --ros-args -p use_sim_time:=true -p z_des:=1.0 -p log_file:="$tmp/steps.log" > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    "$QC" plant --realtime --scenario "$SCENARIO" --duration 20 --wait-for-controller --timeout 30 \
+      --record "$tmp/trajectory.csv" > "$tmp/plant.log" 2>&1 &
+    plant=$!
+    pids+=("$plant")
+    start=$(date +%s.%N)
+    for _ in $(seq 100); do [ -s "$tmp/steps.log" ] && break; sleep 0.1; done
+    [ -s "$tmp/steps.log" ] || fail "the controller never stepped"
+    started=$(date +%s.%N)
+
+    ros2 node list --no-daemon --spin-time 3 > "$tmp/node_list.out" 2> "$tmp/node_list.log" || fail "ros2 node list failed"
+    for n in /quadrotor_plant /attitude_controller; do
+      grep -qx "$n" "$tmp/node_list.out" || { cat "$tmp/node_list.out"; fail "ros2 node list does not show $n"; }
+    done
+
+    timeout 20 ros2 topic echo --no-daemon --once /drone/Pose geometry_msgs/msg/PoseStamped > "$tmp/echo.out" 2> "$tmp/echo.log" ||
+      fail "ros2 topic echo --once /drone/Pose failed"
+    grep -q "frame_id: world" "$tmp/echo.out" || { cat "$tmp/echo.out"; fail "the echoed Pose has no frame_id world"; }
+
+    ros2 topic info -v --no-daemon --spin-time 3 /drone/Pose > "$tmp/info.out" 2> "$tmp/info.log" || fail "ros2 topic info -v failed"
+    # The plant's publisher and the controller's subscription, each with the same valid hash.
+    grep -q "Node name: quadrotor_plant" "$tmp/info.out" || { cat "$tmp/info.out"; fail "topic info does not show the plant"; }
+    hashes=$(sed -n 's/^Topic type hash: //p' "$tmp/info.out" | sort -u)
+    [ "$(sed -n 's/^Topic type hash: //p' "$tmp/info.out" | wc -l)" -ge 2 ] || { cat "$tmp/info.out"; fail "fewer than 2 endpoints on /drone/Pose"; }
+    [[ "$hashes" =~ ^RIHS01_[0-9a-f]{64}$ ]] || { cat "$tmp/info.out"; fail "the endpoints' type hashes are not one valid RIHS01 hash: $hashes"; }
+
+    ros2 param set --no-daemon /attitude_controller z_des 3.0 > "$tmp/param.out" 2> "$tmp/param.log" || fail "ros2 param set failed"
+    grep -q "Set parameter successful" "$tmp/param.out" || { cat "$tmp/param.out"; fail "ros2 param set was not successful"; }
+    # Simulated time runs with the wall clock from the first step on.
+    t_set=$("$ROS_PY" -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$started" "$(date +%s.%N)")
+    rc=0
+    wait "$plant" || rc=$?
+    [ "$rc" = 0 ] || fail "the plant exited with $rc"
+    for f in controller node_list echo info param; do no_warnings "$tmp/$f.log" "$f"; done
+    # z near 1 m shortly before the set (settled after 6 s), near 3 m at the end (>= 6.5 s after the
+    # set: within 4 %).
+    "$ROS_PY" - "$tmp/trajectory.csv" "$t_set" <<'EOF' || fail "the vehicle did not follow z_des 1 m -> 3 m (above)"
+import csv, sys
+rows = [r for r in csv.reader(open(sys.argv[1]))][1:]
+t_set = float(sys.argv[2])
+z = {round(float(r[0]), 2): float(r[3]) for r in rows}
+before = z[round(t_set - 0.5, 2)] if t_set > 6.5 else None
+end = float(rows[-1][3])
+print("param set at t = %.2f s; z then %s m, z(20 s) = %.3f m" % (t_set, before, end))
+ok = 2.88 < end < 3.12 and t_set < 13.5 and (before is None or 0.95 < before < 1.05)
+sys.exit(0 if ok else 1)
+EOF
+    echo "ros2 node list, topic echo, topic info -v (hash $hashes) and param set work on quadcosim's nodes"
+    ;;
+  *)
+    echo "unknown case $case_arg" >&2
+    exit 2
+    ;;
+esac
