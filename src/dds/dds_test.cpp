@@ -629,6 +629,32 @@ TEST(GraphTest, ListsTopicsSortedUniqueWithTypes) {
   EXPECT_EQ(format_topic_list({}, true), "");
 }
 
+TEST(GraphTest, FindsTheNodeBehindAPublisherByItsParticipantsParameterServices) {
+  auto ep = [](std::string topic, bool writer, std::uint8_t participant) {
+    Endpoint e{std::move(topic), "t", writer, true, ""};
+    e.participant.fill(participant);
+    return e;
+  };
+  std::vector<Endpoint> es = {
+      ep("rt/drone/motor_commands", true, 1),
+      ep("rq/attitude_controller/get_parametersRequest", false, 1),
+      ep("rq/attitude_controller/set_parametersRequest", false, 1),
+      ep("rr/attitude_controller/get_parametersReply", true, 1),
+      // Another process's node, and a client (a writer of requests) in the publisher's process.
+      ep("rq/quadrotor_plant/get_parametersRequest", false, 2),
+      ep("rq/other/get_parametersRequest", true, 1),
+      ep("rt/drone/motor_commands", false, 2),
+  };
+  EXPECT_EQ(parameter_nodes_writing(es, "/drone/motor_commands"), std::vector<std::string>{"/attitude_controller"});
+  EXPECT_TRUE(parameter_nodes_writing(es, "/uav1/motor_commands").empty());
+  // A process with two nodes (a namespaced one too): both, sorted.
+  es.push_back(ep("rq/uav1/helper/get_parametersRequest", false, 1));
+  EXPECT_EQ(parameter_nodes_writing(es, "/drone/motor_commands"),
+            (std::vector<std::string>{"/attitude_controller", "/uav1/helper"}));
+  // A malformed service topic is not a node.
+  EXPECT_TRUE(parameter_nodes_writing({ep("rt/x", true, 3), ep("rq//get_parametersRequest", false, 3)}, "/x").empty());
+}
+
 TEST(GraphTest, DiscoversAnotherParticipantsEndpoints) {
   DdsTransport node(test_env());
   auto pub = node.advertise<msg::PoseStamped>("/g/Pose");

@@ -85,10 +85,19 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
                                     std::function<void(const void*)> deliver) {
   const TypeOps* ops = nullptr;
   const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
+  add_reader(reader, ros_topic, ops, std::move(deliver));
+}
+
+void DdsTransport::subscribe_raw(dds_entity_t reader, std::string label, std::function<void(const void*)> deliver) {
+  add_reader(reader, std::move(label), nullptr, std::move(deliver));
+}
+
+void DdsTransport::add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops,
+                              std::function<void(const void*)> deliver) {
   auto r = std::make_unique<Reader>();
   r->owner = this;
   r->index = readers_.size();
-  r->topic = ros_topic;
+  r->topic = std::move(topic);
   r->reader = reader;
   r->condition = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
   r->ops = ops;
@@ -151,7 +160,11 @@ int DdsTransport::drain(Reader& r) {
     try {
       for (int i = 0; i < n; ++i) {
         if (!infos[i].valid_data) continue;
-        r.ops->deliver(samples[i], r.deliver);
+        if (r.ops != nullptr) {
+          r.ops->deliver(samples[i], r.deliver);
+        } else {
+          r.deliver(samples[i]);
+        }
         ++delivered;
       }
     } catch (...) {

@@ -65,6 +65,11 @@ class DdsTransport final : public sim::Transport {
 
   const Participant& participant() const { return participant_; }
 
+  /// Delivers the samples of `reader` (made elsewhere on this participant, e.g. a service's reply
+  /// reader; it must outlive the deliveries) as the C samples idlc generates, in turn with the
+  /// subscriptions: by spin_once, or on arrival under an ArrivalExecutor. `label` names it in errors.
+  void subscribe_raw(dds_entity_t reader, std::string label, std::function<void(const void*)> deliver);
+
   /// Extra DDS work served by spin_once beside the subscriptions, e.g. ROS 2 services on this
   /// participant. Each entity in `wake_on` (a read condition, or a reader/writer whose status mask is
   /// set) joins the waitset, so it wakes spin_once; `serve` runs after every wait, after the
@@ -101,9 +106,10 @@ class DdsTransport final : public sim::Transport {
     std::string topic;
     dds_entity_t reader;
     dds_entity_t condition;
-    const TypeOps* ops;
+    const TypeOps* ops;  ///< nullptr: a raw reader (subscribe_raw), its C samples delivered as they are
     std::function<void(const void*)> deliver;
   };
+  void add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops, std::function<void(const void*)> deliver);
   static void on_data_available(dds_entity_t reader, void* arg);
   /// Delivery on arrival for one reader: its listener set, its read condition off the waitset.
   void listen(Reader& r, bool on);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <map>
+#include <set>
 
 #include "dds/participant.hpp"
 
@@ -110,6 +111,7 @@ void take_endpoints(dds_entity_t reader, bool writers, const Key& own, std::map<
       e.dds_topic = s->topic_name ? s->topic_name : "";
       e.dds_type = s->type_name ? s->type_name : "";
       e.writer = writers;
+      std::copy(std::begin(s->participant_key.v), std::end(s->participant_key.v), e.participant.begin());
       dds_reliability_kind_t kind = DDS_RELIABILITY_RELIABLE;
       dds_duration_t blocking = 0;
       if (s->qos && dds_qget_reliability(s->qos, &kind, &blocking)) e.reliable = kind == DDS_RELIABILITY_RELIABLE;
@@ -127,6 +129,24 @@ void take_endpoints(dds_entity_t reader, bool writers, const Key& own, std::map<
 }
 
 }  // namespace
+
+std::vector<std::string> parameter_nodes_writing(const std::vector<Endpoint>& endpoints, std::string_view ros_topic) {
+  constexpr std::string_view kPrefix = "rq/", kSuffix = "/get_parametersRequest";
+  std::set<std::array<std::uint8_t, 16>> writers;
+  for (const Endpoint& e : endpoints) {
+    if (e.writer && ros_topic_name(e.dds_topic) == ros_topic) writers.insert(e.participant);
+  }
+  std::set<std::string> nodes;
+  for (const Endpoint& e : endpoints) {
+    const std::string_view t = e.dds_topic;
+    if (e.writer || !writers.contains(e.participant) || t.size() <= kPrefix.size() + kSuffix.size() ||
+        !t.starts_with(kPrefix) || !t.ends_with(kSuffix)) {
+      continue;
+    }
+    nodes.insert("/" + std::string(t.substr(kPrefix.size(), t.size() - kPrefix.size() - kSuffix.size())));
+  }
+  return {nodes.begin(), nodes.end()};
+}
 
 std::vector<Endpoint> discover_endpoints(dds_entity_t participant, std::int64_t wait_ns,
                                          const std::function<bool(const std::vector<Endpoint>&)>& done) {

@@ -7,6 +7,7 @@
 
 #include <dds/dds.h>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -23,6 +24,7 @@ struct Endpoint {
   bool writer = false;    ///< a writer (publisher) or a reader (subscription)
   bool reliable = true;   ///< its reliability QoS
   std::string user_data;  ///< its USER_DATA QoS as sent ("typehash=RIHS01_...;" from ROS 2 Jazzy), "" if none
+  std::array<std::uint8_t, 16> participant{};  ///< the GUID of the participant it belongs to
 };
 
 /// A ROS topic with everything discovered on it.
@@ -53,6 +55,12 @@ std::vector<RosTopic> ros_topics(const std::vector<Endpoint>& endpoints);
 /// ("/drone/Pose [geometry_msgs/msg/PoseStamped]"; several types are separated by ", "), each
 /// ending in '\n'. Hidden topics are left out unless `include_hidden`.
 std::string format_topic_list(const std::vector<RosTopic>& topics, bool with_types, bool include_hidden = false);
+
+/// The ROS nodes with parameter services ("/attitude_controller", "/uav1/attitude_controller") in the
+/// participants that write `ros_topic` ("/drone/motor_commands"), sorted: read from the DDS topics of
+/// their get_parameters request readers ("rq/attitude_controller/get_parametersRequest"), so the node
+/// behind a publisher is found without ros_discovery_info. Several when a process hosts several nodes.
+std::vector<std::string> parameter_nodes_writing(const std::vector<Endpoint>& endpoints, std::string_view ros_topic);
 
 /// Collects the endpoints that `participant` discovers (other participants' only, not its own) for
 /// up to `wait_ns`, blocking on a waitset. Returns earlier, as soon as `done(endpoints so far)` holds,

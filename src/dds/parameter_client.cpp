@@ -125,6 +125,40 @@ std::string ParameterClient::describe_matches(ParamService service) const {
   return os.str();
 }
 
+namespace {
+// Every request and reply type starts with the in-band header {uint64 guid; int64 seq}.
+struct InBandHeader {
+  std::uint64_t guid;
+  std::int64_t seq;
+};
+}  // namespace
+
+void ParameterClient::send(ParamService service, void* request) {
+  Endpoints& e = endpoints(service);
+  auto* header = static_cast<InBandHeader*>(request);
+  header->guid = e.writer_handle;
+  header->seq = ++next_seq_;
+  last_ = {header->guid, header->seq};
+  check(dds_write(e.writer, request), ("dds_write " + request_topic(node_, service)).c_str());
+}
+
+ParameterClient::Header ParameterClient::send_get(const std::vector<std::string>& names) {
+  if (!matched(endpoints(ParamService::kGet))) {
+    throw ParameterCallError("node " + node_.fully_qualified() + ": no " +
+                             std::string(service_suffix(ParamService::kGet)) + " service matched (" +
+                             describe_matches(ParamService::kGet) + ")");
+  }
+  auto rq = wire::new_sample(wire::service_types(ParamService::kGet).request);
+  wire::to_c(names, static_cast<rcl_interfaces_srv_dds__GetParameters_Request_*>(rq.get())->names);
+  send(ParamService::kGet, rq.get());
+  return last_;
+}
+
+bool ParameterClient::is_reply_to(const void* reply, Header request) {
+  const auto* h = static_cast<const InBandHeader*>(reply);
+  return h->guid == request.guid && h->seq == request.seq;
+}
+
 void ParameterClient::call(ParamService service, void* request, std::int64_t timeout_ns,
                            const std::function<void(const void* reply)>& on_reply) {
   const std::int64_t start = steady_ns(), deadline = start + timeout_ns;
@@ -134,16 +168,7 @@ void ParameterClient::call(ParamService service, void* request, std::int64_t tim
                              std::string(service_suffix(service)) + " service within " + seconds(timeout_ns) + " (" +
                              describe_matches(service) + "); is the node running on this domain?");
   }
-  // Every request type starts with the in-band header {uint64 guid; int64 seq}.
-  struct InBandHeader {
-    std::uint64_t guid;
-    std::int64_t seq;
-  };
-  auto* header = static_cast<InBandHeader*>(request);
-  header->guid = e.writer_handle;
-  header->seq = ++next_seq_;
-  last_ = {header->guid, header->seq};
-  check(dds_write(e.writer, request), ("dds_write " + request_topic(node_, service)).c_str());
+  send(service, request);
 
   for (;;) {
     constexpr int kBatch = 8;
@@ -152,8 +177,7 @@ void ParameterClient::call(ParamService service, void* request, std::int64_t tim
     const dds_return_t n = check(dds_take(e.reader, samples, infos, kBatch, kBatch), "dds_take (parameter reply)");
     bool done = false;
     for (int i = 0; i < n && !done; ++i) {
-      const auto* h = static_cast<const InBandHeader*>(samples[i]);
-      if (!infos[i].valid_data || h->guid != last_.guid || h->seq != last_.seq) continue;  // another client's
+      if (!infos[i].valid_data || !is_reply_to(samples[i], last_)) continue;  // another client's
       on_reply(samples[i]);
       done = true;
     }

@@ -61,6 +61,19 @@ class ParameterClient {
     std::uint64_t guid = 0;
     std::int64_t seq = 0;
   };
+
+  // Asynchronous get_parameters (a lockstep barrier): send_get() sends and returns at once; the
+  // replies arrive on get_reply_reader(), which the caller takes from (e.g. through
+  // DdsTransport::subscribe_raw), matching each with is_reply_to(). Once its reader is handed over,
+  // the client's blocking get() must not be used.
+
+  /// Sends get_parameters(names) and returns its header; throws ParameterCallError when the service
+  /// is not matched.
+  Header send_get(const std::vector<std::string>& names);
+  /// The get_parameters reply reader (made on first use).
+  dds_entity_t get_reply_reader() { return endpoints(ParamService::kGet).reader; }
+  /// True when `reply` (a GetParameters_Response sample from get_reply_reader()) answers `request`.
+  static bool is_reply_to(const void* reply, Header request);
   Header last_request() const { return last_; }
   const NodeName& node() const { return node_; }
 
@@ -74,6 +87,8 @@ class ParameterClient {
   /// Waits for the waitset (at most until `deadline_ns`, steady clock), clears the match triggers
   /// and drops stale replies in every reader but `active`'s.
   void wait(std::int64_t deadline_ns, const Endpoints* active);
+  /// Fills in `request`'s in-band header (a generated request sample) and writes it.
+  void send(ParamService service, void* request);
   /// Sends `request` (a generated request sample; its header is filled in here) and passes the
   /// matching reply sample to `on_reply` before returning.
   void call(ParamService service, void* request, std::int64_t timeout_ns,

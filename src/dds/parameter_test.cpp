@@ -380,6 +380,44 @@ TEST(ParameterServiceTest, RepliesEchoGuidAndSequenceAndEventsAnnounceChanges) {
   EXPECT_TRUE(event) << "no ParameterEvent";
 }
 
+TEST(ParameterServiceTest, AnAsynchronousGetIsAnsweredThroughATransportInOrder) {
+  // send_get returns at once; the replies come through DdsTransport::subscribe_raw, in the order of
+  // the requests, each matched to its own request by is_reply_to.
+  FakeTable table;
+  ServedNode node(table);
+  DdsTransport transport(test_env());
+  ParameterClient client(transport.participant().handle(), parse_node_name("/test_controller"));
+  ParameterClient nobody(transport.participant().handle(), parse_node_name("/nobody_here"));
+  EXPECT_THROW(nobody.send_get({}), ParameterCallError) << "no service matched: refused, not lost";
+  ASSERT_TRUE(client.wait_for_service(ParamService::kGet, 10 * kSecond));
+  std::vector<ParameterClient::Header> requests;
+  std::vector<std::int64_t> answered;  // the seq of each request a reply answered, in arrival order
+  std::vector<double> values;
+  transport.subscribe_raw(client.get_reply_reader(), "get_parameters reply", [&](const void* reply) {
+    for (const auto& rq : requests) {
+      if (!ParameterClient::is_reply_to(reply, rq)) continue;
+      answered.push_back(rq.seq);
+      const auto& r = *static_cast<const rcl_interfaces_srv_dds__GetParameters_Response_*>(reply);
+      values.push_back(r.values._length == 1 ? r.values._buffer[0].double_value : -1.0);
+    }
+  });
+  for (int i = 0; i < 5; ++i) requests.push_back(client.send_get({i % 2 == 0 ? "z_des" : "gain.kp"}));
+  for (int i = 1; i < 5; ++i) EXPECT_EQ(requests[i].seq, requests[i - 1].seq + 1);
+  ASSERT_TRUE(transport.spin_until([&] { return answered.size() == 5; }, 10 * kSecond)) << answered.size();
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(answered[i], requests[i].seq);
+    EXPECT_EQ(values[i], i % 2 == 0 ? 1.0 : 2.0);
+  }
+  // A reply answers its own request only.
+  rcl_interfaces_srv_dds__GetParameters_Response_ other{};
+  other.guid = requests[0].guid;
+  other.seq = requests[0].seq;
+  EXPECT_TRUE(ParameterClient::is_reply_to(&other, requests[0]));
+  EXPECT_FALSE(ParameterClient::is_reply_to(&other, requests[1]));
+  other.guid += 1;
+  EXPECT_FALSE(ParameterClient::is_reply_to(&other, requests[0]));
+}
+
 TEST(ParameterServiceTest, MissingNodeIsAClearTimeout) {
   ParameterClient client(test_env(), parse_node_name("nobody_here"));
   try {
