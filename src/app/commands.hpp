@@ -98,6 +98,11 @@ struct PlantCommandOptions {
   /// Lockstep only (one vehicle or --vehicles N).
   struct Lockstep {
     std::string on_timeout = "abort";  ///< "abort" (exit 4) or "hold" (last commands, go on unpaced)
+    /// How the controller steps (one vehicle): "samples" (on each control tick's samples, answering
+    /// tick 0), "clock" (from a timer on ROS time: samples, a parameter round trip to its node, then
+    /// /clock; first answer one period in), "auto" (clock when the node has use_sim_time true).
+    std::string sync = "auto";
+    std::string controller_node;  ///< the node --sync talks to ("" = found from the command publisher)
   };
   /// Real time only (--realtime).
   struct Realtime {

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "app/commands.hpp"
@@ -19,6 +20,7 @@
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
+#include "dds/graph.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_client.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
@@ -66,24 +68,7 @@ class PlantProcess {
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));
     }
     next_event_ = sc_.schedule.begin();
-    if (o_.lockstep && sc_.simulation.plant.clock_after_sensors) {
-      // A peer that steps on /clock reads whatever samples it holds then. Matched on our side does not
-      // mean it has discovered our writers: its readers may still drop tick 0's samples while a
-      // /clock gets through. So tick 0's /clock waits until the samples are acknowledged (on the main
-      // thread, where tick 0 is published; deliveries go on meanwhile). Later ticks rely on
-      // in-order delivery (docs/simulink.md).
-      plant_.before_clock([this](sim::Tick k) {
-        if (k != 0 || samples_acknowledged_) return;
-        samples_acknowledged_ = host_.unlocked([this] {
-          return transport_.wait_for_acks(topics_.pose, timeout_ns()) &&
-                 transport_.wait_for_acks(topics_.velocity, timeout_ns()) &&
-                 transport_.wait_for_acks(topics_.imu, timeout_ns());
-        });
-        if (!samples_acknowledged_) {
-          std::cerr << fmt::format("plant: warning: tick 0's samples not acknowledged within {} s\n", o_.timeout_s);
-        }
-      });
-    }
+    if (o_.lockstep) plant_.before_clock([this](sim::Tick k) { return before_clock(k); });
     // Real time: the watchdog measures how long ago a command arrived on the wall clock, so a
     // controller that dies is noticed within its limit however the ticks are paced.
     if (!o_.lockstep) plant_.use_receipt_clock(steady_ns);
@@ -97,6 +82,9 @@ class PlantProcess {
   /// Runs every tick; returns the process's exit code.
   int run() {
     if ((o_.lockstep || o_.realtime.wait_for_controller) && !wait_for_controller()) return kExitNoController;
+    if (o_.lockstep) {
+      if (const int rc = choose_sync(); rc != kExitOk) return rc;
+    }
     loop_start_ns_ = steady_ns();
     const int rc = o_.lockstep ? run_lockstep() : run_realtime();
     finish(rc);
@@ -134,6 +122,118 @@ class PlantProcess {
           transport_.matched_readers(topics_.pose), transport_.participant().domain_id());
     }
     return found;
+  }
+
+  /// Lockstep: how the controller steps (--sync). A controller that steps on each control tick's
+  /// samples needs nothing more. One that steps from a timer on ROS time (an rclcpp or rclpy node
+  /// with use_sim_time) reads whatever samples its subscriptions took when /clock makes the timer
+  /// due, and first answers one control period in; for it every control tick goes: samples, a
+  /// get_parameters round trip to its node (its executor serves services after the subscriptions
+  /// that were ready in the same wait, so the reply means the samples are taken), then /clock
+  /// (docs/ros2.md, "Lockstep with your own ROS 2 controller").
+  int choose_sync() {
+    const std::string& sync = o_.lockstep_only.sync;
+    if (sync == "samples" || (sync == "auto" && o_.clock_after_sensors)) return kExitOk;
+    const bool required = sync == "clock";
+    auto fallback = [&](const std::string& why) {
+      if (required) {
+        std::cerr << fmt::format("plant: --sync clock: {}\n", why);
+        return kExitNoController;
+      }
+      std::cerr << fmt::format("plant: lockstep: the controller steps on the samples ({})\n", why);
+      return kExitOk;
+    };
+    std::string node = o_.lockstep_only.controller_node;
+    if (node.empty()) {
+      // The node is in the process that publishes the commands: the one with parameter services there.
+      std::vector<std::string> nodes;
+      const std::int64_t wait_ns = required ? timeout_ns() : std::min<std::int64_t>(timeout_ns(), 500'000'000);
+      host_.unlocked([&] {
+        return dds::discover_endpoints(transport_.participant().handle(), wait_ns, [&](const auto& endpoints) {
+          nodes = dds::parameter_nodes_writing(endpoints, topics_.motor_commands);
+          return !nodes.empty();
+        });
+      });
+      if (nodes.size() != 1) {
+        std::string names;
+        for (const auto& n : nodes) names += (names.empty() ? "" : ", ") + n;
+        return fallback(nodes.empty()
+                            ? fmt::format("no node with parameter services publishes {}", topics_.motor_commands)
+                            : fmt::format("the process publishing {} has several nodes ({}); name one "
+                                          "with --controller-node",
+                                          topics_.motor_commands, names));
+      }
+      node = nodes.front();
+    }
+    auto client = std::make_unique<dds::ParameterClient>(transport_.participant().handle(), dds::parse_node_name(node));
+    std::vector<dds::ParamValue> v;
+    try {
+      v = host_.unlocked([&] { return client->get({"use_sim_time"}, timeout_ns()); });
+    } catch (const dds::ParameterCallError& e) {
+      return fallback(e.what());
+    }
+    const bool sim_time = v.size() == 1 && v[0].type == dds::ParamType::kBool && v[0].bool_value;
+    if (!sim_time) {
+      const bool declared = v.size() == 1 && v[0].type != dds::ParamType::kNotSet;
+      if (declared && !required) {
+        std::cerr << fmt::format(
+            "plant: warning: {} has use_sim_time false: if it steps from a timer, that timer runs on the wall "
+            "clock and lockstep cannot drive it; run it with --ros-args -p use_sim_time:=true\n",
+            node);
+      }
+      return fallback(fmt::format("{} has {}", node, declared ? "use_sim_time false" : "no use_sim_time parameter"));
+    }
+    // The timer's /clock subscription must be there too, or its first /clock is lost.
+    const int own = (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0);
+    if (!transport_.spin_until([&] { return stop_requested() || transport_.matched_readers(topics_.clock) > own; },
+                               timeout_ns())) {
+      std::cerr << fmt::format("plant: {} does not subscribe {} within {} s\n", node, topics_.clock, o_.timeout_s);
+      return kExitNoController;
+    }
+    barrier_ = std::move(client);
+    // The reply is delivered like a command (on arrival, on the receiving thread): it releases the
+    // tick's /clock there, so a control period wakes no other thread of this process.
+    transport_.subscribe_raw(barrier_->get_reply_reader(), "get_parameters reply from " + node,
+                             [this](const void* reply) {
+                               if (clock_held_ >= 0 && dds::ParameterClient::is_reply_to(reply, barrier_request_)) {
+                                 plant_.publish_clock(std::exchange(clock_held_, -1));
+                               }
+                             });
+    plant_.set_clock_after_sensors(true);
+    std::cerr << fmt::format(
+        "plant: lockstep with {} on ROS time: each control tick sends the samples, a get_parameters round trip, "
+        "then /clock; its first command is expected at t = {:g} s\n",
+        node, clock_.seconds(divider_));
+    return kExitOk;
+  }
+
+  /// Between tick k's samples and its /clock (when /clock goes last); false holds the /clock back.
+  bool before_clock(sim::Tick k) {
+    if (k == 0 && !samples_acknowledged_) {
+      // A peer that steps on /clock reads whatever samples it holds then. Matched on our side does
+      // not mean it has discovered our writers: its readers may still drop tick 0's samples while a
+      // /clock gets through. So tick 0's /clock waits until the samples are acknowledged (on the main
+      // thread, where tick 0 is published; deliveries go on meanwhile). Later ticks rely on in-order
+      // delivery (docs/simulink.md).
+      samples_acknowledged_ = host_.unlocked([this] {
+        return transport_.wait_for_acks(topics_.pose, timeout_ns()) &&
+               transport_.wait_for_acks(topics_.velocity, timeout_ns()) &&
+               transport_.wait_for_acks(topics_.imu, timeout_ns());
+      });
+      if (!samples_acknowledged_) {
+        std::cerr << fmt::format("plant: warning: tick 0's samples not acknowledged within {} s\n", o_.timeout_s);
+      }
+    }
+    if (!barrier_) return true;
+    // A request after every tick's samples, answered in order, one per executor wait (rclcpp and
+    // rclpy take one request per service, and one sample per ready subscription, per wait): the reply
+    // to tick k's request means every sample up to tick k has been taken, however many ticks'
+    // samples were queued. A control tick's /clock waits for that reply.
+    const auto request = barrier_->send_get({});
+    if (k < divider_ || k % divider_ != 0) return true;
+    barrier_request_ = request;
+    clock_held_ = k;
+    return false;  // the reply's delivery publishes tick k's /clock
   }
 
   /// The schedule through the controller's parameter services: each change due by tick k is
@@ -179,6 +279,7 @@ class PlantProcess {
     lo.clock = clock_;
     lo.duration_ticks = sc_.simulation.duration_ticks;
     lo.controller_divider = divider_;
+    if (barrier_) lo.first_control_tick = divider_;  // a ROS-time timer first fires one period after it starts
     lo.timeout_ns = timeout_ns();
     lo.on_timeout =
         o_.lockstep_only.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
@@ -313,7 +414,10 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool watchdog_logged_ = false;
-  bool samples_acknowledged_ = false;  ///< --clock-after-sensors: tick 0's samples reached the peer
+  bool samples_acknowledged_ = false;              ///< /clock last: tick 0's samples reached the peer
+  std::unique_ptr<dds::ParameterClient> barrier_;  ///< --sync clock: the controller node's parameter client
+  dds::ParameterClient::Header barrier_request_;   ///< the last barrier request sent
+  sim::Tick clock_held_ = -1;                      ///< the tick whose /clock awaits the barrier reply
   std::int64_t loop_start_ns_ = 0;
   // Last: the drivers and their host (with delivery on arrival) go first.
   DdsDriverHost host_{transport_};
@@ -348,8 +452,10 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
                    "lockstep: wait for the controller / a command; real time: for the controller "
                    "(--wait-for-controller) and each --schedule-via answer [s]")
       ->check(CLI::Range(0.01, 3600.0));
-  plant_cmd->add_option("--schedule-via", plant.one_vehicle.schedule_node,
-                        "one vehicle: apply the scenario's schedule through this node's parameter services");
+  plant_cmd
+      ->add_option("--schedule-via", plant.one_vehicle.schedule_node,
+                   "one vehicle: apply the scenario's schedule through this node's parameter services")
+      ->check(CLI::Validator(check_node_name, "NODE"));
   plant_cmd->add_flag("--wait-for-controller", plant.realtime.wait_for_controller,
                       "real time: start only once a controller is matched (up to --timeout)");
   plant_cmd->add_option("--stats", plant.stats, "write the run's figures (real-time factor, round trip) as JSON here");
@@ -367,6 +473,18 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
                    "hold: keep the last command; stop: motors to omega_min (default: the scenario's, stop)")
       ->check(CLI::IsMember({"hold", "stop"}));
 
+  plant_cmd
+      ->add_option("--sync", plant.lockstep_only.sync,
+                   "lockstep, one vehicle: how the controller steps: samples (on each control tick's samples, "
+                   "as quadcosim's controller), clock (from a timer on ROS time, as rclcpp and rclpy nodes with "
+                   "use_sim_time: samples, a parameter round trip to its node, then /clock), auto (clock when "
+                   "the node publishing the commands has use_sim_time true; docs/ros2.md)")
+      ->check(CLI::IsMember({"auto", "samples", "clock"}));
+  plant_cmd
+      ->add_option("--controller-node", plant.lockstep_only.controller_node,
+                   "with --sync clock/auto: the controller's node (default: the node with parameter services "
+                   "in the process publishing the motor commands)")
+      ->check(CLI::Validator(check_node_name, "NODE"));
   plant_cmd->add_flag("--clock-after-sensors", plant.clock_after_sensors,
                       "publish /clock after each tick's Pose, Velocity and Imu (for a peer that steps on "
                       "/clock and reads the newest samples: Simulink's ROS 2 time model; docs/simulink.md)");
@@ -391,6 +509,9 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
             {"--rate-factor", realtime, "lockstep; it needs --realtime"},
             {"--wait-for-controller", realtime, "lockstep; it needs --realtime (lockstep always waits)"},
             {"--on-timeout", !realtime, "--realtime; it is the lockstep timeout's policy"},
+            {"--sync", !realtime && !swarm, "--realtime or --vehicles; it is one vehicle's lockstep protocol"},
+            {"--controller-node", !realtime && !swarm && plant.lockstep_only.sync != "samples",
+             "--realtime, --vehicles or --sync samples"},
             {"--timeout", !realtime || plant.realtime.wait_for_controller || !plant.one_vehicle.schedule_node.empty(),
              "--realtime alone; it needs lockstep, --wait-for-controller or --schedule-via"},
         });

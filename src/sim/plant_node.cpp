@@ -189,10 +189,11 @@ void PlantNode::publish_outputs(Tick k) {
     t.rotation = to_msg(y.q_WB);
     tf_pub_.publish(tf_);
   }
-  if (clock_pub_ && !clock_first) {
-    if (before_clock_) before_clock_(k);
-    clock_pub_.publish(msg::Clock{stamp});
-  }
+  if (clock_pub_ && !clock_first && (!before_clock_ || before_clock_(k))) clock_pub_.publish(msg::Clock{stamp});
+}
+
+void PlantNode::publish_clock(Tick k) {
+  if (clock_pub_) clock_pub_.publish(msg::Clock{msg::Time::from_ns(options_.clock.ns(k))});
 }
 
 model::Outputs PlantNode::external_outputs(Tick k) {

@@ -99,8 +99,14 @@ class PlantNode final : public SteppablePlant {
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
   /// With clock_after_sensors: runs after tick k's Pose, Velocity and Imu went out, before its /clock
-  /// (a lockstep plant over DDS waits there at tick 0 until the peer has the samples).
-  void before_clock(std::function<void(Tick)> f) { before_clock_ = std::move(f); }
+  /// (a lockstep plant over DDS waits there at tick 0 until the peer has the samples). Returning false
+  /// holds tick k's /clock back: the caller publishes it later with publish_clock(k).
+  void before_clock(std::function<bool(Tick)> f) { before_clock_ = std::move(f); }
+  /// Publishes /clock for tick k (one that before_clock held back).
+  void publish_clock(Tick k);
+  /// Changes PlantOptions::clock_after_sensors before the first tick (a lockstep plant decides once it
+  /// knows how its controller steps).
+  void set_clock_after_sensors(bool after) { options_.clock_after_sensors = after; }
 
   /// Publishes /clock, Pose, Velocity and Imu for the state at tick k (/clock last with
   /// clock_after_sensors), and the plant status when due.
@@ -177,7 +183,7 @@ class PlantNode final : public SteppablePlant {
   Tick last_status_tick_ = -1;
   Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;
-  std::function<void(Tick)> before_clock_;
+  std::function<bool(Tick)> before_clock_;
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
   Publisher<msg::Imu> imu_pub_;
