@@ -82,7 +82,7 @@ class PlantProcess {
   /// Runs every tick; returns the process's exit code.
   int run() {
     if ((o_.lockstep || o_.realtime.wait_for_controller) && !wait_for_controller()) return kExitNoController;
-    if (o_.lockstep) {
+    if (o_.lockstep && !stop_requested()) {
       if (const int rc = choose_sync(); rc != kExitOk) return rc;
     }
     loop_start_ns_ = steady_ns();

@@ -239,13 +239,19 @@ void DdsTransport::remove_extra_work(int id) {
   extra_.erase(it);
 }
 
+namespace {
+constexpr std::int64_t kSpinSliceNs = 100'000'000;
+}  // namespace
+
 bool DdsTransport::spin_until(const std::function<bool()>& done, std::int64_t timeout_ns) {
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::nanoseconds(timeout_ns);
   while (!done()) {
     const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - clock::now()).count();
     if (left <= 0) return done();
-    spin_once(left);
+    // In slices, so a `done` that watches something no DDS event signals (a stop requested by a
+    // signal handler) is seen within one slice.
+    spin_once(std::min<std::int64_t>(left, kSpinSliceNs));
   }
   return true;
 }
