@@ -169,7 +169,10 @@ for k in ("malformedJson", "unknownOp", "unknownChannel", "unknownSubscription",
         errors.append(f"{k}: {a.get(k)}")
 if a["afterErrors"]["subscribedMessages"] < 5:
     errors.append(f"no messages after the errors: {a['afterErrors']}")
-if not a["oversized"] or a["oversized"]["code"] != 1009:
+# 1009 (message too big) as the server closes; or 1006 when the reset of the socket, closed with the
+# rest of the frame unread, reaches the client before that close frame (timing: seen under load).
+# Either way the server's summary below must count the client as disconnected.
+if not a["oversized"] or a["oversized"]["code"] not in (1009, 1006):
     errors.append(f"oversized frame: {a['oversized']}")
 if errors:
     print("\n".join(errors)); sys.exit(1)
