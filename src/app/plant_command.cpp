@@ -291,6 +291,16 @@ class PlantProcess {
     h.after_latch = [this](std::size_t, sim::Tick k) { after_latch(k); };
     h.on_timeout = [this](std::size_t, sim::Tick k) {
       std::cerr << lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s, o_.lockstep_only.on_timeout);
+      if (!barrier_) return;
+      const double period_s = clock_.seconds(divider_);
+      std::cerr << (clock_held_ == k
+                        ? fmt::format("plant: the controller's node has not answered tick {}'s get_parameters request, "
+                                      "so its /clock was held back: is its executor blocked?\n",
+                                      k)
+                        : fmt::format("plant: tick {}'s /clock went out but no command followed: the controller's "
+                                      "timer must fire every {:g} s on ROS time (the scenario's controller_rate_hz "
+                                      "{:g}), first at t = {:g} s\n",
+                                      k, period_s, 1.0 / period_s, period_s));
     };
     h.on_resume = [](sim::Tick k) {
       std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
@@ -368,6 +378,18 @@ class PlantProcess {
       stats["roundtrip_us_max"] = pct(1.0);
     }
     const auto& st = plant_.stats();
+    if (barrier_ && lockstep_) {
+      // One command per control tick from the first on; more means a timer faster than the
+      // scenario's controller rate, whose extra commands are latched by arrival (not deterministic).
+      const sim::Tick ticks = std::min(lockstep_->ticks_run(), sc_.simulation.duration_ticks);
+      const std::uint64_t expected = ticks < divider_ ? 0 : static_cast<std::uint64_t>(ticks / divider_);
+      if (st.commands_received > expected) {
+        std::cerr << fmt::format(
+            "plant: warning: {} commands for {} control ticks: the controller publishes faster than the scenario's "
+            "controller_rate_hz ({:g}); extra commands are applied as they arrive, which is not deterministic\n",
+            st.commands_received, expected, 1.0 / clock_.seconds(divider_));
+      }
+    }
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
     // The simulated time reached, not the time asked for: a run stopped early (Ctrl-C) integrated
     // only the ticks it completed.
