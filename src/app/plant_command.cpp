@@ -127,10 +127,11 @@ class PlantProcess {
   /// Lockstep: how the controller steps (--sync). A controller that steps on each control tick's
   /// samples needs nothing more. One that steps from a timer on ROS time (an rclcpp or rclpy node
   /// with use_sim_time) reads whatever samples its subscriptions took when /clock makes the timer
-  /// due, and first answers one control period in; for it every control tick goes: samples, a
-  /// get_parameters round trip to its node (its executor serves services after the subscriptions
-  /// that were ready in the same wait, so the reply means the samples are taken), then /clock
-  /// (docs/ros2.md, "Lockstep with your own ROS 2 controller").
+  /// due, and first answers one control period in; for it every tick sends its samples, then a
+  /// get_parameters request to its node, and a control tick's /clock waits for the reply (its
+  /// executor serves services after the subscriptions that were ready in the same wait, so the reply
+  /// means the samples are taken: before_clock; docs/ros2.md, "Lockstep with your own ROS 2
+  /// controller").
   int choose_sync() {
     const std::string& sync = o_.lockstep_only.sync;
     if (sync == "samples" || (sync == "auto" && o_.clock_after_sensors)) return kExitOk;
@@ -201,8 +202,8 @@ class PlantProcess {
                              });
     plant_.set_clock_after_sensors(true);
     std::cerr << fmt::format(
-        "plant: lockstep with {} on ROS time: each control tick sends the samples, a get_parameters round trip, "
-        "then /clock; its first command is expected at t = {:g} s\n",
+        "plant: lockstep with {} on ROS time: every tick sends its samples, then a get_parameters request; a "
+        "control tick's /clock waits for the reply; the first command is expected at t = {:g} s\n",
         node, clock_.seconds(divider_));
     return kExitOk;
   }
