@@ -500,7 +500,8 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->add_option("--sync", plant.lockstep_only.sync,
                    "lockstep, one vehicle: how the controller steps: samples (on each control tick's samples, "
                    "as quadcosim's controller), clock (from a timer on ROS time, as rclcpp and rclpy nodes with "
-                   "use_sim_time: samples, a parameter round trip to its node, then /clock), auto (clock when "
+                   "use_sim_time: each tick's samples then a get_parameters request to its node, a control tick's "
+                   "/clock after the reply), auto (clock when "
                    "the node publishing the commands has use_sim_time true; docs/ros2.md)")
       ->check(CLI::IsMember({"auto", "samples", "clock"}));
   plant_cmd
