@@ -648,6 +648,10 @@ class Batch {
     cfg.plant.realism.seed = seed;
     cfg.faults.seed = seed;
     cfg.duration_ticks = std::numeric_limits<sim::Tick>::max() / 4;
+    // Nobody can subscribe to a vehicle's bus but this class: /clock and /tf (and /tf_static and the
+    // robot description), which feed no number, would only cost every tick memory and time.
+    cfg.plant.publish_clock = false;
+    cfg.plant.publish_tf = false;
     std::unique_ptr<sim::Simulation> sim;
     try {
       sim = std::make_unique<sim::Simulation>(cfg, s.vehicle, io::initial_state(s), s.controller, s.schedule);
