@@ -9,7 +9,9 @@
 
 Each vehicle is a complete quadcosim.Simulation (plant, controller node and their bus) of the
 scenario with its own seed and vehicle parameters: vehicle i gives exactly (bit for bit) the numbers
-of quadcosim.Simulation(scenario with vehicle i's keys, seed=seeds[i]). See docs/python.md.
+of quadcosim.Simulation(scenario with vehicle i's keys, seed=seeds[i]). With plant_only=True (rotor
+commands from Python, as in reinforcement learning) each vehicle is its plant alone, with the same
+numbers, and stepping it once per control period is several times faster. See docs/python.md.
 """
 
 import math
