@@ -594,6 +594,27 @@ def test_vector_env_equals_single_envs():
         assert np.array_equal(np.array(single), np.array(seq)[:, i]), f"sub-env {i}"
 
 
+def test_envs_fly_the_plants_alone_with_the_numbers_of_the_full_vehicles():
+    """The envs step Batch(plant_only=True); a scenario with message faults needs the bus and gets the
+    full vehicles. Faults on /clock change nothing a Batch's vehicle computes (it publishes no /clock),
+    so both fly the same numbers."""
+    lean_env = VectorHoverEnv(3, scenario=noisy_hover(), randomize={"mass_kg": (0.4, 0.55)})
+    faulty = noisy_hover()
+    faulty["message_faults"] = {"topics": {"clock": {"drop_probability": 0.5}}}
+    full_env = VectorHoverEnv(3, scenario=faulty, randomize={"mass_kg": (0.4, 0.55)})
+    assert lean_env.batch.plant_only and not full_env.batch.plant_only
+    a, _ = lean_env.reset(seed=5)
+    b, _ = full_env.reset(seed=5)
+    assert np.array_equal(a, b)
+    rng = np.random.default_rng(3)
+    for action in hover_action(lean_env.batch) + rng.uniform(-0.01, 0.01, size=(30, 3, 4)):
+        ra = lean_env.step(action)
+        rb = full_env.step(action)
+        for x, y in zip(ra[:4], rb[:4]):
+            assert np.array_equal(x, y)
+    assert_same_bits(every_array(lean_env.batch), every_array(full_env.batch), "after 30 steps")
+
+
 def test_vector_env_next_step_autoreset():
     venv = VectorHoverEnv(3, max_episode_steps=1000)
     first, _ = venv.reset(seed=0)
