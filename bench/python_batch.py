@@ -17,8 +17,10 @@ simulated time (--periods control periods):
   batch_cmd    Batch.step(omega_cmd=...) and reading Batch.p once per control period: the rotor
                commands come from Python, the controllers are bypassed (no controller work: it
                measures what an RL loop pays per step besides its policy, not the same work as swarm)
+  batch_lean   the same on Batch(plant_only=True): no controller nodes or buses, the plants' state in a
+               contiguous array (the same numbers as batch_cmd's vehicles)
 
-Prints the median and best of each and the ratios of batch, batch_p50 and batch_cmd to swarm.
+Prints the median and best of each and the ratios of batch, batch_p50, batch_cmd and batch_lean to swarm.
 --only NAME runs one case once (for valgrind --tool=callgrind: compare two --periods to remove start-up).
 """
 import argparse
@@ -38,11 +40,12 @@ def main():
     ap.add_argument("--repetitions", type=int, default=7)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--scenario", default="scenarios/swarm/grid_takeoff.yaml")
-    ap.add_argument("--only", choices=["swarm", "swarm_b2", "batch", "batch_p50", "batch_cmd"])
+    ap.add_argument("--only", choices=["swarm", "swarm_b2", "batch", "batch_p50", "batch_cmd", "batch_lean"])
     o = ap.parse_args()
     sc = quadcosim.load_scenario(o.scenario)
     n, periods = o.vehicles, o.periods
     batch = quadcosim.Batch(sc, n, threads=o.threads)
+    lean = quadcosim.Batch(sc, n, threads=o.threads, plant_only=True)
     tps = batch.ticks_per_step
     ticks = periods * tps
     warmup = 10
@@ -70,17 +73,20 @@ def main():
             left -= 50
         return time.perf_counter() - t0
 
-    def run_batch_cmd():
-        batch.reset()
-        batch.step(periods=warmup)
+    def run_batch_cmd(b=batch):
+        b.reset()
+        if b.plant_only:
+            b.step(omega_cmd=cmd, periods=warmup)
+        else:
+            b.step(periods=warmup)
         t0 = time.perf_counter()
         for _ in range(periods):
-            batch.step(omega_cmd=cmd)
-            batch.p
+            b.step(omega_cmd=cmd)
+            b.p
         return time.perf_counter() - t0
 
     cases = {"swarm": lambda: swarm(100), "swarm_b2": lambda: swarm(tps), "batch": run_batch,
-             "batch_p50": run_batch_p50, "batch_cmd": run_batch_cmd}
+             "batch_p50": run_batch_p50, "batch_cmd": run_batch_cmd, "batch_lean": lambda: run_batch_cmd(lean)}
     if o.only:
         wall = cases[o.only]()
         print(f"{o.only}: {n} vehicles x {ticks} ticks in {wall:.3f} s: {n * ticks / wall / 1e6:.3f} M vehicle-steps/s")
@@ -95,7 +101,7 @@ def main():
     print(f"{'case':10s} {'median':>22s} {'best':>22s}")
     for k, r in rate.items():
         print(f"{k:10s} {statistics.median(r) / 1e6:10.3f} M vehicle-steps/s {max(r) / 1e6:10.3f} M vehicle-steps/s")
-    for k in ("batch", "batch_p50", "batch_cmd"):
+    for k in ("batch", "batch_p50", "batch_cmd", "batch_lean"):
         print(f"{k} / swarm: median {statistics.median(rate[k]) / statistics.median(rate['swarm']):.2f}, "
               f"best {max(rate[k]) / max(rate['swarm']):.2f}; / swarm_b2: median "
               f"{statistics.median(rate[k]) / statistics.median(rate['swarm_b2']):.2f}")

@@ -4,6 +4,12 @@
 // preallocated row-major (N, k) buffers, written by the thread that steps the vehicle; Python gets
 // copies as numpy arrays. Stepping releases the GIL and splits the vehicles over a pool of threads
 // kept between steps; the vehicles do not interact, so the thread count changes no number.
+//
+// Plant only (Batch(plant_only=True)): the rotor commands always come from Python, so there is no
+// controller node and no bus; each vehicle is its plant's state in one small object of a contiguous
+// array (LeanPlant), stepped with the model and realism calls PlantNode makes, in its order: the same
+// numbers as the full vehicle flying the same commands, at a fraction of the memory a tick touches
+// (what bounds a step of many vehicles once per control period, the cache being too small for them).
 #include "batch.hpp"
 
 #include <pybind11/numpy.h>
@@ -29,8 +35,11 @@
 #include "control/care.hpp"
 #include "io/scenario.hpp"
 #include "model/vehicle_params.hpp"
+#include "sim/realism.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
+#include "sim/topics.hpp"
+#include "sim/validation.hpp"
 
 namespace py = pybind11;
 
@@ -153,7 +162,7 @@ void merge(YAML::Node into, const YAML::Node& keys) {
   }
 }
 
-double stamp_s(const msg::Header& h) { return h.stamp.sec + h.stamp.nanosec * 1e-9; }
+double stamp_s(const msg::Time& t) { return t.sec + t.nanosec * 1e-9; }
 
 /// Row-major (rows, cols) float64 array holding a copy of `v` (cols 0: a 1-D array of `rows`).
 py::array_t<double> to_array(const std::vector<double>& v, std::size_t rows, std::size_t cols) {
@@ -181,9 +190,10 @@ class Batch {
   /// nominal_controller: every controller is designed for the scenario's own vehicle (as a sweep's
   /// runs are) instead of for its vehicle's parameters.
   Batch(const std::string& yaml, const std::string& source, const std::vector<std::string>& vehicle_keys,
-        const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller)
+        const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller, bool plant_only)
       : source_(source),
         nominal_controller_(nominal_controller),
+        plant_only_(plant_only),
         pool_(std::max(1, std::min<int>(threads, static_cast<int>(vehicle_keys.size())))) {
     if (vehicle_keys.empty()) throw py::value_error("Batch: n must be at least 1");
     if (seeds.size() != vehicle_keys.size()) throw py::value_error("Batch: one seed per vehicle expected");
@@ -191,6 +201,23 @@ class Batch {
     base_ = load_checked(root_, "");
     n_ = vehicle_keys.size();
     vehicles_.resize(n_);
+    if (plant_only_) {
+      const sim::SimulationConfig& c = base_->simulation;
+      if (c.plant.external) {
+        throw io::ConfigError(source_ + ": plant_only: the plant is " + c.plant.external->describe() +
+                              ", plant_only steps quadcosim's own plant model only");
+      }
+      if (c.faults.active()) {
+        throw io::ConfigError(source_ +
+                              ": plant_only: the scenario injects message faults, which act on the bus plant_only "
+                              "has none of");
+      }
+      // Commands come every controller_divider ticks and wait command_delay_ticks: at most this many
+      // are pending after a latch, one more before it.
+      pending_capacity_ = static_cast<std::size_t>(c.plant.command_delay_ticks / c.controller_divider + 2);
+      lean_.resize(n_);
+      pending_.resize(n_ * pending_capacity_);
+    }
     p_.assign(3 * n_, 0.0);
     v_.assign(3 * n_, 0.0);
     q_.assign(4 * n_, 0.0);
@@ -216,6 +243,7 @@ class Batch {
 
   std::size_t size() const { return n_; }
   int threads() const { return pool_.size(); }
+  bool plant_only() const { return plant_only_; }
 
   /// Advances every vehicle `periods` control periods (back to back, each vehicle's data staying in
   /// the cache); with omega_cmd ((N, 4) rotor speeds [rad/s]) the controllers are bypassed and the
@@ -224,6 +252,11 @@ class Batch {
             int periods) {
     if (periods < 1) {
       throw py::value_error("Batch.step: periods = " + std::to_string(periods) + ": expected at least 1");
+    }
+    if (plant_only_ && !omega_cmd) {
+      throw py::value_error(
+          "Batch.step: this batch is plant_only (no controllers): give omega_cmd, an (n, 4) array of rotor speeds "
+          "[rad/s]; nothing was stepped");
     }
     if (omega_cmd) {
       if (omega_cmd->ndim() != 2 || omega_cmd->shape(0) != static_cast<py::ssize_t>(n_) || omega_cmd->shape(1) != 4) {
@@ -245,6 +278,13 @@ class Batch {
     py::gil_scoped_release release;
     std::lock_guard lock(mutex_);
     if (bypass) std::copy(c, c + 4 * n_, omega_cmd_.begin());
+    if (plant_only_) {
+      pool_.run(chunks(), [&](std::uint32_t c) {
+        const std::size_t last = std::min(n_, (c + 1) * kChunk);
+        for (std::size_t i = c * kChunk; i < last; ++i) step_lean(i, periods);
+      });
+      return;
+    }
     pool_.run(chunks(), [&](std::uint32_t c) {
       const std::size_t last = std::min(n_, (c + 1) * kChunk);
       for (std::size_t i = c * kChunk; i < last; ++i) {
@@ -303,6 +343,9 @@ class Batch {
 
   /// Sets setpoints of `indices` (all when None) by keyword: a value for all or one per vehicle.
   void set_setpoints(const std::optional<std::vector<long long>>& indices, const py::kwargs& values) {
+    if (plant_only_) {
+      throw py::value_error("Batch.set_setpoints: this batch is plant_only: it has no controllers to set");
+    }
     std::vector<std::size_t> which;
     if (indices) {
       for (const long long i : *indices) {
@@ -390,7 +433,7 @@ class Batch {
     std::vector<double> x(n_), y(n_), z(n_), roll(n_), pitch(n_), yaw(n_);
     py::list modes;
     for (std::size_t i = 0; i < n_; ++i) {
-      const control::Setpoint& s = vehicles_[i].sim->controller().settings().setpoint;
+      const control::Setpoint& s = setpoint_of(i);
       modes.append(s.mode == control::Mode::kPosition ? "position" : "attitude");
       x[i] = s.p_des_W.x();
       y[i] = s.p_des_W.y();
@@ -426,7 +469,7 @@ class Batch {
         }
         yaw[i] = f.yaw_rad;
       } else {
-        const control::Setpoint& s = vehicles_[i].sim->controller().settings().setpoint;
+        const control::Setpoint& s = setpoint_of(i);
         for (int a = 0; a < 3; ++a) p[3 * i + a] = s.p_des_W[a];
         yaw[i] = s.yaw_des_rad;
       }
@@ -523,6 +566,40 @@ class Batch {
     sim::Tick next_tick = 0;  ///< the next plant tick to run
   };
 
+  /// A plant_only vehicle: what PlantNode keeps of it that a tick reads or writes when the commands
+  /// come from Python (no topics, messages, status or statistics: nobody reads them).
+  struct LeanPlant {
+    LeanPlant() = default;
+    LeanPlant(const io::Scenario& s, std::uint64_t seed)
+        : model(s.vehicle), state(io::initial_state(s)), latched(state.omega_rad_s) {
+      rotor_input = model->rotor_input(latched);
+      sim::RealismConfig realism = s.simulation.plant.realism;
+      realism.seed = seed;
+      if (realism.active() || s.vehicle.aero.active()) {
+        // Named as PlantNode names its noise streams: by the vehicle's namespace (/drone/Pose -> /drone).
+        const std::string pose = sim::Topics::for_namespace(s.simulation.ns).pose;
+        this->realism = std::make_unique<sim::PlantRealism>(realism, s.vehicle, pose.substr(0, pose.rfind('/')),
+                                                            s.simulation.plant.clock);
+      }
+    }
+    std::optional<model::Quadrotor> model;
+    model::State state;
+    model::Vector4 latched = model::Vector4::Zero();    ///< the command acting over [t_k, t_k+1)
+    model::RotorInput rotor_input;                      ///< latched as the model applies it
+    sim::Tick last_valid_tick = 0;                      ///< tick of the newest accepted command
+    std::unique_ptr<sim::PlantRealism> realism;         ///< sensor noise, wind, faults, drag; null: none
+    std::uint32_t pending_head = 0, pending_count = 0;  ///< its commands waiting out the delay (pending_)
+  };
+  struct Pending {
+    sim::Tick effective_tick = 0;
+    model::Vector4 omega = model::Vector4::Zero();
+  };
+
+  const control::Setpoint& setpoint_of(std::size_t i) const {
+    const Vehicle& v = vehicles_[i];
+    return v.sim ? v.sim->controller().settings().setpoint : v.scenario->controller.node.setpoint;
+  }
+
   /// Vehicles per chunk of work (a few microseconds of stepping).
   static constexpr std::size_t kChunk = 16;
   std::uint32_t chunks() const { return static_cast<std::uint32_t>((n_ + kChunk - 1) / kChunk); }
@@ -571,6 +648,10 @@ class Batch {
     cfg.plant.realism.seed = seed;
     cfg.faults.seed = seed;
     cfg.duration_ticks = std::numeric_limits<sim::Tick>::max() / 4;
+    // Nobody can subscribe to a vehicle's bus but this class: /clock and /tf (and /tf_static and the
+    // robot description), which feed no number, would only cost every tick memory and time.
+    cfg.plant.publish_clock = false;
+    cfg.plant.publish_tf = false;
     std::unique_ptr<sim::Simulation> sim;
     try {
       sim = std::make_unique<sim::Simulation>(cfg, s.vehicle, io::initial_state(s), s.controller, s.schedule);
@@ -581,17 +662,17 @@ class Batch {
     const sim::Topics topics = sim::Topics::for_namespace(cfg.ns);
     auto& t = sim->transport();
     t.subscribe<msg::PoseStamped>(topics.pose, [this, i](const msg::PoseStamped& m) {
-      pose_t_[i] = stamp_s(m.header);
+      pose_t_[i] = stamp_s(m.header.stamp);
       set3(pose_p_, i, m.position.x, m.position.y, m.position.z);
       set4(pose_q_, i, m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
     });
     t.subscribe<msg::TwistStamped>(topics.velocity, [this, i](const msg::TwistStamped& m) {
-      velocity_t_[i] = stamp_s(m.header);
+      velocity_t_[i] = stamp_s(m.header.stamp);
       set3(velocity_v_, i, m.linear.x, m.linear.y, m.linear.z);
       set3(velocity_w_, i, m.angular.x, m.angular.y, m.angular.z);
     });
     t.subscribe<msg::Imu>(topics.imu, [this, i](const msg::Imu& m) {
-      imu_t_[i] = stamp_s(m.header);
+      imu_t_[i] = stamp_s(m.header.stamp);
       set4(imu_q_, i, m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
       set3(imu_w_, i, m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
       set3(imu_a_, i, m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
@@ -606,9 +687,15 @@ class Batch {
     std::vector<std::shared_ptr<const io::Scenario>> scenarios;
     scenarios.reserve(which.size());
     for (std::size_t j = 0; j < which.size(); ++j) scenarios.push_back(load(keys[j], which[j]));
-    std::vector<std::unique_ptr<sim::Simulation>> sims;
-    sims.reserve(which.size());
-    for (std::size_t j = 0; j < which.size(); ++j) sims.push_back(build(*scenarios[j], seeds[j], which[j]));
+    std::vector<std::unique_ptr<sim::Simulation>> sims(which.size());
+    std::vector<LeanPlant> lean(plant_only_ ? which.size() : 0);
+    for (std::size_t j = 0; j < which.size(); ++j) {
+      if (plant_only_) {
+        lean[j] = LeanPlant(*scenarios[j], seeds[j]);
+      } else {
+        sims[j] = build(*scenarios[j], seeds[j], which[j]);
+      }
+    }
     for (std::size_t j = 0; j < which.size(); ++j) {
       const std::size_t i = which[j];
       Vehicle& v = vehicles_[i];
@@ -616,6 +703,7 @@ class Batch {
       v.keys = keys[j];
       v.seed = seeds[j];
       v.sim = std::move(sims[j]);
+      if (plant_only_) lean_[i] = std::move(lean[j]);
       v.next_tick = 0;
       pose_t_[i] = velocity_t_[i] = imu_t_[i] = kNaN;
       set3(pose_p_, i, kNaN, kNaN, kNaN);
@@ -654,15 +742,109 @@ class Batch {
     fill_state(i);
   }
 
+  /// Vehicle i (plant_only) over `periods` control periods under its row of omega_cmd_: per tick k
+  /// what Simulation::tick(k) does to a PlantNode when Simulation::override_command holds that command
+  /// (sim/plant_node.cpp, sim/lockstep_core.hpp), each model and realism call the same and in the same
+  /// order: the outputs of x(t_k) and the sensor samples due (written into the rows as the full
+  /// vehicle's subscriptions write them), on control ticks the command checked and queued for its
+  /// delay, the newest due one latched (or the watchdog's), the integration to t_k+1.
+  void step_lean(std::size_t i, int periods) {
+    Vehicle& v = vehicles_[i];
+    LeanPlant& L = lean_[i];
+    const io::Scenario& s = *v.scenario;
+    const sim::PlantOptions& o = s.simulation.plant;
+    const int divider = s.simulation.controller_divider;
+    const double omega_max = L.model->params().motor.omega_max_rad_s;
+    Pending* pending = &pending_[i * pending_capacity_];
+    thread_local msg::Float64MultiArray command;  // the override message, as Simulation publishes it
+    command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
+    thread_local msg::PoseStamped pose;  // what the realism fills in (with it only)
+    thread_local msg::TwistStamped twist;
+    thread_local msg::Imu imu;
+    const sim::Tick end = v.next_tick + static_cast<sim::Tick>(divider) * periods;
+    for (sim::Tick k = v.next_tick; k < end; ++k) {
+      // Outputs and sensors (PlantNode::publish_outputs).
+      const model::Environment* env = L.realism ? &L.realism->environment(k) : nullptr;
+      const model::Outputs y = L.model->outputs(o.clock.seconds(k), L.state, L.rotor_input, env);
+      const double stamp = stamp_s(msg::Time::from_ns(o.clock.ns(k)));
+      if (L.realism) {
+        const sim::PlantRealism::Due due = L.realism->measure(k, y, pose, twist, imu);
+        if (due.pose) write_pose(i, stamp, pose.position, pose.orientation);
+        if (due.velocity) write_velocity(i, stamp, twist.linear, twist.angular);
+        if (due.imu) write_imu(i, stamp, imu.orientation, imu.angular_velocity, imu.linear_acceleration);
+      } else {
+        pose_t_[i] = velocity_t_[i] = imu_t_[i] = stamp;
+        set3(pose_p_, i, y.p_W.x(), y.p_W.y(), y.p_W.z());
+        set4(pose_q_, i, y.q_WB.w(), y.q_WB.x(), y.q_WB.y(), y.q_WB.z());
+        set3(velocity_v_, i, y.v_W.x(), y.v_W.y(), y.v_W.z());
+        set3(velocity_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
+        set4(imu_q_, i, y.q_WB.w(), y.q_WB.x(), y.q_WB.y(), y.q_WB.z());
+        set3(imu_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
+        set3(imu_a_, i, y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z());
+      }
+      // The command on control ticks (PlantNode::on_command; every command answers its own tick).
+      if (k % divider == 0) {
+        const sim::CommandCheck check = sim::check_command(command, omega_max);
+        if (check.verdict() != sim::CommandVerdict::kRejected) {
+          L.last_valid_tick = k;
+          pending[(L.pending_head + L.pending_count) % pending_capacity_] = {k + o.command_delay_ticks,
+                                                                             check.omega_rad_s};
+          ++L.pending_count;
+        }
+      }
+      // The latch (PlantNode::latch_command): the newest due command, then the watchdog.
+      const Pending* newest = nullptr;
+      while (L.pending_count > 0 && pending[L.pending_head].effective_tick <= k) {
+        newest = &pending[L.pending_head];
+        L.pending_head = static_cast<std::uint32_t>((L.pending_head + 1) % pending_capacity_);
+        --L.pending_count;
+      }
+      if (newest) set_latched(L, newest->omega);
+      if (o.watchdog_ticks > 0) {
+        const bool expired = o.clock.ns(k - std::min(L.last_valid_tick, k)) >= o.clock.ns(o.watchdog_ticks);
+        if (expired && o.watchdog_policy == sim::WatchdogPolicy::kStop) {
+          set_latched(L, model::Vector4::Constant(L.model->params().motor.omega_min_rad_s));
+        }
+      }
+      // The integration to t_k+1 (PlantNode::integrate).
+      L.model->step(L.state, o.clock.seconds(k), L.rotor_input, o.clock.period_s(), o.substeps,
+                    L.realism ? &L.realism->environment(k) : nullptr);
+    }
+    v.next_tick = end;
+    fill_state(i);
+  }
+
+  static void set_latched(LeanPlant& L, const model::Vector4& omega_rad_s) {
+    L.latched = omega_rad_s;
+    L.rotor_input = L.model->rotor_input(omega_rad_s);
+  }
+
+  void write_pose(std::size_t i, double t, const msg::Vector3& p, const msg::Quaternion& q) {
+    pose_t_[i] = t;
+    set3(pose_p_, i, p.x, p.y, p.z);
+    set4(pose_q_, i, q.w, q.x, q.y, q.z);
+  }
+  void write_velocity(std::size_t i, double t, const msg::Vector3& v, const msg::Vector3& w) {
+    velocity_t_[i] = t;
+    set3(velocity_v_, i, v.x, v.y, v.z);
+    set3(velocity_w_, i, w.x, w.y, w.z);
+  }
+  void write_imu(std::size_t i, double t, const msg::Quaternion& q, const msg::Vector3& w, const msg::Vector3& a) {
+    imu_t_[i] = t;
+    set4(imu_q_, i, q.w, q.x, q.y, q.z);
+    set3(imu_w_, i, w.x, w.y, w.z);
+    set3(imu_a_, i, a.x, a.y, a.z);
+  }
+
   void fill_state(std::size_t i) {
     const Vehicle& v = vehicles_[i];
-    const model::State& x = v.sim->plant().state();
+    const model::State& x = v.sim ? v.sim->plant().state() : lean_[i].state;
     set3(p_, i, x.p_W.x(), x.p_W.y(), x.p_W.z());
     set3(v_, i, x.v_W.x(), x.v_W.y(), x.v_W.z());
     set4(q_, i, x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z());
     set3(w_, i, x.w_B.x(), x.w_B.y(), x.w_B.z());
     set4(omega_, i, x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]);
-    const model::Vector4& c = v.sim->plant().latched_command();
+    const model::Vector4& c = v.sim ? v.sim->plant().latched_command() : lean_[i].latched;
     set4(command_, i, c[0], c[1], c[2], c[3]);
     t_[i] = v.scenario->simulation.plant.clock.seconds(v.next_tick);
   }
@@ -683,11 +865,15 @@ class Batch {
 
   std::string source_;
   bool nominal_controller_ = false;
+  bool plant_only_ = false;
   std::shared_ptr<const io::Scenario> base_;  ///< the scenario itself (vehicles without keys fly it)
   YAML::Node root_;
   std::size_t n_ = 0;
   std::map<std::string, std::shared_ptr<const io::Scenario>> loaded_;
   std::vector<Vehicle> vehicles_;
+  std::vector<LeanPlant> lean_;   ///< plant_only: the vehicles' plants (else empty)
+  std::vector<Pending> pending_;  ///< plant_only: vehicle i's pending commands from i * pending_capacity_
+  std::size_t pending_capacity_ = 0;
   // (N, k) row-major: state after the last step, the command latched in its last tick, the newest
   // sensor messages (NaN before the first), and each vehicle's time.
   std::vector<double> p_, v_, q_, w_, omega_, command_, omega_cmd_, t_;
@@ -731,9 +917,9 @@ std::string replace_sections(const std::string& yaml, const std::string& section
 void bind_batch(py::module_& m) {
   py::class_<Batch>(m, "_Batch", "N vehicles of one scenario; use quadcosim.Batch.")
       .def(py::init<const std::string&, const std::string&, const std::vector<std::string>&,
-                    const std::vector<std::uint64_t>&, int, bool>(),
+                    const std::vector<std::uint64_t>&, int, bool, bool>(),
            py::arg("yaml"), py::arg("source"), py::arg("vehicle_keys"), py::arg("seeds"), py::arg("threads"),
-           py::arg("nominal_controller"))
+           py::arg("nominal_controller"), py::arg("plant_only") = false)
       .def("step", &Batch::step, py::arg("omega_cmd") = py::none(), py::arg("periods") = 1)
       .def("reset", &Batch::reset, py::arg("indices") = py::none(), py::arg("seeds") = py::none(),
            py::arg("vehicle_keys") = py::none())
@@ -749,7 +935,8 @@ void bind_batch(py::module_& m) {
       .def("ticks_per_step", &Batch::ticks_per_step)
       .def("plant_period_s", &Batch::plant_period_s)
       .def("size", &Batch::size)
-      .def("threads", &Batch::threads);
+      .def("threads", &Batch::threads)
+      .def("plant_only", &Batch::plant_only);
   m.def("_swarm_wall_s", &swarm_wall_s, py::arg("yaml"), py::arg("source"), py::arg("n"), py::arg("ticks"),
         py::arg("threads"), py::arg("block_ticks"), py::arg("warmup_ticks"),
         "Wall seconds of n vehicles of the in-process swarm (sim::Swarm) over `ticks` plant ticks.");

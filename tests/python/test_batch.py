@@ -290,6 +290,127 @@ def test_bad_setpoints_change_nothing():
     assert list(b.setpoints["z"]) == [2.0, 4.0, 2.0]
 
 
+# --- plant_only: the plants alone, the same numbers ------------------------------------------------------
+
+ALL_ARRAYS = STATE + ("command", "t")
+
+
+def realistic_hover(watchdog_s=0.5):
+    """Everything a plant does besides integrating: noisy sensors at their own rates with latency, wind
+    and gusts, drag, motor lag, a rotor losing efficiency, RK4 substeps, a command delay, the watchdog."""
+    return {
+        "name": "realistic_hover",
+        "seed": 4,
+        "simulation": {"plant_rate_hz": 200, "controller_rate_hz": 50, "substeps": 2, "command_delay_ticks": 5,
+                       "watchdog_s": watchdog_s},
+        "sensors": {"imu": {"gyro_noise_density_rad_s_sqrt_hz": 0.0003, "accel_noise_density_m_s2_sqrt_hz": 0.004,
+                            "gyro_bias_random_walk_rad_s2_sqrt_hz": 0.0001, "orientation_sigma_rad": 0.002,
+                            "latency_ticks": 1},
+                    "pose": {"position_sigma_m": 0.01, "orientation_sigma_rad": 0.003, "rate_hz": 50,
+                             "latency_ticks": 3},
+                    "velocity": {"linear_sigma_m_s": 0.02, "rate_hz": 100}},
+        "environment": {"wind_m_s": [2, -1, 0], "gusts": {"w20_m_s": 7.7, "altitude_m": 5}},
+        "faults": [{"at_s": 0.3, "rotor": 2, "efficiency": 0.7}],
+        "vehicle": {"aero": {"linear_drag_N_s_m": [0.25, 0.25, 0.4]},
+                    "motor": {"model": "first_order", "tau_up_s": 0.03, "tau_down_s": 0.04}},
+        "initial": {"position_m": [0, 0, 5], "hover": True},
+        "controller": {"mode": "position", "z_des": 5},
+    }
+
+
+def assert_same_bits(a, b, what):
+    """Every array of a and b the same, byte for byte (NaN before the first sample included)."""
+    for k in a:
+        assert a[k].dtype == b[k].dtype and a[k].shape == b[k].shape and a[k].tobytes() == b[k].tobytes(), \
+            f"{what}: {k}: {a[k]} != {b[k]}"
+
+
+def every_array(batch):
+    out = {k: getattr(batch, k) for k in ALL_ARRAYS}
+    out["tick"] = batch.tick
+    for sensor, fields in batch.sensors.items():
+        for k, a in fields.items():
+            out[f"{sensor}.{k}"] = a
+    return out
+
+
+def fly_commands(batches, steps, rng, n):
+    """Rotor commands around hover, some out of range (clamped by the plant), now and then several
+    periods per call; every batch flies the same."""
+    for k in range(steps):
+        cmd = 4000.0 + rng.uniform(-600, 600, size=(n, 4))
+        if k % 7 == 3:
+            cmd[k % n, k % 4] = -50.0 if k % 2 else 1e6  # clamped to [0, omega_max]
+        periods = 1 + (k % 5 == 0) * 2
+        for b in batches:
+            b.step(omega_cmd=cmd, periods=periods)
+        yield k
+
+
+@pytest.mark.parametrize("watchdog_s", [0.5, 0.01])  # 0.01 s: 2 ticks, the watchdog stops the motors between commands
+def test_plant_only_equals_the_full_vehicles_bit_for_bit(watchdog_s):
+    vehicles = [None, {"mass_kg": 0.5}, {"Ixx_kg_m2": 0.005, "motor": {"tau_up_s": 0.02}}]
+    seeds = [3, 17, 2**40 + 5]
+    n = len(vehicles)
+    sc = realistic_hover(watchdog_s)
+    full = quadcosim.Batch(sc, n, seeds=seeds, vehicles=vehicles, threads=2)
+    lean = quadcosim.Batch(sc, n, seeds=seeds, vehicles=vehicles, threads=2, plant_only=True)
+    assert lean.plant_only and not full.plant_only
+    assert_same_bits(every_array(full), every_array(lean), "before stepping")
+    rng = np.random.default_rng(1)
+    omega_max = lean.vehicle_params["motor.omega_max_rad_s"][:, None]
+    clamped = 0
+    for k in fly_commands([full, lean], 60, rng, n):
+        clamped += np.count_nonzero((lean.command == 0.0) | (lean.command == omega_max))
+        if k % 10 == 0 or k == 59:
+            assert_same_bits(every_array(full), every_array(lean), f"step {k}")
+    # The run did what it is meant to exercise (else equality would prove little).
+    assert lean.tick[0] > 0.3 / lean.plant_period_s  # past the rotor fault
+    assert not np.array_equal(lean.p[0], lean.p[1])
+    assert not np.array_equal(lean.sensors["pose"]["p"], lean.p)  # noisy, and late
+    if watchdog_s < 0.05:
+        assert np.all(lean.command == 0.0)  # the last tick of a period: the watchdog has stopped the motors
+    else:
+        assert clamped > 0  # commands out of range were latched clamped
+    # Reset: back to t = 0 for some, the others fly on; still the same numbers.
+    for b in (full, lean):
+        b.reset([1], seeds=[99], vehicles=[{"mass_kg": 0.45}])
+    assert_same_bits(every_array(full), every_array(lean), "after reset")
+    for k in fly_commands([full, lean], 20, rng, n):
+        pass
+    assert_same_bits(every_array(full), every_array(lean), "after reset and steps")
+
+
+def test_plant_only_equals_a_single_simulation():
+    sc = realistic_hover()
+    lean = quadcosim.Batch(sc, 2, seeds=[8, 9], threads=1, plant_only=True)
+    sims = [quadcosim.Simulation(quadcosim.load_scenario(sc), seed=s) for s in (8, 9)]
+    rng = np.random.default_rng(2)
+    for k in range(40):
+        cmd = 4000.0 + rng.uniform(-600, 600, size=(2, 4))
+        lean.step(omega_cmd=cmd)
+        for i, sim in enumerate(sims):
+            sim.step(omega_cmd=cmd[i])
+    for i, sim in enumerate(sims):
+        assert_same(snapshot_single(sim), snapshot_row(lean, i), f"vehicle {i}")
+
+
+def test_plant_only_refuses_what_needs_a_controller_or_a_bus():
+    lean = quadcosim.Batch(noisy_hover(), 2, threads=1, plant_only=True)
+    with pytest.raises(ValueError, match=r"plant_only .*give omega_cmd.*nothing was stepped"):
+        lean.step()
+    assert np.array_equal(lean.tick, [0, 0])
+    with pytest.raises(ValueError, match=r"plant_only: it has no controllers"):
+        lean.set_setpoints(z=3.0)
+    assert list(lean.setpoints["z"]) == [2.0, 2.0]  # the scenario's
+    assert np.array_equal(lean.reference["p"], [[0.0, 0.0, 2.0]] * 2)
+    faulty = noisy_hover()
+    faulty["message_faults"] = {"topics": {"motor_commands": {"drop_probability": 0.1}}}
+    with pytest.raises(quadcosim.ConfigError, match=r"plant_only: the scenario injects message faults"):
+        quadcosim.Batch(faulty, 2, plant_only=True)
+    assert "plant_only" in repr(lean)
+
+
 # --- Box ------------------------------------------------------------------------------------------------
 
 
@@ -471,6 +592,27 @@ def test_vector_env_equals_single_envs():
             o, *_ = env.step(a[i])
             single.append(o)
         assert np.array_equal(np.array(single), np.array(seq)[:, i]), f"sub-env {i}"
+
+
+def test_envs_fly_the_plants_alone_with_the_numbers_of_the_full_vehicles():
+    """The envs step Batch(plant_only=True); a scenario with message faults needs the bus and gets the
+    full vehicles. Faults on /clock change nothing a Batch's vehicle computes (it publishes no /clock),
+    so both fly the same numbers."""
+    lean_env = VectorHoverEnv(3, scenario=noisy_hover(), randomize={"mass_kg": (0.4, 0.55)})
+    faulty = noisy_hover()
+    faulty["message_faults"] = {"topics": {"clock": {"drop_probability": 0.5}}}
+    full_env = VectorHoverEnv(3, scenario=faulty, randomize={"mass_kg": (0.4, 0.55)})
+    assert lean_env.batch.plant_only and not full_env.batch.plant_only
+    a, _ = lean_env.reset(seed=5)
+    b, _ = full_env.reset(seed=5)
+    assert np.array_equal(a, b)
+    rng = np.random.default_rng(3)
+    for action in hover_action(lean_env.batch) + rng.uniform(-0.01, 0.01, size=(30, 3, 4)):
+        ra = lean_env.step(action)
+        rb = full_env.step(action)
+        for x, y in zip(ra[:4], rb[:4]):
+            assert np.array_equal(x, y)
+    assert_same_bits(every_array(lean_env.batch), every_array(full_env.batch), "after 30 steps")
 
 
 def test_vector_env_next_step_autoreset():

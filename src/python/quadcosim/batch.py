@@ -9,7 +9,9 @@
 
 Each vehicle is a complete quadcosim.Simulation (plant, controller node and their bus) of the
 scenario with its own seed and vehicle parameters: vehicle i gives exactly (bit for bit) the numbers
-of quadcosim.Simulation(scenario with vehicle i's keys, seed=seeds[i]). See docs/python.md.
+of quadcosim.Simulation(scenario with vehicle i's keys, seed=seeds[i]). With plant_only=True (rotor
+commands from Python, as in reinforcement learning) each vehicle is its plant alone, with the same
+numbers, and stepping it once per control period is several times faster. See docs/python.md.
 """
 
 import math
@@ -168,6 +170,13 @@ class Batch:
         only approximate (as the runs of a sweep; what robustness checks and domain randomisation want).
     threads: worker threads that step the vehicles (default: the CPUs this process may use); the
         numbers do not depend on it.
+    plant_only: no controllers: every step() gives omega_cmd (the rotor speeds come from Python, as
+        in reinforcement learning). Each vehicle is then only its plant's state, kept in one
+        contiguous array without the controller node and the bus: the same numbers as a full
+        vehicle flying the same commands (bit for bit: state, command, sensors with their noise), and
+        much faster stepped one control period per call (docs/python.md). set_setpoints raises;
+        setpoints and reference give the scenario's. Scenarios with injected message faults or
+        external dynamics (an FMU) are refused (ConfigError).
 
     Arrays come back as copies: (n, 3) p, v [m, m/s world], w [rad/s body]; (n, 4) q (w, x, y, z body
     -> world), omega, command [rad/s]; (n,) t [s], tick.
@@ -175,7 +184,7 @@ class Batch:
 
     def __init__(self, scenario: Union[Scenario, dict, str, "os.PathLike[str]"], n: int, seeds: Any = None,
                  vehicles: Any = None, threads: Optional[int] = None, controller_vehicle: str = "own",
-                 _sections: Optional[Dict[str, Any]] = None):
+                 plant_only: bool = False, _sections: Optional[Dict[str, Any]] = None):
         from . import load_scenario  # the package's loader (a file, a dict or a Scenario)
 
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
@@ -195,7 +204,7 @@ class Batch:
         if controller_vehicle not in ("own", "nominal"):
             raise ValueError(f"Batch: controller_vehicle = {controller_vehicle!r}: expected 'own' or 'nominal'")
         self._b = _quadcosim._Batch(yaml, sc.source, _vehicle_keys(vehicles, n), _seeds(seeds, n, "__init__"),
-                                    int(threads), controller_vehicle == "nominal")
+                                    int(threads), controller_vehicle == "nominal", bool(plant_only))
         self.n = n
 
     # --- stepping ----------------------------------------------------------------------------------
@@ -205,7 +214,7 @@ class Batch:
 
         omega_cmd: None (each vehicle's controller flies) or an (n, 4) array of rotor speeds [rad/s]
         for this period, the controllers bypassed (as Simulation.step(omega_cmd=)). A wrong shape or a
-        value that is not finite raises ValueError and steps nothing.
+        value that is not finite raises ValueError and steps nothing; so does None in a plant_only batch.
         periods: control periods to advance in this call (the command, if given, held over all of
         them). The numbers equal `periods` calls of step(); each vehicle runs them back to back while
         its data is in the CPU's cache, which is faster for many vehicles (docs/performance.md).
@@ -337,6 +346,11 @@ class Batch:
         return self._b.plant_period_s()
 
     @property
+    def plant_only(self) -> bool:
+        """True when the batch has no controllers (Batch(plant_only=True)): step() needs omega_cmd."""
+        return self._b.plant_only()
+
+    @property
     def threads(self) -> int:
         """Worker threads in use (at most n)."""
         return self._b.threads()
@@ -345,4 +359,5 @@ class Batch:
         return self.n
 
     def __repr__(self) -> str:
-        return f"<quadcosim.Batch '{self.scenario.name}' n={self.n} threads={self.threads}>"
+        lean = " plant_only" if self.plant_only else ""
+        return f"<quadcosim.Batch '{self.scenario.name}' n={self.n} threads={self.threads}{lean}>"
