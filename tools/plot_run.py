@@ -787,6 +787,10 @@ def plot_overview(traj, out_path, metrics, run_dir):
         lo_hi = _finite_minmax(*(traj[c] for c in cols + (tuple(des_cols) if des_cols else ())))
         if lo_hi is not None:
             lo, hi = lo_hi
+            # A signal that varies by round-off only (vz ~1e-16 m/s in a yaw step) is drawn flat at
+            # its value, not magnified into noise.
+            if hi - lo < 1e-9 * max(1.0, abs(lo), abs(hi)):
+                lo = hi = 0.5 * (lo + hi)
             pad = 0.08 * (hi - lo) if hi > lo else max(0.05, abs(hi) * 0.1)
             # headroom at the top for the legend
             ax.set_ylim(lo - pad, hi + pad + 0.3 * max(hi - lo, 2 * pad))
