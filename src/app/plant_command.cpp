@@ -355,7 +355,12 @@ class PlantProcess {
     // Delivery on arrival ended with the driver's run: what is still in the readers is taken below.
     if (csv_) csv_->close();
     if (mcap_ && code == kExitOk) {
-      while (transport_.spin_once(0) > 0) {  // what is still in the readers
+      // What is still in the readers. In lockstep, also what is still arriving: the delivery that
+      // answered the last tick may have ended the run before Cyclone put the same sample into the
+      // recorder's own reader, so wait for a 20 ms lull (at most 200 ms), or the recording could
+      // miss the last command or status under load.
+      const std::int64_t lull_ns = o_.lockstep ? 20'000'000 : 0, until = steady_ns() + 200'000'000;
+      while (transport_.spin_once(lull_ns) > 0 && steady_ns() < until) {
       }
       mcap_->close();
       const std::filesystem::path p(o_.one_vehicle.mcap);
