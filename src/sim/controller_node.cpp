@@ -29,22 +29,27 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
-  transport.subscribe<msg::PoseStamped>(topics.pose, [this, topic = topics.pose](const msg::PoseStamped& m) {
-    if (!accept(check_pose(m, pose_stamp_ns_), topic, pose_backwards_)) return;
+  // The callbacks capture only the node (the topic names are members): the transport stores them in
+  // place, not in a heap block of their own read on every sample.
+  pose_topic_ = topics.pose;
+  velocity_topic_ = topics.velocity;
+  imu_topic_ = topics.imu;
+  transport.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) {
+    if (!accept(check_pose(m, pose_stamp_ns_), pose_topic_, pose_backwards_)) return;
     observation_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference(pose_stamp_ns_);
     if (on_sample_) on_sample_();
   });
-  transport.subscribe<msg::TwistStamped>(topics.velocity, [this, topic = topics.velocity](const msg::TwistStamped& m) {
-    if (!accept(check_velocity(m, velocity_stamp_ns_), topic, velocity_backwards_)) return;
+  transport.subscribe<msg::TwistStamped>(topics.velocity, [this](const msg::TwistStamped& m) {
+    if (!accept(check_velocity(m, velocity_stamp_ns_), velocity_topic_, velocity_backwards_)) return;
     observation_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference(velocity_stamp_ns_);
     if (on_sample_) on_sample_();
   });
-  transport.subscribe<msg::Imu>(topics.imu, [this, topic = topics.imu](const msg::Imu& m) {
-    if (!accept(check_imu(m, imu_stamp_ns_), topic, imu_backwards_)) return;
+  transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
+    if (!accept(check_imu(m, imu_stamp_ns_), imu_topic_, imu_backwards_)) return;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     observation_.q_WB = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);

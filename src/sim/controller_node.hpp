@@ -191,6 +191,7 @@ class ControllerNode {
   bool step_in_flight_ = false;  ///< an asynchronous step has been started and not yet published
   std::optional<std::string> failure_;
   LogThrottle failure_log_, late_log_;
+  std::string pose_topic_, velocity_topic_, imu_topic_;  ///< for the log of refused samples
 };
 
 }  // namespace quadcosim::sim

@@ -6,15 +6,19 @@
 namespace quadcosim::sim {
 
 InProcessTransport::Channel& InProcessTransport::channel(const std::string& topic, const TopicType& type) {
-  auto [it, inserted] = channels_.try_emplace(topic);
-  Channel& c = it->second;
+  auto [it, inserted] = channels_.try_emplace(topic, nullptr);
+  if (inserted) {
+    it->second =
+        inline_used_ < kInlineChannels ? &inline_channels_[inline_used_++] : &overflow_channels_.emplace_back();
+  }
+  Channel& c = *it->second;
   if (inserted) {
     c.ros_type = type.ros_type;
     c.cpp_type = type.cpp_type;
     c.clone = type.clone;
     if (auto f = faults_.topics.find(topic); f != faults_.topics.end() && f->second.active()) {
       c.faults = f->second;
-      c.stream.emplace(faults_.seed, topic);
+      c.stream = std::make_unique<FaultStream>(faults_.seed, topic);
     }
   } else if (c.cpp_type != type.cpp_type) {
     throw std::logic_error("topic '" + topic + "' is already used with type " + std::string(c.ros_type) + ", not " +
@@ -48,16 +52,21 @@ std::function<void(const void*)> InProcessTransport::make_sink(const std::string
 
 void InProcessTransport::deliver(Channel& c, const void* message) {
   ++c.delivered;
-  for (const auto& d : c.subscribers) d(message);
+  if (!c.first) return;
+  c.first(message);
+  if (!c.second) return;
+  c.second(message);
+  for (const auto& d : c.more) d(message);
 }
 
 void InProcessTransport::set_faults(const FaultConfig& faults) {
   faults_ = faults;
-  for (auto& [topic, c] : channels_) {
+  for (auto& [topic, channel] : channels_) {
+    Channel& c = *channel;
     const auto f = faults_.topics.find(topic);
     c.faults = f == faults_.topics.end() ? TopicFaults{} : f->second;
     if (c.faults.active()) {
-      c.stream.emplace(faults_.seed, topic);
+      c.stream = std::make_unique<FaultStream>(faults_.seed, topic);
     } else {
       c.stream.reset();
     }
@@ -75,17 +84,24 @@ void InProcessTransport::advance_to(Tick k) {
 
 std::uint64_t InProcessTransport::dropped(const std::string& topic) const {
   auto it = channels_.find(topic);
-  return it == channels_.end() ? 0 : it->second.dropped;
+  return it == channels_.end() ? 0 : it->second->dropped;
 }
 
 void InProcessTransport::add_subscription(const std::string& topic, const TopicType& type,
                                           std::function<void(const void*)> deliver) {
-  channel(topic, type).subscribers.push_back(std::move(deliver));
+  Channel& c = channel(topic, type);
+  if (!c.first) {
+    c.first = std::move(deliver);
+  } else if (!c.second) {
+    c.second = std::move(deliver);
+  } else {
+    c.more.push_back(std::move(deliver));
+  }
 }
 
 std::uint64_t InProcessTransport::delivered(const std::string& topic) const {
   auto it = channels_.find(topic);
-  return it == channels_.end() ? 0 : it->second.delivered;
+  return it == channels_.end() ? 0 : it->second->delivered;
 }
 
 }  // namespace quadcosim::sim
