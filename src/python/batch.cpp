@@ -662,20 +662,13 @@ class Batch {
     const sim::Topics topics = sim::Topics::for_namespace(cfg.ns);
     auto& t = sim->transport();
     t.subscribe<msg::PoseStamped>(topics.pose, [this, i](const msg::PoseStamped& m) {
-      pose_t_[i] = stamp_s(m.header.stamp);
-      set3(pose_p_, i, m.position.x, m.position.y, m.position.z);
-      set4(pose_q_, i, m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
+      write_pose(i, stamp_s(m.header.stamp), m.position, m.orientation);
     });
     t.subscribe<msg::TwistStamped>(topics.velocity, [this, i](const msg::TwistStamped& m) {
-      velocity_t_[i] = stamp_s(m.header.stamp);
-      set3(velocity_v_, i, m.linear.x, m.linear.y, m.linear.z);
-      set3(velocity_w_, i, m.angular.x, m.angular.y, m.angular.z);
+      write_velocity(i, stamp_s(m.header.stamp), m.linear, m.angular);
     });
     t.subscribe<msg::Imu>(topics.imu, [this, i](const msg::Imu& m) {
-      imu_t_[i] = stamp_s(m.header.stamp);
-      set4(imu_q_, i, m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
-      set3(imu_w_, i, m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
-      set3(imu_a_, i, m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
+      write_imu(i, stamp_s(m.header.stamp), m.orientation, m.angular_velocity, m.linear_acceleration);
     });
     return sim;
   }
