@@ -102,10 +102,14 @@ class PlantProcess {
     return sim::PlantNode(transport_, topics_, sc_.vehicle, po, io::initial_state(sc_));
   }
 
+  /// Readers of this process's own on each topic (the recorder's, the Foxglove server's): matched
+  /// counts include them.
+  int own_readers() const { return (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0); }
+
   /// Waits until a controller is there to answer, so tick 0 is not published into the void.
   bool wait_for_controller() {
     // The recorder's and the Foxglove server's own readers (same participant) match too: look for one more.
-    const int own = (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0);
+    const int own = own_readers();
     const bool found = transport_.spin_until(
         [&] {
           return stop_requested() ||
@@ -185,7 +189,7 @@ class PlantProcess {
       return fallback(fmt::format("{} has {}", node, declared ? "use_sim_time false" : "no use_sim_time parameter"));
     }
     // The timer's /clock subscription must be there too, or its first /clock is lost.
-    const int own = (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0);
+    const int own = own_readers();
     if (!transport_.spin_until([&] { return stop_requested() || transport_.matched_readers(topics_.clock) > own; },
                                timeout_ns())) {
       std::cerr << fmt::format("plant: {} does not subscribe {} within {} s\n", node, topics_.clock, o_.timeout_s);
