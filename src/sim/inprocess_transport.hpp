@@ -20,6 +20,11 @@ namespace quadcosim::sim {
 
 class InProcessTransport final : public Transport {
  public:
+  InProcessTransport() = default;
+  // channels_ and the sinks point into inline_channels_: a copy or move would leave them pointing at
+  // the original.
+  InProcessTransport(const InProcessTransport&) = delete;
+  InProcessTransport& operator=(const InProcessTransport&) = delete;
   /// Messages delivered so far, per topic.
   std::uint64_t delivered(const std::string& topic) const;
 
