@@ -15,10 +15,10 @@ std::int64_t ParameterSchedule::due_ns() const {
   return next_ < schedule_.size() ? clock_.ns(schedule_[next_].tick) : std::numeric_limits<std::int64_t>::max();
 }
 
-void ParameterSchedule::apply_due(ControllerNode& node, std::int64_t now_ns) {
+void ParameterSchedule::apply_due(ControllerCore& core, std::int64_t now_ns) {
   while (next_due_ns_ <= now_ns) {
     const ScheduledParameter& p = schedule_[next_];
-    if (std::string err = node.set_parameter(p.name, p.value); !err.empty()) {
+    if (std::string err = core.set_parameter(p.name, p.value); !err.empty()) {
       throw std::invalid_argument("scheduled parameter at t=" + std::to_string(clock_.seconds(p.tick)) +
                                   " s refused: " + err);
     }

@@ -25,14 +25,15 @@ class ParameterSchedule {
  public:
   /// Orders the changes by tick (changes of one tick keep their order).
   ParameterSchedule(std::vector<ScheduledParameter> schedule, const TickClock& clock);
-  /// Sets on `node` every change due by `now_ns` [ns, simulated] not set yet. Throws
+  /// Sets on the node (or its core) every change due by `now_ns` [ns, simulated] not set yet. Throws
   /// std::invalid_argument naming the change's time and the node's reason when it refuses one.
-  void apply(ControllerNode& node, std::int64_t now_ns) {
-    if (now_ns >= next_due_ns_) apply_due(node, now_ns);  // one compare per tick on the hot path
+  void apply(ControllerCore& core, std::int64_t now_ns) {
+    if (now_ns >= next_due_ns_) apply_due(core, now_ns);  // one compare per tick on the hot path
   }
+  void apply(ControllerNode& node, std::int64_t now_ns) { apply(node.core(), now_ns); }
 
  private:
-  void apply_due(ControllerNode& node, std::int64_t now_ns);
+  void apply_due(ControllerCore& core, std::int64_t now_ns);
   /// When schedule_[next_] is due [ns], or INT64_MAX after the last change.
   std::int64_t due_ns() const;
   std::vector<ScheduledParameter> schedule_;  ///< by tick
