@@ -1,15 +1,21 @@
-// quadcosim.Batch's compiled part: N vehicles of one scenario, each a complete sim::Simulation (plant,
-// controller node, in-process bus: what quadcosim.Simulation steps), with its own seed, vehicle
-// parameters and setpoint. C++ keeps their state and the sensor readings their controllers see in
+// quadcosim.Batch's compiled part: N vehicles of one scenario, each with its own seed, vehicle
+// parameters and setpoint, flying the numbers quadcosim.Simulation flies (plant node, controller node,
+// in-process bus). C++ keeps their state and the sensor readings their controllers see in
 // preallocated row-major (N, k) buffers, written by the thread that steps the vehicle; Python gets
 // copies as numpy arrays. Stepping releases the GIL and splits the vehicles over a pool of threads
 // kept between steps; the vehicles do not interact, so the thread count changes no number.
 //
-// Plant only (Batch(plant_only=True)): the rotor commands always come from Python, so there is no
-// controller node and no bus; each vehicle is its plant's state in one small object of a contiguous
-// array (LeanPlant), stepped with the model and realism calls PlantNode makes, in its order: the same
-// numbers as the full vehicle flying the same commands, at a fraction of the memory a tick touches
-// (what bounds a step of many vehicles once per control period, the cache being too small for them).
+// A vehicle is one small object of a contiguous array (LeanVehicle), not a bus with two nodes on it:
+// its plant's state, stepped with the model and realism calls PlantNode makes, in its order, and its
+// controller's sim::ControllerCore (what ControllerNode decides with), fed the samples the plant node
+// would publish and stepped on the ticks the node steps, its commands checked and queued as the plant
+// node takes them. Nobody can subscribe to a Batch vehicle's topics, so nothing else of the nodes
+// feeds a number; a tick touches a fraction of the memory (what bounds a step of many vehicles once
+// per control period, the cache being too small for them). A scenario that needs the bus (injected
+// message faults) or a plant from elsewhere (an FMU) makes each vehicle a whole sim::Simulation.
+// The tests hold both to a single Simulation bit for bit.
+//
+// Plant only (Batch(plant_only=True)): the rotor commands always come from Python; no controllers.
 #include "batch.hpp"
 
 #include <pybind11/numpy.h>
@@ -35,6 +41,8 @@
 #include "control/care.hpp"
 #include "io/scenario.hpp"
 #include "model/vehicle_params.hpp"
+#include "sim/controller_core.hpp"
+#include "sim/parameter_schedule.hpp"
 #include "sim/realism.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
@@ -201,8 +209,8 @@ class Batch {
     base_ = load_checked(root_, "");
     n_ = vehicle_keys.size();
     vehicles_.resize(n_);
+    const sim::SimulationConfig& c = base_->simulation;
     if (plant_only_) {
-      const sim::SimulationConfig& c = base_->simulation;
       if (c.plant.external) {
         throw io::ConfigError(source_ + ": plant_only: the plant is " + c.plant.external->describe() +
                               ", plant_only steps quadcosim's own plant model only");
@@ -212,6 +220,9 @@ class Batch {
                               ": plant_only: the scenario injects message faults, which act on the bus plant_only "
                               "has none of");
       }
+    }
+    lean_vehicles_ = !c.plant.external && !c.faults.active();
+    if (lean_vehicles_) {
       // Commands come every controller_divider ticks and wait command_delay_ticks: at most this many
       // are pending after a latch, one more before it.
       pending_capacity_ = static_cast<std::size_t>(c.plant.command_delay_ticks / c.controller_divider + 2);
@@ -244,6 +255,8 @@ class Batch {
   std::size_t size() const { return n_; }
   int threads() const { return pool_.size(); }
   bool plant_only() const { return plant_only_; }
+  /// The vehicles are LeanVehicles (no bus), not whole Simulations.
+  bool lean_vehicles() const { return lean_vehicles_; }
 
   /// Advances every vehicle `periods` control periods (back to back, each vehicle's data staying in
   /// the cache); with omega_cmd ((N, 4) rotor speeds [rad/s]) the controllers are bypassed and the
@@ -278,10 +291,13 @@ class Batch {
     py::gil_scoped_release release;
     std::lock_guard lock(mutex_);
     if (bypass) std::copy(c, c + 4 * n_, omega_cmd_.begin());
-    if (plant_only_) {
+    if (lean_vehicles_) {
       pool_.run(chunks(), [&](std::uint32_t c) {
         const std::size_t last = std::min(n_, (c + 1) * kChunk);
-        for (std::size_t i = c * kChunk; i < last; ++i) step_lean(i, periods);
+        for (std::size_t i = c * kChunk; i < last; ++i) {
+          if (i + 1 < last) prefetch(lean_[i + 1]);
+          step_lean(i, bypass, periods);
+        }
       });
       return;
     }
@@ -406,16 +422,16 @@ class Batch {
     // Applied vehicle by vehicle; a refused value puts back what was set before it.
     std::vector<std::vector<control::ParameterValue>> before(m);
     for (std::size_t j = 0; j < m; ++j) {
-      sim::ControllerNode& node = vehicles_[which[j]].sim->controller();
+      sim::ControllerCore& node = controller_of(which[j]);
       for (const Column& c : columns) before[j].push_back(*node.get_parameter(c.parameter));
     }
     for (std::size_t j = 0; j < m; ++j) {
-      sim::ControllerNode& node = vehicles_[which[j]].sim->controller();
+      sim::ControllerCore& node = controller_of(which[j]);
       for (std::size_t c = 0; c < columns.size(); ++c) {
         const std::string why = node.set_parameter(columns[c].parameter, columns[c].values[j]);
         if (why.empty()) continue;
         for (std::size_t r = 0; r <= j; ++r) {
-          sim::ControllerNode& back = vehicles_[which[r]].sim->controller();
+          sim::ControllerCore& back = controller_of(which[r]);
           for (std::size_t b = columns.size(); b-- > 0;) back.set_parameter(columns[b].parameter, before[r][b]);
         }
         const control::ParameterValue& got = columns[c].values[j];
@@ -566,20 +582,25 @@ class Batch {
     sim::Tick next_tick = 0;  ///< the next plant tick to run
   };
 
-  /// A plant_only vehicle: what PlantNode keeps of it that a tick reads or writes when the commands
-  /// come from Python (no topics, messages, status or statistics: nobody reads them).
-  struct LeanPlant {
-    LeanPlant() = default;
-    LeanPlant(const io::Scenario& s, std::uint64_t seed)
+  /// A vehicle without a bus: what PlantNode keeps of its plant that a tick reads or writes when
+  /// nobody reads its topics, statuses or statistics, and, unless plant_only, what ControllerNode
+  /// decides with (its core) and the scenario's schedule of parameter changes.
+  struct LeanVehicle {
+    LeanVehicle() = default;
+    LeanVehicle(const io::Scenario& s, std::uint64_t seed, bool with_controller)
         : model(s.vehicle), state(io::initial_state(s)), latched(state.omega_rad_s) {
       rotor_input = model->rotor_input(latched);
+      const sim::Topics topics = sim::Topics::for_namespace(s.simulation.ns);
       sim::RealismConfig realism = s.simulation.plant.realism;
       realism.seed = seed;
       if (realism.active() || s.vehicle.aero.active()) {
         // Named as PlantNode names its noise streams: by the vehicle's namespace (/drone/Pose -> /drone).
-        const std::string pose = sim::Topics::for_namespace(s.simulation.ns).pose;
-        this->realism = std::make_unique<sim::PlantRealism>(realism, s.vehicle, pose.substr(0, pose.rfind('/')),
-                                                            s.simulation.plant.clock);
+        this->realism = std::make_unique<sim::PlantRealism>(
+            realism, s.vehicle, topics.pose.substr(0, topics.pose.rfind('/')), s.simulation.plant.clock);
+      }
+      if (with_controller) {
+        controller.emplace(s.controller, topics);
+        if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
       }
     }
     std::optional<model::Quadrotor> model;
@@ -589,6 +610,8 @@ class Batch {
     sim::Tick last_valid_tick = 0;                      ///< tick of the newest accepted command
     std::unique_ptr<sim::PlantRealism> realism;         ///< sensor noise, wind, faults, drag; null: none
     std::uint32_t pending_head = 0, pending_count = 0;  ///< its commands waiting out the delay (pending_)
+    std::optional<sim::ControllerCore> controller;      ///< none: plant_only
+    std::optional<sim::ParameterSchedule> schedule;     ///< the scenario's, when it has one
   };
   struct Pending {
     sim::Tick effective_tick = 0;
@@ -597,7 +620,12 @@ class Batch {
 
   const control::Setpoint& setpoint_of(std::size_t i) const {
     const Vehicle& v = vehicles_[i];
-    return v.sim ? v.sim->controller().settings().setpoint : v.scenario->controller.node.setpoint;
+    if (v.sim) return v.sim->controller().settings().setpoint;
+    return plant_only_ ? v.scenario->controller.node.setpoint : lean_[i].controller->settings().setpoint;
+  }
+  /// Vehicle i's controller (not plant_only).
+  sim::ControllerCore& controller_of(std::size_t i) {
+    return vehicles_[i].sim ? vehicles_[i].sim->controller().core() : *lean_[i].controller;
   }
 
   /// Vehicles per chunk of work (a few microseconds of stepping).
@@ -681,10 +709,14 @@ class Batch {
     scenarios.reserve(which.size());
     for (std::size_t j = 0; j < which.size(); ++j) scenarios.push_back(load(keys[j], which[j]));
     std::vector<std::unique_ptr<sim::Simulation>> sims(which.size());
-    std::vector<LeanPlant> lean(plant_only_ ? which.size() : 0);
+    std::vector<LeanVehicle> lean(lean_vehicles_ ? which.size() : 0);
     for (std::size_t j = 0; j < which.size(); ++j) {
-      if (plant_only_) {
-        lean[j] = LeanPlant(*scenarios[j], seeds[j]);
+      if (lean_vehicles_) {
+        try {
+          lean[j] = LeanVehicle(*scenarios[j], seeds[j], !plant_only_);
+        } catch (const std::invalid_argument& e) {
+          throw io::ConfigError("vehicle " + std::to_string(which[j]) + ": " + scenarios[j]->path + ": " + e.what());
+        }
       } else {
         sims[j] = build(*scenarios[j], seeds[j], which[j]);
       }
@@ -696,7 +728,7 @@ class Batch {
       v.keys = keys[j];
       v.seed = seeds[j];
       v.sim = std::move(sims[j]);
-      if (plant_only_) lean_[i] = std::move(lean[j]);
+      if (lean_vehicles_) lean_[i] = std::move(lean[j]);
       v.next_tick = 0;
       pose_t_[i] = velocity_t_[i] = imu_t_[i] = kNaN;
       set3(pose_p_, i, kNaN, kNaN, kNaN);
@@ -718,9 +750,16 @@ class Batch {
   /// Asks the CPU to load the next vehicle's simulation object (plant, controller node and bus are
   /// members of it) while this one steps: with many vehicles their state no longer fits the core's
   /// cache between two steps, and this object is where each tick starts.
-  static void prefetch(const sim::Simulation& s) {
-    const char* p = reinterpret_cast<const char*>(&s);
-    for (std::size_t b = 0; b < sizeof(sim::Simulation); b += 64) __builtin_prefetch(p + b);
+  static void prefetch(const sim::Simulation& s) { prefetch_bytes(&s, sizeof(sim::Simulation)); }
+  /// The same for a lean vehicle: its object, and its controller's (a heap block of its own; what a
+  /// controller's object holds is its business, so the first kilobyte: a paper controller's size).
+  static void prefetch(const LeanVehicle& v) {
+    prefetch_bytes(&v, sizeof(LeanVehicle));
+    if (v.controller) prefetch_bytes(&v.controller->controller(), 1024);
+  }
+  static void prefetch_bytes(const void* at, std::size_t bytes) {
+    const char* p = static_cast<const char*>(at);
+    for (std::size_t b = 0; b < bytes; b += 64) __builtin_prefetch(p + b);
   }
 
   void step_vehicle(std::size_t i, bool bypass, int periods) {
@@ -735,36 +774,68 @@ class Batch {
     fill_state(i);
   }
 
-  /// Vehicle i (plant_only) over `periods` control periods under its row of omega_cmd_: per tick k
-  /// what Simulation::tick(k) does to a PlantNode when Simulation::override_command holds that command
-  /// (sim/plant_node.cpp, sim/lockstep_core.hpp), each model and realism call the same and in the same
-  /// order: the outputs of x(t_k) and the sensor samples due (written into the rows as the full
-  /// vehicle's subscriptions write them), on control ticks the command checked and queued for its
-  /// delay, the newest due one latched (or the watchdog's), the integration to t_k+1.
-  void step_lean(std::size_t i, int periods) {
+  /// Lean vehicle i over `periods` control periods: per tick k what Simulation::tick(k) does to its
+  /// nodes (sim/simulation.hpp, sim/plant_node.cpp, sim/controller_node.cpp), each model, realism and
+  /// controller call the same and in the same order: the scheduled parameter changes due; the outputs
+  /// of x(t_k) and the sensor samples due, taken in by the controller and written into the rows as
+  /// the full vehicle's subscriptions write them; on control ticks the controller's step (or, with
+  /// `bypass`, the row of omega_cmd_ as Simulation::override_command sends it), its command checked
+  /// and queued for its delay; the newest due one latched (or the watchdog's); the integration to
+  /// t_k+1.
+  void step_lean(std::size_t i, bool bypass, int periods) {
     Vehicle& v = vehicles_[i];
-    LeanPlant& L = lean_[i];
+    LeanVehicle& L = lean_[i];
     const io::Scenario& s = *v.scenario;
     const sim::PlantOptions& o = s.simulation.plant;
     const int divider = s.simulation.controller_divider;
+    const double control_dt_s = o.clock.period_s() * divider;  // as Simulation's
     const double omega_max = L.model->params().motor.omega_max_rad_s;
+    sim::ControllerCore* const controller = L.controller ? &*L.controller : nullptr;
     Pending* pending = &pending_[i * pending_capacity_];
-    thread_local msg::Float64MultiArray command;  // the override message, as Simulation publishes it
-    command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
-    thread_local msg::PoseStamped pose;  // what the realism fills in (with it only)
+    thread_local msg::Float64MultiArray command;  // the command message, as the controller node or Simulation sends it
+    if (bypass) {
+      command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
+    } else {
+      command.data.resize(4);
+    }
+    thread_local msg::PoseStamped pose;  // the samples, as the plant node publishes them
     thread_local msg::TwistStamped twist;
     thread_local msg::Imu imu;
     const sim::Tick end = v.next_tick + static_cast<sim::Tick>(divider) * periods;
     for (sim::Tick k = v.next_tick; k < end; ++k) {
+      // Scheduled parameter changes (Simulation's before_outputs).
+      if (L.schedule) L.schedule->apply(*controller, o.clock.ns(k));
       // Outputs and sensors (PlantNode::publish_outputs).
       const model::Environment* env = L.realism ? &L.realism->environment(k) : nullptr;
       const model::Outputs y = L.model->outputs(o.clock.seconds(k), L.state, L.rotor_input, env);
-      const double stamp = stamp_s(msg::Time::from_ns(o.clock.ns(k)));
-      if (L.realism) {
-        const sim::PlantRealism::Due due = L.realism->measure(k, y, pose, twist, imu);
-        if (due.pose) write_pose(i, stamp, pose.position, pose.orientation);
-        if (due.velocity) write_velocity(i, stamp, twist.linear, twist.angular);
-        if (due.imu) write_imu(i, stamp, imu.orientation, imu.angular_velocity, imu.linear_acceleration);
+      const msg::Time time = msg::Time::from_ns(o.clock.ns(k));
+      const double stamp = stamp_s(time);
+      if (controller || L.realism) {
+        sim::PlantRealism::Due due{true, true, true};
+        if (L.realism) {
+          due = L.realism->measure(k, y, pose, twist, imu);
+        } else {
+          pose.position = {y.p_W.x(), y.p_W.y(), y.p_W.z()};
+          pose.orientation = {y.q_WB.x(), y.q_WB.y(), y.q_WB.z(), y.q_WB.w()};
+          twist.linear = {y.v_W.x(), y.v_W.y(), y.v_W.z()};
+          twist.angular = {y.w_B.x(), y.w_B.y(), y.w_B.z()};
+          imu.orientation = pose.orientation;
+          imu.angular_velocity = twist.angular;
+          imu.linear_acceleration = {y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z()};
+        }
+        pose.header.stamp = twist.header.stamp = imu.header.stamp = time;
+        if (due.pose) {
+          if (controller) controller->take_pose(pose);
+          write_pose(i, stamp, pose.position, pose.orientation);
+        }
+        if (due.velocity) {
+          if (controller) controller->take_velocity(twist);
+          write_velocity(i, stamp, twist.linear, twist.angular);
+        }
+        if (due.imu) {
+          if (controller) controller->take_imu(imu);
+          write_imu(i, stamp, imu.orientation, imu.angular_velocity, imu.linear_acceleration);
+        }
       } else {
         pose_t_[i] = velocity_t_[i] = imu_t_[i] = stamp;
         set3(pose_p_, i, y.p_W.x(), y.p_W.y(), y.p_W.z());
@@ -775,8 +846,15 @@ class Batch {
         set3(imu_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
         set3(imu_a_, i, y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z());
       }
-      // The command on control ticks (PlantNode::on_command; every command answers its own tick).
+      // On control ticks the controller's step or the command given (Simulation's after_outputs), taken
+      // in as PlantNode::on_command takes it (every command answers its own tick).
       if (k % divider == 0) {
+        if (!bypass) {
+          const sim::ControllerCore::Begun begun = controller->begin_step(o.clock.ns(k));
+          controller->decide(begun.safety, control_dt_s);
+          const model::Vector4& omega = controller->output().omega_rad_s;
+          for (int r = 0; r < 4; ++r) command.data[r] = omega[r];
+        }
         const sim::CommandCheck check = sim::check_command(command, omega_max);
         if (check.verdict() != sim::CommandVerdict::kRejected) {
           L.last_valid_tick = k;
@@ -807,7 +885,7 @@ class Batch {
     fill_state(i);
   }
 
-  static void set_latched(LeanPlant& L, const model::Vector4& omega_rad_s) {
+  static void set_latched(LeanVehicle& L, const model::Vector4& omega_rad_s) {
     L.latched = omega_rad_s;
     L.rotor_input = L.model->rotor_input(omega_rad_s);
   }
@@ -859,13 +937,14 @@ class Batch {
   std::string source_;
   bool nominal_controller_ = false;
   bool plant_only_ = false;
+  bool lean_vehicles_ = false;                ///< vehicles are LeanVehicles in lean_ (else whole Simulations)
   std::shared_ptr<const io::Scenario> base_;  ///< the scenario itself (vehicles without keys fly it)
   YAML::Node root_;
   std::size_t n_ = 0;
   std::map<std::string, std::shared_ptr<const io::Scenario>> loaded_;
   std::vector<Vehicle> vehicles_;
-  std::vector<LeanPlant> lean_;   ///< plant_only: the vehicles' plants (else empty)
-  std::vector<Pending> pending_;  ///< plant_only: vehicle i's pending commands from i * pending_capacity_
+  std::vector<LeanVehicle> lean_;  ///< lean_vehicles_: the vehicles (else empty)
+  std::vector<Pending> pending_;   ///< lean_vehicles_: vehicle i's pending commands from i * pending_capacity_
   std::size_t pending_capacity_ = 0;
   // (N, k) row-major: state after the last step, the command latched in its last tick, the newest
   // sensor messages (NaN before the first), and each vehicle's time.
@@ -929,7 +1008,8 @@ void bind_batch(py::module_& m) {
       .def("plant_period_s", &Batch::plant_period_s)
       .def("size", &Batch::size)
       .def("threads", &Batch::threads)
-      .def("plant_only", &Batch::plant_only);
+      .def("plant_only", &Batch::plant_only)
+      .def("lean_vehicles", &Batch::lean_vehicles);
   m.def("_swarm_wall_s", &swarm_wall_s, py::arg("yaml"), py::arg("source"), py::arg("n"), py::arg("ticks"),
         py::arg("threads"), py::arg("block_ticks"), py::arg("warmup_ticks"),
         "Wall seconds of n vehicles of the in-process swarm (sim::Swarm) over `ticks` plant ticks.");
