@@ -48,6 +48,7 @@
 #include "sim/swarm.hpp"
 #include "sim/topics.hpp"
 #include "sim/validation.hpp"
+#include "worker_pool.hpp"
 
 namespace py = pybind11;
 
@@ -56,106 +57,6 @@ namespace quadcosim::python {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-/// Threads that run one job over the vehicles in chunks, kept between steps: a step of 1,000
-/// vehicles takes a fraction of a millisecond, of which starting threads every time would be a
-/// visible part. Chunks are taken from a shared counter, so a thread the OS does not run for a while
-/// (the machine is shared) delays a step by one chunk at most: the others take the rest, the calling
-/// thread too. Which thread steps which vehicle changes nothing (the vehicles do not interact).
-class WorkerPool {
- public:
-  explicit WorkerPool(int threads) : threads_(std::max(threads, 1)) {
-    for (int t = 1; t < threads_; ++t) workers_.emplace_back([this] { work(); });
-  }
-  WorkerPool(const WorkerPool&) = delete;
-  WorkerPool& operator=(const WorkerPool&) = delete;
-  ~WorkerPool() {
-    {
-      std::lock_guard lock(mutex_);
-      stop_ = true;
-    }
-    start_.notify_all();
-    for (auto& w : workers_) w.join();
-  }
-
-  int size() const { return threads_; }
-
-  /// Runs job(c) for every chunk c in [0, chunks) on the pool and the calling thread, and returns
-  /// when all are done. Rethrows the first exception a chunk raised (the other chunks still ran).
-  void run(std::uint32_t chunks, const std::function<void(std::uint32_t)>& job) {
-    if (threads_ == 1 || chunks <= 1) {
-      for (std::uint32_t c = 0; c < chunks; ++c) job(c);
-      return;
-    }
-    std::uint64_t generation = 0;
-    {
-      std::lock_guard lock(mutex_);
-      job_ = &job;
-      chunks_ = chunks;
-      done_chunks_ = 0;
-      failure_ = nullptr;
-      generation = ++generation_;
-      next_.store(generation << 32, std::memory_order_release);
-    }
-    start_.notify_all();
-    take_chunks(generation, job, chunks);
-    std::unique_lock lock(mutex_);
-    done_.wait(lock, [&] { return done_chunks_ == chunks_; });
-    job_ = nullptr;
-    if (failure_) std::rethrow_exception(failure_);
-  }
-
- private:
-  /// Takes chunks of `generation` until none is left (the counter holds the generation in its high
-  /// half, so a thread that wakes late never takes a chunk of a later job with an earlier one).
-  void take_chunks(std::uint64_t generation, const std::function<void(std::uint32_t)>& job, std::uint32_t chunks) {
-    for (;;) {
-      std::uint64_t v = next_.load(std::memory_order_acquire);
-      std::uint32_t c = 0;
-      do {
-        if ((v >> 32) != generation || static_cast<std::uint32_t>(v) >= chunks) return;
-        c = static_cast<std::uint32_t>(v);
-      } while (!next_.compare_exchange_weak(v, v + 1, std::memory_order_acq_rel));
-      std::exception_ptr failure;
-      try {
-        job(c);
-      } catch (...) {
-        failure = std::current_exception();
-      }
-      std::lock_guard lock(mutex_);
-      if (failure && !failure_) failure_ = failure;
-      if (++done_chunks_ == chunks_) done_.notify_all();
-    }
-  }
-
-  void work() {
-    std::uint64_t seen = 0;
-    for (;;) {
-      const std::function<void(std::uint32_t)>* job = nullptr;
-      std::uint32_t chunks = 0;
-      {
-        std::unique_lock lock(mutex_);
-        start_.wait(lock, [&] { return stop_ || generation_ != seen; });
-        if (stop_) return;
-        seen = generation_;
-        job = job_;
-        chunks = chunks_;
-      }
-      if (job) take_chunks(seen, *job, chunks);
-    }
-  }
-
-  int threads_;
-  std::vector<std::thread> workers_;
-  std::mutex mutex_;
-  std::condition_variable start_, done_;
-  const std::function<void(std::uint32_t)>* job_ = nullptr;
-  std::uint64_t generation_ = 0;
-  std::uint32_t chunks_ = 0, done_chunks_ = 0;
-  std::atomic<std::uint64_t> next_{0};  ///< generation << 32 | the next chunk to take
-  bool stop_ = false;
-  std::exception_ptr failure_;
-};
 
 /// Merges the mapping `keys` into the mapping `into` (nested mappings key by key; anything else replaces).
 void merge(YAML::Node into, const YAML::Node& keys) {
