@@ -51,8 +51,7 @@ bool finite(const control::Observation& e) {
 void ControllerCore::safety_output(const control::Reference& ref, control::ControllerOutput& out) const {
   // Algorithm 1, lines 3-5: every rotor at one speed; nothing else is decided. The attitude shown as
   // tracked is the reference's in attitude mode and level in position mode.
-  out.omega_rad_s.setConstant(settings_.safety == control::SafetyMode::kHover ? hover_omega_rad_s_
-                                                                              : omega_min_rad_s_);
+  out.omega_rad_s.setConstant(settings_.safety == control::SafetyMode::kHover ? hover_omega_rad_s_ : omega_min_rad_s_);
   out.U.setZero();
   const bool attitude = ref.mode == control::Mode::kAttitude;
   out.roll_des_rad = attitude ? ref.roll_rad : 0.0;
