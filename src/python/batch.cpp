@@ -43,6 +43,7 @@
 #include "model/vehicle_params.hpp"
 #include "sim/controller_core.hpp"
 #include "sim/parameter_schedule.hpp"
+#include "sim/plant_node.hpp"
 #include "sim/realism.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
@@ -704,6 +705,7 @@ class Batch {
     thread_local msg::Imu imu;
     const sim::Tick end = v.next_tick + static_cast<sim::Tick>(divider) * periods;
     for (sim::Tick k = v.next_tick; k < end; ++k) {
+      v.next_tick = k + 1;  // as step_vehicle counts a tick begun (one whose controller threw, say)
       // Scheduled parameter changes (Simulation's before_outputs).
       if (L.schedule) L.schedule->apply(*controller, o.clock.ns(k));
       // Outputs and sensors (PlantNode::publish_outputs).
@@ -712,19 +714,9 @@ class Batch {
       const msg::Time time = msg::Time::from_ns(o.clock.ns(k));
       const double stamp = stamp_s(time);
       if (controller || L.realism) {
+        sim::write_sensor_messages(y, time, pose, twist, imu);
         sim::PlantRealism::Due due{true, true, true};
-        if (L.realism) {
-          due = L.realism->measure(k, y, pose, twist, imu);
-        } else {
-          pose.position = {y.p_W.x(), y.p_W.y(), y.p_W.z()};
-          pose.orientation = {y.q_WB.x(), y.q_WB.y(), y.q_WB.z(), y.q_WB.w()};
-          twist.linear = {y.v_W.x(), y.v_W.y(), y.v_W.z()};
-          twist.angular = {y.w_B.x(), y.w_B.y(), y.w_B.z()};
-          imu.orientation = pose.orientation;
-          imu.angular_velocity = twist.angular;
-          imu.linear_acceleration = {y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z()};
-        }
-        pose.header.stamp = twist.header.stamp = imu.header.stamp = time;
+        if (L.realism) due = L.realism->measure(k, y, pose, twist, imu);
         if (due.pose) {
           if (controller) controller->take_pose(pose);
           write_pose(i, stamp, pose.position, pose.orientation);
@@ -782,7 +774,6 @@ class Batch {
       L.model->step(L.state, o.clock.seconds(k), L.rotor_input, o.clock.period_s(), o.substeps,
                     L.realism ? &L.realism->environment(k) : nullptr);
     }
-    v.next_tick = end;
     fill_state(i);
   }
 

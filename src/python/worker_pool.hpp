@@ -66,7 +66,8 @@ class WorkerPool {
       done_chunks_.store(0, std::memory_order_relaxed);
       failure_ = nullptr;
       generation = generation_.load(std::memory_order_relaxed) + 1;
-      for (int t = 0; t < threads_; ++t) next_[t].value.store(generation << 32 | first_chunk(t, chunks), std::memory_order_relaxed);
+      for (int t = 0; t < threads_; ++t)
+        next_[t].value.store(generation << 32 | first_chunk(t, chunks), std::memory_order_relaxed);
       generation_.store(generation, std::memory_order_release);
       if (sleeping_ > 0) start_.notify_all();
     }

@@ -160,18 +160,7 @@ void PlantNode::publish_outputs(Tick k) {
 
   // The messages are kept between ticks (their frame ids are set once); every field that changes
   // is written here or by the realism below.
-  pose_.header.stamp = stamp;
-  pose_.position = to_msg(y.p_W);
-  pose_.orientation = to_msg(y.q_WB);
-
-  twist_.header.stamp = stamp;
-  twist_.linear = to_msg(y.v_W);
-  twist_.angular = to_msg(y.w_B);
-
-  imu_.header.stamp = stamp;
-  imu_.orientation = to_msg(y.q_WB);  // from y, not from pose_: no reload of what was just stored
-  imu_.angular_velocity = to_msg(y.w_B);
-  imu_.linear_acceleration = to_msg(y.specific_force_B);
+  write_sensor_messages(y, stamp, pose_, twist_, imu_);
   if (realism_) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
     const PlantRealism::Due due = realism_->measure(k, y, pose_, twist_, imu_);
     if (due.pose) pose_pub_.publish(pose_);

@@ -71,6 +71,26 @@ struct PlantOptions {
 /// "vehicle.aero.linear_drag_N_s_m.x"): a plant with PlantOptions::external cannot honour it.
 std::string external_plant_conflict(const RealismConfig& realism, const model::VehicleParams& vehicle);
 
+/// The sensor messages of the plant's outputs `y` at `stamp` as PlantNode publishes them: every field
+/// a tick changes (the frame ids are set once). With sensor realism, PlantRealism::measure then
+/// overwrites what the sensors measure. quadcosim.Batch's vehicles, which have no bus, fill theirs
+/// with this too.
+inline void write_sensor_messages(const model::Outputs& y, const msg::Time& stamp, msg::PoseStamped& pose,
+                                  msg::TwistStamped& twist, msg::Imu& imu) {
+  const auto v3 = [](const Eigen::Vector3d& v) { return msg::Vector3{v.x(), v.y(), v.z()}; };
+  const auto q = msg::Quaternion{y.q_WB.x(), y.q_WB.y(), y.q_WB.z(), y.q_WB.w()};
+  pose.header.stamp = stamp;
+  pose.position = v3(y.p_W);
+  pose.orientation = q;
+  twist.header.stamp = stamp;
+  twist.linear = v3(y.v_W);
+  twist.angular = v3(y.w_B);
+  imu.header.stamp = stamp;
+  imu.orientation = q;
+  imu.angular_velocity = v3(y.w_B);
+  imu.linear_acceleration = v3(y.specific_force_B);
+}
+
 /// What became of the motor commands (sim/validation.hpp check_command).
 struct PlantStats {
   std::uint64_t commands_received = 0;
