@@ -7,11 +7,13 @@
     batch.step(omega_cmd=np.full((1000, 4), 450.0))   # or rotor speeds [rad/s], controllers bypassed
     batch.p, batch.q, batch.sensors["imu"]["a"]        # (1000, 3), (1000, 4), (1000, 3)
 
-Each vehicle is a complete quadcosim.Simulation (plant, controller node and their bus) of the
-scenario with its own seed and vehicle parameters: vehicle i gives exactly (bit for bit) the numbers
-of quadcosim.Simulation(scenario with vehicle i's keys, seed=seeds[i]). With plant_only=True (rotor
+Each vehicle flies the scenario with its own seed and vehicle parameters: vehicle i gives exactly
+(bit for bit) the numbers of quadcosim.Simulation(scenario with vehicle i's keys, seed=seeds[i]). A
+vehicle has no bus (nobody could subscribe to it): its plant and its controller node's core are
+stepped directly, in the nodes' order, the vehicles in one contiguous array; a scenario with message
+faults or an FMU plant makes each vehicle a whole Simulation instead. With plant_only=True (rotor
 commands from Python, as in reinforcement learning) each vehicle is its plant alone, with the same
-numbers, and stepping it once per control period is several times faster. See docs/python.md.
+numbers. See docs/python.md.
 """
 
 import math
@@ -171,10 +173,9 @@ class Batch:
     threads: worker threads that step the vehicles (default: the CPUs this process may use); the
         numbers do not depend on it.
     plant_only: no controllers: every step() gives omega_cmd (the rotor speeds come from Python, as
-        in reinforcement learning). Each vehicle is then only its plant's state, kept in one
-        contiguous array without the controller node and the bus: the same numbers as a full
-        vehicle flying the same commands (bit for bit: state, command, sensors with their noise), and
-        much faster stepped one control period per call (docs/python.md). set_setpoints raises;
+        in reinforcement learning). Each vehicle is then only its plant: the same numbers as a
+        vehicle with its controller flying the same commands (bit for bit: state, command, sensors
+        with their noise), with less memory per step (docs/python.md). set_setpoints raises;
         setpoints and reference give the scenario's. Scenarios with injected message faults or
         external dynamics (an FMU) are refused (ConfigError).
 
