@@ -88,7 +88,25 @@ void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& wh
   while (server.subscriptions() == 0 && !stop_requested() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  if (server.subscriptions() == 0) std::cerr << fmt::format("{}: foxglove: no client subscribed; running\n", who);
+  if (server.subscriptions() == 0) {
+    std::cerr << fmt::format("{}: foxglove: no client subscribed; running\n", who);
+    return;
+  }
+  // A client subscribes to each topic with a request of its own (Foxglove's panels, one by one): the
+  // run starts once its subscriptions have stopped coming (200 ms without a new one, at most 2 s), so
+  // none of them misses the first messages.
+  const auto quiet = std::chrono::milliseconds(200);
+  const auto last = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  auto changed = std::chrono::steady_clock::now();
+  for (std::size_t seen = server.subscriptions(); !stop_requested();) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    const auto now = std::chrono::steady_clock::now();
+    if (const std::size_t n = server.subscriptions(); n != seen) {
+      seen = n;
+      changed = now;
+    }
+    if (now - changed >= quiet || now >= last) break;
+  }
 }
 
 void finish_foxglove(const FoxgloveCliOptions& o, const std::string& who, foxglove::Server& server) {
