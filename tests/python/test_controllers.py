@@ -399,6 +399,54 @@ def test_an_exception_in_step_is_the_cause():
     assert e.value.__cause__.__traceback__ is not None
 
 
+def test_a_batch_flies_a_python_controller_as_single_simulations_do():
+    """Each vehicle its own instance, stepped from the batch's worker threads (each step takes the GIL):
+    bit for bit the numbers of a single Simulation with that vehicle's keys."""
+    masses = [None, 1.7, 2.3]
+    def scenario(m):
+        d = hover_scenario(z0=1.0)
+        d["controller"]["z_des"] = 2.0
+        if m:
+            d["vehicle"] = {"mass_kg": m}
+        return d
+    batch = quadcosim.Batch(quadcosim.load_scenario(scenario(None), controller=AltitudePD), 3,
+                            vehicles=[None if m is None else {"mass_kg": m} for m in masses], threads=2)
+    singles = [quadcosim.Simulation(quadcosim.load_scenario(scenario(m), controller=AltitudePD)) for m in masses]
+    for k in range(150):
+        batch.step(periods=1 + k % 2)
+        for s in singles:
+            for _ in range(1 + k % 2):
+                s.step()
+    for i, s in enumerate(singles):
+        for key in ("p", "v", "q", "w", "omega"):
+            assert np.array_equal(batch.state[key][i], s.state[key]), (i, key)
+    # The vehicles climbed to their setpoint, each with its own mass (else equality would prove little).
+    assert np.all(np.abs(batch.p[:, 2] - 2.0) < 0.05)
+    assert len({float(w) for w in batch.omega[:, 0]}) == 3
+
+
+class RaisesAtItsFourthStep:
+    """Hovers for three steps, then raises (module level: a Batch loads its vehicles' controllers by
+    their module:Class name)."""
+
+    def __init__(self, vehicle):
+        self.w, self.n = vehicle["hover_omega_rad_s"], 0
+
+    def step(self, obs, ref, dt):
+        self.n += 1
+        if self.n > 3:
+            raise RuntimeError("boom")
+        return (self.w,) * 4
+
+
+def test_a_python_controller_that_raises_in_a_batch_is_named_with_its_step():
+    batch = quadcosim.Batch(quadcosim.load_scenario(hover_scenario(), controller=RaisesAtItsFourthStep), 2, threads=2)
+    batch.step(periods=3)
+    with pytest.raises(quadcosim.ControllerError,
+                       match=r"RaisesAtItsFourthStep.step at step 3 \(t = 0\.06 s\): raised RuntimeError: boom"):
+        batch.step()
+
+
 def test_outputs_of_the_wrong_length_or_missing_are_refused():
     with pytest.raises(quadcosim.ControllerError, match=r"returned 1 values, expected 2 outputs \(a, b\)"):
         quadcosim.run(hover_scenario(), controller=failing(after=0, value=((400.0,) * 4, (1.0,)), outputs=("a", "b")))
