@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Soak (prints figures; asserts nothing): a long lockstep run over DDS, plant and controller as two
 # processes on this machine, with each process's resident set (VmRSS of /proc/PID/status) sampled
-# every second. Prints the series' summary per process: first and last sample, min, max, the median
+# every INTERVAL_S seconds (default 1). Prints the series' summary per process: first and last sample, min, max, the median
 # and maximum of each quarter of the run, and the growth from the first quarter to the last (median
 # of the last quarter minus median of the first: warm-up, such as Cyclone's buffers and the first
 # discovery, falls in the first quarter; medians, because the plant copies and sorts its round-trip
 # series as it finishes, a short spike the last samples may catch) in kB and as slopes in kB per
 # hour of wall and of simulated time.
-# Usage: bench/soak.sh [BINARY] [SIMULATED_SECONDS] [JSON_OUT]
+# Usage: bench/soak.sh [BINARY] [SIMULATED_SECONDS] [JSON_OUT] [INTERVAL_S]
 #   SIMULATED_SECONDS defaults to 86400 (one simulated day: about 15 min to 1.5 h of wall time at
 #   the 20-100x real time lockstep runs here under load, docs/reliability.md). JSON_OUT, when given,
 #   receives the summary and the whole series. The scenario is tests/faults/hover_gusts.yaml (position
@@ -19,6 +19,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${1:-$root/build/bin/quadcosim}"
 seconds="${2:-86400}"
 json="${3:-}"
+interval="${4:-1}"
 scenario="$root/tests/faults/hover_gusts.yaml"
 export ROS_DOMAIN_ID="${ROS_DOMAIN_ID:-198}" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
@@ -40,11 +41,11 @@ ctl=$!; pids+=("$ctl")
 plant=$!; pids+=("$plant")
 echo "soak: $seconds s simulated in lockstep, plant pid $plant, controller pid $ctl, domain $ROS_DOMAIN_ID" >&2
 
-# Samples both processes' VmRSS every second until the plant exits, then summarises.
-/usr/bin/python3 - "$plant" "$ctl" "$tmp/plant.log" "$json" <<'PY'
+# Samples both processes' VmRSS every INTERVAL_S until the plant exits, then summarises.
+/usr/bin/python3 - "$plant" "$ctl" "$tmp/plant.log" "$json" "$interval" <<'PY'
 import json, re, statistics, sys, time
 
-plant, ctl, plant_log, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4]
+plant, ctl, plant_log, out, interval = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4], float(sys.argv[5])
 
 
 def rss_kb(pid):
@@ -66,7 +67,7 @@ while True:
     if p is None:
         break
     series.append((round(time.monotonic() - t0, 3), p, c))
-    next_t += 1.0
+    next_t += interval
     time.sleep(max(0.0, next_t - time.monotonic()))
 wall = time.monotonic() - t0
 
