@@ -6,14 +6,13 @@
 // kept between steps; the vehicles do not interact, so the thread count changes no number.
 //
 // A vehicle is one small object of a contiguous array (LeanVehicle), not a bus with two nodes on it:
-// its plant's state, stepped with the model and realism calls PlantNode makes, in its order, and its
-// controller's sim::ControllerCore (what ControllerNode decides with), fed the samples the plant node
-// would publish and stepped on the ticks the node steps, its commands checked and queued as the plant
-// node takes them. Nobody can subscribe to a Batch vehicle's topics, so nothing else of the nodes
-// feeds a number; a tick touches a fraction of the memory (what bounds a step of many vehicles once
-// per control period, the cache being too small for them). A scenario that needs the bus (injected
-// message faults) or a plant from elsewhere (an FMU) makes each vehicle a whole sim::Simulation.
-// The tests hold both to a single Simulation bit for bit.
+// its plant's sim::PlantCore (what PlantNode steps) and its controller's sim::ControllerCore (what
+// ControllerNode decides with), the core fed the samples the plant node would publish and stepped on
+// the ticks the node steps, its commands checked and queued as the plant node takes them. Nobody can subscribe to a
+// Batch vehicle's topics, so nothing else of the nodes feeds a number; a tick touches a fraction of the memory (what
+// bounds a step of many vehicles once per control period, the cache being too small for them). A scenario that needs
+// the bus (injected message faults) or a plant from elsewhere (an FMU) makes each vehicle a whole sim::Simulation. The
+// tests hold both to a single Simulation bit for bit.
 //
 // Plant only (Batch(plant_only=True)): the rotor commands always come from Python; no controllers.
 #include "batch.hpp"
@@ -124,13 +123,7 @@ class Batch {
       }
     }
     lean_vehicles_ = !c.plant.external && !c.faults.active();
-    if (lean_vehicles_) {
-      // Commands come every controller_divider ticks and wait command_delay_ticks: at most this many
-      // are pending after a latch, one more before it.
-      pending_capacity_ = static_cast<std::size_t>(c.plant.command_delay_ticks / c.controller_divider + 2);
-      lean_.resize(n_);
-      pending_.resize(n_ * pending_capacity_);
-    }
+    if (lean_vehicles_) lean_.resize(n_);
     p_.assign(3 * n_, 0.0);
     v_.assign(3 * n_, 0.0);
     q_.assign(4 * n_, 0.0);
@@ -484,40 +477,25 @@ class Batch {
     sim::Tick next_tick = 0;  ///< the next plant tick to run
   };
 
-  /// A vehicle without a bus: what PlantNode keeps of its plant that a tick reads or writes when
-  /// nobody reads its topics, statuses or statistics, and, unless plant_only, what ControllerNode
-  /// decides with (its core) and the scenario's schedule of parameter changes.
+  /// A vehicle without a bus: its plant's PlantCore (what PlantNode steps) and, unless plant_only, its
+  /// controller node's ControllerCore and the scenario's schedule of parameter changes.
   struct LeanVehicle {
     LeanVehicle() = default;
-    LeanVehicle(const io::Scenario& s, std::uint64_t seed, bool with_controller)
-        : model(s.vehicle), state(io::initial_state(s)), latched(state.omega_rad_s) {
-      rotor_input = model->rotor_input(latched);
+    LeanVehicle(const io::Scenario& s, std::uint64_t seed, bool with_controller) {
       const sim::Topics topics = sim::Topics::for_namespace(s.simulation.ns);
       sim::RealismConfig realism = s.simulation.plant.realism;
       realism.seed = seed;
-      if (realism.active() || s.vehicle.aero.active()) {
-        // Named as PlantNode names its noise streams: by the vehicle's namespace (/drone/Pose -> /drone).
-        this->realism = std::make_unique<sim::PlantRealism>(
-            realism, s.vehicle, topics.pose.substr(0, topics.pose.rfind('/')), s.simulation.plant.clock);
-      }
+      // The noise streams named as PlantNode names them: by the vehicle's namespace (/drone/Pose -> /drone).
+      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s),
+                             topics.pose.substr(0, topics.pose.rfind('/')));
       if (with_controller) {
         controller.emplace(s.controller, topics);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
       }
     }
-    std::optional<model::Quadrotor> model;
-    model::State state;
-    model::Vector4 latched = model::Vector4::Zero();    ///< the command acting over [t_k, t_k+1)
-    model::RotorInput rotor_input;                      ///< latched as the model applies it
-    sim::Tick last_valid_tick = 0;                      ///< tick of the newest accepted command
-    std::unique_ptr<sim::PlantRealism> realism;         ///< sensor noise, wind, faults, drag; null: none
-    std::uint32_t pending_head = 0, pending_count = 0;  ///< its commands waiting out the delay (pending_)
-    std::optional<sim::ControllerCore> controller;      ///< none: plant_only
-    std::optional<sim::ParameterSchedule> schedule;     ///< the scenario's, when it has one
-  };
-  struct Pending {
-    sim::Tick effective_tick = 0;
-    model::Vector4 omega = model::Vector4::Zero();
+    sim::PlantCore plant;
+    std::optional<sim::ControllerCore> controller;   ///< none: plant_only
+    std::optional<sim::ParameterSchedule> schedule;  ///< the scenario's, when it has one
   };
 
   const control::Setpoint& setpoint_of(std::size_t i) const {
@@ -657,6 +635,7 @@ class Batch {
   /// controller's object holds is its business, so the first kilobyte: a paper controller's size).
   static void prefetch(const LeanVehicle& v) {
     prefetch_bytes(&v, sizeof(LeanVehicle));
+    v.plant.prefetch();
     if (v.controller) prefetch_bytes(&v.controller->controller(), 1024);
   }
   static void prefetch_bytes(const void* at, std::size_t bytes) {
@@ -691,9 +670,8 @@ class Batch {
     const sim::PlantOptions& o = s.simulation.plant;
     const int divider = s.simulation.controller_divider;
     const double control_dt_s = o.clock.period_s() * divider;  // as Simulation's
-    const double omega_max = L.model->params().motor.omega_max_rad_s;
+    const double omega_max = L.plant.model().params().motor.omega_max_rad_s;
     sim::ControllerCore* const controller = L.controller ? &*L.controller : nullptr;
-    Pending* pending = &pending_[i * pending_capacity_];
     thread_local msg::Float64MultiArray command;  // the command message, as the controller node or Simulation sends it
     if (bypass) {
       command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
@@ -708,15 +686,13 @@ class Batch {
       v.next_tick = k + 1;  // as step_vehicle counts a tick begun (one whose controller threw, say)
       // Scheduled parameter changes (Simulation's before_outputs).
       if (L.schedule) L.schedule->apply(*controller, o.clock.ns(k));
-      // Outputs and sensors (PlantNode::publish_outputs).
-      const model::Environment* env = L.realism ? &L.realism->environment(k) : nullptr;
-      const model::Outputs y = L.model->outputs(o.clock.seconds(k), L.state, L.rotor_input, env);
+      // Outputs and sensors (PlantNode::publish_outputs), taken in by the controller node's core and
+      // written into the rows as the whole vehicle's subscriptions write them.
+      const model::Outputs y = L.plant.outputs(o.clock, k);
       const msg::Time time = msg::Time::from_ns(o.clock.ns(k));
       const double stamp = stamp_s(time);
-      if (controller || L.realism) {
-        sim::write_sensor_messages(y, time, pose, twist, imu);
-        sim::PlantRealism::Due due{true, true, true};
-        if (L.realism) due = L.realism->measure(k, y, pose, twist, imu);
+      if (controller || L.plant.has_realism()) {
+        const sim::PlantRealism::Due due = L.plant.sense(k, y, time, pose, twist, imu);
         if (due.pose) {
           if (controller) controller->take_pose(pose);
           write_pose(i, stamp, pose.position, pose.orientation);
@@ -729,7 +705,7 @@ class Batch {
           if (controller) controller->take_imu(imu);
           write_imu(i, stamp, imu.orientation, imu.angular_velocity, imu.linear_acceleration);
         }
-      } else {
+      } else {  // plant_only, exact sensors: the rows straight from the outputs (no messages to make)
         pose_t_[i] = velocity_t_[i] = imu_t_[i] = stamp;
         set3(pose_p_, i, y.p_W.x(), y.p_W.y(), y.p_W.z());
         set4(pose_q_, i, y.q_WB.w(), y.q_WB.x(), y.q_WB.y(), y.q_WB.z());
@@ -749,37 +725,19 @@ class Batch {
           for (int r = 0; r < 4; ++r) command.data[r] = omega[r];
         }
         const sim::CommandCheck check = sim::check_command(command, omega_max);
-        if (check.verdict() != sim::CommandVerdict::kRejected) {
-          L.last_valid_tick = k;
-          pending[(L.pending_head + L.pending_count) % pending_capacity_] = {k + o.command_delay_ticks,
-                                                                             check.omega_rad_s};
-          ++L.pending_count;
-        }
+        if (check.verdict() != sim::CommandVerdict::kRejected)
+          L.plant.queue(k, o.command_delay_ticks, check.omega_rad_s);
       }
       // The latch (PlantNode::latch_command): the newest due command, then the watchdog.
-      const Pending* newest = nullptr;
-      while (L.pending_count > 0 && pending[L.pending_head].effective_tick <= k) {
-        newest = &pending[L.pending_head];
-        L.pending_head = static_cast<std::uint32_t>((L.pending_head + 1) % pending_capacity_);
-        --L.pending_count;
-      }
-      if (newest) set_latched(L, newest->omega);
-      if (o.watchdog_ticks > 0) {
-        const bool expired = o.clock.ns(k - std::min(L.last_valid_tick, k)) >= o.clock.ns(o.watchdog_ticks);
-        if (expired && o.watchdog_policy == sim::WatchdogPolicy::kStop) {
-          set_latched(L, model::Vector4::Constant(L.model->params().motor.omega_min_rad_s));
-        }
+      L.plant.latch_due(k);
+      if (o.watchdog_ticks > 0 && o.watchdog_policy == sim::WatchdogPolicy::kStop &&
+          L.plant.command_age_ns(o.clock, k) >= o.clock.ns(o.watchdog_ticks)) {
+        L.plant.set_latched(model::Vector4::Constant(L.plant.model().params().motor.omega_min_rad_s));
       }
       // The integration to t_k+1 (PlantNode::integrate).
-      L.model->step(L.state, o.clock.seconds(k), L.rotor_input, o.clock.period_s(), o.substeps,
-                    L.realism ? &L.realism->environment(k) : nullptr);
+      L.plant.integrate(o.clock, k, o.substeps);
     }
     fill_state(i);
-  }
-
-  static void set_latched(LeanVehicle& L, const model::Vector4& omega_rad_s) {
-    L.latched = omega_rad_s;
-    L.rotor_input = L.model->rotor_input(omega_rad_s);
   }
 
   void write_pose(std::size_t i, double t, const msg::Vector3& p, const msg::Quaternion& q) {
@@ -801,13 +759,13 @@ class Batch {
 
   void fill_state(std::size_t i) {
     const Vehicle& v = vehicles_[i];
-    const model::State& x = v.sim ? v.sim->plant().state() : lean_[i].state;
+    const model::State& x = v.sim ? v.sim->plant().state() : lean_[i].plant.state();
     set3(p_, i, x.p_W.x(), x.p_W.y(), x.p_W.z());
     set3(v_, i, x.v_W.x(), x.v_W.y(), x.v_W.z());
     set4(q_, i, x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z());
     set3(w_, i, x.w_B.x(), x.w_B.y(), x.w_B.z());
     set4(omega_, i, x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]);
-    const model::Vector4& c = v.sim ? v.sim->plant().latched_command() : lean_[i].latched;
+    const model::Vector4& c = v.sim ? v.sim->plant().latched_command() : lean_[i].plant.latched();
     set4(command_, i, c[0], c[1], c[2], c[3]);
     t_[i] = v.scenario->simulation.plant.clock.seconds(v.next_tick);
   }
@@ -836,8 +794,6 @@ class Batch {
   std::map<std::string, std::shared_ptr<const io::Scenario>> loaded_;
   std::vector<Vehicle> vehicles_;
   std::vector<LeanVehicle> lean_;  ///< lean_vehicles_: the vehicles (else empty)
-  std::vector<Pending> pending_;   ///< lean_vehicles_: vehicle i's pending commands from i * pending_capacity_
-  std::size_t pending_capacity_ = 0;
   // (N, k) row-major: state after the last step, the command latched in its last tick, the newest
   // sensor messages (NaN before the first), and each vehicle's time.
   std::vector<double> p_, v_, q_, w_, omega_, command_, omega_cmd_, t_;

@@ -32,11 +32,10 @@ std::string external_plant_conflict(const RealismConfig& realism, const model::V
 
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
-    : model_(vehicle),
-      options_(options),
-      state_(initial),
-      latched_(initial.omega_rad_s),
-      rotor_input_(model_.rotor_input(latched_)) {
+    : core_(vehicle, options.realism, options.clock, initial,
+            // The vehicle's namespace names its noise streams: /drone/Pose -> /drone.
+            topics.pose.substr(0, topics.pose.rfind('/'))),
+      options_(options) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   if (options.external) {
     if (std::string key = external_plant_conflict(options.realism, vehicle); !key.empty()) {
@@ -46,11 +45,6 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
     external_ = options.external->make(vehicle, initial, options.clock);
   }
   status_pub_ = transport.advertise<msg::PlantStatus>(topics.plant_status);
-  if (options.realism.active() || vehicle.aero.active()) {
-    // The vehicle's namespace names its noise streams: /drone/Pose -> /drone.
-    const std::string ns = topics.pose.substr(0, topics.pose.rfind('/'));
-    realism_ = std::make_unique<PlantRealism>(options.realism, vehicle, ns, options.clock);
-  }
   if (options.publish_clock) clock_pub_ = transport.advertise<msg::Clock>(topics.clock);
   pose_pub_ = transport.advertise<msg::PoseStamped>(topics.pose);
   velocity_pub_ = transport.advertise<msg::TwistStamped>(topics.velocity);
@@ -91,7 +85,7 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     return;
   }
   if (stamp >= 0) last_label_seen_ns_ = stamp;
-  const CommandCheck check = check_command(m, model_.params().motor.omega_max_rad_s);
+  const CommandCheck check = check_command(m, core_.model().params().motor.omega_max_rad_s);
   if (check.verdict() == CommandVerdict::kRejected) {
     stats_.last_problem = check.reason();
     ++stats_.commands_rejected;
@@ -117,9 +111,8 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
 
 void PlantNode::accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s) {
   last_command_stamp_ns_ = stamp_ns;
-  last_valid_tick_ = current_tick_;
   if (receipt_clock_) last_valid_receipt_ns_ = receipt_clock_();
-  pending_.push_back({current_tick_ + options_.command_delay_ticks, omega_rad_s});
+  core_.queue(current_tick_, options_.command_delay_ticks, omega_rad_s);
 }
 
 void PlantNode::publish_status(Tick k) {
@@ -145,9 +138,7 @@ void PlantNode::publish_status(Tick k) {
 void PlantNode::publish_outputs(Tick k) {
   current_tick_ = k;
   const msg::Time stamp = msg::Time::from_ns(options_.clock.ns(k));
-  const model::Outputs y = external_ ? external_outputs(k)
-                                     : model_.outputs(options_.clock.seconds(k), state_, rotor_input_,
-                                                      realism_ ? &realism_->environment(k) : nullptr);
+  const model::Outputs y = external_ ? external_outputs(k) : core_.outputs(options_.clock, k);
 
   const bool clock_first = !options_.clock_after_sensors;
   if (clock_pub_ && clock_first) clock_pub_.publish(msg::Clock{stamp});
@@ -159,10 +150,11 @@ void PlantNode::publish_outputs(Tick k) {
   publish_status(k);
 
   // The messages are kept between ticks (their frame ids are set once); every field that changes
-  // is written here or by the realism below.
+  // is written here or by the realism below (PlantCore::sense, spelt out: no sample is skipped
+  // without realism).
   write_sensor_messages(y, stamp, pose_, twist_, imu_);
-  if (realism_) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
-    const PlantRealism::Due due = realism_->measure(k, y, pose_, twist_, imu_);
+  if (core_.has_realism()) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
+    const PlantRealism::Due due = core_.measure(k, y, pose_, twist_, imu_);
     if (due.pose) pose_pub_.publish(pose_);
     if (due.velocity) velocity_pub_.publish(twist_);
     if (due.imu) imu_pub_.publish(imu_);
@@ -187,28 +179,19 @@ void PlantNode::publish_clock(Tick k) {
 
 model::Outputs PlantNode::external_outputs(Tick k) {
   model::Outputs y;
-  external_->outputs(k, y, state_);
+  external_->outputs(k, y, core_.state());
   return y;
 }
 
 void PlantNode::latch_command(Tick k) {
-  const std::size_t first = pending_head_;
-  while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
-  if (pending_head_ > first) set_latched(pending_[pending_head_ - 1].omega);  // the newest one due
-  if (pending_head_ == pending_.size()) {
-    pending_.clear();  // keeps the capacity
-    pending_head_ = 0;
-  } else if (pending_head_ > 64 && pending_head_ * 2 > pending_.size()) {
-    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
-    pending_head_ = 0;
-  }
+  core_.latch_due(k);
   if (options_.watchdog_ticks <= 0) return;
   if (receipt_clock_) {
     const std::int64_t now = receipt_clock_();
     if (last_valid_receipt_ns_ < 0) last_valid_receipt_ns_ = now;  // the limit runs from the first tick
     command_age_ns_ = now - last_valid_receipt_ns_;
   } else {
-    command_age_ns_ = options_.clock.ns(k - std::min(last_valid_tick_, k));
+    command_age_ns_ = core_.command_age_ns(options_.clock, k);
   }
   const bool expired = command_age_ns_ >= options_.clock.ns(options_.watchdog_ticks);
   if (expired && !watchdog_active_) ++stats_.watchdog_trips;
@@ -216,22 +199,16 @@ void PlantNode::latch_command(Tick k) {
   if (!expired) return;
   ++stats_.watchdog_ticks;
   if (options_.watchdog_policy == WatchdogPolicy::kStop) {
-    set_latched(model::Vector4::Constant(model_.params().motor.omega_min_rad_s));
+    core_.set_latched(model::Vector4::Constant(core_.model().params().motor.omega_min_rad_s));
   }
-}
-
-void PlantNode::set_latched(const model::Vector4& omega_rad_s) {
-  latched_ = omega_rad_s;
-  rotor_input_ = model_.rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
 }
 
 void PlantNode::integrate(Tick k) {
   if (external_) {
-    external_->step(k, latched_);
+    external_->step(k, core_.latched());
     return;
   }
-  model_.step(state_, options_.clock.seconds(k), rotor_input_, options_.clock.period_s(), options_.substeps,
-              realism_ ? &realism_->environment(k) : nullptr);
+  core_.integrate(options_.clock, k, options_.substeps);
 }
 
 }  // namespace quadcosim::sim

@@ -12,6 +12,7 @@
 #include "sim/clock.hpp"
 #include "sim/external_dynamics.hpp"
 #include "sim/messages.hpp"
+#include "sim/plant_core.hpp"
 #include "sim/realism.hpp"
 #include "sim/steppable_plant.hpp"
 #include "sim/topics.hpp"
@@ -71,26 +72,6 @@ struct PlantOptions {
 /// "vehicle.aero.linear_drag_N_s_m.x"): a plant with PlantOptions::external cannot honour it.
 std::string external_plant_conflict(const RealismConfig& realism, const model::VehicleParams& vehicle);
 
-/// The sensor messages of the plant's outputs `y` at `stamp` as PlantNode publishes them: every field
-/// a tick changes (the frame ids are set once). With sensor realism, PlantRealism::measure then
-/// overwrites what the sensors measure. quadcosim.Batch's vehicles, which have no bus, fill theirs
-/// with this too.
-inline void write_sensor_messages(const model::Outputs& y, const msg::Time& stamp, msg::PoseStamped& pose,
-                                  msg::TwistStamped& twist, msg::Imu& imu) {
-  const auto v3 = [](const Eigen::Vector3d& v) { return msg::Vector3{v.x(), v.y(), v.z()}; };
-  const auto q = msg::Quaternion{y.q_WB.x(), y.q_WB.y(), y.q_WB.z(), y.q_WB.w()};
-  pose.header.stamp = stamp;
-  pose.position = v3(y.p_W);
-  pose.orientation = q;
-  twist.header.stamp = stamp;
-  twist.linear = v3(y.v_W);
-  twist.angular = v3(y.w_B);
-  imu.header.stamp = stamp;
-  imu.orientation = q;
-  imu.angular_velocity = v3(y.w_B);
-  imu.linear_acceleration = v3(y.specific_force_B);
-}
-
 /// What became of the motor commands (sim/validation.hpp check_command).
 struct PlantStats {
   std::uint64_t commands_received = 0;
@@ -145,11 +126,11 @@ class PlantNode final : public SteppablePlant {
 
   /// The state at the current tick (external dynamics: as they reported it at the last
   /// publish_outputs).
-  const model::State& state() const { return state_; }
-  const model::Quadrotor& model() const { return model_; }
+  const model::State& state() const { return core_.state(); }
+  const model::Quadrotor& model() const { return core_.model(); }
   /// The command latched for the current interval, as received after check_command (speeds within
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
-  const model::Vector4& latched_command() const { return latched_; }
+  const model::Vector4& latched_command() const { return core_.latched(); }
   const PlantStats& stats() const { return stats_; }
   /// Its label_ns is the stamp label of the newest accepted command; labels are read with
   /// drop_stale_commands (lockstep) only, otherwise it stays -1.
@@ -162,37 +143,20 @@ class PlantNode final : public SteppablePlant {
   /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
   void accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
-  /// The external dynamics' outputs at tick k; state_ becomes the state they report.
+  /// The external dynamics' outputs at tick k; the core's state becomes the state they report.
   model::Outputs external_outputs(Tick k);
-  /// Latches a command: latched_ and, formed once here, rotor_input_.
-  void set_latched(const model::Vector4& omega_rad_s);
 
-  model::Quadrotor model_;
+  PlantCore core_;  ///< the model, its state, the command queue and latch, the realism
   PlantOptions options_;
-  std::unique_ptr<ExternalDynamics> external_;  ///< options.external's dynamics; null: model_
-  model::State state_;
+  std::unique_ptr<ExternalDynamics> external_;  ///< options.external's dynamics; null: the core's model
   Tick current_tick_ = 0;
   std::int64_t last_command_stamp_ns_ = -1;
   std::int64_t last_label_seen_ns_ = -1;  ///< newest command label received (accepted or not)
-  model::Vector4 latched_ = model::Vector4::Zero();
-  model::RotorInput rotor_input_;  ///< latched_ as the model applies it (model_.rotor_input(latched_))
-  struct Pending {
-    Tick effective_tick;
-    model::Vector4 omega;
-  };
-  // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
-  // dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a
-  // block every few commands).
-  std::vector<Pending> pending_;
-  std::size_t pending_head_ = 0;
   PlantStats stats_;
   std::function<std::int64_t()> receipt_clock_;
-  Tick last_valid_tick_ = 0;                 ///< tick during which the newest valid command arrived
   std::int64_t last_valid_receipt_ns_ = -1;  ///< receipt clock: its arrival (-1: none, from the first latch)
   std::int64_t command_age_ns_ = 0;
   bool watchdog_active_ = false;
-  /// Present when options.realism or the vehicle's drag asks for it; null keeps the paper's plant.
-  std::unique_ptr<PlantRealism> realism_;
   std::function<void(const std::string&)> log_;
   LogThrottle rejected_log_, clamped_log_;
   msg::PlantStatus status_;

@@ -1,0 +1,145 @@
+// The native plant's tick without a bus: the 6-DOF model's state, the outputs of a tick and the
+// sensor messages made of them (with the sensor realism: noise, rates, latency), the command queue (a
+// command takes effect command_delay_ticks after the tick it arrived in), the zero-order hold of the
+// newest due command, the command's age for the watchdog, and the integration to the next tick (wind,
+// rotor faults and drag acting inside the model).
+//
+// sim::PlantNode wraps one in the bus (topics, the command checks and statistics, lockstep labels, a
+// receipt clock, the watchdog's policy, external dynamics); quadcosim.Batch steps one per vehicle
+// directly (src/python/batch.cpp), so both run the same calls in the same order. The options are the
+// caller's (a node keeps its own copy; a batch's vehicles share their scenario's).
+#pragma once
+
+#include <algorithm>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/quadrotor.hpp"
+#include "sim/clock.hpp"
+#include "sim/messages.hpp"
+#include "sim/realism.hpp"
+
+namespace quadcosim::sim {
+
+/// The sensor messages of the plant's outputs `y` at `stamp` as the plant publishes them: every field
+/// a tick changes (the frame ids are set once). With sensor realism, PlantRealism::measure then
+/// overwrites what the sensors measure.
+inline void write_sensor_messages(const model::Outputs& y, const msg::Time& stamp, msg::PoseStamped& pose,
+                                  msg::TwistStamped& twist, msg::Imu& imu) {
+  const auto v3 = [](const Eigen::Vector3d& v) { return msg::Vector3{v.x(), v.y(), v.z()}; };
+  const auto q = msg::Quaternion{y.q_WB.x(), y.q_WB.y(), y.q_WB.z(), y.q_WB.w()};
+  pose.header.stamp = stamp;
+  pose.position = v3(y.p_W);
+  pose.orientation = q;
+  twist.header.stamp = stamp;
+  twist.linear = v3(y.v_W);
+  twist.angular = v3(y.w_B);
+  imu.header.stamp = stamp;
+  imu.orientation = q;
+  imu.angular_velocity = v3(y.w_B);
+  imu.linear_acceleration = v3(y.specific_force_B);
+}
+
+class PlantCore {
+ public:
+  PlantCore() = default;
+  /// The realism (noise streams named by `ns`, the vehicle's namespace "/drone") is made when
+  /// `realism` is active or the vehicle has aerodynamic drag; the paper's plant otherwise.
+  PlantCore(const model::VehicleParams& vehicle, const RealismConfig& realism, const TickClock& clock,
+            const model::State& initial, const std::string& ns)
+      : model_(vehicle), state_(initial), latched_(initial.omega_rad_s), rotor_input_(model_->rotor_input(latched_)) {
+    if (realism.active() || vehicle.aero.active()) {
+      realism_ = std::make_unique<PlantRealism>(realism, vehicle, ns, clock);
+    }
+    pending_.reserve(4);  // now, beside the rest of the plant, not at the first command
+  }
+
+  /// The outputs of the state at tick k (at t_k on `clock`).
+  model::Outputs outputs(const TickClock& clock, Tick k) {
+    return model_->outputs(clock.seconds(k), state_, rotor_input_, environment(k));
+  }
+  /// The sensor messages of tick k's outputs `y` (stamped `stamp`), and which sensors have a sample
+  /// due (all of them without realism). A tick measured twice (a lockstep repeat) gives the same sample.
+  PlantRealism::Due sense(Tick k, const model::Outputs& y, const msg::Time& stamp, msg::PoseStamped& pose,
+                          msg::TwistStamped& twist, msg::Imu& imu) {
+    write_sensor_messages(y, stamp, pose, twist, imu);
+    if (realism_) return measure(k, y, pose, twist, imu);
+    return {true, true, true};
+  }
+  /// What the sensors make of the outputs (noise, rates, latency) in messages written from them;
+  /// with realism only (has_realism()).
+  PlantRealism::Due measure(Tick k, const model::Outputs& y, msg::PoseStamped& pose, msg::TwistStamped& twist,
+                            msg::Imu& imu) {
+    return realism_->measure(k, y, pose, twist, imu);
+  }
+  bool has_realism() const { return static_cast<bool>(realism_); }
+
+  /// A valid command (speeds within [0, omega_max]) received during tick k takes effect at tick
+  /// k + delay_ticks.
+  void queue(Tick k, Tick delay_ticks, const model::Vector4& omega_rad_s) {
+    last_valid_tick_ = k;
+    pending_.push_back({k + delay_ticks, omega_rad_s});
+  }
+  /// Latches the newest command due by tick k (the others due are dropped); false when none is due.
+  bool latch_due(Tick k) {
+    const std::size_t first = pending_head_;
+    while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
+    const bool latched = pending_head_ > first;
+    if (latched) set_latched(pending_[pending_head_ - 1].omega);  // the newest one due
+    if (pending_head_ == pending_.size()) {
+      pending_.clear();  // keeps the capacity
+      pending_head_ = 0;
+    } else if (pending_head_ > 64 && pending_head_ * 2 > pending_.size()) {
+      pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
+      pending_head_ = 0;
+    }
+    return latched;
+  }
+  /// Latches a command: the speeds and, formed once here, the model's rotor input.
+  void set_latched(const model::Vector4& omega_rad_s) {
+    latched_ = omega_rad_s;
+    rotor_input_ = model_->rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
+  }
+  /// Time [ns] at tick k since the tick of the newest valid command (0 before any: from tick 0).
+  std::int64_t command_age_ns(const TickClock& clock, Tick k) const {
+    return clock.ns(k - std::min(last_valid_tick_, k));
+  }
+  /// Integrates the state from t_k to t_k+1 under the latched command, in `substeps` RK4 steps.
+  void integrate(const TickClock& clock, Tick k, int substeps) {
+    model_->step(state_, clock.seconds(k), rotor_input_, clock.period_s(), substeps, environment(k));
+  }
+
+  /// Asks the CPU to load the command queue's buffer, the one part of a tick's data outside the
+  /// object (a batch steps many plants in turn, each long out of the cache).
+  void prefetch() const { __builtin_prefetch(pending_.data()); }
+
+  const model::Quadrotor& model() const { return *model_; }
+  const model::State& state() const { return state_; }
+  /// The state, for dynamics computed elsewhere to report (PlantNode's external dynamics).
+  model::State& state() { return state_; }
+  const model::Vector4& latched() const { return latched_; }
+
+ private:
+  const model::Environment* environment(Tick k) { return realism_ ? &realism_->environment(k) : nullptr; }
+
+  std::optional<model::Quadrotor> model_;  ///< optional only to be default-constructible (a batch's array)
+  model::State state_;
+  model::Vector4 latched_ = model::Vector4::Zero();  ///< the command acting over [t_k, t_k+1)
+  model::RotorInput rotor_input_;                    ///< latched_ as the model applies it
+  Tick last_valid_tick_ = 0;                         ///< tick during which the newest valid command arrived
+  struct Pending {
+    Tick effective_tick;
+    model::Vector4 omega;
+  };
+  // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
+  // dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a
+  // block every few commands).
+  std::vector<Pending> pending_;
+  std::size_t pending_head_ = 0;
+  /// Present when the realism or the vehicle's drag asks for it; null keeps the paper's plant.
+  std::unique_ptr<PlantRealism> realism_;
+};
+
+}  // namespace quadcosim::sim
