@@ -732,7 +732,7 @@ class Batch {
       L.plant.latch_due(k);
       if (o.watchdog_ticks > 0 && o.watchdog_policy == sim::WatchdogPolicy::kStop &&
           L.plant.command_age_ns(o.clock, k) >= o.clock.ns(o.watchdog_ticks)) {
-        L.plant.set_latched(model::Vector4::Constant(L.plant.model().params().motor.omega_min_rad_s));
+        L.plant.latch_omega_min();
       }
       // The integration to t_k+1 (PlantNode::integrate).
       L.plant.integrate(o.clock, k, o.substeps);

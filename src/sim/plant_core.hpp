@@ -102,6 +102,8 @@ class PlantCore {
     latched_ = omega_rad_s;
     rotor_input_ = model_->rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
   }
+  /// Latches every motor at the vehicle's omega_min_rad_s (the watchdog's stop policy).
+  void latch_omega_min() { set_latched(model::Vector4::Constant(model_->params().motor.omega_min_rad_s)); }
   /// Time [ns] at tick k since the tick of the newest valid command (0 before any: from tick 0).
   std::int64_t command_age_ns(const TickClock& clock, Tick k) const {
     return clock.ns(k - std::min(last_valid_tick_, k));

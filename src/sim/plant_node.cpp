@@ -199,7 +199,7 @@ void PlantNode::latch_command(Tick k) {
   if (!expired) return;
   ++stats_.watchdog_ticks;
   if (options_.watchdog_policy == WatchdogPolicy::kStop) {
-    core_.set_latched(model::Vector4::Constant(core_.model().params().motor.omega_min_rad_s));
+    core_.latch_omega_min();
   }
 }
 
