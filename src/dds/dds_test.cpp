@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <functional>
@@ -21,6 +22,7 @@
 #include "dds/arrival_executor.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/idl_walk.hpp"
+#include "dds/peer_pairing.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::dds {
@@ -448,6 +450,68 @@ TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) 
   EXPECT_TRUE(arrival.wait_until([&] { return rig.count == 8; }, 5'000'000'000));
   more.join();
   EXPECT_EQ(runs, 8);
+}
+
+TEST(PeerFilterTest, TakesOnlyThePairedWritersSamplesByTokenOrByParticipant) {
+  DdsTransport peer(test_env()), stranger(test_env()), me(test_env());
+  peer.set_user_data_keys(std::string(kPairTokenKey) + "=run-1;");  // before its endpoints exist
+  stranger.set_user_data_keys(std::string(kPairTokenKey) + "=run-0;");
+  PeerFilter filter(me);
+  std::vector<std::int64_t> accepted, refused;
+  std::vector<sim::SenderId> senders;
+  me.subscribe_with_sender<msg::Clock>("/t/in", [&](const msg::Clock& m, sim::SenderId s) {
+    (filter.accepts("/t/in", s) ? accepted : refused).push_back(m.clock.to_ns());
+    senders.push_back(s);
+  });
+  auto from_peer = peer.advertise<msg::Clock>("/t/in");
+  auto from_stranger = stranger.advertise<msg::Clock>("/t/in");
+  ASSERT_TRUE(me.spin_until([&] { return me.matched_writers("/t/in") == 2; }, 5'000'000'000));
+  ASSERT_TRUE(peer.spin_until([&] { return peer.matched_readers("/t/in") == 1; }, 5'000'000'000));
+  ASSERT_TRUE(stranger.spin_until([&] { return stranger.matched_readers("/t/in") == 1; }, 5'000'000'000));
+  auto send_both = [&](std::int64_t base) {
+    accepted.clear();
+    refused.clear();
+    for (int i = 1; i <= 3; ++i) from_peer.publish(clock_at(base + i));
+    for (int i = 1; i <= 2; ++i) from_stranger.publish(clock_at(base + 100 + i));
+    ASSERT_TRUE(me.spin_until([&] { return accepted.size() + refused.size() == 5; }, 5'000'000'000));
+    std::sort(accepted.begin(), accepted.end());
+    std::sort(refused.begin(), refused.end());
+  };
+
+  send_both(0);  // unpaired: everyone's samples are taken
+  EXPECT_FALSE(filter.paired());
+  EXPECT_EQ(accepted, (std::vector<std::int64_t>{1, 2, 3, 101, 102}));
+
+  filter.pair_by_token("run-1");
+  send_both(1000);
+  EXPECT_EQ(accepted, (std::vector<std::int64_t>{1001, 1002, 1003}));
+  EXPECT_EQ(refused, (std::vector<std::int64_t>{1101, 1102}));
+
+  // By participant: the stranger's, read from its samples' sender through discovery.
+  const auto info = me.sender_info("/t/in", senders.back());
+  ASSERT_TRUE(info.has_value());
+  EXPECT_EQ(info->pair_token, "run-0");
+  filter.pair_by_participant(info->participant);
+  send_both(2000);
+  EXPECT_EQ(accepted, (std::vector<std::int64_t>{2101, 2102}));
+  EXPECT_EQ(refused, (std::vector<std::int64_t>{2001, 2002, 2003}));
+}
+
+TEST(PeerFilterTest, TokensAreFreshAndTheEnvironmentsIsChecked) {
+  const std::string a = new_pair_token(), b = new_pair_token();
+  EXPECT_EQ(a.size(), 16u);
+  EXPECT_NE(a, b);
+  EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos) << a;
+  ::setenv(kPairTokenEnv, "ok_token-1", 1);
+  EXPECT_EQ(pair_token_from_environment(), "ok_token-1");
+  for (const char* bad : {"has;semicolon", "a=b", "", "with space"}) {
+    ::setenv(kPairTokenEnv, bad, 1);
+    EXPECT_THROW(pair_token_from_environment(), std::invalid_argument) << "'" << bad << "'";
+  }
+  ::setenv(kPairTokenEnv, std::string(65, 'x').c_str(), 1);
+  EXPECT_THROW(pair_token_from_environment(), std::invalid_argument);
+  ::unsetenv(kPairTokenEnv);
+  EXPECT_EQ(pair_token_from_environment(), "");
 }
 
 TEST(DdsTransportTest, TopicAndTypeNamesFollowRos2) {
@@ -925,6 +989,7 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "rejected_bad_quaternion: 22\n"
             "rejected_bad_stamp: 333\n"
             "rejected_stamp_backwards: 18446744073709551615\n"
+            "rejected_stamp_ahead: 0\n"
             "output_names:\n"
             "- error.z\n- error.roll\n- error.pitch\n- error.yaw\n"
             "outputs:\n"
@@ -941,6 +1006,8 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
   ps.watchdog_active = true;
   ps.watchdog_trips = 3;
   ps.watchdog_ticks = 250;
+  ps.commands_stale = 7;
+  ps.commands_foreign = 1;
   EXPECT_EQ(to_yaml(ps),
             "header:\n"
             "  stamp:\n"
@@ -954,7 +1021,9 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "last_problem: 'rotor 2: speed above omega_max'\n"
             "watchdog_active: true\n"
             "watchdog_trips: 3\n"
-            "watchdog_ticks: 250\n");
+            "watchdog_ticks: 250\n"
+            "commands_stale: 7\n"
+            "commands_foreign: 1\n");
 }
 
 TEST(TopicToolsTest, RateWindowAsRos2TopicHz) {

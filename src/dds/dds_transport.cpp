@@ -6,6 +6,7 @@
 #include <thread>
 #include <utility>
 
+#include "dds/parameter_wire.hpp"
 #include "dds/type_hash.hpp"
 
 namespace quadcosim::dds {
@@ -53,7 +54,7 @@ dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const s
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
   const QosProfile p = qos_for(ros_topic);
   dds_qos_t* qos = ros_qos(p.depth, p.reliable, p.transient_local);
-  set_endpoint_user_data(qos, ops->descriptor->m_typename);
+  set_endpoint_user_data(qos, ops->descriptor->m_typename, user_data_keys_);
   const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos, nullptr)
                                 : dds_create_reader(participant_.handle(), topic, qos, nullptr);
   dds_delete_qos(qos);
@@ -86,6 +87,61 @@ void DdsTransport::add_subscription(const std::string& ros_topic, const sim::Top
   const TypeOps* ops = nullptr;
   const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
   add_reader(reader, ros_topic, ops, std::move(deliver));
+}
+
+void DdsTransport::add_subscription_with_sender(const std::string& ros_topic, const sim::TopicType& type,
+                                                std::function<void(const void*, sim::SenderId)> deliver) {
+  const TypeOps* ops = nullptr;
+  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
+  // The reader's entry is made by add_reader at this index (entries keep their addresses).
+  add_reader(reader, ros_topic, ops,
+             [this, index = readers_.size(), d = std::move(deliver)](const void* m) { d(m, readers_[index]->sender); });
+}
+
+std::optional<DdsTransport::SenderInfo> DdsTransport::sender_info(const std::string& ros_topic,
+                                                                  sim::SenderId sender) const {
+  for (const auto& r : readers_) {
+    if (r->topic != ros_topic) continue;
+    dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(r->reader, sender);
+    if (e == nullptr) continue;
+    SenderInfo info;
+    std::copy(std::begin(e->participant_key.v), std::end(e->participant_key.v), info.participant.begin());
+    info.pair_token = wire::user_data_value(e->qos, kPairTokenKey);
+    dds_builtintopic_free_endpoint(e);
+    return info;
+  }
+  return std::nullopt;
+}
+
+std::vector<sim::SenderId> DdsTransport::matched_senders(const std::string& ros_topic) const {
+  std::vector<sim::SenderId> out;
+  for (const auto& r : readers_) {
+    if (r->topic != ros_topic) continue;
+    dds_instance_handle_t handles[64];
+    const dds_return_t n = dds_get_matched_publications(r->reader, handles, 64);
+    for (dds_return_t i = 0; i < std::min<dds_return_t>(n, 64); ++i) out.push_back(handles[i]);
+  }
+  return out;
+}
+
+std::vector<std::array<std::uint8_t, 16>> DdsTransport::matched_reader_participants(
+    const std::string& ros_topic) const {
+  std::vector<std::array<std::uint8_t, 16>> out;
+  const auto it = writers_.find(ros_topic);
+  if (it == writers_.end()) return out;
+  for (dds_entity_t w : it->second) {
+    dds_instance_handle_t handles[64];
+    const dds_return_t n = dds_get_matched_subscriptions(w, handles, 64);
+    for (dds_return_t i = 0; i < std::min<dds_return_t>(n, 64); ++i) {
+      dds_builtintopic_endpoint_t* e = dds_get_matched_subscription_data(w, handles[i]);
+      if (e == nullptr) continue;
+      std::array<std::uint8_t, 16> p{};
+      std::copy(std::begin(e->participant_key.v), std::end(e->participant_key.v), p.begin());
+      out.push_back(p);
+      dds_builtintopic_free_endpoint(e);
+    }
+  }
+  return out;
 }
 
 void DdsTransport::subscribe_raw(dds_entity_t reader, std::string label, std::function<void(const void*)> deliver) {
@@ -160,6 +216,7 @@ int DdsTransport::drain(Reader& r) {
     try {
       for (int i = 0; i < n; ++i) {
         if (!infos[i].valid_data) continue;
+        r.sender = infos[i].publication_handle;
         if (r.ops != nullptr) {
           r.ops->deliver(samples[i], r.deliver);
         } else {

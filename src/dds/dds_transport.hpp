@@ -5,11 +5,13 @@
 // (dds/arrival_executor.hpp), which states its threading rule.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,9 @@ struct QosProfile {
   /// (reliable, transient local, depth 1), the ROS default for every other topic.
   static QosProfile for_topic(const std::string& ros_topic);
 };
+
+/// The USER_DATA key of a pairing token (dds/peer_pairing.hpp).
+inline constexpr const char* kPairTokenKey = "quadcosim_pair";
 
 /// "/drone/Pose" -> "rt/drone/Pose".
 std::string dds_topic_name(const std::string& ros_topic);
@@ -65,6 +70,23 @@ class DdsTransport final : public sim::Transport {
 
   const Participant& participant() const { return participant_; }
 
+  /// What discovery says of `sender`, a writer matched by our reader of `ros_topic` (the SenderId of
+  /// a delivery on that topic): nullopt when it is not (or no longer) matched.
+  struct SenderInfo {
+    std::array<std::uint8_t, 16> participant{};  ///< the GUID of its participant
+    std::string pair_token;                      ///< its USER_DATA's quadcosim_pair value ("" when none)
+  };
+  std::optional<SenderInfo> sender_info(const std::string& ros_topic, sim::SenderId sender) const;
+  /// The writers matched by our readers of `ros_topic`, as the SenderIds their samples come with.
+  std::vector<sim::SenderId> matched_senders(const std::string& ros_topic) const;
+  /// The participants (GUIDs) of the readers matched by our writers of `ros_topic`, one entry per reader.
+  std::vector<std::array<std::uint8_t, 16>> matched_reader_participants(const std::string& ros_topic) const;
+
+  /// Put in the USER_DATA of every endpoint made after this call ("key=value;" pairs, before the type
+  /// hash ROS 2 puts there): e.g. the pairing token by which a plant and its controller know each
+  /// other's writers (dds/peer_pairing.hpp).
+  void set_user_data_keys(std::string keys) { user_data_keys_ = std::move(keys); }
+
   /// Delivers the samples of `reader` (made elsewhere on this participant, e.g. a service's reply
   /// reader; it must outlive the deliveries) as the C samples idlc generates, in turn with the
   /// subscriptions: by spin_once, or on arrival under an ArrivalExecutor. `label` names it in errors.
@@ -84,6 +106,9 @@ class DdsTransport final : public sim::Transport {
   std::function<void(const void*)> make_sink(const std::string& topic, const sim::TopicType& type) override;
   void add_subscription(const std::string& topic, const sim::TopicType& type,
                         std::function<void(const void*)> deliver) override;
+  /// The sender is the publication handle of the sample's writer (dds_sample_info_t).
+  void add_subscription_with_sender(const std::string& topic, const sim::TopicType& type,
+                                    std::function<void(const void*, sim::SenderId)> deliver) override;
 
  private:
   friend class ArrivalExecutor;  // delivery on arrival (dds/arrival_executor.hpp): the calls below
@@ -108,6 +133,7 @@ class DdsTransport final : public sim::Transport {
     dds_entity_t condition;
     const TypeOps* ops;  ///< nullptr: a raw reader (subscribe_raw), its C samples delivered as they are
     std::function<void(const void*)> deliver;
+    sim::SenderId sender = 0;  ///< the writer of the sample being delivered (its publication handle)
   };
   void add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops, std::function<void(const void*)> deliver);
   static void on_data_available(dds_entity_t reader, void* arg);
@@ -146,6 +172,7 @@ class DdsTransport final : public sim::Transport {
   std::vector<std::function<void()>> serving_;  ///< spin_once's copy of the extra work's callbacks
   int next_extra_id_ = 1;
   std::function<void(std::size_t)> arrival_sink_;  ///< set_arrival_sink's (empty: delivery by spin_once)
+  std::string user_data_keys_;
 };
 
 }  // namespace quadcosim::dds

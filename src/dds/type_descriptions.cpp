@@ -85,6 +85,7 @@ const std::vector<MessageDescription>& message_descriptions() {
        "uint64 rejected_bad_quaternion\n"
        "uint64 rejected_bad_stamp\n"
        "uint64 rejected_stamp_backwards\n"
+       "uint64 rejected_stamp_ahead\n"
        "string[] output_names\n"
        "float64[] outputs"},
       {"quadcosim_msgs/msg/PlantStatus",
@@ -96,7 +97,9 @@ const std::vector<MessageDescription>& message_descriptions() {
        "string last_problem\n"
        "bool watchdog_active\n"
        "uint64 watchdog_trips\n"
-       "uint64 watchdog_ticks"},
+       "uint64 watchdog_ticks\n"
+       "uint64 commands_stale\n"
+       "uint64 commands_foreign"},
       // ros_discovery_info (Jazzy: 16-byte GIDs).
       {"rmw_dds_common/msg/Gid", "char[16] data"},
       {"rmw_dds_common/msg/NodeEntitiesInfo",

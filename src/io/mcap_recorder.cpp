@@ -88,7 +88,7 @@ template <class T>
 void McapRecorder::add(sim::Transport& transport, const std::string& topic, Qos qos) {
   if (!wanted(topic)) return;
   const std::size_t index = open_channel<T>(topic, qos);
-  transport.subscribe<T>(topic, [this, index](const T& m) {
+  transport.subscribe_with_sender<T>(topic, [this, index](const T& m, sim::SenderId sender) {
     const std::int64_t t = stamp_of(m, last_stamp_ns_);
     bool stamped = true;  // the message carries its own time (header, clock, or command label)
     if constexpr (std::is_same_v<T, msg::Float64MultiArray>) stamped = msg::command_stamp_ns(m) >= 0;
@@ -97,7 +97,7 @@ void McapRecorder::add(sim::Transport& transport, const std::string& topic, Qos 
     // so the file does not depend on whether a repeat happened.
     if constexpr (std::is_same_v<T, msg::TFMessage>) {  // per child frame: one /tf carries many vehicles
       if (!m.transforms.empty()) {
-        auto [it, first] = c.newest_by_frame.try_emplace(m.transforms.front().child_frame_id, t);
+        auto [it, first] = c.newest_by_frame.try_emplace({sender, m.transforms.front().child_frame_id}, t);
         if (!first && t <= it->second) {
           ++repeats_;
           return;
@@ -105,11 +105,18 @@ void McapRecorder::add(sim::Transport& transport, const std::string& topic, Qos 
         it->second = t;
       }
     } else {
-      if (stamped && c.newest_ns >= 0 && t <= c.newest_ns) {
-        ++repeats_;
-        return;
+      if (stamped) {
+        auto it = std::find_if(c.newest_by_sender.begin(), c.newest_by_sender.end(),
+                               [sender](const auto& e) { return e.first == sender; });
+        if (it == c.newest_by_sender.end()) {
+          c.newest_by_sender.emplace_back(sender, t);
+        } else if (t <= it->second) {
+          ++repeats_;
+          return;
+        } else {
+          it->second = t;
+        }
       }
-      if (stamped) c.newest_ns = t;
     }
     if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) last_stamp_ns_ = std::max(last_stamp_ns_, t);
     push(static_cast<std::uint16_t>(index), t, to_cdr(m));

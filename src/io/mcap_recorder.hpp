@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/mcap_writer.hpp"
@@ -30,7 +31,9 @@ class McapRecorder {
   /// Writes every buffered message stamped before `sim_ns` [ns], in (time, channel, arrival) order.
   /// Messages are stamped with their header time (motor commands: the time in their label, or the
   /// last header time seen); buffering makes the file independent of the order messages arrive in.
-  /// A stamped message no newer than the last one on its channel is a repeat and is not recorded.
+  /// A stamped message no newer than the last one its writer sent on its channel is a repeat and is
+  /// not recorded; every writer's messages are recorded, a stranger's too, and none is dropped for
+  /// another writer's stamps.
   void flush_before(std::int64_t sim_ns);
   /// How long [ns] messages stay buffered behind the current simulated time, so late arrivals of a
   /// tick still go in order (several ticks; lockstep answers within one).
@@ -55,7 +58,7 @@ class McapRecorder {
   void write_bag_metadata(const std::string& dir, const std::string& mcap_file_name) const;
 
   std::uint64_t messages() const { return written_; }
-  /// Repeated samples (same channel, stamp not newer than the last) that were not recorded again.
+  /// Repeated samples (same channel and writer, stamp not newer than its last) not recorded again.
   std::uint64_t repeats() const { return repeats_; }
 
  private:
@@ -78,9 +81,12 @@ class McapRecorder {
     Qos qos{10, true, false};
     std::uint64_t count = 0;
     std::uint32_t sequence = 0;
-    std::int64_t newest_ns = -1;  ///< newest own stamp accepted on this channel
-    /// tf2_msgs/TFMessage: newest stamp per child frame (many vehicles share /tf, each its own frame)
-    std::map<std::string, std::int64_t> newest_by_frame;
+    /// Newest stamp recorded per writer (a stranger's stamps say nothing about the run's own
+    /// messages: each writer's repeats are its own); a handful of writers per channel.
+    std::vector<std::pair<sim::SenderId, std::int64_t>> newest_by_sender;
+    /// tf2_msgs/TFMessage: newest stamp per writer and child frame (many vehicles share /tf, each its
+    /// own frame)
+    std::map<std::pair<sim::SenderId, std::string>, std::int64_t> newest_by_frame;
   };
   /// The channel of `topic` with T's schema; its index in channels_.
   template <class T>

@@ -89,5 +89,56 @@ TEST(McapRecorderTest, TfRepeatsArePerChildFrameAndTheVehicleIsDescribedOnce) {
   std::filesystem::remove_all(dir);
 }
 
+// A transport whose test says who sent each message (as DDS does with the writer's handle).
+class SendersTransport final : public sim::Transport {
+ public:
+  template <class T>
+  void deliver(const std::string& topic, const T& m, sim::SenderId sender) {
+    for (auto& [t, d] : subs_) {
+      if (t == topic) d(&m, sender);
+    }
+  }
+
+ protected:
+  std::function<void(const void*)> make_sink(const std::string&, const sim::TopicType&) override {
+    return [](const void*) {};
+  }
+  void add_subscription(const std::string& topic, const sim::TopicType& type,
+                        std::function<void(const void*)> d) override {
+    add_subscription_with_sender(topic, type, [d = std::move(d)](const void* m, sim::SenderId) { d(m); });
+  }
+  void add_subscription_with_sender(const std::string& topic, const sim::TopicType&,
+                                    std::function<void(const void*, sim::SenderId)> d) override {
+    subs_.emplace_back(topic, std::move(d));
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::function<void(const void*, sim::SenderId)>>> subs_;
+};
+
+// A stranger's far-future stamp says nothing of the run's own messages: repeats are per writer, so
+// every message of the run's own writer is recorded (and the stranger's too, once each).
+TEST(McapRecorderTest, RepeatsArePerWriterSoAStrangersStampDropsNothing) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mcap_writers_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  SendersTransport bus;
+  const sim::Topics topics = sim::Topics::for_namespace("/drone");
+  McapRecorder rec((dir / "run.mcap").string(), bus, topics);
+  constexpr sim::SenderId kOwn = 7, kStranger = 9;
+  msg::ControllerStatus s;
+  s.header.stamp = msg::Time::from_ns(2'000'000'000LL * 1'000'000'000LL);
+  bus.deliver(topics.controller_status, s, kStranger);
+  for (int k = 1; k <= 100; ++k) {
+    s.header.stamp = msg::Time::from_ns(k * 20'000'000LL);
+    bus.deliver(topics.controller_status, s, kOwn);
+    if (k % 10 == 0) bus.deliver(topics.controller_status, s, kOwn);  // a repeat of the own writer's
+  }
+  bus.deliver(topics.controller_status, s, kStranger);  // older than the stranger's own newest: a repeat
+  rec.close();
+  EXPECT_EQ(rec.messages(), 100u + 1u);
+  EXPECT_EQ(rec.repeats(), 10u + 1u);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace quadcosim::io

@@ -71,6 +71,7 @@ json j(const msg::ControllerStatus& m) {
           {"rejected_bad_quaternion", std::to_string(m.rejected_bad_quaternion)},
           {"rejected_bad_stamp", std::to_string(m.rejected_bad_stamp)},
           {"rejected_stamp_backwards", std::to_string(m.rejected_stamp_backwards)},
+          {"rejected_stamp_ahead", std::to_string(m.rejected_stamp_ahead)},
           {"output_names", m.output_names},
           {"outputs", m.outputs}};
 }
@@ -84,7 +85,9 @@ json j(const msg::PlantStatus& m) {
           {"last_problem", m.last_problem},
           {"watchdog_active", m.watchdog_active},
           {"watchdog_trips", std::to_string(m.watchdog_trips)},
-          {"watchdog_ticks", std::to_string(m.watchdog_ticks)}};
+          {"watchdog_ticks", std::to_string(m.watchdog_ticks)},
+          {"commands_stale", std::to_string(m.commands_stale)},
+          {"commands_foreign", std::to_string(m.commands_foreign)}};
 }
 
 // One recorded topic: its channel and what has been written on it.

@@ -276,13 +276,15 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
             "float64[3] position_error\nfloat64 yaw_error\nfloat64 attitude_error\n"
             "bool[4] rotor_saturated\nbool tilt_saturated\nbool safety\nuint64 rejected_non_finite\n"
             "uint64 rejected_bad_quaternion\nuint64 rejected_bad_stamp\nuint64 rejected_stamp_backwards\n"
+            "uint64 rejected_stamp_ahead\n"
             "string[] output_names\nfloat64[] outputs\n");
   const std::string& plant = ros2msg_definition(msg::PlantStatus::kRosType);
   EXPECT_EQ(msg_blocks(plant), (V{"std_msgs/Header", "builtin_interfaces/Time"}));
   EXPECT_EQ(plant.substr(0, plant.find("====")),
             "std_msgs/Header header\nuint64 commands_accepted\nuint64 commands_clamped\n"
             "uint64 commands_rejected_length\nuint64 commands_rejected_non_finite\nstring last_problem\n"
-            "bool watchdog_active\nuint64 watchdog_trips\nuint64 watchdog_ticks\n");
+            "bool watchdog_active\nuint64 watchdog_trips\nuint64 watchdog_ticks\nuint64 commands_stale\n"
+            "uint64 commands_foreign\n");
   const std::string& tf = ros2msg_definition(msg::TFMessage::kRosType);
   EXPECT_EQ(msg_blocks(tf), (V{"geometry_msgs/TransformStamped", "std_msgs/Header", "builtin_interfaces/Time",
                                "geometry_msgs/Transform", "geometry_msgs/Vector3", "geometry_msgs/Quaternion"}));

@@ -82,6 +82,7 @@ inline msg::ControllerStatus sample_status(int i) {
   m.rejected_bad_quaternion = static_cast<std::uint64_t>(i) / 5;
   m.rejected_bad_stamp = i % 2;
   m.rejected_stamp_backwards = 0x0102030405060708ull + static_cast<std::uint64_t>(i);  // all 8 bytes in use
+  m.rejected_stamp_ahead = static_cast<std::uint64_t>(i) * 11;
   return m;
 }
 
@@ -96,6 +97,8 @@ inline msg::PlantStatus sample_plant_status(int i) {
   m.watchdog_active = i % 3 == 1;
   m.watchdog_trips = static_cast<std::uint64_t>(i) / 5;
   m.watchdog_ticks = 0x0123456789abcdefull + static_cast<std::uint64_t>(i);
+  m.commands_stale = static_cast<std::uint64_t>(i) * 3;
+  m.commands_foreign = 0x8000000000000000ull + static_cast<std::uint64_t>(i);
   return m;
 }
 

@@ -26,10 +26,12 @@ ControllerCore::ControllerCore(const control::ControllerConfig& config, const To
 }
 
 bool ControllerCore::accept_refused(const SensorCheck& check, const std::string& topic, int& backwards) {
-  if (check.fault == SensorFault::kStampBackwards && ++backwards > kStampRestartCount) {
-    log_("controller: " + topic + ": " + std::to_string(kStampRestartCount) +
-         " samples in a row older than the newest accepted; taking it that the sender's clock restarted (" +
-         check.reason() + ")");
+  const bool stamp = check.fault == SensorFault::kStampBackwards || check.fault == SensorFault::kStampAhead;
+  if (stamp && ++backwards > kStampRestartCount) {
+    log_("controller: " + topic + ": " + std::to_string(kStampRestartCount) + " samples in a row " +
+         (check.fault == SensorFault::kStampAhead ? "too far ahead of the newest accepted"
+                                                  : "older than the newest accepted") +
+         "; taking it that the sender's clock restarted (" + check.reason() + ")");
     backwards = 0;
     return true;
   }

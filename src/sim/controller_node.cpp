@@ -12,8 +12,9 @@
 
 namespace quadcosim::sim {
 
-ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config)
-    : core_(config, topics) {
+ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config,
+                               SampleFilter accepts)
+    : core_(config, topics), accepts_(std::move(accepts)) {
   const control::Controller& controller = core_.controller();
   status_.controller = controller.type();
   status_.output_names.assign(controller.output_names().begin(), controller.output_names().end());
@@ -22,6 +23,21 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
+  if (accepts_) {  // over a network: each sample's writer is checked first
+    transport.subscribe_with_sender<msg::PoseStamped>(topics.pose,
+                                                      [this, t = topics.pose](const msg::PoseStamped& m, SenderId s) {
+                                                        if (from_plant(t, s) && core_.take_pose(m) && on_sample_)
+                                                          on_sample_();
+                                                      });
+    transport.subscribe_with_sender<msg::TwistStamped>(
+        topics.velocity, [this, t = topics.velocity](const msg::TwistStamped& m, SenderId s) {
+          if (from_plant(t, s) && core_.take_velocity(m) && on_sample_) on_sample_();
+        });
+    transport.subscribe_with_sender<msg::Imu>(topics.imu, [this, t = topics.imu](const msg::Imu& m, SenderId s) {
+      if (from_plant(t, s) && core_.take_imu(m) && on_sample_) on_sample_();
+    });
+    return;
+  }
   // The callbacks capture only the node: the transport stores them in place, not in a heap block of
   // their own read on every sample.
   transport.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) {
@@ -33,6 +49,17 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
   transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
     if (core_.take_imu(m) && on_sample_) on_sample_();
   });
+}
+
+bool ControllerNode::from_plant(const std::string& topic, SenderId sender) {
+  if (accepts_(topic, sender)) return true;
+  if (foreign_log_.count()) {
+    core_.log(
+        fmt::format("controller: sample on {} from a writer other than the plant's ignored; {} ignored so far "
+                    "(logged: 1st, then every 100th)",
+                    topic, foreign_log_.total()));
+  }
+  return false;
 }
 
 const control::ControllerOutput& ControllerNode::step(std::int64_t now_ns, double dt_s) {
@@ -66,6 +93,7 @@ void ControllerNode::publish(const control::Observation& obs, const control::Ref
   status_.rejected_bad_quaternion = core_.rejected(SensorFault::kBadQuaternion);
   status_.rejected_bad_stamp = core_.rejected(SensorFault::kBadStamp);
   status_.rejected_stamp_backwards = core_.rejected(SensorFault::kStampBackwards);
+  status_.rejected_stamp_ahead = core_.rejected(SensorFault::kStampAhead);
   status_.outputs = out.outputs;
   status_pub_.publish(status_);
 

@@ -63,8 +63,14 @@ struct ControllerThreading {
 
 class ControllerNode {
  public:
-  /// Flies a clone of config.controller (which must be set).
-  ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config);
+  /// Whether a sensor sample on a topic comes from the plant the node paired with (over DDS:
+  /// dds/peer_pairing.hpp); one that does not is foreign: counted, logged rate-limited, not taken.
+  using SampleFilter = std::function<bool(const std::string& topic, SenderId sender)>;
+
+  /// Flies a clone of config.controller (which must be set). Without `accepts` every sample is the
+  /// plant's (in-process: every message is the process's own).
+  ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config,
+                 SampleFilter accepts = {});
   ~ControllerNode();
 
   /// From now on the controller runs on a thread of its own (sim/controller_thread.hpp): every call
@@ -91,6 +97,8 @@ class ControllerNode {
 
   /// The newest stamp [ns] among Pose, Velocity, Imu (simulated time), or -1 before any arrived.
   std::int64_t newest_stamp_ns() const { return core_.newest_stamp_ns(); }
+  /// Sensor samples from writers other than the paired plant's, ignored (SampleFilter).
+  std::uint64_t foreign_samples() const { return foreign_log_.total(); }
 
   /// Publishes the last status and command again (a lockstep peer that asked twice for one tick).
   void republish();
@@ -161,6 +169,10 @@ class ControllerNode {
   bool step_in_flight_ = false;  ///< an asynchronous step has been started and not yet published
   std::optional<std::string> failure_;
   LogThrottle failure_log_, late_log_;
+  SampleFilter accepts_;
+  LogThrottle foreign_log_;  ///< foreign sensor samples: counted, logged 1st and every 100th
+  /// A sample on `topic` from `sender` is the plant's; counts and logs it when not.
+  bool from_plant(const std::string& topic, SenderId sender);
 };
 
 }  // namespace quadcosim::sim

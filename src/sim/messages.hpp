@@ -208,6 +208,7 @@ struct ControllerStatus {
   std::uint64_t rejected_bad_quaternion = 0;   ///< orientation not a unit quaternion (zero included)
   std::uint64_t rejected_bad_stamp = 0;        ///< sec < 0 or nanosec >= 1e9
   std::uint64_t rejected_stamp_backwards = 0;  ///< older than the newest accepted on its topic
+  std::uint64_t rejected_stamp_ahead = 0;      ///< further ahead of the newest accepted than sim::kStampAheadLimitNs
   std::vector<std::string> output_names;       ///< the controller's own figures: names ...
   std::vector<double> outputs;                 ///< ... and values (NaN under the safety command)
   template <class M, class V>
@@ -227,6 +228,7 @@ struct ControllerStatus {
     v.field("rejected_bad_quaternion", m.rejected_bad_quaternion);
     v.field("rejected_bad_stamp", m.rejected_bad_stamp);
     v.field("rejected_stamp_backwards", m.rejected_stamp_backwards);
+    v.field("rejected_stamp_ahead", m.rejected_stamp_ahead);
     v.field("output_names", m.output_names);
     v.field("outputs", m.outputs);
   }
@@ -244,9 +246,11 @@ struct PlantStatus {
   std::uint64_t commands_rejected_length = 0;      ///< not exactly 4 values (empty included): ignored
   std::uint64_t commands_rejected_non_finite = 0;  ///< a NaN/Inf speed: ignored
   std::string last_problem;                        ///< why the newest rejected or clamped command was ("" for none yet)
-  bool watchdog_active = false;      ///< the watchdog's policy sets the motors (no valid command for its limit)
-  std::uint64_t watchdog_trips = 0;  ///< times the watchdog took over
-  std::uint64_t watchdog_ticks = 0;  ///< ticks latched under the watchdog's policy
+  bool watchdog_active = false;        ///< the watchdog's policy sets the motors (no valid command for its limit)
+  std::uint64_t watchdog_trips = 0;    ///< times the watchdog took over
+  std::uint64_t watchdog_ticks = 0;    ///< ticks latched under the watchdog's policy
+  std::uint64_t commands_stale = 0;    ///< lockstep repeats of an answered tick: dropped
+  std::uint64_t commands_foreign = 0;  ///< from a writer other than the paired controller's: ignored
   template <class M, class V>
   static void fields(M& m, V& v) {
     v.field("header", m.header);
@@ -258,6 +262,8 @@ struct PlantStatus {
     v.field("watchdog_active", m.watchdog_active);
     v.field("watchdog_trips", m.watchdog_trips);
     v.field("watchdog_ticks", m.watchdog_ticks);
+    v.field("commands_stale", m.commands_stale);
+    v.field("commands_foreign", m.commands_foreign);
   }
 };
 

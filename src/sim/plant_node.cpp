@@ -68,24 +68,39 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   }
   status_period_ticks_ = options.status_period_ticks > 0 ? options.status_period_ticks
                                                          : std::max<Tick>(1, 1'000'000'000 / options.clock.period_ns);
-  transport.subscribe<msg::Float64MultiArray>(topics.motor_commands,
-                                              [this](const msg::Float64MultiArray& m) { on_command(m); });
+  transport.subscribe_with_sender<msg::Float64MultiArray>(
+      topics.motor_commands, [this](const msg::Float64MultiArray& m, SenderId sender) { on_command(m, sender); });
 }
 
-void PlantNode::on_command(const msg::Float64MultiArray& m) {
+void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
+  if (command_filter_ && !command_filter_(sender)) {
+    ++stats_.commands_foreign;
+    if (foreign_log_.count()) {
+      log_("plant: motor command from a writer other than the controller's ignored; " +
+           std::to_string(foreign_log_.total()) + " ignored so far (logged: 1st, then every 100th)");
+    }
+    return;
+  }
+  if (clock_held_ >= 0) {
+    ++stats_.commands_early;
+    if (on_early_command_) on_early_command_(clock_held_);
+    return;
+  }
   ++stats_.commands_received;
-  // Lockstep repeats first, whatever their content: an answer to an earlier tick, or a second copy
-  // of the answer to this one (the controller sends its last command again when the plant repeats a
-  // tick). Dropped and counted apart, so the other counters are those of a run without repeats.
+  // Checked first, so that what a command says about its tick counts only once it is known to be a
+  // command at all.
+  const CommandCheck check = check_command(m, core_.model().params().motor.omega_max_rad_s);
+  // Lockstep repeats, whatever their content: an answer to an earlier tick, or a second copy of the
+  // accepted answer to this one (the controller sends its last command again when the plant repeats
+  // a tick). Dropped and counted apart, so the other counters are those of a run without repeats.
   // The label is read only in lockstep, where commands cross a network and may come twice or late;
   // delivered in-process, every command answers the tick it arrives in.
   const std::int64_t stamp = options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1;
-  if (stamp >= 0 && (stamp < options_.clock.ns(current_tick_) || stamp == last_label_seen_ns_)) {
+  if (stamp >= 0 && (stamp < options_.clock.ns(current_tick_) || stamp == last_label_accepted_ns_)) {
     ++stats_.commands_stale;
     return;
   }
-  if (stamp >= 0) last_label_seen_ns_ = stamp;
-  const CommandCheck check = check_command(m, core_.model().params().motor.omega_max_rad_s);
+  last_command_stamp_ns_ = stamp;  // the controller's answer to its tick, whatever its verdict
   if (check.verdict() == CommandVerdict::kRejected) {
     stats_.last_problem = check.reason();
     ++stats_.commands_rejected;
@@ -97,6 +112,7 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
     }
     return;
   }
+  if (stamp >= 0) last_label_accepted_ns_ = stamp;
   ++stats_.commands_accepted;
   if (check.fault == CommandFault::kOutOfRange) {
     stats_.last_problem = check.reason();
@@ -106,11 +122,10 @@ void PlantNode::on_command(const msg::Float64MultiArray& m) {
            " clamped so far (logged: 1st, then every 100th)");
     }
   }
-  accept_command(stamp, check.omega_rad_s);
+  accept_command(check.omega_rad_s);
 }
 
-void PlantNode::accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s) {
-  last_command_stamp_ns_ = stamp_ns;
+void PlantNode::accept_command(const model::Vector4& omega_rad_s) {
   if (receipt_clock_) last_valid_receipt_ns_ = receipt_clock_();
   core_.queue(current_tick_, options_.command_delay_ticks, omega_rad_s);
 }
@@ -119,6 +134,7 @@ void PlantNode::publish_status(Tick k) {
   const bool problem = stats_.commands_rejected_length != status_.commands_rejected_length ||
                        stats_.commands_rejected_non_finite != status_.commands_rejected_non_finite ||
                        stats_.commands_clamped != status_.commands_clamped ||
+                       stats_.commands_foreign != status_.commands_foreign ||
                        watchdog_active_ != status_.watchdog_active;
   if (!problem && k % status_period_ticks_ != 0) return;
   if (k == last_status_tick_) return;  // one status per tick, also when a tick's outputs are repeated
@@ -132,6 +148,8 @@ void PlantNode::publish_status(Tick k) {
   status_.watchdog_active = watchdog_active_;
   status_.watchdog_trips = stats_.watchdog_trips;
   status_.watchdog_ticks = stats_.watchdog_ticks;
+  status_.commands_stale = stats_.commands_stale;
+  status_.commands_foreign = stats_.commands_foreign;
   status_pub_.publish(status_);
 }
 
@@ -170,10 +188,17 @@ void PlantNode::publish_outputs(Tick k) {
     t.rotation = to_msg(y.q_WB);
     tf_pub_.publish(tf_);
   }
-  if (clock_pub_ && !clock_first && (!before_clock_ || before_clock_(k))) clock_pub_.publish(msg::Clock{stamp});
+  if (clock_pub_ && !clock_first) {
+    if (!before_clock_ || before_clock_(k)) {
+      clock_pub_.publish(msg::Clock{stamp});
+    } else {
+      clock_held_ = k;
+    }
+  }
 }
 
 void PlantNode::publish_clock(Tick k) {
+  if (k == clock_held_) clock_held_ = -1;
   if (clock_pub_) clock_pub_.publish(msg::Clock{msg::Time::from_ns(options_.clock.ns(k))});
 }
 

@@ -82,6 +82,12 @@ struct PlantStats {
   std::uint64_t commands_clamped = 0;              ///< a speed < 0 or > omega_max: used clamped to [0, omega_max]
   std::uint64_t commands_stale =
       0;  ///< lockstep repeats (an earlier tick's command, or a second copy of this one), dropped
+  /// From a writer other than the paired controller's (set_command_filter): ignored, in no other count
+  std::uint64_t commands_foreign = 0;
+  /// The controller's, arriving while before_clock held a tick's /clock back: not a timer's answer on
+  /// ROS time (it came before the time that fires the timer). Ignored, in no other count; reported to
+  /// the early-command callback.
+  std::uint64_t commands_early = 0;
   std::uint64_t watchdog_trips = 0;  ///< times the watchdog took over (no valid command for its limit)
   std::uint64_t watchdog_ticks = 0;  ///< ticks latched under the watchdog's policy
   std::string last_problem;          ///< the reason given for the newest rejected/clamped command
@@ -99,12 +105,20 @@ class PlantNode final : public SteppablePlant {
   /// every 100th, each line with the count so far). Default: stderr.
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
+  /// Commands whose sender `accepts` refuses are foreign: counted (commands_foreign), logged
+  /// rate-limited, and otherwise ignored (not received, not an answer, no label seen). Unset: every
+  /// sender is the controller (in-process, where every message is the process's own).
+  void set_command_filter(std::function<bool(SenderId)> accepts) { command_filter_ = std::move(accepts); }
+
   /// With clock_after_sensors: runs after tick k's Pose, Velocity and Imu went out, before its /clock
   /// (a lockstep plant over DDS waits there at tick 0 until the peer has the samples). Returning false
   /// holds tick k's /clock back: the caller publishes it later with publish_clock(k).
   void before_clock(std::function<bool(Tick)> f) { before_clock_ = std::move(f); }
   /// Publishes /clock for tick k (one that before_clock held back).
   void publish_clock(Tick k);
+  /// Told of each command of the controller's that arrives while a tick's /clock is held back
+  /// (commands_early), with that tick: the lockstep host decides what it means.
+  void on_early_command(std::function<void(Tick)> f) { on_early_command_ = std::move(f); }
   /// Changes PlantOptions::clock_after_sensors before the first tick (a lockstep plant decides once it
   /// knows how its controller steps).
   void set_clock_after_sensors(bool after) { options_.clock_after_sensors = after; }
@@ -132,16 +146,20 @@ class PlantNode final : public SteppablePlant {
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& latched_command() const { return core_.latched(); }
   const PlantStats& stats() const { return stats_; }
-  /// Its label_ns is the stamp label of the newest accepted command; labels are read with
-  /// drop_stale_commands (lockstep) only, otherwise it stays -1.
-  CommandReceipt command_receipt() const override { return {stats_.commands_received, last_command_stamp_ns_}; }
+  /// The controller's commands (foreign and stale ones aside); its label_ns is the stamp label of the
+  /// newest of them, accepted or rejected (a rejected command answers its tick: the last good one is
+  /// held, as in-process). Labels are read with drop_stale_commands (lockstep) only, otherwise it
+  /// stays -1.
+  CommandReceipt command_receipt() const override {
+    return {stats_.commands_received - stats_.commands_stale, last_command_stamp_ns_};
+  }
   const PlantOptions& options() const { return options_; }
   Tick current_tick() const { return current_tick_; }
 
  private:
-  void on_command(const msg::Float64MultiArray& m);
+  void on_command(const msg::Float64MultiArray& m, SenderId sender);
   /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
-  void accept_command(std::int64_t stamp_ns, const model::Vector4& omega_rad_s);
+  void accept_command(const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
   /// The external dynamics' outputs at tick k; the core's state becomes the state they report.
   model::Outputs external_outputs(Tick k);
@@ -151,14 +169,15 @@ class PlantNode final : public SteppablePlant {
   std::unique_ptr<ExternalDynamics> external_;  ///< options.external's dynamics; null: the core's model
   Tick current_tick_ = 0;
   std::int64_t last_command_stamp_ns_ = -1;
-  std::int64_t last_label_seen_ns_ = -1;  ///< newest command label received (accepted or not)
+  std::int64_t last_label_accepted_ns_ = -1;  ///< label of the newest accepted command (a copy is a repeat)
   PlantStats stats_;
   std::function<std::int64_t()> receipt_clock_;
   std::int64_t last_valid_receipt_ns_ = -1;  ///< receipt clock: its arrival (-1: none, from the first latch)
   std::int64_t command_age_ns_ = 0;
   bool watchdog_active_ = false;
   std::function<void(const std::string&)> log_;
-  LogThrottle rejected_log_, clamped_log_;
+  LogThrottle rejected_log_, clamped_log_, foreign_log_;
+  std::function<bool(SenderId)> command_filter_;
   msg::PlantStatus status_;
   Tick status_period_ticks_ = 1;  ///< ticks between periodic statuses (options or one simulated second)
   msg::PoseStamped pose_;         ///< the outgoing sensor messages, reused from tick to tick
@@ -168,6 +187,8 @@ class PlantNode final : public SteppablePlant {
   Publisher<msg::PlantStatus> status_pub_;
   Publisher<msg::Clock> clock_pub_;
   std::function<bool(Tick)> before_clock_;
+  std::function<void(Tick)> on_early_command_;
+  Tick clock_held_ = -1;  ///< the tick whose /clock before_clock held back, until publish_clock
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
   Publisher<msg::Imu> imu_pub_;

@@ -2,6 +2,7 @@
 // name and message type only; they never learn which transport is underneath.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -26,6 +27,11 @@ TopicType topic_type() {
 }
 
 class Transport;
+
+/// Who sent a delivered message, as far as the transport can tell: 0 when it cannot tell (in-process,
+/// every message is the process's own); over DDS the instance handle of the writer, so a node can take
+/// a topic from the peer it paired with and count everything else as foreign.
+using SenderId = std::uint64_t;
 
 /// Typed handle for publishing on one topic.
 template <class T>
@@ -59,11 +65,24 @@ class Transport {
                      [cb = std::move(callback)](const void* m) { cb(*static_cast<const T*>(m)); });
   }
 
+  /// As subscribe, with the sender: `callback` takes (const T&, SenderId).
+  template <class T, class F>
+  void subscribe_with_sender(const std::string& topic, F callback) {
+    add_subscription_with_sender(topic, topic_type<T>(), [cb = std::move(callback)](const void* m, SenderId s) {
+      cb(*static_cast<const T*>(m), s);
+    });
+  }
+
  protected:
   /// Returns the function that sends one message (passed as a pointer to the T of `type`).
   virtual std::function<void(const void*)> make_sink(const std::string& topic, const TopicType& type) = 0;
   virtual void add_subscription(const std::string& topic, const TopicType& type,
                                 std::function<void(const void*)> deliver) = 0;
+  /// A transport that can tell senders apart overrides this; by default every sender is 0.
+  virtual void add_subscription_with_sender(const std::string& topic, const TopicType& type,
+                                            std::function<void(const void*, SenderId)> deliver) {
+    add_subscription(topic, type, [d = std::move(deliver)](const void* m) { d(m, 0); });
+  }
 };
 
 }  // namespace quadcosim::sim

@@ -132,7 +132,11 @@ bool orientation_ok(SensorCheck& c, const msg::Quaternion& q) {
 
 bool stamp_ok(SensorCheck& c, const msg::Time& t, std::int64_t last_stamp_ns) {
   if (t.sec < 0 || t.nanosec >= 1'000'000'000u) return refuse_stamp(c, SensorFault::kBadStamp, t, 0);
-  return t.to_ns() >= last_stamp_ns || refuse_stamp(c, SensorFault::kStampBackwards, t, last_stamp_ns);
+  const std::int64_t ns = t.to_ns();
+  if (ns < last_stamp_ns) return refuse_stamp(c, SensorFault::kStampBackwards, t, last_stamp_ns);
+  // Before the first (INT64_MIN) any stamp is accepted; the difference is taken only after one.
+  return last_stamp_ns == INT64_MIN || ns - last_stamp_ns <= kStampAheadLimitNs ||
+         refuse_stamp(c, SensorFault::kStampAhead, t, last_stamp_ns);
 }
 
 std::string shown(const std::array<double, 4>& v, bool quaternion) {
@@ -171,6 +175,7 @@ const char* to_string(SensorFault f) {
     case SensorFault::kBadQuaternion: return "non-unit quaternion";
     case SensorFault::kBadStamp: return "malformed stamp";
     case SensorFault::kStampBackwards: return "stamp went backwards";
+    case SensorFault::kStampAhead: return "stamp too far ahead";
   }
   return "?";
 }
@@ -202,6 +207,10 @@ std::string SensorCheck::reason() const {
       return fmt::format("stamp sec {} nanosec {}: expected sec >= 0 and nanosec < 1e9", stamp.sec, stamp.nanosec);
     case SensorFault::kStampBackwards:
       return fmt::format("stamp {} ns is older than the newest accepted, {} ns", stamp.to_ns(), newest_ns);
+    case SensorFault::kStampAhead:
+      return fmt::format("stamp {} ns is {:g} s ahead of the newest accepted, {} ns (at most {:g} s)", stamp.to_ns(),
+                         static_cast<double>(stamp.to_ns() - newest_ns) / 1e9, newest_ns,
+                         static_cast<double>(kStampAheadLimitNs) / 1e9);
   }
   return "?";
 }

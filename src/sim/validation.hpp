@@ -65,8 +65,17 @@ enum class SensorFault : std::uint8_t {
   kBadQuaternion,   ///< orientation norm not within kQuaternionNormTolerance of 1 (zero included)
   kBadStamp,        ///< stamp.sec < 0 or stamp.nanosec >= 1e9: not a ROS time
   kStampBackwards,  ///< stamp older than the newest accepted one on the same topic
+  kStampAhead,      ///< stamp further ahead of the newest accepted one on the same topic than kStampAheadLimitNs
 };
-constexpr int kSensorFaultCount = 5;
+constexpr int kSensorFaultCount = 6;
+
+/// A sample stamped more than this [ns] after the newest accepted on its topic is refused: one
+/// sample stamped far in the future (a stranger's, a broken clock) would otherwise become the newest
+/// and make every genuine sample after it "older than the newest", blinding the controller. Two
+/// seconds: more than the period of any sensor the plant simulates, far less than a stale-data limit
+/// a controller would survive. A sender whose clock really jumped forward is taken after
+/// kStampRestartCount such samples in a row, as a restart is.
+constexpr std::int64_t kStampAheadLimitNs = 2'000'000'000;
 const char* to_string(SensorFault f);
 
 /// The field of a sensor message at fault (its name in the ROS 2 message).
@@ -97,7 +106,7 @@ struct SensorCheck {
   /// (kNonFinite, kBadQuaternion). Unused for the stamp.
   std::array<double, 4> value{};
   msg::Time stamp;             ///< the stamp as sent (kBadStamp, kStampBackwards)
-  std::int64_t newest_ns = 0;  ///< the newest accepted stamp it is older than [ns] (kStampBackwards)
+  std::int64_t newest_ns = 0;  ///< the newest accepted stamp it is older than, or too far ahead of [ns]
 
   bool ok() const { return fault == SensorFault::kNone; }
   /// The field and value at fault and what was expected, e.g. "position (nan, 2, 3): expected finite
@@ -106,7 +115,8 @@ struct SensorCheck {
 };
 
 /// `last_stamp_ns`: the newest stamp [ns] accepted on this topic, or INT64_MIN before any. A stamp
-/// equal to it is accepted (a lockstep peer may repeat a tick's sample); an older one is refused.
+/// equal to it is accepted (a lockstep peer may repeat a tick's sample); an older one is refused, and
+/// so is one more than kStampAheadLimitNs newer.
 /// Checked in this order, the first fault reported (content first, so kStampBackwards means a
 /// well-formed sample that is only too old): Pose position, orientation, stamp; Velocity linear,
 /// angular, stamp; Imu orientation, angular_velocity, linear_acceleration, stamp. An orientation is

@@ -420,15 +420,74 @@ TEST(PlantValidationTest, LockstepRepeatsOfACommandAreNotCountedTwice) {
   rig.plant->integrate(0);
   rig.tick(1);
   rig.plant->publish_outputs(2);
-  rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));  // a refused answer, and its copy
+  // A refused answer, and its copy: the label of a refused command is not remembered (what a command
+  // says of its tick counts only once it is known to be a command), so the copy is refused again, not
+  // dropped as a repeat.
+  rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));
   rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));
   rig.cmd.publish(labelled({5, 6, 7, 8}, 0));  // an answer to an earlier tick
   const PlantStats& st = rig.plant->stats();
   EXPECT_EQ(st.commands_received, 5u);
   EXPECT_EQ(st.commands_accepted, 1u);
-  EXPECT_EQ(st.commands_rejected_length, 1u);
-  EXPECT_EQ(st.commands_stale, 3u);
+  EXPECT_EQ(st.commands_rejected_length, 2u);
+  EXPECT_EQ(st.commands_stale, 2u);
   EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+  // The refused answer answered tick 2 (the last good command held, as in-process).
+  EXPECT_EQ(rig.plant->command_receipt().label_ns, 20'000'000);
+}
+
+// A NaN command labelled with the current tick, then the valid answer with the same label: the valid
+// one is taken, not dropped as a copy of the NaN.
+TEST(PlantValidationTest, ANonFiniteCommandLabelledWithTheTickDoesNotMakeTheAnswerARepeat) {
+  PlantOptions options;
+  options.drop_stale_commands = true;
+  Rig rig(options);
+  auto labelled = [](std::vector<double> w, std::int64_t stamp_ns) {
+    msg::Float64MultiArray m = command(std::move(w));
+    m.dim.push_back({msg::command_label(stamp_ns), 4, 4});
+    return m;
+  };
+  rig.plant->publish_outputs(0);
+  rig.cmd.publish(labelled({kNaN, 1, 1, 1}, 0));
+  rig.cmd.publish(labelled({100, 200, 300, 400}, 0));
+  rig.plant->latch_command(0);
+  const PlantStats& st = rig.plant->stats();
+  EXPECT_EQ(st.commands_rejected_non_finite, 1u);
+  EXPECT_EQ(st.commands_accepted, 1u);
+  EXPECT_EQ(st.commands_stale, 0u);
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+}
+
+// Commands whose sender the filter refuses are foreign: counted, logged once per 100, and nothing
+// else: not received, not an answer, no label seen, nothing latched.
+TEST(PlantValidationTest, CommandsOfAnotherWriterAreForeignAndChangeNothing) {
+  PlantOptions options;
+  options.drop_stale_commands = true;
+  Rig rig(options);
+  // The in-process transport says 0 for every sender: a filter refusing it makes every command foreign.
+  rig.plant->set_command_filter([](SenderId s) { return s != 0; });
+  const model::Vector4 before = rig.plant->latched_command();
+  msg::Float64MultiArray m = command({100, 200, 300, 400});
+  m.dim.push_back({msg::command_label(0), 4, 4});
+  rig.plant->publish_outputs(0);
+  for (int i = 0; i < 150; ++i) rig.cmd.publish(m);
+  rig.plant->latch_command(0);
+  const PlantStats& st = rig.plant->stats();
+  EXPECT_EQ(st.commands_foreign, 150u);
+  EXPECT_EQ(st.commands_received, 0u);
+  EXPECT_EQ(st.commands_accepted, 0u);
+  EXPECT_EQ(st.commands_stale, 0u);
+  EXPECT_EQ(rig.plant->command_receipt().received, 0u);
+  EXPECT_EQ(rig.plant->command_receipt().label_ns, -1);
+  EXPECT_EQ(rig.plant->latched_command(), before);
+  ASSERT_EQ(rig.log.size(), 2u);  // the 1st and the 101st
+  EXPECT_EQ(rig.log[0],
+            "plant: motor command from a writer other than the controller's ignored; 1 ignored so far (logged: 1st, "
+            "then every 100th)");
+  // The count is published in the plant status.
+  rig.tick(1);
+  ASSERT_FALSE(rig.statuses.empty());
+  EXPECT_EQ(rig.statuses.back().commands_foreign, 150u);
 }
 
 TEST(PlantValidationTest, LogIsRateLimitedAndSaysHowMany) {
@@ -542,6 +601,31 @@ TEST(ControllerValidationTest, ValidDataRecoversAndBackwardStampsAreRefused) {
     const bool stale = ns - 40'000'000 > 100'000'000;
     EXPECT_EQ(rig.node->step(ns, 0.02).safety, stale) << "t = " << ns << " ns";
   }
+}
+
+// One sample stamped far in the future (a stranger's, a broken clock) does not become the newest: it is
+// refused as too far ahead, and the genuine samples after it are taken, so the controller is not blinded.
+TEST(ControllerValidationTest, ASampleStampedFarAheadIsRefusedAndDoesNotBlindTheController) {
+  ControllerRig rig;
+  rig.send(20'000'000, 1.0, 5.0);
+  EXPECT_FALSE(rig.node->step(20'000'000, 0.02).safety);
+  rig.send(2'000'000'000LL * 1'000'000'000LL, 1.0, 99.0);    // 2e9 s: refused on every topic
+  rig.send(20'000'000 + kStampAheadLimitNs + 1, 1.0, 98.0);  // just beyond the limit: refused too
+  for (std::int64_t ns = 40'000'000; ns <= 400'000'000; ns += 20'000'000) {
+    rig.send(ns, 1.0, 5.0);
+    EXPECT_FALSE(rig.node->step(ns, 0.02).safety) << "t = " << ns << " ns";
+    EXPECT_EQ(rig.node->observation().p_W.z(), 5.0);
+  }
+  EXPECT_EQ(rig.node->status().rejected_stamp_ahead, 6u);  // two samples on each of the three topics
+  EXPECT_EQ(rig.node->status().rejected_stamp_backwards, 0u);
+  EXPECT_EQ(rig.node->status().header.stamp.to_ns(), 400'000'000) << "the future stamp leaked into the status";
+  // A sample exactly at the limit is a sender's legitimate jump (a slow sensor): taken.
+  rig.send(400'000'000 + kStampAheadLimitNs, 1.0, 6.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 6.0);
+  EXPECT_NE(rig.log.front().find("stamp too far ahead (stamp 2000000000000000000 ns is 2e+09 s ahead of the newest "
+                                 "accepted, 20000000 ns (at most 2 s))"),
+            std::string::npos)
+      << rig.log.front();
 }
 
 TEST(ControllerValidationTest, ASenderWhoseClockRestartedIsFollowedAfterARunOfOldSamples) {
