@@ -17,6 +17,7 @@
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_service.hpp"
+#include "dds/peer_pairing.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "io/scenario.hpp"
 #include "sim/controller_node.hpp"
@@ -130,7 +131,17 @@ int controller_command(const ControllerCommandOptions& o) {
 
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
   if (o.sensor_qos) use_sensor_qos(transport, topics);
-  sim::ControllerNode node(transport, topics, sc.controller);
+  // Paired with the plant by the run's token (run --transport dds): the node's writers carry it, and
+  // it takes sensor samples from the plant's writers only (dds/peer_pairing.hpp).
+  const std::string pair_token = dds::pair_token_from_environment();
+  dds::PeerFilter pairing(transport);
+  sim::ControllerNode::SampleFilter from_plant;
+  if (!pair_token.empty()) {
+    transport.set_user_data_keys(std::string(dds::kPairTokenKey) + "=" + pair_token + ";");
+    pairing.pair_by_token(pair_token);
+    from_plant = [&pairing](const std::string& topic, sim::SenderId s) { return pairing.accepts(topic, s); };
+  }
+  sim::ControllerNode node(transport, topics, sc.controller, std::move(from_plant));
   // A controller written in Python runs on a thread of its own (docs/python.md): one that blocks holds
   // up neither the DDS threads (discovery, parameter services) nor a stop.
   const bool on_thread = sc.controller.type() == "python";
@@ -201,6 +212,10 @@ int controller_command(const ControllerCommandOptions& o) {
     std::cerr << fmt::format(
         "controller: {} failed steps (safety command sent instead), {} {}\n", node.controller_failures(),
         node.late_steps(), o.lockstep ? "ticks not answered (controller busy)" : "late periods (safety command sent)");
+  }
+  if (node.foreign_samples() > 0) {
+    std::cerr << fmt::format("controller: {} sensor samples from writers other than the plant's ignored\n",
+                             node.foreign_samples());
   }
   std::cerr << "controller: stopped\n";
   if (fox) finish_foxglove(o.foxglove, "controller", *fox);

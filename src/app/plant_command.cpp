@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -23,6 +24,7 @@
 #include "dds/graph.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_client.hpp"
+#include "dds/peer_pairing.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
 #include "drivers/realtime_plant_driver.hpp"
 #include "io/mcap_recorder.hpp"
@@ -50,13 +52,30 @@ class PlantProcess {
         divider_(sc_.simulation.controller_divider),
         topics_(sim::Topics::for_namespace(sc_.simulation.ns)),
         transport_(dds::read_ros_environment(o.enclave)),
+        pair_token_(dds::pair_token_from_environment()),
+        pairing_(transport_),
         plant_(make_plant()),
         announcer_(transport_.participant().handle(), "quadrotor_plant") {
     status_.header.stamp = msg::Time::from_ns(-1);
-    transport_.subscribe<msg::ControllerStatus>(topics_.controller_status, [this](const msg::ControllerStatus& m) {
-      status_ = m;
-      have_status_ = true;
+    plant_.set_command_filter([this](sim::SenderId s) { return pairing_.accepts(topics_.motor_commands, s); });
+    plant_.on_early_command([this](sim::Tick k) {
+      if (!ambiguous_.empty()) return;
+      ambiguous_ = fmt::format(
+          "the controller sent a command before tick {}'s /clock (t = {:g} s) went out: it does not step from a "
+          "timer on ROS time (it publishes from a subscription callback, or from a wall-clock timer), so with "
+          "--sync clock its command answers no tick and the run stopped rather than fly a trajectory that differs "
+          "from run to run. A controller that answers each control tick's samples runs with --sync samples; one "
+          "that answers every sample needs simulation.controller_rate_hz equal to that sample rate (docs/ros2.md)",
+          k, clock_.seconds(k));
+      request_stop();  // wakes the lockstep's wait for the answer that will not come
     });
+    transport_.subscribe_with_sender<msg::ControllerStatus>(topics_.controller_status,
+                                                            [this](const msg::ControllerStatus& m, sim::SenderId s) {
+                                                              if (!pairing_.accepts(topics_.controller_status, s))
+                                                                return;  // a stranger's says nothing of this run
+                                                              status_ = m;
+                                                              have_status_ = true;
+                                                            });
     if (!o_.one_vehicle.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.one_vehicle.record);
     if (!o_.one_vehicle.mcap.empty()) {
       mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
@@ -97,6 +116,10 @@ class PlantProcess {
  private:
   sim::PlantNode make_plant() {
     if (o_.sensor_qos) use_sensor_qos(transport_, topics_);
+    if (!pair_token_.empty()) {
+      transport_.set_user_data_keys(std::string(dds::kPairTokenKey) + "=" + pair_token_ + ";");
+      pairing_.pair_by_token(pair_token_);
+    }
     sim::PlantOptions po = sc_.simulation.plant;
     po.drop_stale_commands = o_.lockstep;
     return sim::PlantNode(transport_, topics_, sc_.vehicle, po, io::initial_state(sc_));
@@ -106,26 +129,127 @@ class PlantProcess {
   /// counts include them.
   int own_readers() const { return (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0); }
 
-  /// Waits until a controller is there to answer, so tick 0 is not published into the void.
-  bool wait_for_controller() {
-    // The recorder's and the Foxglove server's own readers (same participant) match too: look for one more.
-    const int own = own_readers();
-    const bool found = transport_.spin_until(
-        [&] {
-          return stop_requested() ||
-                 (transport_.matched_writers(topics_.motor_commands) > 0 &&
-                  transport_.matched_readers(topics_.pose) > own &&
-                  transport_.matched_readers(topics_.velocity) > own && transport_.matched_readers(topics_.imu) > own);
-        },
-        timeout_ns());
-    if (!found) {
-      std::cerr << fmt::format(
-          "plant: no controller on {} within {} s (matched command writers: {}, "
-          "pose readers: {}); is it running on ROS_DOMAIN_ID {}?\n",
-          topics_.motor_commands, o_.timeout_s, transport_.matched_writers(topics_.motor_commands),
-          transport_.matched_readers(topics_.pose), transport_.participant().domain_id());
+  using Guid = std::array<std::uint8_t, 16>;
+
+  static std::string hex(const Guid& g) {
+    std::string s;
+    for (std::uint8_t b : g) s += fmt::format("{:02x}", b);
+    return s;
+  }
+
+  /// The participants whose writers of the motor commands may be the controller's: with a pairing
+  /// token, those whose writers carry it; otherwise those whose writers carry no token (a token means
+  /// the controller of another quadcosim run) and, with --controller-node, only the node's own.
+  std::vector<Guid> controller_candidates() const {
+    std::vector<Guid> found;
+    for (const sim::SenderId s : transport_.matched_senders(topics_.motor_commands)) {
+      const auto info = transport_.sender_info(topics_.motor_commands, s);
+      if (!info) continue;
+      if (pair_token_.empty() ? !info->pair_token.empty() : info->pair_token != pair_token_) continue;
+      if (node_participant_ && info->participant != *node_participant_) continue;
+      if (std::find(found.begin(), found.end(), info->participant) == found.end()) found.push_back(info->participant);
     }
     return found;
+  }
+
+  /// Which of Pose, Velocity and Imu `peer` subscribes (readers matched by ours).
+  std::vector<std::string> sensors_subscribed_by(const Guid& peer) const {
+    std::vector<std::string> out;
+    for (const std::string* t : {&topics_.pose, &topics_.velocity, &topics_.imu}) {
+      const auto parts = transport_.matched_reader_participants(*t);
+      if (std::find(parts.begin(), parts.end(), peer) != parts.end()) out.push_back(*t);
+    }
+    return out;
+  }
+
+  /// Finds the controller, pairs with its writers (dds/peer_pairing.hpp: only its commands are
+  /// answers; every other writer's are counted as foreign and ignored) and waits until it subscribes
+  /// the sensors it needs (any of Pose, Velocity, Imu: what its participant's readers ask for), so
+  /// tick 0 is not published into the void. False, with the reason on stderr, when none comes within
+  /// the timeout or the controller is ambiguous (several participants could be it).
+  bool wait_for_controller() {
+    const std::string& node = o_.lockstep_only.controller_node;
+    if (pair_token_.empty() && !node.empty() && !find_node_participant(node)) return false;
+    // Discovery of one participant's endpoints arrives close together but not at once: once the
+    // controller subscribes one sensor, the others it subscribes have this long to show up.
+    constexpr std::int64_t kSettleNs = 300'000'000;
+    std::optional<Guid> peer;
+    std::vector<std::string> sensors;
+    std::int64_t settled_at = 0;
+    bool ambiguous = false;
+    const bool found = transport_.spin_until(
+        [&] {
+          if (stop_requested()) return true;
+          const std::vector<Guid> candidates = controller_candidates();
+          if (candidates.size() > 1 && pair_token_.empty()) {
+            ambiguous = true;
+            std::string list;
+            for (const Guid& g : candidates) list += " " + hex(g);
+            std::cerr << fmt::format(
+                "plant: {} participants publish {} and could be the controller:{}; a stranger or a controller "
+                "left over from an earlier run? End it, use another ROS_DOMAIN_ID, or name the controller's node "
+                "with --controller-node\n",
+                candidates.size(), topics_.motor_commands, list);
+            return true;
+          }
+          if (candidates.empty()) return false;
+          peer = candidates.front();
+          const std::vector<std::string> now = sensors_subscribed_by(*peer);
+          if (now.size() != sensors.size()) settled_at = steady_ns() + kSettleNs;
+          sensors = now;
+          return sensors.size() == 3 || (!sensors.empty() && steady_ns() >= settled_at);
+        },
+        timeout_ns());
+    if (ambiguous) return false;
+    if (!found) {
+      std::string subscribed;
+      for (const std::string& t : sensors) subscribed += (subscribed.empty() ? "" : ", ") + t;
+      std::cerr << fmt::format("plant: no controller on {} within {} s: {}; is it running on ROS_DOMAIN_ID {}?\n",
+                               topics_.motor_commands, o_.timeout_s,
+                               !peer ? fmt::format("no {}writer of {} is matched{}",
+                                                   pair_token_.empty() ? "" : "paired ", topics_.motor_commands,
+                                                   transport_.matched_writers(topics_.motor_commands) > 0
+                                                       ? fmt::format(" ({} writers of other runs or nodes are)",
+                                                                     transport_.matched_writers(topics_.motor_commands))
+                                                       : "")
+                                     : fmt::format("participant {} publishes it but subscribes none of {}, {}, {}",
+                                                   hex(*peer), topics_.pose, topics_.velocity, topics_.imu),
+                               transport_.participant().domain_id());
+      return false;
+    }
+    if (!peer) return true;  // stopped
+    peer_ = peer;
+    if (pair_token_.empty()) pairing_.pair_by_participant(*peer);
+    if (sensors.size() < 3) {
+      std::string list;
+      for (const std::string& t : sensors) list += (list.empty() ? "" : ", ") + t;
+      std::cerr << fmt::format("plant: the controller subscribes {} only; the other sensor samples go to no one\n",
+                               list);
+    }
+    return true;
+  }
+
+  /// --controller-node without a pairing token: the participant hosting that node's parameter
+  /// services is the controller's. False, with the reason on stderr, when it is not found in time.
+  bool find_node_participant(const std::string& node) {
+    const std::string request = "rq" + node + "/get_parametersRequest";
+    std::optional<Guid> found;
+    host_.unlocked([&] {
+      dds::discover_endpoints(transport_.participant().handle(), timeout_ns(), [&](const auto& endpoints) {
+        for (const dds::Endpoint& e : endpoints) {
+          if (!e.writer && e.dds_topic == request) found = e.participant;
+        }
+        return found.has_value() || stop_requested();
+      });
+      return 0;
+    });
+    if (!found) {
+      std::cerr << fmt::format("plant: --controller-node {}: no such node (no reader of {}) within {} s\n", node,
+                               request, o_.timeout_s);
+      return false;
+    }
+    node_participant_ = found;
+    return true;
   }
 
   /// Lockstep: how the controller steps (--sync). A controller that steps on each control tick's
@@ -155,7 +279,12 @@ class PlantProcess {
       const std::int64_t wait_ns = required ? timeout_ns() : std::min<std::int64_t>(timeout_ns(), 500'000'000);
       host_.unlocked([&] {
         return dds::discover_endpoints(transport_.participant().handle(), wait_ns, [&](const auto& endpoints) {
-          nodes = dds::parameter_nodes_writing(endpoints, topics_.motor_commands);
+          // The controller's own participant only: a stranger's nodes are not asked.
+          std::vector<dds::Endpoint> own;
+          for (const dds::Endpoint& e : endpoints) {
+            if (!peer_ || e.participant == *peer_) own.push_back(e);
+          }
+          nodes = dds::parameter_nodes_writing(own, topics_.motor_commands);
           return !nodes.empty();
         });
       });
@@ -288,12 +417,15 @@ class PlantProcess {
     lo.timeout_ns = timeout_ns();
     lo.on_timeout =
         o_.lockstep_only.on_timeout == "hold" ? drivers::TimeoutPolicy::kHold : drivers::TimeoutPolicy::kAbort;
-    drivers::DrivenPlant p{&plant_, [this] { return transport_.matched_writers(topics_.controller_status) > 0; },
+    drivers::DrivenPlant p{&plant_, [this] { return controller_writes_status(); },
                            [this] { return status_.header.stamp.to_ns(); }};
     drivers::LockstepHooks h;
     h.main_thread_due = [this](sim::Tick k) { return schedule_due(k); };
-    h.before_outputs = [this](sim::Tick k) { return apply_due_schedule(k); };
-    h.after_latch = [this](std::size_t, sim::Tick k) { after_latch(k); };
+    h.before_outputs = [this](sim::Tick k) { return ambiguous_.empty() && apply_due_schedule(k); };
+    h.after_latch = [this](std::size_t, sim::Tick k) {
+      after_latch(k);
+      check_one_answer_per_period(k);
+    };
     h.on_timeout = [this](std::size_t, sim::Tick k) {
       std::cerr << lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s, o_.lockstep_only.on_timeout);
       if (!barrier_) return;
@@ -314,12 +446,68 @@ class PlantProcess {
     host_.on_delivery([this] { return lockstep_->on_delivery(); });
     const drivers::LockstepResult r = lockstep_->run();
     host_.on_delivery(nullptr);
+    if (!ambiguous_.empty()) {
+      std::cerr << "plant: " << ambiguous_ << '\n';
+      return kExitNoController;
+    }
     if (r == drivers::LockstepResult::kRefused) return kExitRefused;
     if (r == drivers::LockstepResult::kTimedOut) return kExitNoController;
-    return kExitOk;
+    return r == drivers::LockstepResult::kDone && !stop_requested() ? check_answer_count() : kExitOk;
+  }
+
+  /// Lockstep matches an unlabelled command to the tick being awaited when it is delivered. A
+  /// controller that sends more commands than it was asked for (one per sensor sample, or again when
+  /// a tick's samples were published twice) leaves the surplus queued, and each later tick then takes
+  /// an answer to an earlier one: the per-period count cannot see this, the total can. So once the
+  /// last tick ran and what is still arriving came in (a 20 ms lull, at most 200 ms), more commands
+  /// than control periods (one may answer the final samples) stop the run's success.
+  int check_answer_count() {
+    const std::int64_t until = steady_ns() + 200'000'000;
+    while (transport_.spin_once(20'000'000) > 0 && steady_ns() < until) {
+    }
+    const std::uint64_t periods = lockstep_->round_trips_ns().count();
+    const std::uint64_t answers = plant_.command_receipt().received;
+    if (answers <= periods + 1) return kExitOk;
+    std::cerr << fmt::format(
+        "plant: the controller sent {} commands for {} control periods, where lockstep expects one each: it "
+        "publishes more than once per control period (e.g. answering every Pose, Velocity or Imu sample), so "
+        "every command after the first surplus one was taken as the answer to a later tick than the one it "
+        "answered, and this run's trajectory depends on timing. Publish once per control period, label each "
+        "command with its tick (docs/ros2.md, \"Lockstep with your own ROS 2 controller\"), or set "
+        "simulation.controller_rate_hz to the rate it publishes at\n",
+        answers, periods);
+    return kExitNoController;
   }
 
   /// What follows tick k's latch, before the plant integrates: log, record.
+  /// The paired controller publishes its status (so a control tick's answer includes it).
+  bool controller_writes_status() {
+    for (const sim::SenderId s : transport_.matched_senders(topics_.controller_status)) {
+      if (pairing_.accepts(topics_.controller_status, s)) return true;
+    }
+    return false;
+  }
+
+  /// Lockstep: the controller answers each control tick once. A second command within one control
+  /// period cannot be matched to a tick (it would be latched by its arrival time: not deterministic),
+  /// so the run stops at the first one, saying what the controller must change.
+  void check_one_answer_per_period(sim::Tick k) {
+    if (k % divider_ != 0 || k < (barrier_ ? divider_ : 0)) return;
+    const sim::CommandReceipt r = plant_.command_receipt();
+    const std::uint64_t answers = r.received - answers_at_last_control_;
+    answers_at_last_control_ = r.received;
+    if (answers <= 1 || !ambiguous_.empty()) return;
+    ambiguous_ = fmt::format(
+        "the controller sent {} commands in the control period ending at t = {:g} s, where lockstep expects one: it "
+        "publishes faster than the scenario's controller_rate_hz ({:g}), e.g. {}. Which tick such a command answers "
+        "depends on when it arrives, so the run stopped rather than fly a trajectory that differs from run to run. "
+        "Publish once per control period, or set simulation.controller_rate_hz to the rate it publishes at "
+        "(docs/ros2.md, \"Lockstep with your own ROS 2 controller\")",
+        answers, clock_.seconds(k), 1.0 / clock_.seconds(divider_),
+        barrier_ ? "from a timer faster than that rate" : "answering every Pose, Velocity or Imu sample");
+    request_stop();
+  }
+
   void after_latch(sim::Tick k) {
     log_watchdog(k);
     record(k);
@@ -388,18 +576,6 @@ class PlantProcess {
       stats["roundtrip_us_max"] = pct(1.0);
     }
     const auto& st = plant_.stats();
-    if (barrier_ && lockstep_) {
-      // One command per control tick from the first on; more means a timer faster than the
-      // scenario's controller rate, whose extra commands are latched by arrival (not deterministic).
-      const sim::Tick ticks = std::min(lockstep_->ticks_run(), sc_.simulation.duration_ticks);
-      const std::uint64_t expected = ticks < divider_ ? 0 : static_cast<std::uint64_t>(ticks / divider_);
-      if (st.commands_received > expected) {
-        std::cerr << fmt::format(
-            "plant: warning: {} commands for {} control ticks: the controller publishes faster than the scenario's "
-            "controller_rate_hz ({:g}); extra commands are applied as they arrive, which is not deterministic\n",
-            st.commands_received, expected, 1.0 / clock_.seconds(divider_));
-      }
-    }
     const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
     // The simulated time reached, not the time asked for: a run stopped early (Ctrl-C) integrated
     // only the ticks it completed.
@@ -408,9 +584,9 @@ class PlantProcess {
     const double sim_s = clock_.seconds(std::min(completed, asked));
     std::cerr << fmt::format(
         "plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
-        "rejected {}, clamped {}, stale {}\n",
+        "rejected {}, clamped {}, stale {}; foreign (not the controller's writers) {}\n",
         sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected, st.commands_clamped,
-        st.commands_stale);
+        st.commands_stale, st.commands_foreign);
     std::cerr << fmt::format("plant: watchdog ({:g} s, policy {}) took over {} times for {} ticks\n",
                              clock_.seconds(plant_.options().watchdog_ticks),
                              sim::to_string(plant_.options().watchdog_policy), st.watchdog_trips, st.watchdog_ticks);
@@ -435,6 +611,10 @@ class PlantProcess {
   int divider_;
   sim::Topics topics_;
   dds::DdsTransport transport_;
+  std::string pair_token_;   ///< $QUADCOSIM_PAIR_TOKEN: the controller's writers carry it (run --transport dds)
+  dds::PeerFilter pairing_;  ///< whose commands are the controller's (set by wait_for_controller)
+  std::optional<std::array<std::uint8_t, 16>> node_participant_;  ///< --controller-node's participant
+  std::optional<std::array<std::uint8_t, 16>> peer_;              ///< the controller's participant
   sim::PlantNode plant_;
   dds::NodeAnnouncer announcer_;
   msg::ControllerStatus status_;
@@ -450,6 +630,8 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> barrier_;  ///< --sync clock: the controller node's parameter client
   dds::ParameterClient::Header barrier_request_;   ///< the last barrier request sent
   sim::Tick clock_held_ = -1;                      ///< the tick whose /clock awaits the barrier reply
+  std::uint64_t answers_at_last_control_ = 0;      ///< the plant's command receipts at the last control tick
+  std::string ambiguous_;  ///< why the controller's answers cannot be matched to ticks ("": they can)
   std::int64_t loop_start_ns_ = 0;
   // Last: the drivers and their host (with delivery on arrival) go first.
   DdsDriverHost host_{transport_};
@@ -515,8 +697,9 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
       ->check(CLI::IsMember({"auto", "samples", "clock"}));
   plant_cmd
       ->add_option("--controller-node", plant.lockstep_only.controller_node,
-                   "with --sync clock/auto: the controller's node (default: the node with parameter services "
-                   "in the process publishing the motor commands)")
+                   "the controller's node: only the writers of its process are the controller's, and --sync "
+                   "clock/auto asks it (default: the one process publishing the motor commands, and its node with "
+                   "parameter services)")
       ->check(CLI::Validator(check_node_name, "NODE"));
   plant_cmd->add_flag("--clock-after-sensors", plant.clock_after_sensors,
                       "publish /clock after each tick's Pose, Velocity and Imu (for a peer that steps on "
@@ -543,8 +726,8 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
             {"--wait-for-controller", realtime, "lockstep; it needs --realtime (lockstep always waits)"},
             {"--on-timeout", !realtime, "--realtime; it is the lockstep timeout's policy"},
             {"--sync", !realtime && !swarm, "--realtime or --vehicles; it is one vehicle's lockstep protocol"},
-            {"--controller-node", !realtime && !swarm && plant.lockstep_only.sync != "samples",
-             "--realtime, --vehicles or --sync samples"},
+            {"--controller-node", !swarm && (!realtime || plant.realtime.wait_for_controller),
+             "--vehicles, or --realtime without --wait-for-controller"},
             {"--timeout", !realtime || plant.realtime.wait_for_controller || !plant.one_vehicle.schedule_node.empty(),
              "--realtime alone; it needs lockstep, --wait-for-controller or --schedule-via"},
         });

@@ -21,6 +21,7 @@
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
+#include "dds/peer_pairing.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -74,6 +75,9 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     controller_args.push_back(opt.controller);
   }
   const std::string mcap_path = (std::filesystem::path(csv_path).parent_path() / "run.mcap").string();
+  // A fresh pairing token for this run's two children: each takes the other's writers only
+  // (dds/peer_pairing.hpp), so a stranger's message or a controller left from another run bends nothing.
+  setenv(dds::kPairTokenEnv, dds::new_pair_token().c_str(), 1);
   std::vector<std::string> plant_args = {self,     "plant",  "--scenario", opt.scenario, "--record",
                                          csv_path, "--mcap", mcap_path,    "--timeout",  timeout};
   if (!opt.realtime) {

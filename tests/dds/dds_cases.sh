@@ -2,7 +2,7 @@
 # Co-simulation over DDS with real processes. Usage: dds_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID
 # Every case runs on its own ROS_DOMAIN_ID with localhost-only discovery, and ends every process it
 # started (trap), also on failure.
-bin="$1"; src="$2"
+bin="$1"; src="$2"; stranger="${5:-}"  # tests/stranger, for the stranger_* cases
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 paper="$src/scenarios/paper"
 
@@ -47,7 +47,71 @@ identical_all() {
   echo "$n scenarios identical in-process and over DDS${QUADCOSIM_REFERENCE_DIR:+ and to the reference}"
 }
 
+# A stranger publishing on the run's topics before and during `run --transport dds`: the trajectory,
+# metrics and the run's own recorded messages are those of the in-process run, the plant counts what
+# it ignored. Usage: with_stranger MODE (stranger.cpp: commands | sensors).
+with_stranger() {
+  "$bin" run "$paper/altitude_step.yaml" --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process run failed"
+  "$stranger" "$1" 40 > "$tmp/stranger.out" 2> "$tmp/stranger.log" &
+  local spid=$!
+  pids+=("$spid")
+  sleep 1  # the stranger is on the domain first: its messages are there when the run starts
+  "$bin" run "$paper/altitude_step.yaml" --out "$tmp/dds" --no-plots --transport dds > "$tmp/dds.log" 2>&1 \
+    || fail "DDS run with a stranger failed"
+  kill "$spid" 2> /dev/null || true
+  cmp "$tmp/in/trajectory.csv" "$tmp/dds/trajectory.csv" || fail "the stranger changed the trajectory"
+  cmp "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "the stranger changed the metrics"
+}
+
+# Message count of TOPIC in a run folder's metadata.yaml.
+bag_count() {
+  /usr/bin/python3 - "$1/metadata.yaml" "$2" <<'PY'
+import sys, yaml
+info = yaml.safe_load(open(sys.argv[1]))["rosbag2_bagfile_information"]
+print(sum(t["message_count"] for t in info["topics_with_message_count"] if t["topic_metadata"]["name"] == sys.argv[2]))
+PY
+}
+
 case "$case_name" in
+  stranger_commands)
+    with_stranger commands
+    grep -Eq "foreign \(not the controller's writers\) [1-9][0-9]*" "$tmp/dds.log" ||
+      fail "the plant counted no foreign commands: $(grep 'plant: done' "$tmp/dds.log")"
+    grep -q "stale 0;" "$tmp/dds.log" || fail "stale commands: $(grep 'plant: done' "$tmp/dds.log")"
+    ;;
+  stranger_sensors)
+    with_stranger sensors
+    grep -Eq "controller: [1-9][0-9]* sensor samples from writers other than the plant's ignored" "$tmp/dds.log" ||
+      fail "the controller counted no foreign samples"
+    # Every status the run's own controller published is recorded, beside the stranger's.
+    own=$(bag_count "$tmp/in" /drone/controller_status)
+    got=$(bag_count "$tmp/dds" /drone/controller_status)
+    [ "$own" -gt 700 ] && [ "$got" -gt "$own" ] ||
+      fail "run.mcap holds $got controller statuses; the run's own controller published $own"
+    ;;
+  leftover_controller)  # a controller of an earlier run still alive on the domain: no pairing token
+    "$bin" run "$paper/altitude_step.yaml" --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1 || fail "in-process run failed"
+    "$bin" controller --scenario "$paper/altitude_step.yaml" > "$tmp/leftover.log" 2>&1 &
+    pids+=($!)
+    sleep 1
+    "$bin" run "$paper/altitude_step.yaml" --out "$tmp/dds" --no-plots --transport dds > "$tmp/dds.log" 2>&1 \
+      || fail "DDS run beside a leftover controller failed"
+    cmp "$tmp/in/trajectory.csv" "$tmp/dds/trajectory.csv" || fail "the leftover controller changed the trajectory"
+    grep -Eq "foreign \(not the controller's writers\) [1-9][0-9]*" "$tmp/dds.log" ||
+      fail "the leftover controller's commands were not counted as foreign"
+    ;;
+  answer_every_sample)  # a controller answering each sensor sample: lockstep stops and says so
+    "$stranger" answer_every_sample 30 > "$tmp/controller.out" 2> "$tmp/controller.log" &
+    pids+=($!)
+    set +e
+    timeout 60 "$bin" plant --scenario "$paper/altitude_step.yaml" --timeout 5 > "$tmp/plant.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -eq 4 ] || fail "plant exit $rc, expected 4 (docs/reliability.md): $(cat "$tmp/plant.log")"
+    grep -Eq "the controller sent [0-9]+ commands for [0-9]+ control periods, where lockstep expects one each" \
+      "$tmp/plant.log" ||
+      fail "no reason given: $(cat "$tmp/plant.log")"
+    ;;
   identical_all_scenarios) identical_all ;;
   identical_altitude) identical altitude_step ;;
   identical_roll) identical roll_step ;;
