@@ -240,6 +240,7 @@ struct SecurityOptions {
   std::string dir;                        ///< the keystore
   std::string name;                       ///< the enclave (create-enclave, check)
   std::vector<std::string> deny_publish;  ///< create-enclave: ROS topics the enclave may not publish
+  bool read_only = false;                 ///< create-enclave: subscribe only
   int domain_id = -1;                     ///< < 0: ROS_DOMAIN_ID (or 0), as sros2 does
 };
 CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& options);

@@ -54,12 +54,18 @@ CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& o) {
   en->add_option("name", o.name, "enclave name, e.g. /quadcosim/plant")
       ->required()
       ->check(CLI::Validator(check_enclave_name, "ENCLAVE"));
-  en->add_option("--deny-publish", o.deny_publish,
-                 "a ROS topic this enclave may not publish, e.g. /drone/motor_commands (repeatable)");
+  auto* deny = en->add_option("--deny-publish", o.deny_publish,
+                              "a ROS topic this enclave may not publish, e.g. /drone/motor_commands (repeatable); "
+                              "it may then set no node's parameters either (it may still read both)");
+  en->add_flag("--read-only", o.read_only,
+               "subscribe only, e.g. for a monitoring station: read every topic, publish none, call no "
+               "service (no parameter changes)")
+      ->excludes(deny);
   domain(en);
   en->callback([&o] { o.verb = "create-enclave"; });
 
-  auto* chk = sec->add_subcommand("check", "can a node use this enclave? (files present, signatures verify)");
+  auto* chk = sec->add_subcommand(
+      "check", "can a node use this enclave? (files present, signatures verify, XML as signed, keys private)");
   chk->add_option("dir", o.dir, "keystore directory")->required()->check(CLI::ExistingDirectory);
   chk->add_option("name", o.name, "enclave name")->required()->check(CLI::Validator(check_enclave_name, "ENCLAVE"));
   chk->callback([&o] { o.verb = "check"; });
@@ -76,16 +82,22 @@ int security_command(const SecurityOptions& o) {
   if (o.verb == "create-enclave") {
     security::EnclavePolicy policy;
     policy.deny_publish = o.deny_publish;
+    policy.read_only = o.read_only;
     policy.domain_id = domain_or_env(o.domain_id);
     const fs::path dir = security::create_enclave(o.dir, o.name, policy);
-    std::cout << fmt::format(
-        "created enclave {} in {} (domain {}{})\n", o.name, dir.string(), policy.domain_id,
-        o.deny_publish.empty() ? "" : fmt::format(", may not publish {}", fmt::join(o.deny_publish, " ")));
+    std::string limits;
+    if (o.read_only) limits = ", read-only: subscribes to topics, publishes none, calls no service";
+    if (!o.deny_publish.empty()) {
+      limits = fmt::format(", may not publish {} nor set any node's parameters", fmt::join(o.deny_publish, " "));
+    }
+    std::cout << fmt::format("created enclave {} in {} (domain {}{})\n", o.name, dir.string(), policy.domain_id,
+                             limits);
     return exit_code::kOk;
   }
   if (o.verb == "check") {
     const fs::path dir = security::enclave_dir(o.dir, o.name);
-    const auto problems = security::check_enclave(dir);
+    auto problems = security::check_enclave(dir);
+    for (auto& p : security::key_mode_problems(o.dir, dir)) problems.push_back(std::move(p));
     for (const auto& p : problems) std::cout << "problem: " << p << '\n';
     if (problems.empty()) std::cout << "enclave " << o.name << " in " << dir.string() << " is usable\n";
     return problems.empty() ? exit_code::kOk : exit_code::kFailed;

@@ -10,8 +10,15 @@
 #include <openssl/x509.h>
 #include <openssl/x509v3.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <memory>
@@ -59,12 +66,49 @@ std::string read_file(const fs::path& p) {
   return s.str();
 }
 
-void write_file(const fs::path& p, const std::string& text, bool secret = false) {
-  {
-    std::ofstream f(p, std::ios::binary | std::ios::trunc);
-    if (!f || !(f << text) || !f.flush()) throw KeystoreError(p.string() + ": cannot write");
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream f(p, std::ios::binary | std::ios::trunc);
+  if (!f || !(f << text) || !f.flush()) throw KeystoreError(p.string() + ": cannot write");
+}
+
+std::string errno_text(int e) { return std::strerror(e); }
+
+// The process's umask for one scope.
+class ScopedUmask {
+ public:
+  explicit ScopedUmask(mode_t mask) : old_(::umask(mask)) {}
+  ~ScopedUmask() { ::umask(old_); }
+  ScopedUmask(const ScopedUmask&) = delete;
+  ScopedUmask& operator=(const ScopedUmask&) = delete;
+
+ private:
+  mode_t old_;
+};
+
+// Writes private key material to the new file `p`, created 0600 in the same call that creates it
+// (O_CREAT|O_EXCL, umask 077 meanwhile), so that no other user can open it at any moment; never
+// follows a link and never overwrites: an existing `p` is an error. A partly written file is removed.
+// (OpenSSL writes no file here: keys are encoded into memory and written by this function only.)
+void write_secret(const fs::path& p, const std::string& text) {
+  const ScopedUmask mask(077);
+  const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    const int e = errno;
+    throw KeystoreError(p.string() + ": cannot create the key file (" + errno_text(e) +
+                        (e == EEXIST ? "; a key file is never overwritten: remove it first" : "") + ")");
   }
-  if (secret) fs::permissions(p, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  const int write_errno = errno;
+  if (::close(fd) != 0 || done != text.size()) {
+    ::unlink(p.c_str());
+    throw KeystoreError(p.string() + ": cannot write the key file (" + errno_text(write_errno) + ")");
+  }
 }
 
 std::string bio_text(BIO* b) {
@@ -180,6 +224,28 @@ void make_dir(const fs::path& p) {
   if (ec) throw KeystoreError(p.string() + ": cannot create directory: " + ec.message());
 }
 
+// `p` as a folder for keys: created 0700 (its parents as make_dir makes them), or an existing folder
+// of this user set to 0700; one owned by another user is refused (its owner could read our keys).
+void make_private_dir(const fs::path& p) {
+  make_dir(p.parent_path());
+  {
+    const ScopedUmask mask(077);
+    if (::mkdir(p.c_str(), 0700) != 0 && errno != EEXIST) {
+      throw KeystoreError(p.string() + ": cannot create directory: " + errno_text(errno));
+    }
+  }
+  struct stat st {};
+  if (::stat(p.c_str(), &st) != 0) throw KeystoreError(p.string() + ": " + errno_text(errno));
+  if (!S_ISDIR(st.st_mode)) throw KeystoreError(p.string() + ": not a directory");
+  if (st.st_uid != ::geteuid()) {
+    throw KeystoreError(p.string() + ": owned by user id " + std::to_string(st.st_uid) +
+                        ", not by this user; keys are not written into another user's folder");
+  }
+  if ((st.st_mode & 07777) != 0700 && ::chmod(p.c_str(), 0700) != 0) {
+    throw KeystoreError(p.string() + ": cannot set mode 0700: " + errno_text(errno));
+  }
+}
+
 const char kGovernanceHeader[] =
     "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
     "<dds xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
@@ -282,10 +348,21 @@ std::string governance_xml(std::uint32_t domain_id) {
   return x.str();
 }
 
+const std::vector<std::string>& parameter_change_requests() {
+  static const std::vector<std::string> topics = {"rq/*/set_parametersRequest",
+                                                  "rq/*/set_parameters_atomicallyRequest"};
+  return topics;
+}
+
 std::string permissions_xml(const std::string& enclave, const EnclavePolicy& policy, const std::string& not_before,
                             const std::string& not_after) {
   if (const std::string why = enclave_name_error(enclave); !why.empty()) {
     throw KeystoreError("enclave '" + enclave + "': " + why);
+  }
+  if (policy.read_only && !policy.deny_publish.empty()) {
+    throw KeystoreError("enclave '" + enclave +
+                        "': a read-only policy denies every publication already; "
+                        "it takes no topics to deny");
   }
   // SROS2's default policy (topics "/*", services "/*", actions "/*" all allowed), as its
   // permissions.xsl expands it: the same topic set is published and subscribed.
@@ -307,26 +384,44 @@ std::string permissions_xml(const std::string& enclave, const EnclavePolicy& pol
     }
     denied.insert("rt" + topic);
   }
+  // Whoever may set a node's parameters decides what it publishes (a controller's z_des moves the
+  // vehicle as surely as a motor command), and an enclave does not know which node publishes a topic:
+  // denying any topic also denies setting any node's parameters. Getting, listing and describing stay.
+  if (!denied.empty()) denied.insert(parameter_change_requests().begin(), parameter_change_requests().end());
   std::ostringstream x;
   x << kPermissionsHeader << "  <permissions>\n"
     << "    <grant name=\"" << xml_escape(enclave) << "\">\n"
     << "      <subject_name>CN=" << xml_escape(enclave) << "</subject_name>\n"
     << "      <validity>\n        <not_before>" << not_before << "</not_before>\n        <not_after>" << not_after
     << "</not_after>\n      </validity>\n";
-  // Rules are applied in document order and the first that names a topic decides: the deny rule
-  // comes first, as sros2's permissions.xsl places it.
-  if (!denied.empty()) {
-    x << "      <deny_rule>\n";
+  // Rules apply in document order. For a writer (reader) the first rule whose publish (subscribe)
+  // list names the topic decides; whether the topic may be created at all, Cyclone DDS decides by the
+  // first rule naming it in either list. So the denied topics are first allowed for subscribing only
+  // (the enclave still reads them, and serves its own parameters), then denied for publishing, ahead
+  // of the allow rules, as sros2's permissions.xsl places deny rules.
+  if (policy.read_only) {
+    x << "      <allow_rule>\n";
     domains_block(x, policy.domain_id);
-    topics_block(x, "publish", denied);
-    x << "      </deny_rule>\n";
+    topics_block(x, "subscribe", {"rt/*"});
+    x << "      </allow_rule>\n";
+  } else {
+    if (!denied.empty()) {
+      x << "      <allow_rule>\n";
+      domains_block(x, policy.domain_id);
+      topics_block(x, "subscribe", denied);
+      x << "      </allow_rule>\n      <deny_rule>\n";
+      domains_block(x, policy.domain_id);
+      topics_block(x, "publish", denied);
+      x << "      </deny_rule>\n";
+    }
+    x << "      <allow_rule>\n";
+    domains_block(x, policy.domain_id);
+    topics_block(x, "publish", all);
+    topics_block(x, "subscribe", all);
+    x << "      </allow_rule>\n";
   }
-  x << "      <allow_rule>\n";
-  domains_block(x, policy.domain_id);
-  topics_block(x, "publish", all);
-  topics_block(x, "subscribe", all);
-  x << "      </allow_rule>\n";
-  // The ROS graph topic (no rt/ prefix) every rmw with graph information uses.
+  // The ROS graph topic (no rt/ prefix) every rmw with graph information uses; rmw_cyclonedds and
+  // quadcosim's nodes cannot start without its writer. It carries node names, not data.
   x << "      <allow_rule>\n";
   domains_block(x, policy.domain_id);
   topics_block(x, "publish", {"ros_discovery_info"});
@@ -348,11 +443,12 @@ bool is_keystore(const fs::path& dir) {
 
 void create_keystore(const fs::path& dir, std::uint32_t domain_id) {
   if (is_keystore(dir)) throw KeystoreError(dir.string() + ": a keystore exists there already");
-  for (const char* sub : {"public", "private", "enclaves"}) make_dir(dir / sub);
+  for (const char* sub : {"public", "enclaves"}) make_dir(dir / sub);
   const fs::path pub = dir / "public", priv = dir / "private";
+  make_private_dir(priv);
   Own<EVP_PKEY> key = new_ec_key();
   Own<X509> ca = make_cert("sros2CA", key.get(), true, nullptr, key.get());
-  write_file(priv / "ca.key.pem", key_pem(key.get()), true);
+  write_secret(priv / "ca.key.pem", key_pem(key.get()));
   write_file(pub / "ca.cert.pem", cert_pem(ca.get()));
   for (const char* role : {"identity_ca", "permissions_ca"}) {
     symlink_to(pub / "ca.cert.pem", pub / (std::string(role) + ".cert.pem"));
@@ -375,7 +471,7 @@ fs::path create_enclave(const fs::path& dir, const std::string& name, const Encl
   }
   const fs::path pub = dir / "public", priv = dir / "private";
   const fs::path edir = enclave_dir(dir, name);
-  make_dir(edir);
+  make_private_dir(edir);
   symlink_to(pub / "identity_ca.cert.pem", edir / "identity_ca.cert.pem");
   symlink_to(pub / "permissions_ca.cert.pem", edir / "permissions_ca.cert.pem");
   symlink_to(dir / "enclaves" / "governance.p7s", edir / "governance.p7s");
@@ -386,7 +482,8 @@ fs::path create_enclave(const fs::path& dir, const std::string& name, const Encl
     Own<EVP_PKEY> id_ca_key = load_key(priv / "identity_ca.key.pem");
     Own<EVP_PKEY> key = new_ec_key();
     Own<X509> cert = make_cert(name, key.get(), false, id_ca.get(), id_ca_key.get());
-    write_file(edir / "key.pem", key_pem(key.get()), true);
+    fs::remove(edir / "key.pem", ec);  // a key without its certificate is replaced
+    write_secret(edir / "key.pem", key_pem(key.get()));
     write_file(edir / "cert.pem", cert_pem(cert.get()));
   }
   Own<X509> cert = load_cert(edir / "cert.pem");
@@ -416,6 +513,34 @@ std::string verified_smime_content(const fs::path& file, X509* ca) {
                         openssl_error() + ")");
   }
   return bio_text(out.get());
+}
+
+// Where a link chain ends, keeping the caller's spelling of the path (no canonicalisation).
+fs::path resolve_links(fs::path p) {
+  std::error_code ec;
+  for (int hops = 0; hops < 40 && fs::is_symlink(p, ec); ++hops) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = (target.is_absolute() ? target : p.parent_path() / target).lexically_normal();
+  }
+  return p;
+}
+
+// The XML a signed document `p7s` was made from lies beside it (sros2 and `create-*` keep both; for
+// an enclave's governance.p7s, a link, beside the file it links to). Cyclone enforces the signed
+// text, so an XML that says something else misleads whoever reads it: a problem when it differs.
+void check_xml_beside(const fs::path& p7s, std::string signed_text) {
+  const fs::path xml = resolve_links(p7s).replace_extension(".xml");
+  std::error_code ec;
+  if (!fs::is_regular_file(xml, ec)) return;  // rmw does not read it; sros2 writes it
+  std::string text = read_file(xml);
+  // S/MIME text mode signs CRLF line ends; the file may have either.
+  std::erase(signed_text, '\r');
+  std::erase(text, '\r');
+  if (text != signed_text) {
+    throw KeystoreError(xml.string() + ": differs from what " + p7s.filename().string() +
+                        " signs (nodes enforce the signed text: sign this XML again, or restore it)");
+  }
 }
 
 std::string common_name(X509* c) {
@@ -464,9 +589,12 @@ std::vector<std::string> check_enclave(const fs::path& dir) {
     }
   }
   if (perm_ca) {
-    attempt([&] { verified_smime_content(dir / "governance.p7s", perm_ca.get()); });
+    attempt([&] {
+      check_xml_beside(dir / "governance.p7s", verified_smime_content(dir / "governance.p7s", perm_ca.get()));
+    });
     attempt([&] {
       const std::string perms = verified_smime_content(dir / "permissions.p7s", perm_ca.get());
+      check_xml_beside(dir / "permissions.p7s", perms);
       const std::string cn = cert ? common_name(cert.get()) : std::string();
       if (!cn.empty() && perms.find("CN=" + cn) == std::string::npos) {
         throw KeystoreError((dir / "permissions.p7s").string() + ": no grant for the identity's subject CN=" + cn);
@@ -474,6 +602,34 @@ std::vector<std::string> check_enclave(const fs::path& dir) {
     });
   }
   ERR_clear_error();
+  return problems;
+}
+
+std::vector<std::string> key_mode_problems(const fs::path& keystore, const fs::path& enclave) {
+  std::vector<std::string> problems;
+  std::set<std::string> seen;
+  // `p`, when it exists, must give group and others none of the access bits in `loose`.
+  auto check = [&](const fs::path& p, mode_t loose, bool folder) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) != 0) return;  // absent: check_enclave names a missing enclave file
+    const fs::path real = resolve_links(p);
+    if (!seen.insert(real.string()).second) return;
+    const unsigned mode = st.st_mode & 07777;
+    if ((mode & loose) == 0) return;
+    char octal[8];
+    std::snprintf(octal, sizeof octal, "%04o", mode);
+    problems.push_back(real.string() + ": mode " + octal + " lets group or others " +
+                       (folder ? "into a folder of private keys" : "at a private key") + " (want " +
+                       (folder ? "0700: chmod 700 " : "0600: chmod 600 ") + real.string() + ")");
+  };
+  const mode_t kFolderLoose = S_IRGRP | S_IWGRP | S_IROTH | S_IWOTH;  // listing or changing it
+  const mode_t kKeyLoose = S_IRWXG | S_IRWXO;
+  check(enclave, kFolderLoose, true);
+  check(enclave / "key.pem", kKeyLoose, false);
+  check(keystore / "private", kFolderLoose, true);
+  for (const char* key : {"ca.key.pem", "identity_ca.key.pem", "permissions_ca.key.pem"}) {
+    check(keystore / "private" / key, kKeyLoose, false);
+  }
   return problems;
 }
 

@@ -42,13 +42,22 @@ std::filesystem::path enclave_dir(const std::filesystem::path& keystore, const s
 
 /// What an enclave may do. The default is SROS2's default policy: publish and subscribe every topic
 /// (rt/*), call and serve every service (rq/*Request, rr/*Reply) and action, and ros_discovery_info.
+/// docs/security.md lists the DDS topics each policy grants and denies.
 struct EnclavePolicy {
   /// ROS topic names (fully qualified, e.g. "/drone/motor_commands"; DDS wildcards * ? allowed) the
-  /// enclave may NOT publish: a deny rule ahead of the allow rules.
+  /// enclave may NOT publish; when any is given, it may not set any node's parameters either
+  /// (parameter_change_requests()). It may still subscribe them.
   std::vector<std::string> deny_publish;
   /// The DDS domain the grant holds for (sros2 takes ROS_DOMAIN_ID at creation time).
   std::uint32_t domain_id = 0;
+  /// Subscribe only: every topic (rt/*) may be read, nothing written (no topic, no service request
+  /// or reply), except ros_discovery_info, which carries the node's name. Excludes deny_publish.
+  bool read_only = false;
 };
+
+/// The DDS request topics that change a node's parameters (set_parameters, set_parameters_atomically
+/// of every node), denied with any deny_publish.
+const std::vector<std::string>& parameter_change_requests();
 
 /// The governance document sros2 writes: no unauthenticated participants, join access control,
 /// discovery and liveliness ENCRYPT, RTPS SIGN, every topic with read/write access control and
@@ -65,12 +74,15 @@ std::string permissions_xml(const std::string& enclave, const EnclavePolicy& pol
 bool is_keystore(const std::filesystem::path& dir);
 
 /// Creates a keystore in `dir` (created when missing) for `domain_id`: CA, governance. Throws when
-/// `dir` already is a keystore (nothing is overwritten).
+/// `dir` already is a keystore (nothing is overwritten). private/ is made 0700 (also when it existed)
+/// and its key is created 0600 (O_CREAT|O_EXCL, umask 077): never readable by others, not for an
+/// instant; an existing private/ca.key.pem is an error, never overwritten.
 void create_keystore(const std::filesystem::path& dir, std::uint32_t domain_id);
 
 /// Creates (or updates) enclave `name` in keystore `dir`: identity key and certificate when they do
 /// not exist yet (kept otherwise, as sros2 does), CA and governance links, permissions.xml and
-/// permissions.p7s always rewritten from `policy`. Returns the enclave's directory.
+/// permissions.p7s always rewritten from `policy`. Returns the enclave's directory, made 0700 (also
+/// when it existed), with key.pem created 0600 as create_keystore creates the CA key.
 std::filesystem::path create_enclave(const std::filesystem::path& dir, const std::string& name,
                                      const EnclavePolicy& policy);
 
@@ -78,9 +90,16 @@ std::filesystem::path create_enclave(const std::filesystem::path& dir, const std
 /// a missing file, a PEM that does not parse, an identity certificate that does not verify against
 /// identity_ca.cert.pem or is outside its validity, a key that does not belong to the certificate,
 /// a governance or permissions document whose S/MIME signature does not verify against
-/// permissions_ca.cert.pem, a permissions document without a grant for the certificate's subject.
-/// Empty when the enclave is usable.
+/// permissions_ca.cert.pem, a permissions document without a grant for the certificate's subject,
+/// a governance.xml or permissions.xml (beside the .p7s, or beside the file it links to) whose text
+/// is not the text signed. Empty when the enclave is usable.
 std::vector<std::string> check_enclave(const std::filesystem::path& dir);
+
+/// Every private key or folder of keys that group or others may use, each naming the path, its mode
+/// and the mode wanted: `enclave` (any group/other read or write bit) and its key.pem (any group/other
+/// bit), `keystore`/private and the CA keys in it (links followed). Paths that do not exist are
+/// skipped (a vehicle's machine may hold one enclave and no private/). Empty when all are private.
+std::vector<std::string> key_mode_problems(const std::filesystem::path& keystore, const std::filesystem::path& enclave);
 
 /// The file names an enclave directory needs (rmw_dds_common's list), in the order checked.
 const std::vector<std::string>& enclave_files();

@@ -2,9 +2,19 @@
 // x509, pkey), and against the layout and rules SROS2 and rcl document.
 #include "security/keystore.hpp"
 
+#include <fcntl.h>
+#include <fnmatch.h>
+#include <grp.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/inotify.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <atomic>
+#include <map>
 
 #include <array>
 #include <cstdio>
@@ -76,6 +86,7 @@ class KeystoreTest : public ::testing::Test {
     create_keystore(*dir_, 42);
     create_enclave(*dir_, "/quadcosim/plant", {{}, 42});
     create_enclave(*dir_, "/rogue", {{"/drone/motor_commands"}, 42});
+    create_enclave(*dir_, "/monitor", {{}, 42, true});
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
@@ -84,6 +95,7 @@ class KeystoreTest : public ::testing::Test {
   static const fs::path& ks() { return *dir_; }
   static fs::path plant() { return ks() / "enclaves" / "quadcosim" / "plant"; }
   static fs::path rogue() { return ks() / "enclaves" / "rogue"; }
+  static fs::path monitor() { return ks() / "enclaves" / "monitor"; }
 
  private:
   static fs::path* dir_;
@@ -243,16 +255,105 @@ TEST_F(KeystoreTest, PermissionsForTheEnclave) {
   EXPECT_NE(p.find("<not_after>" + iso(openssl_date(d.out, "notAfter")) + "</not_after>"), std::string::npos) << p;
 }
 
-TEST_F(KeystoreTest, DenyPublishComesFirst) {
+// The rules of a permissions document, evaluated as the DDS Security specification (9.4.1.3) and
+// Cyclone DDS's access control plugin apply them: for a writer (reader), the first rule whose
+// publish (subscribe) list matches the topic (fnmatch, '*' also across '/') decides; whether the
+// topic may be created at all, the first rule naming it in either list; otherwise <default>.
+class Grant {
+ public:
+  explicit Grant(const std::string& xml) {
+    EXPECT_NE(xml.find("<default>DENY</default>"), std::string::npos);
+    for (std::size_t at = 0;;) {
+      const auto allow = xml.find("<allow_rule>", at), deny = xml.find("<deny_rule>", at);
+      if (allow == std::string::npos && deny == std::string::npos) break;
+      Rule r;
+      r.allow = allow < deny;
+      const auto begin = std::min(allow, deny);
+      const auto end = xml.find(r.allow ? "</allow_rule>" : "</deny_rule>", begin);
+      const std::string body = xml.substr(begin, end - begin);
+      r.publish = topics(body, "publish");
+      r.subscribe = topics(body, "subscribe");
+      rules_.push_back(r);
+      at = end;
+    }
+  }
+  bool may_write(const std::string& topic) const { return decide(topic, true, false); }
+  bool may_read(const std::string& topic) const { return decide(topic, false, true); }
+  bool may_create_topic(const std::string& topic) const { return decide(topic, true, true); }
+
+ private:
+  struct Rule {
+    bool allow = false;
+    std::vector<std::string> publish, subscribe;
+  };
+  static std::vector<std::string> topics(const std::string& body, const std::string& kind) {
+    std::vector<std::string> out;
+    const auto begin = body.find("<" + kind + ">");
+    if (begin == std::string::npos) return out;
+    const auto end = body.find("</" + kind + ">", begin);
+    for (auto at = body.find("<topic>", begin); at < end; at = body.find("<topic>", at + 1)) {
+      const auto from = at + 7;
+      out.push_back(body.substr(from, body.find("</topic>", from) - from));
+    }
+    return out;
+  }
+  static bool names(const std::vector<std::string>& patterns, const std::string& topic) {
+    for (const auto& p : patterns) {
+      if (fnmatch(p.c_str(), topic.c_str(), 0) == 0) return true;
+    }
+    return false;
+  }
+  bool decide(const std::string& topic, bool publish, bool subscribe) const {
+    for (const Rule& r : rules_) {
+      if ((publish && names(r.publish, topic)) || (subscribe && names(r.subscribe, topic))) return r.allow;
+    }
+    return false;  // <default>DENY</default>
+  }
+  std::vector<Rule> rules_;
+};
+
+TEST_F(KeystoreTest, WhatEachPolicyGrants) {
+  const Grant all(slurp(plant() / "permissions.xml"));
+  const Grant deny(slurp(rogue() / "permissions.xml"));  // --deny-publish /drone/motor_commands
+  const Grant ro(slurp(monitor() / "permissions.xml"));  // --read-only
+  struct Row {
+    std::string topic;
+    bool deny_write, deny_read, ro_write, ro_read;
+  };
+  // DDS topic names as ROS 2 puts them on the wire.
+  const std::vector<Row> rows = {
+      {"rt/drone/motor_commands", false, true, false, true},
+      {"rt/drone/Pose", true, true, false, true},
+      {"rt/drone/Imu", true, true, false, true},
+      {"rt/uav1/drone/Imu", true, true, false, true},
+      {"rt/clock", true, true, false, true},
+      {"rt/parameter_events", true, true, false, true},
+      {"rq/attitude_controller/set_parametersRequest", false, true, false, false},
+      {"rq/uav1/attitude_controller/set_parameters_atomicallyRequest", false, true, false, false},
+      {"rq/attitude_controller/get_parametersRequest", true, true, false, false},
+      {"rq/attitude_controller/list_parametersRequest", true, true, false, false},
+      {"rr/attitude_controller/set_parametersReply", true, true, false, false},
+      {"rq/nav/_action/send_goalRequest", true, true, false, false},
+      {"ros_discovery_info", true, true, true, true},
+  };
+  for (const Row& r : rows) {
+    EXPECT_TRUE(all.may_write(r.topic) && all.may_read(r.topic)) << r.topic;
+    EXPECT_EQ(deny.may_write(r.topic), r.deny_write) << "--deny-publish, write " << r.topic;
+    EXPECT_EQ(deny.may_read(r.topic), r.deny_read) << "--deny-publish, read " << r.topic;
+    EXPECT_EQ(ro.may_write(r.topic), r.ro_write) << "--read-only, write " << r.topic;
+    EXPECT_EQ(ro.may_read(r.topic), r.ro_read) << "--read-only, read " << r.topic;
+    // Cyclone refuses a reader or writer whose topic it may not create: every topic read is creatable.
+    if (r.deny_read) EXPECT_TRUE(deny.may_create_topic(r.topic)) << r.topic;
+    if (r.ro_read) EXPECT_TRUE(ro.may_create_topic(r.topic)) << r.topic;
+  }
+  // Only the denied topics are named ahead of the sros2 default rule; no subscribe is denied.
   const std::string p = slurp(rogue() / "permissions.xml");
-  const auto deny = p.find("<deny_rule>"), allow = p.find("<allow_rule>");
-  ASSERT_NE(deny, std::string::npos);
-  ASSERT_NE(allow, std::string::npos);
-  EXPECT_LT(deny, allow);  // rules apply in order: the first naming a topic decides
-  const std::string rule = p.substr(deny, p.find("</deny_rule>") - deny);
-  EXPECT_NE(rule.find("<publish>"), std::string::npos);
+  const std::string rule = p.substr(p.find("<deny_rule>"), p.find("</deny_rule>") - p.find("<deny_rule>"));
   EXPECT_EQ(rule.find("<subscribe>"), std::string::npos);
-  EXPECT_NE(rule.find("<topic>rt/drone/motor_commands</topic>"), std::string::npos);
+  EXPECT_EQ(count(rule, "<topic>"), 3u) << rule;
+  EXPECT_THROW(
+      permissions_xml("/m", {{"/drone/motor_commands"}, 0, true}, "2026-01-01T00:00:00", "2036-01-01T00:00:00"),
+      KeystoreError);
 }
 
 TEST_F(KeystoreTest, CreatingAnEnclaveAgainKeepsItsIdentity) {
@@ -296,6 +397,185 @@ TEST_F(KeystoreTest, CheckNamesWhatIsWrong) {
   EXPECT_NE(joined().find("governance.p7s: missing"), std::string::npos) << joined();
   fs::remove_all(bad);
   EXPECT_NE(check_enclave(bad).at(0).find("no such directory"), std::string::npos);
+}
+
+// ---- keys are never readable by others ------------------------------------------------------------
+
+// Sets the process's umask for one scope.
+class ScopedUmask {
+ public:
+  explicit ScopedUmask(mode_t mask) : old_(umask(mask)) {}
+  ~ScopedUmask() { umask(old_); }
+  ScopedUmask(const ScopedUmask&) = delete;
+  ScopedUmask& operator=(const ScopedUmask&) = delete;
+
+ private:
+  mode_t old_;
+};
+
+unsigned mode_of(const fs::path& p) {
+  struct stat st {};
+  EXPECT_EQ(stat(p.c_str(), &st), 0) << p;
+  return st.st_mode & 07777;
+}
+
+// What inotify saw happen to each name in the watched directories: created, attributes changed.
+struct Seen {
+  int created = 0;
+  int attrib = 0;
+};
+
+std::map<std::string, Seen> drain(int fd, const std::map<int, std::string>& dirs) {
+  std::map<std::string, Seen> seen;
+  alignas(inotify_event) char buf[65536];
+  for (ssize_t n; (n = read(fd, buf, sizeof buf)) > 0;) {
+    for (char* at = buf; at < buf + n;) {
+      const auto* ev = reinterpret_cast<const inotify_event*>(at);
+      if (ev->len > 0) {
+        Seen& s = seen[dirs.at(ev->wd) + "/" + ev->name];
+        if (ev->mask & IN_CREATE) ++s.created;
+        if (ev->mask & IN_ATTRIB) ++s.attrib;
+      }
+      at += sizeof(inotify_event) + ev->len;
+    }
+  }
+  return seen;
+}
+
+// A private key's mode can only come from its creation or a later chmod, and inotify reports every
+// chmod (IN_ATTRIB). A key that ends at 0600 without any IN_ATTRIB since its IN_CREATE was created
+// 0600: never, not for a microsecond, readable by others. Under umask 022, as most users have it.
+TEST(KeyFiles, CreatedWithMode0600UnderUmask022) {
+  ScopedUmask mask(022);
+  const fs::path ks = fs::temp_directory_path() / ("quadcosim_keymodes_" + std::to_string(getpid()));
+  fs::remove_all(ks);
+  // The directories exist before (as an attacker or an earlier run may have left them, 0755), so
+  // that inotify watches them from before the first key.
+  fs::create_directories(ks / "private");
+  fs::create_directories(ks / "enclaves" / "monitor");
+  ASSERT_EQ(mode_of(ks / "private"), 0755u);
+  const int fd = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  std::map<int, std::string> dirs;
+  for (const char* d : {"private", "enclaves/monitor"}) {
+    const int wd = inotify_add_watch(fd, (ks / d).c_str(), IN_CREATE | IN_ATTRIB);
+    ASSERT_GE(wd, 0) << d;
+    dirs[wd] = d;
+  }
+  create_keystore(ks, 7);
+  create_enclave(ks, "/monitor", {{}, 7});
+  const auto seen = drain(fd, dirs);
+  close(fd);
+  for (const char* key : {"private/ca.key.pem", "enclaves/monitor/key.pem"}) {
+    ASSERT_TRUE(seen.count(key)) << key << " was not created in the watched directory";
+    EXPECT_EQ(seen.at(key).created, 1) << key;
+    EXPECT_EQ(seen.at(key).attrib, 0) << key << ": its mode or owner changed after creation (created readable?)";
+    EXPECT_EQ(mode_of(ks / key), 0600u) << key;
+  }
+  // The folders that hold keys: the owner's only, also when they existed with a looser mode.
+  EXPECT_EQ(mode_of(ks / "private"), 0700u);
+  EXPECT_EQ(mode_of(ks / "enclaves" / "monitor"), 0700u);
+  fs::remove_all(ks);
+}
+
+// An attacker's view: another local user (nobody) opens the key files as fast as it can while
+// keystores and enclaves are made under umask 022; any descriptor it gets is a copied key. Needs
+// root (to become nobody).
+TEST(KeyFiles, AnotherUserNeverOpensAKey) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to run the reader as the user nobody";
+  ScopedUmask mask(022);
+  constexpr int kRounds = 40;
+  const fs::path base = fs::temp_directory_path() / ("quadcosim_keyrace_" + std::to_string(getpid()));
+  fs::remove_all(base);
+  fs::create_directories(base);
+  fs::permissions(base, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                            fs::perms::others_exec);
+  // Shared with the reader: the round being made (-1: stop) and the keys it opened.
+  struct Shared {
+    std::atomic<int> round;
+    std::atomic<int> opened;
+    std::atomic<int> nonempty;
+  };
+  void* mem = mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(mem, MAP_FAILED);
+  auto* shared = new (mem) Shared{{0}, {0}, {0}};
+  auto paths = [&](int round) {
+    const fs::path ks = base / ("ks" + std::to_string(round));
+    return std::array<std::string, 2>{(ks / "private" / "ca.key.pem").string(),
+                                      (ks / "enclaves" / "monitor" / "key.pem").string()};
+  };
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (setgroups(0, nullptr) != 0 || setgid(65534) != 0 || setuid(65534) != 0) _exit(3);
+    std::map<std::string, int> fds;  // one descriptor per key file opened
+    for (int r; (r = shared->round.load()) >= 0;) {
+      for (const auto& p : paths(r)) {
+        if (fds.count(p)) continue;
+        const int f = open(p.c_str(), O_RDONLY | O_CLOEXEC);
+        if (f >= 0) fds[p] = f;
+      }
+    }
+    // Read what the descriptors hold now that the writer has finished.
+    for (const auto& [path, f] : fds) {
+      char c;
+      shared->opened.fetch_add(1);
+      if (pread(f, &c, 1, 0) == 1) shared->nonempty.fetch_add(1);
+    }
+    _exit(0);
+  }
+  for (int r = 0; r < kRounds; ++r) {
+    shared->round.store(r);
+    const fs::path ks = base / ("ks" + std::to_string(r));
+    create_keystore(ks, 7);
+    create_enclave(ks, "/monitor", {{}, 7});
+  }
+  shared->round.store(-1);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << status;
+  ASSERT_EQ(WEXITSTATUS(status), 0) << "the reader could not become nobody";
+  EXPECT_EQ(shared->opened.load(), 0) << "nobody opened " << shared->opened.load() << " key files ("
+                                      << shared->nonempty.load() << " with the key in them) of " << 2 * kRounds;
+  shared->~Shared();
+  munmap(mem, sizeof(Shared));
+  fs::remove_all(base);
+}
+
+// ---- the XML beside a signature is what is signed ------------------------------------------------
+
+TEST_F(KeystoreTest, CheckRefusesAnXmlThatDiffersFromItsSignature) {
+  const fs::path bad = ks() / "enclaves" / "quadcosim" / "edited";  // beside plant: its relative links hold
+  fs::remove_all(bad);
+  fs::create_directories(bad);
+  for (const auto& f : enclave_files()) fs::copy(plant() / f, bad / f, fs::copy_options::copy_symlinks);
+  fs::copy(plant() / "permissions.xml", bad / "permissions.xml");
+  auto joined = [&] {
+    std::string s;
+    for (const auto& p : check_enclave(bad)) s += p + "\n";
+    return s;
+  };
+  ASSERT_EQ(joined(), "");
+  // A user edits permissions.xml (here: allows everything by default) and does not sign it again.
+  std::string xml = slurp(bad / "permissions.xml");
+  xml.replace(xml.find("<default>DENY</default>"), 23, "<default>ALLOW</default>");
+  std::ofstream(bad / "permissions.xml", std::ios::trunc) << xml;
+  EXPECT_NE(joined().find((bad / "permissions.xml").string() + ": differs from what permissions.p7s signs"),
+            std::string::npos)
+      << joined();
+  fs::copy(plant() / "permissions.xml", bad / "permissions.xml", fs::copy_options::overwrite_existing);
+  EXPECT_EQ(joined(), "");
+  // The governance: the enclave's governance.p7s links to enclaves/governance.p7s, beside which
+  // governance.xml lies.
+  const fs::path gov = ks() / "enclaves" / "governance.xml";
+  const std::string original = slurp(gov);
+  std::string edited = original;
+  edited.replace(edited.find("<rtps_protection_kind>SIGN"), 26, "<rtps_protection_kind>NONE");
+  std::ofstream(gov, std::ios::trunc) << edited;
+  EXPECT_NE(joined().find(gov.string() + ": differs from what governance.p7s signs"), std::string::npos) << joined();
+  std::ofstream(gov, std::ios::trunc) << original;
+  EXPECT_EQ(joined(), "");
+  fs::remove_all(bad);
 }
 
 }  // namespace

@@ -92,8 +92,8 @@ case "$case_name" in
     set -e
     [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "the denied controller ran (exit $rc)"
     grep -q "security (Enforce): enclave /rogue" "$tmp/rogue.log" || fail "the rogue did not authenticate"
-    grep -q "rt/drone/motor_commands failed: Not Allowed By Security" "$tmp/rogue.log" \
-      || fail "no access-control refusal naming rt/drone/motor_commands"
+    grep -q "drone/motor_commands failed: Not Allowed By Security" "$tmp/rogue.log" \
+      || fail "no access-control refusal naming /drone/motor_commands"
     # A participant that skips that local check: its own governance (signed with the CA key, which a
     # real intruder would not have) leaves the command topic unprotected, so it creates its writer;
     # the plant, under the keystore's governance, refuses to match it.
@@ -196,6 +196,107 @@ EOF
     grep -q "security (Enforce): enclave /quadcosim/controller" "$tmp/sec.log" || fail "controller not secured"
     openssl verify -CAfile "$ks/public/ca.cert.pem" "$ks/enclaves/quadcosim/plant/cert.pem" > "$tmp/verify.log" 2>&1 \
       || fail "our identity does not verify against the openssl-made CA"
+    ;;
+
+  read_only_monitor)  # --read-only: a monitoring station reads everything and can move nothing
+    "$bin" security create-keystore "$ks" > "$tmp/ks.log" 2>&1 || fail "create-keystore failed"
+    for e in /quadcosim/plant /quadcosim/controller /tools; do
+      "$bin" security create-enclave "$ks" "$e" >> "$tmp/ks.log" 2>&1 || fail "create-enclave $e failed"
+    done
+    "$bin" security create-enclave "$ks" /monitor --read-only >> "$tmp/ks.log" 2>&1 \
+      || fail "create-enclave --read-only failed"
+    "$bin" security check "$ks" /monitor > "$tmp/check.log" 2>&1 || fail "the /monitor enclave is not usable"
+    start_secured_plant 5
+    secure /quadcosim/controller "$bin" controller --scenario "$scenario" --realtime > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    in_monitor() { timeout 20 bash -c "$(declare -f secure); ks='$ks'; secure /monitor $*"; }
+    # It reads: the pose and the motor commands.
+    in_monitor "'$bin' topic echo /drone/Pose --count 1 --wait 5" > "$tmp/monitor_pose.log" 2>&1 \
+      || fail "the monitor cannot read /drone/Pose"
+    grep -q "frame_id: world" "$tmp/monitor_pose.log" || fail "the monitor printed no pose"
+    in_monitor "'$bin' topic echo /drone/motor_commands --count 1 --wait 5" > "$tmp/monitor_cmd.log" 2>&1 \
+      || fail "the monitor cannot read /drone/motor_commands"
+    # It writes nothing: a parameter change (the attack: z_des 8.0), motor commands, sensor messages.
+    refused_in_monitor() {  # refused_in_monitor LOG COMMAND...: exits non-zero, refused by access control
+      local log="$1"; shift
+      set +e
+      in_monitor "$*" > "$tmp/$log" 2>&1
+      local rc=$?
+      set -e
+      [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "the monitor ran '$*' (exit $rc)"
+      grep -q "Not Allowed By Security" "$tmp/$log" || fail "'$*' was not refused by access control"
+    }
+    refused_in_monitor monitor_param.log "'$bin' param set /attitude_controller z_des 8.0"
+    grep -q "rq/attitude_controller/set_parametersRequest" "$tmp/monitor_param.log" \
+      || fail "the parameter refusal does not name the request topic"
+    refused_in_monitor monitor_controller.log "'$bin' controller --scenario '$scenario' --realtime"
+    refused_in_monitor monitor_plant.log "'$bin' plant --scenario '$scenario' --realtime --duration 1"
+    # The controller's z_des is the scenario's 10 m, not the monitor's 8 m (read with a full enclave).
+    timeout 20 bash -c "$(declare -f secure); ks='$ks'; secure /tools '$bin' param get /attitude_controller z_des" \
+      > "$tmp/get.log" 2>&1 || fail "param get from /tools failed"
+    grep -qx "Double value is: 10.0" "$tmp/get.log" || fail "z_des changed: $(cat "$tmp/get.log")"
+    finish_plant
+    ;;
+
+  deny_publish_params)  # --deny-publish also denies setting parameters; the topic stays readable
+    "$bin" security create-keystore "$ks" > "$tmp/ks.log" 2>&1 || fail "create-keystore failed"
+    for e in /quadcosim/plant /quadcosim/controller; do
+      "$bin" security create-enclave "$ks" "$e" >> "$tmp/ks.log" 2>&1 || fail "create-enclave $e failed"
+    done
+    "$bin" security create-enclave "$ks" /station --deny-publish /drone/motor_commands >> "$tmp/ks.log" 2>&1 \
+      || fail "create-enclave --deny-publish failed"
+    start_secured_plant 5
+    secure /quadcosim/controller "$bin" controller --scenario "$scenario" --realtime > "$tmp/controller.log" 2>&1 &
+    pids+=($!)
+    in_station() { timeout 20 bash -c "$(declare -f secure); ks='$ks'; secure /station $*"; }
+    set +e
+    in_station "'$bin' param set /attitude_controller z_des 8.0" > "$tmp/station_set.log" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "the station set a controller parameter (exit $rc)"
+    grep -q "rq/attitude_controller/set_parametersRequest failed: Not Allowed By Security" "$tmp/station_set.log" \
+      || fail "the parameter change was not refused by access control"
+    # Reading parameters and the denied topic itself stays allowed.
+    in_station "'$bin' param get /attitude_controller z_des" > "$tmp/station_get.log" 2>&1 \
+      || fail "the station cannot read a parameter"
+    grep -qx "Double value is: 10.0" "$tmp/station_get.log" || fail "z_des changed: $(cat "$tmp/station_get.log")"
+    in_station "'$bin' topic echo /drone/motor_commands --count 1 --wait 5" > "$tmp/station_cmd.log" 2>&1 \
+      || fail "the station cannot read /drone/motor_commands"
+    finish_plant
+    ;;
+
+  check_loose)  # create-* make keys 0600 in 0700 folders; check refuses looser modes and unsigned edits
+    ( umask 022
+      "$bin" security create-keystore "$ks" > "$tmp/ks.log" 2>&1
+      "$bin" security create-enclave "$ks" /quadcosim/plant >> "$tmp/ks.log" 2>&1 ) || fail "create-* failed"
+    edir="$ks/enclaves/quadcosim/plant"
+    for f in "$ks/private:700" "$ks/private/ca.key.pem:600" "$edir:700" "$edir/key.pem:600"; do
+      [ "$(stat -c %a "${f%:*}")" = "${f##*:}" ] || fail "${f%:*}: mode $(stat -c %a "${f%:*}"), want ${f##*:}"
+    done
+    "$bin" security check "$ks" /quadcosim/plant > "$tmp/check.log" 2>&1 || fail "a fresh enclave fails the check"
+    expect_problem() {  # expect_problem TEXT: security check exits 1 naming TEXT on a problem: line
+      set +e
+      "$bin" security check "$ks" /quadcosim/plant > "$tmp/check.log" 2>&1
+      local rc=$?
+      set -e
+      [ "$rc" -eq 1 ] || fail "security check: expected exit 1, got $rc"
+      grep -F "problem: " "$tmp/check.log" | grep -qF -- "$1" || fail "security check does not name '$1'"
+    }
+    for f in "$edir/key.pem:644:600" "$edir/key.pem:660:600" "$edir:755:700" "$edir:770:700" \
+             "$ks/private:755:700" "$ks/private/ca.key.pem:604:600"; do
+      IFS=: read -r path loose tight <<< "$f"
+      chmod "$loose" "$path"
+      expect_problem "$path: mode 0$loose"
+      chmod "$tight" "$path"
+    done
+    "$bin" security check "$ks" /quadcosim/plant > "$tmp/check.log" 2>&1 || fail "check fails after the modes are fixed"
+    # permissions.xml edited without signing it again: what Cyclone enforces is not what it says.
+    cp "$edir/permissions.xml" "$tmp/permissions.xml"
+    sed -i 's|<default>DENY</default>|<default>ALLOW</default>|' "$edir/permissions.xml"
+    expect_problem "$edir/permissions.xml: differs from what permissions.p7s signs"
+    cp "$tmp/permissions.xml" "$edir/permissions.xml"
+    sed -i 's|<rtps_protection_kind>SIGN|<rtps_protection_kind>NONE|' "$ks/enclaves/governance.xml"
+    expect_problem "$ks/enclaves/governance.xml: differs from what governance.p7s signs"
     ;;
 
   *) echo "unknown case $case_name"; exit 2 ;;
