@@ -15,6 +15,7 @@
 #include "control/controller_config.hpp"
 #include "fmi/isolated_instance.hpp"
 #include "fmi/quadrotor_variables.hpp"
+#include "sim/controller_node.hpp"
 
 namespace quadcosim::fmi {
 
@@ -321,13 +322,13 @@ void FmuController::step(const control::Observation& o, const control::Reference
     instance_->get_real(shared_->out_vrs, out_);
   } catch (const std::exception& e) {
     const std::string logged = log_ ? log_->text() : "";
-    throw std::runtime_error(fmt::format("{}: control step {} (t = {:g} s) failed: {}{}", describe(), steps_, t,
-                                         e.what(), logged.empty() ? "" : " (the FMU logged: " + logged + ")"));
+    throw sim::ControllerFailure(fmt::format("{}: control step {} (t = {:g} s) failed: {}{}", describe(), steps_, t,
+                                             e.what(), logged.empty() ? "" : " (the FMU logged: " + logged + ")"));
   }
   for (std::size_t i = 0; i < 4; ++i) {
     if (!std::isfinite(out_[i])) {
-      throw std::runtime_error(fmt::format("{}: control step {} (t = {:g} s): output '{}' is {}; not commanded",
-                                           describe(), steps_, t, shared_->out_names[i], out_[i]));
+      throw sim::ControllerFailure(fmt::format("{}: control step {} (t = {:g} s): output '{}' is {}; not commanded",
+                                               describe(), steps_, t, shared_->out_names[i], out_[i]));
     }
   }
   ++steps_;

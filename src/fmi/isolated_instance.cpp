@@ -122,10 +122,9 @@ std::string describe_end(int status) {
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     const char* name = strsignal(sig);
-    return fmt::format("was killed by signal {} ({}){}", sig, name != nullptr ? name : "?",
-                       sig == SIGSEGV || sig == SIGBUS || sig == SIGABRT || sig == SIGFPE || sig == SIGILL
-                           ? ": the FMU crashed"
-                           : "");
+    return fmt::format(
+        "was killed by signal {} ({}){}", sig, name != nullptr ? name : "?",
+        sig == SIGSEGV || sig == SIGBUS || sig == SIGABRT || sig == SIGFPE || sig == SIGILL ? ": the FMU crashed" : "");
   }
   return fmt::format("ended (wait status {})", status);
 }
@@ -246,7 +245,10 @@ std::string describe_end(int status) {
 class IsolatedInstance final : public Instance {
  public:
   IsolatedInstance(const std::shared_ptr<Fmu>& fmu, const std::string& name, LogSink log)
-      : Instance(fmu), name_(name), log_(std::move(log)), prefix_(fmu->description().version == FmiVersion::k2 ? "fmi2" : "fmi3") {
+      : Instance(fmu),
+        name_(name),
+        log_(std::move(log)),
+        prefix_(fmu->description().version == FmiVersion::k2 ? "fmi2" : "fmi3") {
     int fds[2];
     if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds) != 0) {
       throw FmuError(fmt::format("FMU '{}': cannot make a socket pair for its process: {}",
@@ -262,8 +264,8 @@ class IsolatedInstance final : public Instance {
       const int err = errno;
       ::close(fds[0]);
       ::close(fds[1]);
-      throw FmuError(fmt::format("FMU '{}': cannot start its process: {}", fmu->description().model_name,
-                                 std::strerror(err)));
+      throw FmuError(
+          fmt::format("FMU '{}': cannot start its process: {}", fmu->description().model_name, std::strerror(err)));
     }
     if (pid_ == 0) {
       ::prctl(PR_SET_PDEATHSIG, SIGKILL);
@@ -313,10 +315,11 @@ class IsolatedInstance final : public Instance {
   }
 
   void enter_initialization(double start_time_s, std::optional<double> stop_time_s) override {
-    call([&] { return fmt::format("{}EnterInitializationMode(t = {:g})", prefix_, start_time_s); },
-         [&](Writer& w) {
-           w.put(Op::kEnterInitialization).put(start_time_s).put(stop_time_s.has_value()).put(stop_time_s.value_or(0.0));
-         });
+    call(
+        [&] { return fmt::format("{}EnterInitializationMode(t = {:g})", prefix_, start_time_s); },
+        [&](Writer& w) {
+          w.put(Op::kEnterInitialization).put(start_time_s).put(stop_time_s.has_value()).put(stop_time_s.value_or(0.0));
+        });
   }
   void exit_initialization() override {
     call([&] { return prefix_ + "ExitInitializationMode"; }, [](Writer& w) { w.put(Op::kExitInitialization); });
@@ -382,7 +385,7 @@ class IsolatedInstance final : public Instance {
   }
 
   void forward_log(const std::vector<std::uint8_t>& in) {
-    Reader r(std::span(in).subspan(1));
+    Reader r(std::span<const std::uint8_t>(in).subspan(1));
     const std::string category = r.text(), status = r.text(), message = r.text();
     last_logged_ = fmt::format("[{}] {}", status, message);
     if (log_) {
@@ -435,7 +438,7 @@ class IsolatedInstance final : public Instance {
         continue;
       }
       if (answer_[0] == kFailed) {
-        Reader r(std::span(answer_).subspan(1));
+        Reader r(std::span<const std::uint8_t>(answer_).subspan(1));
         throw FmuError(r.text());
       }
       return Reader(std::span<const std::uint8_t>(answer_).subspan(1));
@@ -449,8 +452,9 @@ class IsolatedInstance final : public Instance {
     }
     reaped_ = ended_ = true;
     end_ = r == pid_ ? describe_end(status) : "ended";
-    throw FmuError(fmt::format("{} of {}: the FMU's process {}{}", call_text, who(), end_,
-                               last_logged_.empty() ? "; the FMU logged nothing" : "; it logged last: " + last_logged_));
+    throw FmuError(
+        fmt::format("{} of {}: the FMU's process {}{}", call_text, who(), end_,
+                    last_logged_.empty() ? "; the FMU logged nothing" : "; it logged last: " + last_logged_));
   }
 
   std::string name_;
