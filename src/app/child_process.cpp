@@ -4,7 +4,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,18 +20,59 @@ extern char** environ;
 namespace quadcosim::app {
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::string& output_path) {
+  // Everything the child needs is made before fork(): between fork and exec only async-signal-safe
+  // calls are allowed (this process may have threads).
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
+  int out_fd = -1;
   if (!output_path.empty()) {
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    out_fd = ::open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (out_fd < 0) throw std::runtime_error("cannot open " + output_path + ": " + std::strerror(errno));
   }
-  const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
+  // A pipe that exec closes: the child writes errno into it when exec fails.
+  int status_pipe[2];
+  if (::pipe2(status_pipe, O_CLOEXEC) != 0) {
+    if (out_fd >= 0) ::close(out_fd);
+    throw std::runtime_error(std::string("cannot start ") + argv[0] + ": " + std::strerror(errno));
+  }
+  std::cout.flush();
+  std::cerr.flush();
+  const pid_t parent = ::getpid();
+  pid_ = ::fork();
+  if (pid_ == 0) {
+    // Die with the parent, however it ends (SIGKILL included); if it is already gone, do not start.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) _exit(127);
+    // The parent's SIGINT/SIGTERM handlers do not survive exec; dispositions and the mask reset.
+    sigset_t none;
+    sigemptyset(&none);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    if (out_fd >= 0) {
+      ::dup2(out_fd, STDOUT_FILENO);
+      ::dup2(out_fd, STDERR_FILENO);
+    }
+    ::execve(args[0], args.data(), environ);
+    const int err = errno;
+    [[maybe_unused]] const ssize_t n = ::write(status_pipe[1], &err, sizeof err);
+    _exit(127);
+  }
+  const int fork_errno = errno;
+  ::close(status_pipe[1]);
+  if (out_fd >= 0) ::close(out_fd);
+  if (pid_ < 0) {
+    ::close(status_pipe[0]);
+    throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(fork_errno));
+  }
+  int exec_errno = 0;
+  ssize_t n;
+  while ((n = ::read(status_pipe[0], &exec_errno, sizeof exec_errno)) < 0 && errno == EINTR) {
+  }
+  ::close(status_pipe[0]);
+  if (n == static_cast<ssize_t>(sizeof exec_errno)) {
+    wait(10.0);
+    throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(exec_errno));
+  }
 }
 
 ChildProcess::~ChildProcess() {
@@ -73,6 +114,17 @@ std::string self_executable() {
   return std::string(buf, static_cast<std::size_t>(n));
 }
 
+namespace {
+/// "exited with status 3", "was killed by signal 9 (Killed)".
+std::string how_it_ended(int status) {
+  if (status > 128) {
+    const char* name = strsignal(status - 128);
+    return "was killed by signal " + std::to_string(status - 128) + " (" + (name ? name : "?") + ")";
+  }
+  return "exited with status " + std::to_string(status);
+}
+}  // namespace
+
 int run_plant_and_controller(const std::vector<std::string>& plant_argv,
                              const std::vector<std::string>& controller_argv) {
   ChildProcess controller(controller_argv);
@@ -80,21 +132,28 @@ int run_plant_and_controller(const std::vector<std::string>& plant_argv,
   std::optional<int> plant_status;
   while (!(plant_status = plant.wait(0.1))) {
     if (stop_requested()) {
+      // Each child handles SIGTERM by finishing its outputs; one stuck in a step is killed after the
+      // grace period, so a Ctrl-C ends the run within about a second.
       std::cerr << "run: interrupted; stopping plant and controller\n";
-      plant.stop();
-      controller.stop();
+      ::kill(plant.pid(), SIGTERM);
+      ::kill(controller.pid(), SIGTERM);
+      plant.stop(ChildProcess::kStopGraceS);
+      controller.stop(0.05);  // it had the same second to end
       return 130;
     }
     if (auto c = controller.wait(0.0)) {
-      std::cerr << "run: the controller exited early (status " << *c << "); stopping the plant\n";
-      plant.stop();
-      return 4;
+      std::cerr << "run: the controller " << how_it_ended(*c) << " before the plant finished; stopping the plant\n";
+      plant.stop(ChildProcess::kStopGraceS);
+      // The controller's own code (5: its step failed, 2: bad input, ...) says more than "gone".
+      return (*c > 0 && *c < 128) ? *c : 4;
     }
   }
-  controller.stop();
+  controller.stop(ChildProcess::kStopGraceS);
   if (*plant_status != 0) {
-    std::cerr << "run: the plant exited with status " << *plant_status << '\n';
-    return *plant_status == 2 ? 2 : 4;
+    std::cerr << "run: the plant " << how_it_ended(*plant_status) << '\n';
+    // Its own code (2 bad input, 3 an output not written, 4 no controller, 6 its FMU failed, 130);
+    // killed by a signal it has none: 4.
+    return *plant_status < 128 || *plant_status == 130 ? *plant_status : 4;
   }
   return 0;
 }

@@ -1,5 +1,7 @@
 // Child processes that are always ended: a ChildProcess kills (SIGTERM, then SIGKILL) and reaps its
-// process when it goes out of scope, whatever path the parent takes.
+// process when it goes out of scope, whatever path the parent takes, and the child dies with its
+// parent even when the parent cannot clean up (SIGKILL): PR_SET_PDEATHSIG (SIGKILL) is set between
+// fork and exec, and a child whose parent is already gone then does not start.
 #pragma once
 
 #include <sys/types.h>
@@ -26,6 +28,9 @@ class ChildProcess {
   std::optional<int> wait(double timeout_s);
   /// SIGTERM, a grace period, then SIGKILL; returns the exit status.
   int stop(double grace_s = 3.0);
+  /// The grace run gives its children on Ctrl-C: a node that is not stuck finishes its files in far
+  /// less; one stuck in a foreign step is killed after it.
+  static constexpr double kStopGraceS = 1.0;
 
  private:
   pid_t pid_ = -1;
@@ -33,8 +38,10 @@ class ChildProcess {
 };
 
 /// Runs a plant and a controller process side by side until the plant ends (the controller is then
-/// stopped): 0 when the plant succeeded, 2 when it refused its input, 4 when it failed otherwise or
-/// the controller exited first, 130 on Ctrl-C (both stopped). Messages go to stderr prefixed "run:".
+/// stopped): 0 when the plant succeeded; otherwise the plant's own exit code (2 bad input, 3 an output
+/// not written, 4 no controller, 6 its FMU failed), or 4 when it was killed by a signal; when the
+/// controller ends first, its own code (5: its step failed), or 4 when it exited 0 or was killed; 130
+/// on Ctrl-C or SIGTERM (both stopped, within about kStopGraceS). Messages go to stderr prefixed "run:".
 int run_plant_and_controller(const std::vector<std::string>& plant_argv,
                              const std::vector<std::string>& controller_argv);
 

@@ -7,8 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/signals.hpp"
 #include "control/care.hpp"
 #include "dds/parameter_client.hpp"
+#include "fmi/model_description.hpp"
 #include "io/scenario.hpp"
 #include "security/keystore.hpp"
 #include "sim/controller_node.hpp"
@@ -28,12 +30,19 @@ const std::vector<ExitCodeRow>& exit_code_table() {
       {kFailed, "no message arrived on the topic", "topic"},
       {kBadInput, "bad input: a file, flag or value (the message names it); nothing was run", "*"},
       {kOutput, "an output could not be written, or a tool or system call failed", "*"},
-      {kNoPeer, "lockstep: the peer did not answer within --timeout, or the controller exited early", "run plant"},
+      {kNoPeer,
+       "lockstep: the peer did not answer within --timeout, or the controller exited early or was killed without "
+       "a code of its own",
+       "run plant"},
       {kNoPeer, "the node was not found, or did not answer within --timeout", "param"},
       {kControllerFailed,
-       "the controller's step failed: it raised or returned garbage (the message names the controller, the "
-       "step and its time)",
-       "controller"},
+       "the controller's step failed: it raised, returned garbage, crashed, exited or did not return in time (the "
+       "message names the controller, the step and its time)",
+       "run controller"},
+      {kPlantFailed,
+       "the plant's FMU failed: it answered Error, gave a non-finite output, crashed or exited (the message names the "
+       "FMU, the call, the tick and its time)",
+       "run plant"},
       {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant"},
   };
   return table;
@@ -80,6 +89,9 @@ int run_guarded(const std::string& command, const std::function<int()>& body) {
   } catch (const sim::ControllerFailure& e) {  // names the controller, the step and its time
     std::cerr << "error: " << command << ": " << e.what() << '\n';
     return exit_code::kControllerFailed;
+  } catch (const fmi::FmuError& e) {  // names the FMU, the call, the tick and its time
+    std::cerr << "error: " << command << ": " << e.what() << '\n';
+    return stop_requested() ? exit_code::kInterrupted : exit_code::kPlantFailed;
   } catch (const dds::ParameterCallError& e) {
     std::cerr << "error: " << e.what() << '\n';
     return exit_code::kNoPeer;

@@ -22,7 +22,8 @@ enum : int {
   kBadInput = 2,          ///< a file, flag or value was wrong (the message names it); nothing was run
   kOutput = 3,            ///< an output could not be written, or a tool or system call failed
   kNoPeer = 4,            ///< a DDS peer did not answer in time (lockstep timeout, no such node)
-  kControllerFailed = 5,  ///< the controller node's controller failed (raised, returned garbage)
+  kControllerFailed = 5,  ///< the controller failed (raised, returned garbage, crashed, exited, hung)
+  kPlantFailed = 6,       ///< the plant's FMU failed (answered Error, crashed, exited, gave a NaN)
   kInterrupted = 130      ///< SIGINT / SIGTERM (Ctrl-C) before the end; the outputs hold what ran
 };
 }
@@ -46,8 +47,9 @@ void add_exit_code_footers(CLI::App& app);
 
 /// Runs `body` (a command), mapping what it throws to an exit code after printing it on stderr:
 /// io::ConfigError, std::invalid_argument, control::CareError, security::KeystoreError -> kBadInput;
-/// dds::ParameterCallError -> kNoPeer; sim::ControllerFailure -> kControllerFailed; any other std::exception ->
-/// kOutput. `command` names the command in messages that would not otherwise say where they come from.
+/// dds::ParameterCallError -> kNoPeer; sim::ControllerFailure -> kControllerFailed; fmi::FmuError (the plant's
+/// FMU failed while running) -> kPlantFailed, or kInterrupted when a stop request gave it up; any other std::exception
+/// -> kOutput. `command` names the command in messages that would not otherwise say where they come from.
 int run_guarded(const std::string& command, const std::function<int()>& body);
 
 }  // namespace quadcosim::app

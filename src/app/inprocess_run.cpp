@@ -4,6 +4,7 @@
 
 #include <fstream>
 
+#include "app/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
@@ -26,6 +27,7 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
   if (attach) attach(simulation.transport(), sim::Topics::for_namespace(sc.simulation.ns));
   bool watchdog = false;
   bool completed = true;
+  std::exception_ptr failure;  // a step that failed (a foreign one crashed): rethrown once the files are finished
   try {
     simulation.run([&](const sim::TickRecord& r) {
       const io::ControlColumns c = io::ControlColumns::from(r.status);
@@ -44,11 +46,17 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
     });
   } catch (const Stopped&) {
     completed = false;
+  } catch (const std::exception&) {
+    // A foreign step given up on a stop request (Ctrl-C, SIGTERM while an FMU's step hung) is an
+    // interruption, not a failure: what ran is recorded below like any interrupted run's.
+    completed = false;
+    if (!stop_requested()) failure = std::current_exception();
   }
   if (completed && on_end) on_end();
   csv.close();
   mcap.close();
   mcap.write_bag_metadata(out.string(), "run.mcap");
+  if (failure) std::rethrow_exception(failure);  // the outputs hold every tick up to the failed one
   if (!completed) return false;
 
   const auto& st = simulation.plant().stats();

@@ -1,26 +1,62 @@
 #include "app/signals.hpp"
 
+#include <semaphore.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <thread>
+
+#include "fmi/isolated_instance.hpp"
 
 namespace quadcosim::app {
 
 namespace {
-// The one piece of process-wide state a signal handler may touch.
+// The one piece of process-wide state a signal handler may touch, and the semaphore it posts
+// (sem_post is async-signal-safe) to wake the stop deadline below.
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_stop_signal(int) { g_stop = 1; }
+sem_t g_stop_posted;
+extern "C" void on_stop_signal(int) {
+  g_stop = 1;
+  sem_post(&g_stop_posted);
+}
+
+// Waits for the first stop request, then gives the command kStopDeadlineS to end by itself; one that
+// is still running then is stuck in code that never returns to its loop (a Python step sleeping in C,
+// say): the process ends with 130 and says so. What the outputs' writers had flushed stays.
+void stop_deadline() {
+  while (sem_wait(&g_stop_posted) != 0) {
+  }
+  std::this_thread::sleep_for(std::chrono::duration<double>(kStopDeadlineS));
+  static const char kText[] =
+      "\nerror: interrupted, and a step did not return within 1.5 s of the request (foreign code that never "
+      "returns to quadcosim); exiting with status 130\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kText, sizeof kText - 1);
+  std::fflush(nullptr);
+  _exit(130);
+}
 }  // namespace
 
 void install_stop_handlers() {
+  static const bool installed = [] {
+    sem_init(&g_stop_posted, 0, 0);
+    std::thread(stop_deadline).detach();
+    return true;
+  }();
+  (void)installed;
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  // A wait on an FMU's process (a step that does not return) gives up when asked to stop.
+  fmi::set_stop_check(&stop_requested);
 }
 
 bool stop_requested() { return g_stop != 0; }
 
-void request_stop() { g_stop = 1; }
+void request_stop() { g_stop = 1; }  // the command's own request: no deadline
 
 }  // namespace quadcosim::app

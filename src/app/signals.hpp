@@ -3,11 +3,17 @@
 
 namespace quadcosim::app {
 
-/// Routes SIGINT and SIGTERM to stop_requested().
+/// Routes SIGINT and SIGTERM to stop_requested(), which is also what a wait on an FMU's process polls
+/// (fmi::set_stop_check): a step that hangs there is given up and its process killed.
+/// Also starts, once, a thread that ends the process with 130 when the command has not ended
+/// kStopDeadlineS after the first stop request (a step stuck in code that never returns): Ctrl-C and
+/// SIGTERM always end a command within about that.
 void install_stop_handlers();
+/// Seconds a command has after a stop request before the process is ended for it [s].
+inline constexpr double kStopDeadlineS = 1.5;
 /// True once SIGINT or SIGTERM arrived, or request_stop() was called.
 bool stop_requested();
-/// Asks the command's loops to stop, as a signal does (from any thread).
+/// Asks the command's loops to stop, as a signal does (from any thread), without the deadline.
 void request_stop();
 
 }  // namespace quadcosim::app

@@ -13,7 +13,9 @@
 #include <stdexcept>
 
 #include "control/controller_config.hpp"
+#include "fmi/isolated_instance.hpp"
 #include "fmi/quadrotor_variables.hpp"
+#include "sim/controller_node.hpp"
 
 namespace quadcosim::fmi {
 
@@ -107,6 +109,7 @@ struct FmuController::Shared {
   std::vector<control::ParameterSpec> specs;
   std::vector<const Variable*> parameter_vars;
   std::vector<double> defaults;
+  bool isolated = true;  ///< FmuMapping::isolated
 };
 
 std::span<const Signal> controller_inputs() { return kInputs; }
@@ -116,6 +119,7 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
     : model_(vehicle) {
   auto sh = std::make_shared<Shared>();
   sh->fmu = std::move(fmu);
+  sh->isolated = mapping.isolated;
   sh->description = describe_fmu(*sh->fmu);
   const ModelDescription& md = sh->fmu->description();
   const std::string name = fmu_name(*sh->fmu);
@@ -204,9 +208,10 @@ FmuController::~FmuController() = default;
 void FmuController::instantiate() {
   auto log = std::make_shared<LogTail>();
   log_ = log;
-  instance_ = shared_->fmu->instantiate(
-      fmt::format("{}_{}", shared_->fmu->description().model_identifier, instances_made++),
-      [log](const std::string& c, const std::string& s, const std::string& m) { log->add(c, s, m); });
+  const std::string name = fmt::format("{}_{}", shared_->fmu->description().model_identifier, instances_made++);
+  LogSink sink = [log](const std::string& c, const std::string& s, const std::string& m) { log->add(c, s, m); };
+  instance_ = shared_->isolated ? instantiate_isolated(shared_->fmu, name, std::move(sink))
+                                : shared_->fmu->instantiate(name, std::move(sink));
   initialised_ = false;
   steps_ = 0;
   in_.assign(shared_->in_vrs.size(), 0.0);
@@ -317,13 +322,13 @@ void FmuController::step(const control::Observation& o, const control::Reference
     instance_->get_real(shared_->out_vrs, out_);
   } catch (const std::exception& e) {
     const std::string logged = log_ ? log_->text() : "";
-    throw std::runtime_error(fmt::format("{}: control step {} (t = {:g} s) failed: {}{}", describe(), steps_, t,
-                                         e.what(), logged.empty() ? "" : " (the FMU logged: " + logged + ")"));
+    throw sim::ControllerFailure(fmt::format("{}: control step {} (t = {:g} s) failed: {}{}", describe(), steps_, t,
+                                             e.what(), logged.empty() ? "" : " (the FMU logged: " + logged + ")"));
   }
   for (std::size_t i = 0; i < 4; ++i) {
     if (!std::isfinite(out_[i])) {
-      throw std::runtime_error(fmt::format("{}: control step {} (t = {:g} s): output '{}' is {}; not commanded",
-                                           describe(), steps_, t, shared_->out_names[i], out_[i]));
+      throw sim::ControllerFailure(fmt::format("{}: control step {} (t = {:g} s): output '{}' is {}; not commanded",
+                                               describe(), steps_, t, shared_->out_names[i], out_[i]));
     }
   }
   ++steps_;

@@ -27,6 +27,10 @@ struct FmuMapping {
   /// FMU variable name -> value as written (a number, or true/false for a Boolean), set before
   /// initialisation after everything quadcosim sets itself.
   std::vector<std::pair<std::string, std::string>> parameters;
+  /// Each instance runs in a child process of its own (fmi/isolated_instance.hpp): the FMU's crashes,
+  /// exits and hangs end the run with a message instead of taking it down. false (the scenario's
+  /// `in_process: true`): the FMU runs in quadcosim's process, which costs no round trip per step.
+  bool isolated = true;
 };
 
 /// A mapping that does not fit the FMU. key(): the scenario key under the `plant:`/`controller:`

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fmi/isolated_instance.hpp"
 #include "fmi/quadrotor_variables.hpp"
 
 namespace quadcosim::fmi {
@@ -157,9 +158,10 @@ class FmuDynamics final : public sim::ExternalDynamics {
       // every plant tick); command_ is the one the FMU holds (the initial speeds at first).
       if (omega_rad_s != command_) instance_->set_real(omega_cmd_, cmd);
       instance_->do_step(clock_.seconds(k), clock_.period_s());
+    } catch (const InstanceInterrupted&) {
+      throw;  // a stop request, not the FMU's failure
     } catch (const std::exception& e) {
-      throw std::runtime_error(
-          fmt::format("{}: step at tick {} (t = {:g} s) failed: {}", name_, k, clock_.seconds(k), e.what()));
+      throw FmuError(fmt::format("{}: step at tick {} (t = {:g} s) failed: {}", name_, k, clock_.seconds(k), e.what()));
     }
     command_ = omega_rad_s;
     read(k + 1);
@@ -171,13 +173,13 @@ class FmuDynamics final : public sim::ExternalDynamics {
     try {
       instance_->get_real(vrs_, values_);
     } catch (const std::exception& e) {
-      throw std::runtime_error(fmt::format("{}: reading the outputs at tick {} (t = {:g} s) failed: {}", name_, k,
-                                           clock_.seconds(k), e.what()));
+      throw FmuError(fmt::format("{}: reading the outputs at tick {} (t = {:g} s) failed: {}", name_, k,
+                                 clock_.seconds(k), e.what()));
     }
     for (std::size_t i = 0; i < values_.size(); ++i) {
       if (!std::isfinite(values_[i])) {
-        throw std::runtime_error(fmt::format("{}: output '{}' is {} at tick {} (t = {:g} s)", name_, names_[i],
-                                             values_[i], k, clock_.seconds(k)));
+        throw FmuError(fmt::format("{}: output '{}' is {} at tick {} (t = {:g} s)", name_, names_[i], values_[i], k,
+                                   clock_.seconds(k)));
       }
     }
     const double* v = values_.data();
@@ -237,7 +239,9 @@ std::unique_ptr<sim::ExternalDynamics> FmuPlant::make(const model::VehicleParams
                     name));
   }
   const int n = (*made_)++;
-  std::unique_ptr<Instance> instance = fmu_->instantiate(fmt::format("{}_{}", md.model_identifier, n));
+  const std::string instance_name = fmt::format("{}_{}", md.model_identifier, n);
+  std::unique_ptr<Instance> instance =
+      mapping_.isolated ? instantiate_isolated(fmu_, instance_name) : fmu_->instantiate(instance_name);
   ++*alive_;
   std::shared_ptr<std::atomic<int>> alive = alive_;
   struct Undo {  // the count goes down again if anything below throws

@@ -197,6 +197,8 @@ FmuSpec read_fmu_spec(YamlSection& s, const std::filesystem::path& folder) {
   const fs::path full = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
   if (!fs::exists(full)) s.fail("fmu", "got '" + given + "': no such file (" + full.string() + ")");
   spec.path = full.lexically_normal().string();
+  // Each FMU instance runs in a child process unless asked otherwise (docs/reliability.md).
+  spec.mapping.isolated = !s.boolean("in_process", false);
   for (const char* side : {"inputs", "outputs"}) {
     auto m = s.section(side);
     if (!m) continue;

@@ -1,0 +1,161 @@
+#!/usr/bin/env bash
+# Foreign code that crashes, exits or hangs inside a run (docs/reliability.md, "Foreign code").
+# Usage: foreign_code_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID FAULTY_FMU_DIR
+# The FMUs (faulty_fmu/faulty_fmu.c) misbehave at the doStep whose time reaches $FAULTY_FMU_AT as
+# $FAULTY_FMU_FAULT says (segv, abort, exit, hang, error). Every process a case starts is ended by PID.
+bin="$1"; src="$2"; fmus="$5"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
+hover="$src/tests/faults/hover.yaml"
+export TMPDIR="$tmp/tmpdir"  # where the master unpacks FMUs: it must be empty after every run
+mkdir -p "$TMPDIR"
+
+# A scenario of $1 simulated seconds: the hover, with `$2` (a YAML line) added.
+scenario() {
+  { sed "s/duration_s: 30/duration_s: $1/" "$hover"; echo "$2"; } > "$tmp/s.yaml"
+  cp "$fmus"/faulty_plant.fmu "$fmus"/faulty_controller.fmu "$tmp/"
+}
+plant_fmu() { scenario "${1:-5}" "plant: {fmu: faulty_plant.fmu${2:-}}"; }
+
+# What every end must leave: no unpacked FMU, a CSV of whole rows up to the tick $1 whose step
+# failed (its state at that time was complete), and a finished run.mcap (it ends with the MCAP magic).
+check_outputs() {
+  local at="$1" last
+  [ -z "$(ls -A "$TMPDIR")" ] || fail "left in the temporary directory: $(ls -A "$TMPDIR")"
+  last="$(tail -1 "$tmp/out/trajectory.csv" | cut -d, -f1)"
+  python3 -c "import sys; t=float('$last'); sys.exit(0 if abs(t - $at) < 1e-9 else 1)" \
+    || fail "trajectory.csv ends at t = $last, expected $at"
+  [ "$(tail -c 8 "$tmp/out/run.mcap" | od -An -tx1 | tr -d ' \n')" = "894d434150300d0a" ] \
+    || fail "run.mcap is not finished (no closing magic)"
+  grep -q "trajectory.csv" "$tmp/out/.quadcosim-outputs.json" || fail "the manifest does not list trajectory.csv"
+}
+
+# run the scenario, expecting exit $1 and stderr lines matching each further argument
+run_expect() {
+  local want="$1"; shift
+  local rc=0
+  "$bin" run "$tmp/s.yaml" --out "$tmp/out" --no-plots ${RUN_FLAGS:-} > "$tmp/run.log" 2>&1 || rc=$?
+  [ "$rc" = "$want" ] || fail "run exited $rc, expected $want"
+  for pattern in "$@"; do grep -qE "$pattern" "$tmp/run.log" || fail "no line matching '$pattern' in the run's output"; done
+  echo "exit $rc: $(grep -m1 'error' "$tmp/run.log" | cut -c1-400)"
+}
+
+# Start the run in the background, wait until it hangs at $1 s (the CSV stops growing), send $2,
+# and expect exit 130 within 2.5 s, with everything up to the hang recorded.
+hang_and_signal() {
+  local at="$1" sig="$2"
+  FAULTY_FMU_FAULT=hang FAULTY_FMU_AT="$at" "$bin" run "$tmp/s.yaml" --out "$tmp/out" --no-plots ${RUN_FLAGS:-} \
+    > "$tmp/run.log" 2>&1 &
+  local pid=$!; pids+=("$pid")
+  sleep 3  # the run reaches the hang within a few hundred milliseconds
+  kill -0 "$pid" 2>/dev/null || fail "the run ended before the signal"
+  local children; children="$(ps -o pid= --ppid "$pid" | tr -d ' ' | tr '\n' ' ')"
+  [ -n "$children" ] || fail "the run has no FMU process"
+  local t0; t0="$(date +%s.%N)"
+  kill "-$sig" "$pid"
+  local rc=0; wait "$pid" || rc=$?
+  local took; took="$(python3 -c "print(round($(date +%s.%N) - $t0, 2))")"
+  [ "$rc" = 130 ] || fail "run exited $rc after SIG$sig, expected 130"
+  python3 -c "import sys; sys.exit(0 if $took <= 2.5 else 1)" || fail "the run took $took s to end after SIG$sig"
+  for c in $children; do kill -0 "$c" 2>/dev/null && fail "the FMU's process $c outlived the run"; done
+  grep -qE "interrupted" "$tmp/run.log" || fail "the run did not say it was interrupted"
+  echo "SIG$sig during a hung doStep at t = $at s: exit 130 after $took s; children ($children) gone"
+}
+
+case "$case_name" in
+  fmu_plant_segv)  # the plant FMU writes through a null pointer at t = 2 s
+    plant_fmu
+    FAULTY_FMU_FAULT=segv FAULTY_FMU_AT=2 run_expect 6 "faulty_plant" "tick 200 \(t = 2 s\)" "fmi2DoStep\(t = 2" \
+      "killed by signal 11"
+    check_outputs 2 ;;
+  fmu_plant_abort)
+    plant_fmu
+    FAULTY_FMU_FAULT=abort FAULTY_FMU_AT=1.5 run_expect 6 "faulty_plant" "tick 150 \(t = 1.5 s\)" "killed by signal 6"
+    check_outputs 1.5 ;;
+  fmu_plant_exit)  # exit(0) inside doStep: not a success
+    plant_fmu
+    FAULTY_FMU_FAULT=exit FAULTY_FMU_AT=3 run_expect 6 "faulty_plant" "tick 300 \(t = 3 s\)" "exited with status 0"
+    check_outputs 3 ;;
+  fmu_plant_error)  # fmi2Error from doStep, isolated: the same message as in-process
+    plant_fmu
+    FAULTY_FMU_FAULT=error FAULTY_FMU_AT=1 run_expect 6 "faulty_plant" "tick 100 \(t = 1 s\)" "answered Error"
+    check_outputs 1 ;;
+  fmu_controller_segv)  # the controller FMU crashes at its control step at t = 2 s: exit 5
+    scenario 5 ""
+    sed -i 's/^controller:$/controller:\n  fmu: faulty_controller.fmu/' "$tmp/s.yaml"
+    FAULTY_FMU_FAULT=segv FAULTY_FMU_AT=2 run_expect 5 "faulty_controller" "control step [0-9]+ \(t = 2 s\)" \
+      "killed by signal 11"
+    [ -z "$(ls -A "$TMPDIR")" ] || fail "left in the temporary directory: $(ls -A "$TMPDIR")" ;;
+  fmu_hang_sigint)
+    plant_fmu 30
+    hang_and_signal 1 INT
+    check_outputs 1 ;;
+  fmu_hang_sigterm)
+    plant_fmu 30
+    hang_and_signal 2 TERM
+    check_outputs 2 ;;
+  fmu_dds_segv)  # over DDS the plant process survives its FMU's crash and exits 6; run passes 6 on
+    plant_fmu
+    RUN_FLAGS="--transport dds" FAULTY_FMU_FAULT=segv FAULTY_FMU_AT=2 run_expect 6 "faulty_plant" \
+      "tick 200 \(t = 2 s\)" "killed by signal 11" "run: the plant exited with status 6"
+    check_outputs 2 ;;
+  isolation_bit_identical)  # the same bytes with the FMU in its own process and in quadcosim's
+    plant_fmu 10
+    run_expect 0
+    mv "$tmp/out" "$tmp/isolated"
+    plant_fmu 10 ", in_process: true"
+    run_expect 0
+    cmp "$tmp/isolated/trajectory.csv" "$tmp/out/trajectory.csv" || fail "trajectory.csv differs with in_process: true"
+    echo "trajectory.csv identical ($(wc -l < "$tmp/out/trajectory.csv") lines) isolated and in-process" ;;
+  dds_children_die_with_run)  # SIGKILL of run: its plant and controller die with it
+    "$bin" run "$hover" --out "$tmp/out" --no-plots --transport dds --realtime > "$tmp/run.log" 2>&1 &
+    pid=$!; pids+=("$pid")
+    for _ in $(seq 1 100); do
+      sleep 0.1
+      children="$(ps -o pid= --ppid "$pid" | tr -d ' ' | tr '\n' ' ')"
+      [ "$(echo $children | wc -w)" = 2 ] && break
+    done
+    [ "$(echo $children | wc -w)" = 2 ] || fail "expected a plant and a controller process, found '$children'"
+    pids+=($children)
+    sleep 1
+    kill -KILL "$pid"
+    wait "$pid" 2>/dev/null || true
+    sleep 0.5
+    # Gone, or a zombie that nobody reaped yet (PID 1 of a container may not): not running either way.
+    for c in $children; do
+      st="$(ps -o stat= -p "$c" 2>/dev/null || true)"
+      [ -z "$st" ] || [[ "$st" == Z* ]] || fail "child $c outlived the SIGKILLed run (state $st)"
+    done
+    echo "children $children ended with the run" ;;
+  dds_child_exit_code)  # the plant cannot write trajectory.csv (file size limit): run exits 3, as the plant
+    trap '' XFSZ  # inherited: a write past the limit fails with EFBIG instead of killing the writer
+    ( ulimit -f 64; exec "$bin" run "$hover" --out "$tmp/out" --no-plots --transport dds ) > "$tmp/run.log" 2>&1 \
+      && rc=0 || rc=$?
+    [ "$rc" = 3 ] || fail "run exited $rc, expected the plant's 3"
+    grep -q "run: the plant exited with status 3" "$tmp/run.log" || fail "run did not name the plant's status"
+    echo "run exited 3, the plant's code" ;;
+  python_hang_sigint)  # a Python controller sleeping in step: Ctrl-C still ends the run, 130
+    mkdir -p "$tmp/py"
+    cat > "$tmp/py/sleepy.py" <<'PY'
+import time
+import quadcosim
+class Sleepy(quadcosim.Controller):
+    def step(self, obs, ref, dt):
+        time.sleep(1000)
+        return [0.0, 0.0, 0.0, 0.0]
+PY
+    { sed "s/duration_s: 30/duration_s: 5/" "$hover" | grep -v '^controller:\|z_des'; \
+      printf 'controller:\n  python: "sleepy:Sleepy"\n  step_timeout_s: 0.5\n'; } > "$tmp/py/s.yaml"
+    "$bin" run "$tmp/py/s.yaml" --out "$tmp/out" --no-plots > "$tmp/run.log" 2>&1 &
+    pid=$!; pids+=("$pid")
+    sleep 3
+    if ! kill -0 "$pid" 2>/dev/null; then
+      grep -q "built without Python" "$tmp/run.log" && { echo "SKIPPED: this quadcosim was built without Python"; exit 77; }
+      fail "the run ended before the signal"
+    fi
+    t0="$(date +%s.%N)"; kill -INT "$pid"; rc=0; wait "$pid" || rc=$?
+    took="$(python3 -c "print(round($(date +%s.%N) - $t0, 2))")"
+    [ "$rc" = 130 ] || fail "run exited $rc after SIGINT, expected 130"
+    python3 -c "import sys; sys.exit(0 if $took <= 2.5 else 1)" || fail "took $took s to end after SIGINT"
+    echo "SIGINT during a sleeping Python step: exit 130 after $took s" ;;
+  *) echo "unknown case $case_name"; exit 2 ;;
+esac
