@@ -34,7 +34,7 @@ const std::vector<ExitCodeRow>& exit_code_table() {
        "the controller's step failed: it raised or returned garbage (the message names the controller, the "
        "step and its time)",
        "controller"},
-      {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant"},
+      {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant sweep"},
   };
   return table;
 }
