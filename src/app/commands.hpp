@@ -283,6 +283,7 @@ struct SweepOptions {
   std::string keep = "none";       ///< trajectories kept: none, failing, all
   std::string shard;               ///< "K/N" or ""
   bool force = false;
+  bool resume = false;  ///< finish the interrupted sweep in out_dir (its missing runs only)
   std::string out_dir;
   int jobs = 2;  ///< threads
   double min_pass_rate = 1.0;

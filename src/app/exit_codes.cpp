@@ -31,8 +31,9 @@ const std::vector<ExitCodeRow>& exit_code_table() {
       {kBadInput, "bad input: a file, flag or value (the message names it); nothing was run", "*"},
       {kOutput, "an output could not be written, or a tool or system call failed", "*"},
       {kNoPeer,
-       "lockstep: the peer did not answer within --timeout, or the controller exited early or was killed without "
-       "a code of its own",
+       "lockstep: the peer did not answer within --timeout, the controller exited early or was killed without a "
+       "code of its own, could not be told from another writer, or sent more commands than lockstep can match to "
+       "ticks",
        "run plant"},
       {kNoPeer, "the node was not found, or did not answer within --timeout", "param"},
       {kControllerFailed,
@@ -43,7 +44,7 @@ const std::vector<ExitCodeRow>& exit_code_table() {
        "the plant's FMU failed: it answered Error, gave a non-finite output, crashed or exited (the message names the "
        "FMU, the call, the tick and its time)",
        "run plant"},
-      {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant"},
+      {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant sweep"},
   };
   return table;
 }

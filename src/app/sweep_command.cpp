@@ -4,14 +4,20 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
@@ -28,8 +34,15 @@ namespace {
 void print_summary(const nlohmann::json& j, std::ostream& os) {
   const int runs = j["runs"].get<int>();
   const int passed = j["passed"].get<int>();
-  os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", j["scenario"].get<std::string>(), passed,
-                    runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
+  if (j.contains("partial")) {
+    const int finished = j["partial"]["finished"].get<int>();
+    os << fmt::format("sweep {}: interrupted: {} of {} runs finished; {} of them passed ({:.1f} %), seed {}\n",
+                      j["scenario"].get<std::string>(), finished, runs, passed,
+                      finished > 0 ? 100.0 * passed / finished : 0.0, j["seed"].get<std::uint64_t>());
+  } else {
+    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", j["scenario"].get<std::string>(), passed,
+                      runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
+  }
   int failed_runs = 0;
   for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
   if (failed_runs > 0)
@@ -52,6 +65,17 @@ int verdict(const nlohmann::json& j, double min_pass_rate) {
   return j["passed"].get<int>() >= sweep::passes_needed(min_pass_rate, j["runs"].get<int>()) ? exit_code::kOk
                                                                                              : exit_code::kFailed;
 }
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A copy of `from` at `to`, written atomically and never through a link at `to`.
+void copy_output(const fs::path& from, const fs::path& to) { io::write_file_atomically(to, read_file(from)); }
 
 bool parse_shard(const std::string& text, int& k, int& n) {
   const auto slash = text.find('/');
@@ -82,7 +106,7 @@ int rerun_command(const SweepOptions& o) {
   io::OutputFolder folder = io::OutputFolder::claim(o.out_dir, "sweep rerun", {.force = o.force}, std::cerr);
   const fs::path out(o.out_dir);
   return run_guarded(fmt::format("sweep run {}", o.rerun_index), [&] {
-    fs::copy_file(fs::path(o.sweep_dir) / "scenario.yaml", out / "scenario.yaml", fs::copy_options::overwrite_existing);
+    copy_output(fs::path(o.sweep_dir) / "scenario.yaml", out / "scenario.yaml");
     const sweep::RunResult r = sweep::rerun(plan, o.rerun_index, out);
     std::ifstream txt(out / "metrics.txt");
     std::cout << fmt::format("sweep run {} (seed {}):", o.rerun_index, r.sample.seed);
@@ -116,6 +140,14 @@ int merge_command(const SweepOptions& o) {
       std::cerr << "error: " << file.string() << ": not a shard's results: " << e.what() << '\n';
       return exit_code::kBadInput;
     }
+    if (j.contains("partial")) {
+      std::cerr << fmt::format(
+          "error: {}: shard {} was interrupted ({} of its runs finished); finish it first with its `quadcosim "
+          "sweep ... --shard {} --out {} --resume`\n",
+          file.string(), j.value("shard", std::string("?")), j["per_run"].size(), j.value("shard", std::string("K/N")),
+          dir);
+      return exit_code::kBadInput;
+    }
     if (header.is_null()) {
       header = j["header"];
     } else if (j["header"] != header) {
@@ -129,8 +161,7 @@ int merge_command(const SweepOptions& o) {
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
   const fs::path out(o.out_dir);
   io::OutputFolder folder = io::OutputFolder::claim(out, "sweep merge", {.force = o.force}, std::cerr);
-  fs::copy_file(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml",
-                fs::copy_options::overwrite_existing);
+  copy_output(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml");
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
@@ -159,6 +190,8 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   c->add_flag("--force", o.force,
               "--out holds a previous command's outputs or other files: remove exactly the outputs its manifest "
               "lists first (files quadcosim did not write are kept)");
+  c->add_flag("--resume", o.resume,
+              "finish the interrupted sweep in --out (same scenario and options): run only its missing runs");
   c->add_option("--out", o.out_dir, "output directory: new or empty (created when missing)");
   c->add_option("--jobs", o.jobs, "parallel runs (threads)")->check(CLI::Range(1, 64));
   c->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
@@ -208,40 +241,113 @@ int sweep_command(const SweepOptions& o) {
               << "trajectory to track; a sweep needs something to judge\n";
     return exit_code::kBadInput;
   }
+  if (o.resume && o.force) {
+    std::cerr << "error: sweep: --resume finishes the sweep in --out, --force starts a new one there: give one\n";
+    return exit_code::kBadInput;
+  }
   const fs::path out(o.out_dir);
-  io::OutputFolder folder = io::OutputFolder::claim(out, "sweep", {.force = o.force}, std::cerr);
+  const nlohmann::json header = sweep::header_json(plan);
+  std::vector<nlohmann::json> per_run;  // the runs finished before (--resume), then these
+  std::optional<io::OutputFolder> folder;
+  if (o.resume) {
+    folder.emplace(io::OutputFolder::resume(out, "sweep"));
+    if (!fs::is_regular_file(out / "scenario.yaml") || read_file(o.scenario) != read_file(out / "scenario.yaml")) {
+      std::cerr << fmt::format(
+          "error: sweep --resume: {} differs from the scenario the sweep in {} flew ({}); resume "
+          "with that file, or start this one in another folder\n",
+          o.scenario, out.string(), (out / "scenario.yaml").string());
+      return exit_code::kBadInput;
+    }
+    bool complete = false;
+    per_run = sweep::finished_runs(out, header, o.shard, complete);  // bad input: names the file
+    if (complete) {
+      std::cout << fmt::format("sweep {}: {} already holds all its runs; nothing to resume\n", plan.nominal.name,
+                               out.string());
+      if (!o.shard.empty()) return exit_code::kOk;
+      const nlohmann::json summary = nlohmann::json::parse(read_file(out / "summary.json"));
+      print_summary(summary, std::cout);
+      return verdict(summary, o.min_pass_rate);
+    }
+  } else {
+    // --force removes the runs the previous sweep's manifest lists; runs/ files no manifest lists
+    // (an older quadcosim's interrupted sweep) are refused rather than kept beside the new runs.
+    folder.emplace(io::OutputFolder::claim(out, "sweep", {.force = o.force, .exclusive = {"runs"}}, std::cerr));
+    copy_output(o.scenario, out / "scenario.yaml");
+  }
   fs::create_directories(out / "runs");
-  fs::copy_file(o.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
   const sweep::Keep keep = o.keep == "all"       ? sweep::Keep::kAll
                            : o.keep == "failing" ? sweep::Keep::kFailing
                                                  : sweep::Keep::kNone;
-  const std::vector<int> indices = sweep::shard_indices(plan.runs, shard, shards);
-  const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep);
-
-  std::vector<nlohmann::json> per_run;
-  per_run.reserve(results.size());
+  std::set<int> done;
+  for (const auto& r : per_run) done.insert(r.at("index").get<int>());
+  std::vector<int> indices;
+  for (const int i : sweep::shard_indices(plan.runs, shard, shards)) {
+    if (done.count(i) == 0) indices.push_back(i);
+  }
+  if (o.resume) {
+    std::cout << fmt::format("sweep {}: resuming in {}: {} runs finished, {} to run\n", plan.nominal.name, out.string(),
+                             done.size(), indices.size());
+  }
+  // Ctrl-C or SIGTERM: no new run starts, those under way finish, and the summary of the finished ones
+  // is written. Meanwhile the manifest lists what is written, at most a second late.
+  install_stop_handlers();
+  auto last_record = std::chrono::steady_clock::now();
+  sweep::RunControl control;
+  control.stop = [] { return stop_requested(); };
+  control.finished = [&](const sweep::RunResult&) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_record < std::chrono::seconds(1)) return;
+    last_record = now;
+    try {
+      folder->record("outputs");
+    } catch (const std::exception&) {
+      // A full disk, say: the manifest stays the last one written; the run's own write reports it.
+    }
+  };
+  const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep, control);
   for (const auto& r : results) {
     if (!r.error.empty()) {
       std::cerr << fmt::format("sweep: run {} (seed {}) failed: {}\n", r.sample.index, r.sample.seed, r.error);
     }
     per_run.push_back(sweep::per_run_json(plan, r));
   }
-  const nlohmann::json header = sweep::header_json(plan);
+  std::sort(per_run.begin(), per_run.end(), [](const auto& a, const auto& b) {
+    return a.at("index").template get<int>() < b.at("index").template get<int>();
+  });
+  const bool interrupted = results.size() < indices.size();
+  const std::string resume_hint = "finish it with the same command and --resume instead of --force";
   if (!o.shard.empty()) {
+    const std::size_t expected = done.size() + indices.size();
     int passed = 0;
-    for (const auto& r : results) passed += r.passed ? 1 : 0;
+    for (const auto& r : per_run) passed += r.at("passed").get<bool>() ? 1 : 0;
     nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
+    if (interrupted) j["partial"] = {{"finished", per_run.size()}, {"runs", expected}};
     sweep::write_json(out / "shard.json", j);
+    if (interrupted) {
+      std::cout << fmt::format("sweep {} shard {}: interrupted: {} of its {} runs finished ({} passed); wrote {}; {}\n",
+                               plan.nominal.name, o.shard, per_run.size(), expected, passed,
+                               (out / "shard.json").string(), resume_hint);
+      return exit_code::kInterrupted;
+    }
     std::cout << fmt::format(
         "sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
         "join the shards with `quadcosim sweep merge OUT DIR...`\n",
-        plan.nominal.name, o.shard, results.size(), plan.runs, passed, (out / "shard.json").string());
-    return exit_code::kOk;
+        plan.nominal.name, o.shard, per_run.size(), plan.runs, passed, (out / "shard.json").string());
+    return stop_requested() ? exit_code::kInterrupted : exit_code::kOk;
+  }
+  if (interrupted) {
+    const nlohmann::json summary = sweep::partial_summary_json(header, std::move(per_run));
+    sweep::write_json(out / "summary.json", summary);
+    print_summary(summary, std::cout);
+    std::cout << fmt::format("wrote {} (partial) and runs/NNNN/metrics.json; {}\n", (out / "summary.json").string(),
+                             resume_hint);
+    return exit_code::kInterrupted;
   }
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
+  if (stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
   if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
+#include "io/output_folder.hpp"
 #include "io/ros2_cdr.hpp"
 #include "sim/messages.hpp"
 #include "sim/vehicle_description.hpp"
@@ -157,7 +159,7 @@ void McapRecorder::close() {
 void McapRecorder::write_bag_metadata(const std::string& dir, const std::string& file) const {
   const std::int64_t start = first_ns_ < 0 ? 0 : first_ns_;
   const std::int64_t duration = last_ns_ < 0 ? 0 : last_ns_ - start;
-  std::ofstream y(dir + "/metadata.yaml");
+  std::ostringstream y;
   y << "rosbag2_bagfile_information:\n"
     << "  version: 5\n"
     << "  storage_identifier: mcap\n"
@@ -185,7 +187,7 @@ void McapRecorder::write_bag_metadata(const std::string& dir, const std::string&
     << "      starting_time:\n        nanoseconds_since_epoch: " << start << "\n"
     << "      duration:\n        nanoseconds: " << duration << "\n"
     << "      message_count: " << written_ << "\n";
-  if (!y) throw std::runtime_error(dir + "/metadata.yaml: write failed");
+  write_file_atomically(dir + "/metadata.yaml", y.str());  // throws "…/metadata.yaml: write failed (why)"
 }
 
 }  // namespace quadcosim::io

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "io/output_folder.hpp"
+
 #ifndef QUADCOSIM_VERSION
 #define QUADCOSIM_VERSION "unknown"
 #endif
@@ -112,8 +114,11 @@ std::array<std::uint8_t, 9> record_prefix(std::uint8_t opcode, std::uint64_t len
 }  // namespace
 
 McapWriter::McapWriter(const std::string& path, McapOptions options) : path_(path), options_(std::move(options)) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) throw std::runtime_error("McapWriter: cannot create '" + path + "': " + std::strerror(errno));
+  try {
+    file_ = open_output_file(path);  // never through a link planted at `path`
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string("McapWriter: cannot create '") + path + "': " + e.what());
+  }
   if (options_.compress) {
     zstd_ = ZSTD_createCCtx();
     if (!zstd_) {

@@ -2,6 +2,7 @@
 // --force, which removes exactly the listed files; plot-style reopening replaces one group.
 #include "io/output_folder.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -228,6 +229,160 @@ TEST(OutputFolder, AFileInPlaceOfTheFolderIsRefused) {
   TempDir t;
   write(t.path() / "f");
   EXPECT_NE(refusal(t.path() / "f", "run").find("exists and is not a folder"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace quadcosim::io
+
+namespace quadcosim::io {
+namespace {
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A folder a command wrote (summary.json, runs/0000/metrics.json), with its manifest.
+void used_folder(const fs::path& dir) {
+  std::ostringstream notes;
+  OutputFolder f = OutputFolder::claim(dir, "sweep", {}, notes);
+  write(dir / "summary.json");
+  write(dir / "runs" / "0000" / "metrics.json");
+}
+
+TEST(OutputFolder, AnEmptyManifestLeftByAnOlderVersionIsRefusedWithAWayForward) {
+  TempDir t;
+  write(t.path() / "trajectory.csv");
+  write(t.path() / kOutputManifest, "");
+  const std::string why = refusal(t.path(), "run", {.force = true});
+  EXPECT_NE(why.find(kOutputManifest), std::string::npos) << why;
+  EXPECT_NE(why.find("empty (0 bytes)"), std::string::npos) << why;
+  EXPECT_NE(why.find("by hand"), std::string::npos) << why;
+  EXPECT_TRUE(fs::exists(t.path() / "trajectory.csv"));  // nothing removed on its word
+  write(t.path() / kOutputManifest, R"({"command": "run", "files": {"outputs": ["trajectory.csv",)");
+  const std::string cut = refusal(t.path(), "run", {.force = true});
+  EXPECT_NE(cut.find("not JSON (cut short?"), std::string::npos) << cut;
+}
+
+TEST(OutputFolder, TheManifestIsNeverLeftEmptyOrPartWritten) {
+  TempDir t;
+  std::ostringstream notes;
+  OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
+  write(t.path() / "a.csv");
+  f.record("outputs");
+  // Every record leaves a whole manifest (written beside it and renamed over it) and no temporary
+  // file; a write that fails is in WriteFileAtomically..., a full disk in cli.output_folder_disk_full.
+  for (int i = 0; i < 5; ++i) {
+    write(t.path() / fmt::format("f{}.csv", i));
+    f.record("outputs");
+    EXPECT_EQ(manifest_json(t.path())["files"]["outputs"].size(), static_cast<std::size_t>(i + 2));
+  }
+  for (const auto& e : fs::directory_iterator(t.path())) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  }
+}
+
+TEST(OutputFolder, WriteFileAtomicallyReplacesALinkAndNeverWritesThroughIt) {
+  TempDir t;
+  write(t.path() / "outside.txt", "precious");
+  fs::create_directories(t.path() / "out");
+  fs::create_symlink(t.path() / "outside.txt", t.path() / "out" / "summary.json");
+  write_file_atomically(t.path() / "out" / "summary.json", "{}\n");
+  EXPECT_EQ(read_text(t.path() / "outside.txt"), "precious");
+  EXPECT_FALSE(fs::is_symlink(t.path() / "out" / "summary.json"));
+  EXPECT_EQ(read_text(t.path() / "out" / "summary.json"), "{}\n");
+  // A failed write (a folder where the file goes) leaves what was there and no temporary file.
+  fs::create_directories(t.path() / "out" / "metrics.json");
+  try {
+    write_file_atomically(t.path() / "out" / "metrics.json", "x");
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("metrics.json: write failed"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_directory(t.path() / "out" / "metrics.json"));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(t.path() / "out")) ++entries;
+  EXPECT_EQ(entries, 2u);  // summary.json and the metrics.json folder
+}
+
+TEST(OutputFolder, OpenOutputFileRefusesALinkAtItsPath) {
+  TempDir t;
+  write(t.path() / "outside.txt", "precious");
+  fs::create_symlink(t.path() / "outside.txt", t.path() / "trajectory.csv");
+  try {
+    std::FILE* f = open_output_file(t.path() / "trajectory.csv");
+    std::fclose(f);
+    ADD_FAILURE() << "opened through a link";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("symbolic link"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(read_text(t.path() / "outside.txt"), "precious");
+  std::FILE* f = open_output_file(t.path() / "new.csv");
+  ASSERT_NE(f, nullptr);
+  std::fputs("t\n", f);
+  EXPECT_EQ(std::fclose(f), 0);
+  EXPECT_EQ(read_text(t.path() / "new.csv"), "t\n");
+}
+
+TEST(OutputFolder, ForceRefusesALinkPlantedInTheFolderAndLeavesItsTargetAlone) {
+  TempDir t;
+  const fs::path dir = t.path() / "out", outside = t.path() / "outside.txt";
+  write(outside, "precious");
+  used_folder(dir);
+  // In place of a listed file, and at a path the next command writes (a run folder it did not list).
+  fs::remove(dir / "summary.json");
+  fs::create_symlink(outside, dir / "summary.json");
+  fs::create_directories(dir / "runs" / "0001");
+  fs::create_symlink(outside, dir / "runs" / "0001" / "metrics.json");
+  const std::string why = refusal(dir, "sweep", {.force = true});
+  EXPECT_NE(why.find("not a regular file"), std::string::npos) << why;
+  EXPECT_NE(why.find("runs/0001/metrics.json"), std::string::npos) << why;
+  EXPECT_NE(why.find("summary.json"), std::string::npos) << why;
+  EXPECT_EQ(read_text(outside), "precious");
+  EXPECT_TRUE(fs::is_symlink(dir / "summary.json"));  // refused: nothing changed
+  EXPECT_TRUE(fs::exists(dir / "runs" / "0000" / "metrics.json"));
+  // A link to a folder (runs/ pointing elsewhere) too.
+  TempDir u;
+  fs::create_directories(u.path() / "elsewhere");
+  fs::create_directories(u.path() / "out");
+  fs::create_directory_symlink(u.path() / "elsewhere", u.path() / "out" / "runs");
+  EXPECT_NE(refusal(u.path() / "out", "sweep", {.force = true}).find("runs"), std::string::npos);
+}
+
+TEST(OutputFolder, ForceRefusesUnlistedFilesInAnExclusiveSubFolder) {
+  TempDir t;
+  used_folder(t.path());
+  write(t.path() / "runs" / "0050" / "metrics.json");  // a run the manifest does not list
+  write(t.path() / "notes.txt");
+  const std::string why = refusal(t.path(), "sweep", {.force = true, .exclusive = {"runs"}});
+  EXPECT_NE(why.find("runs/ holds 1 file that no manifest lists (runs/0050/metrics.json)"), std::string::npos) << why;
+  EXPECT_TRUE(fs::exists(t.path() / "runs" / "0000" / "metrics.json"));  // nothing removed
+  fs::remove_all(t.path() / "runs" / "0050");
+  std::ostringstream notes;
+  { OutputFolder f = OutputFolder::claim(t.path(), "sweep", {.force = true, .exclusive = {"runs"}}, notes); }
+  EXPECT_FALSE(fs::exists(t.path() / "runs"));
+  EXPECT_TRUE(fs::exists(t.path() / "notes.txt"));  // outside runs/: kept, as ever
+}
+
+TEST(OutputFolder, ResumeKeepsTheListedFilesAndAddsTheNewOnes) {
+  TempDir t;
+  used_folder(t.path());
+  {
+    OutputFolder f = OutputFolder::resume(t.path(), "sweep");
+    write(t.path() / "runs" / "0001" / "metrics.json");
+    write(t.path() / "summary.json", "rewritten");
+  }
+  EXPECT_EQ(manifest_json(t.path())["files"]["outputs"],
+            nlohmann::json({"runs/0000/metrics.json", "runs/0001/metrics.json", "summary.json"}));
+  try {
+    OutputFolder f = OutputFolder::resume(t.path(), "run");
+    ADD_FAILURE() << "resumed another command's folder";
+  } catch (const OutputFolderRefused& e) {
+    EXPECT_NE(std::string(e.what()).find("not of `quadcosim run`"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(OutputFolder::resume(t.path() / "none", "sweep"), OutputFolderRefused);
 }
 
 }  // namespace

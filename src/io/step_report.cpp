@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "analysis/tracking.hpp"
+#include "io/output_folder.hpp"
 
 namespace quadcosim::io {
 
@@ -361,9 +362,7 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
 void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
                         const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
                         const std::optional<TrackingResult>& tracking) {
-  std::ofstream out(path);
-  out << metrics_json(scenario, results, hold, saturation, tracking).dump(2) << '\n';
-  if (!out) throw std::runtime_error(path + ": write failed");
+  write_file_atomically(path, metrics_json(scenario, results, hold, saturation, tracking).dump(2) + "\n");
 }
 
 namespace {

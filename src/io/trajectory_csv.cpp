@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "io/output_folder.hpp"
 #include "model/attitude.hpp"
 
 namespace quadcosim::io {
@@ -49,8 +50,7 @@ const std::vector<std::string>& TrajectoryWriter::columns() {
 }
 
 TrajectoryWriter::TrajectoryWriter(const std::string& path) : path_(path) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) throw std::runtime_error(path + ": cannot open for writing");
+  file_ = open_output_file(path);  // never through a link planted at `path`
   std::string header;
   for (const auto& c : columns()) header += (header.empty() ? "" : ",") + c;
   header += '\n';

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <mutex>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -14,6 +16,7 @@
 #include "analysis/tracking.hpp"
 #include "control/care.hpp"
 #include "io/mcap_recorder.hpp"
+#include "io/output_folder.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
 #include "sim/topics.hpp"
@@ -164,29 +167,35 @@ RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep kee
 }
 
 std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs, const fs::path& runs_dir,
-                                Keep keep) {
+                                Keep keep, const RunControl& control) {
   std::vector<RunResult> results(indices.size());
   std::atomic<std::size_t> next{0};
+  std::mutex finished_mutex;  // one `finished` call at a time
   auto worker = [&] {
     io::SeriesRecorder series;  // one per thread, reused run after run
-    for (std::size_t i; (i = next.fetch_add(1)) < indices.size();) {
+    for (;;) {
+      // Asked before an index is taken, so the runs started are always indices[0 .. next).
+      if (control.stop && control.stop()) return;
+      const std::size_t i = next.fetch_add(1);
+      if (i >= indices.size()) return;
       const int index = indices[i];
       results[i] =
           run_into(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep, series);
+      if (control.finished) {
+        const std::lock_guard lock(finished_mutex);
+        control.finished(results[i]);
+      }
     }
   };
   std::vector<std::thread> pool;
   const int threads = std::max(1, std::min<int>(jobs, static_cast<int>(indices.size())));
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
+  results.resize(std::min(next.load(), indices.size()));
   return results;
 }
 
-void write_json(const fs::path& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  f << j.dump(2) << '\n';
-  if (!f) throw std::runtime_error(path.string() + ": write failed");
-}
+void write_json(const fs::path& path, const nlohmann::json& j) { io::write_file_atomically(path, j.dump(2) + "\n"); }
 
 int passes_needed(double rate, int runs) {
   if (!(rate >= 0.0 && rate <= 1.0) || runs < 0) {
@@ -217,9 +226,7 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   (void)simulate(sc, series, &csv, &dir);
   judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
   write_json(dir / "metrics.json", run_metrics_json(plan, sc, r));
-  std::ofstream txt(dir / "metrics.txt");
-  txt << io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking);
-  if (!txt) throw std::runtime_error((dir / "metrics.txt").string() + ": write failed");
+  io::write_file_atomically(dir / "metrics.txt", io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking));
   return r;
 }
 
@@ -275,28 +282,23 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r) {
   return run;
 }
 
-nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run) {
-  const int runs = header.at("runs").get<int>();
+namespace {
+
+void sort_by_index(std::vector<nlohmann::json>& per_run) {
   std::sort(per_run.begin(), per_run.end(), [](const auto& a, const auto& b) {
     return a.at("index").template get<int>() < b.at("index").template get<int>();
   });
-  for (std::size_t i = 0; i < per_run.size(); ++i) {
-    const int index = per_run[i].at("index").get<int>();
-    if (index != static_cast<int>(i)) {
-      throw std::invalid_argument(index < static_cast<int>(i) ? fmt::format("run {} appears twice", index)
-                                                              : fmt::format("run {} is missing", i));
-    }
-  }
-  if (static_cast<int>(per_run.size()) != runs) {
-    throw std::invalid_argument(per_run.size() < static_cast<std::size_t>(runs)
-                                    ? fmt::format("run {} is missing", per_run.size())
-                                    : fmt::format("{} runs for a sweep of {}", per_run.size(), runs));
-  }
+}
+
+// The summary of the runs of `per_run` (sorted, checked): header, passed, pass_rate over them, per_run
+// and the figures' statistics.
+nlohmann::json summarise(const nlohmann::json& header, std::vector<nlohmann::json> per_run) {
+  const auto flown = static_cast<std::ptrdiff_t>(per_run.size());
   nlohmann::json j = header;
   const auto passed =
       std::count_if(per_run.begin(), per_run.end(), [](const auto& r) { return r.at("passed").template get<bool>(); });
   j["passed"] = passed;
-  j["pass_rate"] = runs > 0 ? static_cast<double>(passed) / runs : 0.0;
+  j["pass_rate"] = flown > 0 ? static_cast<double>(passed) / static_cast<double>(flown) : 0.0;
   std::map<std::string, std::vector<std::optional<double>>> values;
   for (const auto& r : per_run) {
     for (const auto& [name, v] : r.at("figures").items()) {
@@ -323,6 +325,99 @@ nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::
   j["per_run"] = std::move(per_run);
   j["figures"] = dist;
   return j;
+}
+
+}  // namespace
+
+nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run) {
+  const int runs = header.at("runs").get<int>();
+  sort_by_index(per_run);
+  for (std::size_t i = 0; i < per_run.size(); ++i) {
+    const int index = per_run[i].at("index").get<int>();
+    if (index != static_cast<int>(i)) {
+      throw std::invalid_argument(index < static_cast<int>(i) ? fmt::format("run {} appears twice", index)
+                                                              : fmt::format("run {} is missing", i));
+    }
+  }
+  if (static_cast<int>(per_run.size()) != runs) {
+    throw std::invalid_argument(per_run.size() < static_cast<std::size_t>(runs)
+                                    ? fmt::format("run {} is missing", per_run.size())
+                                    : fmt::format("{} runs for a sweep of {}", per_run.size(), runs));
+  }
+  return summarise(header, std::move(per_run));
+}
+
+nlohmann::json partial_summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run) {
+  const int runs = header.at("runs").get<int>();
+  sort_by_index(per_run);
+  for (std::size_t i = 0; i < per_run.size(); ++i) {
+    const int index = per_run[i].at("index").get<int>();
+    if (index < 0 || index >= runs)
+      throw std::invalid_argument(fmt::format("run {} is not in a sweep of {}", index, runs));
+    if (i > 0 && per_run[i - 1].at("index").get<int>() == index) {
+      throw std::invalid_argument(fmt::format("run {} appears twice", index));
+    }
+  }
+  const std::size_t finished = per_run.size();
+  nlohmann::json j = summarise(header, std::move(per_run));
+  j["partial"] = {{"finished", finished}, {"runs", runs}};
+  return j;
+}
+
+std::vector<nlohmann::json> finished_runs(const fs::path& dir, const nlohmann::json& header, const std::string& shard,
+                                          bool& complete) {
+  const fs::path file = dir / (shard.empty() ? "summary.json" : "shard.json");
+  std::ifstream in(file);
+  if (!in) {
+    throw std::invalid_argument(fmt::format(
+        "{}: not found, so which runs finished is unknown (was the sweep killed before it could write it?); "
+        "start the sweep again with --force instead of --resume",
+        file.string()));
+  }
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+    // summary.json holds the header's keys at its top; shard.json under "header".
+    nlohmann::json as_shard =
+        shard.empty() ? nlohmann::json{{"header", j}, {"per_run", j.value("per_run", nlohmann::json())}} : j;
+    check_shard_json(as_shard);
+    nlohmann::json theirs = as_shard.at("header");
+    if (shard.empty()) {
+      for (const char* k : {"passed", "pass_rate", "per_run", "figures", "partial"}) theirs.erase(k);
+    }
+    if (theirs != header) {
+      std::string differ;
+      for (const auto& [k, v] : header.items()) {
+        if (!theirs.contains(k) || theirs.at(k) != v) differ += (differ.empty() ? "" : ", ") + k;
+      }
+      throw std::invalid_argument(
+          fmt::format("the sweep there is another one ({} differ{}); resume it with the options it was started with, "
+                      "or start this one in another folder",
+                      differ.empty() ? "its header" : differ, differ.find(',') == std::string::npos ? "s" : ""));
+    }
+    if (!shard.empty() && j.value("shard", std::string()) != shard) {
+      throw std::invalid_argument(
+          fmt::format("it is shard {}, not shard {}", j.value("shard", std::string("?")), shard));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(
+        fmt::format("{}: not a sweep's results (cut short? {}); start the sweep again with "
+                    "--force",
+                    file.string(), e.what()));
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(fmt::format("{}: {}", file.string(), e.what()));
+  }
+  complete = !j.contains("partial");
+  std::vector<nlohmann::json> per_run = j.at("per_run").get<std::vector<nlohmann::json>>();
+  const int runs = header.at("runs").get<int>();
+  std::set<int> seen;
+  for (const auto& r : per_run) {
+    const int index = r.at("index").get<int>();
+    if (index < 0 || index >= runs || !seen.insert(index).second) {
+      throw std::invalid_argument(fmt::format("{}: run {} is out of range or appears twice", file.string(), index));
+    }
+  }
+  return per_run;
 }
 
 void check_shard_json(const nlohmann::json& shard) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -31,16 +32,28 @@ struct RunResult {
 /// in RunResult::error.
 RunResult run_one(const Plan& plan, int index, const std::filesystem::path& run_dir, Keep keep = Keep::kNone);
 
+/// How run_many may be stopped early and tells of its progress (both optional).
+struct RunControl {
+  /// Asked before each run is started (from the worker threads): true stops starting runs; the runs
+  /// already started are finished (Ctrl-C of a sweep).
+  std::function<bool()> stop;
+  /// Called after each run is done, its files written (from the worker threads, one call at a time).
+  std::function<void(const RunResult&)> finished;
+};
+
 /// Runs `indices` on `jobs` threads, each into runs_dir/NNNN (no files when runs_dir is empty);
-/// results in the order of `indices`, whatever the scheduling.
+/// results in the order of `indices`, whatever the scheduling. When `control.stop` stopped it, the
+/// results are those of the runs started, a leading part of `indices` (fewer than asked).
 std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs,
-                                const std::filesystem::path& runs_dir, Keep keep = Keep::kNone);
+                                const std::filesystem::path& runs_dir, Keep keep = Keep::kNone,
+                                const RunControl& control = {});
 
 /// Runs i with i % count == shard - 1 (shard in 1..count), ascending.
 std::vector<int> shard_indices(int runs, int shard, int count);
 
 /// Writes `j` to `path` as JSON indented by 2, with a final newline (summary.json, shard.json, a
-/// run's metrics.json). Throws std::runtime_error naming the file when it cannot be written.
+/// run's metrics.json), atomically (io::write_file_atomically: the old file or the new one, never a
+/// part, never through a link). Throws std::runtime_error naming the file when it cannot be written.
 void write_json(const std::filesystem::path& path, const nlohmann::json& j);
 
 /// The fewest passing runs out of `runs` that meet a pass rate `rate` (--min-pass-rate, in [0, 1]):
@@ -71,11 +84,24 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r);
 /// Throws std::invalid_argument when an index is missing, repeated or out of range.
 nlohmann::json summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run);
 
+/// summary.json of an interrupted sweep: the runs that finished (any of the sweep's, each once),
+/// "passed" among them, "pass_rate" = passed / finished, the figures' statistics over them, and
+/// "partial": {"finished": F, "runs": N}. Throws std::invalid_argument for an index repeated or out of
+/// range.
+nlohmann::json partial_summary_json(const nlohmann::json& header, std::vector<nlohmann::json> per_run);
+
 /// Checks a parsed shard.json for what `sweep merge` reads: "header" an object with "runs" a whole
 /// number, "per_run" an array of objects each with "index" (a whole number), "passed" (true or false)
 /// and "figures" (an object of numbers or nulls). Throws std::invalid_argument naming the first field
 /// missing or of another type and what it holds ("per_run[3].passed: expected true or false, got \"yes\"").
 void check_shard_json(const nlohmann::json& shard);
+
+/// The per_run entries of the interrupted sweep in `sweep_dir` (its summary.json, or shard.json for a
+/// shard), for `sweep --resume`. Throws std::invalid_argument naming the file and saying what to do
+/// when there is none, it is not a sweep's (or is cut short), or its header or shard differ from
+/// `header` and `shard` ("" unsharded); sets `complete` when the sweep there had already finished.
+std::vector<nlohmann::json> finished_runs(const std::filesystem::path& sweep_dir, const nlohmann::json& header,
+                                          const std::string& shard, bool& complete);
 
 /// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it).
 /// Throws std::runtime_error naming the file.

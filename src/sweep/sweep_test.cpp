@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <unistd.h>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -454,6 +455,46 @@ TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {
   EXPECT_THROW(summary_json(header_json(p), a), std::invalid_argument);
   a.push_back(a.front());
   EXPECT_THROW(summary_json(header_json(p), a), std::invalid_argument);
+}
+
+TEST(RunMany, StoppedItReturnsTheRunsStartedALeadingPartAndAResumeGivesTheSameSummary) {
+  const Plan p =
+      make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 9, 8, Sampler::kRandom);
+  const std::vector<int> all = shard_indices(p.runs, 1, 1);
+  const nlohmann::json header = header_json(p);
+  std::vector<nlohmann::json> whole;
+  for (const auto& r : run_many(p, all, 2, {})) whole.push_back(per_run_json(p, r));
+  const std::string dump = summary_json(header, whole).dump(2);
+  // Stopped after the third run finished: the runs started (3 or 4 with two threads) are indices[0 .. k).
+  std::atomic<int> finished{0};
+  RunControl control;
+  control.stop = [&] { return finished.load() >= 3; };
+  control.finished = [&](const RunResult&) { ++finished; };
+  const auto first = run_many(p, all, 2, {}, Keep::kNone, control);
+  ASSERT_GE(first.size(), 3u);
+  ASSERT_LT(first.size(), all.size());
+  std::vector<nlohmann::json> done;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].sample.index, all[i]);
+    done.push_back(nlohmann::json::parse(per_run_json(p, first[i]).dump()));  // as read back from summary.json
+  }
+  const nlohmann::json partial = partial_summary_json(header, done);
+  EXPECT_EQ(partial["partial"]["finished"].get<std::size_t>(), first.size());
+  EXPECT_EQ(partial["partial"]["runs"].get<int>(), 8);
+  EXPECT_EQ(partial["figures"]["z.steady_state_error_pct"]["count"].get<std::size_t>(), first.size());
+  int passed = 0;
+  for (const auto& r : done) passed += r["passed"].get<bool>() ? 1 : 0;
+  EXPECT_EQ(partial["passed"].get<int>(), passed);
+  // The rest, on one thread this time: the summary is the uninterrupted sweep's, byte for byte.
+  const std::vector<int> rest(all.begin() + static_cast<std::ptrdiff_t>(first.size()), all.end());
+  for (const auto& r : run_many(p, rest, 1, {})) done.push_back(per_run_json(p, r));
+  EXPECT_EQ(summary_json(header, done).dump(2), dump);
+  // A partial summary refuses a run twice or out of range.
+  std::vector<nlohmann::json> twice = {whole[0], whole[0]};
+  EXPECT_THROW(partial_summary_json(header, twice), std::invalid_argument);
+  nlohmann::json out_of_range = whole[0];
+  out_of_range["index"] = 8;
+  EXPECT_THROW(partial_summary_json(header, {out_of_range}), std::invalid_argument);
 }
 
 }  // namespace

@@ -122,6 +122,38 @@ PYEOF
     [ "$rc" = 2 ] && grep -q "$TMP/s is not empty" "$TMP/err" || fail "rerun into the sweep's folder: exit $rc"
     ;;
 
+  disk_full)  # the disk fills during an in-process run: exit 3, the manifest whole (never 0 bytes), --force works after
+    # A small tmpfs of its own: only root can mount one; elsewhere SKIPPED (77) with the reason.
+    [ "$(id -u)" = 0 ] || { echo "SKIPPED: mounting a small tmpfs needs root"; exit 77; }
+    mkdir "$TMP/small"
+    mount -t tmpfs -o size=96k tmpfs "$TMP/small" 2> "$TMP/mount.err" \
+      || { echo "SKIPPED: cannot mount a tmpfs here: $(cat "$TMP/mount.err")"; exit 77; }
+    trap 'umount "$TMP/small" 2> /dev/null || true; rm -rf "$TMP"' EXIT
+    rc=$(rc_of "$QC" run "$TMP/alt.yaml" --out "$TMP/small/d" --no-plots)
+    [ "$rc" = 3 ] && grep -q "No space left on device" "$TMP/err" || { cat "$TMP/err"; fail "a full disk: exit $rc, expected 3"; }
+    [ -s "$TMP/small/d/$MANIFEST" ] || fail "the manifest is empty or missing after the disk filled"
+    "$PY" -c 'import json,sys; assert json.load(open(sys.argv[1]))["command"] == "run"' "$TMP/small/d/$MANIFEST" \
+      || fail "the manifest is not whole: $(cat "$TMP/small/d/$MANIFEST")"
+    ls -a "$TMP/small/d" | grep -q '\.tmp-' && fail "a temporary file was left: $(ls -a "$TMP/small/d")"
+    # With room again, --force takes the folder (the manifest is read, not refused).
+    mount -o remount,size=64m "$TMP/small"
+    rc=$(rc_of "$QC" run "$TMP/alt.yaml" --out "$TMP/small/d" --no-plots --force)
+    [ "$rc" -le 1 ] || { cat "$TMP/err"; fail "--force after the disk filled: exit $rc"; }
+    [ -s "$TMP/small/d/metrics.json" ] || fail "no metrics.json after --force"
+    umount "$TMP/small"
+    ;;
+
+  symlink)  # `run --force` never writes through a link planted in its folder
+    echo precious > "$TMP/victim"
+    rc=$(rc_of "$QC" run "$TMP/alt.yaml" --out "$TMP/d" --no-plots)
+    [ "$rc" -le 1 ] || fail "first run: exit $rc"
+    rm "$TMP/d/metrics.json" && ln -s "$TMP/victim" "$TMP/d/metrics.json"
+    rc=$(rc_of "$QC" run "$TMP/alt.yaml" --out "$TMP/d" --no-plots --force)
+    [ "$rc" = 2 ] && grep -q "metrics.json: symbolic links" "$TMP/err" || { cat "$TMP/err"; fail "planted link: exit $rc"; }
+    [ "$(cat "$TMP/victim")" = precious ] || fail "the link's target was written"
+    [ -L "$TMP/d/metrics.json" ] || fail "the refusal removed the link"
+    ;;
+
   *) fail "unknown case" ;;
 esac
 echo "ok [$CASE]"

@@ -169,6 +169,28 @@ PYEOF
     set -e
     ;;
 
+  symlink)  # a link planted in a sweep folder is refused, never written through; its target is untouched
+    echo precious > "$TMP/victim"
+    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --no-plots --out "$TMP/o1" > /dev/null
+    mkdir -p "$TMP/o1/runs/0002"
+    ln -s "$TMP/victim" "$TMP/o1/runs/0002/metrics.json"  # where run 2 of a longer sweep writes
+    set +e
+    "$QC" sweep "$HOVER" --runs 3 --min-pass-rate 0 --no-plots --force --out "$TMP/o1" > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 2 ] && grep -q "runs/0002/metrics.json: symbolic links" "$TMP/o" || { cat "$TMP/o"; fail "planted link not refused (rc $rc)"; }
+    [ "$(cat "$TMP/victim")" = precious ] || fail "the link's target was written"
+    [ -L "$TMP/o1/runs/0002/metrics.json" ] && [ -e "$TMP/o1/runs/0001/metrics.json" ] || fail "the refusal changed the folder"
+    # In place of a file the previous sweep wrote (summary.json), and in a folder no sweep wrote.
+    rm "$TMP/o1/runs/0002/metrics.json" "$TMP/o1/summary.json"
+    ln -s "$TMP/victim" "$TMP/o1/summary.json"
+    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --no-plots --force --out "$TMP/o1" > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 2 ] && grep -q "summary.json: symbolic links" "$TMP/o" || { cat "$TMP/o"; fail "a link in place of summary.json (rc $rc)"; }
+    mkdir "$TMP/o2" && ln -s "$TMP/victim" "$TMP/o2/summary.json"
+    "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --no-plots --force --out "$TMP/o2" > "$TMP/o" 2>&1; rc=$?
+    [ $rc -eq 2 ] || { cat "$TMP/o"; fail "a link in a new folder (rc $rc)"; }
+    set -e
+    [ "$(cat "$TMP/victim")" = precious ] || fail "the link's target was written"
+    ;;
+
   console)  # every figure with its count and missing runs; a figure no run has says so
     sed 's/duration_s: 15/duration_s: 3/' "$ALT" > "$TMP/short.yaml"
     "$QC" sweep "$TMP/short.yaml" --runs 20 --vary mass=20% --min-pass-rate 0 --no-plots --out "$TMP/c" > "$TMP/log" 2>&1 || fail "sweep"
