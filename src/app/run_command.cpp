@@ -103,6 +103,8 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
   if (!opt.foxglove.listen.empty()) {  // the plant serves: it has every topic, and the simulated time
     plant_args.insert(plant_args.end(), {"--foxglove", opt.foxglove.listen, "--foxglove-queue-kib",
                                          fmt::format("{}", opt.foxglove.queue_kib)});
+    for (const std::string& origin : opt.foxglove.allow_origins)
+      plant_args.insert(plant_args.end(), {"--foxglove-allow-origin", origin});
     if (opt.foxglove.linger_s > 0)
       plant_args.insert(plant_args.end(), {"--foxglove-linger", fmt::format("{}", opt.foxglove.linger_s)});
   }
