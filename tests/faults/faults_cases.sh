@@ -663,6 +663,99 @@ assert controller["growth_kB"] <= 512, controller["growth_kB"]
 PY
     ;;
 
+  limits)  # sane limits: each refusal exit 2 naming the key and the limit, each overridable
+    expect_refusal() {  # expect_refusal WHAT TEXT... -- COMMAND...: exit 2 and every TEXT in the message
+      local what="$1"; shift
+      local texts=()
+      while [ "$1" != "--" ]; do texts+=("$1"); shift; done
+      shift
+      set +e
+      /usr/bin/time -f "max_rss_kb %M" "$@" > "$tmp/limit.log" 2>&1
+      local rc=$?
+      set -e
+      [ "$rc" -eq 2 ] || fail "$what: expected exit 2, got $rc: $(tail -3 "$tmp/limit.log")"
+      local t
+      for t in "${texts[@]}"; do
+        grep -qF -- "$t" "$tmp/limit.log" || fail "$what: message lacks '$t': $(cat "$tmp/limit.log")"
+      done
+      echo "$what: $(grep -m1 'error' "$tmp/limit.log" | cut -c1-220) [$(grep max_rss_kb "$tmp/limit.log")]"
+    }
+    run_ok() {  # run_ok WHAT COMMAND...
+      local what="$1"; shift
+      "$@" > "$tmp/ok.log" 2>&1 || fail "$what: exit $?: $(tail -3 "$tmp/ok.log")"
+      echo "$what: accepted"
+    }
+    scen() { printf 'simulation: {plant_rate_hz: %s, controller_rate_hz: 50, duration_s: %s}\n' "$1" "$2"; }
+    # A plant at a megahertz, and at 20 kHz: refused by default, the latter flown with the limit raised.
+    scen 1e6 0.1 > "$tmp/fast.yaml"
+    expect_refusal "plant at 1 MHz" "simulation.plant_rate_hz: got 1e+06 Hz, more than the limit of 10000 Hz" \
+      "--limit plant_rate_hz=N" "--no-limits" -- "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots
+    scen 2e4 0.1 > "$tmp/fast.yaml"
+    expect_refusal "plant at 20 kHz" "simulation.plant_rate_hz: got 20000 Hz, more than the limit of 10000 Hz" -- \
+      "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots
+    run_ok "plant at 20 kHz with --limit plant_rate_hz=2e4" \
+      "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots --limit plant_rate_hz=2e4
+    # 1e7 s: about 500 GB of outputs projected against the free disk of --out, both named.
+    scen 100 1e7 > "$tmp/long.yaml"
+    expect_refusal "1e7 s run" "the outputs would need about" "free on the disk of $tmp/long" -- \
+      "$bin" run "$tmp/long.yaml" --out "$tmp/long" --no-plots
+    [ ! -e "$tmp/long" ] || fail "1e7 s run: the refused run created its output folder"
+    # A 94 MB scenario of 2 M schedule entries: refused by its size before it is parsed (small RSS).
+    python3 - "$tmp" <<'PY'
+import sys
+tmp = sys.argv[1]
+def write(name, entries, key="mode", value="attitude"):
+    with open(f"{tmp}/{name}", "w") as f:
+        f.write("simulation: {duration_s: 1}\nschedule:\n")
+        line = f"  - {{at_s: 0.5, set: {{{key}: {value}}}}}\n"
+        f.write(line * entries)
+write("huge.yaml", 2_000_000, "altitude.kp", "12.000000")  # 94 MB
+write("long_schedule.yaml", 20_001)  # 0.8 MB
+write("eleven.yaml", 11)
+PY
+    size=$(stat -c %s "$tmp/huge.yaml")
+    expect_refusal "94 MB scenario" "the file is $size bytes, more than the 2097152 a scenario file may have" \
+      "limit scenario_bytes" -- "$bin" run "$tmp/huge.yaml" --out "$tmp/huge" --no-plots
+    rss=$(sed -n 's/max_rss_kb //p' "$tmp/limit.log")
+    [ "$rss" -lt 100000 ] || fail "94 MB scenario: the refusal took $rss kB (parsed before refusing?)"
+    expect_refusal "20,001 schedule entries" "schedule: 20001 entries, more than the limit of 20000" -- \
+      "$bin" run "$tmp/long_schedule.yaml" --out "$tmp/ls" --no-plots
+    expect_refusal "11 schedule entries under a limit of 10" "schedule: 11 entries, more than the limit of 10" -- \
+      "$bin" run "$tmp/eleven.yaml" --out "$tmp/e" --no-plots --limit schedule_entries=10
+    run_ok "11 schedule entries under the default" "$bin" run "$tmp/eleven.yaml" --out "$tmp/e" --no-plots
+    expect_refusal "an unknown limit" "--limit nope=1: expected NAME=VALUE with NAME one of scenario_bytes" -- \
+      "$bin" run "$tmp/eleven.yaml" --out "$tmp/e2" --no-plots --limit nope=1
+    # A swarm beyond the memory: 10 M vehicles at about 40 kB each against MemAvailable.
+    expect_refusal "10 M vehicles" "--vehicles 10000000: the swarm would need about" "available (MemAvailable)" -- \
+      "$bin" run "$hover" --out "$tmp/swarm" --no-plots --vehicles 10000000
+    # FMUs: 200,000 variables, 10,001 entries, and an archive that unpacks beyond the bound.
+    python3 - "$tmp" <<'PY'
+import sys, zipfile
+tmp = sys.argv[1]
+def md(n):
+    v = "".join(f'<ScalarVariable name="v{i}" valueReference="{i}"><Real/></ScalarVariable>' for i in range(n))
+    return ('<?xml version="1.0"?><fmiModelDescription fmiVersion="2.0" modelName="m" guid="g">'
+            '<CoSimulation modelIdentifier="m"/><ModelVariables>' + v + '</ModelVariables></fmiModelDescription>')
+with zipfile.ZipFile(f"{tmp}/vars.fmu", "w", zipfile.ZIP_DEFLATED) as z:
+    z.writestr("modelDescription.xml", md(200_000))
+with zipfile.ZipFile(f"{tmp}/entries.fmu", "w") as z:
+    z.writestr("modelDescription.xml", md(1))
+    for i in range(10_001):
+        z.writestr(f"resources/f{i}", "")
+with zipfile.ZipFile(f"{tmp}/bomb.fmu", "w", zipfile.ZIP_DEFLATED) as z:
+    z.writestr("modelDescription.xml", md(1))
+    z.writestr("resources/zeros", b"\0" * (8 << 20))  # 8 MiB, 8 kB packed
+for name in ("vars", "entries", "bomb"):
+    open(f"{tmp}/{name}.yaml", "w").write(f"simulation: {{duration_s: 1}}\nplant: {{fmu: {name}.fmu}}\n")
+PY
+    expect_refusal "FMU of 200,000 variables" "ModelVariables lists 200000 variables, more than the 100000" \
+      "limit fmu_variables" -- "$bin" run "$tmp/vars.yaml" --out "$tmp/v" --no-plots
+    expect_refusal "FMU of 10,002 entries" "the archive has 10002 entries, more than the 10000" -- \
+      "$bin" run "$tmp/entries.yaml" --out "$tmp/en" --no-plots
+    expect_refusal "FMU unpacking to 8 MiB under a limit of 4 MB" "unpack to more than 4000000 bytes" \
+      "limit fmu_unpacked_bytes" -- "$bin" run "$tmp/bomb.yaml" --out "$tmp/b" --no-plots --limit fmu_unpacked_bytes=4e6
+    ;;
+
   netns_netem)  # 10 % loss and 5 ms delay on the veth (tc netem), real-time hover across namespaces
     make_namespaces
     if ! ip netns exec "$nsA" tc qdisc add dev "$nsA" root netem loss 10% delay 5ms > "$tmp/tc.log" 2>&1; then
