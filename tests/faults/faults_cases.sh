@@ -695,6 +695,9 @@ PY
       "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots
     run_ok "plant at 20 kHz with --limit plant_rate_hz=2e4" \
       "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots --limit plant_rate_hz=2e4
+    # run --transport dds hands the raised limit to its plant and controller processes.
+    run_ok "plant at 20 kHz over DDS with --limit plant_rate_hz=2e4" \
+      "$bin" run "$tmp/fast.yaml" --out "$tmp/fast_dds" --no-plots --transport dds --limit plant_rate_hz=2e4
     # 1e7 s: about 500 GB of outputs projected against the free disk of --out, both named.
     scen 100 1e7 > "$tmp/long.yaml"
     expect_refusal "1e7 s run" "the outputs would need about" "free on the disk of $tmp/long" -- \
