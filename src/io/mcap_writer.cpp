@@ -361,6 +361,10 @@ void McapWriter::close() {
   if (closed_) return;
   closed_ = true;  // also when finishing fails: the file is not to be written again
   finish();
+  if (spill_) {  // its bytes are in the summary now; closing it frees them on the disk
+    std::fclose(spill_);
+    spill_ = nullptr;
+  }
   const int rc = std::fclose(file_);
   file_ = nullptr;
   if (rc != 0) throw std::runtime_error("McapWriter: cannot write '" + path_ + "': " + std::strerror(errno));
