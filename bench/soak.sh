@@ -6,7 +6,11 @@
 # of the last quarter minus median of the first: warm-up, such as Cyclone's buffers and the first
 # discovery, falls in the first quarter; medians, because the plant copies and sorts its round-trip
 # series as it finishes, a short spike the last samples may catch) in kB and as slopes in kB per
-# hour of wall and of simulated time.
+# hour of wall and of simulated time. The plant records as `quadcosim run --transport dds` makes it
+# record (trajectory CSV, run.mcap and its schedule through the controller's parameter services), so
+# what a user's long recorded run holds in memory is measured too; RECORD=0 runs without recording.
+# The outputs go to a temporary folder (about 0.5 kB per plant tick: 170 MB per simulated hour), and
+# are removed at the end; their sizes are printed.
 # Usage: bench/soak.sh [BINARY] [SIMULATED_SECONDS] [JSON_OUT] [INTERVAL_S]
 #   SIMULATED_SECONDS defaults to 86400 (one simulated day: about 15 min to 1.5 h of wall time at
 #   the 20-100x real time lockstep runs here under load, docs/reliability.md). JSON_OUT, when given,
@@ -35,17 +39,25 @@ cleanup() {
 }
 trap cleanup EXIT
 
-"$bin" controller --scenario "$scenario" > "$tmp/controller.log" 2>&1 &
+record=()
+if [ "${RECORD:-1}" = 1 ]; then
+  record=(--record "$tmp/trajectory.csv" --mcap "$tmp/run.mcap" --schedule-via /attitude_controller)
+  ctl_args=(--no-schedule)
+else
+  ctl_args=()
+fi
+"$bin" controller --scenario "$scenario" "${ctl_args[@]}" > "$tmp/controller.log" 2>&1 &
 ctl=$!; pids+=("$ctl")
-"$bin" plant --scenario "$scenario" --duration "$seconds" --timeout 30 > "$tmp/plant.log" 2>&1 &
+"$bin" plant --scenario "$scenario" --duration "$seconds" --timeout 30 "${record[@]}" > "$tmp/plant.log" 2>&1 &
 plant=$!; pids+=("$plant")
 echo "soak: $seconds s simulated in lockstep, plant pid $plant, controller pid $ctl, domain $ROS_DOMAIN_ID" >&2
 
 # Samples both processes' VmRSS every INTERVAL_S until the plant exits, then summarises.
-/usr/bin/python3 - "$plant" "$ctl" "$tmp/plant.log" "$json" "$interval" <<'PY'
-import json, re, statistics, sys, time
+/usr/bin/python3 - "$plant" "$ctl" "$tmp/plant.log" "$json" "$interval" "$tmp" <<'PY'
+import json, os, re, statistics, sys, time
 
 plant, ctl, plant_log, out, interval = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4], float(sys.argv[5])
+folder = sys.argv[6]
 
 
 def rss_kb(pid):
@@ -76,6 +88,8 @@ m = re.search(r"([0-9.]+) s simulated in ([0-9.]+) s \(([0-9.]+)x real time\)", 
 summary = {"samples": len(series), "wall_s": round(wall, 1),
            "simulated_s": float(m.group(1)) if m else None, "rtf": float(m.group(3)) if m else None,
            "plant_done": m is not None}
+summary["outputs_bytes"] = {f: os.path.getsize(os.path.join(folder, f)) for f in ("trajectory.csv", "run.mcap")
+                            if os.path.exists(os.path.join(folder, f))}
 for i, name in ((1, "plant"), (2, "controller")):
     values = [s[i] for s in series if s[i] is not None]
     n = len(values)
@@ -104,7 +118,8 @@ for name in ("plant", "controller"):
           f"min {s['min_kB']}, max {s['max_kB']}; quarter medians {s['quarter_median_kB']}, quarter maxima "
           f"{s['quarter_max_kB']}; growth first -> last quarter {s['growth_kB']} kB ({s['growth_pct']} %, "
           f"{s['growth_kB_per_hour']} kB per hour of wall time, {s['growth_kB_per_simulated_hour']} kB per simulated hour)")
-print(f"soak: {summary['simulated_s']} s simulated in {summary['wall_s']} s wall ({summary['rtf']}x real time)")
+print(f"soak: {summary['simulated_s']} s simulated in {summary['wall_s']} s wall ({summary['rtf']}x real time); "
+      f"outputs {summary['outputs_bytes'] or 'none (RECORD=0)'}")
 if out:
     summary["series"] = series
     json.dump(summary, open(out, "w"), indent=1)

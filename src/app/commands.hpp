@@ -26,6 +26,8 @@ struct FoxgloveCliOptions {
   double wait_s = 0.0;           ///< in-process run: wait this long for a client to subscribe first [s]
   double pace = 0.0;             ///< in-process run: run at this many times real time (0: unpaced)
   std::size_t queue_kib = 1024;  ///< per-client queue above which messages are dropped [KiB]
+  /// --foxglove-allow-origin: browser Origins admitted besides the local ones ("*": any)
+  std::vector<std::string> allow_origins;
 };
 
 struct RunOptions {

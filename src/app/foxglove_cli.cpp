@@ -23,8 +23,14 @@ void add_foxglove_options(CLI::App& cmd, FoxgloveCliOptions& o, bool inprocess) 
   auto* queue = cmd.add_option("--foxglove-queue-kib", o.queue_kib,
                                "per-client queue [KiB] above which a slow client's messages are dropped")
                     ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 20));
+  auto* origin =
+      cmd.add_option("--foxglove-allow-origin", o.allow_origins,
+                     "admit browser pages from this Origin too (repeatable; e.g. https://app.foxglove.dev; '*': "
+                     "any). Default: only clients without an Origin and pages on localhost, 127.0.0.1 or [::1]")
+          ->allow_extra_args(false);
   linger->needs("--foxglove");
   queue->needs("--foxglove");
+  origin->needs("--foxglove");
   if (inprocess) {
     cmd.add_option("--foxglove-wait", o.wait_s, "in-process: wait up to this long for a client to subscribe first [s]")
         ->check(CLI::Range(0.0, 1e6))
@@ -70,6 +76,14 @@ std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveCliOptions& o, co
   so.name = fmt::format("{}: foxglove", who);
   so.client_queue_bytes = o.queue_kib * 1024;
   so.keep_last = o.linger_s > 0.0;
+  for (const std::string& origin : o.allow_origins) {
+    if (origin != "*" && origin.find("://") == std::string::npos)
+      throw io::ConfigError(fmt::format(
+          "--foxglove-allow-origin \"{}\": expected an origin as SCHEME://HOST[:PORT] (e.g. https://app.foxglove.dev) "
+          "or *",
+          origin));
+  }
+  so.allowed_origins = o.allow_origins;
   auto server = std::make_unique<foxglove::Server>(so);
   foxglove::serve_vehicle_topics(*server, transport, topics);
   server->start();

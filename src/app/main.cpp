@@ -11,6 +11,7 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/python_host.hpp"
+#include "io/scenario_limits.hpp"
 
 namespace {
 
@@ -75,6 +76,19 @@ int main(int argc, char** argv) {
       {add_fmu_subcommand(app, fmu), [&] { return fmu_command(fmu); }},
   };
   add_exit_code_footers(app);
+  // Limits on what files and flags may ask for (io/scenario_limits.hpp), on the commands that read
+  // scenarios and FMUs.
+  bool no_limits = false;
+  std::vector<std::string> limit_overrides;
+  for (const char* name : {"run", "plant", "controller", "sweep", "fmu"}) {
+    CLI::App* sub = app.get_subcommand(name);
+    sub->add_flag("--no-limits", no_limits,
+                  "lift every limit on scenarios, FMUs, outputs and swarms (docs/scenarios.md, \"Limits\")");
+    sub->add_option("--limit", limit_overrides,
+                    "raise one limit: NAME=VALUE (repeatable; scenario_bytes, schedule_entries, plant_rate_hz, "
+                    "fmu_entries, fmu_unpacked_bytes, fmu_variables)")
+        ->allow_extra_args(false);
+  }
 
   // Bad flags and arguments: CLI11's message (it names the flag, the value and what was expected) and
   // exit 2, as for every other bad input; --help and --version exit 0.
@@ -89,6 +103,17 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? exit_code::kOk : exit_code::kBadInput;
+  }
+  {
+    quadcosim::io::Limits limits;
+    limits.enabled = !no_limits;
+    for (const std::string& a : limit_overrides) {
+      if (const std::string err = quadcosim::io::apply_limit(limits, a); !err.empty()) {
+        std::cerr << "error: " << err << '\n';
+        return exit_code::kBadInput;
+      }
+    }
+    quadcosim::io::set_limits(limits);
   }
   // A scenario's `controller: {python: ...}` resolves through the embedded Python (started on first
   // use only).

@@ -25,6 +25,7 @@
 #include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
+#include "io/scenario_limits.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
@@ -104,9 +105,15 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     plant_args.push_back(fmt::format("{}", opt.rate_factor));
   }
   if (opt.pin) pin_apart(plant_args, controller_args);
+  for (const std::string& a : io::limit_arguments(io::limits())) {  // the child processes read the same files
+    plant_args.push_back(a);
+    controller_args.push_back(a);
+  }
   if (!opt.foxglove.listen.empty()) {  // the plant serves: it has every topic, and the simulated time
     plant_args.insert(plant_args.end(), {"--foxglove", opt.foxglove.listen, "--foxglove-queue-kib",
                                          fmt::format("{}", opt.foxglove.queue_kib)});
+    for (const std::string& origin : opt.foxglove.allow_origins)
+      plant_args.insert(plant_args.end(), {"--foxglove-allow-origin", origin});
     if (opt.foxglove.linger_s > 0)
       plant_args.insert(plant_args.end(), {"--foxglove-linger", fmt::format("{}", opt.foxglove.linger_s)});
   }
@@ -177,6 +184,13 @@ int run_command(const RunOptions& opt) {
   if ((opt.vehicles > 0 || sc.swarm) && !opt.foxglove.listen.empty()) {
     std::cerr << "error: --foxglove serves one vehicle; " << opt.scenario << " flies a swarm\n";
     return exit_code::kBadInput;
+  }
+  // Limits (io/scenario_limits.hpp): a swarm against the memory, one vehicle's outputs against the disk.
+  if (opt.vehicles > 0 || sc.swarm) {
+    io::check_swarm_fits(opt.vehicles > 0 ? opt.vehicles : sc.swarm->layout.vehicles);
+  } else {
+    const double ticks = static_cast<double>(sc.simulation.duration_ticks) + 1.0;
+    io::check_output_fits(opt.scenario, opt.out_dir, ticks, ticks / sc.simulation.controller_divider);
   }
   // Refused (exit 2) when it holds anything, unless --force; every file written below is listed in
   // its manifest, also when the run is interrupted or fails.

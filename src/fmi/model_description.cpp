@@ -18,6 +18,8 @@
 
 #include "fmi/model_description.hpp"
 
+#include "fmi/unzip.hpp"
+
 namespace quadcosim::fmi {
 
 std::string_view to_string(VariableType t) {
@@ -392,6 +394,14 @@ ModelDescription parse_model_description(std::string_view xml, const std::string
     r.fail(root, "fmiVersion=\"{}\" is not supported: quadcosim masters FMI 2.0 and 3.0", md.fmi_version);
   }
   const bool v2 = md.version == FmiVersion::k2;
+  if (const xmlNode* list = child(root, "ModelVariables"); list != nullptr && fmu_limits().enabled) {
+    std::uint64_t n = 0;
+    for (const xmlNode* c = list->children; c != nullptr; c = c->next) n += c->type == XML_ELEMENT_NODE ? 1 : 0;
+    if (n > fmu_limits().variables) {
+      r.fail(list, "ModelVariables lists {} variables, more than the {} an FMU may have ({})", n,
+             fmu_limits().variables, limit_hint("fmu_variables"));
+    }
+  }
   md.model_name = r.required(root, "fmiModelDescription", "modelName");
   md.guid = r.required(root, "fmiModelDescription", v2 ? "guid" : "instantiationToken");
   md.description = Reader::attr(root, "description").value_or("");

@@ -89,14 +89,47 @@ void make_directory(const std::string& path, const std::string& archive, const s
   }
 }
 
+FmuLimits& limits_in_force() {
+  static FmuLimits limits;  // set once by the command line before any FMU is read
+  return limits;
+}
+
 }  // namespace
+
+const FmuLimits& fmu_limits() { return limits_in_force(); }
+void set_fmu_limits(const FmuLimits& limits) { limits_in_force() = limits; }
+std::string limit_hint(const std::string& name) {
+  return fmt::format("limit {}; raise it with --limit {}=N, or --no-limits", name, name);
+}
 
 void unzip(const std::string& archive, const std::string& dir) {
   std::unique_ptr<void, ZipCloser> zip(unzOpen64(archive.c_str()));
   if (!zip) throw FmuError(fmt::format("{}: cannot open as a zip archive (missing, unreadable or not a zip)", archive));
+  const FmuLimits& limits = fmu_limits();
+  if (limits.enabled) {  // from the central directory, before anything is unpacked
+    unz_global_info64 global{};
+    if (unzGetGlobalInfo64(zip.get(), &global) != UNZ_OK) {
+      throw FmuError(fmt::format("{}: cannot read the zip directory", archive));
+    }
+    if (global.number_entry > limits.entries) {
+      throw FmuError(fmt::format("{}: the archive has {} entries, more than the {} an FMU may have ({})", archive,
+                                 global.number_entry, limits.entries, limit_hint("fmu_entries")));
+    }
+    std::uint64_t declared = 0;
+    for (int r = unzGoToFirstFile(zip.get()); r == UNZ_OK; r = unzGoToNextFile(zip.get())) {
+      unz_file_info64 info{};
+      if (unzGetCurrentFileInfo64(zip.get(), &info, nullptr, 0, nullptr, 0, nullptr, 0) != UNZ_OK) break;
+      declared += info.uncompressed_size;
+      if (declared > limits.unpacked_bytes) {
+        throw FmuError(fmt::format("{}: the archive's entries unpack to more than {} bytes, the most an FMU may ({})",
+                                   archive, limits.unpacked_bytes, limit_hint("fmu_unpacked_bytes")));
+      }
+    }
+  }
   int rc = unzGoToFirstFile(zip.get());
   if (rc == UNZ_END_OF_LIST_OF_FILE) throw FmuError(fmt::format("{}: the zip archive is empty", archive));
   std::vector<char> buffer(1 << 16);
+  std::uint64_t unpacked = 0;
   for (; rc == UNZ_OK; rc = unzGoToNextFile(zip.get())) {
     unz_file_info64 info{};
     if (unzGetCurrentFileInfo64(zip.get(), &info, nullptr, 0, nullptr, 0, nullptr, 0) != UNZ_OK) {
@@ -139,6 +172,13 @@ void unzip(const std::string& archive, const std::string& dir) {
         throw FmuError(fmt::format("{}: entry '{}': corrupt data (minizip error {})", archive, entry, n));
       }
       if (n == 0) break;
+      unpacked += static_cast<std::uint64_t>(n);
+      if (limits.enabled && unpacked > limits.unpacked_bytes) {  // a declared size may lie
+        unzCloseCurrentFile(zip.get());
+        throw FmuError(
+            fmt::format("{}: entry '{}': the archive unpacks to more than {} bytes, the most an FMU may ({})", archive,
+                        entry, limits.unpacked_bytes, limit_hint("fmu_unpacked_bytes")));
+      }
       for (int written = 0; written < n;) {
         const ssize_t w = ::write(out.fd, buffer.data() + written, static_cast<std::size_t>(n - written));
         if (w < 0 && errno == EINTR) continue;

@@ -12,11 +12,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <iostream>
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -31,8 +33,13 @@ using nlohmann::json;
 // Binary opcodes (server to client) and status levels of the protocol.
 constexpr std::uint8_t kMessageData = 0x01, kTime = 0x02;
 constexpr int kStatusError = 2;
-// Per client: the first errors are logged, the rest only counted; this many close the connection.
-constexpr std::uint64_t kLoggedErrors = 5, kErrorsBeforeDisconnect = 100;
+// Per client: the first error is logged, the rest only counted; this many close the connection.
+constexpr std::uint64_t kErrorsBeforeDisconnect = 100;
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
 
 void put_le(std::uint8_t* p, std::uint64_t v, int bytes) {
   for (int i = 0; i < bytes; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
@@ -49,6 +56,36 @@ std::optional<std::uint32_t> as_u32(const json& v) {
 
 }  // namespace
 
+bool origin_allowed(const std::string& origin, const std::vector<std::string>& allowed) {
+  if (origin.empty()) return true;
+  std::string o = lower(origin);
+  while (!o.empty() && o.back() == '/') o.pop_back();
+  for (const std::string& a : allowed) {
+    std::string w = lower(a);
+    while (!w.empty() && w.back() == '/') w.pop_back();
+    if (w == "*" || w == o) return true;
+  }
+  // scheme://host[:port], nothing else (no path, no user info)
+  std::string rest;
+  if (o.rfind("http://", 0) == 0) {
+    rest = o.substr(7);
+  } else if (o.rfind("https://", 0) == 0) {
+    rest = o.substr(8);
+  } else {
+    return false;
+  }
+  for (const char* host : {"localhost", "127.0.0.1", "[::1]"}) {
+    const std::string h(host);
+    if (rest.compare(0, h.size(), h) != 0) continue;
+    const std::string port = rest.substr(h.size());
+    if (port.empty()) return true;
+    if (port.size() >= 2 && port.size() <= 6 && port[0] == ':' &&
+        std::all_of(port.begin() + 1, port.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      return true;
+  }
+  return false;
+}
+
 struct Server::Impl {
   struct Channel {
     std::string topic, schema_name, schema;
@@ -64,6 +101,7 @@ struct Server::Impl {
     std::vector<std::int64_t> subscription_of;             // channel -> subscription id, -1 for none
     std::uint64_t dropped = 0, errors = 0;
     bool dropping = false;  // its queue is full (logged once per episode)
+    bool closing = false;   // disconnected for its errors: nothing more it sends is read
   };
   struct Handed {
     std::uint32_t channel;
@@ -88,8 +126,12 @@ struct Server::Impl {
 
   // Server thread only.
   std::map<Hdl, Client, std::owner_less<Hdl>> clients;
+  // Handshakes accepted whose connection has not opened (or failed) yet: they count against
+  // max_clients, so a burst of simultaneous connects cannot pass the check before any of them opens.
+  std::set<Hdl, std::owner_less<Hdl>> admitted;
   std::uint64_t next_client_id = 1;
-  std::int64_t time_ns = -1;  // the newest time sent
+  std::int64_t time_ns = -1;             // the newest time sent
+  std::uint64_t n_refused_in_a_row = 0;  // refusals for the client limit since a connection last opened
 
   std::atomic<std::size_t> open{0};
   std::atomic<std::uint64_t> n_clients{0}, n_refused{0}, n_sent{0}, n_dropped{0}, n_handoff_dropped{0}, n_time{0},
@@ -114,18 +156,32 @@ struct Server::Impl {
       c->set_status(websocketpp::http::status_code::bad_request);
       return false;
     }
-    if (clients.size() >= options.max_clients) {
+    if (const std::string& origin = c->get_request_header("Origin"); !origin_allowed(origin, options.allowed_origins)) {
       ++n_refused;
-      log(fmt::format("refused {}: {} clients already connected", c->get_remote_endpoint(), clients.size()));
+      log(fmt::format("refused {}: Origin {} is not local nor allowed (--foxglove-allow-origin)",
+                      c->get_remote_endpoint(), origin));
+      c->set_status(websocketpp::http::status_code::forbidden);
+      return false;
+    }
+    if (clients.size() + admitted.size() >= options.max_clients) {
+      // Logged once per episode of refusals (a burst would otherwise log a line per connect).
+      if (++n_refused_in_a_row == 1)
+        log(fmt::format("refused {}: {} clients already connected (the limit); further refusals are counted",
+                        c->get_remote_endpoint(), clients.size() + admitted.size()));
+      ++n_refused;
       c->set_status(websocketpp::http::status_code::service_unavailable);
       return false;
     }
     websocketpp::lib::error_code ec;
     c->select_subprotocol(kSubprotocol, ec);
-    return !ec;
+    if (ec) return false;
+    admitted.insert(h);
+    return true;
   }
 
   void on_open(Hdl h) {
+    admitted.erase(h);
+    n_refused_in_a_row = 0;
     WsServer::connection_ptr c = connection(h);
     if (!c) return;
     Client& cl = clients[h];
@@ -157,6 +213,7 @@ struct Server::Impl {
   }
 
   void on_close(Hdl h) {
+    admitted.erase(h);  // a handshake accepted whose connection failed before it opened
     const auto it = clients.find(h);
     if (it == clients.end()) return;
     Client& cl = it->second;
@@ -175,14 +232,18 @@ struct Server::Impl {
   }
 
   // --- client requests ---------------------------------------------------------------------------
+  // A bad request: an error status back, counted. The client's first error is logged (one line);
+  // its 100th closes the connection (one more line), after which nothing it sent is read.
   void error(Hdl h, Client& cl, const std::string& what) {
+    if (cl.closing) return;
     ++n_bad;
     ++cl.errors;
-    if (cl.errors <= kLoggedErrors) log(fmt::format("client {} ({}): {}", cl.id, cl.remote, what));
-    if (cl.errors == kLoggedErrors + 1)
-      log(fmt::format("client {} ({}): further errors are only counted", cl.id, cl.remote));
+    if (cl.errors == 1)
+      log(fmt::format("client {} ({}): {} (further errors of this client are only counted; the {}th disconnects it)",
+                      cl.id, cl.remote, what, kErrorsBeforeDisconnect));
     send_text(h, json{{"op", "status"}, {"level", kStatusError}, {"message", what}});
     if (cl.errors >= kErrorsBeforeDisconnect) {
+      cl.closing = true;
       ++n_disconnected;
       log(fmt::format("client {} ({}): {} errors: disconnected", cl.id, cl.remote, cl.errors));
       websocketpp::lib::error_code ec;
@@ -192,7 +253,7 @@ struct Server::Impl {
 
   void on_message(Hdl h, WsServer::message_ptr m) {
     const auto it = clients.find(h);
-    if (it == clients.end()) return;
+    if (it == clients.end() || it->second.closing) return;
     Client& cl = it->second;
     if (m->get_opcode() != websocketpp::frame::opcode::text) {
       error(h, cl, "binary client messages need the clientPublish capability, which this server does not offer");
@@ -223,6 +284,7 @@ struct Server::Impl {
       return;
     }
     for (const json& s : j["subscriptions"]) {
+      if (cl.closing) return;
       const auto id = s.is_object() && s.contains("id") ? as_u32(s["id"]) : std::nullopt;
       const auto channel = s.is_object() && s.contains("channelId") ? as_u32(s["channelId"]) : std::nullopt;
       if (!id || !channel) {
@@ -257,6 +319,7 @@ struct Server::Impl {
       return;
     }
     for (const json& v : j["subscriptionIds"]) {
+      if (cl.closing) return;
       const auto id = as_u32(v);
       const auto it = id ? cl.subscriptions.find(*id) : cl.subscriptions.end();
       if (it == cl.subscriptions.end()) {

@@ -29,17 +29,29 @@ struct ServerOptions {
   std::size_t handoff_messages = 1 << 16;
   /// Largest frame a client may send [bytes]; a longer one closes its connection (1009, message too big).
   std::size_t max_client_frame_bytes = 64 * 1024;
-  std::size_t max_clients = 16;  ///< further connections are refused (HTTP 503)
+  /// Connections at most, counting those whose handshake was accepted and is still being answered;
+  /// further handshakes are refused (HTTP 503), also in a burst of simultaneous connects.
+  std::size_t max_clients = 16;
+  /// Origins a browser page may connect from, besides the local ones (see origin_allowed()); "*"
+  /// admits any. A handshake with another Origin header is refused (HTTP 403).
+  std::vector<std::string> allowed_origins;
   /// Hand every message over even while nobody subscribes, so that the newest one of each channel can
   /// be sent to a client that subscribes later (e.g. after the run ended); costs the serialisation of
   /// every message. Off: nothing is serialised while no client subscribes.
   bool keep_last = false;
 };
 
+/// Whether a handshake with Origin header `origin` ("" when it has none) is admitted: no Origin (a
+/// native client: Foxglove desktop, a script), an http(s) origin on localhost, 127.0.0.1 or [::1] (any
+/// port), or one of `allowed` (compared without regard to case; "*" admits every origin). Anything
+/// else, "null" included, is a page of another site and is refused.
+bool origin_allowed(const std::string& origin, const std::vector<std::string>& allowed);
+
 /// What the server has done, summed over its clients (read any time, from any thread).
 struct ServerStats {
   std::uint64_t clients = 0;           ///< connections accepted
-  std::uint64_t refused = 0;           ///< handshakes refused: no foxglove.websocket.v1, or too many clients
+  std::uint64_t refused = 0;           ///< handshakes refused: no foxglove.websocket.v1, an Origin not
+                                       ///< allowed, or too many clients
   std::uint64_t messages_sent = 0;     ///< message frames queued to clients
   std::uint64_t messages_dropped = 0;  ///< message frames not sent: the client's queue was full
   std::uint64_t handoff_dropped = 0;   ///< messages dropped before the server thread saw them

@@ -478,5 +478,45 @@ TEST_F(McapWriterTest, ClosedFileHasDataEndSummaryOffsetsFooterAndMagic) {
   EXPECT_EQ(b[le64(b, footer_at + 17)], 0x0E);
 }
 
+TEST_F(McapWriterTest, ChunkIndexesBeyondTheMemoryBoundGoToASpillFileAndAllReachTheSummary) {
+  // Tiny chunks (one Pose each, uncompressed): 4,000 chunks are 4,000 Chunk Index records of one
+  // channel, 83 bytes each (332 kB in all), far more than kChunkIndexMemoryBytes (64 KiB): most spill.
+  const std::string file = path("spill.mcap");
+  std::uint64_t chunks = 0, spilled = 0;
+  {
+    McapWriter w(file, {"ros2", 64, false});
+    const auto s =
+        w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
+    const auto c = w.add_channel("/drone/Pose", s, "cdr");
+    for (int i = 0; i < 4000; ++i) {
+      const auto b = pose_bytes(i);
+      w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+    }
+    chunks = w.chunks();
+    spilled = w.spilled_index_bytes();
+    EXPECT_EQ(chunks, 4000u);
+    EXPECT_GT(spilled, 0u);
+    EXPECT_FALSE(fs::exists(file + ".chunk-indexes")) << "the spill file is unlinked once open";
+    w.close();
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "only the .mcap is left";
+  const auto b = read_file(file);
+  const auto records = top_level_records(b);
+  std::vector<std::size_t> chunk_at, index_to;
+  std::uint64_t index_bytes = 0;
+  for (const auto& [op, at] : records) {
+    if (op == 0x06) chunk_at.push_back(at);
+    if (op == 0x08) {
+      index_to.push_back(le64(b, at + 9 + 16));  // Chunk Index: chunk_start_offset
+      index_bytes = 9 + le64(b, at + 1);
+    }
+  }
+  EXPECT_EQ(index_bytes, 83u);  // 9 + 32 (times, offset, length) + 14 (one channel) + 8 + 4 ("") + 16
+  EXPECT_EQ(spilled % index_bytes, 0u) << "whole records only";
+  EXPECT_GT(spilled, chunks * index_bytes - McapWriter::kChunkIndexMemoryBytes - index_bytes);
+  ASSERT_EQ(chunk_at.size(), chunks);
+  EXPECT_EQ(index_to, chunk_at) << "one Chunk Index per chunk, in order, each at its chunk";
+}
+
 }  // namespace
 }  // namespace quadcosim::io

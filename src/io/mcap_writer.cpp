@@ -8,6 +8,9 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "io/output_folder.hpp"
 
 #ifndef QUADCOSIM_VERSION
@@ -127,6 +130,7 @@ McapWriter::McapWriter(const std::string& path, McapOptions options) : path_(pat
     }
   }
   try {
+    chunk_indexes_.reserve(kChunkIndexMemoryBytes + 1024);  // the bound and one record beyond it
     crc_ = kCrcInit;
     emit(kMagic.data(), kMagic.size());
     const std::string library = std::string("quadcosim ") + QUADCOSIM_VERSION;
@@ -149,6 +153,7 @@ McapWriter::~McapWriter() {
     // close() reports errors to callers that ask; a destructor must not throw.
   }
   if (file_) std::fclose(file_);
+  if (spill_) std::fclose(spill_);
   ZSTD_freeCCtx(zstd_);
 }
 
@@ -281,12 +286,7 @@ void McapWriter::write_chunk() {
     compression = "zstd";
   }
 
-  ChunkIndex index{};
-  index.start_time = chunk_start_time_;
-  index.end_time = chunk_end_time_;
-  index.offset = offset_;
-  index.compressed_size = records_size;
-  index.uncompressed_size = chunk_.size();
+  const std::uint64_t chunk_offset = offset_;
   std::vector<std::uint8_t> head;
   Fields(head)
       .u64(chunk_start_time_)
@@ -299,25 +299,65 @@ void McapWriter::write_chunk() {
   emit(prefix.data(), prefix.size());
   emit(head.data(), head.size());
   emit(records, records_size);
-  index.length = offset_ - index.offset;
+  const std::uint64_t chunk_length = offset_ - chunk_offset;
 
   const std::uint64_t indexes_start = offset_;
+  std::map<std::uint16_t, std::uint64_t> message_index_offsets;
+  std::vector<std::uint8_t> body;
   for (const auto& [channel, entries] : chunk_index_) {
-    std::vector<std::uint8_t> body;
+    body.clear();
     Fields f(body);
     f.u16(channel);
     const std::size_t at = f.begin_length();
     for (const auto& [log_time, offset] : entries) f.u64(log_time).u64(offset);
     f.end_length(at);
-    index.message_index_offsets[channel] = offset_;
+    message_index_offsets[channel] = offset_;
     emit_record(kMessageIndex, body);
   }
-  index.message_index_length = offset_ - indexes_start;
-  chunk_indexes_.push_back(std::move(index));
+  // The chunk's Chunk Index record for the summary, serialised now (opcode, length, body).
+  body.clear();
+  Fields(body)
+      .u64(chunk_start_time_)
+      .u64(chunk_end_time_)
+      .u64(chunk_offset)
+      .u64(chunk_length)
+      .id_map(message_index_offsets)
+      .u64(offset_ - indexes_start)
+      .str(compression)
+      .u64(records_size)
+      .u64(chunk_.size());
+  const auto index_prefix = record_prefix(kChunkIndex, body.size());
+  chunk_indexes_.insert(chunk_indexes_.end(), index_prefix.begin(), index_prefix.end());
+  chunk_indexes_.insert(chunk_indexes_.end(), body.begin(), body.end());
+  ++chunk_count_;
+  if (chunk_indexes_.size() >= kChunkIndexMemoryBytes) spill_chunk_indexes();
 
   chunk_.clear();
   chunk_index_.clear();
   flush_file();
+}
+
+void McapWriter::spill_chunk_indexes() {
+  if (chunk_indexes_.empty()) return;
+  if (!spill_) {
+    const std::string spill_path = path_ + ".chunk-indexes";
+    // Created new (O_EXCL: never through a link planted there, never another file's bytes).
+    const int fd = ::open(spill_path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+    spill_ = fd >= 0 ? ::fdopen(fd, "w+b") : nullptr;
+    if (!spill_) {
+      if (fd >= 0) ::close(fd);
+      throw std::runtime_error("McapWriter: cannot create '" + spill_path + "' (the chunk indexes of '" + path_ +
+                               "' beyond " + std::to_string(kChunkIndexMemoryBytes) +
+                               " bytes): " + std::strerror(errno));
+    }
+    ::unlink(spill_path.c_str());  // open, it stays readable; nothing is left behind
+  }
+  if (std::fwrite(chunk_indexes_.data(), 1, chunk_indexes_.size(), spill_) != chunk_indexes_.size()) {
+    throw std::runtime_error("McapWriter: cannot write the chunk indexes of '" + path_ +
+                             "' beside it: " + std::strerror(errno));
+  }
+  spilled_bytes_ += chunk_indexes_.size();
+  chunk_indexes_.clear();
 }
 
 void McapWriter::flush() {
@@ -330,6 +370,10 @@ void McapWriter::close() {
   if (closed_) return;
   closed_ = true;  // also when finishing fails: the file is not to be written again
   finish();
+  if (spill_) {  // its bytes are in the summary now; closing it frees them on the disk
+    std::fclose(spill_);
+    spill_ = nullptr;
+  }
   const int rc = std::fclose(file_);
   file_ = nullptr;
   if (rc != 0) throw std::runtime_error("McapWriter: cannot write '" + path_ + "': " + std::strerror(errno));
@@ -370,20 +414,24 @@ void McapWriter::finish() {
     }
   });
   group(kChunkIndex, [&] {
-    for (const ChunkIndex& i : chunk_indexes_) {
-      body.clear();
-      Fields(body)
-          .u64(i.start_time)
-          .u64(i.end_time)
-          .u64(i.offset)
-          .u64(i.length)
-          .id_map(i.message_index_offsets)
-          .u64(i.message_index_length)
-          .str(zstd_ ? "zstd" : "")
-          .u64(i.compressed_size)
-          .u64(i.uncompressed_size);
-      emit_record(kChunkIndex, body);
+    if (spill_) {  // the records spilled first, in the order they were written, then those in memory
+      if (std::fflush(spill_) != 0 || std::fseek(spill_, 0, SEEK_SET) != 0) {
+        throw std::runtime_error("McapWriter: cannot read back the chunk indexes of '" + path_ +
+                                 "': " + std::strerror(errno));
+      }
+      std::vector<std::uint8_t> buffer(64 * 1024);
+      std::uint64_t left = spilled_bytes_;
+      while (left > 0) {
+        const std::size_t n = std::fread(buffer.data(), 1, std::min<std::uint64_t>(left, buffer.size()), spill_);
+        if (n == 0) {
+          throw std::runtime_error("McapWriter: cannot read back the chunk indexes of '" + path_ +
+                                   "': " + std::strerror(errno));
+        }
+        emit(buffer.data(), n);
+        left -= n;
+      }
     }
+    emit(chunk_indexes_.data(), chunk_indexes_.size());
   });
   group(kStatistics, [&] {
     std::map<std::uint16_t, std::uint64_t> counts;
@@ -395,7 +443,7 @@ void McapWriter::finish() {
         .u32(static_cast<std::uint32_t>(channels_.size()))
         .u32(0)  // attachments
         .u32(0)  // metadata
-        .u32(static_cast<std::uint32_t>(chunk_indexes_.size()))
+        .u32(static_cast<std::uint32_t>(chunk_count_))
         .u64(start_time_)
         .u64(end_time_)
         .id_map(counts);

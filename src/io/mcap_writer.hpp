@@ -16,6 +16,13 @@
 // @mcap/core, tested in mcap_interop_test.sh; the mcap CLI's `recover` works the same way). No
 // fsync: a power cut may lose what the OS had not written yet.
 //
+// Memory: what the summary needs of each chunk (its Chunk Index record, 77 + 10 bytes per channel in
+// the chunk: 157 bytes for a chunk of 8 channels) is serialised as the chunk is written and kept in
+// memory up to kChunkIndexMemoryBytes; beyond that it is appended to a spill file beside the output
+// (`<path>.chunk-indexes`, unlinked as soon as it is opened, so nothing is left behind even after a
+// SIGKILL) and copied into the summary at close. The writer's memory is so bounded whatever the run's
+// length; the spill file grows by those bytes per chunk on the output's disk.
+//
 // Not thread-safe: one thread writes (the recorder).
 #pragma once
 
@@ -83,6 +90,15 @@ class McapWriter {
 
   /// Messages written so far (including those in the open chunk).
   std::uint64_t messages() const { return message_count_; }
+  /// Chunks written so far.
+  std::uint64_t chunks() const { return chunk_count_; }
+  /// Bytes of Chunk Index records moved to the spill file so far (0 until the memory bound is reached).
+  std::uint64_t spilled_index_bytes() const { return spilled_bytes_; }
+
+  /// Chunk Index records kept in memory before they go to the spill file [bytes] (reserved at once, so
+  /// the writer's memory does not change as they come and go: about 400 chunks, 3-5 simulated minutes
+  /// of a recorded run at 100 Hz).
+  static constexpr std::size_t kChunkIndexMemoryBytes = 64 * 1024;
 
  private:
   struct Schema {
@@ -94,11 +110,6 @@ class McapWriter {
     std::string topic, message_encoding;
     std::map<std::string, std::string> metadata;
   };
-  struct ChunkIndex {
-    std::uint64_t start_time, end_time, offset, length;
-    std::map<std::uint16_t, std::uint64_t> message_index_offsets;
-    std::uint64_t message_index_length, compressed_size, uncompressed_size;
-  };
 
   void require_open(const char* what) const;
   /// Writes bytes to the file, keeping the offset and the running CRC.
@@ -107,6 +118,8 @@ class McapWriter {
   /// fflush; throws std::runtime_error naming the path when the OS refuses the bytes.
   void flush_file();
   void write_chunk();
+  /// Moves the Chunk Index records held in memory to the spill file (opened on first use).
+  void spill_chunk_indexes();
   void finish();
 
   std::string path_;
@@ -119,7 +132,10 @@ class McapWriter {
   std::vector<Schema> schemas_;
   std::vector<Channel> channels_;                      ///< channels_[id - 1]
   std::vector<std::uint64_t> channel_message_counts_;  ///< by channel id - 1
-  std::vector<ChunkIndex> chunk_indexes_;
+  std::uint64_t chunk_count_ = 0;
+  std::vector<std::uint8_t> chunk_indexes_;  ///< serialised Chunk Index records not spilled yet
+  std::FILE* spill_ = nullptr;               ///< the spill file (unlinked), once opened
+  std::uint64_t spilled_bytes_ = 0;
 
   // The open chunk: its uncompressed records, log time range and message index (channel -> log
   // time, offset in the records).

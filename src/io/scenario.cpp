@@ -15,6 +15,7 @@
 #include "fmi/fmu_controller.hpp"
 #include "fmi/fmu_plant.hpp"
 #include "io/realism_yaml.hpp"
+#include "io/scenario_limits.hpp"
 #include "io/trajectory_yaml.hpp"
 #include "io/yaml_reader.hpp"
 #include "sim/topics.hpp"
@@ -327,6 +328,10 @@ sim::Tick tick_at(YamlSection& s, const std::string& key, double seconds, std::i
 
 void read_simulation(YamlSection& s, sim::SimulationConfig& cfg, double& duration_s) {
   const double plant_hz = s.number("plant_rate_hz", 100.0, 1e-3, 1e6);
+  if (const Limits& l = limits(); l.enabled && plant_hz > l.plant_rate_hz) {
+    s.fail("plant_rate_hz", fmt::format("got {:g} Hz, more than the limit of {:g} Hz ({})", plant_hz, l.plant_rate_hz,
+                                        limit_hint("plant_rate_hz")));
+  }
   const double period_ns = 1e9 / plant_hz;
   if (std::abs(period_ns - std::round(period_ns)) > 1e-6) {
     s.fail("plant_rate_hz",
@@ -476,7 +481,12 @@ void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
 
 void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
   int index = 0;
-  for (const YAML::Node& n : root.sequence("schedule")) {
+  const std::vector<YAML::Node> entries = root.sequence("schedule");
+  if (const Limits& l = limits(); l.enabled && entries.size() > l.schedule_entries) {
+    root.fail("schedule", fmt::format("{} entries, more than the limit of {} ({})", entries.size(), l.schedule_entries,
+                                      limit_hint("schedule_entries")));
+  }
+  for (const YAML::Node& n : entries) {
     const std::string where = "schedule[" + std::to_string(index++) + "]";
     if (!n.IsMap()) root.fail(where, "expected a mapping with at_s and set");
     YamlSection s(n, root.file(), root.key_path(where));
@@ -493,6 +503,10 @@ void read_schedule(YamlSection& root, Scenario& sc, double duration_s) {
     }
     read_parameters(*set, scratch, &values);
     for (auto& [name, value] : values) sc.schedule.push_back({tick, name, value});
+    if (const Limits& l = limits(); l.enabled && sc.schedule.size() > l.schedule_entries) {
+      root.fail(where, fmt::format("the schedule sets more than {} parameter values ({})", l.schedule_entries,
+                                   limit_hint("schedule_entries")));
+    }
     s.reject_unknown_keys();
   }
 }

@@ -1,7 +1,12 @@
 #include "io/yaml_reader.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <filesystem>
 #include <sstream>
+
+#include "io/scenario_limits.hpp"
 
 namespace quadcosim::io {
 
@@ -9,6 +14,15 @@ YamlSection::YamlSection(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
 YamlSection YamlSection::load_file(const std::string& file) {
+  // Before parsing: a file of tens of megabytes parses into gigabytes of nodes.
+  if (const Limits& l = limits(); l.enabled) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(file, ec);
+    if (!ec && size > l.scenario_bytes) {
+      throw ConfigError(fmt::format("{}: the file is {} bytes, more than the {} a scenario file may have ({})", file,
+                                    size, l.scenario_bytes, limit_hint("scenario_bytes")));
+    }
+  }
   YAML::Node root;
   try {
     root = YAML::LoadFile(file);

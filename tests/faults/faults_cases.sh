@@ -635,9 +635,11 @@ assert z[-1] - z[799] >= 0.3, z[-1]  # and flying the step: the in-process one c
 PY
     ;;
 
-  soak_rss)  # a long lockstep run: neither process's resident set grows after warm-up
+  soak_rss)  # a long recorded lockstep run: neither process's resident set grows after warm-up
     # One simulated hour (18-100 s here at 40-200x real time), localhost in the test's namespace,
-    # sampled every 0.25 s (every second gave too few samples on a fast machine).
+    # sampled every 0.25 s (every second gave too few samples on a fast machine). The plant records
+    # the CSV and run.mcap as `run --transport dds` does (bench/soak.sh): with every chunk's index
+    # held in memory it grew by 3.3 MB per simulated hour, 2.5 MB in the quarters compared here.
     ROS_DOMAIN_ID="$domain" bash "$src/bench/soak.sh" "$bin" 3600 "$tmp/soak.json" 0.25 > "$tmp/soak.log" 2>&1 ||
       fail "soak run failed: $(cat "$tmp/soak.log")"
     grep "^soak: " "$tmp/soak.log"
@@ -646,15 +648,115 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["simulated_s"] == 3600, s["simulated_s"]
 assert s["samples"] >= 20, s["samples"]  # at least 5 samples per quarter
+outputs = s["outputs_bytes"]
+print(f"recorded: {outputs}")
+assert outputs.get("trajectory.csv", 0) > 100e6 and outputs.get("run.mcap", 0) > 100e6, outputs  # it recorded
 plant, controller = s["plant"], s["controller"]
 print(f"growth first -> last quarter: plant {plant['growth_kB']} kB, controller {controller['growth_kB']} kB")
 # Growth is the median of the last quarter's samples less the median of the first's (warm-up). The
-# lockstep round trips are kept in a fixed-size histogram (analysis/log_histogram.hpp), so nothing
-# may grow with the run's length: at most 0.5 MB each (a leak of one 100-byte allocation per control
-# tick would add 13 MB; keeping every round trip, as the plant once did, 1 MB).
+# lockstep round trips are kept in a fixed-size histogram (analysis/log_histogram.hpp) and the MCAP
+# chunk indexes beyond 64 KiB in a spill file (io/mcap_writer.hpp), so nothing may grow with the
+# run's length: at most 0.5 MB each (a leak of one 100-byte allocation per control tick would add
+# 13 MB; keeping every round trip, as the plant once did, 1 MB; every chunk index, 2.5 MB).
 assert plant["growth_kB"] <= 512, plant["growth_kB"]
 assert controller["growth_kB"] <= 512, controller["growth_kB"]
 PY
+    ;;
+
+  limits)  # sane limits: each refusal exit 2 naming the key and the limit, each overridable
+    expect_refusal() {  # expect_refusal WHAT TEXT... -- COMMAND...: exit 2 and every TEXT in the message
+      local what="$1"; shift
+      local texts=()
+      while [ "$1" != "--" ]; do texts+=("$1"); shift; done
+      shift
+      set +e
+      /usr/bin/time -f "max_rss_kb %M" "$@" > "$tmp/limit.log" 2>&1
+      local rc=$?
+      set -e
+      [ "$rc" -eq 2 ] || fail "$what: expected exit 2, got $rc: $(tail -3 "$tmp/limit.log")"
+      local t
+      for t in "${texts[@]}"; do
+        grep -qF -- "$t" "$tmp/limit.log" || fail "$what: message lacks '$t': $(cat "$tmp/limit.log")"
+      done
+      echo "$what: $(grep -m1 'error' "$tmp/limit.log" | cut -c1-220) [$(grep max_rss_kb "$tmp/limit.log")]"
+    }
+    run_ok() {  # run_ok WHAT COMMAND...
+      local what="$1"; shift
+      "$@" > "$tmp/ok.log" 2>&1 || fail "$what: exit $?: $(tail -3 "$tmp/ok.log")"
+      echo "$what: accepted"
+    }
+    scen() { printf 'simulation: {plant_rate_hz: %s, controller_rate_hz: 50, duration_s: %s}\n' "$1" "$2"; }
+    # A plant at a megahertz, and at 20 kHz: refused by default, the latter flown with the limit raised.
+    scen 1e6 0.1 > "$tmp/fast.yaml"
+    expect_refusal "plant at 1 MHz" "simulation.plant_rate_hz: got 1e+06 Hz, more than the limit of 10000 Hz" \
+      "--limit plant_rate_hz=N" "--no-limits" -- "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots
+    scen 2e4 0.1 > "$tmp/fast.yaml"
+    expect_refusal "plant at 20 kHz" "simulation.plant_rate_hz: got 20000 Hz, more than the limit of 10000 Hz" -- \
+      "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots
+    run_ok "plant at 20 kHz with --limit plant_rate_hz=2e4" \
+      "$bin" run "$tmp/fast.yaml" --out "$tmp/fast" --no-plots --limit plant_rate_hz=2e4
+    # run --transport dds hands the raised limit to its plant and controller processes.
+    run_ok "plant at 20 kHz over DDS with --limit plant_rate_hz=2e4" \
+      "$bin" run "$tmp/fast.yaml" --out "$tmp/fast_dds" --no-plots --transport dds --limit plant_rate_hz=2e4
+    # 1e7 s: about 500 GB of outputs projected against the free disk of --out, both named.
+    scen 100 1e7 > "$tmp/long.yaml"
+    expect_refusal "1e7 s run" "the outputs would need about" "free on the disk of $tmp/long" -- \
+      "$bin" run "$tmp/long.yaml" --out "$tmp/long" --no-plots
+    [ ! -e "$tmp/long" ] || fail "1e7 s run: the refused run created its output folder"
+    # A 94 MB scenario of 2 M schedule entries: refused by its size before it is parsed (small RSS).
+    python3 - "$tmp" <<'PY'
+import sys
+tmp = sys.argv[1]
+def write(name, entries, key="mode", value="attitude"):
+    with open(f"{tmp}/{name}", "w") as f:
+        f.write("simulation: {duration_s: 1}\nschedule:\n")
+        line = f"  - {{at_s: 0.5, set: {{{key}: {value}}}}}\n"
+        f.write(line * entries)
+write("huge.yaml", 2_000_000, "altitude.kp", "12.000000")  # 94 MB
+write("long_schedule.yaml", 20_001)  # 0.8 MB
+write("eleven.yaml", 11)
+PY
+    size=$(stat -c %s "$tmp/huge.yaml")
+    expect_refusal "94 MB scenario" "the file is $size bytes, more than the 2097152 a scenario file may have" \
+      "limit scenario_bytes" -- "$bin" run "$tmp/huge.yaml" --out "$tmp/huge" --no-plots
+    rss=$(sed -n 's/max_rss_kb //p' "$tmp/limit.log")
+    [ "$rss" -lt 100000 ] || fail "94 MB scenario: the refusal took $rss kB (parsed before refusing?)"
+    expect_refusal "20,001 schedule entries" "schedule: 20001 entries, more than the limit of 20000" -- \
+      "$bin" run "$tmp/long_schedule.yaml" --out "$tmp/ls" --no-plots
+    expect_refusal "11 schedule entries under a limit of 10" "schedule: 11 entries, more than the limit of 10" -- \
+      "$bin" run "$tmp/eleven.yaml" --out "$tmp/e" --no-plots --limit schedule_entries=10
+    run_ok "11 schedule entries under the default" "$bin" run "$tmp/eleven.yaml" --out "$tmp/e" --no-plots
+    expect_refusal "an unknown limit" "--limit nope=1: expected NAME=VALUE with NAME one of scenario_bytes" -- \
+      "$bin" run "$tmp/eleven.yaml" --out "$tmp/e2" --no-plots --limit nope=1
+    # A swarm beyond the memory: 10 M vehicles at about 40 kB each against MemAvailable.
+    expect_refusal "10 M vehicles" "--vehicles 10000000: the swarm would need about" "available (MemAvailable)" -- \
+      "$bin" run "$hover" --out "$tmp/swarm" --no-plots --vehicles 10000000
+    # FMUs: 200,000 variables, 10,001 entries, and an archive that unpacks beyond the bound.
+    python3 - "$tmp" <<'PY'
+import sys, zipfile
+tmp = sys.argv[1]
+def md(n):
+    v = "".join(f'<ScalarVariable name="v{i}" valueReference="{i}"><Real/></ScalarVariable>' for i in range(n))
+    return ('<?xml version="1.0"?><fmiModelDescription fmiVersion="2.0" modelName="m" guid="g">'
+            '<CoSimulation modelIdentifier="m"/><ModelVariables>' + v + '</ModelVariables></fmiModelDescription>')
+with zipfile.ZipFile(f"{tmp}/vars.fmu", "w", zipfile.ZIP_DEFLATED) as z:
+    z.writestr("modelDescription.xml", md(200_000))
+with zipfile.ZipFile(f"{tmp}/entries.fmu", "w") as z:
+    z.writestr("modelDescription.xml", md(1))
+    for i in range(10_001):
+        z.writestr(f"resources/f{i}", "")
+with zipfile.ZipFile(f"{tmp}/bomb.fmu", "w", zipfile.ZIP_DEFLATED) as z:
+    z.writestr("modelDescription.xml", md(1))
+    z.writestr("resources/zeros", b"\0" * (8 << 20))  # 8 MiB, 8 kB packed
+for name in ("vars", "entries", "bomb"):
+    open(f"{tmp}/{name}.yaml", "w").write(f"simulation: {{duration_s: 1}}\nplant: {{fmu: {name}.fmu}}\n")
+PY
+    expect_refusal "FMU of 200,000 variables" "ModelVariables lists 200000 variables, more than the 100000" \
+      "limit fmu_variables" -- "$bin" run "$tmp/vars.yaml" --out "$tmp/v" --no-plots
+    expect_refusal "FMU of 10,002 entries" "the archive has 10002 entries, more than the 10000" -- \
+      "$bin" run "$tmp/entries.yaml" --out "$tmp/en" --no-plots
+    expect_refusal "FMU unpacking to 8 MiB under a limit of 4 MB" "unpack to more than 4000000 bytes" \
+      "limit fmu_unpacked_bytes" -- "$bin" run "$tmp/bomb.yaml" --out "$tmp/b" --no-plots --limit fmu_unpacked_bytes=4e6
     ;;
 
   netns_netem)  # 10 % loss and 5 ms delay on the veth (tc netem), real-time hover across namespaces

@@ -15,6 +15,11 @@
 #                  trajectory CSV; the server closes when the plant ends
 #   shutdown       SIGINT to a running plant and SIGTERM to a lingering run, each with a client
 #                  connected: both end within seconds; a client arriving after the run gets the final Pose
+#   admission      Origins: local ones and none admitted, any other site's page refused (403) unless
+#                  --foxglove-allow-origin names it (or '*'); a burst of 120 simultaneous connects
+#                  admits exactly the 16 clients of the limit (503 for the rest); a frame of 20,000 bad
+#                  subscriptions disconnects its client with one line logged for the errors and one for
+#                  the disconnection
 # Every process this script starts is killed by PID on exit (tests/lib/process_case.sh).
 bin="$1"; src="$2"
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
@@ -255,6 +260,80 @@ p = msgs[0]["msg"]["pose"]["position"]
 assert [p["x"], p["y"], p["z"]] == [float(last[c]) for c in "xyz"], (p, last)
 PY
     echo "lingering run with a client ended $ms ms after SIGTERM (exit $rc); the late client got the final Pose"
+    ;;
+  admission)
+    # A lingering run serves its last state until SIGTERM: a server that stays up for the clients below.
+    serve() {  # serve NAME [OPTIONS...]: starts a lingering run; sets url and server_pid
+      local name="$1"; shift
+      "$bin" run "$scenario" --out "$tmp/$name" --no-plots --foxglove 0 --foxglove-linger 300 "$@" \
+        > "$tmp/$name.log" 2>&1 &
+      server_pid=$!; pids+=("$server_pid")
+      url="$(url_of "$tmp/$name.log")"
+      await "$tmp/$name.log" "serving its last state"
+    }
+    stop_server() { kill -TERM "$server_pid"; wait "$server_pid" || true; }
+    origins=(- http://localhost http://localhost:3000 https://127.0.0.1:8443 "http://[::1]:8080" HTTP://LOCALHOST:1
+             https://app.foxglove.dev http://evil.example http://localhost.evil.example http://127.0.0.1.evil.example
+             http://localhost:80/x null file://)
+    serve plain
+    client origin "$url" "${origins[@]}" > "$tmp/origins.json" 2> "$tmp/origins_client.log" || fail "origin client"
+    client burst "$url" 120 > "$tmp/burst.json" 2> "$tmp/burst_client.log" || fail "burst client"
+    client flood "$url" 20000 --seconds 20 > "$tmp/flood.json" 2> "$tmp/flood_client.log" || fail "flood client"
+    stop_server
+    serve allowed --foxglove-allow-origin https://app.foxglove.dev --foxglove-allow-origin http://10.0.0.5:8080
+    client origin "$url" https://app.foxglove.dev http://10.0.0.5:8080 http://evil.example - \
+      > "$tmp/allowed.json" 2> "$tmp/allowed_client.log" || fail "origin client (allowed)"
+    stop_server
+    serve any --foxglove-allow-origin '*'
+    client origin "$url" http://evil.example null - > "$tmp/any.json" 2> "$tmp/any_client.log" || fail "origin client (*)"
+    stop_server
+    python3 - "$tmp" <<'PY' || fail "admission (see above)"
+import json, re, sys
+tmp = sys.argv[1]
+errors = []
+def need(cond, what):
+    if not cond:
+        errors.append(what)
+def opened(f, origin, want):
+    r = json.load(open(f"{tmp}/{f}"))[origin]
+    if want:
+        need(r["opened"], f"{f}: Origin {origin} refused: {r}")
+    else:
+        need(not r["opened"] and r["status"] == 403, f"{f}: Origin {origin}: expected HTTP 403, got {r}")
+for o in ("-", "http://localhost", "http://localhost:3000", "https://127.0.0.1:8443", "http://[::1]:8080",
+          "HTTP://LOCALHOST:1"):
+    opened("origins.json", o, True)
+for o in ("https://app.foxglove.dev", "http://evil.example", "http://localhost.evil.example",
+          "http://127.0.0.1.evil.example", "http://localhost:80/x", "null", "file://"):
+    opened("origins.json", o, False)
+for o in ("https://app.foxglove.dev", "http://10.0.0.5:8080", "-"):
+    opened("allowed.json", o, True)
+opened("allowed.json", "http://evil.example", False)
+for o in ("http://evil.example", "null", "-"):
+    opened("any.json", o, True)
+b = json.load(open(f"{tmp}/burst.json"))
+need(b["opened"] == 16 and b["refused"] == {"503": 104}, f"burst of 120: {b}, expected 16 opened and 104 refused with 503")
+f = json.load(open(f"{tmp}/flood.json"))
+need(f["close"] == 1008, f"flood: close {f['close']}, expected 1008 (policy violation)")
+need(f["statuses"] <= 100, f"flood: {f['statuses']} error statuses, expected at most 100")
+log = open(f"{tmp}/plain.log").read().splitlines()
+# The flood's client is the one whose errors disconnected it.
+disc = [l for l in log if "errors: disconnected" in l]
+need(len(disc) == 1, f"{len(disc)} 'disconnected' lines, expected 1: {disc[:3]}")
+if disc:
+    client = re.search(r"client (\d+) ", disc[0]).group(1)
+    lines = [l for l in log if f"client {client} (" in l]
+    need(len(lines) == 2, f"client {client}: {len(lines)} lines logged, expected 2 (first error, disconnect): {lines[:5]}")
+refusals = [l for l in log if "clients already connected" in l]
+need(1 <= len(refusals) <= 3, f"{len(refusals)} lines for the refused burst, expected one per episode")
+summary = [l for l in log if l.startswith("run: foxglove: ")]
+need(summary and "1 clients disconnected" in summary[-1], f"summary: {summary}")
+if errors:
+    print("\n".join(errors)); sys.exit(1)
+print(f"origins as expected; burst of 120: {b['opened']} opened, {b['refused']} refused; flood of "
+      f"{f['sent']} errors in one {f['frameBytes']}-byte frame: {f['statuses']} statuses, close {f['close']}, "
+      f"{len(disc)} disconnect line; {summary[-1]}")
+PY
     ;;
   *) fail "unknown case" ;;
 esac

@@ -12,6 +12,12 @@
 //                                        frame, a valid subscription to TOPIC (messages must still
 //                                        come), then a frame longer than the server takes; the answer to
 //                                        each
+//   node client.mjs origin URL ORIGIN... one handshake per ORIGIN sent as its Origin header ("-": none);
+//                                        whether each opened or the HTTP status that refused it
+//   node client.mjs burst URL N          N connections started at once; how many opened and the status
+//                                        of each refusal (all held open until every one has settled)
+//   node client.mjs flood URL N          one subscribe frame (under the 64 KiB frame limit) with N
+//                                        empty subscriptions, each an error; the statuses and the close
 // Progress goes to stderr ("subscribed", "paused") for the test driving it.
 import FoxgloveClientModule from "@foxglove/ws-protocol";
 import { parse } from "@foxglove/rosmsg";
@@ -30,7 +36,7 @@ if (si >= 0) {
 }
 const [mode, url, ...topics] = args;
 if (!mode || !url) {
-  console.error("usage: client.mjs watch|stall|abuse URL TOPIC... [--seconds S]");
+  console.error("usage: client.mjs watch|stall|abuse|origin|burst|flood URL ARG... [--seconds S]");
   process.exit(2);
 }
 
@@ -161,7 +167,59 @@ async function abuse() {
   done(result);
 }
 
+// One handshake; resolves to {opened, status, ws}.
+function handshake(options = {}) {
+  return new Promise((resolve) => {
+    const w = new WebSocket(url, [SUBPROTOCOL], options);
+    w.on("unexpected-response", (_req, res) => { resolve({ opened: false, status: res.statusCode }); res.resume(); });
+    w.on("open", () => resolve({ opened: true, ws: w }));
+    w.on("error", (e) => resolve({ opened: false, error: String(e.message) }));
+  });
+}
+
+async function origins() {
+  const result = {};
+  for (const origin of topics) {
+    const r = await handshake(origin === "-" ? {} : { origin });
+    if (r.ws) r.ws.close();
+    result[origin] = { opened: r.opened, status: r.status ?? null, error: r.error ?? null };
+  }
+  done(result);
+}
+
+async function burst() {
+  const n = Number(topics[0]);
+  const all = await Promise.all(Array.from({ length: n }, () => handshake()));
+  const result = { started: n, opened: 0, refused: {} };
+  for (const r of all) {
+    if (r.opened) result.opened++;
+    else { const k = String(r.status ?? r.error); result.refused[k] = (result.refused[k] ?? 0) + 1; }
+  }
+  for (const r of all) if (r.ws) r.ws.close();
+  done(result);
+}
+
+async function flood() {
+  const n = Number(topics[0]);
+  const ws = new WebSocket(url, [SUBPROTOCOL]);
+  const result = { sent: n, statuses: 0, close: null };
+  ws.on("message", (data, isBinary) => {
+    if (!isBinary && JSON.parse(data.toString()).op === "status") result.statuses++;
+  });
+  const closed = new Promise((resolve) => ws.on("close", (code) => { result.close = code; resolve(); }));
+  await new Promise((resolve, reject) => { ws.on("open", resolve); ws.on("error", reject); });
+  const subscriptions = Array.from({ length: n }, () => ({}));
+  const frame = JSON.stringify({ op: "subscribe", subscriptions });
+  result.frameBytes = frame.length;
+  ws.send(frame);
+  await Promise.race([closed, new Promise((r) => setTimeout(r, seconds * 1000))]);
+  done(result);
+}
+
 if (mode === "watch") subscribeClient(false);
+else if (mode === "origin") origins().catch((e) => done({ error: String(e?.stack ?? e) }, 1));
+else if (mode === "burst") burst().catch((e) => done({ error: String(e?.stack ?? e) }, 1));
+else if (mode === "flood") flood().catch((e) => done({ error: String(e?.stack ?? e) }, 1));
 else if (mode === "stall") subscribeClient(true);
 else if (mode === "abuse") abuse().catch((e) => done({ error: String(e?.stack ?? e) }, 1));
 else {
