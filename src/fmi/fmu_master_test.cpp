@@ -20,6 +20,13 @@
 namespace quadcosim::fmi {
 namespace {
 
+/// A mapping whose instances stay in this process: the in-memory FMUs below record their calls in a
+/// Journal here (an isolated instance would record them in its child; tests/foreign covers isolation).
+FmuMapping in_memory(FmuMapping m = {}) {
+  m.isolated = false;
+  return m;
+}
+
 /// What the in-memory instances were asked, over all of them.
 struct Journal {
   std::vector<std::string> calls;
@@ -139,7 +146,7 @@ class MemoryFmu final : public Fmu {
 TEST(FmuPlantAsPlant, StepsThePointMassAndSetsVehicleAndInitialState) {
   Journal j;
   auto fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
-  const FmuPlant plant(fmu, {});
+  const FmuPlant plant(fmu, in_memory());
   EXPECT_TRUE(plant.refs().q_WB.empty());
   model::VehicleParams vehicle;
   model::State x0;
@@ -178,14 +185,14 @@ TEST(FmuPlantAsPlant, ScenarioParametersWinAndAreChecked) {
   auto fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
   FmuMapping m;
   m.parameters = {{"vehicle.mass_kg", "3"}, {"drag", "0.5"}};
-  const FmuPlant plant(fmu, m);
+  const FmuPlant plant(fmu, in_memory(m));
   auto d = plant.make(model::VehicleParams{}, model::State{}, sim::TickClock{});
   EXPECT_EQ(j.set.at("vehicle.mass_kg"), 3.0);
   EXPECT_EQ(j.set.at("drag"), 0.5);
 
   auto refused = [&](FmuMapping mm, const std::string& key, const std::string& words) {
     try {
-      FmuPlant p(fmu, mm);
+      FmuPlant p(fmu, in_memory(mm));
       ADD_FAILURE() << "not refused: " << key;
     } catch (const MappingError& e) {
       EXPECT_EQ(e.key(), key) << e.what();
@@ -206,7 +213,7 @@ TEST(FmuPlantAsPlant, MappingRefusalsNameTheKeyTheVariableAndTheUnit) {
   auto refused = [&](ModelDescription md, FmuMapping m, const std::string& key, const std::string& words) {
     auto fmu = std::make_shared<MemoryFmu>(std::move(md), j);
     try {
-      FmuPlant p(fmu, m);
+      FmuPlant p(fmu, in_memory(m));
       ADD_FAILURE() << "not refused: " << key;
     } catch (const MappingError& e) {
       EXPECT_EQ(e.key(), key) << e.what();
@@ -247,7 +254,7 @@ TEST(FmuPlantAsPlant, FailuresNameTheTickAndNothingNonFiniteGetsThrough) {
   Journal j;
   auto fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
   fmu->fail_at = 0.05;
-  const FmuPlant plant(fmu, {});
+  const FmuPlant plant(fmu, in_memory());
   auto d = plant.make(model::VehicleParams{}, model::State{}, sim::TickClock{});
   for (sim::Tick k = 0; k < 5; ++k) d->step(k, model::Vector4::Zero());
   try {
@@ -260,7 +267,7 @@ TEST(FmuPlantAsPlant, FailuresNameTheTickAndNothingNonFiniteGetsThrough) {
   auto nan_fmu = std::make_shared<MemoryFmu>(point_mass_description(), j);
   nan_fmu->nan_x = NAN;
   try {
-    FmuPlant(nan_fmu, {}).make(model::VehicleParams{}, model::State{}, sim::TickClock{});
+    FmuPlant(nan_fmu, in_memory()).make(model::VehicleParams{}, model::State{}, sim::TickClock{});
     ADD_FAILURE() << "a NaN output went unnoticed";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("output 'p_W[1]' is nan at tick 0"), std::string::npos) << e.what();
@@ -403,7 +410,7 @@ class ControllerFmu final : public Fmu {
 TEST(FmuControllerAsController, StepsSetsInputsAndReadsTheCommand) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
-  FmuController c(fmu, {}, model::VehicleParams{});
+  FmuController c(fmu, in_memory(), model::VehicleParams{});
   EXPECT_EQ(c.type(), "fmu");
   ASSERT_EQ(c.output_names().size(), 1u);
   EXPECT_EQ(c.output_names()[0], "error.z");
@@ -439,7 +446,7 @@ TEST(FmuControllerAsController, StepsSetsInputsAndReadsTheCommand) {
 TEST(FmuControllerAsController, ParametersAllOrNothingFixedOnesUntilTheFirstStepCloneAfresh) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
-  FmuController c(fmu, {}, model::VehicleParams{});
+  FmuController c(fmu, in_memory(), model::VehicleParams{});
   const std::vector<control::Setting> both = {{"gain", 50.0}, {"base", 300.0}};
   EXPECT_EQ(c.set_parameters(both), "");
   const std::vector<control::Setting> out_of_range = {{"gain", 60.0}, {"base", 1.0}, {"gain", 2000.0}};
@@ -473,7 +480,7 @@ TEST(FmuControllerAsController, ParametersAllOrNothingFixedOnesUntilTheFirstStep
 TEST(FmuControllerAsController, AFailedStepOrANanCommandThrowsNamingTheFmuAndTheStep) {
   Journal j;
   auto fmu = std::make_shared<ControllerFmu>(j);
-  FmuController c(fmu, {}, model::VehicleParams{});
+  FmuController c(fmu, in_memory(), model::VehicleParams{});
   control::ControllerOutput out;
   out.outputs.resize(1);
   c.step({}, {}, 0.02, out);
@@ -487,7 +494,7 @@ TEST(FmuControllerAsController, AFailedStepOrANanCommandThrowsNamingTheFmuAndThe
     EXPECT_NE(std::string(e.what()).find("control step 1 (t = 0.02 s)"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("gain too high"), std::string::npos) << e.what();
   }
-  FmuController nan(fmu, {}, model::VehicleParams{});
+  FmuController nan(fmu, in_memory(), model::VehicleParams{});
   const std::vector<control::Setting> negative = {{"gain", -1.0}};
   ASSERT_EQ(nan.set_parameters(negative), "");
   out.omega_rad_s.setConstant(7.0);
@@ -505,7 +512,7 @@ TEST(FmuControllerAsController, MappingRefusals) {
   auto fmu = std::make_shared<ControllerFmu>(j);
   auto refused = [&](FmuMapping m, const std::string& key, const std::string& words) {
     try {
-      FmuController c(fmu, m, model::VehicleParams{});
+      FmuController c(fmu, in_memory(m), model::VehicleParams{});
       ADD_FAILURE() << "not refused: " << key;
     } catch (const MappingError& e) {
       EXPECT_EQ(e.key(), key) << e.what();
