@@ -1,5 +1,8 @@
 #include "io/trajectory_csv.hpp"
 
+#include <cerrno>
+#include <cstring>
+
 #include <fmt/format.h>
 
 #include <cassert>
@@ -86,10 +89,13 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
 void TrajectoryWriter::close() {
   if (!file_) return;
   const bool ok = std::fwrite(buffer_.data(), 1, buffer_.size(), file_) == buffer_.size();
+  int err = ok ? 0 : errno;
   buffer_.clear();
   const bool closed = std::fclose(file_) == 0;
+  if (!closed && err == 0) err = errno;
   file_ = nullptr;
-  if (!ok || !closed) throw std::runtime_error(path_ + ": write failed");
+  // "No space left on device", "File too large": what the user must fix.
+  if (!ok || !closed) throw std::runtime_error(path_ + ": write failed (" + std::strerror(err) + ")");
 }
 
 SeriesRecorder::SeriesRecorder() {
