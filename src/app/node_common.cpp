@@ -10,6 +10,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 
 #include <algorithm>
 #include <cstdlib>
@@ -205,6 +206,13 @@ std::string use_cpus(const std::string& list) {
     const int err = errno;
     return "CPUs " + list + " refused: " + std::strerror(err) +
            (err == EINVAL ? " (none of them is online and allowed here; see nproc / taskset -p $$)" : "");
+  }
+  // Threads started before (the stop deadline's watcher, an interpreter's) are pinned too: the
+  // affinity is per thread, and only threads started from now on inherit the caller's.
+  std::error_code ec;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    const pid_t tid = static_cast<pid_t>(std::strtol(task.path().filename().c_str(), nullptr, 10));
+    if (tid > 0) sched_setaffinity(tid, sizeof(set), &set);  // a thread that ended meanwhile: nothing to pin
   }
   return {};
 }
