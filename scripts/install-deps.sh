@@ -14,7 +14,7 @@ packages=(
   python3 python3-matplotlib python3-numpy
   pybind11-dev python3-dev python3-pytest  # the Python module (src/python) and its tests (tests/python)
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` into a venv (tests/install)
-  colcon python3-colcon-ros python3-colcon-cmake  # package.xml as a ROS 2 workspace reads it (tests/install)
+  colcon python3-colcon-ros python3-colcon-cmake python3-colcon-package-information  # package.xml as a ROS 2 workspace reads it; `colcon list` (tests/install)
   slurm-wlm munge  # a private single-node Slurm cluster for the sweep job array test (tests/sweep/slurm_test.sh)
   iproute2  # ip netns, veth, tc: the two-namespace and network fault tests (tests/faults)
   nftables  # nft: packet loss, bursts and cuts on the veth between the namespaces (tests/faults)
