@@ -57,7 +57,8 @@ class PlantProcess {
         plant_(make_plant()),
         announcer_(transport_.participant().handle(), "quadrotor_plant") {
     status_.header.stamp = msg::Time::from_ns(-1);
-    plant_.set_command_filter([this](sim::SenderId s) { return pairing_.accepts(topics_.motor_commands, s); });
+    plant_.set_command_filter(
+        [this](sim::SenderId s) { return pairing_.accepts(topics_.motor_commands, s) || take_over(s); });
     plant_.on_early_command([this](sim::Tick k) {
       if (!ambiguous_.empty()) return;
       ambiguous_ = fmt::format(
@@ -226,6 +227,29 @@ class PlantProcess {
       std::cerr << fmt::format("plant: the controller subscribes {} only; the other sensor samples go to no one\n",
                                list);
     }
+    return true;
+  }
+
+  /// A controller that was restarted (killed, started again: the paper's stale-data scenario) is a
+  /// new participant. Without a token it may take over from the paired one, but only once the
+  /// watchdog holds (the paired controller has been silent past its limit: it is gone as far as the
+  /// vehicle is concerned), only when it carries no token, and only when it is the one participant
+  /// besides the old one that could be the controller. So a stranger cannot take over from a
+  /// controller that is alive, nor two newcomers race. True when `s` is now the controller's.
+  bool take_over(sim::SenderId s) {
+    if (!pair_token_.empty() || !peer_ || !plant_.watchdog_active()) return false;
+    const auto info = transport_.sender_info(topics_.motor_commands, s);
+    if (!info || !info->pair_token.empty() || info->participant == *peer_) return false;
+    if (node_participant_) return false;  // --controller-node names one participant, the one found at the start
+    std::vector<Guid> others = controller_candidates();
+    std::erase(others, *peer_);
+    if (others.size() != 1 || others.front() != info->participant) return false;
+    std::cerr << fmt::format(
+        "plant: the controller's participant {} has been silent past the watchdog's limit; participant {} "
+        "publishes {} now and is taken as the controller\n",
+        hex(*peer_), hex(info->participant), topics_.motor_commands);
+    peer_ = info->participant;
+    pairing_.pair_by_participant(*peer_);
     return true;
   }
 
