@@ -207,7 +207,11 @@ int controller_command(const ControllerCommandOptions& o) {
     driver.run();
     if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
   }
-  if (std::optional<std::string> failure = node.controller_failure()) throw sim::ControllerFailure(*failure);
+  // A step given up on SIGINT or SIGTERM (an isolated Python controller's wait) ends the node as the
+  // signal does, not as a failure of the controller.
+  if (std::optional<std::string> failure = node.controller_failure(); failure && !stop_signalled()) {
+    throw sim::ControllerFailure(*failure);
+  }
   if (on_thread && (node.controller_failures() > 0 || node.late_steps() > 0)) {
     std::cerr << fmt::format(
         "controller: {} failed steps (safety command sent instead), {} {}\n", node.controller_failures(),

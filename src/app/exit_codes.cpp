@@ -89,7 +89,8 @@ int run_guarded(const std::string& command, const std::function<int()>& body) {
     return exit_code::kBadInput;
   } catch (const sim::ControllerFailure& e) {  // names the controller, the step and its time
     std::cerr << "error: " << command << ": " << e.what() << '\n';
-    return exit_code::kControllerFailed;
+    // A wait on an isolated controller given up on Ctrl-C or SIGTERM ends its step too.
+    return stop_signalled() ? exit_code::kInterrupted : exit_code::kControllerFailed;
   } catch (const fmi::FmuError& e) {  // names the FMU, the call, the tick and its time
     std::cerr << "error: " << command << ": " << e.what() << '\n';
     return stop_requested() ? exit_code::kInterrupted : exit_code::kPlantFailed;

@@ -9,17 +9,18 @@
 #include <cstdio>
 #include <thread>
 
-#include "fmi/isolated_instance.hpp"
+#include "isolation/child.hpp"
 
 namespace quadcosim::app {
 
 namespace {
 // The one piece of process-wide state a signal handler may touch, and the semaphore it posts
 // (sem_post is async-signal-safe) to wake the stop deadline below.
-volatile std::sig_atomic_t g_stop = 0;
+volatile std::sig_atomic_t g_stop = 0, g_signalled = 0;
 sem_t g_stop_posted;
 extern "C" void on_stop_signal(int) {
   g_stop = 1;
+  g_signalled = 1;
   sem_post(&g_stop_posted);
 }
 
@@ -51,11 +52,14 @@ void install_stop_handlers() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
-  // A wait on an FMU's process (a step that does not return) gives up when asked to stop.
-  fmi::set_stop_check(&stop_requested);
+  // A wait on foreign code's process (an FMU's or a Python controller's step that does not return)
+  // gives up when asked to stop.
+  isolation::set_stop_check(&stop_requested);
 }
 
 bool stop_requested() { return g_stop != 0; }
+
+bool stop_signalled() { return g_signalled != 0; }
 
 void request_stop() { g_stop = 1; }  // the command's own request: no deadline
 

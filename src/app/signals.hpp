@@ -13,6 +13,9 @@ void install_stop_handlers();
 inline constexpr double kStopDeadlineS = 1.5;
 /// True once SIGINT or SIGTERM arrived, or request_stop() was called.
 bool stop_requested();
+/// True once SIGINT or SIGTERM arrived (not for request_stop()): an isolated foreign step given up on
+/// that signal is an interruption, not the foreign code's failure.
+bool stop_signalled();
 /// Asks the command's loops to stop, as a signal does (from any thread), without the deadline.
 void request_stop();
 

@@ -1,28 +1,20 @@
-// fmi/isolated_instance.hpp: one child process per FMU instance, a SOCK_SEQPACKET socket pair between
-// them, one datagram per request and per answer.
+// fmi/isolated_instance.hpp: one child process per FMU instance (isolation/child.hpp), one datagram
+// per request, per answer and per log line.
 #include "fmi/isolated_instance.hpp"
 
+#include "isolation/child.hpp"
+
 #include <fmt/format.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <iostream>
 #include <vector>
 
 namespace quadcosim::fmi {
 
 namespace {
-
-std::atomic<bool (*)()> g_stop_check{nullptr};
 
 enum class Op : std::uint8_t {
   kEnterInitialization = 1,
@@ -41,97 +33,14 @@ enum class Op : std::uint8_t {
 };
 constexpr std::uint8_t kLog = 'L', kAnswer = 'A', kFailed = 'F';
 
-/// Bytes of a message: values appended as they are in memory (both ends are the same program).
-class Writer {
- public:
-  template <class T>
-  Writer& put(const T& v) {
-    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
-    return *this;
-  }
-  template <class T>
-  Writer& span(std::span<const T> v) {
-    put(static_cast<std::uint64_t>(v.size()));
-    const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
-    bytes.insert(bytes.end(), p, p + v.size_bytes());
-    return *this;
-  }
-  Writer& text(std::string_view s) {
-    put(static_cast<std::uint64_t>(s.size()));
-    bytes.insert(bytes.end(), s.begin(), s.end());
-    return *this;
-  }
-  std::vector<std::uint8_t> bytes;
-};
-
-class Reader {
- public:
-  explicit Reader(std::span<const std::uint8_t> b) : b_(b) {}
-  template <class T>
-  T get() {
-    T v{};
-    take(&v, sizeof(T));
-    return v;
-  }
-  template <class T>
-  std::vector<T> vec() {
-    std::vector<T> v(static_cast<std::size_t>(get<std::uint64_t>()));
-    take(v.data(), v.size() * sizeof(T));
-    return v;
-  }
-  std::string text() {
-    std::string s(static_cast<std::size_t>(get<std::uint64_t>()), '\0');
-    take(s.data(), s.size());
-    return s;
-  }
-
- private:
-  void take(void* to, std::size_t n) {
-    if (n > b_.size() - at_) throw FmuError("isolated FMU instance: a message ended early");
-    if (n > 0) std::memcpy(to, b_.data() + at_, n);
-    at_ += n;
-  }
-  std::span<const std::uint8_t> b_;
-  std::size_t at_ = 0;
-};
-
-bool send_all(int fd, const std::vector<std::uint8_t>& bytes) {
-  for (;;) {
-    const ssize_t n = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
-    if (n >= 0) return static_cast<std::size_t>(n) == bytes.size();
-    if (errno != EINTR) return false;
-  }
-}
-
-/// One datagram; false at the end of the stream (the other side closed or died).
-bool receive(int fd, std::vector<std::uint8_t>& into) {
-  for (;;) {
-    const ssize_t size = ::recv(fd, nullptr, 0, MSG_PEEK | MSG_TRUNC);
-    if (size < 0 && errno == EINTR) continue;
-    if (size <= 0) return false;
-    into.resize(static_cast<std::size_t>(size));
-    const ssize_t n = ::recv(fd, into.data(), into.size(), 0);
-    if (n < 0 && errno == EINTR) continue;
-    return n == size;
-  }
-}
-
-std::string describe_end(int status) {
-  if (WIFEXITED(status)) return fmt::format("exited with status {} inside the call", WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
-    const char* name = strsignal(sig);
-    return fmt::format(
-        "was killed by signal {} ({}){}", sig, name != nullptr ? name : "?",
-        sig == SIGSEGV || sig == SIGBUS || sig == SIGABRT || sig == SIGFPE || sig == SIGILL ? ": the FMU crashed" : "");
-  }
-  return fmt::format("ended (wait status {})", status);
-}
+using isolation::Child;
+using isolation::Reader;
+using isolation::send_all;
+using isolation::Writer;
 
 // ---- the child: serves calls on `fd` until kFree or the parent's end ------------------------------
 
-[[noreturn]] void serve(int fd, const std::shared_ptr<Fmu>& fmu, const std::string& name) {
+void serve(int fd, const std::shared_ptr<Fmu>& fmu, const std::string& name) {
   const LogSink sink = [fd](const std::string& category, const std::string& status, const std::string& message) {
     Writer w;
     w.put(kLog).text(category).text(status).text(message);
@@ -155,7 +64,7 @@ std::string describe_end(int status) {
     if (!send_all(fd, w.bytes)) _exit(0);
   }
   std::vector<std::uint8_t> in;
-  while (receive(fd, in)) {
+  while (isolation::receive(fd, in)) {
     Reader r(in);
     Writer out;
     out.put(kAnswer);
@@ -249,66 +158,22 @@ class IsolatedInstance final : public Instance {
         name_(name),
         log_(std::move(log)),
         prefix_(fmu->description().version == FmiVersion::k2 ? "fmi2" : "fmi3") {
-    int fds[2];
-    if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds) != 0) {
-      throw FmuError(fmt::format("FMU '{}': cannot make a socket pair for its process: {}",
-                                 fmu->description().model_name, std::strerror(errno)));
-    }
-    // What this process buffered must not be written twice (once more by the child at its exit).
-    std::cout.flush();
-    std::cerr.flush();
-    std::fflush(nullptr);
-    const pid_t parent = ::getpid();
-    pid_ = ::fork();
-    if (pid_ < 0) {
-      const int err = errno;
-      ::close(fds[0]);
-      ::close(fds[1]);
-      throw FmuError(
-          fmt::format("FMU '{}': cannot start its process: {}", fmu->description().model_name, std::strerror(err)));
-    }
-    if (pid_ == 0) {
-      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-      if (::getppid() != parent) _exit(0);  // the parent died before prctl took effect
-      ::signal(SIGINT, SIG_IGN);
-      ::signal(SIGTERM, SIG_DFL);
-      ::signal(SIGPIPE, SIG_IGN);
-      ::close(fds[0]);
-      serve(fds[1], fmu, name);
-    }
-    ::close(fds[1]);
-    fd_ = fds[0];
+    child_ = std::make_unique<Child>(fmt::format("FMU '{}'", fmu->description().model_name),
+                                     [&](int fd) { serve(fd, fmu, name); });
     call([] { return std::string("instantiate"); }, [](Writer&) {}, /*instantiate=*/true);
   }
 
   ~IsolatedInstance() override {
-    if (pid_ > 0 && !ended_) {
+    if (!child_->ended()) {
       Writer w;
       w.put(Op::kFree);
-      if (send_all(fd_, w.bytes)) {
-        // Terminate and free get a while to answer; a child that hangs in them is killed.
-        pollfd p{fd_, POLLIN, 0};
+      if (child_->send(w.bytes)) {
+        // Terminate and free get a while to answer; a child that hangs in them is killed (Child's end).
         std::vector<std::uint8_t> in;
-        for (int waited = 0; waited < 2000; waited += 50) {
-          if (::poll(&p, 1, 50) > 0) {
-            if (!receive(fd_, in)) break;
-            if (!in.empty() && in[0] == kLog) {
-              forward_log(in);
-              continue;
-            }
-            break;
-          }
-          const auto stop = g_stop_check.load();
-          if (stop != nullptr && stop()) break;
-        }
-      }
-    }
-    if (fd_ >= 0) ::close(fd_);
-    if (pid_ > 0 && !reaped_) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) != pid_) {
-        ::kill(pid_, SIGKILL);
-        while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+        const std::int64_t deadline = Child::now_ns() + 2'000'000'000;
+        while (child_->next(in, deadline) == Child::Wait::kMessage) {
+          if (in.empty() || in[0] != kLog) break;
+          forward_log(in);
         }
       }
     }
@@ -403,35 +268,27 @@ class IsolatedInstance final : public Instance {
   /// naming `call_text()` when the child ended, InstanceInterrupted when asked to stop.
   template <class Text, class Fill>
   Reader call(Text&& call_text, Fill&& fill, bool instantiate = false) {
-    if (ended_) {
-      throw FmuError(fmt::format("{} of {}: refused, the FMU's process has ended ({})", call_text(), who(), end_));
+    if (child_->ended()) {
+      throw FmuError(
+          fmt::format("{} of {}: refused, the FMU's process has ended ({})", call_text(), who(), child_->end()));
     }
     if (!instantiate) {
       Writer w;
       fill(w);
-      if (!send_all(fd_, w.bytes)) return child_ended(call_text());
+      if (!child_->send(w.bytes)) return child_ended(call_text());
     }
-    pollfd p{fd_, POLLIN, 0};
     for (;;) {
-      const int ready = ::poll(&p, 1, 50);
-      if (ready < 0 && errno != EINTR) return child_ended(call_text());
-      if (ready <= 0) {
-        const auto stop = g_stop_check.load();
-        if (stop != nullptr && stop()) {
-          ::kill(pid_, SIGKILL);
-          int status = 0;
-          while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
-          }
-          reaped_ = ended_ = true;
-          end_ = "killed on a stop request";
+      switch (child_->next(answer_)) {
+        case Child::Wait::kMessage: break;
+        case Child::Wait::kEnded:
+        case Child::Wait::kTimedOut: return child_ended(call_text());
+        case Child::Wait::kStopped:
+          child_->kill("killed on a stop request");
           throw InstanceInterrupted(
               fmt::format("{} of {}: interrupted (Ctrl-C or SIGTERM) while the FMU was inside the call; its "
                           "process was killed",
                           call_text(), who()));
-        }
-        continue;
       }
-      if (!receive(fd_, answer_)) return child_ended(call_text());
       if (answer_.empty()) continue;
       if (answer_[0] == kLog) {
         forward_log(answer_);
@@ -446,24 +303,16 @@ class IsolatedInstance final : public Instance {
   }
 
   [[noreturn]] Reader child_ended(const std::string& call_text) {
-    int status = 0;
-    pid_t r;
-    while ((r = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
-    }
-    reaped_ = ended_ = true;
-    end_ = r == pid_ ? describe_end(status) : "ended";
+    const std::string end = child_->reap();
     throw FmuError(
-        fmt::format("{} of {}: the FMU's process {}{}", call_text, who(), end_,
+        fmt::format("{} of {}: the FMU's process {} inside the call{}", call_text, who(), end,
                     last_logged_.empty() ? "; the FMU logged nothing" : "; it logged last: " + last_logged_));
   }
 
   std::string name_;
   LogSink log_;
   std::string prefix_;
-  pid_t pid_ = -1;
-  int fd_ = -1;
-  bool ended_ = false, reaped_ = false;
-  std::string end_;
+  std::unique_ptr<Child> child_;
   std::string last_logged_;
   std::vector<std::uint8_t> answer_;
 };
@@ -474,7 +323,5 @@ std::unique_ptr<Instance> instantiate_isolated(const std::shared_ptr<Fmu>& fmu, 
                                                LogSink log) {
   return std::make_unique<IsolatedInstance>(fmu, instance_name, std::move(log));
 }
-
-void set_stop_check(bool (*stop_requested)()) { g_stop_check.store(stop_requested); }
 
 }  // namespace quadcosim::fmi

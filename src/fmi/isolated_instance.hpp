@@ -5,8 +5,8 @@
 // FmuError naming the FMU, the instance, the call (with its time) and how the process ended
 // ("killed by signal 11 (Segmentation fault)", "exited with status 0"), and every later call is
 // refused. A call that does not return cannot be waited out for ever: while it waits, the master
-// polls the stop check (set_stop_check: Ctrl-C, SIGTERM) every 50 ms and, once asked to stop, kills
-// the child and throws InstanceInterrupted.
+// polls the stop check (isolation::set_stop_check: Ctrl-C, SIGTERM) every 50 ms and, once asked to
+// stop, kills the child and throws InstanceInterrupted.
 //
 // The child dies with its parent (PR_SET_PDEATHSIG, SIGKILL) and ignores SIGINT: a Ctrl-C is the
 // parent's to handle. What the FMU logs is sent to the parent and reaches the instance's LogSink in
@@ -33,10 +33,5 @@ class InstanceInterrupted : public FmuError {
 /// the instantiation fails (its message, as in-process), or ends the child.
 std::unique_ptr<Instance> instantiate_isolated(const std::shared_ptr<Fmu>& fmu, const std::string& instance_name,
                                                LogSink log = {});
-
-/// What an isolated instance's wait asks, every 50 ms, whether to give up (e.g. a SIGINT flag). One
-/// per process (signals are per process); null (the default) waits until the call returns or the
-/// child ends.
-void set_stop_check(bool (*stop_requested)());
 
 }  // namespace quadcosim::fmi

@@ -16,6 +16,14 @@ scenario() {
 }
 plant_fmu() { scenario "${1:-5}" "plant: {fmu: faulty_plant.fmu${2:-}}"; }
 
+# A scenario of $1 simulated seconds flying tests/foreign/faulty_controller.py, with `$2` (YAML lines of
+# its controller: section) added. SKIPPED where quadcosim was built without Python.
+python_scenario() {
+  { sed "s/duration_s: 30/duration_s: $1/" "$hover" | grep -v '^controller:\|z_des'
+    printf 'controller:\n  python: "faulty_controller:Faulty"\n'; [ -z "${2:-}" ] || echo "$2"; } > "$tmp/s.yaml"
+  cp "$src/tests/foreign/faulty_controller.py" "$tmp/"
+}
+
 # What every end must leave: no unpacked FMU, a CSV of whole rows up to the tick $1 whose step
 # failed (its state at that time was complete), and a finished run.mcap (it ends with the MCAP magic).
 check_outputs() {
@@ -34,6 +42,9 @@ run_expect() {
   local want="$1"; shift
   local rc=0
   "$bin" run "$tmp/s.yaml" --out "$tmp/out" --no-plots ${RUN_FLAGS:-} > "$tmp/run.log" 2>&1 || rc=$?
+  if [ "$rc" != "$want" ] && grep -q "built without Python" "$tmp/run.log"; then
+    echo "SKIPPED: this quadcosim was built without Python"; exit 77
+  fi
   [ "$rc" = "$want" ] || fail "run exited $rc, expected $want"
   for pattern in "$@"; do grep -qE "$pattern" "$tmp/run.log" || fail "no line matching '$pattern' in the run's output"; done
   echo "exit $rc: $(grep -m1 'error' "$tmp/run.log" | cut -c1-400)"
@@ -144,7 +155,7 @@ class Sleepy(quadcosim.Controller):
         return [0.0, 0.0, 0.0, 0.0]
 PY
     { sed "s/duration_s: 30/duration_s: 5/" "$hover" | grep -v '^controller:\|z_des'; \
-      printf 'controller:\n  python: "sleepy:Sleepy"\n  step_timeout_s: 0.5\n'; } > "$tmp/py/s.yaml"
+      printf 'controller:\n  python: "sleepy:Sleepy"\n'; } > "$tmp/py/s.yaml"  # no step_timeout_s: only a signal ends it
     "$bin" run "$tmp/py/s.yaml" --out "$tmp/out" --no-plots > "$tmp/run.log" 2>&1 &
     pid=$!; pids+=("$pid")
     sleep 3
@@ -157,5 +168,20 @@ PY
     [ "$rc" = 130 ] || fail "run exited $rc after SIGINT, expected 130"
     python3 -c "import sys; sys.exit(0 if $took <= 2.5 else 1)" || fail "took $took s to end after SIGINT"
     echo "SIGINT during a sleeping Python step: exit 130 after $took s" ;;
+  python_segv | python_abort | python_exit | python_hang)  # each ends the run: exit 5, named, outputs kept
+    python_scenario 5 "  step_timeout_s: 0.5"
+    fault="${case_name#python_}"
+    declare -A how=([segv]="killed by signal 11" [abort]="killed by signal 6" [exit]="exited with status 0"
+                    [hang]="did not return within step_timeout_s = 0.5 s")
+    FAULTY_FAULT="$fault" FAULTY_AT=2 run_expect 5 "faulty_controller.Faulty.step at step 100 \(t = 2 s\)" \
+      "${how[$fault]}" "faulty controller: $fault at t = 2 s"
+    check_outputs 1.99 ;;  # every tick before the control step that failed
+  python_isolation_bit_identical)  # the same bytes with the controller in its own process and in quadcosim's
+    python_scenario 5
+    run_expect 0
+    mv "$tmp/out" "$tmp/isolated"
+    QUADCOSIM_PYTHON_IN_PROCESS=1 run_expect 0
+    cmp "$tmp/isolated/trajectory.csv" "$tmp/out/trajectory.csv" || fail "trajectory.csv differs in-process"
+    echo "trajectory.csv identical ($(wc -l < "$tmp/out/trajectory.csv") lines) isolated and in-process" ;;
   *) echo "unknown case $case_name"; exit 2 ;;
 esac

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "app/python/isolated_controller.hpp"
 #include "app/python_host.hpp"
 #include "io/scenario.hpp"
 #include "python/py_controller.hpp"
@@ -44,6 +45,16 @@ void start_python() {
   });
 }
 
+/// The controller `target` names, flown in a process of its own unless QUADCOSIM_PYTHON_IN_PROCESS=1
+/// (app/python/isolated_controller.hpp).
+std::shared_ptr<const control::Controller> load(const std::string& target, const fs::path& folder,
+                                                const model::VehicleParams& vehicle) {
+  start_python();
+  std::shared_ptr<const python::PyController> loaded = python::load_python_controller(target, folder, vehicle);
+  if (!python_controllers_isolated()) return loaded;
+  return isolate_python_controller(std::move(loaded));
+}
+
 }  // namespace
 
 bool built_with_python() { return true; }
@@ -52,17 +63,15 @@ void install_python_controllers() {
   io::set_python_controller_factory(
       [](const std::string& target, const fs::path& folder,
          const model::VehicleParams& vehicle) -> std::shared_ptr<const control::Controller> {
-        start_python();
-        return python::load_python_controller(target, folder, vehicle);  // io names the key in its error
+        return load(target, folder, vehicle);  // io names the key in its error
       });
 }
 
 std::shared_ptr<const control::Controller> make_python_controller(const std::string& spec, const fs::path& folder,
                                                                   const model::VehicleParams& vehicle,
                                                                   const std::string& what) {
-  start_python();
   try {
-    return python::load_python_controller(spec, folder, vehicle);
+    return load(spec, folder, vehicle);
   } catch (const std::exception& e) {
     throw io::ConfigError(what + ": " + e.what());
   }
