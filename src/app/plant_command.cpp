@@ -198,6 +198,9 @@ class PlantProcess {
           const std::vector<std::string> now = sensors_subscribed_by(*peer);
           if (now.size() != sensors.size()) settled_at = steady_ns() + kSettleNs;
           sensors = now;
+          // The run's own controller (a token) publishes its status, which tick 0's answer includes:
+          // matched too, or tick 0 would be taken without it.
+          if (!pair_token_.empty() && !controller_writes_status()) return false;
           return sensors.size() == 3 || (!sensors.empty() && steady_ns() >= settled_at);
         },
         timeout_ns());
@@ -221,6 +224,7 @@ class PlantProcess {
     if (!peer) return true;  // stopped
     peer_ = peer;
     if (pair_token_.empty()) pairing_.pair_by_participant(*peer);
+    if (scheduler_) scheduler_->only_from(*peer);  // the schedule goes to the controller's node, not a namesake
     if (sensors.size() < 3) {
       std::string list;
       for (const std::string& t : sensors) list += (list.empty() ? "" : ", ") + t;
@@ -250,6 +254,8 @@ class PlantProcess {
         hex(*peer_), hex(info->participant), topics_.motor_commands);
     peer_ = info->participant;
     pairing_.pair_by_participant(*peer_);
+    status_writers_seen_ = -1;  // whose statuses count changed with the controller
+    if (scheduler_) scheduler_->only_from(*peer_);
     return true;
   }
 
@@ -324,6 +330,7 @@ class PlantProcess {
       node = nodes.front();
     }
     auto client = std::make_unique<dds::ParameterClient>(transport_.participant().handle(), dds::parse_node_name(node));
+    if (peer_) client->only_from(*peer_);  // the controller's node, not a namesake's
     std::vector<dds::ParamValue> v;
     try {
       v = host_.unlocked([&] { return client->get({"use_sim_time"}, timeout_ns()); });
@@ -351,12 +358,14 @@ class PlantProcess {
     barrier_ = std::move(client);
     // The reply is delivered like a command (on arrival, on the receiving thread): it releases the
     // tick's /clock there, so a control period wakes no other thread of this process.
-    transport_.subscribe_raw(barrier_->get_reply_reader(), "get_parameters reply from " + node,
-                             [this](const void* reply) {
-                               if (clock_held_ >= 0 && dds::ParameterClient::is_reply_to(reply, barrier_request_)) {
-                                 plant_.publish_clock(std::exchange(clock_held_, -1));
-                               }
-                             });
+    const dds_entity_t replies = barrier_->get_reply_reader();
+    transport_.subscribe_raw_with_sender(
+        replies, "get_parameters reply from " + node, [this, replies](const void* reply, sim::SenderId from) {
+          if (clock_held_ >= 0 && dds::ParameterClient::is_reply_to(reply, barrier_request_) &&
+              barrier_->from_peer(replies, from)) {
+            plant_.publish_clock(std::exchange(clock_held_, -1));
+          }
+        });
     plant_.set_clock_after_sensors(true);
     std::cerr << fmt::format(
         "plant: lockstep with {} on ROS time: every tick sends its samples, then a get_parameters request; a "
@@ -505,11 +514,22 @@ class PlantProcess {
 
   /// What follows tick k's latch, before the plant integrates: log, record.
   /// The paired controller publishes its status (so a control tick's answer includes it).
+  /// Asked once per control tick: the writers are looked at again only when their count changed (a
+  /// status read costs tens of instructions, the matched writers' list about 1,400 per tick).
   bool controller_writes_status() {
+    const int writers = transport_.matched_writers(topics_.controller_status);
+    if (writers == status_writers_seen_) return status_from_controller_;
+    status_from_controller_ = false;
+    bool described = true;  // a writer discovery cannot describe yet is looked at again next time
     for (const sim::SenderId s : transport_.matched_senders(topics_.controller_status)) {
-      if (pairing_.accepts(topics_.controller_status, s)) return true;
+      if (pairing_.accepts(topics_.controller_status, s)) {
+        status_from_controller_ = true;
+      } else if (!transport_.sender_info(topics_.controller_status, s)) {
+        described = false;
+      }
     }
-    return false;
+    status_writers_seen_ = described || status_from_controller_ ? writers : -1;
+    return status_from_controller_;
   }
 
   /// Lockstep: the controller answers each control tick once. A second command within one control
@@ -639,6 +659,8 @@ class PlantProcess {
   dds::PeerFilter pairing_;  ///< whose commands are the controller's (set by wait_for_controller)
   std::optional<std::array<std::uint8_t, 16>> node_participant_;  ///< --controller-node's participant
   std::optional<std::array<std::uint8_t, 16>> peer_;              ///< the controller's participant
+  int status_writers_seen_ = -1;  ///< matched ControllerStatus writers when status_from_controller_ was found
+  bool status_from_controller_ = false;
   sim::PlantNode plant_;
   dds::NodeAnnouncer announcer_;
   msg::ControllerStatus status_;

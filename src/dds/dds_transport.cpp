@@ -148,6 +148,12 @@ void DdsTransport::subscribe_raw(dds_entity_t reader, std::string label, std::fu
   add_reader(reader, std::move(label), nullptr, std::move(deliver));
 }
 
+void DdsTransport::subscribe_raw_with_sender(dds_entity_t reader, std::string label,
+                                             std::function<void(const void*, sim::SenderId)> deliver) {
+  add_reader(reader, std::move(label), nullptr,
+             [this, index = readers_.size(), d = std::move(deliver)](const void* m) { d(m, readers_[index]->sender); });
+}
+
 void DdsTransport::add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops,
                               std::function<void(const void*)> deliver) {
   auto r = std::make_unique<Reader>();

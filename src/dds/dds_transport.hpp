@@ -91,6 +91,9 @@ class DdsTransport final : public sim::Transport {
   /// reader; it must outlive the deliveries) as the C samples idlc generates, in turn with the
   /// subscriptions: by spin_once, or on arrival under an ArrivalExecutor. `label` names it in errors.
   void subscribe_raw(dds_entity_t reader, std::string label, std::function<void(const void*)> deliver);
+  /// subscribe_raw, with each sample's writer (its publication handle on `reader`).
+  void subscribe_raw_with_sender(dds_entity_t reader, std::string label,
+                                 std::function<void(const void*, sim::SenderId)> deliver);
 
   /// Extra DDS work served by spin_once beside the subscriptions, e.g. ROS 2 services on this
   /// participant. Each entity in `wake_on` (a read condition, or a reader/writer whose status mask is

@@ -1,5 +1,6 @@
 #include "dds/parameter_client.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -73,11 +74,36 @@ ParameterClient::Endpoints& ParameterClient::endpoints(ParamService service) {
   return e;
 }
 
+namespace {
+/// True when one of the endpoints matched by `entity` (a writer's subscriptions, a reader's
+/// publications) belongs to `participant`.
+bool matches_participant(dds_entity_t entity, bool writer, const std::array<std::uint8_t, 16>& participant) {
+  dds_instance_handle_t handles[64];
+  const dds_return_t n =
+      writer ? dds_get_matched_subscriptions(entity, handles, 64) : dds_get_matched_publications(entity, handles, 64);
+  for (dds_return_t i = 0; i < std::min<dds_return_t>(n, 64); ++i) {
+    dds_builtintopic_endpoint_t* e = writer ? dds_get_matched_subscription_data(entity, handles[i])
+                                            : dds_get_matched_publication_data(entity, handles[i]);
+    if (e == nullptr) continue;
+    const bool same = std::equal(std::begin(e->participant_key.v), std::end(e->participant_key.v), participant.begin());
+    dds_builtintopic_free_endpoint(e);
+    if (same) return true;
+  }
+  return false;
+}
+}  // namespace
+
 bool ParameterClient::matched(const Endpoints& e) const {
   dds_publication_matched_status_t pub;
   dds_subscription_matched_status_t sub;
-  return dds_get_publication_matched_status(e.writer, &pub) >= 0 && pub.current_count > 0 &&
-         dds_get_subscription_matched_status(e.reader, &sub) >= 0 && sub.current_count > 0;
+  const bool any = dds_get_publication_matched_status(e.writer, &pub) >= 0 && pub.current_count > 0 &&
+                   dds_get_subscription_matched_status(e.reader, &sub) >= 0 && sub.current_count > 0;
+  if (!any || !peer_) return any;
+  // With only_from(): the peer's own request reader and reply writer (a namesake's do not answer).
+  // Once found they stay matched for the peer's life: looked up once per service.
+  if (e.peer_matched) return true;
+  e.peer_matched = matches_participant(e.writer, true, *peer_) && matches_participant(e.reader, false, *peer_);
+  return e.peer_matched;
 }
 
 void ParameterClient::wait(std::int64_t deadline_ns, const Endpoints* active) {
@@ -154,6 +180,23 @@ ParameterClient::Header ParameterClient::send_get(const std::vector<std::string>
   return last_;
 }
 
+void ParameterClient::only_from(const std::array<std::uint8_t, 16>& participant) {
+  peer_ = participant;
+  peer_writers_.clear();
+  for (Endpoints& e : ep_) e.peer_matched = false;
+}
+
+bool ParameterClient::from_peer(dds_entity_t reader, dds_instance_handle_t writer) {
+  if (!peer_) return true;
+  if (std::find(peer_writers_.begin(), peer_writers_.end(), writer) != peer_writers_.end()) return true;
+  dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader, writer);
+  if (e == nullptr) return false;  // gone, or not described yet: not known to be the peer's
+  const bool ok = std::equal(std::begin(e->participant_key.v), std::end(e->participant_key.v), peer_->begin());
+  dds_builtintopic_free_endpoint(e);
+  if (ok) peer_writers_.push_back(writer);
+  return ok;
+}
+
 bool ParameterClient::is_reply_to(const void* reply, Header request) {
   const auto* h = static_cast<const InBandHeader*>(reply);
   return h->guid == request.guid && h->seq == request.seq;
@@ -178,6 +221,7 @@ void ParameterClient::call(ParamService service, void* request, std::int64_t tim
     bool done = false;
     for (int i = 0; i < n && !done; ++i) {
       if (!infos[i].valid_data || !is_reply_to(samples[i], last_)) continue;  // another client's
+      if (!from_peer(e.reader, infos[i].publication_handle)) continue;        // a namesake's
       on_reply(samples[i]);
       done = true;
     }

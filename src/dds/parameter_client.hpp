@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,14 @@ class ParameterClient {
   std::vector<ParamDescriptor> describe(const std::vector<std::string>& names, std::int64_t timeout_ns);
   ListResult list(const std::vector<std::string>& prefixes, std::uint64_t depth, std::int64_t timeout_ns);
 
+  /// Takes replies only from writers of the participant with this GUID (the paired controller's): a
+  /// node of the same name elsewhere on the domain (a controller left over from another run, a
+  /// stranger) answers nothing of this client's. Until called, any writer's reply to its request is.
+  void only_from(const std::array<std::uint8_t, 16>& participant);
+  /// True when a reply that arrived on `reader` (one of this client's reply readers) from `writer` (its
+  /// publication handle) may be taken: always without only_from().
+  bool from_peer(dds_entity_t reader, dds_instance_handle_t writer);
+
   /// Waits up to `timeout_ns` until `service` is matched; false on timeout.
   bool wait_for_service(ParamService service, std::int64_t timeout_ns);
 
@@ -81,8 +90,11 @@ class ParameterClient {
   struct Endpoints {
     dds_entity_t writer = 0, reader = 0, read_condition = 0;
     dds_instance_handle_t writer_handle = 0;
+    mutable bool peer_matched = false;  ///< only_from(): the peer's service found matched
   };
   Endpoints& endpoints(ParamService service);
+  std::optional<std::array<std::uint8_t, 16>> peer_;  ///< only_from()
+  std::vector<dds_instance_handle_t> peer_writers_;   ///< writers found to be the peer's
   bool matched(const Endpoints& e) const;
   /// Waits for the waitset (at most until `deadline_ns`, steady clock), clears the match triggers
   /// and drops stale replies in every reader but `active`'s.

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -95,6 +97,13 @@ class ServedNode {
     thread_.join();
   }
   const ParameterServer& server() const { return server_; }
+  std::array<std::uint8_t, 16> participant_guid() {
+    dds_guid_t g;
+    dds_get_guid(transport_.participant().handle(), &g);
+    std::array<std::uint8_t, 16> out{};
+    std::copy(std::begin(g.v), std::end(g.v), out.begin());
+    return out;
+  }
 
  private:
   DdsTransport transport_;
@@ -416,6 +425,31 @@ TEST(ParameterServiceTest, AnAsynchronousGetIsAnsweredThroughATransportInOrder) 
   EXPECT_FALSE(ParameterClient::is_reply_to(&other, requests[1]));
   other.guid += 1;
   EXPECT_FALSE(ParameterClient::is_reply_to(&other, requests[0]));
+}
+
+TEST(ParameterServiceTest, OnlyFromTakesThePeersRepliesNotANamesakes) {
+  FakeTable peer_table, namesake_table;
+  ServedNode namesake(namesake_table);  // the same node name on another participant: a leftover
+  ServedNode peer(peer_table);
+  ParameterClient client(test_env(), parse_node_name("/test_controller"));
+  const std::int64_t t = 10 * kSecond;
+  client.only_from(peer.participant_guid());
+  // Told apart by their answers: the peer's z_des is 7, the namesake's stays 1.
+  ASSERT_TRUE(client.set({param("z_des", ParamValue::of_double(7.0))}, t)[0].successful);
+  ASSERT_EQ(peer_table.number("z_des"), 7.0);                           // applied before the peer's reply came
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));          // the namesake took the request too
+  namesake_table.callbacks().set("z_des", ParamValue::of_double(1.0));  // and now answers 1
+  for (int i = 0; i < 20; ++i) {
+    const auto v = client.get({"z_des"}, t);
+    ASSERT_EQ(v.size(), 1u);
+    EXPECT_EQ(v[0], ParamValue::of_double(7.0)) << "call " << i << " took the namesake's reply";
+  }
+  // A client told to listen to a participant that has no such node waits for it, and says so.
+  ParameterClient lost(test_env(), parse_node_name("/test_controller"));
+  std::array<std::uint8_t, 16> nobody{};
+  nobody.fill(0xab);
+  lost.only_from(nobody);
+  EXPECT_THROW(lost.get({"z_des"}, kSecond / 2), ParameterCallError);
 }
 
 TEST(ParameterServiceTest, MissingNodeIsAClearTimeout) {
