@@ -87,6 +87,14 @@ struct Setting {
   ParameterValue value;
 };
 
+/// A controller's step failed: it threw (a Python controller that raised or returned garbage, an FMU
+/// whose step failed, a controller process that crashed). The message is the controller's own: it names
+/// the controller, the step and its time. Every command exits 5 for it (app/exit_codes.hpp).
+class ControllerFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class Controller {
  public:
   virtual ~Controller() = default;

@@ -288,7 +288,8 @@ class Watchdog {
 // ---------------------------------------------------------------------------------------------------
 // Errors
 
-ControllerError::ControllerError(const std::string& message, py::object python_error) : std::runtime_error(message) {
+ControllerError::ControllerError(const std::string& message, py::object python_error)
+    : control::ControllerFailure(message) {
   if (python_error && !python_error.is_none()) {
     interrupt_ = !PyObject_IsInstance(python_error.ptr(), PyExc_Exception) &&
                  !PyObject_IsInstance(python_error.ptr(), globals().step_timeout.ptr());
@@ -296,7 +297,7 @@ ControllerError::ControllerError(const std::string& message, py::object python_e
   }
 }
 
-ControllerError::ControllerError(const std::string& message) : std::runtime_error(message) {}
+ControllerError::ControllerError(const std::string& message) : control::ControllerFailure(message) {}
 
 py::object ControllerError::python_error() const { return error_ ? *error_ : py::none(); }
 

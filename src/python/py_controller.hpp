@@ -42,8 +42,9 @@ namespace quadcosim::python {
 
 /// A Python controller failed (raised, returned something that cannot be commanded, timed out, or
 /// could not be copied or configured). what() is the whole message; python_error() the Python
-/// exception it came from (for `__cause__`), when there was one.
-class ControllerError : public std::runtime_error {
+/// exception it came from (for `__cause__`), when there was one. A control::ControllerFailure: the CLI
+/// exits 5 for it whichever way the controller flies.
+class ControllerError : public control::ControllerFailure {
  public:
   ControllerError(const std::string& message, pybind11::object python_error);
   explicit ControllerError(const std::string& message);

@@ -33,12 +33,8 @@ namespace quadcosim::sim {
 
 class ControllerThread;
 
-/// A controller's step failed (it threw: a Python controller that raised or returned garbage); the
-/// message is the controller's own (it names the controller, the step and its time).
-class ControllerFailure : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+/// A controller's step failed (control/controller.hpp).
+using ControllerFailure = control::ControllerFailure;
 
 /// How a node runs its controller on a thread of its own (ControllerNode::run_controller_on_thread).
 struct ControllerThreading {

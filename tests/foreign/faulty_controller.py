@@ -1,6 +1,6 @@
 """A Python controller that misbehaves at the step whose time reaches FAULTY_AT (environment) as
 FAULTY_FAULT says: segv (reads address 0 through ctypes), abort (os.abort()), exit (os._exit(0)),
-hang (time.sleep in C, past its step_timeout_s). Before that it holds altitude with equal rotor
+hang (time.sleep in C, past its step_timeout_s), raise (a ValueError: the controller's own error). Before that it holds altitude with equal rotor
 speeds, so the run has a trajectory to keep. docs/reliability.md, "Foreign code"."""
 import ctypes
 import math
@@ -33,6 +33,8 @@ class Faulty:
                 os._exit(0)
             elif self.fault == "hang":
                 time.sleep(1000)
+            elif self.fault == "raise":
+                raise ValueError("the test asks this step to fail")
         err = ref.p[2] - obs.p[2]
         thrust = self.mass * (self.g + 4.0 * err - 3.0 * obs.v[2])
         w = math.sqrt(max(thrust, 0.0) / (4.0 * self.kt))

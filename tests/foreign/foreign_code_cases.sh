@@ -176,6 +176,15 @@ PY
     FAULTY_FAULT="$fault" FAULTY_AT=2 run_expect 5 "faulty_controller.Faulty.step at step 100 \(t = 2 s\)" \
       "${how[$fault]}" "faulty controller: $fault at t = 2 s"
     check_outputs 1.99 ;;  # every tick before the control step that failed
+  python_raise_one_exit_code)  # a raising step: exit 5 isolated, in quadcosim's process and over DDS
+    python_scenario 5
+    for how in isolated in_process dds; do
+      flags=""; [ "$how" = dds ] && flags="--transport dds"
+      in_process=0; [ "$how" = in_process ] && in_process=1
+      rm -rf "$tmp/out"
+      QUADCOSIM_PYTHON_IN_PROCESS=$in_process FAULTY_FAULT=raise FAULTY_AT=2 RUN_FLAGS="$flags" \
+        run_expect 5 "faulty_controller.Faulty.step at step 100 \(t = 2 s\): raised ValueError"
+    done ;;
   python_isolation_bit_identical)  # the same bytes with the controller in its own process and in quadcosim's
     python_scenario 5
     run_expect 0
