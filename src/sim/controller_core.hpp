@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -38,21 +39,21 @@ class ControllerCore {
   /// Sensor samples: true when taken; a sample that fails its check is counted, logged (1st of each
   /// reason, then every 100th) and dropped, the observation keeping its last valid values and ages.
   bool take_pose(const msg::PoseStamped& m) {
-    if (!accept(check_pose(m, pose_stamp_ns_), pose_topic_, pose_backwards_)) return false;
+    if (!accept(check_pose(m, pose_stamp_ns_, ahead_limit(pose_ref_ns_)), pose_topic_, pose_backwards_)) return false;
     observation_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
     pose_ref_ns_ = reference_time(pose_stamp_ns_);
     return true;
   }
   bool take_velocity(const msg::TwistStamped& m) {
-    if (!accept(check_velocity(m, velocity_stamp_ns_), velocity_topic_, velocity_backwards_)) return false;
+    if (!accept(check_velocity(m, velocity_stamp_ns_, ahead_limit(velocity_ref_ns_)), velocity_topic_, velocity_backwards_)) return false;
     observation_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference_time(velocity_stamp_ns_);
     return true;
   }
   bool take_imu(const msg::Imu& m) {
-    if (!accept(check_imu(m, imu_stamp_ns_), imu_topic_, imu_backwards_)) return false;
+    if (!accept(check_imu(m, imu_stamp_ns_, ahead_limit(imu_ref_ns_)), imu_topic_, imu_backwards_)) return false;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     observation_.q_WB = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -128,6 +129,13 @@ class ControllerCore {
   }
   bool accept_refused(const SensorCheck& check, const std::string& topic, int& backwards);
   std::int64_t reference_time(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
+  /// How far ahead of the newest accepted stamp a topic's next may be: kStampAheadLimitNs, plus on the
+  /// receipt clock the time since that newest was taken (`ref_ns`, its receipt time): a plant whose
+  /// samples were cut off for longer has simulated on meanwhile, in real time.
+  std::int64_t ahead_limit(std::int64_t ref_ns) const {
+    return receipt_clock_ && ref_ns != kNever ? kStampAheadLimitNs + std::max<std::int64_t>(receipt_clock_() - ref_ns, 0)
+                                              : kStampAheadLimitNs;
+  }
   /// reference_ at simulated time now_ns: the step setpoints (or the trajectory).
   void update_reference(std::int64_t now_ns);
 

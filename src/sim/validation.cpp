@@ -122,21 +122,22 @@ bool orientation_ok(SensorCheck& c, const msg::Quaternion& q) {
 }
 
 [[gnu::noinline, gnu::cold]] bool refuse_stamp(SensorCheck& c, SensorFault f, const msg::Time& t,
-                                               std::int64_t newest_ns) {
+                                               std::int64_t newest_ns, std::int64_t ahead_limit_ns = 0) {
   c.fault = f;
   c.field = SensorField::kStamp;
   c.stamp = t;
   c.newest_ns = newest_ns;
+  c.ahead_limit_ns = ahead_limit_ns;
   return false;
 }
 
-bool stamp_ok(SensorCheck& c, const msg::Time& t, std::int64_t last_stamp_ns) {
+bool stamp_ok(SensorCheck& c, const msg::Time& t, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns) {
   if (t.sec < 0 || t.nanosec >= 1'000'000'000u) return refuse_stamp(c, SensorFault::kBadStamp, t, 0);
   const std::int64_t ns = t.to_ns();
   if (ns < last_stamp_ns) return refuse_stamp(c, SensorFault::kStampBackwards, t, last_stamp_ns);
   // Before the first (INT64_MIN) any stamp is accepted; the difference is taken only after one.
-  return last_stamp_ns == INT64_MIN || ns - last_stamp_ns <= kStampAheadLimitNs ||
-         refuse_stamp(c, SensorFault::kStampAhead, t, last_stamp_ns);
+  return last_stamp_ns == INT64_MIN || ns - last_stamp_ns <= ahead_limit_ns ||
+         refuse_stamp(c, SensorFault::kStampAhead, t, last_stamp_ns, ahead_limit_ns);
 }
 
 std::string shown(const std::array<double, 4>& v, bool quaternion) {
@@ -146,25 +147,25 @@ std::string shown(const std::array<double, 4>& v, bool quaternion) {
 
 }  // namespace
 
-SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns) {
+SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns) {
   SensorCheck c;
   (void)(vector_ok(c, SensorField::kPosition, m.position) && orientation_ok(c, m.orientation) &&
-         stamp_ok(c, m.header.stamp, last_stamp_ns));
+         stamp_ok(c, m.header.stamp, last_stamp_ns, ahead_limit_ns));
   return c;
 }
 
-SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns) {
+SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns) {
   SensorCheck c;
   (void)(vector_ok(c, SensorField::kLinear, m.linear) && vector_ok(c, SensorField::kAngular, m.angular) &&
-         stamp_ok(c, m.header.stamp, last_stamp_ns));
+         stamp_ok(c, m.header.stamp, last_stamp_ns, ahead_limit_ns));
   return c;
 }
 
-SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns) {
+SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns) {
   SensorCheck c;
   (void)(orientation_ok(c, m.orientation) && vector_ok(c, SensorField::kAngularVelocity, m.angular_velocity) &&
          vector_ok(c, SensorField::kLinearAcceleration, m.linear_acceleration) &&
-         stamp_ok(c, m.header.stamp, last_stamp_ns));
+         stamp_ok(c, m.header.stamp, last_stamp_ns, ahead_limit_ns));
   return c;
 }
 
@@ -210,7 +211,7 @@ std::string SensorCheck::reason() const {
     case SensorFault::kStampAhead:
       return fmt::format("stamp {} ns is {:g} s ahead of the newest accepted, {} ns (at most {:g} s)", stamp.to_ns(),
                          static_cast<double>(stamp.to_ns() - newest_ns) / 1e9, newest_ns,
-                         static_cast<double>(kStampAheadLimitNs) / 1e9);
+                         static_cast<double>(ahead_limit_ns) / 1e9);
   }
   return "?";
 }

@@ -74,7 +74,9 @@ constexpr int kSensorFaultCount = 6;
 /// and make every genuine sample after it "older than the newest", blinding the controller. Two
 /// seconds: more than the period of any sensor the plant simulates, far less than a stale-data limit
 /// a controller would survive. A sender whose clock really jumped forward is taken after
-/// kStampRestartCount such samples in a row, as a restart is.
+/// kStampRestartCount such samples in a row, as a restart is. A controller that measures age on the
+/// receipt clock (real time) adds the time since it accepted the newest: a plant whose samples did
+/// not reach it for longer (a cut link) has simulated that much further meanwhile.
 constexpr std::int64_t kStampAheadLimitNs = 2'000'000'000;
 const char* to_string(SensorFault f);
 
@@ -107,6 +109,7 @@ struct SensorCheck {
   std::array<double, 4> value{};
   msg::Time stamp;             ///< the stamp as sent (kBadStamp, kStampBackwards)
   std::int64_t newest_ns = 0;  ///< the newest accepted stamp it is older than, or too far ahead of [ns]
+  std::int64_t ahead_limit_ns = 0;  ///< kStampAhead: how far ahead of newest_ns was allowed [ns]
 
   bool ok() const { return fault == SensorFault::kNone; }
   /// The field and value at fault and what was expected, e.g. "position (nan, 2, 3): expected finite
@@ -116,15 +119,18 @@ struct SensorCheck {
 
 /// `last_stamp_ns`: the newest stamp [ns] accepted on this topic, or INT64_MIN before any. A stamp
 /// equal to it is accepted (a lockstep peer may repeat a tick's sample); an older one is refused, and
-/// so is one more than kStampAheadLimitNs newer.
+/// so is one more than `ahead_limit_ns` (kStampAheadLimitNs, or more: see there) newer.
 /// Checked in this order, the first fault reported (content first, so kStampBackwards means a
 /// well-formed sample that is only too old): Pose position, orientation, stamp; Velocity linear,
 /// angular, stamp; Imu orientation, angular_velocity, linear_acceleration, stamp. An orientation is
 /// checked for NaN/Inf, then for its norm; a stamp for its form, then its age. Covariances and
 /// frame_id are not read. Allocate nothing.
-SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns);
-SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns);
-SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns);
+SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns,
+                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns,
+                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns,
+                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
 
 /// A sender whose clock restarted (a plant process started again under a running controller) sends
 /// only well-formed samples older than the newest accepted. After this many such samples in a row

@@ -628,6 +628,31 @@ TEST(ControllerValidationTest, ASampleStampedFarAheadIsRefusedAndDoesNotBlindThe
       << rig.log.front();
 }
 
+// Real time: a link cut for longer than the limit (3 s here) brings samples that far ahead when it heals.
+// On the receipt clock the 3 s spent waiting are allowed on top of the limit, so the first sample
+// across the healed link is taken at once (it was refused for kStampRestartCount samples, half a
+// second of the safety command, when the limit did not grow); a stamp beyond that growth still is not.
+TEST(ControllerValidationTest, OnTheReceiptClockTheTimeWaitedIsAllowedOnTopOfTheAheadLimit) {
+  ControllerRig rig;
+  std::int64_t wall_ns = 1'000'000'000'000;  // the node's steady clock, unrelated to the stamps
+  rig.node->use_receipt_clock([&] { return wall_ns; });
+  rig.send(1'000'000'000, 1.0, 5.0);  // t = 1 s
+  EXPECT_FALSE(rig.node->step(wall_ns, 0.02).safety);
+  wall_ns += 3'000'000'000;           // 3 s of cut link: nothing arrives
+  EXPECT_TRUE(rig.node->step(wall_ns, 0.02).safety);
+  rig.send(4'010'000'000, 1.0, 6.0);  // 3.01 s ahead: within 2 s + 3 s waited
+  EXPECT_EQ(rig.node->observation().p_W.z(), 6.0);
+  EXPECT_FALSE(rig.node->step(wall_ns, 0.02).safety);
+  EXPECT_EQ(rig.node->status().rejected_stamp_ahead, 0u);
+  // 2 s + the 10 ms since is what is allowed now: a stamp 2.5 s ahead of the newest is refused.
+  wall_ns += 10'000'000;
+  rig.send(4'010'000'000 + 2'500'000'000, 1.0, 7.0);
+  EXPECT_EQ(rig.node->observation().p_W.z(), 6.0);
+  rig.node->step(wall_ns, 0.02);  // the status counts as of the step
+  EXPECT_EQ(rig.node->status().rejected_stamp_ahead, 3u);
+  EXPECT_NE(rig.log.back().find("(at most 2.01 s)"), std::string::npos) << rig.log.back();
+}
+
 TEST(ControllerValidationTest, ASenderWhoseClockRestartedIsFollowedAfterARunOfOldSamples) {
   ControllerRig rig;
   rig.send(50'000'000'000, 1.0, 5.0);  // t = 50 s
