@@ -20,6 +20,7 @@
 #include "dds/peer_pairing.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "io/scenario.hpp"
+#include "isolation/child.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/topics.hpp"
 
@@ -96,6 +97,24 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
   });
   return ctl_cmd;
 }
+
+namespace {
+/// Runs a node's loop. A step given up on SIGINT or SIGTERM (an isolated Python controller's process
+/// is killed on a stop request, and the steps after find it gone) ends the node as the signal does,
+/// exit 0, not as a failure of the controller.
+template <class Loop>
+void run_until_stopped(Loop&& loop) {
+  try {
+    loop();
+  } catch (const sim::ControllerFailure& e) {
+    if (!stop_signalled()) throw;
+    std::cerr << "controller: stop requested while the controller was stepping (" << e.what() << ")\n";
+  } catch (const isolation::Interrupted& e) {
+    if (!stop_signalled()) throw;
+    std::cerr << "controller: " << e.what() << '\n';
+  }
+}
+}  // namespace
 
 int controller_command(const ControllerCommandOptions& o) {
   std::optional<io::Scenario> started =
@@ -177,7 +196,7 @@ int controller_command(const ControllerCommandOptions& o) {
     DdsDriverHost host(transport);
     drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,
                                              host);
-    driver.run();
+    run_until_stopped([&] { driver.run(); });
   } else {
     // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
     node.use_receipt_clock(steady_ns);
@@ -204,11 +223,9 @@ int controller_command(const ControllerCommandOptions& o) {
     DdsDriverHost host(transport, /*precise_deadlines=*/true);
     drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,
                                              o.realtime.rate_factor, std::move(h), host);
-    driver.run();
+    run_until_stopped([&] { driver.run(); });
     if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
   }
-  // A step given up on SIGINT or SIGTERM (an isolated Python controller's wait) ends the node as the
-  // signal does, not as a failure of the controller.
   if (std::optional<std::string> failure = node.controller_failure(); failure && !stop_signalled()) {
     throw sim::ControllerFailure(*failure);
   }

@@ -39,15 +39,6 @@ bool python_alive() {
 #endif
 }
 
-/// Deletes a heap-held Python object under the GIL (or leaks it when Python has gone).
-void release(py::object* o) {
-  if (!o) return;
-  if (python_alive()) {
-    py::gil_scoped_acquire gil;
-    delete o;
-  }
-}
-
 /// The pending Python exception, normalised, with its traceback attached; clears it.
 py::object fetch_error() {
   PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
@@ -293,13 +284,21 @@ ControllerError::ControllerError(const std::string& message, py::object python_e
   if (python_error && !python_error.is_none()) {
     interrupt_ = !PyObject_IsInstance(python_error.ptr(), PyExc_Exception) &&
                  !PyObject_IsInstance(python_error.ptr(), globals().step_timeout.ptr());
-    error_ = std::shared_ptr<py::object>(new py::object(std::move(python_error)), release);
+    // Released under the GIL, or leaked when Python has gone.
+    error_ = std::shared_ptr<PyObject>(python_error.release().ptr(), [](PyObject* o) {
+      if (o && python_alive()) {
+        py::gil_scoped_acquire gil;
+        Py_DECREF(o);
+      }
+    });
   }
 }
 
 ControllerError::ControllerError(const std::string& message) : control::ControllerFailure(message) {}
 
-py::object ControllerError::python_error() const { return error_ ? *error_ : py::none(); }
+py::object ControllerError::python_error() const {
+  return error_ ? py::reinterpret_borrow<py::object>(error_.get()) : py::object(py::none());
+}
 
 // ---------------------------------------------------------------------------------------------------
 // The controller

@@ -55,7 +55,9 @@ class ControllerError : public control::ControllerFailure {
   bool interrupt() const { return interrupt_; }
 
  private:
-  std::shared_ptr<pybind11::object> error_;  ///< released under the GIL
+  /// The exception's reference (a PyObject, not a pybind11::object: the latter's hidden visibility would
+  /// not fit an exception class), released under the GIL.
+  std::shared_ptr<PyObject> error_;
   bool interrupt_ = false;
 };
 

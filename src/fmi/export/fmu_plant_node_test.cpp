@@ -115,7 +115,9 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
       const std::vector<double> cmd = {w, hover, w, hover};
       commands.publish(msg::Float64MultiArray{cmd, {}, 0});
       ASSERT_EQ(QC_FMI(fmi2SetReal)(fmu, cmd_vrs.data(), 4, cmd.data()), fmi2OK);
-      if (k < 300) ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+      if (k < 300) {
+        ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+      }
     }
     node.latch_command(k);
     node.integrate(k);
@@ -170,7 +172,9 @@ TEST(FmuPlantNode, SensorNoiseLeftToTheMasterKeepsTheTrueStateOfANoisyNode) {
       for (std::size_t i = 0; i < want.size(); ++i) {
         ASSERT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0) << "output " << i << " at tick " << k;
       }
-      if (k < 200) ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+      if (k < 200) {
+        ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
+      }
     }
     node.latch_command(k);
     node.integrate(k);
