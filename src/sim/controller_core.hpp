@@ -46,7 +46,8 @@ class ControllerCore {
     return true;
   }
   bool take_velocity(const msg::TwistStamped& m) {
-    if (!accept(check_velocity(m, velocity_stamp_ns_, ahead_limit(velocity_ref_ns_)), velocity_topic_, velocity_backwards_)) return false;
+    const SensorCheck check = check_velocity(m, velocity_stamp_ns_, ahead_limit(velocity_ref_ns_));
+    if (!accept(check, velocity_topic_, velocity_backwards_)) return false;
     observation_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
     velocity_ref_ns_ = reference_time(velocity_stamp_ns_);
@@ -133,8 +134,9 @@ class ControllerCore {
   /// receipt clock the time since that newest was taken (`ref_ns`, its receipt time): a plant whose
   /// samples were cut off for longer has simulated on meanwhile, in real time.
   std::int64_t ahead_limit(std::int64_t ref_ns) const {
-    return receipt_clock_ && ref_ns != kNever ? kStampAheadLimitNs + std::max<std::int64_t>(receipt_clock_() - ref_ns, 0)
-                                              : kStampAheadLimitNs;
+    return receipt_clock_ && ref_ns != kNever
+               ? kStampAheadLimitNs + std::max<std::int64_t>(receipt_clock_() - ref_ns, 0)
+               : kStampAheadLimitNs;
   }
   /// reference_ at simulated time now_ns: the step setpoints (or the trajectory).
   void update_reference(std::int64_t now_ns);

@@ -107,8 +107,8 @@ struct SensorCheck {
   /// That field's values as sent: x, y, z of a vector (kNonFinite), x, y, z, w of an orientation
   /// (kNonFinite, kBadQuaternion). Unused for the stamp.
   std::array<double, 4> value{};
-  msg::Time stamp;             ///< the stamp as sent (kBadStamp, kStampBackwards)
-  std::int64_t newest_ns = 0;  ///< the newest accepted stamp it is older than, or too far ahead of [ns]
+  msg::Time stamp;                  ///< the stamp as sent (kBadStamp, kStampBackwards)
+  std::int64_t newest_ns = 0;       ///< the newest accepted stamp it is older than, or too far ahead of [ns]
   std::int64_t ahead_limit_ns = 0;  ///< kStampAhead: how far ahead of newest_ns was allowed [ns]
 
   bool ok() const { return fault == SensorFault::kNone; }
@@ -126,11 +126,10 @@ struct SensorCheck {
 /// checked for NaN/Inf, then for its norm; a stamp for its form, then its age. Covariances and
 /// frame_id are not read. Allocate nothing.
 SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns,
-                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+                       std::int64_t ahead_limit_ns = kStampAheadLimitNs);
 SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns,
-                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
-SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns,
-                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+                           std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns = kStampAheadLimitNs);
 
 /// A sender whose clock restarted (a plant process started again under a running controller) sends
 /// only well-formed samples older than the newest accepted. After this many such samples in a row

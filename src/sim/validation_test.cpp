@@ -638,7 +638,7 @@ TEST(ControllerValidationTest, OnTheReceiptClockTheTimeWaitedIsAllowedOnTopOfThe
   rig.node->use_receipt_clock([&] { return wall_ns; });
   rig.send(1'000'000'000, 1.0, 5.0);  // t = 1 s
   EXPECT_FALSE(rig.node->step(wall_ns, 0.02).safety);
-  wall_ns += 3'000'000'000;           // 3 s of cut link: nothing arrives
+  wall_ns += 3'000'000'000;  // 3 s of cut link: nothing arrives
   EXPECT_TRUE(rig.node->step(wall_ns, 0.02).safety);
   rig.send(4'010'000'000, 1.0, 6.0);  // 3.01 s ahead: within 2 s + 3 s waited
   EXPECT_EQ(rig.node->observation().p_W.z(), 6.0);
