@@ -1,7 +1,9 @@
 // Tests of the file layer: scenario loading and its error messages, the trajectory CSV, command
 // schedules, and the step report (criteria and metrics.json).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <array>
@@ -31,6 +33,8 @@ namespace quadcosim::io {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 const fs::path kSourceDir = QUADCOSIM_SOURCE_DIR;
 
@@ -290,6 +294,95 @@ schedule:
     EXPECT_EQ(sc->schedule[0].name, "lqr.pitch.q_angle");
     EXPECT_EQ(std::get<double>(sc->schedule[0].value), 4.0);
   }
+}
+
+// Gains in a type's section apply when that type flies and are checked, but not used, when another does;
+// what is flown (the node's mode and setpoints) is the same for every type.
+TEST(ScenarioTest, TypeSectionsHoldEachControllersGains) {
+  TempDir dir;
+  const std::string file = dir.write("typed.yaml", R"(controller:
+  mode: position
+  z_des: 4
+  paper:
+    lqr: {roll: {q_angle: 2.0}}
+    position.kp: 0.9
+  se3:
+    k_x.x: 7.5
+schedule:
+  - at_s: 1
+    set: {z_des: 6, paper: {position.kd: 1.1}, se3: {k_v.x: 2.5}}
+)");
+  const Scenario paper = load_scenario(file);
+  EXPECT_EQ(paper.controller.type(), "paper");
+  EXPECT_EQ(paper_params(paper.controller).roll.q_angle, 2.0);
+  EXPECT_EQ(paper_params(paper.controller).position.kp, 0.9);
+  const Scenario se3 = load_scenario(file, "se3");
+  EXPECT_EQ(se3.controller.type(), "se3");
+  EXPECT_EQ(std::get<double>(*control::get_parameter(se3.controller, "k_x.x")), 7.5);
+  for (const Scenario* sc : {&paper, &se3}) {
+    SCOPED_TRACE(sc->controller.type());
+    EXPECT_EQ(sc->controller.node.setpoint.mode, control::Mode::kPosition);
+    EXPECT_EQ(sc->controller.node.setpoint.p_des_W.z(), 4.0);
+    // The schedule holds the node's change and the flying type's gain only.
+    ASSERT_EQ(sc->schedule.size(), 2u);
+    EXPECT_EQ(sc->schedule[0].name, "z_des");
+    EXPECT_EQ(sc->schedule[1].name, sc == &paper ? "position.kd" : "k_v.x");
+  }
+  // A typo in the gains of a type that does not fly is still an error, named at its key.
+  const std::string typo = dir.write("typo.yaml", "controller:\n  paper:\n    lqr: {roll: {q_angel: 2}}\n");
+  try {
+    (void)load_scenario(typo, "se3");
+    ADD_FAILURE() << "a misspelt paper gain was accepted while se3 flies";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel'"));
+  }
+  // The node's parameters belong to what is flown, not to a type's gains.
+  const std::string node = dir.write("node.yaml", "controller:\n  se3: {z_des: 3}\n");
+  try {
+    (void)load_scenario(node);
+    ADD_FAILURE() << "z_des inside se3: was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("controller.se3.z_des: 'z_des' is the node's"));
+  }
+}
+
+// A file that writes the paper controller's gains directly under controller: (the older form) flies
+// any other type: --controller moves them into the paper section, where they are checked and unused.
+TEST(ScenarioTest, AnotherTypeTakesTheFilesFlatGainsAsThePaperControllers) {
+  TempDir dir;
+  const std::string file = dir.write("flat.yaml", R"(controller:
+  mode: position
+  z_des: 2
+  lqr: {roll: {q_angle: 3.0}}
+  position: {kp: 0.7}
+)");
+  EXPECT_EQ(paper_params(load_scenario(file).controller).roll.q_angle, 3.0);
+  const Scenario se3 = load_scenario(file, "se3");
+  EXPECT_EQ(se3.controller.type(), "se3");
+  EXPECT_EQ(se3.controller.node.setpoint.p_des_W.z(), 2.0);
+  YAML::Node root = YAML::LoadFile(file);
+  set_controller_type(root, "se3");
+  EXPECT_EQ(root["controller"]["type"].as<std::string>(), "se3");
+  EXPECT_FALSE(root["controller"]["lqr"]);
+  EXPECT_EQ(root["controller"]["paper"]["lqr"]["roll"]["q_angle"].as<double>(), 3.0);
+  EXPECT_EQ(root["controller"]["paper"]["position"]["kp"].as<double>(), 0.7);
+  EXPECT_EQ(root["controller"]["z_des"].as<double>(), 2.0);
+  // Back to paper: the moved gains apply again, from their section.
+  set_controller_type(root, "paper");
+  EXPECT_EQ(paper_params(load_scenario(root, file).controller).roll.q_angle, 3.0);
+}
+
+TEST(ScenarioTest, ControllerChoicesAreParsedOrRefusedWithWhatWasExpected) {
+  EXPECT_EQ(parse_controller_choice("se3").kind, ControllerChoice::Kind::kType);
+  const ControllerChoice py = parse_controller_choice("python:my_controllers:LevelPD");
+  EXPECT_EQ(py.kind, ControllerChoice::Kind::kPython);
+  EXPECT_EQ(py.target, "my_controllers:LevelPD");
+  EXPECT_THAT([] { (void)parse_controller_choice("python:nocolon"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("expected python:MODULE:CLASS")));
+  EXPECT_THAT([] { (void)parse_controller_choice("fmu:/no/such.fmu"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("no such file '/no/such.fmu'")));
+  EXPECT_THAT([] { (void)parse_controller_choice("cascade"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("expected a controller type (paper, ")));
 }
 
 TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {

@@ -118,11 +118,23 @@ bool controller_section_key(const std::string& key) {
   return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters" || key == "python";
 }
 
+// A key of a `controller:` section (or of a schedule's `set:`) named after a registered controller
+// type holds that type's gains (`paper: {lqr: ...}`): applied when that type flies, checked against
+// its table when another does.
+bool type_section_key(const std::string& key) { return controllers::find_controller_type(key) != nullptr; }
+
+// Where a parameter is read from: directly under `controller:` (the node's and the flying
+// controller's), or inside a type's gains section (its gains only).
+enum class ParameterPlace { kTop, kTypeSection };
+
 void collect_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
                         std::vector<control::Setting>& controller_settings,
-                        std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth) {
+                        std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth,
+                        ParameterPlace place = ParameterPlace::kTop) {
   for (const std::string& key : s.keys()) {
-    if (depth == 1 && controller_section_key(key)) continue;  // read by the caller
+    if (depth == 1 && place == ParameterPlace::kTop && (controller_section_key(key) || type_section_key(key))) {
+      continue;  // read by the caller
+    }
     const YAML::Node n = s.raw(key);
     const std::string name = prefix.empty() ? key : prefix + "." + key;
     if (n.IsMap()) {
@@ -130,8 +142,14 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
         s.fail(key, "unknown controller parameter '" + name + "' (nested too deeply; see `quadcosim params`)");
       }
       YamlSection child(n, s.file(), s.key_path(key));
-      collect_parameters(child, name, c, controller_settings, out, depth + 1);
+      collect_parameters(child, name, c, controller_settings, out, depth + 1, place);
       continue;
+    }
+    const bool node = control::node_parameters().find(name) != nullptr;
+    if (node && place == ParameterPlace::kTypeSection) {
+      s.fail(key, "'" + name +
+                      "' is the node's (what is flown, for every controller type); expected it directly "
+                      "under controller:, not in a type's gains section");
     }
     const control::ParameterSpec* spec = control::find_parameter(c, name);
     if (!spec) {
@@ -139,13 +157,47 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
                       "' (see `quadcosim params --controller " + std::string(c.type()) + "`)");
     }
     const control::ParameterValue value = parameter_value(s, key, *spec, n);
-    if (control::node_parameters().find(name)) {
+    if (node) {
       if (std::string err = control::set_parameter(c, name, value); !err.empty()) s.fail(key, err);
     } else {
       if (std::string err = control::check_value(*spec, value); !err.empty()) s.fail(key, err);
+      for (const control::Setting& before : controller_settings) {
+        if (before.name == name) {
+          s.fail(key, "'" + name + "' is set twice: directly under controller: and in the " + std::string(c.type()) +
+                          " gains section; keep one");
+        }
+      }
       controller_settings.push_back({name, value});
     }
     if (out) out->emplace_back(name, value);
+  }
+}
+
+// The gains sections of `s` (keys named after registered types): the flying type's into `settings`
+// (and `out`), every other checked against its own type's table, as designed for `vehicle`, and left
+// unused.
+void read_type_sections(YamlSection& s, control::ControllerConfig& c, const model::VehicleParams& vehicle,
+                        std::vector<control::Setting>& settings,
+                        std::vector<std::pair<std::string, control::ParameterValue>>* out) {
+  for (const std::string& key : s.keys()) {
+    if (!type_section_key(key)) continue;
+    auto section = s.section(key);
+    if (!section) continue;  // `paper:` with nothing under it
+    if (key == c.type()) {
+      collect_parameters(*section, "", c, settings, out, 1, ParameterPlace::kTypeSection);
+      continue;
+    }
+    control::ControllerConfig other;
+    try {
+      other = controllers::make_config(key, vehicle);
+    } catch (const std::exception&) {
+      continue;  // not designable for this vehicle; it does not fly here, so its gains are not checked
+    }
+    std::vector<control::Setting> unused;
+    collect_parameters(*section, "", other, unused, nullptr, 1, ParameterPlace::kTypeSection);
+    if (unused.empty()) continue;
+    std::unique_ptr<control::Controller> probe = other.controller->clone();
+    if (std::string err = probe->set_parameters(unused); !err.empty()) section->fail(unused.front().name, err);
   }
 }
 
@@ -153,6 +205,7 @@ void read_parameters(YamlSection& s, control::ControllerConfig& c,
                      std::vector<std::pair<std::string, control::ParameterValue>>* out) {
   std::vector<control::Setting> settings;
   collect_parameters(s, "", c, settings, out, 1);
+  read_type_sections(s, c, c.vehicle, settings, out);
   if (settings.empty()) return;
   std::unique_ptr<control::Controller> next = c.controller->clone();
   if (std::string err = next->set_parameters(settings); !err.empty()) s.fail(settings.front().name, err);
@@ -557,16 +610,92 @@ model::State initial_state(const Scenario& sc) {
 
 Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path, nullptr); }
 
-void set_controller_type(YAML::Node root, const std::string& controller_type) {
+ControllerChoice parse_controller_choice(const std::string& text) {
+  ControllerChoice c;
+  if (text.rfind("python:", 0) == 0) {
+    c.kind = ControllerChoice::Kind::kPython;
+    c.target = text.substr(7);
+    const std::size_t colon = c.target.find(':');
+    if (colon == 0 || colon == std::string::npos || colon + 1 == c.target.size()) {
+      throw std::invalid_argument("got '" + text +
+                                  "', expected python:MODULE:CLASS (e.g. python:my_controllers:LevelPD)");
+    }
+  } else if (text.rfind("fmu:", 0) == 0) {
+    c.kind = ControllerChoice::Kind::kFmu;
+    c.target = text.substr(4);
+    if (c.target.empty()) throw std::invalid_argument("got '" + text + "', expected fmu:PATH of a co-simulation FMU");
+    std::error_code ec;
+    if (!std::filesystem::exists(c.target, ec)) {
+      throw std::invalid_argument("got '" + text + "': no such file '" + c.target + "'");
+    }
+    c.target = std::filesystem::absolute(c.target).lexically_normal().string();
+  } else if (text == "python") {
+    c.kind = ControllerChoice::Kind::kPython;  // the class is named by the caller (controller.python)
+  } else {
+    if (!controllers::find_controller_type(text)) {
+      throw std::invalid_argument("got '" + text + "', expected a controller type (" +
+                                  controllers::controller_type_names() +
+                                  "), python:MODULE:CLASS (a class written in Python) or fmu:PATH (an FMU)");
+    }
+    c.target = text;
+  }
+  return c;
+}
+
+void set_controller_type(YAML::Node root, const std::string& controller) {
+  const ControllerChoice choice = parse_controller_choice(controller);
   if (!root["controller"] || !root["controller"].IsMap()) {
     if (root["controller"] && !root["controller"].IsNull()) return;  // load_scenario refuses it, naming the key
     root["controller"] = YAML::Node(YAML::NodeType::Map);
   }
-  root["controller"]["type"] = controller_type;
-  if (controller_type != "python") {
-    // Another type in place of a Python controller: its class and time limit go with it.
-    root["controller"].remove("python");
-    root["controller"].remove("step_timeout_s");
+  YAML::Node c = root["controller"];
+  // What the file flies: a Python class, an FMU, or a registered type (paper by default).
+  const bool was_python = c["python"] || (c["type"] && c["type"].IsScalar() && c["type"].Scalar() == "python");
+  const bool was_fmu = static_cast<bool>(c["fmu"]);
+  const std::string was_type = was_python                          ? "python"
+                               : was_fmu                           ? "fmu"
+                               : c["type"] && c["type"].IsScalar() ? c["type"].Scalar()
+                                                                   : "paper";
+  const bool same = choice.kind == ControllerChoice::Kind::kType ? !was_python && !was_fmu && was_type == choice.target
+                    : choice.kind == ControllerChoice::Kind::kPython
+                        ? was_python && (choice.target.empty() || (c["python"] && c["python"].IsScalar() &&
+                                                                   c["python"].Scalar() == choice.target))
+                        : was_fmu && c["fmu"].IsScalar() && c["fmu"].Scalar() == choice.target;
+  if (!same) {
+    // The gains written directly under controller: are the file's controller's. A registered type's
+    // move into its own section (kept, checked, unused); a Python class's or an FMU's go with it.
+    YAML::Node gains(YAML::NodeType::Map);
+    std::vector<std::string> moved;
+    for (const auto& kv : c) {
+      const std::string key = kv.first.as<std::string>();
+      if (controller_section_key(key) || type_section_key(key) || key == "step_timeout_s" || key == "in_process") {
+        continue;
+      }
+      if (control::node_parameters().find(key)) continue;
+      moved.push_back(key);
+    }
+    const bool keep = !was_python && !was_fmu && controllers::find_controller_type(was_type);
+    for (const std::string& key : moved) {
+      if (keep) {
+        if (!c[was_type] || !c[was_type].IsMap()) c[was_type] = YAML::Node(YAML::NodeType::Map);
+        if (!c[was_type][key]) c[was_type][key] = YAML::Clone(c[key]);
+      }
+      c.remove(key);
+    }
+    for (const char* key : {"python", "step_timeout_s", "fmu", "inputs", "outputs", "parameters", "in_process"}) {
+      c.remove(key);
+    }
+  }
+  switch (choice.kind) {
+    case ControllerChoice::Kind::kType: c["type"] = choice.target; break;
+    case ControllerChoice::Kind::kPython:
+      c["type"] = "python";
+      if (!choice.target.empty()) c["python"] = choice.target;
+      break;
+    case ControllerChoice::Kind::kFmu:
+      c.remove("type");
+      c["fmu"] = choice.target;
+      break;
   }
 }
 

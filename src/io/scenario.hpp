@@ -151,13 +151,27 @@ model::State initial_state(const Scenario& scenario);
 /// wrong type, value out of range, a rate that is not a whole divisor, ...).
 Scenario load_scenario(const std::string& path);
 
-/// The same with `controller.type` set to `controller_type` when it is not empty (the CLI's
-/// --controller): the file's controller parameters are then checked against that type's table.
-Scenario load_scenario(const std::string& path, const std::string& controller_type);
+/// The same flown by `controller` when it is not empty (the CLI's --controller; see
+/// set_controller_type for what it may name).
+Scenario load_scenario(const std::string& path, const std::string& controller);
 
-/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed; a type other
-/// than python drops the section's `python` and `step_timeout_s` (a Python controller's).
-void set_controller_type(YAML::Node root, const std::string& controller_type);
+/// What `--controller` names: a registered type ("se3"), a class written in Python
+/// ("python:MODULE:CLASS"), or a co-simulation FMU ("fmu:PATH", made absolute from the current
+/// directory). Throws std::invalid_argument saying what was expected.
+struct ControllerChoice {
+  enum class Kind { kType, kPython, kFmu } kind = Kind::kType;
+  std::string target;  ///< the type's name, MODULE:CLASS ("" for a bare "python") or the FMU's absolute path
+};
+ControllerChoice parse_controller_choice(const std::string& text);
+
+/// Makes a parsed scenario (a mapping) fly `controller` (parse_controller_choice; a bare "python"
+/// leaves the class to the caller's controller.python), creating the section if needed. What is
+/// flown (the node's mode, setpoints, safety) stays. The gains written directly under controller:
+/// belong to the file's controller: a registered type's move into its own gains section (`paper:
+/// {lqr: ...}`, still checked, not used); a Python class's or an FMU's (and its python, fmu,
+/// inputs, outputs, parameters, step_timeout_s) are dropped. The gains section of the type that
+/// flies now, when the file has one, applies. Throws std::invalid_argument as parse_controller_choice.
+void set_controller_type(YAML::Node root, const std::string& controller);
 
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file
 /// and `path` is recorded as the scenario's path. A sweep sets keys in the parsed file and loads each
