@@ -363,8 +363,10 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
       ->check(CLI::Range(4, 400));
   cmd->add_option("--min-frequency", o.min_frequency, "measured: the lowest frequency [rad/s]")
       ->check(CLI::Range(1e-3, 1e4));
-  cmd->add_option("--out", o.out_dir,
-                  "write margins.json, frequency_response.csv and Bode/Nyquist PNGs here: a new or empty folder");
+  cmd->add_option(
+      "--out", o.out_dir,
+      "write margins.json, margins.txt, the analytic and/or measured response CSV and Bode/Nyquist PNGs here: a "
+      "new or empty folder");
   cmd->add_flag("--force", o.force,
                 "--out holds a previous command's outputs or other files: remove exactly the outputs its manifest "
                 "lists first (files quadcosim did not write are kept)");
