@@ -194,7 +194,8 @@ PYEOF
 
   console)  # every figure with its count and missing runs; a figure no run has says so
     sed 's/duration_s: 15/duration_s: 3/' "$ALT" > "$TMP/short.yaml"
-    "$QC" sweep "$TMP/short.yaml" --runs 20 --vary mass=20% --min-pass-rate 0 --no-plots --out "$TMP/c" > "$TMP/log" 2>&1 || fail "sweep"
+    "$QC" sweep "$TMP/short.yaml" --runs 20 --vary mass=20% --min-pass-rate 0 --no-plots --out "$TMP/c" > "$TMP/log" \
+      2> "$TMP/err" || fail "sweep"
     "$PY" - "$TMP/c/summary.json" "$TMP/log" <<'PYEOF' || { cat "$TMP/log"; fail "console table"; }
 import json, sys
 s = json.load(open(sys.argv[1])); log = open(sys.argv[2]).read().splitlines()
