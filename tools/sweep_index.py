@@ -12,12 +12,12 @@ inline script to sort the table; no URL outside the folder) with
   - the headline scatter plots of tools/plot_sweep.py (headline_<key>.png: the
     figures the scenario's criteria bound against each varied key, passing runs
     green, failing red) and links to every other plot it wrote;
-  - a table of every run: its index and seed, each varied key's value, the
-    headline figures, PASS or FAIL and, for a failed run, each criterion it
-    failed with its value and the bound it is outside (or the note saying why
-    it could not be judged), or the error of a run that could not be flown;
-    links to the run's folder, its metrics.json, and its report.html and
-    trajectory.csv when present (`quadcosim sweep rerun` makes a run's report).
+  - a table of every run: its index, PASS or FAIL and, for a failed run, each
+    criterion it failed with its value and the bound it is outside (or the note
+    saying why it could not be judged), or the error of a run that could not be
+    flown; each varied key's value, the headline figures, links to the run's
+    folder, its metrics.json, and its report.html and trajectory.csv when
+    present (`quadcosim sweep rerun` makes a run's report), and its seed.
 
 A run's verdict and failed criteria are read from its own metrics.json (its
 "passed" and each section's criteria with "passed": false), so whatever the
@@ -54,6 +54,8 @@ th { background: #eee; cursor: pointer; position: sticky; top: 0; }
 td.num { text-align: right; font-family: "DejaVu Sans Mono", monospace; }
 td.pass { color: #2a7f2a; font-weight: bold; }
 td.fail { color: #c62828; font-weight: bold; }
+td.why { min-width: 22em; max-width: 40em; }
+td.seed { color: #777; font-size: 0.85em; }
 tr.failed { background: #fdf0f0; }
 .plots img { max-width: 100%; border: 1px solid #ddd; margin: 0.3em 0; }
 .small { color: #555; font-size: 0.9em; }
@@ -218,27 +220,28 @@ def build(sweep_dir, summary):
     w('<p class="small"><label><input type="checkbox" id="only-failed"> only the failed runs</label>; '
       "click a column to sort. A run's full outputs (trajectory, report.html): "
       f"<code>quadcosim sweep rerun {esc(sweep_dir)} INDEX --out DIR</code>.</p>")
-    w('<table class="runs"><thead><tr><th>run</th><th>seed</th>')
+    # What failed first, then the run's values and figures; the seed last (20 digits).
+    w('<table class="runs"><thead><tr><th>run</th><th>verdict</th><th>failed criteria</th>')
     for key in keys:
         w(f"<th>{esc(key)}</th>")
     for h in headline:
         w(f"<th>{esc(h)}</th>")
-    w("<th>verdict</th><th>failed criteria</th><th>outputs</th></tr></thead><tbody>")
+    w("<th>outputs</th><th>seed</th></tr></thead><tbody>")
     for r, has_metrics, passed, failed in rows:
         i = r["index"]
         w(f'<tr id="run{i}"' + ("" if passed else ' class="failed"') + ">")
-        w(f'<td class="num" data-v="{i}">{i}</td><td class="num">{esc(r.get("seed", ""))}</td>')
+        w(f'<td class="num" data-v="{i}">{i}</td>')
+        w(f'<td class="{"pass" if passed else "fail"}">{"PASS" if passed else "FAIL"}</td>')
+        if r.get("error"):
+            w(f'<td class="why">could not be flown: {esc(r["error"])}</td>')
+        else:
+            w('<td class="why">' + "<br>".join(esc(describe(fc)) for fc in failed) + "</td>")
         for key in keys:
             v = r.get("values", {}).get(key)
             w(f'<td class="num" data-v="{esc(v if v is not None else "")}">{num(v)}</td>')
         for h in headline:
             v = r.get("figures", {}).get(h)
             w(f'<td class="num" data-v="{esc(v if v is not None else "")}">{num(v)}</td>')
-        w(f'<td class="{"pass" if passed else "fail"}">{"PASS" if passed else "FAIL"}</td>')
-        if r.get("error"):
-            w(f"<td>could not be flown: {esc(r['error'])}</td>")
-        else:
-            w("<td>" + "<br>".join(esc(describe(fc)) for fc in failed) + "</td>")
         links = []
         d = run_dir_of(i)
         if os.path.isdir(os.path.join(sweep_dir, d)):
@@ -248,7 +251,7 @@ def build(sweep_dir, summary):
         for extra in ("report.html", "trajectory.csv"):
             if os.path.isfile(os.path.join(sweep_dir, d, extra)):
                 links.append(f'<a href="{esc(d)}/{extra}">{extra}</a>')
-        w("<td>" + " ".join(links) + "</td></tr>")
+        w("<td>" + " ".join(links) + f'</td><td class="num seed">{esc(r.get("seed", ""))}</td></tr>')
     w("</tbody></table>")
     w(f"<script>{SCRIPT}</script>")
     w("</body></html>")
