@@ -165,8 +165,9 @@ def build(sweep_dir, summary):
     for r in runs:
         i = r["index"]
         m = read_metrics(sweep_dir, i)
-        if m is not None:  # the run's own verdict and criteria
-            passed, failed = bool(m.get("passed")), failed_criteria(m)
+        if m is not None:  # the run's own verdict and criteria (named for a failed run, as summary.json does)
+            passed = bool(m.get("passed"))
+            failed = [] if passed else failed_criteria(m)
         else:
             passed, failed = bool(r.get("passed")), r.get("failed_criteria", [])
         rows.append((r, m is not None, passed, failed))
