@@ -290,7 +290,9 @@ struct SweepOptions {
   int jobs = 2;  ///< threads
   double min_pass_rate = 1.0;
   bool plots = true;
-  std::string sweep_dir;  ///< rerun: the sweep
+  bool progress = true;           ///< runs done, pass rate and time left on stderr while the runs go
+  double progress_every_s = 5.0;  ///< seconds between progress lines when stderr is no terminal (0: each run)
+  std::string sweep_dir;          ///< rerun: the sweep
   int rerun_index = 0;
   std::vector<std::string> shard_dirs;  ///< merge: the shards
 };
