@@ -17,6 +17,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -39,9 +40,13 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
     os << fmt::format("sweep {}: interrupted: {} of {} runs finished; {} of them passed ({:.1f} %), seed {}\n",
                       j["scenario"].get<std::string>(), finished, runs, passed,
                       finished > 0 ? 100.0 * passed / finished : 0.0, j["seed"].get<std::uint64_t>());
+  } else if (j.value("judge", std::string("spec")) == "none") {
+    os << fmt::format("sweep {}: {} runs, figures only (--judge none: no verdict), seed {}\n",
+                      j["scenario"].get<std::string>(), runs, j["seed"].get<std::uint64_t>());
   } else {
-    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", j["scenario"].get<std::string>(), passed,
-                      runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
+    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %) against {}, seed {}\n",
+                      j["scenario"].get<std::string>(), passed, runs, 100.0 * passed / runs,
+                      j.value("judge", std::string("spec")), j["seed"].get<std::uint64_t>());
   }
   int failed_runs = 0;
   for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
@@ -197,6 +202,7 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   c->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
   c->add_flag("!--no-plots", o.plots, "skip the plots");
+  add_judge_option(*c, o.judge);
 
   auto* r = c->add_subcommand("rerun", "fly run I of a sweep again with the outputs of `run`");
   r->add_option("dir", o.sweep_dir, "sweep folder (summary.json or shard.json, scenario.yaml)")->required();
@@ -234,8 +240,12 @@ int sweep_command(const SweepOptions& o) {
   // A bad --vary or scenario: io::ConfigError or std::invalid_argument, bad input (run_guarded).
   bool grid = false;
   for (const auto& spec : o.vary) grid = grid || sweep::parse_vary(spec).distribution == sweep::Distribution::kGrid;
-  const sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
-                                            o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
+  sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
+                                      o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
+  plan.judge = io::parse_judge(o.judge).value_or(io::Judge::kSpec);  // --judge checked its value
+  if (const std::string note = io::nothing_judged_note(plan.nominal, plan.judge); !note.empty()) {
+    std::cout << "sweep " << plan.nominal.name << ": " << note << '\n';
+  }
   if (plan.nominal.steps.empty() && !plan.nominal.hold && !plan.nominal.tracking) {
     std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps, no hold criterion and no "
               << "trajectory to track; a sweep needs something to judge\n";
