@@ -231,11 +231,13 @@ def build_html(run_dir, metrics, version_text):
     if judged == "none":
         w('<div class="verdict none" id="verdict">FIGURES ONLY (not judged)</div>')
     elif verdict is True:
-        w(f'<div class="verdict passed" id="verdict">PASSED {esc(judged_text.get(judged, ""))}</div>')
+        w('<div class="verdict passed" id="verdict">PASSED</div>')
     elif verdict is False:
-        w(f'<div class="verdict failed" id="verdict">FAILED {esc(judged_text.get(judged, ""))}</div>')
+        w('<div class="verdict failed" id="verdict">FAILED</div>')
     else:
         w('<div class="verdict none" id="verdict">NO CRITERIA</div>')
+    if judged != "none":
+        w(f'<p class="source" id="judged">judged {esc(judged_text.get(judged, judged))}</p>')
     w('<p class="source">spec: the scenario\'s specification, bounds a good controller must meet. paper: the '
       "paper's controller's response, bands around its measured figures (not a specification). The judged "
       "set's checks read ok/FAIL, the other's in/out.</p>")

@@ -89,7 +89,8 @@ struct PaperScenario {
   double z0;            ///< initial height [m]
   bool hover;
   double z_des;
-  std::vector<Criterion> criteria;  ///< in file order
+  std::vector<Criterion> criteria;  ///< the paper: bands, in file order
+  std::vector<Criterion> spec;      ///< the spec: bounds, in file order
 };
 
 std::vector<PaperScenario> paper_scenarios() {
@@ -98,6 +99,10 @@ std::vector<PaperScenario> paper_scenarios() {
                                            {"t95_s", 3.5, 4.5},
                                            {"settling_time_2pct_s", 5.0, 7.0},
                                            {"steady_state_error_pct", none, 1.0}};
+  const std::vector<Criterion> attitude_spec = {{"overshoot_pct", none, 10.0},
+                                                {"t95_s", none, 5.0},
+                                                {"settling_time_2pct_s", none, 8.0},
+                                                {"steady_state_error_pct", none, 1.0}};
   return {
       {"altitude_step.yaml",
        "altitude_step",
@@ -109,9 +114,13 @@ std::vector<PaperScenario> paper_scenarios() {
        {{"overshoot_pct", 15.0, 21.0},
         {"peak_time_s", 2.0, 3.0},
         {"settling_time_2pct_s", none, 8.5},
+        {"steady_state_error_pct", none, 1.0}},
+       {{"overshoot_pct", none, 25.0},
+        {"t95_s", none, 5.0},
+        {"settling_time_2pct_s", none, 10.0},
         {"steady_state_error_pct", none, 1.0}}},
-      {"roll_step.yaml", "roll_step", "roll", 0.1, 10.0, true, 10.0, attitude},
-      {"pitch_step.yaml", "pitch_step", "pitch", 0.15, 10.0, true, 10.0, attitude},
+      {"roll_step.yaml", "roll_step", "roll", 0.1, 10.0, true, 10.0, attitude, attitude_spec},
+      {"pitch_step.yaml", "pitch_step", "pitch", 0.15, 10.0, true, 10.0, attitude, attitude_spec},
       {"yaw_step.yaml",
        "yaw_step",
        "yaw",
@@ -119,7 +128,11 @@ std::vector<PaperScenario> paper_scenarios() {
        10.0,
        true,
        10.0,
-       {{"overshoot_pct", none, 2.0}, {"settling_time_2pct_s", 7.0, 9.0}, {"steady_state_error_pct", none, 1.0}}},
+       {{"overshoot_pct", none, 2.0}, {"settling_time_2pct_s", 7.0, 9.0}, {"steady_state_error_pct", none, 1.0}},
+       {{"overshoot_pct", none, 10.0},
+        {"t95_s", none, 8.0},
+        {"settling_time_2pct_s", none, 10.0},
+        {"steady_state_error_pct", none, 1.0}}},
   };
 }
 
@@ -170,12 +183,16 @@ TEST_P(PaperScenarioTest, LoadsWithTheDocumentedValues) {
   const StepSpec& step = sc.steps[0];
   EXPECT_EQ(step.channel, e.channel);
   EXPECT_EQ(step.t_step_s, 0.0);
-  ASSERT_EQ(step.criteria.size(), e.criteria.size());
-  for (std::size_t i = 0; i < e.criteria.size(); ++i) {
-    SCOPED_TRACE(e.criteria[i].figure);
-    EXPECT_EQ(step.criteria[i].figure, e.criteria[i].figure);
-    EXPECT_EQ(step.criteria[i].min, e.criteria[i].min);
-    EXPECT_EQ(step.criteria[i].max, e.criteria[i].max);
+  // The spec bounds first, then the paper's bands, each in file order.
+  ASSERT_EQ(step.criteria.size(), e.spec.size() + e.criteria.size());
+  for (std::size_t i = 0; i < step.criteria.size(); ++i) {
+    const bool spec = i < e.spec.size();
+    const Criterion& want = spec ? e.spec[i] : e.criteria[i - e.spec.size()];
+    SCOPED_TRACE(want.figure);
+    EXPECT_EQ(step.criteria[i].set, spec ? CriteriaSet::kSpec : CriteriaSet::kPaper);
+    EXPECT_EQ(step.criteria[i].figure, want.figure);
+    EXPECT_EQ(step.criteria[i].min, want.min);
+    EXPECT_EQ(step.criteria[i].max, want.max);
   }
   EXPECT_NE(step.reference_source.find("paper"), std::string::npos);
   EXPECT_TRUE(step.reference.count("settling_time_2pct_s"));
