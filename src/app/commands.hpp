@@ -47,6 +47,9 @@ struct RunOptions {
   /// /quadcosim/plant and /quadcosim/controller ("" = as the ROS_SECURITY_* environment says).
   std::string keystore;
   FoxgloveCliOptions foxglove;
+  /// --judge: the criteria set the run is judged against: spec (the scenario's specification), paper
+  /// (the paper controller's measured bands) or none (figures only; exit 0 whatever they are).
+  std::string judge = "spec";
 };
 int run_command(const RunOptions& options);
 CLI::App* add_run_subcommand(CLI::App& app, RunOptions& options);
@@ -295,6 +298,7 @@ struct SweepOptions {
   std::string sweep_dir;          ///< rerun: the sweep
   int rerun_index = 0;
   std::vector<std::string> shard_dirs;  ///< merge: the shards
+  std::string judge = "spec";           ///< --judge: spec, paper or none (as `run`'s)
 };
 CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
 int sweep_command(const SweepOptions& options);

@@ -22,8 +22,9 @@ const std::vector<ExitCodeRow>& exit_code_table() {
   // README.md "Exit codes" shows these rows; tests/cli/exit_codes.py compares the two.
   static const std::vector<ExitCodeRow> table = {
       {kOk, "success", "*"},
-      {kFailed, "a step, hold, limits or tracking criterion failed", "run summary"},
-      {kFailed, "fewer runs passed than --min-pass-rate asks", "sweep"},
+      {kFailed, "a judged criterion failed (of the set --judge names: spec by default, or paper; never with none)",
+       "run summary"},
+      {kFailed, "fewer runs passed their judged criteria than --min-pass-rate asks", "sweep"},
       {kFailed, "a loop is unstable closed-loop, or left hover while measured (its margins are undefined)", "margins"},
       {kFailed, "the enclave has problems (listed)", "security"},
       {kFailed, "the node refused the value, or has no such parameter", "param"},

@@ -76,16 +76,18 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
   return true;
 }
 
-RunJudgement judge_run(const io::Scenario& sc, const fs::path& out) {
+RunJudgement judge_run(const io::Scenario& sc, const fs::path& out, io::Judge judge) {
   RunJudgement j;
+  j.judge = judge;
   const io::Series series = io::read_series((out / "trajectory.csv").string());
-  j.steps = io::evaluate_steps(sc.steps, series);
-  if (sc.hold) j.hold = io::evaluate_hold(*sc.hold, series);
-  j.saturation = io::evaluate_saturation(sc, series);
-  if (sc.tracking) j.tracking = io::evaluate_tracking(*sc.tracking, series);
-  io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking);
-  j.table = io::format_step_table(sc, j.steps, j.hold, j.saturation, j.tracking);
+  j.steps = io::evaluate_steps(sc.steps, series, judge);
+  if (sc.hold) j.hold = io::evaluate_hold(*sc.hold, series, judge);
+  j.saturation = io::evaluate_saturation(sc, series, judge);
+  if (sc.tracking) j.tracking = io::evaluate_tracking(*sc.tracking, series, judge);
+  io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking, judge);
+  j.table = io::format_step_table(sc, j.steps, j.hold, j.saturation, j.tracking, judge);
   std::ofstream((out / "metrics.txt").string()) << j.table;
+  j.nothing_note = io::nothing_judged_note(sc, judge);
   j.passed = io::passed_overall(j.steps, j.hold, j.saturation, j.tracking);
   return j;
 }

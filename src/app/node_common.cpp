@@ -84,6 +84,13 @@ void add_controller_type_option(CLI::App& cmd, std::string& type) {
           "TYPE|python:MODULE:CLASS|fmu:PATH"));
 }
 
+void add_judge_option(CLI::App& cmd, std::string& judge) {
+  cmd.add_option("--judge", judge,
+                 "judge the run against: spec (the scenario's specification, default), paper (the paper "
+                 "controller's measured response bands), none (figures only, no verdict)")
+      ->check(CLI::IsMember(io::judge_names()));
+}
+
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
   // (the timer slack matters for the blocking part)
   static const bool slack_set = prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0;

@@ -18,6 +18,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -40,9 +41,13 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
     os << fmt::format("sweep {}: interrupted: {} of {} runs finished; {} of them passed ({:.1f} %), seed {}\n",
                       j["scenario"].get<std::string>(), finished, runs, passed,
                       finished > 0 ? 100.0 * passed / finished : 0.0, j["seed"].get<std::uint64_t>());
+  } else if (j.value("judge", std::string("spec")) == "none") {
+    os << fmt::format("sweep {}: {} runs, figures only (--judge none: no verdict), seed {}\n",
+                      j["scenario"].get<std::string>(), runs, j["seed"].get<std::uint64_t>());
   } else {
-    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", j["scenario"].get<std::string>(), passed,
-                      runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
+    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %) against {}, seed {}\n",
+                      j["scenario"].get<std::string>(), passed, runs, 100.0 * passed / runs,
+                      j.value("judge", std::string("spec")), j["seed"].get<std::uint64_t>());
   }
   int failed_runs = 0;
   for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
@@ -298,6 +303,7 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   c->add_option("--progress-every", o.progress_every_s,
                 "seconds between progress lines when stderr is not a terminal (0: after each run; default 5)")
       ->check(CLI::Range(0.0, 1e6));
+  add_judge_option(*c, o.judge);
 
   auto* r = c->add_subcommand("rerun", "fly run I of a sweep again with the outputs of `run`");
   r->add_option("dir", o.sweep_dir, "sweep folder (summary.json or shard.json, scenario.yaml)")->required();
@@ -352,6 +358,10 @@ int sweep_command(const SweepOptions& o) {
   if (!recorded_file.empty()) {
     plan.scenario_file = recorded_file;
     plan.nominal.path = recorded_file;
+  }
+  plan.judge = io::parse_judge(o.judge).value_or(io::Judge::kSpec);  // --judge checked its value
+  if (const std::string note = io::nothing_judged_note(plan.nominal, plan.judge); !note.empty()) {
+    std::cout << "sweep " << plan.nominal.name << ": " << note << '\n';
   }
   if (plan.nominal.steps.empty() && !plan.nominal.hold && !plan.nominal.tracking) {
     std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps, no hold criterion and no "

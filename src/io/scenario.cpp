@@ -14,6 +14,7 @@
 #include "controllers/registry.hpp"
 #include "fmi/fmu_controller.hpp"
 #include "fmi/fmu_plant.hpp"
+#include "io/criteria_yaml.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/scenario_limits.hpp"
 #include "io/trajectory_yaml.hpp"
@@ -449,42 +450,54 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
   f.reject_unknown_keys();
 }
 
-// analysis.limits: each key an upper bound >= 0 on a saturation or control-effort figure.
-LimitsSpec read_limits(YamlSection& l, double duration_s) {
+// analysis.limits: each key an upper bound >= 0 on a saturation or control-effort figure, at the top
+// of the section (a specification, as the keys were read before the two sets existed) or under its
+// `spec:` and `paper:`.
+LimitsSpec read_limits(YamlSection& limits, double duration_s) {
   LimitsSpec spec;
-  auto bound = [&](const std::string& key, double hi, const std::vector<std::string>& figures) {
-    if (!l.has(key)) return;
-    const double v = l.number(key, 0.0, 0.0, hi);
-    for (const auto& f : figures) spec.criteria.push_back(Criterion{f, std::nullopt, v});
+  const auto read_set = [&](YamlSection& l, CriteriaSet set) {
+    auto bound = [&](const std::string& key, double hi, const std::vector<std::string>& figures) {
+      if (!l.has(key)) return;
+      const double v = l.number(key, 0.0, 0.0, hi);
+      for (const auto& f : figures) spec.criteria.push_back(Criterion{f, std::nullopt, v, set});
+    };
+    bound("max_saturated_s", duration_s, {"saturated_s"});
+    bound("max_rotor_saturated_s", duration_s,
+          {"rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s", "rotor4_saturated_s"});
+    bound("max_tilt_saturated_s", duration_s, {"tilt_saturated_s"});
+    bound("max_rms_u1_deviation_n", kHuge, {"rms_u1_deviation_n"});
   };
-  bound("max_saturated_s", duration_s, {"saturated_s"});
-  bound("max_rotor_saturated_s", duration_s,
-        {"rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s", "rotor4_saturated_s"});
-  bound("max_tilt_saturated_s", duration_s, {"tilt_saturated_s"});
-  bound("max_rms_u1_deviation_n", kHuge, {"rms_u1_deviation_n"});
-  l.reject_unknown_keys();
+  const bool sets = limits.has("spec") || limits.has("paper");
+  if (sets) {
+    for (const auto& key : limits.node()) {
+      const std::string name = key.first.as<std::string>("");
+      if (name != "spec" && name != "paper") {
+        limits.fail(name, "beside spec/paper; with spec: or paper: every bound goes under one of them");
+      }
+    }
+    if (auto s = limits.section("spec")) {
+      read_set(*s, CriteriaSet::kSpec);
+      s->reject_unknown_keys();
+    }
+    if (auto p = limits.section("paper")) {
+      read_set(*p, CriteriaSet::kPaper);
+      p->reject_unknown_keys();
+    }
+  } else {
+    read_set(limits, CriteriaSet::kSpec);
+  }
+  limits.reject_unknown_keys();
   return spec;
 }
 
-// analysis.tracking: after_s and criteria on the tracking figures, as a step's criteria.
+// analysis.tracking: after_s and the bands on the tracking figures, as a step's.
 TrackingSpec read_tracking(YamlSection& s, double duration_s) {
   TrackingSpec spec;
   spec.after_s = s.number("after_s", 0.0, 0.0, duration_s);
-  auto c = s.section("criteria");
-  if (!c) s.fail("criteria", "missing; expected e.g. {position_rmse_m: [null, 0.05]}");
-  const auto& names = analysis::tracking_figure_names();
-  for (const std::string& fig : c->keys()) {
-    if (std::find(names.begin(), names.end(), fig) == names.end()) {
-      std::string expected;
-      for (std::size_t i = 0; i < names.size(); ++i) {
-        expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-      }
-      c->fail(fig, "unknown tracking figure (expected " + expected + ")");
-    }
-    const auto [min, max] = c->bounds(fig);
-    spec.criteria.push_back(Criterion{fig, min, max});
-  }
-  if (spec.criteria.empty()) s.fail("criteria", "expected at least one figure");
+  auto criteria = read_criteria_sets(s, analysis::tracking_figure_names(), "tracking figure");
+  if (!criteria) s.fail("spec", "missing; expected e.g. spec: {position_rmse_m: [null, 0.05]}");
+  spec.criteria = std::move(*criteria);
+  if (spec.criteria.empty()) s.fail("spec", "expected at least one figure");
   s.reject_unknown_keys();
   return spec;
 }
@@ -498,24 +511,15 @@ void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
   int index = 0;
   for (const YAML::Node& n : analysis.sequence("steps")) {
     const std::string where = "steps[" + std::to_string(index++) + "]";
-    if (!n.IsMap()) analysis.fail(where, "expected a mapping with channel, at_s, criteria");
+    if (!n.IsMap()) analysis.fail(where, "expected a mapping with channel, at_s, spec and/or paper");
     YamlSection s(n, analysis.file(), analysis.key_path(where));
     StepSpec step;
     step.channel = s.choice("channel", "", channels);
     if (step.channel.empty()) s.fail("channel", "missing; expected one of x y z roll pitch yaw");
     step.t_step_s = s.number("at_s", 0.0, 0.0, duration_s);
     step.settling_band = s.number("settling_band_pct", 2.0, 0.01, 50.0) / 100.0;
-    if (auto c = s.section("criteria")) {
-      for (const std::string& fig : c->keys()) {
-        bool known = false;
-        for (const auto& f : analysis::figure_names()) known = known || f == fig;
-        if (!known)
-          c->fail(fig,
-                  "unknown step figure (expected overshoot_pct, peak_time_s, rise_time_s, t95_s, settling_time_2pct_s "
-                  "or steady_state_error_pct)");
-        const auto [min, max] = c->bounds(fig);
-        step.criteria.push_back(Criterion{fig, min, max});
-      }
+    if (auto criteria = read_criteria_sets(s, analysis::figure_names(), "step figure")) {
+      step.criteria = std::move(*criteria);
     }
     if (auto r = s.section("reference")) {
       for (const std::string& key : r->keys()) {
@@ -597,6 +601,38 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
 Scenario read_scenario(YamlSection root, const std::string& path, const model::VehicleParams* controller_vehicle);
 
 }  // namespace
+
+const char* to_string(CriteriaSet set) { return set == CriteriaSet::kSpec ? "spec" : "paper"; }
+
+const char* to_string(Judge judge) {
+  switch (judge) {
+    case Judge::kSpec: return "spec";
+    case Judge::kPaper: return "paper";
+    case Judge::kNone: return "none";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& judge_names() {
+  static const std::vector<std::string> names = {"spec", "paper", "none"};
+  return names;
+}
+
+std::optional<Judge> parse_judge(const std::string& name) {
+  for (Judge j : {Judge::kSpec, Judge::kPaper, Judge::kNone}) {
+    if (name == to_string(j)) return j;
+  }
+  return std::nullopt;
+}
+
+bool has_criteria(const Scenario& sc, CriteriaSet set) {
+  const auto any = [&](const std::vector<Criterion>& criteria) {
+    return std::any_of(criteria.begin(), criteria.end(), [&](const Criterion& c) { return c.set == set; });
+  };
+  return std::any_of(sc.steps.begin(), sc.steps.end(), [&](const StepSpec& s) { return any(s.criteria); }) ||
+         (sc.hold && any(sc.hold->criteria)) || (sc.limits && any(sc.limits->criteria)) ||
+         (sc.tracking && any(sc.tracking->criteria));
+}
 
 const std::vector<std::string>& hold_figure_names() {
   static const std::vector<std::string> names = {"max_horizontal_error_m", "rms_horizontal_error_m",

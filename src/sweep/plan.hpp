@@ -78,6 +78,7 @@ struct Plan {
   std::vector<int> grid_sizes;                         ///< one per grid spec, in order (the first varies slowest)
   int runs = 0;                                        ///< product of grid_sizes times repeats
   std::map<std::string, std::vector<int>> lhs_strata;  ///< per random key: run -> stratum
+  io::Judge judge = io::Judge::kSpec;                  ///< the criteria set each run is judged against (--judge)
 };
 
 /// Loads the scenario, resolves every spec's keys (refusing unknown keys, keys varied twice, a

@@ -63,11 +63,11 @@ const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, c
   return series.series();
 }
 
-void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
-  r.steps = io::evaluate_steps(sc.steps, series);
-  if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
-  r.saturation = io::evaluate_saturation(sc, series);
-  if (sc.tracking) r.tracking = io::evaluate_tracking(*sc.tracking, series);
+void judge(const io::Scenario& sc, const io::Series& series, io::Judge set, RunResult& r) {
+  r.steps = io::evaluate_steps(sc.steps, series, set);
+  if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series, set);
+  r.saturation = io::evaluate_saturation(sc, series, set);
+  if (sc.tracking) r.tracking = io::evaluate_tracking(*sc.tracking, series, set);
   r.passed = io::passed_overall(r.steps, r.hold, r.saturation, r.tracking);
 }
 
@@ -114,7 +114,7 @@ nlohmann::json values_json(const Sample& s) {
 }  // namespace
 
 nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r) {
-  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation, r.tracking);
+  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation, r.tracking, plan.judge);
   nlohmann::json s;
   s["index"] = r.sample.index;
   s["seed"] = r.sample.seed;
@@ -195,7 +195,7 @@ RunResult run_into(const Plan& plan, int index, const fs::path& run_dir, Keep ke
     if (!run_dir.empty()) fs::create_directories(run_dir);
     const fs::path csv = run_dir / "trajectory.csv";
     const bool record_now = keep == Keep::kAll && !run_dir.empty();
-    judge(sc, simulate(sc, series, record_now ? &csv : nullptr, nullptr), r);
+    judge(sc, simulate(sc, series, record_now ? &csv : nullptr, nullptr), plan.judge, r);
     if (keep == Keep::kFailing && !r.passed && !run_dir.empty()) (void)simulate(sc, series, &csv, nullptr);
     const nlohmann::json metrics = run_metrics_json(plan, sc, r);
     if (!run_dir.empty()) write_json(run_dir / "metrics.json", metrics);
@@ -277,11 +277,12 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   const fs::path csv = dir / "trajectory.csv";
   io::SeriesRecorder series;
   (void)simulate(sc, series, &csv, &dir);
-  judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
+  judge(sc, io::read_series(csv.string()), plan.judge, r);  // as `run` does: from the recorded doubles
   const nlohmann::json metrics = run_metrics_json(plan, sc, r);
   write_json(dir / "metrics.json", metrics);
   if (!r.passed) r.failed_criteria = failed_criteria(metrics);
-  io::write_file_atomically(dir / "metrics.txt", io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking));
+  io::write_file_atomically(dir / "metrics.txt",
+                            io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking, plan.judge));
   return r;
 }
 
@@ -293,6 +294,9 @@ nlohmann::json header_json(const Plan& plan) {
   j["runs"] = plan.runs;
   j["runs_per_point"] = plan.repeats;
   j["sampler"] = to_string(plan.sampler);
+  // Written only when not the default, so the header of a sweep judged against its spec is that of a
+  // sweep from before --judge existed (--resume and merge compare headers).
+  if (plan.judge != io::Judge::kSpec) j["judge"] = io::to_string(plan.judge);
   j["vary"] = nlohmann::json::array();
   for (const Vary& v : plan.vary) {
     nlohmann::json keys = nlohmann::json::array();
@@ -608,6 +612,10 @@ Plan plan_of(const fs::path& dir) {
                        h.at("sampler").get<std::string>() == "lhs" ? Sampler::kLhs : Sampler::kRandom,
                        origin ? scenario_source_of(*origin) : std::string());
     if (p.runs != h.at("runs").get<int>()) throw std::runtime_error("the plan gives another number of runs");
+    const std::string judge = h.value("judge", std::string("spec"));
+    const auto set = io::parse_judge(judge);
+    if (!set) throw std::runtime_error("judge: got '" + judge + "', expected spec, paper or none");
+    p.judge = *set;
     return p;
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(file.string() + ": not a sweep's summary (" + e.what() + ")");
