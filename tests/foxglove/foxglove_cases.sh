@@ -480,8 +480,8 @@ PY
     ;;
   inproc_3d)
     bash "$src/tools/mcap_verify/install.sh" || { echo "SKIPPED: cannot install the MCAP reader's npm packages"; exit 77; }
-    # Paced (5 s for the 15 s scenario at 3x) so a second client can join while it flies.
-    "$bin" run "$scenario" --out "$tmp/served" --no-plots --foxglove 0 --foxglove-wait 30 --foxglove-pace 3 \
+    # Paced (7.5 s for the 15 s scenario at 2x) so a second client can join while it flies.
+    "$bin" run "$scenario" --out "$tmp/served" --no-plots --foxglove 0 --foxglove-wait 30 --foxglove-pace 2 \
       > "$tmp/run.log" 2>&1 &
     pids+=($!); run_pid=$!
     url="$(url_of "$tmp/run.log")"
