@@ -234,7 +234,7 @@ int run_command(const RunOptions& opt) {
       std::unique_ptr<foxglove::Server> fox;
       std::chrono::steady_clock::time_point paced_from;
       const auto attach = [&](sim::Transport& transport, const sim::Topics& topics) {
-        fox = start_foxglove(opt.foxglove, "run", transport, topics);
+        fox = start_foxglove(opt.foxglove, "run", transport, topics, sc);
         if (fox) wait_for_foxglove_client(opt.foxglove, "run", *fox);
         paced_from = std::chrono::steady_clock::now();
       };
