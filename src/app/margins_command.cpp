@@ -5,6 +5,7 @@
 // FMU), and the paper's too with --measure, are measured in the closed-loop simulation by injecting
 // sinusoids where the loop is broken (analysis/measured_margins.hpp). docs/margins.md.
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -21,6 +22,7 @@
 #include "analysis/measured_margins.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/node_common.hpp"
 #include "controllers/registry.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -82,7 +84,14 @@ Eigen::Vector3d trim_position(const control::ControllerConfig& c, std::vector<st
 Setup setup_from(const std::string& path, const std::string& controller_type) {
   Setup s;
   if (path.empty()) {
-    s.controller = controllers::make_config(controller_type.empty() ? "paper" : controller_type, s.plant);
+    if (controller_type.empty() ||
+        io::parse_controller_choice(controller_type).kind == io::ControllerChoice::Kind::kType) {
+      s.controller = controllers::make_config(controller_type.empty() ? "paper" : controller_type, s.plant);
+    } else {  // a Python class or an FMU, made as a scenario's controller section makes it
+      YAML::Node root(YAML::NodeType::Map);
+      io::set_controller_type(root, controller_type);
+      s.controller = io::load_scenario(root, "--controller").controller;
+    }
     s.source = fmt::format("defaults (the paper's vehicle, {} controller, plant 100 Hz, controller 50 Hz)",
                            s.controller.type());
     s.measured.vehicle = s.plant;
@@ -350,10 +359,7 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
       app.add_subcommand("margins", "gain, phase and delay margins of each control loop about hover (docs/margins.md)");
   cmd->add_option("scenario", o.scenario, "scenario YAML (default: the paper's vehicle and controller)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--controller", o.controller,
-                  "the controller type to analyse, replacing the scenario's controller.type (`quadcosim params "
-                  "--list`); any but the paper's is measured")
-      ->check(CLI::IsMember(controllers::controller_type_list()));
+  add_controller_type_option(*cmd, o.controller);  // any but the paper's is measured
   cmd->add_flag("--measure", o.measure,
                 "the paper controller: measure its margins in simulation too, beside the analytic ones (other "
                 "controllers are always measured)");

@@ -711,6 +711,9 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       moved.push_back(key);
     }
     const bool keep = !was_python && !was_fmu && controllers::find_controller_type(was_type);
+    // A Python class takes the flat gains as its own (its declared parameters, the way a scenario
+    // dict passes them with quadcosim.run(..., controller=Class)); they stay where they are.
+    if (choice.kind == ControllerChoice::Kind::kPython && keep) moved.clear();
     for (const std::string& key : moved) {
       if (keep) {
         if (!c[was_type] || !c[was_type].IsMap()) c[was_type] = YAML::Node(YAML::NodeType::Map);
@@ -718,9 +721,10 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       }
       c.remove(key);
     }
-    for (const char* key : {"python", "step_timeout_s", "fmu", "inputs", "outputs", "parameters", "in_process"}) {
-      c.remove(key);
-    }
+    // The other kinds' own keys go; a Python controller's time limit stays for the Python class
+    // that replaces it (the scenario's step_timeout_s applies to whichever class flies).
+    for (const char* key : {"python", "fmu", "inputs", "outputs", "parameters", "in_process"}) c.remove(key);
+    if (choice.kind != ControllerChoice::Kind::kPython) c.remove("step_timeout_s");
   }
   switch (choice.kind) {
     case ControllerChoice::Kind::kType: c["type"] = choice.target; break;

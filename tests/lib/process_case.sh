@@ -11,7 +11,12 @@ unset ROS_SECURITY_ENABLE ROS_SECURITY_STRATEGY ROS_SECURITY_KEYSTORE ROS_SECURI
 tmp="$(mktemp -d)"
 pids=()
 cleanup() {
-  for p in "${pids[@]}" $(jobs -p); do kill -KILL "$p" 2>/dev/null || true; done
+  # A job that runs a shell function (`secure ... &`) is a subshell whose command is its child: end the
+  # children first, or they outlive the case (two real-time controllers were found running minutes later).
+  for p in "${pids[@]}" $(jobs -p); do
+    pkill -KILL -P "$p" 2>/dev/null || true
+    kill -KILL "$p" 2>/dev/null || true
+  done
   wait 2>/dev/null || true
   rm -rf "$tmp"
 }
