@@ -700,7 +700,6 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
   if (!same) {
     // The gains written directly under controller: are the file's controller's. A registered type's
     // move into its own section (kept, checked, unused); a Python class's or an FMU's go with it.
-    YAML::Node gains(YAML::NodeType::Map);
     std::vector<std::string> moved;
     for (const auto& kv : c) {
       const std::string key = kv.first.as<std::string>();
@@ -737,6 +736,21 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       c["fmu"] = choice.target;
       break;
   }
+}
+
+Scenario defaults_flown_by(const std::string& controller) {
+  Scenario sc;
+  if (!controller.empty()) {
+    if (parse_controller_choice(controller).kind == ControllerChoice::Kind::kType) {
+      sc.controller = controllers::make_config(controller, sc.vehicle);
+    } else {
+      YAML::Node root(YAML::NodeType::Map);
+      set_controller_type(root, controller);
+      sc = load_scenario(root, "--controller");
+    }
+  }
+  sc.name = "defaults";
+  return sc;
 }
 
 Scenario load_scenario(const std::string& path, const std::string& controller_type) {

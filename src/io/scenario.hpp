@@ -192,6 +192,11 @@ struct ControllerChoice {
 };
 ControllerChoice parse_controller_choice(const std::string& text);
 
+/// What a command without a scenario file flies: the defaults (the paper's vehicle, named "defaults")
+/// flown by `controller` (parse_controller_choice; "" keeps the paper's). A Python class or an FMU is
+/// made as a scenario's controller section makes it. Throws as load_scenario and parse_controller_choice.
+Scenario defaults_flown_by(const std::string& controller);
+
 /// Makes a parsed scenario (a mapping) fly `controller` (parse_controller_choice; a bare "python"
 /// leaves the class to the caller's controller.python), creating the section if needed. What is
 /// flown (the node's mode, setpoints, safety) stays. The gains written directly under controller:
