@@ -26,3 +26,14 @@ fail() {
   for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done
   exit 1
 }
+
+# skip_without_python BINARY: exits 77 (SKIPPED), saying why, when that quadcosim was built without
+# Python controllers.
+skip_without_python() {
+  if "$1" controller --python "no_such_module_for_the_check:X" > "$tmp/check.log" 2>&1; then :; fi
+  if grep -q "built without Python" "$tmp/check.log"; then
+    echo "SKIP: this quadcosim was built without Python: $(cat "$tmp/check.log")"
+    exit 77
+  fi
+  rm -f "$tmp/check.log"
+}
