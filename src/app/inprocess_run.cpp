@@ -6,6 +6,7 @@
 
 #include "app/signals.hpp"
 #include "io/mcap_recorder.hpp"
+#include "io/provenance.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
 
@@ -76,14 +77,19 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
   return true;
 }
 
-RunJudgement judge_run(const io::Scenario& sc, const fs::path& out) {
+RunJudgement judge_run(const io::Scenario& sc, const fs::path& out, const nlohmann::json& provenance) {
   RunJudgement j;
   const io::Series series = io::read_series((out / "trajectory.csv").string());
   j.steps = io::evaluate_steps(sc.steps, series);
   if (sc.hold) j.hold = io::evaluate_hold(*sc.hold, series);
   j.saturation = io::evaluate_saturation(sc, series);
   if (sc.tracking) j.tracking = io::evaluate_tracking(*sc.tracking, series);
-  io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking);
+  if (provenance.is_null()) {
+    io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking);
+  } else {
+    io::write_metrics_with_provenance(out / "metrics.json",
+                                      io::metrics_json(sc, j.steps, j.hold, j.saturation, j.tracking), provenance);
+  }
   j.table = io::format_step_table(sc, j.steps, j.hold, j.saturation, j.tracking);
   std::ofstream((out / "metrics.txt").string()) << j.table;
   j.passed = io::passed_overall(j.steps, j.hold, j.saturation, j.tracking);
