@@ -143,11 +143,13 @@ class ReportTest(ToolTestBase):
         self.assertIn(">position_rmse_m<", page)
         self.assertIn(">0.03 m<", page)
         self.assertIn("≤ 0.05", page)
-        # overview and the three tracking figures, in that order
+        # the headline first: the tracking table and its three figures, then overview
         self.assertEqual(page.count("data:image/png;base64,"), 4)
-        order = [page.index(f">{n}<") for n in ("overview.png", "tracking_path.png", "tracking_axes.png",
-                                               "tracking_error.png")]
+        order = [page.index(f">{n}<") for n in ("tracking_path.png", "tracking_axes.png", "tracking_error.png",
+                                               "overview.png")]
         self.assertEqual(order, sorted(order))
+        self.assertLess(page.index('id="tracking"'), page.index('id="steps"') if 'id="steps"' in page else len(page))
+        self.assertIn('id="headline">position tracking RMSE 0.03 m', page)
 
     def test_failed_tracking_criterion_shows_fail(self):
         def fail_tracking(m):
