@@ -213,8 +213,8 @@ int run_command(const RunOptions& opt) {
   try {  // the model's and the controller's checks of the scenario name no file: say which
     // The scenario as flown: the file, or with --controller applied.
     io::write_file_atomically(out / "scenario.yaml", io::effective_scenario_text(opt.scenario, opt.controller));
-    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder);
     const nlohmann::json provenance = run_provenance(opt, sc);
+    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder, provenance);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
       const int rc = run_over_dds(opt, csv_path);
