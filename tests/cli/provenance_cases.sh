@@ -89,6 +89,36 @@ assert yaml.safe_load(open(run + "/metadata.yaml"))["quadcosim_provenance"] == p
 PYEOF
     ;;
 
+  fmu_controller)  # an FMU as the controller: its path and the SHA-256 of the .fmu file
+    "$QC" fmu export controller --out "$TMP/c.fmu" > "$TMP/export.log" 2>&1 || { cat "$TMP/export.log"; fail "fmu export"; }
+    sed "s|^controller:\$|controller:\n  fmu: $TMP/c.fmu|" "$ALT" > "$TMP/fmu.yaml"
+    run "$TMP/fmu.yaml" "$TMP/f" --no-plots
+    "$PY" - "$TMP/f" "$(realpath "$TMP/c.fmu")" "$(sha256sum "$TMP/c.fmu" | cut -c1-64)" <<'PYEOF' \
+      || fail "the FMU controller is not recorded"
+import json, sys
+run, path, sha = sys.argv[1:]
+c = json.load(open(run + "/metrics.json"))["provenance"]["controller"]
+assert c["type"] == "fmu" and c["scenario_type"] == "fmu" and c["label"] == "fmu c.fmu", c
+assert c["fmu"] == {"path": path, "sha256": sha}, c["fmu"]
+PYEOF
+    ;;
+
+  sweep_runs)  # each run of a sweep records what flew
+    "$QC" sweep "$ALT" --runs 2 --seed 3 --vary mass=5% --min-pass-rate 0 --no-plots --out "$TMP/s" > "$TMP/log" 2>&1 \
+      || { cat "$TMP/log"; fail "sweep failed"; }
+    for r in 0000 0001; do
+      "$PY" - "$TMP/s/runs/$r/metrics.json" "$(sha256sum "$ALT" | cut -c1-64)" <<'PYEOF' || fail "run $r has no provenance"
+import json, sys
+p = json.load(open(sys.argv[1]))["provenance"]
+assert p["controller"]["type"] == "paper" and p["transport"] == "inproc", p
+assert p["command_line"][1] == "sweep" and p["scenario"]["sha256"] == sys.argv[2], p
+PYEOF
+    done
+    "$PY" -c 'import json, sys; s = json.load(open(sys.argv[1]))
+assert "provenance" not in s and all("provenance" not in r for r in s["per_run"])' "$TMP/s/summary.json" \
+      || fail "summary.json has a provenance: it would differ between shards"
+    ;;
+
   summary_controllers)  # one scenario, two controllers: two rows each naming its controller; a step run too
     run "$CIRCLE" "$TMP/a" --no-plots
     run "$CIRCLE" "$TMP/b" --no-plots --controller example_pd
