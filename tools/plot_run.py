@@ -315,6 +315,9 @@ def load_metrics(path):
     steps = obj.get("steps")
     if not isinstance(steps, list):
         raise InputError(f"{path}: missing or non-list key 'steps'")
+    judged = obj.get("judged", "spec")
+    if judged not in ("spec", "paper", "none"):
+        raise InputError(f"{path}: key 'judged' must be 'spec', 'paper' or 'none', got {judged!r}")
     clean = []
     for i, s in enumerate(steps):
         where = f"{path}: steps[{i}]"
@@ -358,14 +361,18 @@ def load_metrics(path):
             raise InputError(f"{where}: key 'criteria' must be a list of objects")
         step["criteria"] = criteria
         passed = s.get("passed")
-        if not isinstance(passed, bool):
-            flags = [c.get("passed") for c in criteria if isinstance(c.get("passed"), bool)]
+        if not isinstance(passed, bool) and judged != "none":
+            # Only the judged set's criteria give the verdict ("judged" absent in older files: all are).
+            flags = [c.get("passed") for c in criteria
+                     if isinstance(c.get("passed"), bool) and c.get("judged", True) is True]
             passed = all(flags) if flags else None
-        step["passed"] = passed
+        step["passed"] = passed if isinstance(passed, bool) else None
         clean.append(step)
     return {
         "scenario": str(obj.get("scenario", "")),
         "description": str(obj.get("description", "")),
+        # The criteria set judged: spec, paper or none (figures only); older files judged their one set.
+        "judged": judged,
         "passed": obj.get("passed") if isinstance(obj.get("passed"), bool) else None,
         "steps": clean,
         # Position-hold figures (analysis.hold), passed through as written; None without one.
@@ -525,8 +532,11 @@ def _criterion_line(c, settling_band_pct=DEFAULT_SETTLING_BAND_PCT):
     else:
         rng = "defined"
     passed = c.get("passed")
-    mark = "✓" if passed is True else ("✗" if passed is False else "?")
-    return f"{mark} {_figure_label(fig, settling_band_pct)} {rng}"
+    if c.get("judged", True) is True:
+        mark = "✓" if passed is True else ("✗" if passed is False else "?")
+    else:  # the other set's band: shown, not judged
+        mark = "·" if passed is True else ("○" if passed is False else "?")
+    return f"{mark} {c.get('set', 'spec')}: {_figure_label(fig, settling_band_pct)} {rng}"
 
 
 def _align_zero(ax_left, ax_right):
@@ -765,9 +775,10 @@ def _figures_text(step, has_metrics):
         lines.extend(src)
     crit = step["criteria"]
     if crit:
-        npass = sum(1 for c in crit if c.get("passed") is True)
+        judged = [c for c in crit if c.get("judged", True) is True]
+        npass = sum(1 for c in judged if c.get("passed") is True)
         lines.append("")
-        lines.append(f"criteria {npass}/{len(crit)} passed")
+        lines.append(f"judged {npass}/{len(judged)} passed" if judged else "not judged (figures only)")
         lines.extend(_criterion_line(c, band)[: lw + 2 * cw] for c in crit)
     return "\n".join(lines)
 

@@ -13,6 +13,9 @@ Reads SWEEP_DIR/summary.json (written by `quadcosim sweep`) and writes
   SWEEP_DIR/scatter_<key>.png  for each varied key, every figure against the
                                key's value, one point per run, passing runs
                                green and failing ones red, the bounds in red;
+  SWEEP_DIR/headline_<key>.png the same for the headline figures only (those
+                               the scenario's criteria bound, see
+                               headline_figures), the plots index.html shows;
   SWEEP_DIR/map_<figure>.png   for a sweep with exactly two grid keys, the mean
   SWEEP_DIR/map_pass.png       of each figure over each grid point's runs as a
                                coloured map, and the passing runs of each point
@@ -36,27 +39,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
+HERE = os.path.dirname(os.path.abspath(__file__))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+
+from sweep_results import (InputError, headline_figures, load, safe, values_of,  # noqa: E402,F401
+                           varied_keys)
+
 DPI = 110
 SAVE = {"dpi": DPI, "metadata": {"Software": None}}  # no version stamp: same data, same bytes
 
 
-class InputError(Exception):
-    pass
 
-
-def load(sweep_dir):
-    path = os.path.join(sweep_dir, "summary.json")
-    try:
-        with open(path, encoding="utf-8") as f:
-            summary = json.load(f)
-    except FileNotFoundError:
-        raise InputError(f"{path}: file not found")
-    except json.JSONDecodeError as e:
-        raise InputError(f"{path}: not JSON ({e})")
-    for key in ("runs", "passed", "figures", "per_run"):
-        if key not in summary:
-            raise InputError(f"{path}: no '{key}'")
-    return summary
 
 
 def bounds_of(sweep_dir, summary, figure):
@@ -81,24 +75,19 @@ def bounds_of(sweep_dir, summary, figure):
     return None, None
 
 
-def values_of(summary, figure):
-    return [r["figures"][figure] for r in summary["per_run"]
-            if r["figures"].get(figure) is not None]
 
 
-def safe(name):
-    return "".join(ch if ch.isalnum() or ch in "._-" else "_" for ch in name)
 
 
-def varied_keys(summary):
-    keys = []
-    for v in summary.get("vary", []):
-        for k in v.get("keys", []):
-            keys.append(k["path"])
-    return keys
 
 
-def scatter(sweep_dir, summary, figures, key, title):
+
+
+
+
+
+
+def scatter(sweep_dir, summary, figures, key, title, prefix="scatter", what="figures"):
     """Every figure against one varied key's value: a point per run, pass green, fail red."""
     n = len(figures)
     if n == 0:
@@ -128,9 +117,9 @@ def scatter(sweep_dir, summary, figures, key, title):
         ax.legend(fontsize=7, loc="best")
     for ax in list(axes.flat)[n:]:
         ax.axis("off")
-    fig.suptitle(f"{title}\nfigures against {key}", fontsize=9)
+    fig.suptitle(f"{title}\n{what} against {key}", fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(sweep_dir, f"scatter_{safe(key)}.png"), **SAVE)
+    fig.savefig(os.path.join(sweep_dir, f"{prefix}_{safe(key)}.png"), **SAVE)
     plt.close(fig)
 
 
@@ -231,13 +220,16 @@ def main(argv):
         fig.savefig(os.path.join(sweep_dir, "box.png"), **SAVE)
         plt.close(fig)
     keys = varied_keys(summary)
+    headline = [f for f in headline_figures(sweep_dir, summary) if f in figures]
     for key in keys:
         scatter(sweep_dir, summary, figures, key, title)
+        scatter(sweep_dir, summary, headline, key, title, prefix="headline", what="the criteria's figures")
     grids = [v for v in summary.get("vary", []) if v.get("distribution") == "grid"]
     maps = 0
     if len(grids) == 2 and figures:
         maps = grid_maps(sweep_dir, summary, figures, grids, title)
-    print(f"wrote {len(figures)} histograms, box.png, {len(keys)} scatter plots and {maps} maps to {sweep_dir}")
+    print(f"wrote {len(figures)} histograms, box.png, {len(keys)} scatter plots (and as many of the headline "
+          f"figures) and {maps} maps to {sweep_dir}")
     return 0
 
 

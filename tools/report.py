@@ -9,17 +9,20 @@ embedded as base64 data URIs, no external URL) with
   - the scenario name, the controller that flew (metrics.json "provenance")
     and the scenario's description (marked as the file's when another
     controller flew than the one it names),
-  - a verdict banner (PASSED / FAILED) and the headline figure: the position
-    tracking RMSE of a tracking run, else the first step's overshoot and
-    settling time,
+  - a verdict banner (PASSED / FAILED against the set judged, or FIGURES
+    ONLY) and the headline figure: the position tracking RMSE of a tracking
+    run, else the first step's overshoot and settling time,
   - the provenance block: controller (with a Python class's module file and
     SHA-256, an FMU's path and SHA-256, the parameter values), transport,
     scenario file and its SHA-256, command line, version and git commit, host,
-  - the headline section first: for a tracking run the tracking figures and
-    their criteria with tracking_path.png, tracking_axes.png and
-    tracking_error.png; for a step run, per analysed step a table of the step
-    figures (our value, the criterion band, ok/FAIL, and the reference value
-    and its source when metrics.json has a "reference") with the step plots,
+  - the headline section first: for a tracking run the tracking figures
+    against their spec and paper bands with tracking_path.png,
+    tracking_axes.png and tracking_error.png; for a step run, per analysed
+    step a table of the step figures (our value, the spec band (the
+    specification) and the paper band (the paper's controller's response),
+    each with its check (ok/FAIL for the judged set, in/out for the other),
+    and the reference value and its source when metrics.json has a
+    "reference") with the step plots,
   - the hold and saturation tables, then overview.png (other PNGs in RUN_DIR
     are not this run's and are left out),
   - the scenario as flown (RUN_DIR/scenario.yaml) in a <pre>,
@@ -99,26 +102,54 @@ def _band(c):
     return "—"
 
 
-def figure_table(w, section, show):
-    """Writes a section's figures (hold, saturation, tracking) as a table against its criteria;
-    show(key, value) gives the value as text with its unit."""
-    crit = {c.get("figure"): c for c in section.get("criteria", []) if isinstance(c, dict)}
-    w("<table>")
-    w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th></tr>")
-    for key, value in (section.get("figures") or {}).items():
-        c = crit.get(key)
-        band = _band(c) if c else "—"
-        status = "" if c is None else ("ok" if c.get("passed") is True else "FAIL")
+SETS = ("spec", "paper")
+SET_HEADERS = "<th>spec</th><th>check</th><th>paper</th><th>check</th>"
+
+
+def _by_set(criteria):
+    """{set: {figure: criterion}}; a criterion written before the sets existed is a spec."""
+    out = {s: {} for s in SETS}
+    for c in criteria:
+        if isinstance(c, dict):
+            out.setdefault(str(c.get("set", "spec")), {}).setdefault(str(c.get("figure", "?")), c)
+    return out
+
+
+def _check(c):
+    """The check of one criterion: ok/FAIL when judged, in/out for a band shown but not judged."""
+    if c is None:
+        return "—", ""
+    p = c.get("passed")
+    if c.get("judged", True) is True:
+        return _band(c), ("ok" if p is True else ("FAIL" if p is False else "?"))
+    return _band(c), ("in" if p is True else ("out" if p is False else "?"))
+
+
+def _set_cells(by_set, key):
+    cells = ""
+    for s in SETS:
+        band, status = _check(by_set.get(s, {}).get(key))
         cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+        cells += f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td>"
+    return cells
+
+
+def figure_table(w, section, show):
+    """Writes a section's figures (hold, saturation, tracking) as a table against its spec and paper
+    bands; show(key, value) gives the value as text with its unit."""
+    by_set = _by_set(section.get("criteria", []))
+    w("<table>")
+    w(f"<tr><th>figure</th><th>ours</th>{SET_HEADERS}</tr>")
+    for key, value in (section.get("figures") or {}).items():
         ours = "—" if not plot_run._is_number(value) else show(key, float(value))
-        w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>"
-          f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td></tr>")
+        w(f"<tr><td>{esc(key)}</td><td class=\"num\">{esc(ours)}</td>{_set_cells(by_set, key)}</tr>")
     w("</table>")
 
 
 def step_rows(step):
-    """Rows (figure key, ours, band, status, reference) of one step's table."""
+    """Rows (figure key, ours, set cells, reference) of one step's table."""
     figs, ref = step["figures"], step["reference"]
+    by_set = _by_set(step["criteria"])
     crit = {}
     for c in step["criteria"]:
         crit.setdefault(str(c.get("figure", "?")), c)
@@ -133,17 +164,12 @@ def step_rows(step):
         c = crit.get(k)
         if value is None and c is not None and plot_run._is_number(c.get("value")):
             value = float(c["value"])
-        if c is None:
-            band, status = "—", ""
-        else:
-            band = _band(c)
-            p = c.get("passed")
-            status = "ok" if p is True else ("FAIL" if p is False else "?")
+        cells = _set_cells(by_set, k)
         reference = plot_run._figure_cell(k, ref[k]) if k in ref else ""
         cell = plot_run._figure_cell(k, value)
         if value is None and k == "settling_time_2pct_s" and step.get("verdict") == "not settled":
             cell = "not settled"
-        rows.append((k, cell, band, status, reference))
+        rows.append((k, cell, cells, reference))
     return rows
 
 
@@ -306,15 +332,13 @@ def step_section(w, metrics):
         if not rows:
             w("<p>No step figures.</p>")
             continue
-        has_ref = any(r[4] for r in rows)
+        has_ref = any(r[3] for r in rows)
         w("<table>")
-        w("<tr><th>figure</th><th>ours</th><th>criterion</th><th>ok/FAIL</th>"
+        w(f"<tr><th>figure</th><th>ours</th>{SET_HEADERS}"
           + ("<th>reference</th>" if has_ref else "") + "</tr>")
-        for key, ours, band, status, reference in rows:
-            cls = ' class="ok"' if status == "ok" else (' class="fail"' if status == "FAIL" else "")
+        for key, ours, cells, reference in rows:
             label = plot_run._figure_label(key, step.get("settling_band_pct", plot_run.DEFAULT_SETTLING_BAND_PCT))
-            w(f"<tr><td>{esc(label)}</td><td class=\"num\">{esc(ours)}</td>"
-              f"<td class=\"num\">{esc(band)}</td><td{cls}>{esc(status)}</td>"
+            w(f"<tr><td>{esc(label)}</td><td class=\"num\">{esc(ours)}</td>{cells}"
               + (f"<td class=\"num\">{esc(reference)}</td>" if has_ref else "") + "</tr>")
         w("</table>")
         notes = [c.get("note") for c in step["criteria"] if isinstance(c.get("note"), str) and c.get("note")]
@@ -326,7 +350,7 @@ def step_section(w, metrics):
 
 def tracking_section(w, tr):
     tp = tr.get("passed")
-    mark = "" if not tr.get("criteria") else (" — ok" if tp else " — FAIL")
+    mark = "" if not tr.get("criteria") or tp is None else (" — ok" if tp else " — FAIL")
     after = tr.get("after_s")
     after = f"{float(after):g}" if plot_run._is_number(after) else "?"
     w(f'<h2 id="tracking">Trajectory tracking from t = {esc(after)} s{esc(mark)}</h2>')
@@ -360,12 +384,22 @@ def build_html(run_dir, metrics, version_text):
               f'one that flew): {esc(metrics["description"])}</p>')
         else:
             w(f'<p class="description">{esc(metrics["description"])}</p>')
-    if verdict is True:
+    judged = metrics.get("judged", "spec")
+    judged_text = {"spec": "against the spec (bounds a good controller must meet)",
+                   "paper": "against the paper bands (the paper's controller's measured response)"}
+    if judged == "none":
+        w('<div class="verdict none" id="verdict">FIGURES ONLY (not judged)</div>')
+    elif verdict is True:
         w('<div class="verdict passed" id="verdict">PASSED</div>')
     elif verdict is False:
         w('<div class="verdict failed" id="verdict">FAILED</div>')
     else:
         w('<div class="verdict none" id="verdict">NO CRITERIA</div>')
+    if judged != "none":
+        w(f'<p class="source" id="judged">judged {esc(judged_text.get(judged, judged))}</p>')
+    w('<p class="source">spec: the scenario\'s specification, bounds a good controller must meet. paper: the '
+      "paper's controller's response, bands around its measured figures (not a specification). The judged "
+      "set's checks read ok/FAIL, the other's in/out.</p>")
     head = headline(metrics)
     if head:
         w(f'<p class="headline" id="headline">{esc(head)}</p>')
@@ -398,7 +432,7 @@ def build_html(run_dir, metrics, version_text):
     sat = metrics.get("saturation")
     if sat:
         sp = sat.get("passed")
-        mark = "" if not sat.get("criteria") else (" — ok" if sp else " — FAIL")
+        mark = "" if not sat.get("criteria") or sp is None else (" — ok" if sp else " — FAIL")
         w(f'<h2 id="saturation">Saturation and control effort{esc(mark)}</h2>')
         figure_table(w, sat, lambda key, v: f"{v:.3f} {'N' if key.endswith('_n') else 's'}")
 

@@ -47,6 +47,9 @@ struct RunOptions {
   /// /quadcosim/plant and /quadcosim/controller ("" = as the ROS_SECURITY_* environment says).
   std::string keystore;
   FoxgloveCliOptions foxglove;
+  /// --judge: the criteria set the run is judged against: spec (the scenario's specification), paper
+  /// (the paper controller's measured bands) or none (figures only; exit 0 whatever they are).
+  std::string judge = "spec";
 };
 int run_command(const RunOptions& options);
 CLI::App* add_run_subcommand(CLI::App& app, RunOptions& options);
@@ -290,23 +293,33 @@ struct SweepOptions {
   int jobs = 2;  ///< threads
   double min_pass_rate = 1.0;
   bool plots = true;
-  std::string sweep_dir;  ///< rerun: the sweep
+  bool progress = true;           ///< runs done, pass rate and time left on stderr while the runs go
+  double progress_every_s = 5.0;  ///< seconds between progress lines when stderr is no terminal (0: each run)
+  std::string sweep_dir;          ///< rerun: the sweep
   int rerun_index = 0;
   std::vector<std::string> shard_dirs;  ///< merge: the shards
+  std::string judge = "spec";           ///< --judge: spec, paper or none (as `run`'s)
 };
 CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
 int sweep_command(const SweepOptions& options);
 
 /// `quadcosim margins [SCENARIO]` (margins_command.cpp, docs/margins.md): gain, phase and delay margins
-/// of each loop about hover. Exit 0 when every loop is stable closed-loop, 1 when one is not (its
-/// margins are undefined), 2 on bad input (file, flag, a vehicle that cannot hover, an LQR design
-/// that fails), 3 when an output cannot be written.
+/// of each loop about hover: analytic for the paper controller, measured in simulation for any
+/// controller (and for the paper's too with --measure). Exit 0 when every loop is stable closed-loop
+/// (measured: every loop stayed in hover), 1 when one is not (its margins are undefined), 2 on bad
+/// input (file, flag, a vehicle that cannot hover, an LQR design that fails), 3 when an output cannot
+/// be written, 5 when the controller's step fails.
 struct MarginsOptions {
-  std::string scenario;  ///< "" for the defaults
-  std::string out_dir;   ///< "" for stdout only
-  bool force = false;    ///< replace a previous command's outputs in out_dir
-  bool json = false;     ///< print JSON instead of the table
-  bool plots = true;     ///< with out_dir: Bode and Nyquist PNGs (tools/plot_margins.py)
+  std::string scenario;        ///< "" for the defaults
+  std::string controller;      ///< --controller: replaces the scenario's controller.type ("" keeps it)
+  std::string out_dir;         ///< "" for stdout only
+  bool force = false;          ///< replace a previous command's outputs in out_dir
+  bool json = false;           ///< print JSON instead of the table
+  bool plots = true;           ///< with out_dir: Bode and Nyquist PNGs (tools/plot_margins.py)
+  bool measure = false;        ///< the paper controller: measure too (other controllers are always measured)
+  double amplitude = 1e-4;     ///< measured: injection, fraction of the hover rotor speed
+  int frequencies = 24;        ///< measured: log-spaced grid frequencies up to Nyquist
+  double min_frequency = 0.1;  ///< measured: lowest grid frequency [rad/s]
 };
 CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& options);
 int margins_command(const MarginsOptions& options);

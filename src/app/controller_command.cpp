@@ -179,7 +179,7 @@ int controller_command(const ControllerCommandOptions& o) {
   dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
   if (!o.apply_schedule) sc.schedule.clear();
   // After the node's own readers, so a plant that counts this process's readers finds the node's first.
-  std::unique_ptr<foxglove::Server> fox = start_foxglove(o.foxglove, "controller", transport, topics);
+  std::unique_ptr<foxglove::Server> fox = start_foxglove(o.foxglove, "controller", transport, topics, sc);
   dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
   announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
   std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s, controller {}\n",

@@ -22,9 +22,10 @@ const std::vector<ExitCodeRow>& exit_code_table() {
   // README.md "Exit codes" shows these rows; tests/cli/exit_codes.py compares the two.
   static const std::vector<ExitCodeRow> table = {
       {kOk, "success", "*"},
-      {kFailed, "a step, hold, limits or tracking criterion failed", "run summary"},
-      {kFailed, "fewer runs passed than --min-pass-rate asks", "sweep"},
-      {kFailed, "a loop is unstable closed-loop (its margins are undefined)", "margins"},
+      {kFailed, "a judged criterion failed (of the set --judge names: spec by default, or paper; never with none)",
+       "run summary"},
+      {kFailed, "fewer runs passed their judged criteria than --min-pass-rate asks", "sweep"},
+      {kFailed, "a loop is unstable closed-loop, or left hover while measured (its margins are undefined)", "margins"},
       {kFailed, "the enclave has problems (listed)", "security"},
       {kFailed, "the node refused the value, or has no such parameter", "param"},
       {kFailed, "no message arrived on the topic", "topic"},
@@ -39,11 +40,11 @@ const std::vector<ExitCodeRow>& exit_code_table() {
       {kControllerFailed,
        "the controller's step failed: it raised, returned garbage, crashed, exited or did not return in time (the "
        "message names the controller, the step and its time)",
-       "run controller"},
+       "run controller margins"},
       {kPlantFailed,
        "the plant's FMU failed: it answered Error, gave a non-finite output, crashed or exited (the message names the "
        "FMU, the call, the tick and its time)",
-       "run plant"},
+       "run plant margins"},
       {kInterrupted, "interrupted (Ctrl-C, SIGTERM); the outputs hold what ran until then", "run plant sweep"},
   };
   return table;

@@ -84,6 +84,11 @@ fs::path find_fmu_library() {
 /// The FMU's configuration from the scenario (or the defaults: the paper's vehicle and controller).
 fmi::FmuConfig config_from(const FmuOptions& o, std::vector<std::string>& notes) {
   io::Scenario sc;
+  if (!o.controller.empty() && io::parse_controller_choice(o.controller).kind != io::ControllerChoice::Kind::kType) {
+    throw io::ConfigError("--controller " + o.controller + ": fmu export packs one of quadcosim's controller types (" +
+                          controllers::controller_type_names() +
+                          "); a class written in Python or an FMU is not packed");
+  }
   if (!o.scenario.empty()) {
     sc = io::load_scenario(o.scenario, o.controller);
   } else if (!o.controller.empty()) {

@@ -67,7 +67,8 @@ std::string parse_listen(const std::string& text, std::string& address, std::uin
 }
 
 std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveCliOptions& o, const std::string& who,
-                                                 sim::Transport& transport, const sim::Topics& topics) {
+                                                 sim::Transport& transport, const sim::Topics& topics,
+                                                 const io::Scenario& sc) {
   if (o.listen.empty()) return nullptr;
   foxglove::ServerOptions so;
   if (std::string err = parse_listen(o.listen, so.address, so.port); !err.empty()) {
@@ -86,6 +87,10 @@ std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveCliOptions& o, co
   so.allowed_origins = o.allow_origins;
   auto server = std::make_unique<foxglove::Server>(so);
   foxglove::serve_vehicle_topics(*server, transport, topics);
+  // As the recorders of run.mcap do (app/inprocess_run.cpp, the plant's --mcap): the vehicle drawn
+  // where its plant publishes its /tf.
+  if (sc.simulation.plant.publish_tf)
+    foxglove::serve_vehicle_description(*server, sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
   server->start();
   const bool v6 = so.address.find(':') != std::string::npos;
   std::cerr << fmt::format("{}: foxglove: serving ws://{}{}{}:{}\n", who, v6 ? "[" : "", so.address, v6 ? "]" : "",

@@ -13,6 +13,10 @@
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
+namespace quadcosim::io {
+struct Scenario;
+}
+
 namespace quadcosim::app {
 
 /// Adds --foxglove, --foxglove-linger and --foxglove-queue-kib to `cmd`; with `inprocess`, also
@@ -23,11 +27,13 @@ void add_foxglove_options(CLI::App& cmd, FoxgloveCliOptions& o, bool inprocess);
 std::string parse_listen(const std::string& text, std::string& address, std::uint16_t& port);
 
 /// The server of `o` for the node `who` (nullptr when --foxglove was not given): the vehicle's topics
-/// as channels, subscribed through `transport`, then listening; prints "WHO: foxglove: serving
-/// ws://ADDR:PORT" on stderr. Throws io::ConfigError for a bad --foxglove, std::runtime_error when it
-/// cannot listen.
+/// as channels, subscribed through `transport`, and, when the plant of `sc` publishes /tf, the
+/// vehicle's robot_description, /tf_static and scene as latched channels (what run.mcap records); then
+/// listening; prints "WHO: foxglove: serving ws://ADDR:PORT" on stderr. Throws io::ConfigError for a
+/// bad --foxglove, std::runtime_error when it cannot listen.
 std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveCliOptions& o, const std::string& who,
-                                                 sim::Transport& transport, const sim::Topics& topics);
+                                                 sim::Transport& transport, const sim::Topics& topics,
+                                                 const io::Scenario& sc);
 
 /// --foxglove-wait: waits up to o.wait_s for a client to subscribe (or Ctrl-C).
 void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& who, foxglove::Server& server);

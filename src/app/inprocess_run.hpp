@@ -34,18 +34,24 @@ bool fly_inprocess(const io::Scenario& scenario, const std::filesystem::path& ou
 
 /// A run's figures and verdicts, judged from its recorded trajectory.csv.
 struct RunJudgement {
+  io::Judge judge = io::Judge::kSpec;  ///< the criteria set judged (--judge)
   std::vector<io::StepResult> steps;
   std::optional<io::HoldResult> hold;
   std::optional<io::SaturationResult> saturation;
   std::optional<io::TrackingResult> tracking;
-  std::string table;  ///< metrics.txt
+  std::string table;         ///< metrics.txt
+  std::string nothing_note;  ///< "no paper bands in this scenario: nothing judged" or "" (io::nothing_judged_note)
+  /// No judged criterion failed: the exit code of `run` is 1 exactly when this is false. True under
+  /// Judge::kNone and when the scenario has none of the judged set (metrics.json's "passed" is then
+  /// null, or true with "judged_criteria": 0).
   bool passed = false;
 };
 
 /// Judges `out`/trajectory.csv (the exact doubles recorded) against the scenario's steps, hold, limits
-/// and tracking, and writes `out`/metrics.json (with `provenance`, the run's io::describe_run record,
+/// and tracking, on the criteria of the set `judge` names (every figure and band is written whatever
+/// the set), and writes `out`/metrics.json (with `provenance`, the run's io::describe_run record,
 /// under "provenance" when it is not null) and `out`/metrics.txt. Throws std::runtime_error on I/O.
 RunJudgement judge_run(const io::Scenario& scenario, const std::filesystem::path& out,
-                       const nlohmann::json& provenance = nullptr);
+                       io::Judge judge = io::Judge::kSpec, const nlohmann::json& provenance = nullptr);
 
 }  // namespace quadcosim::app

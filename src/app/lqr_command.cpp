@@ -21,7 +21,8 @@ std::string complex_str(const std::complex<double>& c) {
 }  // namespace
 
 CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& lqr) {
-  auto* lqr_cmd = app.add_subcommand("lqr", "each attitude axis's A, B, Q, R, gain K and closed-loop poles");
+  auto* lqr_cmd = app.add_subcommand(
+      "lqr", "the paper controller's LQR designs: each attitude axis's A, B, Q, R, gain K and closed-loop poles");
   lqr_cmd->add_option("--params", lqr.params, "controller parameter YAML")->check(CLI::ExistingFile);
   lqr_cmd->add_option("--vehicle", lqr.vehicle, "vehicle YAML")->check(CLI::ExistingFile);
   return lqr_cmd;
@@ -48,10 +49,14 @@ int lqr_command(const LqrOptions& opt) {
       opt.params.empty() ? controllers::make_config("paper", vehicle) : io::load_controller(opt.params, vehicle);
   const controllers::PaperController* paper = controllers::paper_controller(cfg);
   if (!paper) {
-    throw std::invalid_argument(opt.params +
-                                ": `quadcosim lqr` shows the paper controller's LQR designs; this file "
-                                "configures controller type '" +
-                                std::string(cfg.type()) + "'");
+    // Only the paper controller's attitude loops are LQR designs; other controllers have no A, B,
+    // Q, R, K to print.
+    const std::string type(cfg.type());
+    throw std::invalid_argument(fmt::format(
+        "{}: `quadcosim lqr` prints the paper controller's LQR designs, and this file configures controller type "
+        "'{}', which has none; for it use `quadcosim params --controller {}` (its parameters) and "
+        "`quadcosim margins SCENARIO --controller {}` (its loop margins, measured)",
+        opt.params, type, type, type));
   }
   const controllers::PaperController& fc = *paper;
   const char* names[3] = {"roll", "pitch", "yaw"};

@@ -1,7 +1,9 @@
-// `quadcosim margins [SCENARIO] [--out DIR] [--json] [--no-plots]`: gain, phase and delay margins of
-// every loop of the scenario's controller, linearised about level hover, sampled at the controller's
-// rate with the scenario's command delay and sensor latencies (analysis/hover_loops.hpp,
-// docs/margins.md).
+// `quadcosim margins [SCENARIO] [--controller TYPE] [--measure] [--out DIR] [--json] [--no-plots]`: gain,
+// phase and delay margins of every loop of the scenario's controller about level hover. The paper
+// controller's are analytic: linearised, sampled at the controller's rate with the scenario's command
+// delay and sensor latencies (analysis/hover_loops.hpp). Any other controller's (registered, Python,
+// FMU), and the paper's too with --measure, are measured in the closed-loop simulation by injecting
+// sinusoids where the loop is broken (analysis/measured_margins.hpp). docs/margins.md.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
@@ -16,11 +18,13 @@
 
 #include "analysis/hover_loops.hpp"
 #include "analysis/margins.hpp"
+#include "analysis/measured_margins.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "controllers/registry.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
+#include "model/attitude.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::app {
@@ -36,6 +40,10 @@ struct Setup {
   control::ControllerConfig controller;
   analysis::LoopTiming timing;
   std::vector<std::string> notes;  ///< what the linearisation leaves out, said once each
+  /// What the measurement flies: the scenario's simulation with noise, wind, rotor faults and
+  /// message drops left out (delays, latencies and sensor rates kept).
+  analysis::HoverMeasurementSetup measured;
+  std::vector<std::string> measured_notes;
 };
 
 int delay_of(const sim::FaultConfig& f, const std::string& topic) {
@@ -43,24 +51,49 @@ int delay_of(const sim::FaultConfig& f, const std::string& topic) {
   return it == f.topics.end() ? 0 : static_cast<int>(it->second.delay_ticks);
 }
 
+// The scenario's plant and timing for the measurement: its simulation without what is not part of
+// the small-signal loops (each named in a note when the scenario has it).
+sim::SimulationConfig measured_simulation(const sim::SimulationConfig& scenario) {
+  sim::SimulationConfig m = scenario;
+  const sim::RealismConfig& r = scenario.plant.realism;
+  m.plant.realism = sim::RealismConfig{};
+  m.plant.realism.imu.timing = r.imu.timing;
+  m.plant.realism.pose.timing = r.pose.timing;
+  m.plant.realism.velocity.timing = r.velocity.timing;
+  for (auto& [topic, f] : m.faults.topics) f.drop_probability = 0.0;
+  return m;
+}
+
+// Where the measurement trims: the setpoint position, level, heading 0 (translation and heading do
+// not change the loops), lifted to 10 m when the setpoint is within 1 m of the ground (ground contact
+// and ground effect are not part of the loops).
+Eigen::Vector3d trim_position(const control::ControllerConfig& c, std::vector<std::string>& notes) {
+  Eigen::Vector3d p = c.node.setpoint.p_des_W;
+  if (c.trajectory) notes.push_back("the trajectory is not flown: the measurement hovers at the step setpoints");
+  if (p.z() < 1.0) {
+    notes.push_back(fmt::format("z_des {:g} m is within 1 m of the ground: trimmed at 10 m instead", p.z()));
+    p.z() = 10.0;
+  }
+  return p;
+}
+
 // The scenario's controller after its schedule, its plant and its timing. Throws io::ConfigError
 // (bad file) or std::invalid_argument (a refused scheduled change).
-Setup setup_from(const std::string& path) {
+Setup setup_from(const std::string& path, const std::string& controller_type) {
   Setup s;
   if (path.empty()) {
-    s.source = "defaults (the paper's vehicle and controller, plant 100 Hz, controller 50 Hz)";
-    s.controller = controllers::make_config("paper", s.plant);
+    s.controller = controllers::make_config(controller_type.empty() ? "paper" : controller_type, s.plant);
+    s.source = fmt::format("defaults (the paper's vehicle, {} controller, plant 100 Hz, controller 50 Hz)",
+                           s.controller.type());
+    s.measured.vehicle = s.plant;
+    s.measured.controller = s.controller;
+    s.measured.trim_p_W = trim_position(s.controller, s.measured_notes);
     return s;
   }
-  const io::Scenario sc = io::load_scenario(path);
+  const io::Scenario sc = io::load_scenario(path, controller_type);
   s.source = path;
   s.plant = sc.vehicle;
   s.controller = sc.controller;
-  if (!controllers::paper_controller(s.controller)) {
-    throw std::invalid_argument(
-        fmt::format("{}: margins analyses the paper controller's loops; this scenario flies controller type '{}'", path,
-                    s.controller.type()));
-  }
   bool later_design_change = false;
   std::vector<sim::ScheduledParameter> schedule = sc.schedule;
   std::stable_sort(schedule.begin(), schedule.end(), [](const auto& a, const auto& b) { return a.tick < b.tick; });
@@ -112,6 +145,21 @@ Setup setup_from(const std::string& path) {
         fmt::format("sensor latency {:g} s exceeds stale_limit {:g} s: the controller would command "
                     "its safety mode, which these loops do not model",
                     worst_age_s, s.controller.node.stale_limit_s));
+
+  s.measured.simulation = measured_simulation(sim);
+  s.measured.vehicle = s.plant;
+  s.measured.controller = s.controller;
+  s.measured.trim_p_W = trim_position(s.controller, s.measured_notes);
+  // Left out of the measurement: what would swamp or bias a small sinusoid.
+  if (noise) s.measured_notes.push_back("sensor noise and bias are left out of the measurement");
+  if (r.wind.active()) s.measured_notes.push_back("wind is left out of the measurement (still air)");
+  if (!r.faults.empty()) s.measured_notes.push_back("rotor faults are left out of the measurement");
+  for (const auto& [topic, f] : sim.faults.topics) {
+    if (f.drop_probability > 0.0)
+      s.measured_notes.push_back("message drops are left out of the measurement (" + topic + ")");
+  }
+  if (later_design_change) s.measured_notes.push_back(s.notes.front());
+  if (worst_age_s > s.controller.node.stale_limit_s) s.measured_notes.push_back(s.notes.back());
   return s;
 }
 
@@ -156,6 +204,144 @@ bool write_file(const std::filesystem::path& p, const std::string& text) {
   }
   return true;
 }
+// The measured margins of every hover loop: the table's rows, the JSON, the response CSV rows.
+struct MeasuredReport {
+  nlohmann::json doc;
+  std::string table;
+  std::string csv;  ///< measured_response.csv without its header
+  bool all_in_hover = true;
+};
+
+nlohmann::json measured_margin_json(const analysis::Margin& m, const char* unit, double scale) {
+  nlohmann::json j = margin_json(m, unit, scale);
+  if (m.status == MarginStatus::kInfinite) j["status"] = "none_in_band";  // no crossing measured
+  return j;
+}
+
+std::string measured_cell(const analysis::Margin& m, double scale, int precision = 2) {
+  return cell(m, scale, "none", precision);
+}
+
+MeasuredReport measure_all(const Setup& s, const MarginsOptions& o) {
+  const analysis::HoverMeasurementSetup& ms = s.measured;
+  const double T = ms.simulation.plant.clock.period_s() * ms.simulation.controller_divider;
+  analysis::MeasurementOptions mo;
+  mo.amplitude = o.amplitude;
+  mo.points = o.frequencies;
+  mo.omega_min_rad_s = o.min_frequency;
+  MeasuredReport r;
+  nlohmann::json& doc = r.doc;
+  doc["method"] =
+      "closed-loop simulation, sinusoid injected where the loop is broken, L identified over whole periods "
+      "of the steady state";
+  doc["controller"] = std::string(ms.controller.type());
+  doc["mode"] = control::to_string(ms.controller.node.setpoint.mode);
+  doc["trim_position_m"] = {ms.trim_p_W.x(), ms.trim_p_W.y(), ms.trim_p_W.z()};
+  doc["broken_at"] = "the wrench U = M omega^2 the rotor command asks for, one component at a time";
+  doc["amplitude_of_hover_rotor_speed"] = mo.amplitude;
+  doc["frequencies"] = {{"grid_points", mo.points},
+                        {"min_rad_s", mo.omega_min_rad_s},
+                        {"max_rad_s", std::numbers::pi / T},
+                        {"refinements_per_crossover", mo.refinements}};
+  doc["steady_state"] = {{"settle_s", mo.settle_s},
+                         {"window_min_s", mo.window_min_s},
+                         {"tolerance", mo.tolerance},
+                         {"max_s_per_frequency", mo.max_s}};
+  doc["controller_period_s"] = T;
+  doc["command_delay_ticks"] = ms.simulation.plant.command_delay_ticks;
+  std::vector<std::string> notes = s.measured_notes;
+  doc["loops"] = nlohmann::json::array();
+
+  r.table += fmt::format("measured margins of {} (controller {})\n", s.source, ms.controller.type());
+  r.table += fmt::format(
+      "closed-loop simulation trimmed in hover at ({:g}, {:g}, {:g}) m ({} mode); loop broken at the wrench the "
+      "rotor command asks for; sinusoids of {:g} x hover rotor speed at {} frequencies {:g}..{:.4g} rad/s "
+      "(Nyquist), crossovers refined by bisection\n",
+      ms.trim_p_W.x(), ms.trim_p_W.y(), ms.trim_p_W.z(), control::to_string(ms.controller.node.setpoint.mode),
+      mo.amplitude, mo.points, mo.omega_min_rad_s, std::numbers::pi / T);
+  r.table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>6} {}\n", "loop", "broken at",
+                         "GM [dB]", "w_pc", "GMlo[dB]", "PM [deg]", "w_gc", "DM [s]", "DM [smp]", "freqs", "status");
+  for (const analysis::HoverAxis axis : {analysis::HoverAxis::kRoll, analysis::HoverAxis::kPitch,
+                                         analysis::HoverAxis::kYaw, analysis::HoverAxis::kAltitude}) {
+    const analysis::MeasuredLoop m = analysis::measure_loop(ms, axis, mo);
+    const std::string name = analysis::to_string(axis);
+    double simulated_s = 0.0;
+    for (const auto& p : m.points) simulated_s += p.simulated_s;
+    std::cerr << fmt::format("margins: measured {} at {} frequencies ({:.0f} s simulated)\n", name, m.points.size(),
+                             simulated_s);
+    r.all_in_hover = r.all_in_hover && m.problem.empty();
+    nlohmann::json j;
+    j["name"] = name;
+    j["broken_at"] = analysis::broken_at(axis);
+    j["amplitude"] = m.amplitude;
+    j["stayed_in_hover"] = m.problem.empty();
+    j["problem"] = m.problem.empty() ? nlohmann::json(nullptr) : nlohmann::json(m.problem);
+    nlohmann::json gm = measured_margin_json(m.gain_margin, "factor", 1.0);
+    gm["db"] = m.gain_margin.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(m.gain_margin.value))
+                                                             : nlohmann::json(nullptr);
+    j["gain_margin"] = gm;
+    nlohmann::json gr = measured_margin_json(m.gain_reduction_margin, "factor", 1.0);
+    gr["db"] = m.gain_reduction_margin.status == MarginStatus::kFinite
+                   ? nlohmann::json(20 * std::log10(m.gain_reduction_margin.value))
+                   : nlohmann::json(nullptr);
+    j["gain_reduction_margin"] = gr;
+    j["phase_margin"] = measured_margin_json(m.phase_margin, "deg", kDeg);
+    nlohmann::json dm = measured_margin_json(m.delay_margin, "s", 1.0);
+    dm["samples"] = m.delay_margin.status == MarginStatus::kFinite ? nlohmann::json(m.delay_margin.value / T)
+                                                                   : nlohmann::json(nullptr);
+    j["delay_margin"] = dm;
+    j["gain_crossovers_rad_s"] = m.gain_crossovers_rad_s;
+    j["phase_crossovers_rad_s"] = m.phase_crossovers_rad_s;
+    j["unconverged_points"] = m.unconverged_points;
+    nlohmann::json pts = nlohmann::json::array();
+    double max_tilt = 0.0, max_rotor = 0.0;
+    double unwrapped = 0.0, last_arg = 0.0;
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+      const analysis::MeasuredPoint& p = m.points[i];
+      max_tilt = std::max(max_tilt, p.max_tilt_rad);
+      max_rotor = std::max(max_rotor, p.max_rotor_deviation);
+      const double arg = std::arg(p.L);
+      unwrapped = i == 0 ? arg - 2 * std::numbers::pi * std::ceil(arg / (2 * std::numbers::pi))
+                         : unwrapped + std::remainder(arg - last_arg, 2 * std::numbers::pi);
+      last_arg = arg;
+      const double mag_db = 20 * std::log10(std::abs(p.L));
+      pts.push_back({{"omega_rad_s", p.omega_rad_s},
+                     {"re", p.L.real()},
+                     {"im", p.L.imag()},
+                     {"magnitude_db", mag_db},
+                     {"phase_deg", unwrapped * kDeg},
+                     {"windows", p.windows},
+                     {"periods_per_window", p.periods_per_window},
+                     {"converged", p.converged}});
+      r.csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", name, p.omega_rad_s, p.L.real(), p.L.imag(),
+                           mag_db, unwrapped * kDeg, p.converged ? 1 : 0);
+    }
+    j["max_tilt_rad"] = max_tilt;
+    j["max_rotor_speed_deviation"] = max_rotor;
+    j["points"] = pts;
+    doc["loops"].push_back(j);
+    if (m.unconverged_points > 0)
+      notes.push_back(
+          fmt::format("{}: {} frequencies did not reach steady state within {:g} s (their last window is used)", name,
+                      m.unconverged_points, mo.max_s));
+
+    analysis::Margin dms = m.delay_margin;
+    if (dms.status == MarginStatus::kFinite) dms.value /= T;
+    const std::string status = m.problem.empty() ? "in hover" : "LEFT HOVER: margins undefined";
+    r.table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>6} {}\n", name,
+                           analysis::broken_at(axis), measured_cell(gain_db(m.gain_margin), 1.0),
+                           freq_cell(m.gain_margin), measured_cell(gain_db(m.gain_reduction_margin), 1.0),
+                           measured_cell(m.phase_margin, kDeg, 1), freq_cell(m.phase_margin),
+                           measured_cell(m.delay_margin, 1.0, 3), measured_cell(dms, 1.0, 1), m.points.size(), status);
+    if (!m.problem.empty()) notes.push_back(name + ": " + m.problem);
+  }
+  r.table +=
+      "none: no crossing in the measured band; the measurement is small-signal: saturation and other "
+      "nonlinearities at larger amplitudes are not in it\n";
+  for (const std::string& n : notes) r.table += "note: " + n + '\n';
+  doc["notes"] = notes;
+  return r;
+}
 
 }  // namespace
 
@@ -164,8 +350,23 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
       app.add_subcommand("margins", "gain, phase and delay margins of each control loop about hover (docs/margins.md)");
   cmd->add_option("scenario", o.scenario, "scenario YAML (default: the paper's vehicle and controller)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", o.out_dir,
-                  "write margins.json, frequency_response.csv and Bode/Nyquist PNGs here: a new or empty folder");
+  cmd->add_option("--controller", o.controller,
+                  "the controller type to analyse, replacing the scenario's controller.type (`quadcosim params "
+                  "--list`); any but the paper's is measured")
+      ->check(CLI::IsMember(controllers::controller_type_list()));
+  cmd->add_flag("--measure", o.measure,
+                "the paper controller: measure its margins in simulation too, beside the analytic ones (other "
+                "controllers are always measured)");
+  cmd->add_option("--amplitude", o.amplitude, "measured: injected sinusoid, as a fraction of the hover rotor speed")
+      ->check(CLI::Range(1e-7, 0.1));
+  cmd->add_option("--frequencies", o.frequencies, "measured: log-spaced frequencies up to the Nyquist frequency")
+      ->check(CLI::Range(4, 400));
+  cmd->add_option("--min-frequency", o.min_frequency, "measured: the lowest frequency [rad/s]")
+      ->check(CLI::Range(1e-3, 1e4));
+  cmd->add_option(
+      "--out", o.out_dir,
+      "write margins.json, margins.txt, the analytic and/or measured response CSV and Bode/Nyquist PNGs here: a "
+      "new or empty folder");
   cmd->add_flag("--force", o.force,
                 "--out holds a previous command's outputs or other files: remove exactly the outputs its manifest "
                 "lists first (files quadcosim did not write are kept)");
@@ -187,16 +388,28 @@ int margins_command(const MarginsOptions& o) {
   // hover: bad input (run_guarded).
   Setup s;
   std::vector<analysis::HoverLoop> loops;
+  bool analytic = false, measured = false;
   try {
-    s = setup_from(o.scenario);
-    s.notes.push_back(
-        "the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
-        "in them");
-    loops = analysis::hover_loops(s.plant, *controllers::paper_controller(s.controller),
-                                  s.controller.node.setpoint.mode, s.timing);
+    s = setup_from(o.scenario, o.controller);
+    const controllers::PaperController* paper = controllers::paper_controller(s.controller);
+    analytic = paper != nullptr;
+    measured = !analytic || o.measure;
+    if (std::string why = analysis::hover_trim_problem(s.plant); !why.empty()) throw std::invalid_argument(why);
+    if (analytic) {
+      s.notes.push_back(
+          "the loops are linearised: the rotor clamp, the tilt limit and the integral bound are not "
+          "in them");
+      loops = analysis::hover_loops(s.plant, *paper, s.controller.node.setpoint.mode, s.timing);
+    }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(
         fmt::format("{}cannot linearise about hover: {}", o.scenario.empty() ? "" : o.scenario + ": ", e.what()));
+  }
+  if (!measured && (o.amplitude != MarginsOptions{}.amplitude || o.frequencies != MarginsOptions{}.frequencies ||
+                    o.min_frequency != MarginsOptions{}.min_frequency)) {
+    std::cerr << "error: --amplitude, --frequencies and --min-frequency set the measurement; the paper controller's "
+                 "margins are analytic unless --measure\n";
+    return exit_code::kBadInput;
   }
   std::optional<io::OutputFolder> folder;
   if (!o.out_dir.empty()) folder.emplace(io::OutputFolder::claim(o.out_dir, "margins", {.force = o.force}, std::cerr));
@@ -208,85 +421,100 @@ int margins_command(const MarginsOptions& o) {
 
   nlohmann::json doc;
   doc["scenario"] = s.source;
-  doc["linearised_about"] = "level hover, still air";
+  doc["controller"] = std::string(s.controller.type());
+  if (analytic) doc["linearised_about"] = "level hover, still air";
   doc["mode"] = control::to_string(s.controller.node.setpoint.mode);
   doc["plant_period_s"] = t.tick_s;
   doc["controller_period_s"] = T;
   doc["command_delay_ticks"] = t.command_delay_ticks;
   doc["latency_ticks"] = {
       {"imu", t.imu_latency_ticks}, {"pose", t.pose_latency_ticks}, {"velocity", t.velocity_latency_ticks}};
-  doc["notes"] = s.notes;
-  doc["loops"] = nlohmann::json::array();
   bool all_stable = true;
-  for (std::size_t i = 0; i < loops.size(); ++i) {
-    const analysis::LoopMargins& m = results[i];
-    all_stable = all_stable && m.closed_loop_stable;
-    nlohmann::json j;
-    j["name"] = loops[i].name;
-    j["broken_at"] = loops[i].broken_at;
-    j["closed_loop_stable"] = m.closed_loop_stable;
-    j["open_loop_unstable_poles"] = m.open_loop_unstable_poles;
-    j["open_loop_marginal_poles"] = m.open_loop_marginal_poles;
-    nlohmann::json gm = margin_json(m.gain_margin, "factor", 1.0);
-    gm["db"] = m.gain_margin.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(m.gain_margin.value))
-                                                             : nlohmann::json(nullptr);
-    j["gain_margin"] = gm;
-    nlohmann::json gr = margin_json(m.gain_reduction_margin, "factor", 1.0);
-    gr["db"] = m.gain_reduction_margin.status == MarginStatus::kFinite
-                   ? nlohmann::json(20 * std::log10(m.gain_reduction_margin.value))
-                   : nlohmann::json(nullptr);
-    j["gain_reduction_margin"] = gr;
-    j["phase_margin"] = margin_json(m.phase_margin, "deg", kDeg);
-    nlohmann::json dm = margin_json(m.delay_margin, "s", 1.0);
-    dm["samples"] = m.delay_margin.status == MarginStatus::kFinite ? nlohmann::json(m.delay_margin.value / T)
-                                                                   : nlohmann::json(nullptr);
-    j["delay_margin"] = dm;
-    j["gain_crossovers_rad_s"] = m.gain_crossovers_rad_s;
-    j["phase_crossovers_rad_s"] = m.phase_crossovers_rad_s;
-    nlohmann::json ranges = nlohmann::json::array();
-    for (const auto& [lo, hi] : m.stable_gain_ranges)
-      ranges.push_back({lo, std::isinf(hi) ? nlohmann::json(nullptr) : nlohmann::json(hi)});
-    j["stable_gain_ranges"] = ranges;
-    // Poles at z = 0 are the delay lines' and the hold's: listed in z, left out in s.
-    nlohmann::json pz = nlohmann::json::array(), ps = nlohmann::json::array();
-    for (Eigen::Index k = 0; k < m.closed_loop_poles.size(); ++k) {
-      const std::complex<double> z = m.closed_loop_poles(k);
-      pz.push_back({z.real(), z.imag()});
-      if (std::abs(z) > 1e-9) {
-        const std::complex<double> sp = std::log(z) / T;
-        ps.push_back({sp.real(), sp.imag()});
+  std::string table;
+  if (analytic) {
+    doc["notes"] = s.notes;
+    doc["loops"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      const analysis::LoopMargins& m = results[i];
+      all_stable = all_stable && m.closed_loop_stable;
+      nlohmann::json j;
+      j["name"] = loops[i].name;
+      j["broken_at"] = loops[i].broken_at;
+      j["closed_loop_stable"] = m.closed_loop_stable;
+      j["open_loop_unstable_poles"] = m.open_loop_unstable_poles;
+      j["open_loop_marginal_poles"] = m.open_loop_marginal_poles;
+      nlohmann::json gm = margin_json(m.gain_margin, "factor", 1.0);
+      gm["db"] = m.gain_margin.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(m.gain_margin.value))
+                                                               : nlohmann::json(nullptr);
+      j["gain_margin"] = gm;
+      nlohmann::json gr = margin_json(m.gain_reduction_margin, "factor", 1.0);
+      gr["db"] = m.gain_reduction_margin.status == MarginStatus::kFinite
+                     ? nlohmann::json(20 * std::log10(m.gain_reduction_margin.value))
+                     : nlohmann::json(nullptr);
+      j["gain_reduction_margin"] = gr;
+      j["phase_margin"] = margin_json(m.phase_margin, "deg", kDeg);
+      nlohmann::json dm = margin_json(m.delay_margin, "s", 1.0);
+      dm["samples"] = m.delay_margin.status == MarginStatus::kFinite ? nlohmann::json(m.delay_margin.value / T)
+                                                                     : nlohmann::json(nullptr);
+      j["delay_margin"] = dm;
+      j["gain_crossovers_rad_s"] = m.gain_crossovers_rad_s;
+      j["phase_crossovers_rad_s"] = m.phase_crossovers_rad_s;
+      nlohmann::json ranges = nlohmann::json::array();
+      for (const auto& [lo, hi] : m.stable_gain_ranges)
+        ranges.push_back({lo, std::isinf(hi) ? nlohmann::json(nullptr) : nlohmann::json(hi)});
+      j["stable_gain_ranges"] = ranges;
+      // Poles at z = 0 are the delay lines' and the hold's: listed in z, left out in s.
+      nlohmann::json pz = nlohmann::json::array(), ps = nlohmann::json::array();
+      for (Eigen::Index k = 0; k < m.closed_loop_poles.size(); ++k) {
+        const std::complex<double> z = m.closed_loop_poles(k);
+        pz.push_back({z.real(), z.imag()});
+        if (std::abs(z) > 1e-9) {
+          const std::complex<double> sp = std::log(z) / T;
+          ps.push_back({sp.real(), sp.imag()});
+        }
       }
+      j["closed_loop_poles_z"] = pz;
+      j["closed_loop_poles_s"] = ps;
+      doc["loops"].push_back(j);
     }
-    j["closed_loop_poles_z"] = pz;
-    j["closed_loop_poles_s"] = ps;
-    doc["loops"].push_back(j);
+
+    table += fmt::format("margins of {}\n", s.source);
+    table += fmt::format(
+        "linearised about level hover ({} mode); controller {:g} Hz (T = {:g} s, zero-order hold), "
+        "plant {:g} Hz; command delay {} ticks; sensor latency imu {}, pose {}, velocity {} ticks\n",
+        control::to_string(s.controller.node.setpoint.mode), 1.0 / T, T, 1.0 / t.tick_s, t.command_delay_ticks,
+        t.imu_latency_ticks, t.pose_latency_ticks, t.velocity_latency_ticks);
+    table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", "loop", "broken at", "GM [dB]",
+                         "w_pc", "GMlo[dB]", "PM [deg]", "w_gc", "DM [s]", "DM [smp]", "closed loop");
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      const analysis::LoopMargins& m = results[i];
+      std::string status = m.closed_loop_stable ? "stable" : "UNSTABLE: margins undefined";
+      if (m.open_loop_unstable_poles > 0)
+        status += fmt::format(" (open loop unstable: {} pole{})", m.open_loop_unstable_poles,
+                              m.open_loop_unstable_poles == 1 ? "" : "s");
+      analysis::Margin dms = m.delay_margin;
+      if (dms.status == MarginStatus::kFinite) dms.value /= T;
+      table +=
+          fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", loops[i].name, loops[i].broken_at,
+                      cell(gain_db(m.gain_margin), 1.0, "inf"), freq_cell(m.gain_margin),
+                      cell(gain_db(m.gain_reduction_margin), 1.0, "-inf"), cell(m.phase_margin, kDeg, "inf", 1),
+                      freq_cell(m.phase_margin), cell(m.delay_margin, 1.0, "inf", 3), cell(dms, 1.0, "inf", 1), status);
+    }
+    table +=
+        "w_pc, w_gc [rad/s]: phase and gain crossover; GMlo: gain reduction margin (-inf: the gain may drop to 0)\n";
+    for (const std::string& n : s.notes) table += "note: " + n + '\n';
   }
 
-  std::string table;
-  table += fmt::format("margins of {}\n", s.source);
-  table += fmt::format(
-      "linearised about level hover ({} mode); controller {:g} Hz (T = {:g} s, zero-order hold), "
-      "plant {:g} Hz; command delay {} ticks; sensor latency imu {}, pose {}, velocity {} ticks\n",
-      control::to_string(s.controller.node.setpoint.mode), 1.0 / T, T, 1.0 / t.tick_s, t.command_delay_ticks,
-      t.imu_latency_ticks, t.pose_latency_ticks, t.velocity_latency_ticks);
-  table += fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", "loop", "broken at", "GM [dB]",
-                       "w_pc", "GMlo[dB]", "PM [deg]", "w_gc", "DM [s]", "DM [smp]", "closed loop");
-  for (std::size_t i = 0; i < loops.size(); ++i) {
-    const analysis::LoopMargins& m = results[i];
-    std::string status = m.closed_loop_stable ? "stable" : "UNSTABLE: margins undefined";
-    if (m.open_loop_unstable_poles > 0)
-      status += fmt::format(" (open loop unstable: {} pole{})", m.open_loop_unstable_poles,
-                            m.open_loop_unstable_poles == 1 ? "" : "s");
-    analysis::Margin dms = m.delay_margin;
-    if (dms.status == MarginStatus::kFinite) dms.value /= T;
-    table +=
-        fmt::format("{:<11} {:<30} {:>8} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {}\n", loops[i].name, loops[i].broken_at,
-                    cell(gain_db(m.gain_margin), 1.0, "inf"), freq_cell(m.gain_margin),
-                    cell(gain_db(m.gain_reduction_margin), 1.0, "-inf"), cell(m.phase_margin, kDeg, "inf", 1),
-                    freq_cell(m.phase_margin), cell(m.delay_margin, 1.0, "inf", 3), cell(dms, 1.0, "inf", 1), status);
+  std::string measured_csv;
+  if (measured) {
+    MeasuredReport r = measure_all(s, o);
+    all_stable = all_stable && r.all_in_hover;
+    if (analytic) table += '\n';
+    table += r.table;
+    if (!analytic) table += "w_pc, w_gc [rad/s]: phase and gain crossover; GMlo: gain reduction margin\n";
+    doc["measured"] = r.doc;
+    measured_csv = r.csv;
   }
-  table += "w_pc, w_gc [rad/s]: phase and gain crossover; GMlo: gain reduction margin (-inf: the gain may drop to 0)\n";
-  for (const std::string& n : s.notes) table += "note: " + n + '\n';
 
   if (o.json)
     std::cout << doc.dump(2) << '\n';
@@ -295,18 +523,23 @@ int margins_command(const MarginsOptions& o) {
 
   if (folder) {
     const std::filesystem::path out(o.out_dir);
-    std::string csv = "loop,omega_rad_s,re,im,magnitude_db,phase_deg\n";
-    analysis::MarginOptions grid;
-    grid.points = 1500;
-    for (const auto& l : loops) {
-      for (const analysis::FrequencyPoint& p : analysis::frequency_response(l.loop, grid)) {
-        if (!std::isfinite(p.L.real()) || !std::isfinite(p.L.imag())) continue;
-        csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", l.name, p.omega_rad_s, p.L.real(), p.L.imag(),
-                           p.magnitude_db, p.phase_deg);
+    if (analytic) {
+      std::string csv = "loop,omega_rad_s,re,im,magnitude_db,phase_deg\n";
+      analysis::MarginOptions grid;
+      grid.points = 1500;
+      for (const auto& l : loops) {
+        for (const analysis::FrequencyPoint& p : analysis::frequency_response(l.loop, grid)) {
+          if (!std::isfinite(p.L.real()) || !std::isfinite(p.L.imag())) continue;
+          csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", l.name, p.omega_rad_s, p.L.real(), p.L.imag(),
+                             p.magnitude_db, p.phase_deg);
+        }
       }
+      if (!write_file(out / "frequency_response.csv", csv)) return exit_code::kOutput;
     }
-    if (!write_file(out / "margins.json", doc.dump(2) + "\n") || !write_file(out / "margins.txt", table) ||
-        !write_file(out / "frequency_response.csv", csv))
+    if (measured && !write_file(out / "measured_response.csv",
+                                "loop,omega_rad_s,re,im,magnitude_db,phase_deg,converged\n" + measured_csv))
+      return exit_code::kOutput;
+    if (!write_file(out / "margins.json", doc.dump(2) + "\n") || !write_file(out / "margins.txt", table))
       return exit_code::kOutput;
     if (o.plots && !run_tool("plot_margins.py", {o.out_dir})) return exit_code::kOutput;
     folder->record("outputs");

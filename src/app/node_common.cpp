@@ -1,5 +1,7 @@
 #include "app/node_common.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -38,7 +40,16 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
     sc = io::load_scenario(scenario, controller_type);
   } else {
     sc.name = "defaults";
-    if (!controller_type.empty()) sc.controller = controllers::make_config(controller_type, sc.vehicle);
+    if (!controller_type.empty()) {
+      if (io::parse_controller_choice(controller_type).kind == io::ControllerChoice::Kind::kType) {
+        sc.controller = controllers::make_config(controller_type, sc.vehicle);
+      } else {  // a Python class or an FMU, made as a scenario's controller section makes it
+        YAML::Node root(YAML::NodeType::Map);
+        io::set_controller_type(root, controller_type);
+        sc = io::load_scenario(root, "--controller");
+        sc.name = "defaults";
+      }
+    }
   }
   if (!vehicle.empty()) {
     sc.vehicle = io::load_vehicle(vehicle);
@@ -59,8 +70,25 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
 
 void add_controller_type_option(CLI::App& cmd, std::string& type) {
   cmd.add_option("--controller", type,
-                 "the controller type to fly, replacing the scenario's controller.type (`quadcosim params --list`)")
-      ->check(CLI::IsMember(controllers::controller_type_list()));
+                 "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
+                 "python:MODULE:CLASS or fmu:PATH; the scenario's setpoints, reference and criteria stay")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            try {
+              (void)io::parse_controller_choice(value);
+              return "";
+            } catch (const std::invalid_argument& e) {
+              return e.what();
+            }
+          },
+          "TYPE|python:MODULE:CLASS|fmu:PATH"));
+}
+
+void add_judge_option(CLI::App& cmd, std::string& judge) {
+  cmd.add_option("--judge", judge,
+                 "judge the run against: spec (the scenario's specification, default), paper (the paper "
+                 "controller's measured response bands), none (figures only, no verdict)")
+      ->check(CLI::IsMember(io::judge_names()));
 }
 
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {

@@ -42,6 +42,10 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
 /// Adds `--controller TYPE` (a registered controller type, checked) to `cmd`.
 void add_controller_type_option(CLI::App& cmd, std::string& type);
 
+/// `--judge spec|paper|none` (run, sweep): the criteria set a run is judged against (io::Judge); any
+/// other value is refused (exit 2) with the choices.
+void add_judge_option(CLI::App& cmd, std::string& judge);
+
 /// Real-time loops: lets the DDS transport deliver messages until 1 ms before `deadline_ns`
 /// (steady_ns), then spins on the clock until the deadline (5 % of a core for a 20 ms period), so
 /// the wake-up lands on the deadline instead of a scheduler wake-up later. The first call also asks

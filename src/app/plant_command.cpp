@@ -82,7 +82,7 @@ class PlantProcess {
       mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
       if (sc_.simulation.plant.publish_tf) mcap_->record_vehicle(sc_.vehicle, sc_.simulation.ns, clock_.ns(0));
     }
-    foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_);
+    foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_, sc_);
     if (!o_.one_vehicle.schedule_node.empty()) {
       scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));

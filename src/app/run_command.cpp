@@ -133,6 +133,28 @@ nlohmann::json run_provenance(const RunOptions& opt, const io::Scenario& flown) 
                                   .python_target = io::python_target_of(root)});
 }
 
+// "run: FAILED against spec: z overshoot_pct 30.2 outside [-, 25]; ...": the judged criteria that failed,
+// each named by its block and figure, so the exit code 1 comes with its reason on one line.
+std::string failed_criteria_line(const RunJudgement& j) {
+  std::vector<std::string> failed;
+  const auto add = [&](const std::string& block, const std::vector<io::CriterionResult>& criteria) {
+    for (const auto& c : criteria) {
+      if (!c.judged || c.passed) continue;
+      const auto bound = [](const std::optional<double>& b) { return b ? fmt::format("{:g}", *b) : "-"; };
+      failed.push_back(fmt::format("{} {} {} outside the {} band [{}, {}]", block, c.criterion.figure,
+                                   c.value ? fmt::format("{:.4g}", *c.value) : "(none)", io::to_string(c.criterion.set),
+                                   bound(c.criterion.min), bound(c.criterion.max)));
+    }
+  };
+  for (const auto& s : j.steps) add("step " + s.spec.channel, s.criteria);
+  if (j.hold) add("hold", j.hold->criteria);
+  if (j.saturation) add("limits", j.saturation->criteria);
+  if (j.tracking) add("tracking", j.tracking->criteria);
+  std::string line = fmt::format("run: FAILED against {}:", io::to_string(j.judge));
+  for (std::size_t i = 0; i < failed.size(); ++i) line += (i == 0 ? " " : "; ") + failed[i];
+  return line + "\n";
+}
+
 }  // namespace
 
 CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
@@ -144,6 +166,7 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
                     "manifest lists first (files quadcosim did not write are kept)");
   run_cmd->add_flag("!--no-plots", run.plots, "skip the PNG plots and report.html");
   add_controller_type_option(*run_cmd, run.controller);
+  add_judge_option(*run_cmd, run.judge);
   run_cmd
       ->add_option("--transport", run.transport,
                    "inproc: one process; dds: plant and controller as two processes over DDS, lockstep")
@@ -228,7 +251,7 @@ int run_command(const RunOptions& opt) {
       std::unique_ptr<foxglove::Server> fox;
       std::chrono::steady_clock::time_point paced_from;
       const auto attach = [&](sim::Transport& transport, const sim::Topics& topics) {
-        fox = start_foxglove(opt.foxglove, "run", transport, topics);
+        fox = start_foxglove(opt.foxglove, "run", transport, topics, sc);
         if (fox) wait_for_foxglove_client(opt.foxglove, "run", *fox);
         paced_from = std::chrono::steady_clock::now();
       };
@@ -253,8 +276,8 @@ int run_command(const RunOptions& opt) {
     }
 
     // Both transports are judged from what was recorded: the exact doubles of trajectory.csv.
-    const RunJudgement judged = judge_run(sc, out, provenance);
-    std::cout << judged.table;
+    const RunJudgement judged = judge_run(sc, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec), provenance);
+    std::cout << judged.table;  // says what was judged, and once when the scenario has none of that set
     if (judged.saturation) {
       if (const std::string w = io::saturation_warning(*judged.saturation); !w.empty()) {
         std::cerr << "run: " << w << '\n';
@@ -263,6 +286,7 @@ int run_command(const RunOptions& opt) {
     std::cout << "wrote " << (out / "trajectory.csv").string()
               << ", run.mcap, metadata.yaml, metrics.json, metrics.txt\n";
     if (opt.plots && !make_plots(opt.out_dir, folder)) return exit_code::kOutput;
+    if (!judged.passed) std::cout << failed_criteria_line(judged);
     return judged.passed ? exit_code::kOk : exit_code::kFailed;
   } catch (const control::CareError& e) {
     throw io::ConfigError(opt.scenario + ": controller design failed: " + e.what());

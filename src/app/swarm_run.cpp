@@ -45,16 +45,16 @@ namespace {
 // `run` judges a single vehicle: writes its metrics.json and metrics.txt, warns when it saturated. Returns
 // one entry per vehicle for summary.json: vehicle, namespace, passed, saturation figures.
 nlohmann::json judge_recorded(const fs::path& out, const io::Scenario& sc, const std::vector<int>& vehicles,
-                              const std::vector<std::string>& dirs, const nlohmann::json& provenance) {
+                              const std::vector<std::string>& dirs, io::Judge judge, const nlohmann::json& provenance) {
   nlohmann::json entries = nlohmann::json::array();
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     const fs::path dir = out / dirs[i];
     const io::Series series = io::read_series((dir / "trajectory.csv").string());
-    const auto results = io::evaluate_steps(sc.steps, series);
-    const auto saturation = io::evaluate_saturation(sc, series);
-    const nlohmann::json metrics = io::metrics_json(sc, results, {}, saturation);
+    const auto results = io::evaluate_steps(sc.steps, series, judge);
+    const auto saturation = io::evaluate_saturation(sc, series, judge);
+    const nlohmann::json metrics = io::metrics_json(sc, results, {}, saturation, {}, judge);
     io::write_metrics_with_provenance(dir / "metrics.json", metrics, provenance);
-    std::ofstream((dir / "metrics.txt").string()) << io::format_step_table(sc, results, {}, saturation);
+    std::ofstream((dir / "metrics.txt").string()) << io::format_step_table(sc, results, {}, saturation, {}, judge);
     if (saturation) {
       if (const std::string w = io::saturation_warning(*saturation); !w.empty()) {
         std::cerr << "run: " << dirs[i] << ": " << w << '\n';
@@ -179,9 +179,12 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     std::cout << fmt::format("swarm: {:g} s simulated in {:.3f} s ({:.1f}x real time, {} threads)\n", sim_s, wall_s,
                              sim_s / wall_s, spec.threads);
   }
-  const nlohmann::json recorded = judge_recorded(out, sc, spec.record_vehicles, dirs, provenance);
-  const bool pass =
-      std::all_of(recorded.begin(), recorded.end(), [](const nlohmann::json& e) { return e["passed"].get<bool>(); });
+  const io::Judge judge = io::parse_judge(opt.judge).value_or(io::Judge::kSpec);  // --judge checked its value
+  const nlohmann::json recorded = judge_recorded(out, sc, spec.record_vehicles, dirs, judge, provenance);
+  // A recorded vehicle's "passed" is null under --judge none: no verdict, nothing fails.
+  const bool pass = std::all_of(recorded.begin(), recorded.end(), [](const nlohmann::json& e) {
+    return e["passed"].is_null() || e["passed"].get<bool>();
+  });
   {  // summary.json (written by whichever process ran the swarm) gains the recorded vehicles' verdicts
     nlohmann::json summary;
     std::ifstream(out / "summary.json") >> summary;

@@ -3,6 +3,7 @@
 // sweep library's (src/sweep/, docs/sweeps.md).
 #include <fmt/format.h>
 
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -17,6 +18,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/node_common.hpp"
 #include "app/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -39,9 +41,13 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
     os << fmt::format("sweep {}: interrupted: {} of {} runs finished; {} of them passed ({:.1f} %), seed {}\n",
                       j["scenario"].get<std::string>(), finished, runs, passed,
                       finished > 0 ? 100.0 * passed / finished : 0.0, j["seed"].get<std::uint64_t>());
+  } else if (j.value("judge", std::string("spec")) == "none") {
+    os << fmt::format("sweep {}: {} runs, figures only (--judge none: no verdict), seed {}\n",
+                      j["scenario"].get<std::string>(), runs, j["seed"].get<std::uint64_t>());
   } else {
-    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %), seed {}\n", j["scenario"].get<std::string>(), passed,
-                      runs, 100.0 * passed / runs, j["seed"].get<std::uint64_t>());
+    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %) against {}, seed {}\n",
+                      j["scenario"].get<std::string>(), passed, runs, 100.0 * passed / runs,
+                      j.value("judge", std::string("spec")), j["seed"].get<std::uint64_t>());
   }
   int failed_runs = 0;
   for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
@@ -90,9 +96,102 @@ bool parse_shard(const std::string& text, int& k, int& n) {
   }
 }
 
+// Progress of the runs on stderr: on a terminal one line rewritten in place (at most 5 times a second),
+// else a line every `every_s` seconds (each run with 0); always the last count. Only stderr: what
+// the sweep writes does not depend on it. Called from run_many's `finished`, one call at a time.
+class Progress {
+ public:
+  Progress(std::string name, int total, int done_before, int passed_before, double every_s)
+      : name_(std::move(name)),
+        total_(total),
+        done_(done_before),
+        passed_(passed_before),
+        done_before_(done_before),
+        tty_(isatty(STDERR_FILENO) == 1),
+        every_s_(tty_ ? 0.2 : every_s),
+        start_(std::chrono::steady_clock::now()),
+        last_(start_) {}
+
+  void finished(bool passed) {
+    ++done_;
+    passed_ += passed ? 1 : 0;
+    const auto now = std::chrono::steady_clock::now();
+    if (done_ < total_ && std::chrono::duration<double>(now - last_).count() < every_s_) return;
+    last_ = now;
+    print(now);
+  }
+
+  // The last count, and the end of the line on a terminal (before anything else is printed).
+  void end() {
+    if (done_ == printed_) {
+      if (tty_ && printed_ >= 0) std::cerr << '\n';
+      return;
+    }
+    print(std::chrono::steady_clock::now());
+    if (tty_) std::cerr << '\n';
+  }
+
+ private:
+  void print(std::chrono::steady_clock::time_point now) {
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const int flown = done_ - done_before_;  // this command's runs: what the time left is estimated from
+    const std::string left = done_ >= total_ ? "done"
+                             : flown > 0 ? fmt::format("about {} left", duration(elapsed / flown * (total_ - done_)))
+                                         : "time left unknown";
+    const std::string line =
+        fmt::format("sweep {}: {}/{} runs done, {} passed ({:.1f} %), {} elapsed, {}", name_, done_, total_, passed_,
+                    done_ > 0 ? 100.0 * passed_ / done_ : 0.0, duration(elapsed), left);
+    if (tty_) {
+      std::cerr << "\r\033[K" << line << std::flush;  // the line rewritten in place
+    } else {
+      std::cerr << line << std::endl;
+    }
+    printed_ = done_;
+  }
+
+  static std::string duration(double s) {
+    if (s < 60.0) return fmt::format("{:.1f} s", s);
+    const auto whole = static_cast<long long>(std::llround(s));
+    if (whole < 3600) return fmt::format("{}:{:02d} min", whole / 60, whole % 60);
+    return fmt::format("{}:{:02d}:{:02d} h", whole / 3600, (whole / 60) % 60, whole % 60);
+  }
+
+  std::string name_;
+  int total_, done_, passed_, done_before_;
+  int printed_ = -1;  ///< the count last printed
+  bool tty_;
+  double every_s_;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
+// Makes PYTHONPATH what the sweep in `dir` recorded (origin.json) ahead of the current one, before
+// anything starts Python, so that a Python controller is imported from where the sweep imported it,
+// whatever the current directory. Returns the record (nullopt: none, a sweep of an older quadcosim).
+std::optional<sweep::Origin> use_origin(const fs::path& dir) {
+  std::optional<sweep::Origin> origin = sweep::read_origin(dir);  // io::ConfigError names the file
+  if (origin) setenv("PYTHONPATH", sweep::python_path_env(*origin, std::getenv("PYTHONPATH")).c_str(), 1);
+  return origin;
+}
+
+// The scenario_file the sweep in `dir` recorded in its summary.json or shard.json ("" when unreadable:
+// finished_runs then says what is wrong).
+std::string recorded_scenario_file(const fs::path& dir, const std::string& shard) {
+  try {
+    const nlohmann::json j = nlohmann::json::parse(read_file(dir / (shard.empty() ? "summary.json" : "shard.json")));
+    const nlohmann::json& h = shard.empty() ? j : j.at("header");
+    return h.at("scenario_file").get<std::string>();
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
+// index.html of a sweep folder (tools/sweep_index.py), after the plots it shows.
+bool make_index(const std::string& dir) { return run_tool("sweep_index.py", {dir}); }
+
 int rerun_command(const SweepOptions& o) {
   sweep::Plan plan;
   try {
+    (void)use_origin(o.sweep_dir);
     plan = sweep::plan_of(o.sweep_dir);
   } catch (const std::runtime_error& e) {  // names the file: not a sweep folder, or not this one's
     std::cerr << "error: " << e.what() << '\n';
@@ -162,10 +261,13 @@ int merge_command(const SweepOptions& o) {
   const fs::path out(o.out_dir);
   io::OutputFolder folder = io::OutputFolder::claim(out, "sweep merge", {.force = o.force}, std::cerr);
   copy_output(fs::path(o.shard_dirs.front()) / "scenario.yaml", out / "scenario.yaml");
+  // The first shard's origin, so that `sweep rerun` of the merged folder finds what its scenario needs.
+  if (fs::is_regular_file(fs::path(o.shard_dirs.front()) / sweep::kOriginFile))
+    copy_output(fs::path(o.shard_dirs.front()) / sweep::kOriginFile, out / sweep::kOriginFile);
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
-  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
+  if (o.plots && !(run_tool("plot_sweep.py", {o.out_dir}) && make_index(o.out_dir))) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }
 
@@ -196,7 +298,12 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   c->add_option("--jobs", o.jobs, "parallel runs (threads)")->check(CLI::Range(1, 64));
   c->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
-  c->add_flag("!--no-plots", o.plots, "skip the plots");
+  c->add_flag("!--no-plots", o.plots, "skip the plots and index.html");
+  c->add_flag("!--no-progress", o.progress, "no progress on stderr while the runs go");
+  c->add_option("--progress-every", o.progress_every_s,
+                "seconds between progress lines when stderr is not a terminal (0: after each run; default 5)")
+      ->check(CLI::Range(0.0, 1e6));
+  add_judge_option(*c, o.judge);
 
   auto* r = c->add_subcommand("rerun", "fly run I of a sweep again with the outputs of `run`");
   r->add_option("dir", o.sweep_dir, "sweep folder (summary.json or shard.json, scenario.yaml)")->required();
@@ -214,7 +321,7 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
               "OUT is not empty: remove the outputs its manifest lists first (other files are kept)");
   m->add_option("--min-pass-rate", o.min_pass_rate, "exit 1 when fewer runs than this fraction pass")
       ->check(CLI::Range(0.0, 1.0));
-  m->add_flag("!--no-plots", o.plots, "skip the plots");
+  m->add_flag("!--no-plots", o.plots, "skip the plots and index.html");
   m->callback([&o] { o.mode = "merge"; });
   return c;
 }
@@ -234,8 +341,28 @@ int sweep_command(const SweepOptions& o) {
   // A bad --vary or scenario: io::ConfigError or std::invalid_argument, bad input (run_guarded).
   bool grid = false;
   for (const auto& spec : o.vary) grid = grid || sweep::parse_vary(spec).distribution == sweep::Distribution::kGrid;
-  const sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
-                                            o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom);
+  const fs::path out(o.out_dir);
+  // --resume continues the sweep where it was started: its scenario is loaded as if from the recorded
+  // file (what it names relative to its folder is found there) and Python imports from the folders
+  // it imported from, whatever the current directory; the header keeps the scenario path as first
+  // typed (the file is checked to be the same bytes below).
+  std::optional<sweep::Origin> origin;
+  std::string recorded_file;
+  if (o.resume && fs::is_directory(out)) {
+    origin = use_origin(out);
+    recorded_file = recorded_scenario_file(out, o.shard);
+  }
+  sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
+                                      o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom,
+                                      origin ? sweep::scenario_source_of(*origin) : std::string());
+  if (!recorded_file.empty()) {
+    plan.scenario_file = recorded_file;
+    plan.nominal.path = recorded_file;
+  }
+  plan.judge = io::parse_judge(o.judge).value_or(io::Judge::kSpec);  // --judge checked its value
+  if (const std::string note = io::nothing_judged_note(plan.nominal, plan.judge); !note.empty()) {
+    std::cout << "sweep " << plan.nominal.name << ": " << note << '\n';
+  }
   if (plan.nominal.steps.empty() && !plan.nominal.hold && !plan.nominal.tracking) {
     std::cerr << "error: " << o.scenario << ": analysis: the scenario has no steps, no hold criterion and no "
               << "trajectory to track; a sweep needs something to judge\n";
@@ -245,7 +372,6 @@ int sweep_command(const SweepOptions& o) {
     std::cerr << "error: sweep: --resume finishes the sweep in --out, --force starts a new one there: give one\n";
     return exit_code::kBadInput;
   }
-  const fs::path out(o.out_dir);
   const nlohmann::json header = sweep::header_json(plan);
   std::vector<nlohmann::json> per_run;  // the runs finished before (--resume), then these
   std::optional<io::OutputFolder> folder;
@@ -273,6 +399,8 @@ int sweep_command(const SweepOptions& o) {
     // (an older quadcosim's interrupted sweep) are refused rather than kept beside the new runs.
     folder.emplace(io::OutputFolder::claim(out, "sweep", {.force = o.force, .exclusive = {"runs"}}, std::cerr));
     copy_output(o.scenario, out / "scenario.yaml");
+    sweep::write_json(out / sweep::kOriginFile,
+                      sweep::origin_json(sweep::origin_of(o.scenario, fs::current_path(), std::getenv("PYTHONPATH"))));
   }
   fs::create_directories(out / "runs");
   const sweep::Keep keep = o.keep == "all"       ? sweep::Keep::kAll
@@ -292,9 +420,17 @@ int sweep_command(const SweepOptions& o) {
   // is written. Meanwhile the manifest lists what is written, at most a second late.
   install_stop_handlers();
   auto last_record = std::chrono::steady_clock::now();
+  int passed_before = 0;
+  for (const auto& r : per_run) passed_before += r.at("passed").get<bool>() ? 1 : 0;
+  std::optional<Progress> progress;
+  if (o.progress && !indices.empty()) {
+    progress.emplace(plan.nominal.name, static_cast<int>(done.size() + indices.size()), static_cast<int>(done.size()),
+                     passed_before, o.progress_every_s);
+  }
   sweep::RunControl control;
   control.stop = [] { return stop_requested(); };
-  control.finished = [&](const sweep::RunResult&) {
+  control.finished = [&](const sweep::RunResult& r) {
+    if (progress) progress->finished(r.passed);
     const auto now = std::chrono::steady_clock::now();
     if (now - last_record < std::chrono::seconds(1)) return;
     last_record = now;
@@ -305,6 +441,7 @@ int sweep_command(const SweepOptions& o) {
     }
   };
   const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep, control);
+  if (progress) progress->end();
   for (const auto& r : results) {
     if (!r.error.empty()) {
       std::cerr << fmt::format("sweep: run {} (seed {}) failed: {}\n", r.sample.index, r.sample.seed, r.error);
@@ -348,7 +485,7 @@ int sweep_command(const SweepOptions& o) {
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
   if (stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
-  if (o.plots && !run_tool("plot_sweep.py", {o.out_dir})) return exit_code::kOutput;
+  if (o.plots && !(run_tool("plot_sweep.py", {o.out_dir}) && make_index(o.out_dir))) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }
 

@@ -440,6 +440,16 @@ std::uint32_t Server::add_channel(const std::string& topic, const std::string& s
   return static_cast<std::uint32_t>(impl_->channels.size() - 1);
 }
 
+std::uint32_t Server::add_latched_channel(const std::string& topic, const std::string& schema_name,
+                                          const std::string& schema, std::int64_t t_ns, std::vector<std::uint8_t> cdr) {
+  const std::uint32_t id = add_channel(topic, schema_name, schema);
+  // The newest message of a channel is what a subscribing client gets at once (Impl::subscribe).
+  Impl::Channel& ch = *impl_->channels[id];
+  ch.last = std::move(cdr);
+  ch.last_t_ns = std::max<std::int64_t>(t_ns, 0);
+  return id;
+}
+
 void Server::start() {
   Impl& s = *impl_;
   const std::string where = fmt::format("{}:{}", s.options.address, s.options.port);

@@ -70,6 +70,11 @@ class Server {
   /// Declares a channel (before start()); returns its id. `schema_name` "pkg/msg/Type", `schema` its
   /// ros2msg text; messages are CDR.
   std::uint32_t add_channel(const std::string& topic, const std::string& schema_name, const std::string& schema);
+  /// A channel whose one message, `cdr` at time `t_ns`, is given now (before start()) and sent to each
+  /// client as it subscribes, as a transient-local ROS 2 topic gives its sample to a late reader
+  /// (robot_description, /tf_static). It does not move the server's time.
+  std::uint32_t add_latched_channel(const std::string& topic, const std::string& schema_name, const std::string& schema,
+                                    std::int64_t t_ns, std::vector<std::uint8_t> cdr);
 
   /// Binds options.address:options.port and starts serving on a thread of its own. Throws
   /// std::runtime_error naming the address and port when it cannot listen there.

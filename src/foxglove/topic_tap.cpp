@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "io/mcap_recorder.hpp"
 #include "io/ros2_cdr.hpp"
 #include "sim/messages.hpp"
 
@@ -15,23 +16,12 @@ namespace {
 using Newest = std::shared_ptr<std::atomic<std::int64_t>>;
 
 template <class T>
-std::int64_t stamp_of(const T& m, const Newest& newest) {
-  if constexpr (std::is_same_v<T, msg::Clock>) {
-    return m.clock.to_ns();
-  } else if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
-    const std::int64_t s = msg::command_stamp_ns(m);
-    return s >= 0 ? s : newest->load(std::memory_order_relaxed);
-  } else {
-    return m.header.stamp.to_ns();
-  }
-}
-
-template <class T>
 void serve(Server& server, sim::Transport& transport, const std::string& topic, const Newest& newest) {
   const std::string type(T::kRosType);
   const std::uint32_t channel = server.add_channel(topic, type, io::ros2msg_definition(type));
   transport.subscribe<T>(topic, [&server, channel, newest](const T& m) {
-    const std::int64_t t = stamp_of(m, newest);
+    // Motor commands without a label: the newest header time seen (as the recorder stamps them).
+    const std::int64_t t = io::message_time_ns(m, newest->load(std::memory_order_relaxed));
     if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) {
       std::int64_t seen = newest->load(std::memory_order_relaxed);
       while (t > seen && !newest->compare_exchange_weak(seen, t, std::memory_order_relaxed)) {
@@ -53,6 +43,14 @@ void serve_vehicle_topics(Server& server, sim::Transport& transport, const sim::
   serve<msg::ControllerStatus>(server, transport, topics.controller_status, newest);
   serve<msg::PlantStatus>(server, transport, topics.plant_status, newest);
   serve<msg::Float64MultiArray>(server, transport, topics.motor_commands, newest);
+  serve<msg::TFMessage>(server, transport, topics.tf, newest);
+}
+
+void serve_vehicle_description(Server& server, const model::VehicleParams& vehicle, const std::string& ns,
+                               std::int64_t t_ns) {
+  for (io::LatchedMessage& m : io::vehicle_description_messages(vehicle, ns, t_ns)) {
+    server.add_latched_channel(m.topic, m.type, io::ros2msg_definition(m.type), t_ns, std::move(m.cdr));
+  }
 }
 
 }  // namespace quadcosim::foxglove

@@ -1,7 +1,9 @@
 // Tests of the file layer: scenario loading and its error messages, the trajectory CSV, command
 // schedules, and the step report (criteria and metrics.json).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <array>
@@ -31,6 +33,8 @@ namespace quadcosim::io {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 const fs::path kSourceDir = QUADCOSIM_SOURCE_DIR;
 
@@ -89,7 +93,8 @@ struct PaperScenario {
   double z0;            ///< initial height [m]
   bool hover;
   double z_des;
-  std::vector<Criterion> criteria;  ///< in file order
+  std::vector<Criterion> criteria;  ///< the paper: bands, in file order
+  std::vector<Criterion> spec;      ///< the spec: bounds, in file order
 };
 
 std::vector<PaperScenario> paper_scenarios() {
@@ -98,6 +103,10 @@ std::vector<PaperScenario> paper_scenarios() {
                                            {"t95_s", 3.5, 4.5},
                                            {"settling_time_2pct_s", 5.0, 7.0},
                                            {"steady_state_error_pct", none, 1.0}};
+  const std::vector<Criterion> attitude_spec = {{"overshoot_pct", none, 10.0},
+                                                {"t95_s", none, 5.0},
+                                                {"settling_time_2pct_s", none, 8.0},
+                                                {"steady_state_error_pct", none, 1.0}};
   return {
       {"altitude_step.yaml",
        "altitude_step",
@@ -109,9 +118,13 @@ std::vector<PaperScenario> paper_scenarios() {
        {{"overshoot_pct", 15.0, 21.0},
         {"peak_time_s", 2.0, 3.0},
         {"settling_time_2pct_s", none, 8.5},
+        {"steady_state_error_pct", none, 1.0}},
+       {{"overshoot_pct", none, 25.0},
+        {"t95_s", none, 5.0},
+        {"settling_time_2pct_s", none, 10.0},
         {"steady_state_error_pct", none, 1.0}}},
-      {"roll_step.yaml", "roll_step", "roll", 0.1, 10.0, true, 10.0, attitude},
-      {"pitch_step.yaml", "pitch_step", "pitch", 0.15, 10.0, true, 10.0, attitude},
+      {"roll_step.yaml", "roll_step", "roll", 0.1, 10.0, true, 10.0, attitude, attitude_spec},
+      {"pitch_step.yaml", "pitch_step", "pitch", 0.15, 10.0, true, 10.0, attitude, attitude_spec},
       {"yaw_step.yaml",
        "yaw_step",
        "yaw",
@@ -119,7 +132,11 @@ std::vector<PaperScenario> paper_scenarios() {
        10.0,
        true,
        10.0,
-       {{"overshoot_pct", none, 2.0}, {"settling_time_2pct_s", 7.0, 9.0}, {"steady_state_error_pct", none, 1.0}}},
+       {{"overshoot_pct", none, 2.0}, {"settling_time_2pct_s", 7.0, 9.0}, {"steady_state_error_pct", none, 1.0}},
+       {{"overshoot_pct", none, 10.0},
+        {"t95_s", none, 8.0},
+        {"settling_time_2pct_s", none, 10.0},
+        {"steady_state_error_pct", none, 1.0}}},
   };
 }
 
@@ -170,12 +187,16 @@ TEST_P(PaperScenarioTest, LoadsWithTheDocumentedValues) {
   const StepSpec& step = sc.steps[0];
   EXPECT_EQ(step.channel, e.channel);
   EXPECT_EQ(step.t_step_s, 0.0);
-  ASSERT_EQ(step.criteria.size(), e.criteria.size());
-  for (std::size_t i = 0; i < e.criteria.size(); ++i) {
-    SCOPED_TRACE(e.criteria[i].figure);
-    EXPECT_EQ(step.criteria[i].figure, e.criteria[i].figure);
-    EXPECT_EQ(step.criteria[i].min, e.criteria[i].min);
-    EXPECT_EQ(step.criteria[i].max, e.criteria[i].max);
+  // The spec bounds first, then the paper's bands, each in file order.
+  ASSERT_EQ(step.criteria.size(), e.spec.size() + e.criteria.size());
+  for (std::size_t i = 0; i < step.criteria.size(); ++i) {
+    const bool spec = i < e.spec.size();
+    const Criterion& want = spec ? e.spec[i] : e.criteria[i - e.spec.size()];
+    SCOPED_TRACE(want.figure);
+    EXPECT_EQ(step.criteria[i].set, spec ? CriteriaSet::kSpec : CriteriaSet::kPaper);
+    EXPECT_EQ(step.criteria[i].figure, want.figure);
+    EXPECT_EQ(step.criteria[i].min, want.min);
+    EXPECT_EQ(step.criteria[i].max, want.max);
   }
   EXPECT_NE(step.reference_source.find("paper"), std::string::npos);
   EXPECT_TRUE(step.reference.count("settling_time_2pct_s"));
@@ -290,6 +311,95 @@ schedule:
     EXPECT_EQ(sc->schedule[0].name, "lqr.pitch.q_angle");
     EXPECT_EQ(std::get<double>(sc->schedule[0].value), 4.0);
   }
+}
+
+// Gains in a type's section apply when that type flies and are checked, but not used, when another does;
+// what is flown (the node's mode and setpoints) is the same for every type.
+TEST(ScenarioTest, TypeSectionsHoldEachControllersGains) {
+  TempDir dir;
+  const std::string file = dir.write("typed.yaml", R"(controller:
+  mode: position
+  z_des: 4
+  paper:
+    lqr: {roll: {q_angle: 2.0}}
+    position.kp: 0.9
+  se3:
+    k_x.x: 7.5
+schedule:
+  - at_s: 1
+    set: {z_des: 6, paper: {position.kd: 1.1}, se3: {k_v.x: 2.5}}
+)");
+  const Scenario paper = load_scenario(file);
+  EXPECT_EQ(paper.controller.type(), "paper");
+  EXPECT_EQ(paper_params(paper.controller).roll.q_angle, 2.0);
+  EXPECT_EQ(paper_params(paper.controller).position.kp, 0.9);
+  const Scenario se3 = load_scenario(file, "se3");
+  EXPECT_EQ(se3.controller.type(), "se3");
+  EXPECT_EQ(std::get<double>(*control::get_parameter(se3.controller, "k_x.x")), 7.5);
+  for (const Scenario* sc : {&paper, &se3}) {
+    SCOPED_TRACE(sc->controller.type());
+    EXPECT_EQ(sc->controller.node.setpoint.mode, control::Mode::kPosition);
+    EXPECT_EQ(sc->controller.node.setpoint.p_des_W.z(), 4.0);
+    // The schedule holds the node's change and the flying type's gain only.
+    ASSERT_EQ(sc->schedule.size(), 2u);
+    EXPECT_EQ(sc->schedule[0].name, "z_des");
+    EXPECT_EQ(sc->schedule[1].name, sc == &paper ? "position.kd" : "k_v.x");
+  }
+  // A typo in the gains of a type that does not fly is still an error, named at its key.
+  const std::string typo = dir.write("typo.yaml", "controller:\n  paper:\n    lqr: {roll: {q_angel: 2}}\n");
+  try {
+    (void)load_scenario(typo, "se3");
+    ADD_FAILURE() << "a misspelt paper gain was accepted while se3 flies";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel'"));
+  }
+  // The node's parameters belong to what is flown, not to a type's gains.
+  const std::string node = dir.write("node.yaml", "controller:\n  se3: {z_des: 3}\n");
+  try {
+    (void)load_scenario(node);
+    ADD_FAILURE() << "z_des inside se3: was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("controller.se3.z_des: 'z_des' is the node's"));
+  }
+}
+
+// A file that writes the paper controller's gains directly under controller: (the older form) flies
+// any other type: --controller moves them into the paper section, where they are checked and unused.
+TEST(ScenarioTest, AnotherTypeTakesTheFilesFlatGainsAsThePaperControllers) {
+  TempDir dir;
+  const std::string file = dir.write("flat.yaml", R"(controller:
+  mode: position
+  z_des: 2
+  lqr: {roll: {q_angle: 3.0}}
+  position: {kp: 0.7}
+)");
+  EXPECT_EQ(paper_params(load_scenario(file).controller).roll.q_angle, 3.0);
+  const Scenario se3 = load_scenario(file, "se3");
+  EXPECT_EQ(se3.controller.type(), "se3");
+  EXPECT_EQ(se3.controller.node.setpoint.p_des_W.z(), 2.0);
+  YAML::Node root = YAML::LoadFile(file);
+  set_controller_type(root, "se3");
+  EXPECT_EQ(root["controller"]["type"].as<std::string>(), "se3");
+  EXPECT_FALSE(root["controller"]["lqr"]);
+  EXPECT_EQ(root["controller"]["paper"]["lqr"]["roll"]["q_angle"].as<double>(), 3.0);
+  EXPECT_EQ(root["controller"]["paper"]["position"]["kp"].as<double>(), 0.7);
+  EXPECT_EQ(root["controller"]["z_des"].as<double>(), 2.0);
+  // Back to paper: the moved gains apply again, from their section.
+  set_controller_type(root, "paper");
+  EXPECT_EQ(paper_params(load_scenario(root, file).controller).roll.q_angle, 3.0);
+}
+
+TEST(ScenarioTest, ControllerChoicesAreParsedOrRefusedWithWhatWasExpected) {
+  EXPECT_EQ(parse_controller_choice("se3").kind, ControllerChoice::Kind::kType);
+  const ControllerChoice py = parse_controller_choice("python:my_controllers:LevelPD");
+  EXPECT_EQ(py.kind, ControllerChoice::Kind::kPython);
+  EXPECT_EQ(py.target, "my_controllers:LevelPD");
+  EXPECT_THAT([] { (void)parse_controller_choice("python:nocolon"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("expected python:MODULE:CLASS")));
+  EXPECT_THAT([] { (void)parse_controller_choice("fmu:/no/such.fmu"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("no such file '/no/such.fmu'")));
+  EXPECT_THAT([] { (void)parse_controller_choice("cascade"); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("expected a controller type (paper, ")));
 }
 
 TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {
@@ -474,6 +584,22 @@ INSTANTIATE_TEST_SUITE_P(
         BadScenario{"criterion_min_above_max",
                     "analysis:\n  steps:\n    - channel: z\n      criteria: {t95_s: [3, 1]}\n",
                     {"analysis.steps[0].criteria.t95_s: ", "min is above max"}},
+        // criteria is the old name of spec: both in one block cannot say which bands were meant.
+        BadScenario{"criteria_beside_spec",
+                    "analysis:\n  steps:\n    - channel: z\n      criteria: {t95_s: [null, 5]}\n"
+                    "      spec: {t95_s: [null, 4]}\n",
+                    {"analysis.steps[0].criteria: ", "given beside spec", "keep one of the two keys"}},
+        BadScenario{"criteria_beside_spec_in_hold",
+                    "analysis:\n  hold:\n    criteria: {max_vertical_error_m: [null, 1]}\n"
+                    "    spec: {max_vertical_error_m: [null, 1]}\n",
+                    {"analysis.hold.criteria: ", "given beside spec"}},
+        BadScenario{"unknown_paper_figure",
+                    "analysis:\n  steps:\n    - channel: z\n      paper: {overshoot: [0, 1]}\n",
+                    {"analysis.steps[0].paper.overshoot: ", "unknown step figure", "overshoot_pct"}},
+        BadScenario{"hold_without_bands", "analysis:\n  hold: {after_s: 1}\n", {"analysis.hold.spec: ", "missing"}},
+        BadScenario{"limits_flat_beside_sets",
+                    "analysis:\n  limits:\n    max_saturated_s: 1\n    paper: {max_saturated_s: 0}\n",
+                    {"analysis.limits.max_saturated_s: ", "beside spec/paper"}},
         BadScenario{"top_level_not_a_mapping", "- 1\n- 2\n", {"mapping"}},
         BadScenario{"section_not_a_mapping", "simulation: 100\n", {"simulation: ", "'100'", "mapping"}},
         // Found by fuzz_config (tests/fuzz/corpus/fuzz_config/regression_*): a list or a mapping as a
@@ -943,6 +1069,174 @@ TEST(StepReportTest, CriteriaPassAndFail) {
   EXPECT_FALSE(all_passed(results));
   EXPECT_TRUE(all_passed({results[0], results[4]}));
   EXPECT_TRUE(all_passed({}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Criteria sets: spec and paper, and what --judge judges
+
+TEST(JudgeTest, NamesParseAndJudgeOneSetEach) {
+  EXPECT_EQ(judge_names(), (std::vector<std::string>{"spec", "paper", "none"}));
+  for (const std::string& name : judge_names()) EXPECT_EQ(to_string(*parse_judge(name)), name);
+  EXPECT_FALSE(parse_judge("Spec").has_value());
+  EXPECT_FALSE(parse_judge("").has_value());
+  EXPECT_TRUE(judges(Judge::kSpec, CriteriaSet::kSpec));
+  EXPECT_FALSE(judges(Judge::kSpec, CriteriaSet::kPaper));
+  EXPECT_TRUE(judges(Judge::kPaper, CriteriaSet::kPaper));
+  EXPECT_FALSE(judges(Judge::kNone, CriteriaSet::kSpec));
+  EXPECT_FALSE(judges(Judge::kNone, CriteriaSet::kPaper));
+}
+
+TEST(JudgeTest, SpecPaperAndTheOldCriteriaKeyAreRead) {
+  TempDir dir;
+  const std::string path = dir.write("sets.yaml",
+                                     "analysis:\n"
+                                     "  steps:\n"
+                                     "    - channel: z\n"
+                                     "      paper: {overshoot_pct: [15, 21]}\n"
+                                     "      spec: {overshoot_pct: [null, 25], t95_s: [null, 5]}\n"
+                                     "    - channel: z\n"
+                                     "      at_s: 1\n"
+                                     "      criteria: {t95_s: [null, 3]}\n"
+                                     "  hold:\n"
+                                     "    paper: {max_vertical_error_m: [0.1, 0.3]}\n"
+                                     "  limits:\n"
+                                     "    spec: {max_saturated_s: 0.5}\n"
+                                     "    paper: {max_tilt_saturated_s: 0}\n");
+  const Scenario sc = load_scenario(path);
+  ASSERT_EQ(sc.steps.size(), 2u);
+  const auto& c = sc.steps[0].criteria;  // spec first, then paper, each in file order
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[0].figure, "overshoot_pct");
+  EXPECT_EQ(c[0].set, CriteriaSet::kSpec);
+  EXPECT_FALSE(c[0].min.has_value());
+  EXPECT_EQ(c[0].max, 25.0);
+  EXPECT_EQ(c[1].figure, "t95_s");
+  EXPECT_EQ(c[1].set, CriteriaSet::kSpec);
+  EXPECT_EQ(c[2].set, CriteriaSet::kPaper);
+  EXPECT_EQ(c[2].min, 15.0);
+  EXPECT_EQ(c[2].max, 21.0);
+  ASSERT_EQ(sc.steps[1].criteria.size(), 1u);  // the old key: a spec
+  EXPECT_EQ(sc.steps[1].criteria[0].set, CriteriaSet::kSpec);
+  EXPECT_EQ(sc.steps[1].criteria[0].max, 3.0);
+  ASSERT_TRUE(sc.hold.has_value());
+  ASSERT_EQ(sc.hold->criteria.size(), 1u);
+  EXPECT_EQ(sc.hold->criteria[0].set, CriteriaSet::kPaper);
+  ASSERT_TRUE(sc.limits.has_value());
+  ASSERT_EQ(sc.limits->criteria.size(), 2u);
+  EXPECT_EQ(sc.limits->criteria[0].figure, "saturated_s");
+  EXPECT_EQ(sc.limits->criteria[0].set, CriteriaSet::kSpec);
+  EXPECT_EQ(sc.limits->criteria[1].figure, "tilt_saturated_s");
+  EXPECT_EQ(sc.limits->criteria[1].set, CriteriaSet::kPaper);
+  EXPECT_TRUE(has_criteria(sc, CriteriaSet::kSpec));
+  EXPECT_TRUE(has_criteria(sc, CriteriaSet::kPaper));
+}
+
+TEST(JudgeTest, OnlyTheJudgedSetDecidesTheVerdict) {
+  // T = 0.5 s: t95 = 0.5 ln 20 = 1.498 -> 1.5 s on the grid, no overshoot. The spec asks for 95 %
+  // within 2 s (met); the paper band, of a slower controller, for 3-4 s (left by this faster one).
+  const Series series = first_order_series(1.0, 0.5, 10.0);
+  const auto none = std::nullopt;
+  const std::vector<StepSpec> steps = {z_step(1.0, {{"t95_s", none, 2.0, CriteriaSet::kSpec},
+                                                    {"t95_s", 3.0, 4.0, CriteriaSet::kPaper},
+                                                    {"overshoot_pct", none, 2.0, CriteriaSet::kPaper}})};
+  Scenario sc;
+  sc.name = "judge";
+  sc.steps = steps;
+
+  const auto spec = evaluate_steps(steps, series, Judge::kSpec);
+  EXPECT_TRUE(spec[0].passed);
+  EXPECT_TRUE(spec[0].criteria[0].judged && spec[0].criteria[0].passed);
+  EXPECT_FALSE(spec[0].criteria[1].judged);
+  EXPECT_FALSE(spec[0].criteria[1].passed);  // checked all the same: 1.5 s is outside [3, 4]
+  EXPECT_TRUE(spec[0].criteria[2].passed);
+  EXPECT_EQ(judged_criteria(spec, {}, {}, {}), 1u);
+
+  const auto paper = evaluate_steps(steps, series, Judge::kPaper);
+  EXPECT_FALSE(paper[0].passed);
+  EXPECT_FALSE(paper[0].criteria[0].judged);
+  EXPECT_TRUE(paper[0].criteria[1].judged);
+  EXPECT_FALSE(paper[0].criteria[1].passed);
+  EXPECT_EQ(judged_criteria(paper, {}, {}, {}), 2u);
+
+  const auto figures_only = evaluate_steps(steps, series, Judge::kNone);
+  EXPECT_TRUE(figures_only[0].passed);  // nothing judged, nothing failed
+  EXPECT_EQ(judged_criteria(figures_only, {}, {}, {}), 0u);
+  EXPECT_EQ(figures_only[0].figures.t95_s, spec[0].figures.t95_s);
+
+  const nlohmann::json js = metrics_json(sc, spec, {}, {}, {}, Judge::kSpec);
+  const nlohmann::json jp = metrics_json(sc, paper, {}, {}, {}, Judge::kPaper);
+  const nlohmann::json jn = metrics_json(sc, figures_only, {}, {}, {}, Judge::kNone);
+  EXPECT_EQ(js.at("judged"), "spec");
+  EXPECT_EQ(js.at("passed"), true);
+  EXPECT_EQ(jp.at("judged"), "paper");
+  EXPECT_EQ(jp.at("passed"), false);
+  EXPECT_EQ(jp.at("steps")[0].at("passed"), false);
+  EXPECT_EQ(jp.at("judged_criteria"), 2);
+  EXPECT_EQ(jn.at("judged"), "none");
+  EXPECT_TRUE(jn.at("passed").is_null());
+  EXPECT_TRUE(jn.at("steps")[0].at("passed").is_null());
+  const auto& c1 = jp.at("steps")[0].at("criteria")[1];
+  EXPECT_EQ(c1.at("set"), "paper");
+  EXPECT_EQ(c1.at("min"), 3.0);
+  EXPECT_EQ(c1.at("max"), 4.0);
+  EXPECT_DOUBLE_EQ(c1.at("value").get<double>(), 1.5);
+  EXPECT_EQ(c1.at("passed"), false);
+  EXPECT_EQ(c1.at("judged"), true);
+  EXPECT_EQ(js.at("steps")[0].at("criteria")[1].at("judged"), false);
+  EXPECT_FALSE(js.contains("judged_note"));
+
+  // metrics.txt: the set judged, and per figure both bands, ok/FAIL for the judged one, in/out for the other.
+  const std::string table = format_step_table(sc, paper, {}, {}, {}, Judge::kPaper);
+  EXPECT_NE(table.find("judged against: paper (the paper's controller's measured response bands)"), std::string::npos)
+      << table;
+  EXPECT_NE(table.find("FAIL ("), std::string::npos) << table;  // the step's verdict
+  const auto row = table.find("  t95_s ");
+  ASSERT_NE(row, std::string::npos) << table;
+  const std::string line = table.substr(row, table.find('\n', row) - row);
+  EXPECT_NE(line.find("[-, 2] in"), std::string::npos) << line;
+  EXPECT_NE(line.find("[3, 4] FAIL"), std::string::npos) << line;
+  const std::string spec_table = format_step_table(sc, spec, {}, {}, {}, Judge::kSpec);
+  EXPECT_NE(spec_table.find("[-, 2] ok"), std::string::npos) << spec_table;
+  EXPECT_NE(spec_table.find("[3, 4] out"), std::string::npos) << spec_table;
+  EXPECT_NE(format_step_table(sc, figures_only, {}, {}, {}, Judge::kNone).find("figures only"), std::string::npos);
+}
+
+TEST(JudgeTest, AScenarioWithoutTheJudgedSetSaysNothingIsJudged) {
+  Scenario sc;
+  sc.steps = {z_step(1.0, {{"t95_s", std::nullopt, 2.0, CriteriaSet::kSpec}})};
+  EXPECT_EQ(nothing_judged_note(sc, Judge::kSpec), "");
+  EXPECT_EQ(nothing_judged_note(sc, Judge::kPaper), "no paper bands in this scenario: nothing judged");
+  EXPECT_EQ(nothing_judged_note(sc, Judge::kNone), "");
+  sc.steps[0].criteria[0].set = CriteriaSet::kPaper;
+  EXPECT_EQ(nothing_judged_note(sc, Judge::kSpec), "no spec criteria in this scenario: nothing judged");
+  const auto results = evaluate_steps(sc.steps, first_order_series(1.0, 0.5, 10.0), Judge::kSpec);
+  const nlohmann::json j = metrics_json(sc, results, {}, {}, {}, Judge::kSpec);
+  EXPECT_EQ(j.at("passed"), true);
+  EXPECT_EQ(j.at("judged_criteria"), 0);
+  EXPECT_EQ(j.at("judged_note"), "no spec criteria in this scenario: nothing judged");
+  const std::string table = format_step_table(sc, results, {}, {}, {}, Judge::kSpec);
+  EXPECT_NE(table.find("no spec criteria ("), std::string::npos) << table;  // the step's verdict
+}
+
+TEST(JudgeTest, HoldAndLimitsJudgeTheirSetOnly) {
+  // z holds 0.25 m below its setpoint: max_vertical_error_m = 0.25 (0.25 is exact in binary).
+  Series s;
+  for (int k = 0; k <= 200; ++k) {
+    s.t_s.push_back(k / 100.0);
+    for (const char* c : {"x", "y", "x_des", "y_des"}) s.append(c, 0.0);
+    s.append("z", 4.75);
+    s.append("z_des", 5.0);
+  }
+  const HoldSpec hold{0.0,
+                      {{"max_vertical_error_m", std::nullopt, 0.5, CriteriaSet::kSpec},
+                       {"max_vertical_error_m", std::nullopt, 0.1, CriteriaSet::kPaper}}};
+  const HoldResult spec = evaluate_hold(hold, s, Judge::kSpec);
+  EXPECT_DOUBLE_EQ(spec.figures.at("max_vertical_error_m"), 0.25);
+  EXPECT_TRUE(spec.passed);
+  EXPECT_FALSE(spec.criteria[1].passed);
+  EXPECT_FALSE(spec.criteria[1].judged);
+  EXPECT_FALSE(evaluate_hold(hold, s, Judge::kPaper).passed);
+  EXPECT_TRUE(evaluate_hold(hold, s, Judge::kNone).passed);
 }
 
 TEST(StepReportTest, SteadyStateErrorCriterion) {

@@ -12,23 +12,16 @@
 
 namespace quadcosim::io {
 
-namespace {
-
-template <class T>
-std::int64_t stamp_of(const T& m, std::int64_t fallback) {
-  if constexpr (std::is_same_v<T, msg::Clock>) {
-    return m.clock.to_ns();
-  } else if constexpr (std::is_same_v<T, msg::TFMessage>) {
-    return m.transforms.empty() ? fallback : m.transforms.front().header.stamp.to_ns();
-  } else if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
-    const std::int64_t s = msg::command_stamp_ns(m);
-    return s >= 0 ? s : fallback;
-  } else {
-    return m.header.stamp.to_ns();
-  }
+std::vector<LatchedMessage> vehicle_description_messages(const model::VehicleParams& vehicle, const std::string& ns,
+                                                         std::int64_t t_ns) {
+  const sim::Topics topics = sim::Topics::for_namespace(ns);
+  const sim::VehicleDescription d = sim::describe_vehicle(vehicle, ns, msg::Time::from_ns(t_ns));
+  std::vector<LatchedMessage> out;
+  out.push_back({topics.robot_description, std::string(msg::String::kRosType), to_cdr(d.urdf)});
+  out.push_back({topics.tf_static, std::string(msg::TFMessage::kRosType), to_cdr(d.rotors)});
+  out.push_back({topics.scene, std::string(msg::SceneUpdate::kRosType), to_cdr(d.scene)});
+  return out;
 }
-
-}  // namespace
 
 McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, const sim::Topics& topics,
                            const std::vector<std::string>& only)
@@ -48,18 +41,10 @@ bool McapRecorder::wanted(const std::string& topic) const {
 }
 
 void McapRecorder::record_vehicle(const model::VehicleParams& vehicle, const std::string& ns, std::int64_t t_ns) {
-  const sim::Topics topics = sim::Topics::for_namespace(ns);
-  const sim::VehicleDescription d = sim::describe_vehicle(vehicle, ns, msg::Time::from_ns(t_ns));
   const Qos latched{1, true, true};  // robot_state_publisher's and tf2's static broadcaster's
-  if (wanted(topics.robot_description)) {
-    push(static_cast<std::uint16_t>(open_channel<msg::String>(topics.robot_description, latched)), t_ns,
-         to_cdr(d.urdf));
-  }
-  if (wanted(topics.tf_static)) {
-    push(static_cast<std::uint16_t>(open_channel<msg::TFMessage>(topics.tf_static, latched)), t_ns, to_cdr(d.rotors));
-  }
-  if (wanted(topics.scene)) {
-    push(static_cast<std::uint16_t>(open_channel<msg::SceneUpdate>(topics.scene, latched)), t_ns, to_cdr(d.scene));
+  for (LatchedMessage& m : vehicle_description_messages(vehicle, ns, t_ns)) {
+    if (!wanted(m.topic)) continue;
+    push(static_cast<std::uint16_t>(open_channel(m.topic, m.type, latched)), t_ns, std::move(m.cdr));
   }
 }
 
@@ -70,9 +55,7 @@ McapRecorder::~McapRecorder() {
   }
 }
 
-template <class T>
-std::size_t McapRecorder::open_channel(const std::string& topic, Qos qos) {
-  const std::string type(T::kRosType);
+std::size_t McapRecorder::open_channel(const std::string& topic, const std::string& type, Qos qos) {
   const std::uint16_t schema = writer_.add_schema(type, "ros2msg", ros2msg_definition(type));
   const std::uint16_t id = writer_.add_channel(
       topic, schema, "cdr",
@@ -89,9 +72,9 @@ std::size_t McapRecorder::open_channel(const std::string& topic, Qos qos) {
 template <class T>
 void McapRecorder::add(sim::Transport& transport, const std::string& topic, Qos qos) {
   if (!wanted(topic)) return;
-  const std::size_t index = open_channel<T>(topic, qos);
+  const std::size_t index = open_channel(topic, std::string(T::kRosType), qos);
   transport.subscribe_with_sender<T>(topic, [this, index](const T& m, sim::SenderId sender) {
-    const std::int64_t t = stamp_of(m, last_stamp_ns_);
+    const std::int64_t t = message_time_ns(m, last_stamp_ns_);
     bool stamped = true;  // the message carries its own time (header, clock, or command label)
     if constexpr (std::is_same_v<T, msg::Float64MultiArray>) stamped = msg::command_stamp_ns(m) >= 0;
     ChannelInfo& c = channels_[index];

@@ -6,15 +6,48 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "io/mcap_writer.hpp"
 #include "model/vehicle_params.hpp"
+#include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
 namespace quadcosim::io {
+
+/// A message's time [ns] as the recorder stamps it (and the live Foxglove view serves it): the header
+/// stamp; /clock's clock; a TFMessage's first transform's stamp; motor commands the time in their
+/// label. `fallback` where the message has none (an empty TFMessage, an unlabelled command).
+template <class T>
+std::int64_t message_time_ns(const T& m, std::int64_t fallback) {
+  if constexpr (std::is_same_v<T, msg::Clock>) {
+    return m.clock.to_ns();
+  } else if constexpr (std::is_same_v<T, msg::TFMessage>) {
+    return m.transforms.empty() ? fallback : m.transforms.front().header.stamp.to_ns();
+  } else if constexpr (std::is_same_v<T, msg::Float64MultiArray>) {
+    const std::int64_t s = msg::command_stamp_ns(m);
+    return s >= 0 ? s : fallback;
+  } else {
+    return m.header.stamp.to_ns();
+  }
+}
+
+/// One message that describes a vehicle: sent once and kept for late readers (transient local).
+struct LatchedMessage {
+  std::string topic;
+  std::string type;  ///< "pkg/msg/Type"
+  std::vector<std::uint8_t> cdr;
+};
+
+/// What describes the vehicle in namespace `ns` to a 3D view, stamped `t_ns`, in this order:
+/// <ns>/robot_description (std_msgs/String, its URDF), /tf_static (base_link -> rotors) and <ns>/scene
+/// (foxglove_msgs/SceneUpdate drawing it frame-locked to <ns>/base_link); sim/vehicle_description.hpp
+/// builds them. What McapRecorder::record_vehicle records and `--foxglove` serves latched.
+std::vector<LatchedMessage> vehicle_description_messages(const model::VehicleParams& vehicle, const std::string& ns,
+                                                         std::int64_t t_ns);
 
 class McapRecorder {
  public:
@@ -88,9 +121,8 @@ class McapRecorder {
     /// own frame)
     std::map<std::pair<sim::SenderId, std::string>, std::int64_t> newest_by_frame;
   };
-  /// The channel of `topic` with T's schema; its index in channels_.
-  template <class T>
-  std::size_t open_channel(const std::string& topic, Qos qos);
+  /// The channel of `topic` with the schema of `type` ("pkg/msg/Type"); its index in channels_.
+  std::size_t open_channel(const std::string& topic, const std::string& type, Qos qos);
   template <class T>
   void add(sim::Transport& transport, const std::string& topic, Qos qos = {10, true, false});
   bool wanted(const std::string& topic) const;

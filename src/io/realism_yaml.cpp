@@ -1,5 +1,7 @@
 #include "io/realism_yaml.hpp"
 
+#include "io/criteria_yaml.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -110,19 +112,10 @@ void read_realism(YamlSection& root, Scenario& sc) {
 HoldSpec read_hold(YamlSection& s, double duration_s) {
   HoldSpec h;
   h.after_s = s.number("after_s", 0.0, 0.0, duration_s);
-  auto c = s.section("criteria");
-  if (!c) s.fail("criteria", "missing; expected e.g. {max_horizontal_error_m: [null, 0.5]}");
-  for (const std::string& fig : c->keys()) {
-    const auto& names = hold_figure_names();
-    if (std::find(names.begin(), names.end(), fig) == names.end()) {
-      c->fail(fig,
-              "unknown hold figure (expected max_horizontal_error_m, rms_horizontal_error_m or "
-              "max_vertical_error_m)");
-    }
-    const auto [min, max] = c->bounds(fig);
-    h.criteria.push_back(Criterion{fig, min, max});
-  }
-  if (h.criteria.empty()) s.fail("criteria", "expected at least one figure");
+  auto criteria = read_criteria_sets(s, hold_figure_names(), "hold figure");
+  if (!criteria) s.fail("spec", "missing; expected e.g. spec: {max_horizontal_error_m: [null, 0.5]}");
+  h.criteria = std::move(*criteria);
+  if (h.criteria.empty()) s.fail("spec", "expected at least one figure");
   s.reject_unknown_keys();
   return h;
 }

@@ -14,6 +14,7 @@
 #include "controllers/registry.hpp"
 #include "fmi/fmu_controller.hpp"
 #include "fmi/fmu_plant.hpp"
+#include "io/criteria_yaml.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/scenario_limits.hpp"
 #include "io/trajectory_yaml.hpp"
@@ -118,11 +119,23 @@ bool controller_section_key(const std::string& key) {
   return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters" || key == "python";
 }
 
+// A key of a `controller:` section (or of a schedule's `set:`) named after a registered controller
+// type holds that type's gains (`paper: {lqr: ...}`): applied when that type flies, checked against
+// its table when another does.
+bool type_section_key(const std::string& key) { return controllers::find_controller_type(key) != nullptr; }
+
+// Where a parameter is read from: directly under `controller:` (the node's and the flying
+// controller's), or inside a type's gains section (its gains only).
+enum class ParameterPlace { kTop, kTypeSection };
+
 void collect_parameters(YamlSection& s, const std::string& prefix, control::ControllerConfig& c,
                         std::vector<control::Setting>& controller_settings,
-                        std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth) {
+                        std::vector<std::pair<std::string, control::ParameterValue>>* out, int depth,
+                        ParameterPlace place = ParameterPlace::kTop) {
   for (const std::string& key : s.keys()) {
-    if (depth == 1 && controller_section_key(key)) continue;  // read by the caller
+    if (depth == 1 && place == ParameterPlace::kTop && (controller_section_key(key) || type_section_key(key))) {
+      continue;  // read by the caller
+    }
     const YAML::Node n = s.raw(key);
     const std::string name = prefix.empty() ? key : prefix + "." + key;
     if (n.IsMap()) {
@@ -130,8 +143,14 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
         s.fail(key, "unknown controller parameter '" + name + "' (nested too deeply; see `quadcosim params`)");
       }
       YamlSection child(n, s.file(), s.key_path(key));
-      collect_parameters(child, name, c, controller_settings, out, depth + 1);
+      collect_parameters(child, name, c, controller_settings, out, depth + 1, place);
       continue;
+    }
+    const bool node = control::node_parameters().find(name) != nullptr;
+    if (node && place == ParameterPlace::kTypeSection) {
+      s.fail(key, "'" + name +
+                      "' is the node's (what is flown, for every controller type); expected it directly "
+                      "under controller:, not in a type's gains section");
     }
     const control::ParameterSpec* spec = control::find_parameter(c, name);
     if (!spec) {
@@ -139,13 +158,47 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
                       "' (see `quadcosim params --controller " + std::string(c.type()) + "`)");
     }
     const control::ParameterValue value = parameter_value(s, key, *spec, n);
-    if (control::node_parameters().find(name)) {
+    if (node) {
       if (std::string err = control::set_parameter(c, name, value); !err.empty()) s.fail(key, err);
     } else {
       if (std::string err = control::check_value(*spec, value); !err.empty()) s.fail(key, err);
+      for (const control::Setting& before : controller_settings) {
+        if (before.name == name) {
+          s.fail(key, "'" + name + "' is set twice: directly under controller: and in the " + std::string(c.type()) +
+                          " gains section; keep one");
+        }
+      }
       controller_settings.push_back({name, value});
     }
     if (out) out->emplace_back(name, value);
+  }
+}
+
+// The gains sections of `s` (keys named after registered types): the flying type's into `settings`
+// (and `out`), every other checked against its own type's table, as designed for `vehicle`, and left
+// unused.
+void read_type_sections(YamlSection& s, control::ControllerConfig& c, const model::VehicleParams& vehicle,
+                        std::vector<control::Setting>& settings,
+                        std::vector<std::pair<std::string, control::ParameterValue>>* out) {
+  for (const std::string& key : s.keys()) {
+    if (!type_section_key(key)) continue;
+    auto section = s.section(key);
+    if (!section) continue;  // `paper:` with nothing under it
+    if (key == c.type()) {
+      collect_parameters(*section, "", c, settings, out, 1, ParameterPlace::kTypeSection);
+      continue;
+    }
+    control::ControllerConfig other;
+    try {
+      other = controllers::make_config(key, vehicle);
+    } catch (const std::exception&) {
+      continue;  // not designable for this vehicle; it does not fly here, so its gains are not checked
+    }
+    std::vector<control::Setting> unused;
+    collect_parameters(*section, "", other, unused, nullptr, 1, ParameterPlace::kTypeSection);
+    if (unused.empty()) continue;
+    std::unique_ptr<control::Controller> probe = other.controller->clone();
+    if (std::string err = probe->set_parameters(unused); !err.empty()) section->fail(unused.front().name, err);
   }
 }
 
@@ -153,6 +206,7 @@ void read_parameters(YamlSection& s, control::ControllerConfig& c,
                      std::vector<std::pair<std::string, control::ParameterValue>>* out) {
   std::vector<control::Setting> settings;
   collect_parameters(s, "", c, settings, out, 1);
+  read_type_sections(s, c, c.vehicle, settings, out);
   if (settings.empty()) return;
   std::unique_ptr<control::Controller> next = c.controller->clone();
   if (std::string err = next->set_parameters(settings); !err.empty()) s.fail(settings.front().name, err);
@@ -396,42 +450,54 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
   f.reject_unknown_keys();
 }
 
-// analysis.limits: each key an upper bound >= 0 on a saturation or control-effort figure.
-LimitsSpec read_limits(YamlSection& l, double duration_s) {
+// analysis.limits: each key an upper bound >= 0 on a saturation or control-effort figure, at the top
+// of the section (a specification, as the keys were read before the two sets existed) or under its
+// `spec:` and `paper:`.
+LimitsSpec read_limits(YamlSection& limits, double duration_s) {
   LimitsSpec spec;
-  auto bound = [&](const std::string& key, double hi, const std::vector<std::string>& figures) {
-    if (!l.has(key)) return;
-    const double v = l.number(key, 0.0, 0.0, hi);
-    for (const auto& f : figures) spec.criteria.push_back(Criterion{f, std::nullopt, v});
+  const auto read_set = [&](YamlSection& l, CriteriaSet set) {
+    auto bound = [&](const std::string& key, double hi, const std::vector<std::string>& figures) {
+      if (!l.has(key)) return;
+      const double v = l.number(key, 0.0, 0.0, hi);
+      for (const auto& f : figures) spec.criteria.push_back(Criterion{f, std::nullopt, v, set});
+    };
+    bound("max_saturated_s", duration_s, {"saturated_s"});
+    bound("max_rotor_saturated_s", duration_s,
+          {"rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s", "rotor4_saturated_s"});
+    bound("max_tilt_saturated_s", duration_s, {"tilt_saturated_s"});
+    bound("max_rms_u1_deviation_n", kHuge, {"rms_u1_deviation_n"});
   };
-  bound("max_saturated_s", duration_s, {"saturated_s"});
-  bound("max_rotor_saturated_s", duration_s,
-        {"rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s", "rotor4_saturated_s"});
-  bound("max_tilt_saturated_s", duration_s, {"tilt_saturated_s"});
-  bound("max_rms_u1_deviation_n", kHuge, {"rms_u1_deviation_n"});
-  l.reject_unknown_keys();
+  const bool sets = limits.has("spec") || limits.has("paper");
+  if (sets) {
+    for (const auto& key : limits.node()) {
+      const std::string name = key.first.as<std::string>("");
+      if (name != "spec" && name != "paper") {
+        limits.fail(name, "beside spec/paper; with spec: or paper: every bound goes under one of them");
+      }
+    }
+    if (auto s = limits.section("spec")) {
+      read_set(*s, CriteriaSet::kSpec);
+      s->reject_unknown_keys();
+    }
+    if (auto p = limits.section("paper")) {
+      read_set(*p, CriteriaSet::kPaper);
+      p->reject_unknown_keys();
+    }
+  } else {
+    read_set(limits, CriteriaSet::kSpec);
+  }
+  limits.reject_unknown_keys();
   return spec;
 }
 
-// analysis.tracking: after_s and criteria on the tracking figures, as a step's criteria.
+// analysis.tracking: after_s and the bands on the tracking figures, as a step's.
 TrackingSpec read_tracking(YamlSection& s, double duration_s) {
   TrackingSpec spec;
   spec.after_s = s.number("after_s", 0.0, 0.0, duration_s);
-  auto c = s.section("criteria");
-  if (!c) s.fail("criteria", "missing; expected e.g. {position_rmse_m: [null, 0.05]}");
-  const auto& names = analysis::tracking_figure_names();
-  for (const std::string& fig : c->keys()) {
-    if (std::find(names.begin(), names.end(), fig) == names.end()) {
-      std::string expected;
-      for (std::size_t i = 0; i < names.size(); ++i) {
-        expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-      }
-      c->fail(fig, "unknown tracking figure (expected " + expected + ")");
-    }
-    const auto [min, max] = c->bounds(fig);
-    spec.criteria.push_back(Criterion{fig, min, max});
-  }
-  if (spec.criteria.empty()) s.fail("criteria", "expected at least one figure");
+  auto criteria = read_criteria_sets(s, analysis::tracking_figure_names(), "tracking figure");
+  if (!criteria) s.fail("spec", "missing; expected e.g. spec: {position_rmse_m: [null, 0.05]}");
+  spec.criteria = std::move(*criteria);
+  if (spec.criteria.empty()) s.fail("spec", "expected at least one figure");
   s.reject_unknown_keys();
   return spec;
 }
@@ -445,24 +511,15 @@ void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
   int index = 0;
   for (const YAML::Node& n : analysis.sequence("steps")) {
     const std::string where = "steps[" + std::to_string(index++) + "]";
-    if (!n.IsMap()) analysis.fail(where, "expected a mapping with channel, at_s, criteria");
+    if (!n.IsMap()) analysis.fail(where, "expected a mapping with channel, at_s, spec and/or paper");
     YamlSection s(n, analysis.file(), analysis.key_path(where));
     StepSpec step;
     step.channel = s.choice("channel", "", channels);
     if (step.channel.empty()) s.fail("channel", "missing; expected one of x y z roll pitch yaw");
     step.t_step_s = s.number("at_s", 0.0, 0.0, duration_s);
     step.settling_band = s.number("settling_band_pct", 2.0, 0.01, 50.0) / 100.0;
-    if (auto c = s.section("criteria")) {
-      for (const std::string& fig : c->keys()) {
-        bool known = false;
-        for (const auto& f : analysis::figure_names()) known = known || f == fig;
-        if (!known)
-          c->fail(fig,
-                  "unknown step figure (expected overshoot_pct, peak_time_s, rise_time_s, t95_s, settling_time_2pct_s "
-                  "or steady_state_error_pct)");
-        const auto [min, max] = c->bounds(fig);
-        step.criteria.push_back(Criterion{fig, min, max});
-      }
+    if (auto criteria = read_criteria_sets(s, analysis::figure_names(), "step figure")) {
+      step.criteria = std::move(*criteria);
     }
     if (auto r = s.section("reference")) {
       for (const std::string& key : r->keys()) {
@@ -545,6 +602,38 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
 
 }  // namespace
 
+const char* to_string(CriteriaSet set) { return set == CriteriaSet::kSpec ? "spec" : "paper"; }
+
+const char* to_string(Judge judge) {
+  switch (judge) {
+    case Judge::kSpec: return "spec";
+    case Judge::kPaper: return "paper";
+    case Judge::kNone: return "none";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& judge_names() {
+  static const std::vector<std::string> names = {"spec", "paper", "none"};
+  return names;
+}
+
+std::optional<Judge> parse_judge(const std::string& name) {
+  for (Judge j : {Judge::kSpec, Judge::kPaper, Judge::kNone}) {
+    if (name == to_string(j)) return j;
+  }
+  return std::nullopt;
+}
+
+bool has_criteria(const Scenario& sc, CriteriaSet set) {
+  const auto any = [&](const std::vector<Criterion>& criteria) {
+    return std::any_of(criteria.begin(), criteria.end(), [&](const Criterion& c) { return c.set == set; });
+  };
+  return std::any_of(sc.steps.begin(), sc.steps.end(), [&](const StepSpec& s) { return any(s.criteria); }) ||
+         (sc.hold && any(sc.hold->criteria)) || (sc.limits && any(sc.limits->criteria)) ||
+         (sc.tracking && any(sc.tracking->criteria));
+}
+
 const std::vector<std::string>& hold_figure_names() {
   static const std::vector<std::string> names = {"max_horizontal_error_m", "rms_horizontal_error_m",
                                                  "max_vertical_error_m"};
@@ -557,16 +646,92 @@ model::State initial_state(const Scenario& sc) {
 
 Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path, nullptr); }
 
-void set_controller_type(YAML::Node root, const std::string& controller_type) {
+ControllerChoice parse_controller_choice(const std::string& text) {
+  ControllerChoice c;
+  if (text.rfind("python:", 0) == 0) {
+    c.kind = ControllerChoice::Kind::kPython;
+    c.target = text.substr(7);
+    const std::size_t colon = c.target.find(':');
+    if (colon == 0 || colon == std::string::npos || colon + 1 == c.target.size()) {
+      throw std::invalid_argument("got '" + text +
+                                  "', expected python:MODULE:CLASS (e.g. python:my_controllers:LevelPD)");
+    }
+  } else if (text.rfind("fmu:", 0) == 0) {
+    c.kind = ControllerChoice::Kind::kFmu;
+    c.target = text.substr(4);
+    if (c.target.empty()) throw std::invalid_argument("got '" + text + "', expected fmu:PATH of a co-simulation FMU");
+    std::error_code ec;
+    if (!std::filesystem::exists(c.target, ec)) {
+      throw std::invalid_argument("got '" + text + "': no such file '" + c.target + "'");
+    }
+    c.target = std::filesystem::absolute(c.target).lexically_normal().string();
+  } else if (text == "python") {
+    c.kind = ControllerChoice::Kind::kPython;  // the class is named by the caller (controller.python)
+  } else {
+    if (!controllers::find_controller_type(text)) {
+      throw std::invalid_argument("got '" + text + "', expected a controller type (" +
+                                  controllers::controller_type_names() +
+                                  "), python:MODULE:CLASS (a class written in Python) or fmu:PATH (an FMU)");
+    }
+    c.target = text;
+  }
+  return c;
+}
+
+void set_controller_type(YAML::Node root, const std::string& controller) {
+  const ControllerChoice choice = parse_controller_choice(controller);
   if (!root["controller"] || !root["controller"].IsMap()) {
     if (root["controller"] && !root["controller"].IsNull()) return;  // load_scenario refuses it, naming the key
     root["controller"] = YAML::Node(YAML::NodeType::Map);
   }
-  root["controller"]["type"] = controller_type;
-  if (controller_type != "python") {
-    // Another type in place of a Python controller: its class and time limit go with it.
-    root["controller"].remove("python");
-    root["controller"].remove("step_timeout_s");
+  YAML::Node c = root["controller"];
+  // What the file flies: a Python class, an FMU, or a registered type (paper by default).
+  const bool was_python = c["python"] || (c["type"] && c["type"].IsScalar() && c["type"].Scalar() == "python");
+  const bool was_fmu = static_cast<bool>(c["fmu"]);
+  const std::string was_type = was_python                          ? "python"
+                               : was_fmu                           ? "fmu"
+                               : c["type"] && c["type"].IsScalar() ? c["type"].Scalar()
+                                                                   : "paper";
+  const bool same = choice.kind == ControllerChoice::Kind::kType ? !was_python && !was_fmu && was_type == choice.target
+                    : choice.kind == ControllerChoice::Kind::kPython
+                        ? was_python && (choice.target.empty() || (c["python"] && c["python"].IsScalar() &&
+                                                                   c["python"].Scalar() == choice.target))
+                        : was_fmu && c["fmu"].IsScalar() && c["fmu"].Scalar() == choice.target;
+  if (!same) {
+    // The gains written directly under controller: are the file's controller's. A registered type's
+    // move into its own section (kept, checked, unused); a Python class's or an FMU's go with it.
+    YAML::Node gains(YAML::NodeType::Map);
+    std::vector<std::string> moved;
+    for (const auto& kv : c) {
+      const std::string key = kv.first.as<std::string>();
+      if (controller_section_key(key) || type_section_key(key) || key == "step_timeout_s" || key == "in_process") {
+        continue;
+      }
+      if (control::node_parameters().find(key)) continue;
+      moved.push_back(key);
+    }
+    const bool keep = !was_python && !was_fmu && controllers::find_controller_type(was_type);
+    for (const std::string& key : moved) {
+      if (keep) {
+        if (!c[was_type] || !c[was_type].IsMap()) c[was_type] = YAML::Node(YAML::NodeType::Map);
+        if (!c[was_type][key]) c[was_type][key] = YAML::Clone(c[key]);
+      }
+      c.remove(key);
+    }
+    for (const char* key : {"python", "step_timeout_s", "fmu", "inputs", "outputs", "parameters", "in_process"}) {
+      c.remove(key);
+    }
+  }
+  switch (choice.kind) {
+    case ControllerChoice::Kind::kType: c["type"] = choice.target; break;
+    case ControllerChoice::Kind::kPython:
+      c["type"] = "python";
+      if (!choice.target.empty()) c["python"] = choice.target;
+      break;
+    case ControllerChoice::Kind::kFmu:
+      c.remove("type");
+      c["fmu"] = choice.target;
+      break;
   }
 }
 

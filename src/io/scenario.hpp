@@ -40,10 +40,34 @@ struct InitialState {
   bool hover = false;  ///< rotors start at hover speed (airborne trimmed start) instead of stopped
 };
 
-/// A pass band on one step figure; either bound may be absent.
+/// The set a criterion belongs to (docs/scenarios.md, "Criteria: spec and paper"). `spec:` is a
+/// specification: bounds any good controller of the vehicle must meet (e.g. overshoot at most 25 %).
+/// `paper:` is the paper's controller's measured response: bands around its figures (e.g. overshoot
+/// 15-21 %), which a better controller leaves. The old key `criteria:` is read as `spec:`.
+enum class CriteriaSet { kSpec, kPaper };
+
+/// What a run is judged against (`--judge`, the Python `judge=`): one criteria set, or none (figures
+/// only: every figure is computed and written, no verdict is given).
+enum class Judge { kSpec, kPaper, kNone };
+
+/// "spec", "paper".
+const char* to_string(CriteriaSet set);
+/// "spec", "paper", "none".
+const char* to_string(Judge judge);
+/// "spec", "paper", "none": the values --judge takes, in this order.
+const std::vector<std::string>& judge_names();
+/// The Judge named `name` (one of judge_names()), or nothing for any other text.
+std::optional<Judge> parse_judge(const std::string& name);
+/// Whether `judge` judges the criteria of `set`.
+constexpr bool judges(Judge judge, CriteriaSet set) {
+  return (judge == Judge::kSpec && set == CriteriaSet::kSpec) || (judge == Judge::kPaper && set == CriteriaSet::kPaper);
+}
+
+/// A pass band on one figure; either bound may be absent.
 struct Criterion {
-  std::string figure;  ///< one of analysis::figure_names()
+  std::string figure;  ///< one of analysis::figure_names() (steps), of the hold, tracking or limits figures
   std::optional<double> min, max;
+  CriteriaSet set = CriteriaSet::kSpec;
 };
 
 /// A step to analyse: the channel's setpoint changes at t_step_s.
@@ -53,7 +77,7 @@ struct StepSpec {
   /// Band of the settled verdict and of the settling time, as a fraction of the step
   /// (analysis.steps[].settling_band_pct / 100; 2 % unless set, e.g. wider where sensor noise exceeds it).
   double settling_band = 0.02;
-  std::vector<Criterion> criteria;
+  std::vector<Criterion> criteria;          ///< both sets, in file order (spec first, then paper)
   std::string reference_source;             ///< where the reference figures come from
   std::map<std::string, double> reference;  ///< published figures to compare with
 };
@@ -70,7 +94,7 @@ struct SwarmSpec {
 /// rms_horizontal_error_m, max_vertical_error_m (max |z - z_des|), all over t >= after_s.
 struct HoldSpec {
   double after_s = 0.0;
-  std::vector<Criterion> criteria;
+  std::vector<Criterion> criteria;  ///< both sets (spec first, then paper)
 };
 
 /// "max_horizontal_error_m", "rms_horizontal_error_m", "max_vertical_error_m".
@@ -81,7 +105,7 @@ const std::vector<std::string>& hold_figure_names();
 /// (after_s 0, no criteria), so every tracking run reports its figures.
 struct TrackingSpec {
   double after_s = 0.0;
-  std::vector<Criterion> criteria;  ///< on analysis::tracking_figure_names()
+  std::vector<Criterion> criteria;  ///< on analysis::tracking_figure_names(), both sets
   /// The controller's period [s] (simulation.controller_rate_hz): only samples at its steps are judged.
   double reference_period_s = 0.0;
 };
@@ -89,9 +113,10 @@ struct TrackingSpec {
 /// analysis.limits: upper bounds on the run's saturation and control effort (io::SaturationResult).
 /// Keys max_saturated_s, max_rotor_saturated_s (each rotor), max_tilt_saturated_s and
 /// max_rms_u1_deviation_n become criteria {figure, max} on the figures saturated_s,
-/// rotor1..4_saturated_s, tilt_saturated_s and rms_u1_deviation_n.
+/// rotor1..4_saturated_s, tilt_saturated_s and rms_u1_deviation_n. The keys stand at the top of
+/// analysis.limits (a specification, as before), or under its `spec:` and `paper:`.
 struct LimitsSpec {
-  std::vector<Criterion> criteria;
+  std::vector<Criterion> criteria;  ///< both sets
 };
 
 /// A scenario's `plant: {fmu: ...}` or `controller: {fmu: ...}` (or the CLI's --fmu): the FMU and how
@@ -131,6 +156,9 @@ struct Scenario {
 using PythonControllerFactory = std::function<std::shared_ptr<const control::Controller>(
     const std::string& target, const std::filesystem::path& folder, const model::VehicleParams& vehicle)>;
 
+/// Whether the scenario has a criterion of `set` (in a step, the hold, the limits or the tracking).
+bool has_criteria(const Scenario& scenario, CriteriaSet set);
+
 /// Sets (or with an empty function, removes) the resolver of `controller: {python: ...}`. Without one,
 /// such a scenario is refused: "controller.python: this quadcosim was built without Python ...".
 void set_python_controller_factory(PythonControllerFactory factory);
@@ -151,13 +179,27 @@ model::State initial_state(const Scenario& scenario);
 /// wrong type, value out of range, a rate that is not a whole divisor, ...).
 Scenario load_scenario(const std::string& path);
 
-/// The same with `controller.type` set to `controller_type` when it is not empty (the CLI's
-/// --controller): the file's controller parameters are then checked against that type's table.
-Scenario load_scenario(const std::string& path, const std::string& controller_type);
+/// The same flown by `controller` when it is not empty (the CLI's --controller; see
+/// set_controller_type for what it may name).
+Scenario load_scenario(const std::string& path, const std::string& controller);
 
-/// Sets `controller.type` in a parsed scenario (a mapping), creating the section if needed; a type other
-/// than python drops the section's `python` and `step_timeout_s` (a Python controller's).
-void set_controller_type(YAML::Node root, const std::string& controller_type);
+/// What `--controller` names: a registered type ("se3"), a class written in Python
+/// ("python:MODULE:CLASS"), or a co-simulation FMU ("fmu:PATH", made absolute from the current
+/// directory). Throws std::invalid_argument saying what was expected.
+struct ControllerChoice {
+  enum class Kind { kType, kPython, kFmu } kind = Kind::kType;
+  std::string target;  ///< the type's name, MODULE:CLASS ("" for a bare "python") or the FMU's absolute path
+};
+ControllerChoice parse_controller_choice(const std::string& text);
+
+/// Makes a parsed scenario (a mapping) fly `controller` (parse_controller_choice; a bare "python"
+/// leaves the class to the caller's controller.python), creating the section if needed. What is
+/// flown (the node's mode, setpoints, safety) stays. The gains written directly under controller:
+/// belong to the file's controller: a registered type's move into its own gains section (`paper:
+/// {lqr: ...}`, still checked, not used); a Python class's or an FMU's (and its python, fmu,
+/// inputs, outputs, parameters, step_timeout_s) are dropped. The gains section of the type that
+/// flies now, when the file has one, applies. Throws std::invalid_argument as parse_controller_choice.
+void set_controller_type(YAML::Node root, const std::string& controller);
 
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file
 /// and `path` is recorded as the scenario's path. A sweep sets keys in the parsed file and loads each

@@ -82,29 +82,36 @@ Series read_series(const std::string& path) {
 namespace {
 bool is_angle(const std::string& channel) { return channel == "roll" || channel == "pitch" || channel == "yaw"; }
 
-CriterionResult judge(const Criterion& c, const std::optional<double>& value, std::string note = "") {
-  CriterionResult cr{c, value, false, std::move(note)};
+// A criterion's value against its band; judged when `judge` judges its set (docs/scenarios.md).
+CriterionResult judge_criterion(const Criterion& c, const std::optional<double>& value, Judge judge,
+                                std::string note = "") {
+  CriterionResult cr{c, value, false, judges(judge, c.set), std::move(note)};
   cr.passed =
       cr.note.empty() && cr.value.has_value() && (!c.min || *cr.value >= *c.min) && (!c.max || *cr.value <= *c.max);
   return cr;
 }
 
-// Judges each criterion on the figure of r.figures it names, into r.criteria and r.passed; a figure
-// that is absent fails, with why(criterion) as the note.
+// Adds `cr` to r.criteria; a judged criterion outside its band fails r.
+template <class Result>
+void add_criterion(Result& r, const CriterionResult& cr) {
+  r.passed = r.passed && (!cr.judged || cr.passed);
+  r.criteria.push_back(cr);
+}
+
+// Checks each criterion on the figure of r.figures it names, into r.criteria and r.passed; a figure
+// that is absent is outside every band, with why(criterion) as the note.
 template <class Result, class Why>
-void judge_figures(const std::vector<Criterion>& criteria, Result& r, Why why) {
+void judge_figures(const std::vector<Criterion>& criteria, Result& r, Judge judge, Why why) {
   for (const Criterion& c : criteria) {
     const auto it = r.figures.find(c.figure);
-    const CriterionResult cr =
-        it == r.figures.end() ? judge(c, std::nullopt, why(c)) : judge(c, std::optional<double>(it->second));
-    r.passed = r.passed && cr.passed;
-    r.criteria.push_back(cr);
+    add_criterion(r, it == r.figures.end() ? judge_criterion(c, std::nullopt, judge, why(c))
+                                           : judge_criterion(c, std::optional<double>(it->second), judge));
   }
 }
 std::string no_note(const Criterion&) { return {}; }
 }  // namespace
 
-std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series) {
+std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series, Judge judge) {
   std::vector<StepResult> out;
   for (const StepSpec& spec : steps) {
     StepResult r;
@@ -132,10 +139,8 @@ std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const
     r.figures = analysis::step_figures(std::span(series.t_s).first(n), std::span(y->second).first(n), spec.t_step_s,
                                        sp->second[i], options);
     for (const Criterion& c : spec.criteria) {
-      const CriterionResult cr =
-          judge(c, analysis::figure(r.figures, c.figure), analysis::unjudgeable_reason(r.figures, c.figure, options));
-      r.passed = r.passed && cr.passed;
-      r.criteria.push_back(cr);
+      add_criterion(r, judge_criterion(c, analysis::figure(r.figures, c.figure), judge,
+                                       analysis::unjudgeable_reason(r.figures, c.figure, options)));
     }
     out.push_back(r);
   }
@@ -149,7 +154,7 @@ const std::vector<std::string>& saturation_figure_names() {
   return names;
 }
 
-std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Series& series) {
+std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Series& series, Judge judge) {
   const auto& v = series.values;
   for (const char* c : {"sat1", "sat2", "sat3", "sat4", "tilt_sat"}) {
     if (!v.count(c)) return std::nullopt;
@@ -186,7 +191,7 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
   for (int k = 0; k < 4; ++k) r.figures[SaturationResult::fmt_rotor(k + 1)] = rotor[k];
   r.figures["tilt_saturated_s"] = tilt;
   if (n_u > 0) r.figures["rms_u1_deviation_n"] = std::sqrt(sum_du2 / static_cast<double>(n_u));
-  if (sc.limits) judge_figures(sc.limits->criteria, r, no_note);
+  if (sc.limits) judge_figures(sc.limits->criteria, r, judge, no_note);
   return r;
 }
 
@@ -213,7 +218,7 @@ bool all_passed(const std::vector<StepResult>& results) {
   return std::all_of(results.begin(), results.end(), [](const auto& r) { return r.passed; });
 }
 
-HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
+HoldResult evaluate_hold(const HoldSpec& spec, const Series& series, Judge judge) {
   HoldResult r;
   r.spec = spec;
   const auto& v = series.values;
@@ -239,11 +244,11 @@ HoldResult evaluate_hold(const HoldSpec& spec, const Series& series) {
     r.figures["rms_horizontal_error_m"] = std::sqrt(sum_h2 / static_cast<double>(count));
     r.figures["max_vertical_error_m"] = max_v;
   }
-  judge_figures(spec.criteria, r, no_note);
+  judge_figures(spec.criteria, r, judge, no_note);
   return r;
 }
 
-TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series) {
+TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series, Judge judge) {
   TrackingResult r;
   r.spec = spec;
   const auto& v = series.values;
@@ -262,7 +267,7 @@ TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series)
   const analysis::TrackingFigures f = analysis::tracking_figures(s, spec.after_s, spec.reference_period_s);
   r.samples = f.samples;
   r.figures = f.values;
-  judge_figures(spec.criteria, r, [&](const Criterion& c) -> std::string {
+  judge_figures(spec.criteria, r, judge, [&](const Criterion& c) -> std::string {
     if (f.samples == 0) return fmt::format("no sample with a reference at or after t = {:g} s", spec.after_s);
     if (c.figure.rfind("attitude_error", 0) == 0) return "the controller reports no attitude error (att_err is NaN)";
     return "no sample with a finite yaw and yaw_des";
@@ -287,15 +292,58 @@ nlohmann::json criteria_json(const std::vector<CriterionResult>& criteria) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& c : criteria) {
     a.push_back({{"figure", c.criterion.figure},
+                 {"set", to_string(c.criterion.set)},
                  {"min", opt(c.criterion.min)},
                  {"max", opt(c.criterion.max)},
                  {"value", opt(c.value)},
                  {"passed", c.passed},
+                 {"judged", c.judged},
                  {"note", c.note.empty() ? nlohmann::json() : nlohmann::json(c.note)}});
   }
   return a;
 }
+
+// A block's (or the run's) verdict: null when nothing is judged (--judge none).
+nlohmann::json verdict_json(Judge judge, bool passed) {
+  return judge == Judge::kNone ? nlohmann::json() : nlohmann::json(passed);
+}
+
+template <class Result>
+std::size_t count_judged(const Result& r) {
+  return static_cast<std::size_t>(
+      std::count_if(r.criteria.begin(), r.criteria.end(), [](const CriterionResult& c) { return c.judged; }));
+}
 }  // namespace
+
+std::size_t judged_criteria(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
+                            const std::optional<SaturationResult>& saturation,
+                            const std::optional<TrackingResult>& tracking) {
+  std::size_t n = 0;
+  for (const StepResult& r : results) n += count_judged(r);
+  if (hold) n += count_judged(*hold);
+  if (saturation) n += count_judged(*saturation);
+  if (tracking) n += count_judged(*tracking);
+  return n;
+}
+
+std::string judged_set_text(Judge judge) {
+  switch (judge) {
+    case Judge::kSpec: return "spec (the specification: bounds a good controller must meet)";
+    case Judge::kPaper: return "paper (the paper's controller's measured response bands)";
+    case Judge::kNone: return "none (figures only: no verdict)";
+  }
+  return "?";
+}
+
+std::string nothing_judged_note(const Scenario& scenario, Judge judge) {
+  if (judge == Judge::kSpec && !has_criteria(scenario, CriteriaSet::kSpec)) {
+    return "no spec criteria in this scenario: nothing judged";
+  }
+  if (judge == Judge::kPaper && !has_criteria(scenario, CriteriaSet::kPaper)) {
+    return "no paper bands in this scenario: nothing judged";
+  }
+  return "";
+}
 
 bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
                     const std::optional<SaturationResult>& saturation, const std::optional<TrackingResult>& tracking) {
@@ -305,11 +353,14 @@ bool passed_overall(const std::vector<StepResult>& results, const std::optional<
 
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
                             const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
-                            const std::optional<TrackingResult>& tracking) {
+                            const std::optional<TrackingResult>& tracking, Judge judge) {
   nlohmann::json j;
   j["scenario"] = scenario.name;
   j["description"] = scenario.description;
   j["scenario_file"] = scenario.path;
+  j["judged"] = to_string(judge);
+  j["judged_criteria"] = judged_criteria(results, hold, saturation, tracking);
+  if (const std::string note = nothing_judged_note(scenario, judge); !note.empty()) j["judged_note"] = note;
   j["steps"] = nlohmann::json::array();
   for (const StepResult& r : results) {
     nlohmann::json s;
@@ -331,7 +382,7 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
       for (const auto& [k, v] : r.spec.reference) ref[k] = v;
       s["reference"] = ref;
     }
-    s["passed"] = r.passed;
+    s["passed"] = verdict_json(judge, r.passed);
     j["steps"].push_back(s);
   }
   if (hold) {
@@ -339,13 +390,13 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
     h["after_s"] = hold->spec.after_s;
     h["figures"] = figures_json(hold_figure_names(), hold->figures);
     h["criteria"] = criteria_json(hold->criteria);
-    h["passed"] = hold->passed;
+    h["passed"] = verdict_json(judge, hold->passed);
     j["hold"] = h;
   }
   if (saturation) {
     j["saturation"] = {{"figures", figures_json(saturation_figure_names(), saturation->figures)},
                        {"criteria", criteria_json(saturation->criteria)},
-                       {"passed", saturation->passed}};
+                       {"passed", verdict_json(judge, saturation->passed)}};
   }
   if (tracking) {
     j["tracking"] = {{"after_s", tracking->spec.after_s},
@@ -353,58 +404,91 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
                      {"samples", tracking->samples},
                      {"figures", figures_json(analysis::tracking_figure_names(), tracking->figures)},
                      {"criteria", criteria_json(tracking->criteria)},
-                     {"passed", tracking->passed}};
+                     {"passed", verdict_json(judge, tracking->passed)}};
   }
-  j["passed"] = passed_overall(results, hold, saturation, tracking);
+  j["passed"] = verdict_json(judge, passed_overall(results, hold, saturation, tracking));
   return j;
 }
 
 void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
                         const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
-                        const std::optional<TrackingResult>& tracking) {
-  write_file_atomically(path, metrics_json(scenario, results, hold, saturation, tracking).dump(2) + "\n");
+                        const std::optional<TrackingResult>& tracking, Judge judge) {
+  write_file_atomically(path, metrics_json(scenario, results, hold, saturation, tracking, judge).dump(2) + "\n");
 }
 
 namespace {
-// The criterion column, verdict and notes of the figure `name` (several criteria may name it).
+// The band and check of the figure `name` in one criteria set, and the notes of its criteria (several
+// criteria may name it). The judged set's check reads ok/FAIL; the other's in/out (shown, not judged).
 struct CriterionCells {
-  std::string crit, verdict;
+  std::string band, check;
   std::vector<std::string> notes;
 };
-CriterionCells cells(const std::vector<CriterionResult>& criteria, const std::string& name) {
+CriterionCells cells(const std::vector<CriterionResult>& criteria, const std::string& name, CriteriaSet set) {
   CriterionCells c;
   for (const auto& r : criteria) {
-    if (r.criterion.figure != name) continue;
-    c.crit = fmt::format("[{}, {}]", r.criterion.min ? fmt::format("{:g}", *r.criterion.min) : "-",
+    if (r.criterion.figure != name || r.criterion.set != set) continue;
+    c.band = fmt::format("[{}, {}]", r.criterion.min ? fmt::format("{:g}", *r.criterion.min) : "-",
                          r.criterion.max ? fmt::format("{:g}", *r.criterion.max) : "-");
-    c.verdict = r.passed ? "ok" : "FAIL";
+    c.check = r.judged ? (r.passed ? "ok" : "FAIL") : (r.passed ? "in" : "out");
     if (!r.note.empty()) c.notes.push_back(r.note);
   }
   return c;
 }
 
-// One table row per figure of `names` (value as `show` writes it, "-" when absent), each followed by
-// the notes of its criteria.
+// The header of a figure table: figure, value, the spec and paper columns, and `last` (reference).
+// A table line without the padding of its empty last cells.
+std::string trimmed_line(std::string line) {
+  line.erase(line.find_last_not_of(' ') + 1);
+  return line + "\n";
+}
+
+std::string header_row(const std::string& last) {
+  return trimmed_line(fmt::format("  {:<24} {:>12} {:>18} {:<4} {:>18} {:<4} {:>10}", "figure", "value", "spec", "",
+                                  "paper", "", last));
+}
+
+// One row: a figure's value, its spec band and check, its paper band and check, and `last`; then its notes.
+std::string figure_row(const std::string& name, const std::string& value, const std::vector<CriterionResult>& criteria,
+                       const std::string& last) {
+  const CriterionCells spec = cells(criteria, name, CriteriaSet::kSpec);
+  const CriterionCells paper = cells(criteria, name, CriteriaSet::kPaper);
+  std::string s = trimmed_line(fmt::format("  {:<24} {:>12} {:>18} {:<4} {:>18} {:<4} {:>10}", name, value, spec.band,
+                                           spec.check, paper.band, paper.check, last));
+  for (const auto* c : {&spec, &paper}) {
+    for (const auto& note : c->notes) s += fmt::format("    {}: {}\n", name, note);
+  }
+  return s;
+}
+
+// One table row per figure of `names` (value as `show` writes it, "-" when absent).
 template <class Show>
 std::string figure_rows(const std::vector<std::string>& names, const std::map<std::string, double>& figures,
                         const std::vector<CriterionResult>& criteria, Show show) {
-  std::string s;
+  std::string s = header_row("");
   for (const auto& name : names) {
     const auto it = figures.find(name);
-    const CriterionCells c = cells(criteria, name);
-    s += fmt::format("  {:<24} {:>12} {:>22} {:>7}\n", name, it != figures.end() ? show(it->second) : "-", c.crit,
-                     c.verdict);
-    for (const auto& note : c.notes) s += fmt::format("    {}: {}\n", name, note);
+    s += figure_row(name, it != figures.end() ? show(it->second) : "-", criteria, "");
   }
   return s;
 }
 std::string fixed3(double v) { return fmt::format("{:.3f}", v); }
+
+// A block's verdict: PASS or FAIL on the judged criteria, "figures only" under --judge none, "no spec
+// criteria" (or paper bands) when the block has none of the judged set.
+template <class Result>
+std::string verdict_text(const Result& r, Judge judge) {
+  if (judge == Judge::kNone) return "figures only";
+  if (r.criteria.empty()) return "no criteria";
+  if (count_judged(r) == 0) return judge == Judge::kSpec ? "no spec criteria" : "no paper bands";
+  return r.passed ? "PASS" : "FAIL";
+}
 }  // namespace
 
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
                               const std::optional<HoldResult>& hold, const std::optional<SaturationResult>& saturation,
-                              const std::optional<TrackingResult>& tracking) {
-  std::string s = fmt::format("scenario {}\n", scenario.name);
+                              const std::optional<TrackingResult>& tracking, Judge judge) {
+  std::string s = fmt::format("scenario {}\njudged against: {}\n", scenario.name, judged_set_text(judge));
+  if (const std::string note = nothing_judged_note(scenario, judge); !note.empty()) s += note + "\n";
   for (const StepResult& r : results) {
     const auto& f = r.figures;
     const bool angle = is_angle(r.spec.channel);
@@ -413,8 +497,8 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
         f.target,
         angle && std::abs(f.step - (f.target - f.initial)) > 1e-12 ? fmt::format(" (shortest path {:+.3f})", f.step)
                                                                    : "",
-        r.spec.t_step_s, r.passed ? "PASS" : "FAIL", analysis::to_string(f.verdict), f.final_window_s, f.post_step_s);
-    s += fmt::format("  {:<24} {:>12} {:>22} {:>7} {:>10}\n", "figure", "value", "criterion", "", "reference");
+        r.spec.t_step_s, verdict_text(r, judge), analysis::to_string(f.verdict), f.final_window_s, f.post_step_s);
+    s += header_row("reference");
     for (const auto& name : analysis::figure_names()) {
       const auto v = analysis::figure(f, name);
       std::string value = v ? fmt::format("{:.3f}", *v) : "-";
@@ -424,28 +508,29 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
           (name == "settling_time_2pct_s" || name == "steady_state_error_pct")) {
         value = "too short";
       }
-      const CriterionCells c = cells(r.criteria, name);
       const auto ref = r.spec.reference.find(name);
-      s += fmt::format("  {:<24} {:>12} {:>22} {:>7} {:>10}\n", name, value, c.crit, c.verdict,
-                       ref != r.spec.reference.end() ? fmt::format("{:g}", ref->second) : "");
-      for (const auto& note : c.notes) s += fmt::format("    {}: {}\n", name, note);
+      s += figure_row(name, value, r.criteria, ref != r.spec.reference.end() ? fmt::format("{:g}", ref->second) : "");
     }
   }
   if (hold) {
-    s += fmt::format("hold from t = {:g} s: {}\n", hold->spec.after_s, hold->passed ? "PASS" : "FAIL");
+    s += fmt::format("hold from t = {:g} s: {}\n", hold->spec.after_s, verdict_text(*hold, judge));
     s += figure_rows(hold_figure_names(), hold->figures, hold->criteria, fixed3);
   }
   if (saturation) {
-    s += fmt::format("limits (rotor speed and tilt saturation, control effort): {}\n",
-                     saturation->passed ? (saturation->criteria.empty() ? "no criteria" : "PASS") : "FAIL");
+    s +=
+        fmt::format("limits (rotor speed and tilt saturation, control effort): {}\n", verdict_text(*saturation, judge));
     s += figure_rows(saturation_figure_names(), saturation->figures, saturation->criteria, fixed3);
   }
   if (tracking) {
     s += fmt::format("tracking from t = {:g} s ({} samples, at the controller's steps every {:g} s): {}\n",
                      tracking->spec.after_s, tracking->samples, tracking->spec.reference_period_s,
-                     tracking->passed ? (tracking->criteria.empty() ? "no criteria" : "PASS") : "FAIL");
+                     verdict_text(*tracking, judge));
     s += figure_rows(analysis::tracking_figure_names(), tracking->figures, tracking->criteria,
                      [](double v) { return fmt::format("{:.4g}", v); });
+  }
+  if (has_criteria(scenario, CriteriaSet::kPaper)) {
+    s += "paper: the paper's controller's response (bands around its measured figures), not a specification; "
+         "spec: bounds a good controller must meet\n";
   }
   return s;
 }

@@ -22,10 +22,13 @@ struct Series {
   void append(const std::string& name, double v) { values[name].push_back(v); }
 };
 
+/// One criterion checked: whether the value lies in its band (`passed`, computed for both sets) and
+/// whether the run is judged on it (its set is the one --judge names).
 struct CriterionResult {
   Criterion criterion;
   std::optional<double> value;
-  bool passed = false;
+  bool passed = false;  ///< the value lies in the band
+  bool judged = false;  ///< the band's set is the judged one: outside it the run fails
   /// Why it failed whatever its bounds (e.g. "the run ended before settling: ..."), else "".
   std::string note;
 };
@@ -34,7 +37,7 @@ struct StepResult {
   StepSpec spec;
   analysis::StepFigures figures;
   std::vector<CriterionResult> criteria;
-  bool passed = true;
+  bool passed = true;  ///< every judged criterion passed (true when none is judged)
 };
 
 /// The position-hold figures (HoldSpec) of a run and their verdicts.
@@ -82,11 +85,15 @@ Series read_series(const std::string& trajectory_csv);
 /// Evaluates every step of the scenario. The target is the channel's setpoint at the step time;
 /// roll, pitch and yaw are judged as angles (shortest-path step, unwrapped response). A step is
 /// judged from its instant to the next later step of the same channel, or to the end of the run.
-std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series);
+/// Every criterion of both sets is checked against its band; the results' verdicts count only the
+/// criteria of the set `judge` names (none under Judge::kNone). The same holds for every evaluate_*.
+std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const Series& series,
+                                       Judge judge = Judge::kSpec);
 
 /// The saturation figures of a run and the verdicts of `scenario.limits`; empty when the series has
 /// no saturation columns (a trajectory.csv written before they existed).
-std::optional<SaturationResult> evaluate_saturation(const Scenario& scenario, const Series& series);
+std::optional<SaturationResult> evaluate_saturation(const Scenario& scenario, const Series& series,
+                                                    Judge judge = Judge::kSpec);
 
 /// One line for the console when the run hit a limit ("run: warning: rotor saturation: ..."), or "".
 std::string saturation_warning(const SaturationResult& saturation);
@@ -94,38 +101,54 @@ std::string saturation_warning(const SaturationResult& saturation);
 bool all_passed(const std::vector<StepResult>& results);
 
 /// The verdict of a run (metrics.json "passed", the exit code of `run`, a sweep run's "passed"):
-/// every step passed, and the hold, the saturation limits and the tracking when judged.
+/// every step passed, and the hold, the saturation limits and the tracking when judged. True when no
+/// criterion is judged (--judge none, or a scenario without the judged set): metrics.json then says so.
 bool passed_overall(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
                     const std::optional<SaturationResult>& saturation,
                     const std::optional<TrackingResult>& tracking = {});
 
+/// How many criteria the results judged (of the set --judge names).
+std::size_t judged_criteria(const std::vector<StepResult>& results, const std::optional<HoldResult>& hold,
+                            const std::optional<SaturationResult>& saturation,
+                            const std::optional<TrackingResult>& tracking);
+
+/// What `judge` judges against, for the table and the console: "spec (the specification: bounds a good
+/// controller must meet)", "paper (the paper's controller's measured response bands)", "none (...)".
+std::string judged_set_text(Judge judge);
+
+/// "no paper bands in this scenario: nothing judged" (or "no spec criteria ...") when the scenario has
+/// no criterion of the set `judge` names; "" otherwise and under Judge::kNone.
+std::string nothing_judged_note(const Scenario& scenario, Judge judge);
+
 /// Evaluates the hold criterion over the samples with t >= spec.after_s.
-HoldResult evaluate_hold(const HoldSpec& spec, const Series& series);
+HoldResult evaluate_hold(const HoldSpec& spec, const Series& series, Judge judge = Judge::kSpec);
 
 /// Evaluates the tracking figures and criteria over the samples with t >= spec.after_s: reference the
 /// x_des, y_des, z_des, yaw_des columns, measured x, y, z, yaw, Psi the att_err column when present. A
 /// criterion on a figure that is absent fails, with a note saying why.
-TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series);
+TrackingResult evaluate_tracking(const TrackingSpec& spec, const Series& series, Judge judge = Judge::kSpec);
 
 /// The content of metrics.json (schema in docs/outputs.md), for callers that add to it (a sweep adds
-/// the run's seed and varied values).
+/// the run's seed and varied values). `judge` is the set the results were evaluated with: written as
+/// "judged", with "judged_criteria"; every "passed" verdict is null under Judge::kNone.
 nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResult>& results,
                             const std::optional<HoldResult>& hold = {},
                             const std::optional<SaturationResult>& saturation = {},
-                            const std::optional<TrackingResult>& tracking = {});
+                            const std::optional<TrackingResult>& tracking = {}, Judge judge = Judge::kSpec);
 
 /// Writes metrics.json (schema in docs/outputs.md). Throws std::runtime_error on I/O failure.
 /// `hold`, `saturation` and `tracking`, when given, are written under their names and count in "passed".
 void write_metrics_json(const std::string& path, const Scenario& scenario, const std::vector<StepResult>& results,
                         const std::optional<HoldResult>& hold = {},
                         const std::optional<SaturationResult>& saturation = {},
-                        const std::optional<TrackingResult>& tracking = {});
+                        const std::optional<TrackingResult>& tracking = {}, Judge judge = Judge::kSpec);
 
-/// A fixed-width table: one line per figure with value, criterion, verdict and reference; a figure
-/// that could not be judged shows why under its line.
+/// A fixed-width table: the set judged against, then one line per figure with its value, its spec band
+/// and check, its paper band and check (ok/FAIL for the judged set, in/out for the other) and the
+/// reference; a figure that could not be judged shows why under its line.
 std::string format_step_table(const Scenario& scenario, const std::vector<StepResult>& results,
                               const std::optional<HoldResult>& hold = {},
                               const std::optional<SaturationResult>& saturation = {},
-                              const std::optional<TrackingResult>& tracking = {});
+                              const std::optional<TrackingResult>& tracking = {}, Judge judge = Judge::kSpec);
 
 }  // namespace quadcosim::io

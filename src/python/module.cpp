@@ -306,7 +306,11 @@ struct TempDir {
 };
 
 /// Flies `s` as `quadcosim run` does in process; the parts the Python RunResult is made of.
-py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool force) {
+py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool force, const std::string& judge_name) {
+  const std::optional<io::Judge> judge = io::parse_judge(judge_name);
+  if (!judge) {
+    throw py::value_error("judge: got '" + judge_name + "', expected 'spec', 'paper' or 'none'");
+  }
   if (s.scenario.swarm) {
     throw py::value_error(s.source +
                           ": swarm: scenarios with a swarm section cannot be run from Python yet; use "
@@ -357,7 +361,7 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
       if (!completed) {
         interrupted = true;
       } else {
-        judged = app::judge_run(s.scenario, dir, provenance);
+        judged = app::judge_run(s.scenario, dir, *judge, provenance);
       }
     } catch (const control::CareError& e) {
       throw io::ConfigError(s.source + ": controller design failed: " + e.what());
@@ -379,7 +383,10 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
   py::dict r;
   r["trajectory"] = trajectory;
   r["metrics_json"] = metrics;
-  r["passed"] = judged.passed;
+  // No verdict under judge="none" (metrics.json's "passed" is null there too).
+  r["passed"] = *judge == io::Judge::kNone ? py::object(py::none()) : py::object(py::bool_(judged.passed));
+  r["judged"] = io::to_string(*judge);
+  r["judged_note"] = judged.nothing_note;
   r["table"] = judged.table;
   r["messages"] = notes.str() + warn.str() + info.str();
   r["out"] = out ? py::object(py::str(*out)) : py::object(py::none());
@@ -689,7 +696,7 @@ Made by quadcosim.load_scenario(path_or_dict); pass it to quadcosim.run() or qua
         py::arg("step_timeout_s") = py::none(),
         "A scenario (a Scenario, file or dict) flown by its controller, a controller type (str) or a Python "
         "controller (instance or class).");
-  m.def("_run", &run, py::arg("scenario"), py::arg("out"), py::arg("force") = false,
+  m.def("_run", &run, py::arg("scenario"), py::arg("out"), py::arg("force") = false, py::arg("judge") = "spec",
         "Runs a scenario in process as `quadcosim run` does; the parts of a RunResult.");
 
   py::class_<PySimulation>(m, "Simulation", R"(One vehicle of a scenario, stepped one control period at a time.

@@ -376,11 +376,23 @@ void set_key(YAML::Node root, const std::string& path, double value,
 }
 
 Plan make_plan(const std::string& scenario_file, const std::vector<std::string>& specs, std::uint64_t seed,
-               int runs_per_point, Sampler sampler) {
+               int runs_per_point, Sampler sampler, const std::string& scenario_source) {
   Plan p;
   p.scenario_file = scenario_file;
-  p.nominal = io::load_scenario(scenario_file);
-  p.root = YAML::LoadFile(scenario_file);  // load_scenario has read it: it parses
+  p.scenario_source = scenario_source.empty() ? scenario_file : scenario_source;
+  if (scenario_source.empty()) {
+    p.nominal = io::load_scenario(scenario_file);
+    p.root = YAML::LoadFile(scenario_file);  // load_scenario has read it: it parses
+  } else {
+    try {
+      p.root = YAML::LoadFile(scenario_file);
+    } catch (const YAML::Exception& e) {
+      throw io::ConfigError(scenario_file + ": " + e.what());
+    }
+    if (!p.root.IsMap()) throw io::ConfigError(scenario_file + ": expected a mapping of scenario sections");
+    p.nominal = io::load_scenario(p.root, p.scenario_source);
+    p.nominal.path = scenario_file;
+  }
   p.seed = seed;
   p.sampler = sampler;
   p.repeats = runs_per_point;
@@ -395,7 +407,7 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
       set_key(root, k.path, v.distribution == Distribution::kPercent ? *k.nominal * value : value, lists);
     }
     try {
-      (void)io::load_scenario(root, scenario_file);
+      (void)io::load_scenario(root, p.scenario_source);
     } catch (const io::ConfigError& e) {
       throw PlanError(fmt::format("--vary {}: {} {:g} refused: {}", v.spec, what, value, e.what()));
     } catch (const std::invalid_argument& e) {
@@ -510,7 +522,8 @@ io::Scenario scenario_for(const Plan& plan, const Sample& s) {
     YAML::Node root = YAML::Clone(plan.root);
     const auto lists = default_lists(plan.nominal);
     for (const auto& [path, value] : s.values) set_key(root, path, value, lists);
-    sc = io::load_scenario(root, plan.scenario_file, &plan.nominal.vehicle);  // designed for the nominal vehicle
+    sc = io::load_scenario(root, plan.scenario_source, &plan.nominal.vehicle);  // designed for the nominal vehicle
+    sc.path = plan.scenario_file;
   }
   sc.simulation.plant.realism.seed = s.seed;
   return sc;

@@ -64,7 +64,11 @@ struct Vary {
 Vary parse_vary(const std::string& spec);
 
 struct Plan {
-  std::string scenario_file;
+  std::string scenario_file;  ///< as recorded in the header and each run's metrics.json
+  /// The path the loader takes the scenario to be at: relative paths in it (a Python controller's
+  /// module, an FMU, a trajectory file) are found from its folder. scenario_file, unless the sweep
+  /// is continued elsewhere (`--resume`, `sweep rerun`: the folder the sweep recorded).
+  std::string scenario_source;
   YAML::Node root;  ///< the scenario file as parsed (never modified)
   io::Scenario nominal;
   std::uint64_t seed = 1;
@@ -74,14 +78,17 @@ struct Plan {
   std::vector<int> grid_sizes;                         ///< one per grid spec, in order (the first varies slowest)
   int runs = 0;                                        ///< product of grid_sizes times repeats
   std::map<std::string, std::vector<int>> lhs_strata;  ///< per random key: run -> stratum
+  io::Judge judge = io::Judge::kSpec;                  ///< the criteria set each run is judged against (--judge)
 };
 
 /// Loads the scenario, resolves every spec's keys (refusing unknown keys, keys varied twice, a
 /// relative spread on a key whose nominal value is unknown, bounds outside a declared range) and
 /// checks each grid value by loading the scenario with it. `runs_per_point` is the number of runs
 /// (no grid) or of runs per grid point. Throws PlanError or io::ConfigError.
+/// With `scenario_source` non-empty, the file is read from `scenario_file` but loaded as if it were
+/// at `scenario_source` (Plan::scenario_source).
 Plan make_plan(const std::string& scenario_file, const std::vector<std::string>& specs, std::uint64_t seed,
-               int runs_per_point, Sampler sampler);
+               int runs_per_point, Sampler sampler, const std::string& scenario_source = "");
 
 /// The draws of one run.
 struct Sample {

@@ -64,11 +64,11 @@ const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, c
   return series.series();
 }
 
-void judge(const io::Scenario& sc, const io::Series& series, RunResult& r) {
-  r.steps = io::evaluate_steps(sc.steps, series);
-  if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series);
-  r.saturation = io::evaluate_saturation(sc, series);
-  if (sc.tracking) r.tracking = io::evaluate_tracking(*sc.tracking, series);
+void judge(const io::Scenario& sc, const io::Series& series, io::Judge set, RunResult& r) {
+  r.steps = io::evaluate_steps(sc.steps, series, set);
+  if (sc.hold) r.hold = io::evaluate_hold(*sc.hold, series, set);
+  r.saturation = io::evaluate_saturation(sc, series, set);
+  if (sc.tracking) r.tracking = io::evaluate_tracking(*sc.tracking, series, set);
   r.passed = io::passed_overall(r.steps, r.hold, r.saturation, r.tracking);
 }
 
@@ -115,7 +115,7 @@ nlohmann::json values_json(const Sample& s) {
 }  // namespace
 
 nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r) {
-  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation, r.tracking);
+  nlohmann::json j = io::metrics_json(flown, r.steps, r.hold, r.saturation, r.tracking, plan.judge);
   nlohmann::json s;
   s["index"] = r.sample.index;
   s["seed"] = r.sample.seed;
@@ -140,6 +140,53 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
   return j;
 }
 
+nlohmann::json failed_criteria(const nlohmann::json& metrics) {
+  nlohmann::json out = nlohmann::json::array();
+  const auto add_failed = [&](const std::string& channel, const nlohmann::json& section) {
+    if (!section.is_object() || !section.contains("criteria") || !section.at("criteria").is_array()) return;
+    for (const auto& c : section.at("criteria")) {
+      if (!c.is_object() || c.value("passed", true) != false) continue;
+      nlohmann::json f = c;
+      f.erase("passed");
+      f.erase("figure");
+      f["channel"] = channel;
+      f["name"] = c.value("figure", std::string());
+      const nlohmann::json value = c.value("value", nlohmann::json());
+      const nlohmann::json min = c.value("min", nlohmann::json()), max = c.value("max", nlohmann::json());
+      f["value"] = value;
+      f["min"] = min;
+      f["max"] = max;
+      f["bound"] = nlohmann::json();
+      f["side"] = nlohmann::json();
+      if (!f.contains("note")) f["note"] = nlohmann::json();
+      // The bound the value is outside; a value inside both failed for its note (not settled, ...).
+      if (value.is_number()) {
+        if (min.is_number() && value.get<double>() < min.get<double>()) {
+          f["bound"] = min;
+          f["side"] = "min";
+        } else if (max.is_number() && value.get<double>() > max.get<double>()) {
+          f["bound"] = max;
+          f["side"] = "max";
+        }
+      }
+      out.push_back(f);
+    }
+  };
+  std::map<std::string, int> seen;  // a channel's second step is "<channel>#2", as in summary.json
+  if (metrics.contains("steps") && metrics.at("steps").is_array()) {
+    for (const auto& step : metrics.at("steps")) {
+      if (!step.is_object()) continue;
+      const std::string channel = step.value("channel", std::string("?"));
+      const int n = ++seen[channel];
+      add_failed(n == 1 ? channel : fmt::format("{}#{}", channel, n), step);
+    }
+  }
+  for (const auto& [key, section] : metrics.items()) {
+    if (key != "steps") add_failed(key, section);
+  }
+  return out;
+}
+
 namespace {
 // run_one, recording into `series` (a worker's, reused run after run).
 RunResult run_into(const Plan& plan, int index, const fs::path& run_dir, Keep keep, io::SeriesRecorder& series) {
@@ -151,15 +198,21 @@ RunResult run_into(const Plan& plan, int index, const fs::path& run_dir, Keep ke
     if (!run_dir.empty()) fs::create_directories(run_dir);
     const fs::path csv = run_dir / "trajectory.csv";
     const bool record_now = keep == Keep::kAll && !run_dir.empty();
-    judge(sc, simulate(sc, series, record_now ? &csv : nullptr, nullptr), r);
+    judge(sc, simulate(sc, series, record_now ? &csv : nullptr, nullptr), plan.judge, r);
     if (keep == Keep::kFailing && !r.passed && !run_dir.empty()) (void)simulate(sc, series, &csv, nullptr);
-    if (!run_dir.empty()) write_json(run_dir / "metrics.json", run_metrics_json(plan, sc, r));
+    const nlohmann::json metrics = run_metrics_json(plan, sc, r);
+    if (!run_dir.empty()) write_json(run_dir / "metrics.json", metrics);
+    // From the metrics written, so what the criteria layer puts there is what summary.json names.
+    if (!r.passed) r.failed_criteria = failed_criteria(metrics);
   } catch (const control::CareError& e) {
     r.error = std::string("controller design failed: ") + e.what();
   } catch (const std::exception& e) {
     r.error = e.what();
   }
-  if (!r.error.empty()) r.passed = false;
+  if (!r.error.empty()) {
+    r.passed = false;
+    r.failed_criteria = nlohmann::json::array();  // the error says why
+  }
   return r;
 }
 }  // namespace
@@ -227,11 +280,13 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   const fs::path csv = dir / "trajectory.csv";
   io::SeriesRecorder series;
   (void)simulate(sc, series, &csv, &dir);
-  judge(sc, io::read_series(csv.string()), r);  // as `run` does: from the recorded doubles
+  judge(sc, io::read_series(csv.string()), plan.judge, r);  // as `run` does: from the recorded doubles
   const nlohmann::json metrics = run_metrics_json(plan, sc, r);
   io::add_provenance_to_bag_metadata(dir, metrics["provenance"]);
   write_json(dir / "metrics.json", metrics);
-  io::write_file_atomically(dir / "metrics.txt", io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking));
+  if (!r.passed) r.failed_criteria = failed_criteria(metrics);
+  io::write_file_atomically(dir / "metrics.txt",
+                            io::format_step_table(sc, r.steps, r.hold, r.saturation, r.tracking, plan.judge));
   return r;
 }
 
@@ -243,6 +298,9 @@ nlohmann::json header_json(const Plan& plan) {
   j["runs"] = plan.runs;
   j["runs_per_point"] = plan.repeats;
   j["sampler"] = to_string(plan.sampler);
+  // Written only when not the default, so the header of a sweep judged against its spec is that of a
+  // sweep from before --judge existed (--resume and merge compare headers).
+  if (plan.judge != io::Judge::kSpec) j["judge"] = io::to_string(plan.judge);
   j["vary"] = nlohmann::json::array();
   for (const Vary& v : plan.vary) {
     nlohmann::json keys = nlohmann::json::array();
@@ -284,6 +342,7 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r) {
   for (const auto& [name, v] : figures_of(r, plan.nominal)) figs[name] = v ? nlohmann::json(*v) : nlohmann::json();
   run["figures"] = figs;
   if (!r.error.empty()) run["error"] = r.error;
+  if (!r.passed) run["failed_criteria"] = r.failed_criteria;
   return run;
 }
 
@@ -469,6 +528,73 @@ void check_shard_json(const nlohmann::json& shard) {
   }
 }
 
+Origin origin_of(const std::string& scenario_file, const fs::path& cwd, const char* python_path_env) {
+  Origin o;
+  const auto absolute = [&](const fs::path& p) { return (p.is_absolute() ? p : cwd / p).lexically_normal(); };
+  o.scenario_file = absolute(scenario_file).string();
+  const auto add = [&](const fs::path& folder) {
+    std::string text = absolute(folder).string();
+    while (text.size() > 1 && text.back() == '/') text.pop_back();  // "a/b/" and "a/b" are one folder
+    if (std::find(o.python_path.begin(), o.python_path.end(), text) == o.python_path.end())
+      o.python_path.push_back(text);
+  };
+  o.cwd = absolute(".").string();
+  while (o.cwd.size() > 1 && o.cwd.back() == '/') o.cwd.pop_back();
+  // As the Python controller loader searches: the scenario's folder, the current directory, PYTHONPATH.
+  add(fs::path(o.scenario_file).parent_path());
+  add(cwd);
+  const std::string env = python_path_env ? python_path_env : "";
+  std::size_t b = 0;
+  while (b <= env.size() && !env.empty()) {
+    const std::size_t e = std::min(env.find(':', b), env.size());
+    add(env.substr(b, e - b).empty() ? fs::path(".") : fs::path(env.substr(b, e - b)));  // "" is the cwd
+    b = e + 1;
+  }
+  return o;
+}
+
+nlohmann::json origin_json(const Origin& o) {
+  return {{"scenario_file", o.scenario_file}, {"cwd", o.cwd}, {"python_path", o.python_path}};
+}
+
+std::optional<Origin> read_origin(const fs::path& dir) {
+  const fs::path file = dir / kOriginFile;
+  if (!fs::exists(file)) return std::nullopt;
+  std::ifstream in(file);
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    Origin o;
+    o.scenario_file = j.at("scenario_file").get<std::string>();
+    o.cwd = j.at("cwd").get<std::string>();
+    o.python_path = j.at("python_path").get<std::vector<std::string>>();
+    if (!fs::path(o.scenario_file).is_absolute()) throw std::invalid_argument("scenario_file is not an absolute path");
+    return o;
+  } catch (const std::exception& e) {
+    throw io::ConfigError(
+        fmt::format("{}: not a sweep's origin record ({}); remove it to continue without it", file.string(), e.what()));
+  }
+}
+
+std::string python_path_env(const Origin& o, const char* current) {
+  std::vector<std::string> entries = o.python_path;
+  const std::string env = current ? current : "";
+  std::size_t b = 0;
+  while (!env.empty() && b <= env.size()) {
+    const std::size_t e = std::min(env.find(':', b), env.size());
+    const std::string entry = env.substr(b, e - b);
+    if (!entry.empty() && std::find(entries.begin(), entries.end(), entry) == entries.end()) entries.push_back(entry);
+    b = e + 1;
+  }
+  std::string out;
+  for (const auto& entry : entries) out += (out.empty() ? "" : ":") + entry;
+  return out;
+}
+
+std::string scenario_source_of(const Origin& o) {
+  std::error_code ec;
+  return fs::is_directory(fs::path(o.scenario_file).parent_path(), ec) ? o.scenario_file : std::string();
+}
+
 Plan plan_of(const fs::path& dir) {
   nlohmann::json h;
   fs::path file = dir / "summary.json";
@@ -483,9 +609,17 @@ Plan plan_of(const fs::path& dir) {
     for (const auto& v : h.at("vary")) specs.push_back(v.at("spec").get<std::string>());
     const fs::path scenario = dir / "scenario.yaml";
     if (!fs::exists(scenario)) throw std::runtime_error(scenario.string() + ": not found");
+    // Loaded as if where the sweep's scenario file is, so that what it names relative to its folder
+    // (a Python controller's module, ...) is found from any current directory.
+    const std::optional<Origin> origin = read_origin(dir);
     Plan p = make_plan(scenario.string(), specs, h.at("seed").get<std::uint64_t>(), h.at("runs_per_point").get<int>(),
-                       h.at("sampler").get<std::string>() == "lhs" ? Sampler::kLhs : Sampler::kRandom);
+                       h.at("sampler").get<std::string>() == "lhs" ? Sampler::kLhs : Sampler::kRandom,
+                       origin ? scenario_source_of(*origin) : std::string());
     if (p.runs != h.at("runs").get<int>()) throw std::runtime_error("the plan gives another number of runs");
+    const std::string judge = h.value("judge", std::string("spec"));
+    const auto set = io::parse_judge(judge);
+    if (!set) throw std::runtime_error("judge: got '" + judge + "', expected spec, paper or none");
+    p.judge = *set;
     return p;
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(file.string() + ": not a sweep's summary (" + e.what() + ")");

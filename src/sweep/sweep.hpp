@@ -25,7 +25,18 @@ struct RunResult {
   std::optional<io::TrackingResult> tracking;      ///< analysis.tracking, or figures of a trajectory run
   bool passed = false;
   std::string error;  ///< non-empty when the run could not be done (a refused value, a failed design)
+  /// The criteria the run failed, read back from its metrics.json (failed_criteria below); empty for
+  /// a passing run or one that could not be flown.
+  nlohmann::json failed_criteria = nlohmann::json::array();
 };
+
+/// The criteria a run's metrics.json (as `run` and a sweep write it) marks failed, in its order (steps,
+/// then the other sections): each {"channel", "name", "value", "bound", "side", "min", "max", "note"},
+/// "channel" being the figure's group as summary.json names it ("z", "z#2" for a channel's second step,
+/// "hold", "saturation", "tracking"), "name" the figure, "bound" the bound the value is outside ("side"
+/// "min" or "max"; both null when the figure has no value, "note" then says why). Every other field of
+/// a criterion is carried over as it is, so what the criteria layer adds reaches the sweep's summary.
+nlohmann::json failed_criteria(const nlohmann::json& metrics);
 
 /// Simulates run `index` in-process and judges it. With `run_dir` non-empty writes its metrics.json
 /// there (and trajectory.csv when `keep` asks for it). Never throws for a bad sample: the reason is
@@ -77,7 +88,7 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
 nlohmann::json header_json(const Plan& plan);
 
 /// A run's entry of summary.json's per_run: index, seed, passed, values, factors, figures (steps, hold,
-/// saturation), error.
+/// saturation), error, and for a failed run "failed_criteria" (RunResult::failed_criteria).
 nlohmann::json per_run_json(const Plan& plan, const RunResult& r);
 
 /// summary.json from the header and every run's per_run entry (any order; sorted by index here).
@@ -103,8 +114,42 @@ void check_shard_json(const nlohmann::json& shard);
 std::vector<nlohmann::json> finished_runs(const std::filesystem::path& sweep_dir, const nlohmann::json& header,
                                           const std::string& shard, bool& complete);
 
-/// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it).
-/// Throws std::runtime_error naming the file.
+/// Where a sweep was started, recorded in its folder (origin.json) so that `--resume` and `sweep rerun`
+/// find what the scenario needs from any current directory: the scenario file (its folder holds a
+/// Python controller's module, an FMU, a trajectory file named relative to it) and the folders
+/// Python imported from (the scenario's folder, the current directory and PYTHONPATH, in the order
+/// the loader searches them). Absolute paths, so it depends on the machine: not one of the outputs
+/// that are the same bytes wherever the sweep runs.
+struct Origin {
+  std::string scenario_file;             ///< absolute, normalised
+  std::string cwd;                       ///< the current directory the sweep was started in
+  std::vector<std::string> python_path;  ///< absolute folders, each once, in search order
+};
+
+/// The file name of the record in a sweep's folder.
+inline constexpr const char* kOriginFile = "origin.json";
+
+/// The origin of a sweep of `scenario_file` started now, in `cwd`, with PYTHONPATH `python_path_env`
+/// (null or "" when unset; relative entries are taken from `cwd`, empty ones are `cwd` itself).
+Origin origin_of(const std::string& scenario_file, const std::filesystem::path& cwd, const char* python_path_env);
+
+nlohmann::json origin_json(const Origin& origin);
+
+/// `sweep_dir`/origin.json, or nullopt when there is none (a sweep of an older quadcosim). Throws
+/// io::ConfigError naming the file when it is not an origin record.
+std::optional<Origin> read_origin(const std::filesystem::path& sweep_dir);
+
+/// PYTHONPATH for continuing a sweep: the recorded folders first (the modules the sweep imported are
+/// imported again), then the entries of `current` (null or "" when unset) not among them.
+std::string python_path_env(const Origin& origin, const char* current);
+
+/// The path a continued sweep loads its scenario as (Plan::scenario_source): the recorded scenario
+/// file while its folder exists, else "" (the caller's own path is all there is).
+std::string scenario_source_of(const Origin& origin);
+
+/// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it),
+/// loaded as if at the scenario file origin.json records (scenario_source_of). Throws
+/// std::runtime_error naming the file.
 Plan plan_of(const std::filesystem::path& sweep_dir);
 
 }  // namespace quadcosim::sweep

@@ -497,5 +497,103 @@ TEST(RunMany, StoppedItReturnsTheRunsStartedALeadingPartAndAResumeGivesTheSameSu
   EXPECT_THROW(partial_summary_json(header, {out_of_range}), std::invalid_argument);
 }
 
+// A metrics.json written by hand: the bound named is the one the value is outside, a figure without
+// a value names none (its note says why), passed criteria are left out, a channel's second step is
+// "<channel>#2" as in summary.json, and fields the criteria layer adds are carried over.
+TEST(FailedCriteria, NamesChannelFigureValueAndTheBoundCrossed) {
+  const nlohmann::json metrics = nlohmann::json::parse(R"({
+    "steps": [
+      {"channel": "z", "criteria": [
+        {"figure": "overshoot_pct", "min": 15.0, "max": 21.0, "value": 3.5, "passed": false, "note": null},
+        {"figure": "peak_time_s", "min": 2.0, "max": 3.0, "value": 2.5, "passed": true, "note": null}]},
+      {"channel": "z", "criteria": [
+        {"figure": "settling_time_2pct_s", "min": null, "max": 8.5, "value": null, "passed": false,
+         "note": "not settled"}]}],
+    "saturation": {"criteria": [
+        {"figure": "saturated_s", "min": null, "max": 0.5, "value": 1.52, "passed": false, "note": null,
+         "kind": "specification"}]},
+    "passed": false})");
+  const nlohmann::json f = failed_criteria(metrics);
+  ASSERT_EQ(f.size(), 3U) << f.dump(2);
+  EXPECT_EQ(f[0]["channel"], "z");
+  EXPECT_EQ(f[0]["name"], "overshoot_pct");
+  EXPECT_EQ(f[0]["value"], 3.5);
+  EXPECT_EQ(f[0]["bound"], 15.0);
+  EXPECT_EQ(f[0]["side"], "min");
+  EXPECT_EQ(f[1]["channel"], "z#2");
+  EXPECT_EQ(f[1]["name"], "settling_time_2pct_s");
+  EXPECT_TRUE(f[1]["value"].is_null() && f[1]["bound"].is_null());
+  EXPECT_EQ(f[1]["note"], "not settled");
+  EXPECT_EQ(f[2]["channel"], "saturation");
+  EXPECT_EQ(f[2]["bound"], 0.5);
+  EXPECT_EQ(f[2]["side"], "max");
+  EXPECT_EQ(f[2]["kind"], "specification");
+  EXPECT_TRUE(failed_criteria(nlohmann::json::parse(R"({"steps": [], "passed": true})")).empty());
+}
+
+// A failing run's per_run entry names what failed, the very criteria of its metrics.json; a passing
+// run's has no failed_criteria.
+TEST(RunOne, AFailedRunNamesItsFailedCriteriaAsItsMetricsJsonHasThem) {
+  const fs::path dir = fs::temp_directory_path() / ("sweep_test_failed_" + std::to_string(::getpid()));
+  // A 1 rad yaw step clamps rotors for about 1.5 s (more than the 0.5 s allowed), 0.2 rad none.
+  const Plan p = make_plan(yaw_scenario_file().string(), {"controller.yaw_des=grid(1,0.2)"}, 1, 1, Sampler::kRandom);
+  const std::vector<RunResult> results = run_many(p, {0, 1}, 1, dir);
+  for (const RunResult& r : results) {
+    std::ifstream in(dir / fmt::format("{:04d}", r.sample.index) / "metrics.json");
+    const nlohmann::json m = nlohmann::json::parse(in);
+    const nlohmann::json entry = per_run_json(p, r);
+    ASSERT_EQ(m["passed"].get<bool>(), r.passed);
+    if (r.passed) {
+      EXPECT_FALSE(entry.contains("failed_criteria"));
+      continue;
+    }
+    // Every criterion metrics.json marks failed, in its order, and no other.
+    std::vector<nlohmann::json> expected;
+    for (const auto& c : m["saturation"]["criteria"]) {
+      if (!c["passed"].get<bool>()) expected.push_back(c);
+    }
+    ASSERT_EQ(expected.size(), 1U);
+    ASSERT_EQ(entry["failed_criteria"].size(), 1U) << entry.dump(2);
+    const nlohmann::json& f = entry["failed_criteria"][0];
+    EXPECT_EQ(f["channel"], "saturation");
+    EXPECT_EQ(f["name"], "saturated_s");
+    EXPECT_EQ(f["value"], expected[0]["value"]);
+    EXPECT_GT(f["value"].get<double>(), 0.5);
+    EXPECT_EQ(f["bound"], 0.5);
+    EXPECT_EQ(f["side"], "max");
+  }
+  EXPECT_FALSE(results[0].passed);
+  fs::remove_all(dir);
+}
+
+// The record of where a sweep started: absolute paths, the loader's search order, each folder once.
+TEST(Origin, RecordsTheScenarioFolderTheCwdAndPythonPathAbsoluteAndOnce) {
+  const Origin o = origin_of("../scn/pd.yaml", "/work/start", "lib::/opt/py:/work/scn/");
+  EXPECT_EQ(o.scenario_file, "/work/scn/pd.yaml");
+  EXPECT_EQ(o.cwd, "/work/start");
+  EXPECT_EQ(o.python_path, (std::vector<std::string>{"/work/scn", "/work/start", "/work/start/lib", "/opt/py"}));
+  EXPECT_EQ(origin_of("pd.yaml", "/w", nullptr).python_path, (std::vector<std::string>{"/w"}));
+  // Continued elsewhere: the recorded folders first, then the current PYTHONPATH's others.
+  EXPECT_EQ(python_path_env(o, "/opt/py:/home/u/mods"), "/work/scn:/work/start:/work/start/lib:/opt/py:/home/u/mods");
+  EXPECT_EQ(python_path_env(o, nullptr), "/work/scn:/work/start:/work/start/lib:/opt/py");
+  // Written and read back; a record that is not one is refused naming the file.
+  const fs::path dir = fs::temp_directory_path() / ("sweep_test_origin_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  EXPECT_FALSE(read_origin(dir).has_value());
+  write_json(dir / kOriginFile, origin_json(o));
+  const std::optional<Origin> back = read_origin(dir);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->scenario_file, o.scenario_file);
+  EXPECT_EQ(back->python_path, o.python_path);
+  std::ofstream(dir / kOriginFile) << "{\"cwd\": 3}";
+  try {
+    (void)read_origin(dir);
+    ADD_FAILURE() << "a malformed origin.json was read";
+  } catch (const io::ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("origin.json"));
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace quadcosim::sweep

@@ -174,6 +174,155 @@ PYEOF
     grep -q "altitude.kp" "$TMP/err" || fail "the refused change is not named: $(cat "$TMP/err")"
     ;;
 
+  measured_any_controller)  # se3 and example_pd measured: finite margins, the table, the files, a Bode PNG
+    "$QC" margins "$P/roll_step.yaml" --controller se3 --out "$TMP/se3" > "$TMP/se3.log" 2>&1 \
+      || { cat "$TMP/se3.log"; fail "margins --controller se3 exited $?"; }
+    grep -q "^measured margins of .*controller se3" "$TMP/se3/margins.txt" || fail "no measured heading"
+    for loop in roll pitch yaw altitude; do
+      grep -q "^$loop .*in hover" "$TMP/se3/margins.txt" || fail "no measured $loop row"
+      grep -q "^$loop," "$TMP/se3/measured_response.csv" || fail "no measured response rows for $loop"
+      [ -s "$TMP/se3/bode_$loop.png" ] && [ -s "$TMP/se3/nyquist_$loop.png" ] || fail "no plots for $loop"
+    done
+    [ -e "$TMP/se3/frequency_response.csv" ] && fail "an analytic response for a controller without one"
+    grep -qi nan "$TMP/se3/margins.txt" && fail "NaN in the table"
+    "$QC" margins --controller example_pd --json > "$TMP/pd.json" 2> /dev/null || fail "example_pd exited $?"
+    "$PY" - "$TMP/se3/margins.json" "$TMP/pd.json" <<'PYEOF' || fail "measured margins not finite"
+import json, math, sys
+for path in sys.argv[1:]:
+    doc = json.load(open(path))
+    assert "loops" not in doc, "analytic loops for a controller without them"
+    m = doc["measured"]
+    assert len(m["loops"]) == 4, m["loops"]
+    for loop in m["loops"]:
+        assert loop["stayed_in_hover"] and loop["unconverged_points"] == 0, loop["name"]
+        pm, gm = loop["phase_margin"], loop["gain_margin"]
+        assert pm["status"] == "finite" and 0 < pm["deg"] < 180, (loop["name"], pm)
+        assert gm["status"] == "finite" and gm["db"] > 0, (loop["name"], gm)
+        assert math.isclose(loop["delay_margin"]["s"], math.radians(pm["deg"]) / pm["frequency_rad_s"], rel_tol=1e-9)
+        print(f"{m['controller']} {loop['name']}: PM {pm['deg']:.1f} deg at {pm['frequency_rad_s']:.3g} rad/s, GM {gm['db']:.1f} dB")
+PYEOF
+    ;;
+
+  measured_paper_and_delay)  # --measure: the paper's measured margins beside its analytic ones; delay costs w tau
+    "$QC" margins "$P/roll_step.yaml" --measure --json > "$TMP/both.json" 2> /dev/null || fail "--measure exited $?"
+    with_simulation delay command_delay_ticks 2
+    "$QC" margins "$TMP/delay.yaml" --controller se3 --json > "$TMP/se3_delay.json" 2> /dev/null || fail "se3 delay exited $?"
+    "$QC" margins "$P/roll_step.yaml" --controller se3 --json > "$TMP/se3.json" 2> /dev/null || fail "se3 exited $?"
+    "$PY" - "$TMP/both.json" "$TMP/se3.json" "$TMP/se3_delay.json" <<'PYEOF' || fail "measured margins off"
+import json, math, sys
+both, se3, late = (json.load(open(p)) for p in sys.argv[1:4])
+for a, m in zip(both["loops"], both["measured"]["loops"]):
+    assert a["name"] == m["name"]
+    assert abs(a["phase_margin"]["deg"] - m["phase_margin"]["deg"]) < 0.05, (a["name"], a["phase_margin"], m["phase_margin"])
+    assert abs(a["gain_margin"]["db"] - m["gain_margin"]["db"]) < 0.02, (a["name"], a["gain_margin"], m["gain_margin"])
+    print(f"paper {a['name']}: PM analytic {a['phase_margin']['deg']:.3f}, measured {m['phase_margin']['deg']:.3f} deg")
+assert late["measured"]["command_delay_ticks"] == 2
+for b, d in zip(se3["measured"]["loops"], late["measured"]["loops"]):
+    w = b["phase_margin"]["frequency_rad_s"]
+    drop = b["phase_margin"]["deg"] - d["phase_margin"]["deg"]
+    assert abs(drop - math.degrees(w * 0.02)) < 0.05, (b["name"], drop, math.degrees(w * 0.02))
+    print(f"se3 {b['name']}: one sample of delay costs {drop:.3f} deg, w tau = {math.degrees(w * 0.02):.3f} deg")
+PYEOF
+    # The analytic-only flags are refused without --measure for the paper controller.
+    set +e
+    "$QC" margins "$P/roll_step.yaml" --amplitude 1e-3 > /dev/null 2> "$TMP/err"; rc=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q -- "--measure" "$TMP/err" || fail "--amplitude without --measure: exit $rc"
+    ;;
+
+  measured_python)  # a controller written in Python against the closed form of its own PD law
+    cat > "$TMP/level_pd.py" <<'PYEOF'
+import math
+
+import quadcosim
+
+
+class LevelPD(quadcosim.Controller):
+    def __init__(self, vehicle):
+        super().__init__(vehicle)
+        self.m, self.g = vehicle["mass_kg"], vehicle["gravity_m_s2"]
+        self.J = (vehicle["Ixx_kg_m2"], vehicle["Iyy_kg_m2"], vehicle["Izz_kg_m2"])
+        self.M = vehicle["mixer_inverse"]
+
+    def step(self, obs, ref, dt):
+        a_z = 1.0 * float(ref.p[2] - obs.p[2]) - 1.4 * float(obs.v[2])
+        errors = (ref.roll - obs.roll, ref.pitch - obs.pitch, math.remainder(ref.yaw - obs.yaw, 2 * math.pi))
+        U = [self.m * (self.g + a_z)] + [J * (64.0 * e - 12.0 * w) for J, e, w in zip(self.J, errors, obs.w)]
+        return [math.sqrt(max(sum(m * u for m, u in zip(row, U)), 0.0)) for row in self.M]
+PYEOF
+    printf 'simulation: {plant_rate_hz: 100, controller_rate_hz: 50}\ncontroller: {python: "level_pd:LevelPD", mode: attitude, z_des: 10}\n' > "$TMP/py.yaml"
+    set +e
+    "$QC" margins "$TMP/py.yaml" --json > "$TMP/py.json" 2> "$TMP/err"; rc=$?
+    set -e
+    if grep -q "without Python" "$TMP/err"; then echo "SKIP: this quadcosim was built without Python"; exit 77; fi
+    [ "$rc" = 0 ] || { cat "$TMP/err"; fail "Python controller: exit $rc"; }
+    "$PY" - "$TMP/py.json" <<'PYEOF' || fail "the Python controller's measured margins differ from the closed form"
+import cmath, json, math, sys
+doc = json.load(open(sys.argv[1]))["measured"]
+assert doc["controller"] == "python", doc["controller"]
+T = doc["controller_period_s"]
+# U = J (kp e - kd w) on a 1/(J s^2) axis sampled with a ZOH: L = kp T^2 (z+1) / (2 (z-1)^2) + kd T / (z-1),
+# the inertia cancelling; altitude alike with kp 1.0, kd 1.4 (the mass cancels).
+gains = {"roll": (64.0, 12.0), "pitch": (64.0, 12.0), "yaw": (64.0, 12.0), "altitude": (1.0, 1.4)}
+for loop in doc["loops"]:
+    kp, kd = gains[loop["name"]]
+    L = lambda w: (lambda z: kp * T * T * (z + 1) / (2 * (z - 1) ** 2) + kd * T / (z - 1))(cmath.exp(1j * w * T))
+    lo, hi = 1e-3, math.pi / T
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if abs(L(mid)) > 1 else (lo, mid)
+    pm = math.degrees(cmath.phase(L(lo))) + 180.0
+    gm_db = -20 * math.log10(abs(L(math.pi / T)))
+    got = loop["phase_margin"]
+    assert abs(got["deg"] - pm) < 0.05 and abs(got["frequency_rad_s"] / lo - 1) < 1e-3, (loop["name"], got, pm, lo)
+    assert abs(loop["gain_margin"]["db"] - gm_db) < 0.02, (loop["name"], loop["gain_margin"], gm_db)
+    print(f"python {loop['name']}: PM {got['deg']:.3f} deg (closed form {pm:.3f}) at {lo:.4f} rad/s, GM {gm_db:.3f} dB")
+PYEOF
+    ;;
+
+  measured_fmu)  # the paper controller exported as an FMU, measured: its analytic margins
+    "$QC" fmu export --help > /dev/null 2>&1 || { echo "SKIP: this build has no 'quadcosim fmu export'"; exit 77; }
+    "$QC" fmu export controller --scenario "$P/roll_step.yaml" --out "$TMP/controller.fmu" > /dev/null 2>&1 \
+      || fail "fmu export controller failed"
+    sed 's/^controller:$/controller:\n  fmu: controller.fmu/' "$P/roll_step.yaml" > "$TMP/fmu.yaml"
+    grep -q 'fmu: controller.fmu' "$TMP/fmu.yaml" || fail "could not write the scenario"
+    "$QC" margins "$TMP/fmu.yaml" --json > "$TMP/fmu.json" 2> "$TMP/err" || { cat "$TMP/err"; fail "FMU controller: exit $?"; }
+    "$QC" margins "$P/roll_step.yaml" --json > "$TMP/paper.json"
+    "$PY" - "$TMP/paper.json" "$TMP/fmu.json" <<'PYEOF' || fail "the FMU controller's measured margins differ from the analytic ones"
+import json, sys
+paper, fmu = (json.load(open(p)) for p in sys.argv[1:3])
+assert fmu["measured"]["controller"] == "fmu", fmu["measured"]["controller"]
+for a, m in zip(paper["loops"], fmu["measured"]["loops"]):
+    assert abs(a["phase_margin"]["deg"] - m["phase_margin"]["deg"]) < 0.05, (a["name"], a["phase_margin"], m["phase_margin"])
+    assert abs(a["gain_margin"]["db"] - m["gain_margin"]["db"]) < 0.02, (a["name"], a["gain_margin"], m["gain_margin"])
+    print(f"FMU {a['name']}: PM {m['phase_margin']['deg']:.3f} deg (analytic {a['phase_margin']['deg']:.3f}), GM {m['gain_margin']['db']:.3f} dB")
+PYEOF
+    ;;
+
+  measured_unstable)  # a measured loop the delay destabilises: exit 1, LEFT HOVER, undefined, no NaN
+    with_simulation late command_delay_ticks 40
+    set +e
+    "$QC" margins "$TMP/late.yaml" --controller example_pd --frequencies 6 > "$TMP/table.txt" 2>&1; rc=$?
+    set -e
+    [ "$rc" = 1 ] || { cat "$TMP/table.txt"; fail "exit $rc, expected 1"; }
+    grep -q "^roll .*undefined.*LEFT HOVER" "$TMP/table.txt" || { cat "$TMP/table.txt"; fail "roll not reported as leaving hover"; }
+    grep -qi nan "$TMP/table.txt" && fail "NaN printed"
+    ;;
+
+  lqr_and_bench_other_controllers)  # lqr names what to use instead; bench --scenario flies any controller
+    printf 'type: se3\n' > "$TMP/se3.yaml"
+    set +e
+    "$QC" lqr --params "$TMP/se3.yaml" > /dev/null 2> "$TMP/err"; rc=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q "controller type 'se3'" "$TMP/err" && grep -q "quadcosim margins SCENARIO --controller se3" "$TMP/err" \
+      || fail "lqr on se3: exit $rc: $(cat "$TMP/err")"
+    "$QC" bench --quick --only inproc --json --scenario "$SRC/scenarios/tracking/circle_se3.yaml" > "$TMP/bench.json" 2> "$TMP/bench.err" \
+      || { cat "$TMP/bench.err"; fail "bench --scenario circle_se3 exited $?"; }
+    "$PY" -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['inproc_rtf']>0 and d['baseline_rtf'] is None and d['inproc_vs_baseline'] is None, d" \
+      "$TMP/bench.json" || fail "bench with se3: $(cat "$TMP/bench.json")"
+    grep -q "baseline_rtf skipped" "$TMP/bench.err" || fail "bench does not say why the baseline is skipped"
+    ;;
+
   *) fail "unknown case" ;;
 esac
 echo "ok [$CASE]"

@@ -112,10 +112,10 @@ PYEOF
     "$QC" sweep "$H" --runs 12 --keep all --min-pass-rate 0 --no-plots --out "$TMP/s" > /dev/null
     [ "$(ls "$TMP/s/runs" | wc -l)" = 12 ] || fail "the first sweep has not 12 runs"
     rc=$(rc_of "$QC" sweep "$H" --runs 2 --keep all --min-pass-rate 0 --no-plots --out "$TMP/s")
-    [ "$rc" = 2 ] && grep -q "outputs of \`quadcosim sweep\` (26 files" "$TMP/err" || fail "reuse: exit $rc: $(cat "$TMP/err")"
+    [ "$rc" = 2 ] && grep -q "outputs of \`quadcosim sweep\` (27 files" "$TMP/err" || fail "reuse: exit $rc: $(cat "$TMP/err")"
     "$QC" sweep "$H" --runs 2 --keep all --min-pass-rate 0 --no-plots --out "$TMP/s" --force > /dev/null || fail "--force"
     [ "$(cd "$TMP/s" && find . -mindepth 1 ! -name $MANIFEST | sed 's|^\./||' | sort | tr '\n' ' ')" = \
-      "runs runs/0000 runs/0000/metrics.json runs/0000/trajectory.csv runs/0001 runs/0001/metrics.json runs/0001/trajectory.csv scenario.yaml summary.json " ] \
+      "origin.json runs runs/0000 runs/0000/metrics.json runs/0000/trajectory.csv runs/0001 runs/0001/metrics.json runs/0001/trajectory.csv scenario.yaml summary.json " ] \
       || fail "left after --force: $(cd "$TMP/s" && find . | sort | tr '\n' ' ')"
     # merge and rerun follow the same rule
     rc=$(rc_of "$QC" sweep rerun "$TMP/s" 1 --out "$TMP/s" --no-plots)

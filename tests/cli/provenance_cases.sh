@@ -133,21 +133,22 @@ import json, sys
 tmp = sys.argv[1]
 lines = open(tmp + "/out").read().splitlines()
 table = open(tmp + "/table.md").read()
-assert "paper" not in table.split("| run |")[0].lower(), "the header speaks of the paper"
+assert "paper" not in table.splitlines()[0].lower(), "the title speaks of the paper"
+# | run | controller | judged | what | figure | value | reference | spec | paper | verdict |
 rows = [[c.strip() for c in l.strip("|").split("|")] for l in lines[2:]]
 def rows_of(run, figure):
-    return [r for r in rows if r[0] == run and r[3] == figure]
+    return [r for r in rows if r[0] == run and r[4] == figure]
 for run, controller in ((tmp + "/a", "se3"), (tmp + "/b", "example_pd")):
     m = json.load(open(run + "/metrics.json"))["tracking"]["figures"]
     rmse = rows_of(run, "position RMSE m")
-    assert len(rmse) == 1 and rmse[0][1] == controller, rmse
-    assert rmse[0][2] == "tracking from t = 12 s" and rmse[0][4] == f"{m['position_rmse_m']:.4g}", rmse
+    assert len(rmse) == 1 and rmse[0][1] == controller and rmse[0][2] == "spec", rmse
+    assert rmse[0][3] == "tracking from t = 12 s" and rmse[0][5] == f"{m['position_rmse_m']:.4g}", rmse
     mx = rows_of(run, "position max m")
-    assert len(mx) == 1 and mx[0][4] == f"{m['position_max_m']:.4g}", mx
-assert rows_of(tmp + "/a", "position RMSE m")[0][6] == "pass"
-assert rows_of(tmp + "/b", "position RMSE m")[0][6] == "**FAIL**"
+    assert len(mx) == 1 and mx[0][5] == f"{m['position_max_m']:.4g}", mx
+assert rows_of(tmp + "/a", "position RMSE m")[0][9] == "pass"
+assert rows_of(tmp + "/b", "position RMSE m")[0][9] == "**FAIL**"
 over = rows_of(tmp + "/alt", "overshoot %")
-assert len(over) == 1 and over[0][1] == "paper" and over[0][2] == "z step 0 → 10", over
+assert len(over) == 1 and over[0][1] == "paper" and over[0][3] == "z step 0 → 10", over
 PYEOF
     ;;
 

@@ -69,7 +69,7 @@ PYEOF
       grep -qF -- "$2" "$TMP/log" || { cat "$TMP/log"; fail "$1: message lacks '$2'"; }
       grep -qF "bad.yaml" "$TMP/log" || fail "$1: message does not name the file"
     }
-    check 's/position_max_m:/position_p99_m:/' "analysis.tracking.criteria.position_p99_m"
+    check 's/position_max_m:/position_p99_m:/' "analysis.tracking.spec.position_p99_m"
     check 's/position_max_m:/position_p99_m:/' "unknown tracking figure"
     check 's/after_s: 12 /after_s: 99 /' "analysis.tracking.after_s"
     check 's/position_max_m: \[null, 0.1\]/position_max_m: [0.2, 0.1]/' "min is above max"

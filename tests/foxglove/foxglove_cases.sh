@@ -20,6 +20,13 @@
 #                  admits exactly the 16 clients of the limit (503 for the rest); a frame of 20,000 bad
 #                  subscriptions disconnects its client with one line logged for the errors and one for
 #                  the disconnection
+#   inproc_3d      run --foxglove: /tf, /tf_static, robot_description and the scene served. A client
+#                  subscribed from the start gets every /tf, each equal to trajectory.csv at its stamp;
+#                  one joining mid-run and one after the end (--foxglove-linger) still get the latched
+#                  three; robot_description parses as a URDF naming the vehicle's links; every message
+#                  and schema equals run.mcap's as @mcap/core reads it
+#   dds_3d         controller --foxglove and plant --foxglove --mcap over DDS: both serve the same 3D
+#                  topics, /tf equal to the plant's CSV, the latched three equal to the plant's MCAP
 # Every process this script starts is killed by PID on exit (tests/lib/process_case.sh).
 bin="$1"; src="$2"
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
@@ -114,6 +121,142 @@ print(json.dumps(counts))
 PY
 }
 ns=/drone
+topics_3d=(/tf /tf_static "$ns/robot_description" "$ns/scene")
+
+# The 3D topics a client received against trajectory.csv (independently read) and against the same
+# topics of run.mcap as @mcap/core decodes them (tools/mcap_verify/dump.mjs). MODE, what of the
+# recording's /tf the client has: "all" (subscribed before the first tick: every one, in order);
+# "mid" (joined mid-run: a run of them, none at stamp 0); "run" (over DDS, where the first samples
+# may go out before discovery matched the reader: a run of them, at least 90 % of the ticks); "tail"
+# (joined at some time, the server lingering after the end: a run of them ending with the final one);
+# "last" (joined after the end: the final one alone).
+check_3d() {  # check_3d CLIENT_JSON CSV MCAP_DUMP_JSON MODE
+  python3 - "$1" "$2" "$3" "$4" "$ns" <<'PY'
+import csv, json, sys
+import xml.etree.ElementTree as ET
+got, dump = json.load(open(sys.argv[1])), json.load(open(sys.argv[3]))
+mode, ns = sys.argv[4], sys.argv[5]
+rows = {}
+with open(sys.argv[2]) as f:
+    for r in csv.DictReader(f):
+        rows[round(float(r["t"]) * 1e9)] = {k: float(v) for k, v in r.items()}
+prefix = ns.lstrip("/") + "/"
+errors = []
+def need(cond, what):
+    if not cond:
+        errors.append(what)
+channels = {c["topic"]: c for c in got["channels"]}
+want = {"/tf": "tf2_msgs/msg/TFMessage", "/tf_static": "tf2_msgs/msg/TFMessage",
+        f"{ns}/robot_description": "std_msgs/msg/String", f"{ns}/scene": "foxglove_msgs/msg/SceneUpdate"}
+for topic, schema in want.items():
+    c, d = channels.get(topic), dump.get(topic)
+    need(c is not None, f"no channel {topic}")
+    need(d is not None, f"no {topic} in run.mcap")
+    if not c or not d:
+        continue
+    need(c["encoding"] == "cdr" and c["schemaEncoding"] == "ros2msg" and c["schemaName"] == schema,
+         f"{topic}: {c['encoding']} {c['schemaEncoding']} {c['schemaName']}")
+    need(c["schemaName"] == d["schemaName"] and c.get("schema") == d["schemaText"], f"{topic}: schema differs from run.mcap's")
+stamp = lambda h: h["stamp"]["sec"] * 10**9 + h["stamp"]["nanosec"]
+
+# The latched three: one message each, the recording's message, whenever the client came.
+for topic in want:
+    if topic == "/tf" or topic not in dump or dump[topic] is None:
+        continue
+    msgs = got["messages"].get(topic, [])
+    need(len(msgs) == 1, f"{topic}: {len(msgs)} messages, expected the 1 latched")
+    rec = dump[topic]["messages"]
+    need(len(rec) == 1, f"run.mcap {topic}: {len(rec)} messages")
+    if msgs and rec:
+        need(msgs[0]["msg"] == rec[0]["message"], f"{topic}: differs from run.mcap's: {str(msgs[0]['msg'])[:300]}")
+        need(msgs[0]["t"] == int(rec[0]["logTime"]), f"{topic}: time {msgs[0]['t']} != run.mcap's {rec[0]['logTime']}")
+links = [f"{prefix}base_link"] + [f"{prefix}rotor_{i}" for i in range(1, 5)]
+desc = got["messages"].get(f"{ns}/robot_description", [])
+if desc:
+    try:
+        robot = ET.fromstring(desc[0]["msg"]["data"])
+        need(robot.tag == "robot" and robot.get("name") == ns.strip("/"), f"URDF root {robot.tag} name {robot.get('name')}")
+        need(sorted(l.get("name") for l in robot.findall("link")) == sorted(links),
+             f"URDF links {[l.get('name') for l in robot.findall('link')]}, expected {links}")
+        joints = {j.find("child").get("link"): j.find("parent").get("link") for j in robot.findall("joint")}
+        need(joints == {l: links[0] for l in links[1:]}, f"URDF joints {joints}")
+    except ET.ParseError as e:
+        need(False, f"robot_description is no XML: {e}")
+static = got["messages"].get("/tf_static", [])
+if static:
+    tfs = static[0]["msg"]["transforms"]
+    need(sorted((t["header"]["frame_id"], t["child_frame_id"]) for t in tfs) == [(links[0], l) for l in links[1:]],
+         f"/tf_static frames {[(t['header']['frame_id'], t['child_frame_id']) for t in tfs]}")
+scene = got["messages"].get(f"{ns}/scene", [])
+if scene:
+    ents = scene[0]["msg"]["entities"]
+    need(len(ents) == 1 and ents[0]["frame_id"] == links[0] and ents[0]["frame_locked"],
+         f"scene entities {[(e['frame_id'], e['frame_locked']) for e in ents]}")
+    if ents:
+        e = ents[0]
+        need((len(e["cubes"]), len(e["cylinders"]), len(e["arrows"])) == (5, 4, 1),
+             f"scene: {len(e['cubes'])} cubes, {len(e['cylinders'])} cylinders, {len(e['arrows'])} arrows; expected body and 4 arms, 4 rotors, the nose")
+
+# /tf: the vehicle's transform each tick, equal to trajectory.csv at its stamp.
+tf = got["messages"].get("/tf", [])
+for m in tf:
+    need(len(m["msg"]["transforms"]) == 1, f"/tf: {len(m['msg']['transforms'])} transforms in one message")
+    t = m["msg"]["transforms"][0]
+    s = stamp(t["header"])
+    need(m["t"] == s, f"/tf: frame time {m['t']} != stamp {s}")
+    need(t["header"]["frame_id"] == "world" and t["child_frame_id"] == links[0],
+         f"/tf: {t['header']['frame_id']} -> {t['child_frame_id']}")
+    r = rows.get(s)
+    if r is None:
+        need(False, f"/tf: stamp {s} not in the CSV")
+    else:
+        p, q = t["transform"]["translation"], t["transform"]["rotation"]
+        need([p["x"], p["y"], p["z"]] == [r["x"], r["y"], r["z"]], f"/tf at {s}: {p} != CSV {[r['x'], r['y'], r['z']]}")
+        need([q["w"], q["x"], q["y"], q["z"]] == [r["qw"], r["qx"], r["qy"], r["qz"]], f"/tf at {s}: rotation {q} != CSV")
+    if len(errors) > 10:
+        break
+rec_tf = [m["message"] for m in dump["/tf"]["messages"]] if dump.get("/tf") else []
+got_tf = [m["msg"] for m in tf]
+last_t = max(rows)
+# Over DDS the lockstep plant may publish a tick again (its controller's answer late): the same /tf,
+# which the recorder records once. Taken out before comparing, and counted.
+repeats = 0
+if mode in ("run", "tail"):
+    kept = []
+    for m in got_tf:
+        if kept and stamp(m["transforms"][0]["header"]) <= stamp(kept[-1]["transforms"][0]["header"]):
+            need(m in kept, f"/tf: a repeated stamp with other content: {m}")
+            repeats += 1
+        else:
+            kept.append(m)
+    got_tf = kept
+stamps = [stamp(m["transforms"][0]["header"]) for m in got_tf]
+def a_run():  # got_tf is a contiguous run of the recording's /tf
+    i = next((k for k, m in enumerate(rec_tf) if got_tf and m == got_tf[0]), None)
+    return i is not None and rec_tf[i:i + len(got_tf)] == got_tf
+if mode == "all":
+    need(got_tf == rec_tf, f"/tf: {len(got_tf)} messages, run.mcap has {len(rec_tf)}, or they differ")
+    need(len(got_tf) == len(rows), f"/tf: {len(got_tf)} messages for {len(rows)} CSV rows")
+elif mode == "mid":
+    need(len(got_tf) >= 1 and stamps[0] > 0, f"/tf: joined mid-run, yet {len(got_tf)} messages from {stamps[:1]}")
+    need(a_run(), "/tf: not a run of run.mcap's messages")
+elif mode == "run":
+    need(len(got_tf) >= 0.9 * len(rows), f"/tf: {len(got_tf)} messages for {len(rows)} CSV rows")
+    need(a_run(), "/tf: not a run of run.mcap's messages")
+elif mode == "tail":
+    need(a_run() and stamps[-1] == last_t, f"/tf: {len(got_tf)} messages, not a run ending at {last_t}")
+else:
+    need(len(got_tf) == 1 and stamps[0] == last_t, f"/tf after the end: {len(got_tf)} messages, expected the final one at {last_t}")
+if errors:
+    print("\n".join(errors[:12]))
+    sys.exit(1)
+first = stamp(got_tf[0]["transforms"][0]["header"]) / 1e9 if got_tf else None
+print(f"{len(got_tf)} /tf (first at {first} s; {repeats} repeated ticks) equal to the CSV; latched three equal to run.mcap's; URDF links {links}")
+PY
+}
+dump_3d() {  # dump_3d MCAP OUT_JSON: the 3D topics of a recording, read by @mcap/core
+  node "$src/tools/mcap_verify/dump.mjs" "$1" "${topics_3d[@]}" > "$2" || fail "dump.mjs $1"
+}
 
 case "$case_name" in
   inproc_watch)
@@ -334,6 +477,72 @@ print(f"origins as expected; burst of 120: {b['opened']} opened, {b['refused']} 
       f"{f['sent']} errors in one {f['frameBytes']}-byte frame: {f['statuses']} statuses, close {f['close']}, "
       f"{len(disc)} disconnect line; {summary[-1]}")
 PY
+    ;;
+  inproc_3d)
+    bash "$src/tools/mcap_verify/install.sh" || { echo "SKIPPED: cannot install the MCAP reader's npm packages"; exit 77; }
+    # Paced (7.5 s for the 15 s scenario at 2x) so a second client can join while it flies.
+    "$bin" run "$scenario" --out "$tmp/served" --no-plots --foxglove 0 --foxglove-wait 30 --foxglove-pace 2 \
+      > "$tmp/run.log" 2>&1 &
+    pids+=($!); run_pid=$!
+    url="$(url_of "$tmp/run.log")"
+    client watch "$url" "${topics_3d[@]}" --seconds 60 > "$tmp/early.json" 2> "$tmp/early.log" &
+    pids+=($!); early_pid=$!
+    await "$tmp/early.log" subscribed
+    sleep 1.5
+    client watch "$url" "${topics_3d[@]}" --seconds 60 > "$tmp/mid.json" 2> "$tmp/mid.log" &
+    pids+=($!); mid_pid=$!
+    wait "$run_pid" || fail "run --foxglove failed"
+    wait "$early_pid" || fail "the early client failed"
+    wait "$mid_pid" || fail "the mid-run client failed"
+    line="$(grep 'run: foxglove: 2 clients' "$tmp/run.log")" || fail "no summary line"
+    echo "$line" | grep -q " 0 dropped for slow clients, 0 dropped before" || fail "drops: $line"
+    dump_3d "$tmp/served/run.mcap" "$tmp/dump.json"
+    early="$(check_3d "$tmp/early.json" "$tmp/served/trajectory.csv" "$tmp/dump.json" all)" || fail "early client: $early"
+    mid="$(check_3d "$tmp/mid.json" "$tmp/served/trajectory.csv" "$tmp/dump.json" mid)" || fail "mid-run client: $mid"
+    echo "early client: $early"
+    echo "mid-run client: $mid"
+
+    # After the end: a lingering run serves the latched three and the final /tf.
+    "$bin" run "$scenario" --out "$tmp/linger" --no-plots --foxglove 0 --foxglove-linger 300 > "$tmp/linger.log" 2>&1 &
+    pids+=($!); run_pid=$!
+    url="$(url_of "$tmp/linger.log")"
+    await "$tmp/linger.log" "serving its last state"
+    client watch "$url" "${topics_3d[@]}" --seconds 3 > "$tmp/late.json" 2> "$tmp/late.log" || fail "the late client failed"
+    kill -TERM "$run_pid"; wait "$run_pid" || true
+    dump_3d "$tmp/linger/run.mcap" "$tmp/linger_dump.json"
+    late="$(check_3d "$tmp/late.json" "$tmp/linger/trajectory.csv" "$tmp/linger_dump.json" last)" || fail "late client: $late"
+    echo "client after the end: $late"
+    ;;
+  dds_3d)
+    bash "$src/tools/mcap_verify/install.sh" || { echo "SKIPPED: cannot install the MCAP reader's npm packages"; exit 77; }
+    # The controller first, its client subscribed before the plant's first tick; then the plant,
+    # whose client joins while (or after) it flies.
+    "$bin" controller --scenario "$scenario" --foxglove 0 > "$tmp/controller.log" 2>&1 &
+    pids+=($!); controller_pid=$!
+    url="$(url_of "$tmp/controller.log")"
+    client watch "$url" "${topics_3d[@]}" --seconds 120 > "$tmp/ctl.json" 2> "$tmp/ctl_client.log" &
+    pids+=($!); ctl_client=$!
+    await "$tmp/ctl_client.log" subscribed
+    "$bin" plant --scenario "$scenario" --record "$tmp/plant.csv" --mcap "$tmp/plant.mcap" --foxglove 0 \
+      --foxglove-linger 300 > "$tmp/plant.log" 2>&1 &
+    pids+=($!); plant_pid=$!
+    url="$(url_of "$tmp/plant.log")"
+    client watch "$url" "${topics_3d[@]}" --seconds 120 > "$tmp/plant.json" 2> "$tmp/plant_client.log" &
+    pids+=($!); plant_client=$!
+    await "$tmp/plant.log" "serving its last state"
+    await "$tmp/plant_client.log" subscribed
+    sleep 0.5
+    kill -TERM "$plant_pid"; wait "$plant_pid" || true
+    wait "$plant_client" || fail "the plant's client failed"
+    kill -INT "$controller_pid"; wait "$controller_pid" || true
+    wait "$ctl_client" || fail "the controller's client failed"
+    dump_3d "$tmp/plant.mcap" "$tmp/dump.json"
+    ctl="$(check_3d "$tmp/ctl.json" "$tmp/plant.csv" "$tmp/dump.json" run)" || fail "controller's client: $ctl"
+    # The plant's client joined at some point of the run or after it (it lingers): a run of /tf ending
+    # with the final one, the latched three.
+    plant="$(check_3d "$tmp/plant.json" "$tmp/plant.csv" "$tmp/dump.json" tail)" || fail "plant's client: $plant"
+    echo "controller's client: $ctl"
+    echo "plant's client: $plant"
     ;;
   *) fail "unknown case" ;;
 esac

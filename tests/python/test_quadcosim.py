@@ -141,6 +141,27 @@ def test_run_returns_the_trajectory_and_figures_of_its_files(tmp_path):
     assert step["channel"] == "z"
 
 
+def test_judge_chooses_the_criteria_set_as_the_cli_does(tmp_path):
+    # SE(3) on the paper's climb: no overshoot, so inside the spec (at most 25 %) and outside the
+    # paper's 15-21 % band. judge= gives the verdict of `quadcosim run --judge`, the same bytes.
+    spec = quadcosim.run(ALTITUDE_STEP, controller="se3")
+    paper = quadcosim.run(ALTITUDE_STEP, controller="se3", judge="paper", out=tmp_path / "py")
+    none = quadcosim.run(ALTITUDE_STEP, controller="se3", judge="none")
+    assert (spec.passed, paper.passed, none.passed) == (True, False, None)
+    assert (spec.judged, paper.judged, none.judged) == ("spec", "paper", "none")
+    assert paper.metrics["judged"] == "paper" and none.metrics["passed"] is None
+    assert spec.figures["steps"][0]["figures"] == none.figures["steps"][0]["figures"]
+    assert spec.figures["steps"][0]["figures"]["overshoot_pct"] < 15
+    cli = tmp_path / "cli"
+    done = subprocess.run([QUADCOSIM, "run", ALTITUDE_STEP, "--controller", "se3", "--judge", "paper", "--out",
+                           str(cli), "--no-plots"], capture_output=True, text=True)
+    assert done.returncode == 1, done.stdout + done.stderr
+    for name in ["metrics.json", "metrics.txt"]:
+        assert filecmp.cmp(cli / name, tmp_path / "py" / name, shallow=False), name
+    with pytest.raises(ValueError, match=r"judge: got 'strict', expected 'spec', 'paper' or 'none'"):
+        quadcosim.run(ALTITUDE_STEP, judge="strict")
+
+
 def test_run_without_out_leaves_nothing_and_gives_the_same_numbers(tmp_path):
     a = quadcosim.run(ALTITUDE_STEP)
     b = quadcosim.run(quadcosim.load_scenario(ALTITUDE_STEP), out=tmp_path / "b")

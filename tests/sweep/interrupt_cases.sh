@@ -26,10 +26,10 @@ same_runs() {
 RUNS=100
 A=(--runs $RUNS --vary mass=10% --vary controller.altitude.kd=uniform\(2,3.5\) --min-pass-rate 0 --no-plots)
 
-# Starts the sweep "$@" in the background (log in $tmp/bg.log), waits until run $WAIT_RUN's
-# metrics.json exists in $OUT, sends $SIGNAL and sets rc to the exit code.
+# Starts the sweep of $SCENARIO (default $HOVER) with "$@" in the background (log in $tmp/bg.log),
+# waits until run $WAIT_RUN's metrics.json exists in $OUT, sends $SIGNAL and sets rc to the exit code.
 interrupt() {
-  "$QC" sweep "$HOVER" "$@" > "$tmp/bg.log" 2>&1 &
+  "$QC" sweep "${SCENARIO:-$HOVER}" "$@" > "$tmp/bg.log" 2>&1 &
   local pid=$!
   pids+=("$pid")
   for _ in $(seq 600); do
@@ -132,6 +132,71 @@ PYEOF
     [ $rc -eq 2 ] && grep -q "runs/ holds 3 files that no manifest lists" "$tmp/o.log" \
       || fail "unlisted runs not refused (rc $rc): $(cat "$tmp/o.log")"
     [ -e "$tmp/s/runs/0002/metrics.json" ] || fail "the refusal removed a file"
+    ;;
+
+  resume_elsewhere)  # --resume and `sweep rerun` from another folder find the Python controller the sweep flew
+    if "$QC" controller --python "no_such_module_for_the_check:X" > "$tmp/check.log" 2>&1; then :; fi
+    if grep -q "built without Python" "$tmp/check.log"; then
+      echo "SKIP: this quadcosim was built without Python: $(cat "$tmp/check.log")"
+      exit 77
+    fi
+    # The scenario's folder holds altitude_pd.py (tests/python_node); the folder the sweep starts in
+    # holds start_pd.py, the class the scenario names, which imports altitude_pd: the first is found
+    # from the scenario's folder, the second only from the starting folder (the current directory).
+    mkdir -p "$tmp/scn" "$tmp/start" "$tmp/other"
+    cp "$SRC/tests/python_node/altitude_pd.py" "$tmp/scn/"
+    printf 'from altitude_pd import AltitudePD as StartPD  # noqa: F401\n' > "$tmp/start/start_pd.py"
+    cat > "$tmp/scn/pd.yaml" <<'YAML'
+name: python_pd
+simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 3}
+initial: {position_m: [0, 0, 0]}
+controller:
+  python: "start_pd:StartPD"
+  mode: attitude
+  z_des: 0
+schedule:
+  - at_s: 0
+    set: {z_des: 1.0}
+analysis:
+  steps:
+    - channel: z
+      at_s: 0
+      criteria:
+        overshoot_pct: [null, 30]
+YAML
+    P=(--runs 24 --vary mass=10% --seed 4 --min-pass-rate 0 --no-plots --no-progress)
+    (cd "$tmp/start" && "$QC" sweep ../scn/pd.yaml "${P[@]}" --jobs 2 --out ../ref > "$tmp/ref.log" 2>&1) \
+      || fail "uninterrupted sweep: $(cat "$tmp/ref.log")"
+    "$PY" -c 'import json,sys; o=json.load(open(sys.argv[1])); assert o["python_path"][:2] == [sys.argv[2], sys.argv[3]], o' \
+      "$tmp/ref/origin.json" "$tmp/scn" "$tmp/start" || fail "origin.json: $(cat "$tmp/ref/origin.json")"
+    cd "$tmp/start"
+    SCENARIO=../scn/pd.yaml OUT="$tmp/s" WAIT_RUN=0003 SIGNAL=INT interrupt "${P[@]}" --jobs 1 --out ../s
+    [ "$rc" -eq 130 ] || fail "SIGINT: exit $rc, expected 130: $(cat "$tmp/bg.log")"
+    cd "$tmp/other"
+    # From elsewhere, the scenario given by another path: the recorded folders are imported from.
+    "$QC" sweep "$tmp/scn/pd.yaml" "${P[@]}" --jobs 2 --resume --out ../s > "$tmp/resume.log" 2>&1 \
+      || fail "--resume from another folder: $(cat "$tmp/resume.log")"
+    grep -q "resuming in ../s: [0-9]* runs finished" "$tmp/resume.log" || fail "resume message: $(cat "$tmp/resume.log")"
+    cmp "$tmp/ref/summary.json" "$tmp/s/summary.json" || fail "the resumed summary.json differs from the uninterrupted one"
+    # Their provenance names the command lines (--resume, another folder): the same judgement.
+    same_runs "$tmp/ref/runs" "$tmp/s/runs" || fail "the resumed runs' metrics.json differ"
+    "$QC" sweep rerun ../s 5 --out ../r5 --no-plots > "$tmp/rerun.log" 2>&1 || [ $? -eq 1 ] \
+      || fail "rerun from another folder: $(cat "$tmp/rerun.log")"
+    "$PY" - "$tmp/s/summary.json" "$tmp/r5/metrics.json" <<'PYEOF' || fail "the rerun differs from the sweep's run"
+import json, sys
+s, m = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+run = s["per_run"][5]
+figs = {"z." + n: v for n, v in m["steps"][0]["figures"].items()}
+figs.update({"saturation." + n: v for n, v in m["saturation"]["figures"].items()})
+assert figs == run["figures"] and m["passed"] == run["passed"], (figs, run)
+PYEOF
+    # Without the record, the starting folder's module is not found from here: what made it work.
+    mkdir "$tmp/bare"
+    cp "$tmp/s/summary.json" "$tmp/s/scenario.yaml" "$tmp/bare/"
+    set +e
+    "$QC" sweep rerun ../bare 5 --out ../r5b --no-plots > "$tmp/bare.log" 2>&1; rc=$?
+    set -e
+    [ $rc -eq 2 ] && grep -q "start_pd" "$tmp/bare.log" || fail "rerun without origin.json (rc $rc): $(cat "$tmp/bare.log")"
     ;;
 
   *) fail "unknown case $CASE" ;;

@@ -133,7 +133,7 @@ PYEOF
     touch "$TMP/o1/notes.txt"
     set +e
     "$QC" sweep "$HOVER" --runs 2 --min-pass-rate 0 --out "$TMP/o1" --no-plots > "$TMP/o" 2>&1; rc=$?
-    [ $rc -eq 2 ] && grep -q "$TMP/o1 is not empty: it holds the outputs of \`quadcosim sweep\` (6 files" "$TMP/o" \
+    [ $rc -eq 2 ] && grep -q "$TMP/o1 is not empty: it holds the outputs of \`quadcosim sweep\` (7 files" "$TMP/o" \
       && grep -q "notes.txt" "$TMP/o" && grep -q -- "--force" "$TMP/o" || { cat "$TMP/o"; fail "reuse not refused (rc $rc)"; }
     [ -e "$TMP/o1/runs/0003/metrics.json" ] || fail "the refusal removed files"
     set -e
@@ -146,7 +146,8 @@ PYEOF
 import json, sys
 m = json.load(open(sys.argv[1]))
 assert m["command"] == "sweep", m
-assert m["files"] == {"outputs": ["runs/0000/metrics.json", "runs/0001/metrics.json", "scenario.yaml", "summary.json"]}, m
+assert m["files"] == {"outputs": ["origin.json", "runs/0000/metrics.json", "runs/0001/metrics.json", "scenario.yaml",
+                                 "summary.json"]}, m
 PYEOF
     # A run's folder: refused, and with --force the run's files go (trajectory.csv), the sweep's come.
     "$QC" run "$HOVER" --out "$TMP/run" --no-plots > /dev/null
@@ -193,7 +194,8 @@ PYEOF
 
   console)  # every figure with its count and missing runs; a figure no run has says so
     sed 's/duration_s: 15/duration_s: 3/' "$ALT" > "$TMP/short.yaml"
-    "$QC" sweep "$TMP/short.yaml" --runs 20 --vary mass=20% --min-pass-rate 0 --no-plots --out "$TMP/c" > "$TMP/log" 2>&1 || fail "sweep"
+    "$QC" sweep "$TMP/short.yaml" --runs 20 --vary mass=20% --min-pass-rate 0 --no-plots --out "$TMP/c" > "$TMP/log" \
+      2> "$TMP/err" || fail "sweep"
     "$PY" - "$TMP/c/summary.json" "$TMP/log" <<'PYEOF' || { cat "$TMP/log"; fail "console table"; }
 import json, sys
 s = json.load(open(sys.argv[1])); log = open(sys.argv[2]).read().splitlines()
@@ -352,6 +354,134 @@ SH
     set -e
     [ $rc -eq 2 ] && grep -q "scenario nowhere.yaml is not a file" "$TMP/o" \
       || { cat "$TMP/o"; fail "a missing scenario (rc $rc)"; }
+    ;;
+
+  index)  # index.html lists every run with the verdict and failed criteria of its own metrics.json
+    # kp 0.5 gives no overshoot (the paper's band is [15, 21] %) and settles late; kp 4 is the paper's.
+    "$QC" sweep "$ALT" --vary controller.altitude.kp=grid\(4,0.5\) --vary mass=2% --runs 2 --seed 3 \
+      --min-pass-rate 0 --out "$TMP/s" > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "sweep"; }
+    [ -s "$TMP/s/index.html" ] || fail "no index.html"
+    "$PY" - "$TMP/s" <<'PYEOF' || fail "index.html"
+import html.parser, json, os, re, sys
+d = sys.argv[1]
+s = json.load(open(os.path.join(d, "summary.json")))
+
+class Page(html.parser.HTMLParser):
+    """The rows of the runs table (cells as text), every href/src, every <script src>."""
+    def __init__(self):
+        super().__init__()
+        self.rows, self.links, self.external = [], [], []
+        self.in_runs = self.cell = None
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "table" and a.get("class") == "runs": self.in_runs = True
+        if self.in_runs and tag == "tr": self.rows.append({"id": a.get("id"), "cells": []})
+        if self.in_runs and tag == "td": self.cell = []
+        if tag == "br" and self.cell is not None: self.cell.append("\n")
+        for k in ("href", "src"):
+            if k in a:
+                self.links.append(a[k])
+        if tag in ("script", "link", "img") and re.match(r"[a-z]+:", a.get("src", a.get("href", ""))):
+            self.external.append(a)
+    def handle_endtag(self, tag):
+        if tag == "table": self.in_runs = False
+        if tag == "td" and self.cell is not None:
+            self.rows[-1]["cells"].append("".join(self.cell).strip()); self.cell = None
+    def handle_data(self, data):
+        if self.cell is not None: self.cell.append(data)
+
+page = Page()
+page.feed(open(os.path.join(d, "index.html")).read())
+assert not page.external, page.external
+assert not any(re.match(r"[a-z]+://", l) for l in page.links), page.links
+for l in page.links:  # every link is a file or folder of the sweep
+    assert os.path.exists(os.path.join(d, l)), l
+body = [r for r in page.rows if r["id"]]
+assert [r["id"] for r in body] == [f"run{i}" for i in range(4)], [r["id"] for r in body]
+verdicts = []
+for i, r in enumerate(body):
+    m = json.load(open(os.path.join(d, "runs", f"{i:04d}", "metrics.json")))
+    cells = r["cells"]
+    verdict = "PASS" if m["passed"] else "FAIL"
+    assert verdict in cells, (i, cells)
+    verdicts.append(m["passed"])
+    failed_text = cells[cells.index(verdict) + 1]
+    # From the run's own metrics.json: each failed criterion, its value and the bound it is outside.
+    expected = []
+    for c in m["steps"][0]["criteria"]:
+        if c["passed"]:
+            assert c["figure"] not in failed_text, (i, c, failed_text)
+            continue
+        v, lo, hi = c["value"], c["min"], c["max"]
+        if v is None:  # no value (no overshoot, so no peak time): the band and the note instead
+            expected.append(f"z.{c['figure']} = no value, band [{'-inf' if lo is None else f'{lo:.4g}'}, "
+                            f"{'inf' if hi is None else f'{hi:.4g}'}]" + (f": {c['note']}" if c["note"] else ""))
+            continue
+        side, bound = ("min", lo) if lo is not None and v < lo else ("max", hi)
+        assert v < lo if side == "min" else v > hi, c
+        expected.append(f"z.{c['figure']} = {v:.4g} {'<' if side == 'min' else '>'} {side} {bound:.4g}")
+    assert failed_text.split("\n") == (expected or [""]), (i, failed_text, expected)
+    # summary.json names the same criteria, with the numbers of metrics.json.
+    entry = s["per_run"][i]
+    assert entry["passed"] == m["passed"]
+    if m["passed"]:
+        assert "failed_criteria" not in entry, entry
+    else:
+        got = [(f["channel"], f["name"], f["value"], f["bound"]) for f in entry["failed_criteria"]]
+        def crossed(c):
+            v, lo, hi = c["value"], c["min"], c["max"]
+            return None if v is None else lo if lo is not None and v < lo else hi if hi is not None and v > hi else None
+        want = [("z", c["figure"], c["value"], crossed(c)) for c in m["steps"][0]["criteria"] if not c["passed"]]
+        assert got == want, (got, want)
+    # The varied keys' values as the run flew them.
+    assert f"{m['sweep']['values']['controller.altitude.kp']:.4g}" in cells, cells
+assert verdicts[:2] != verdicts[2:] and not any(verdicts[2:]), verdicts  # the kp 0.5 runs fail
+assert any("overshoot_pct" in r["cells"][r["cells"].index("FAIL") + 1] for r in body[2:])
+for key in ("controller.altitude.kp", "vehicle.mass_kg"):
+    png = f"headline_{key}.png"
+    assert png in page.links, (png, page.links)
+    assert open(os.path.join(d, png), "rb").read(8) == b"\x89PNG\r\n\x1a\n", png
+print("index.html: runs", verdicts)
+PYEOF
+    # The manifest lists index.html and the plots: a second sweep with --force removes them.
+    grep -q '"index.html"' "$TMP/s/.quadcosim-outputs.json" || fail "index.html not in the manifest"
+    grep -q '"headline_vehicle.mass_kg.png"' "$TMP/s/.quadcosim-outputs.json" || fail "headline plot not in the manifest"
+    ;;
+
+  progress)  # runs done, passed and time left on stderr; the outputs are those of a sweep without it
+    A=(--runs 6 --seed 9 --vary mass=10% --jobs 2 --min-pass-rate 0 --no-plots)
+    "$QC" sweep "$HOVER" "${A[@]}" --progress-every 0 --out "$TMP/p" > "$TMP/out" 2> "$TMP/err" || fail "sweep"
+    "$QC" sweep "$HOVER" "${A[@]}" --no-progress --out "$TMP/q" > "$TMP/out_q" 2> "$TMP/err_q" || fail "sweep --no-progress"
+    cmp "$TMP/p/summary.json" "$TMP/q/summary.json" || fail "progress changed summary.json"
+    # The runs' provenance names the two command lines: the same judgement, metrics.json besides it.
+    [ "$(cd "$TMP/p/runs" && find . -type f | sort)" = "$(cd "$TMP/q/runs" && find . -type f | sort)" ] \
+      || fail "progress changed the run files"
+    for f in "$TMP"/p/runs/*/metrics.json; do
+      "$PY" "$SRC/tests/lib/same_metrics.py" "$f" "$TMP/q/runs/${f#"$TMP/p/runs/"}" || fail "progress changed $f"
+    done
+    [ "$(sed "s|$TMP/p/|OUT/|" "$TMP/out")" = "$(sed "s|$TMP/q/|OUT/|" "$TMP/out_q")" ] || fail "progress changed stdout"
+    ! grep -q "runs done" "$TMP/err_q" || fail "--no-progress printed progress"
+    "$PY" - "$TMP/err" "$TMP/p/summary.json" <<'PYEOF' || { cat "$TMP/err"; fail "progress lines"; }
+import json, re, sys
+lines = [l for l in open(sys.argv[1]).read().splitlines() if "runs done" in l]
+s = json.load(open(sys.argv[2]))
+pat = re.compile(r"^sweep hover_wind_gusts: (\d+)/6 runs done, (\d+) passed \((\d+\.\d) %\), ([0-9.:]+ (s|min|h)) elapsed, (.*)$")
+counts = []
+for l in lines:
+    m = pat.match(l)
+    assert m, l
+    done, passed = int(m.group(1)), int(m.group(2))
+    assert 0 <= passed <= done and abs(float(m.group(3)) - 100.0 * passed / done) < 0.05 + 1e-9, l
+    assert (m.group(6) == "done") == (done == 6) and (done == 6 or m.group(6).startswith("about ")), l
+    counts.append((done, passed))
+assert [c[0] for c in counts] == [1, 2, 3, 4, 5, 6], counts  # a line after each run, the last at the total
+assert all(a[1] <= b[1] for a, b in zip(counts, counts[1:])), counts
+assert counts[-1][1] == s["passed"], (counts, s["passed"])
+PYEOF
+    # By default, not a terminal: a line every 5 s at most, and always the last.
+    "$QC" sweep "$HOVER" "${A[@]}" --out "$TMP/d" > /dev/null 2> "$TMP/err_d" || fail "sweep (default progress)"
+    tail -1 "$TMP/err_d" | grep -q "^sweep hover_wind_gusts: 6/6 runs done, .* elapsed, done$" \
+      || { cat "$TMP/err_d"; fail "no last progress line at 6/6"; }
     ;;
 
   *) echo "unknown case $CASE" >&2; exit 2 ;;

@@ -4,7 +4,8 @@
 // sends is checked by an implementation that is not quadcosim's. Prints one JSON object on stdout.
 //
 //   node client.mjs watch URL TOPIC...   subscribe to TOPICs, decode every message until the server
-//                                        closes the connection (or --seconds S); messages per topic
+//                                        closes the connection (or --seconds S); messages per topic,
+//                                        and the schema text of each subscribed channel
 //   node client.mjs stall URL TOPIC...   subscribe, take the first message, then stop reading (the
 //                                        socket paused) until killed or --seconds S
 //   node client.mjs abuse URL TOPIC      a handshake without the subprotocol, malformed JSON, an unknown
@@ -66,9 +67,11 @@ function subscribeClient(stall) {
   });
   client.on("advertise", (channels) => {
     for (const c of channels) {
-      result.channels.push({ id: c.id, topic: c.topic, encoding: c.encoding, schemaName: c.schemaName,
-                             schemaEncoding: c.schemaEncoding, schemaLines: c.schema.split("\n").length });
+      const channel = { id: c.id, topic: c.topic, encoding: c.encoding, schemaName: c.schemaName,
+                        schemaEncoding: c.schemaEncoding, schemaLines: c.schema.split("\n").length };
+      result.channels.push(channel);
       if (!topics.includes(c.topic)) continue;
+      channel.schema = c.schema;  // the subscribed ones' whole text, to compare with a recording's
       const reader = new MessageReader(parse(c.schema, { ros2: true }));
       const id = client.subscribe(c.id);
       readers.set(id, { topic: c.topic, reader });

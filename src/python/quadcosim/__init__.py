@@ -66,7 +66,8 @@ class RunResult:
     figures: the figures and verdicts of metrics.json besides its header: "steps" (one dict per
         analysed step: channel, figures, criteria, passed, ...), and "hold", "saturation", "tracking"
         when the run has them.
-    passed: the run's verdict (metrics.json "passed"; `quadcosim run` exits 0 exactly when it is True).
+    passed: the run's verdict on the criteria set judged (metrics.json "passed"; `quadcosim run` exits 0
+        exactly when it is not False): True or False, None with judge="none" (figures only).
     metrics: the whole of metrics.json as a dict.
     table: metrics.txt, the table `quadcosim run` prints.
     messages: what the CLI would have printed besides the table (watchdog, injected faults, rejected
@@ -75,16 +76,18 @@ class RunResult:
     provenance: what flew and how (metrics.json "provenance", docs/outputs.md): controller (label, type,
         parameter values; for a Python class module:Class, its module file and SHA-256), transport,
         command line, quadcosim version and git commit, host, scenario file and its SHA-256.
+    judged: the criteria set the run was judged against: "spec", "paper" or "none" (run's judge=).
     """
 
     trajectory: Dict[str, Any]
     figures: Dict[str, Any]
-    passed: bool
+    passed: Optional[bool]
     metrics: Dict[str, Any] = field(repr=False)
     table: str = field(repr=False)
     messages: str = field(repr=False)
     out: Optional[str] = None
     provenance: Dict[str, Any] = field(default_factory=dict, repr=False)
+    judged: str = "spec"
 
     def __repr__(self) -> str:
         n = len(self.trajectory.get("t", []))
@@ -138,11 +141,15 @@ class Controller:
 
 
 # Keys of metrics.json that describe the run rather than judge it.
-_HEADER_KEYS = {"scenario", "scenario_file", "description", "passed", "controller", "schema", "version", "provenance"}
+_HEADER_KEYS = {"scenario", "scenario_file", "description", "passed", "controller", "schema", "version", "judged",
+                "judged_criteria", "judged_note", "provenance"}
+# What run(judge=...) takes, as `quadcosim run --judge`.
+_JUDGE_SETS = ("spec", "paper", "none")
 
 
 def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = None,
-        controller: Any = None, force: bool = False, step_timeout_s: Optional[float] = None) -> RunResult:
+        controller: Any = None, force: bool = False, step_timeout_s: Optional[float] = None,
+        judge: str = "spec") -> RunResult:
     """Runs a scenario in process, as `quadcosim run SCENARIO --out OUT --no-plots` does.
 
     scenario: a Scenario, a scenario file or a dict (see load_scenario).
@@ -158,6 +165,10 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
     step_timeout_s: the per-step time limit of a Python controller [s] (None keeps the scenario's or
         the class's, default 0: no limit); a step that runs longer is stopped with StepTimeout and the
         run raises ControllerError.
+    judge: the criteria set the run is judged against, as `quadcosim run --judge`: "spec" (the
+        scenario's specification: bounds a good controller must meet), "paper" (the paper controller's
+        measured response bands) or "none" (figures only: every figure computed, passed is None).
+        Every figure and both sets' bands are in metrics.json whatever is judged.
 
     Ctrl-C raises KeyboardInterrupt within a few thousand plant ticks; out then holds what ran, as
     after an interrupted `quadcosim run`.
@@ -165,10 +176,12 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
     Returns a RunResult (trajectory, figures, passed, ...). Raises ConfigError for a bad scenario,
     ValueError when out cannot be used (it holds other outputs), RuntimeError on an I/O error.
     """
+    if judge not in _JUDGE_SETS:
+        raise ValueError(f"judge: got {judge!r}, expected 'spec', 'paper' or 'none'")
     sc = load_scenario(scenario, controller, step_timeout_s)
-    r = _quadcosim._run(sc, None if out is None else os.fspath(out), force)
+    r = _quadcosim._run(sc, None if out is None else os.fspath(out), force, judge)
     metrics = json.loads(r["metrics_json"])
     figures = {k: v for k, v in metrics.items() if k not in _HEADER_KEYS}
-    return RunResult(trajectory=r["trajectory"], figures=figures, passed=bool(r["passed"]), metrics=metrics,
-                     table=r["table"], messages=r["messages"], out=r["out"],
+    return RunResult(trajectory=r["trajectory"], figures=figures, passed=r["passed"], metrics=metrics,
+                     table=r["table"], messages=r["messages"], out=r["out"], judged=r["judged"],
                      provenance=metrics.get("provenance", {}))
