@@ -779,7 +779,9 @@ def _figures_text(step, has_metrics):
         npass = sum(1 for c in judged if c.get("passed") is True)
         lines.append("")
         lines.append(f"judged {npass}/{len(judged)} passed" if judged else "not judged (figures only)")
-        lines.extend(_criterion_line(c, band)[: lw + 2 * cw] for c in crit)
+        # Wrapped, not cut: "paper: overshoot in [15, 21]" is wider than the table's columns.
+        for c in crit:
+            lines.extend(textwrap.wrap(_criterion_line(c, band), width=lw + 2 * cw, subsequent_indent="    "))
     return "\n".join(lines)
 
 

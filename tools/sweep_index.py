@@ -122,7 +122,7 @@ def failed_criteria(metrics):
     out = []
     for ch, section in sweep_results.criteria_sections(metrics):
         for c in section.get("criteria", []):
-            if c.get("passed") is not False:
+            if c.get("passed") is not False or c.get("judged") is False:  # not judged: the other set's band
                 continue
             v, lo, hi = c.get("value"), c.get("min"), c.get("max")
             bound, side = None, None

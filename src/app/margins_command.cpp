@@ -21,6 +21,7 @@
 #include "analysis/measured_margins.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/node_common.hpp"
 #include "controllers/registry.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
@@ -82,7 +83,7 @@ Eigen::Vector3d trim_position(const control::ControllerConfig& c, std::vector<st
 Setup setup_from(const std::string& path, const std::string& controller_type) {
   Setup s;
   if (path.empty()) {
-    s.controller = controllers::make_config(controller_type.empty() ? "paper" : controller_type, s.plant);
+    s.controller = io::defaults_flown_by(controller_type).controller;
     s.source = fmt::format("defaults (the paper's vehicle, {} controller, plant 100 Hz, controller 50 Hz)",
                            s.controller.type());
     s.measured.vehicle = s.plant;
@@ -218,6 +219,27 @@ nlohmann::json measured_margin_json(const analysis::Margin& m, const char* unit,
   return j;
 }
 
+// The margins of one loop into `j` (analytic or measured: `to_json` says how one margin reads), with
+// the gain margins also in dB and the delay margin also in control periods of `period_s`.
+template <class Margins>
+void put_margins(nlohmann::json& j, const Margins& m, double period_s,
+                 nlohmann::json (*to_json)(const analysis::Margin&, const char*, double)) {
+  const auto with_db = [&](const analysis::Margin& g) {
+    nlohmann::json x = to_json(g, "factor", 1.0);
+    x["db"] = g.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(g.value)) : nlohmann::json(nullptr);
+    return x;
+  };
+  j["gain_margin"] = with_db(m.gain_margin);
+  j["gain_reduction_margin"] = with_db(m.gain_reduction_margin);
+  j["phase_margin"] = to_json(m.phase_margin, "deg", kDeg);
+  nlohmann::json dm = to_json(m.delay_margin, "s", 1.0);
+  dm["samples"] = m.delay_margin.status == MarginStatus::kFinite ? nlohmann::json(m.delay_margin.value / period_s)
+                                                                 : nlohmann::json(nullptr);
+  j["delay_margin"] = dm;
+  j["gain_crossovers_rad_s"] = m.gain_crossovers_rad_s;
+  j["phase_crossovers_rad_s"] = m.phase_crossovers_rad_s;
+}
+
 std::string measured_cell(const analysis::Margin& m, double scale, int precision = 2) {
   return cell(m, scale, "none", precision);
 }
@@ -276,22 +298,7 @@ MeasuredReport measure_all(const Setup& s, const MarginsOptions& o) {
     j["amplitude"] = m.amplitude;
     j["stayed_in_hover"] = m.problem.empty();
     j["problem"] = m.problem.empty() ? nlohmann::json(nullptr) : nlohmann::json(m.problem);
-    nlohmann::json gm = measured_margin_json(m.gain_margin, "factor", 1.0);
-    gm["db"] = m.gain_margin.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(m.gain_margin.value))
-                                                             : nlohmann::json(nullptr);
-    j["gain_margin"] = gm;
-    nlohmann::json gr = measured_margin_json(m.gain_reduction_margin, "factor", 1.0);
-    gr["db"] = m.gain_reduction_margin.status == MarginStatus::kFinite
-                   ? nlohmann::json(20 * std::log10(m.gain_reduction_margin.value))
-                   : nlohmann::json(nullptr);
-    j["gain_reduction_margin"] = gr;
-    j["phase_margin"] = measured_margin_json(m.phase_margin, "deg", kDeg);
-    nlohmann::json dm = measured_margin_json(m.delay_margin, "s", 1.0);
-    dm["samples"] = m.delay_margin.status == MarginStatus::kFinite ? nlohmann::json(m.delay_margin.value / T)
-                                                                   : nlohmann::json(nullptr);
-    j["delay_margin"] = dm;
-    j["gain_crossovers_rad_s"] = m.gain_crossovers_rad_s;
-    j["phase_crossovers_rad_s"] = m.phase_crossovers_rad_s;
+    put_margins(j, m, T, measured_margin_json);
     j["unconverged_points"] = m.unconverged_points;
     nlohmann::json pts = nlohmann::json::array();
     double max_tilt = 0.0, max_rotor = 0.0;
@@ -350,10 +357,7 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
       app.add_subcommand("margins", "gain, phase and delay margins of each control loop about hover (docs/margins.md)");
   cmd->add_option("scenario", o.scenario, "scenario YAML (default: the paper's vehicle and controller)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--controller", o.controller,
-                  "the controller type to analyse, replacing the scenario's controller.type (`quadcosim params "
-                  "--list`); any but the paper's is measured")
-      ->check(CLI::IsMember(controllers::controller_type_list()));
+  add_controller_type_option(*cmd, o.controller);  // any but the paper's is measured
   cmd->add_flag("--measure", o.measure,
                 "the paper controller: measure its margins in simulation too, beside the analytic ones (other "
                 "controllers are always measured)");
@@ -443,22 +447,7 @@ int margins_command(const MarginsOptions& o) {
       j["closed_loop_stable"] = m.closed_loop_stable;
       j["open_loop_unstable_poles"] = m.open_loop_unstable_poles;
       j["open_loop_marginal_poles"] = m.open_loop_marginal_poles;
-      nlohmann::json gm = margin_json(m.gain_margin, "factor", 1.0);
-      gm["db"] = m.gain_margin.status == MarginStatus::kFinite ? nlohmann::json(20 * std::log10(m.gain_margin.value))
-                                                               : nlohmann::json(nullptr);
-      j["gain_margin"] = gm;
-      nlohmann::json gr = margin_json(m.gain_reduction_margin, "factor", 1.0);
-      gr["db"] = m.gain_reduction_margin.status == MarginStatus::kFinite
-                     ? nlohmann::json(20 * std::log10(m.gain_reduction_margin.value))
-                     : nlohmann::json(nullptr);
-      j["gain_reduction_margin"] = gr;
-      j["phase_margin"] = margin_json(m.phase_margin, "deg", kDeg);
-      nlohmann::json dm = margin_json(m.delay_margin, "s", 1.0);
-      dm["samples"] = m.delay_margin.status == MarginStatus::kFinite ? nlohmann::json(m.delay_margin.value / T)
-                                                                     : nlohmann::json(nullptr);
-      j["delay_margin"] = dm;
-      j["gain_crossovers_rad_s"] = m.gain_crossovers_rad_s;
-      j["phase_crossovers_rad_s"] = m.phase_crossovers_rad_s;
+      put_margins(j, m, T, margin_json);
       nlohmann::json ranges = nlohmann::json::array();
       for (const auto& [lo, hi] : m.stable_gain_ranges)
         ranges.push_back({lo, std::isinf(hi) ? nlohmann::json(nullptr) : nlohmann::json(hi)});

@@ -1,7 +1,5 @@
 #include "app/node_common.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -35,22 +33,8 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
   }
   // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
   if (!cpus.empty()) std::cerr << fmt::format("{}: on CPU(s) {} only\n", who, cpus);
-  io::Scenario sc;
-  if (!scenario.empty()) {
-    sc = io::load_scenario(scenario, controller_type);
-  } else {
-    sc.name = "defaults";
-    if (!controller_type.empty()) {
-      if (io::parse_controller_choice(controller_type).kind == io::ControllerChoice::Kind::kType) {
-        sc.controller = controllers::make_config(controller_type, sc.vehicle);
-      } else {  // a Python class or an FMU, made as a scenario's controller section makes it
-        YAML::Node root(YAML::NodeType::Map);
-        io::set_controller_type(root, controller_type);
-        sc = io::load_scenario(root, "--controller");
-        sc.name = "defaults";
-      }
-    }
-  }
+  io::Scenario sc =
+      scenario.empty() ? io::defaults_flown_by(controller_type) : io::load_scenario(scenario, controller_type);
   if (!vehicle.empty()) {
     sc.vehicle = io::load_vehicle(vehicle);
     if (sc.controller_fmu) {

@@ -700,7 +700,6 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
   if (!same) {
     // The gains written directly under controller: are the file's controller's. A registered type's
     // move into its own section (kept, checked, unused); a Python class's or an FMU's go with it.
-    YAML::Node gains(YAML::NodeType::Map);
     std::vector<std::string> moved;
     for (const auto& kv : c) {
       const std::string key = kv.first.as<std::string>();
@@ -711,6 +710,9 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       moved.push_back(key);
     }
     const bool keep = !was_python && !was_fmu && controllers::find_controller_type(was_type);
+    // A Python class takes the flat gains as its own (its declared parameters, the way a scenario
+    // dict passes them with quadcosim.run(..., controller=Class)); they stay where they are.
+    if (choice.kind == ControllerChoice::Kind::kPython && keep) moved.clear();
     for (const std::string& key : moved) {
       if (keep) {
         if (!c[was_type] || !c[was_type].IsMap()) c[was_type] = YAML::Node(YAML::NodeType::Map);
@@ -718,9 +720,10 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       }
       c.remove(key);
     }
-    for (const char* key : {"python", "step_timeout_s", "fmu", "inputs", "outputs", "parameters", "in_process"}) {
-      c.remove(key);
-    }
+    // The other kinds' own keys go; a Python controller's time limit stays for the Python class
+    // that replaces it (the scenario's step_timeout_s applies to whichever class flies).
+    for (const char* key : {"python", "fmu", "inputs", "outputs", "parameters", "in_process"}) c.remove(key);
+    if (choice.kind != ControllerChoice::Kind::kPython) c.remove("step_timeout_s");
   }
   switch (choice.kind) {
     case ControllerChoice::Kind::kType: c["type"] = choice.target; break;
@@ -733,6 +736,21 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       c["fmu"] = choice.target;
       break;
   }
+}
+
+Scenario defaults_flown_by(const std::string& controller) {
+  Scenario sc;
+  if (!controller.empty()) {
+    if (parse_controller_choice(controller).kind == ControllerChoice::Kind::kType) {
+      sc.controller = controllers::make_config(controller, sc.vehicle);
+    } else {
+      YAML::Node root(YAML::NodeType::Map);
+      set_controller_type(root, controller);
+      sc = load_scenario(root, "--controller");
+    }
+  }
+  sc.name = "defaults";
+  return sc;
 }
 
 Scenario load_scenario(const std::string& path, const std::string& controller_type) {

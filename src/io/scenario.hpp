@@ -192,13 +192,19 @@ struct ControllerChoice {
 };
 ControllerChoice parse_controller_choice(const std::string& text);
 
+/// What a command without a scenario file flies: the defaults (the paper's vehicle, named "defaults")
+/// flown by `controller` (parse_controller_choice; "" keeps the paper's). A Python class or an FMU is
+/// made as a scenario's controller section makes it. Throws as load_scenario and parse_controller_choice.
+Scenario defaults_flown_by(const std::string& controller);
+
 /// Makes a parsed scenario (a mapping) fly `controller` (parse_controller_choice; a bare "python"
 /// leaves the class to the caller's controller.python), creating the section if needed. What is
 /// flown (the node's mode, setpoints, safety) stays. The gains written directly under controller:
 /// belong to the file's controller: a registered type's move into its own gains section (`paper:
 /// {lqr: ...}`, still checked, not used); a Python class's or an FMU's (and its python, fmu,
-/// inputs, outputs, parameters, step_timeout_s) are dropped. The gains section of the type that
-/// flies now, when the file has one, applies. Throws std::invalid_argument as parse_controller_choice.
+/// inputs, outputs, parameters; step_timeout_s unless a Python class flies next) are dropped; a Python
+/// class taking a registered type's place keeps the flat gains as its own. The gains section of the
+/// type that flies now, when the file has one, applies. Throws std::invalid_argument as parse_controller_choice.
 void set_controller_type(YAML::Node root, const std::string& controller);
 
 /// The same from a parsed YAML document (`root` must be a mapping); errors name `source` as the file

@@ -39,22 +39,27 @@ class ControllerCore {
   /// Sensor samples: true when taken; a sample that fails its check is counted, logged (1st of each
   /// reason, then every 100th) and dropped, the observation keeping its last valid values and ages.
   bool take_pose(const msg::PoseStamped& m) {
-    if (!accept(check_pose(m, pose_stamp_ns_, ahead_limit(pose_ref_ns_)), pose_topic_, pose_backwards_)) return false;
+    const std::int64_t received = receipt_now();
+    const SensorCheck check = check_pose(m, pose_stamp_ns_, ahead_limit(pose_ref_ns_, received));
+    if (!accept(check, pose_topic_, pose_backwards_)) return false;
     observation_.p_W = {m.position.x, m.position.y, m.position.z};
     pose_stamp_ns_ = m.header.stamp.to_ns();
-    pose_ref_ns_ = reference_time(pose_stamp_ns_);
+    pose_ref_ns_ = reference_time(pose_stamp_ns_, received);
     return true;
   }
   bool take_velocity(const msg::TwistStamped& m) {
-    const SensorCheck check = check_velocity(m, velocity_stamp_ns_, ahead_limit(velocity_ref_ns_));
+    const std::int64_t received = receipt_now();
+    const SensorCheck check = check_velocity(m, velocity_stamp_ns_, ahead_limit(velocity_ref_ns_, received));
     if (!accept(check, velocity_topic_, velocity_backwards_)) return false;
     observation_.v_W = {m.linear.x, m.linear.y, m.linear.z};
     velocity_stamp_ns_ = m.header.stamp.to_ns();
-    velocity_ref_ns_ = reference_time(velocity_stamp_ns_);
+    velocity_ref_ns_ = reference_time(velocity_stamp_ns_, received);
     return true;
   }
   bool take_imu(const msg::Imu& m) {
-    if (!accept(check_imu(m, imu_stamp_ns_, ahead_limit(imu_ref_ns_)), imu_topic_, imu_backwards_)) return false;
+    const std::int64_t received = receipt_now();
+    const SensorCheck check = check_imu(m, imu_stamp_ns_, ahead_limit(imu_ref_ns_, received));
+    if (!accept(check, imu_topic_, imu_backwards_)) return false;
     // Kept as received; turned into Euler angles when a step uses it (the plant publishes at twice
     // the control rate, so converting on arrival would do half the atan2s for nothing).
     observation_.q_WB = Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z);
@@ -62,7 +67,7 @@ class ControllerCore {
     observation_.w_B = {m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z};
     observation_.specific_force_B = {m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z};
     imu_stamp_ns_ = m.header.stamp.to_ns();
-    imu_ref_ns_ = reference_time(imu_stamp_ns_);
+    imu_ref_ns_ = reference_time(imu_stamp_ns_, received);
     return true;
   }
 
@@ -129,14 +134,19 @@ class ControllerCore {
     return accept_refused(check, topic, backwards);
   }
   bool accept_refused(const SensorCheck& check, const std::string& topic, int& backwards);
-  std::int64_t reference_time(std::int64_t stamp_ns) const { return receipt_clock_ ? receipt_clock_() : stamp_ns; }
+  /// The receipt clock's time now (read once per sample), or kNever without one.
+  std::int64_t receipt_now() const { return receipt_clock_ ? receipt_clock_() : kNever; }
+  /// What a sample's age is measured from: its receipt time on the receipt clock, else its stamp.
+  std::int64_t reference_time(std::int64_t stamp_ns, std::int64_t received_ns) const {
+    return receipt_clock_ ? received_ns : stamp_ns;
+  }
   /// How far ahead of the newest accepted stamp a topic's next may be: kStampAheadLimitNs, plus on the
-  /// receipt clock the time since that newest was taken (`ref_ns`, its receipt time): a plant whose
-  /// samples were cut off for longer has simulated on meanwhile, in real time.
-  std::int64_t ahead_limit(std::int64_t ref_ns) const {
-    return receipt_clock_ && ref_ns != kNever
-               ? kStampAheadLimitNs + std::max<std::int64_t>(receipt_clock_() - ref_ns, 0)
-               : kStampAheadLimitNs;
+  /// receipt clock the time since that newest was taken (`ref_ns`, its receipt time, until
+  /// `received_ns`): a plant whose samples were cut off for longer has simulated on meanwhile, in
+  /// real time.
+  std::int64_t ahead_limit(std::int64_t ref_ns, std::int64_t received_ns) const {
+    return receipt_clock_ && ref_ns != kNever ? kStampAheadLimitNs + std::max<std::int64_t>(received_ns - ref_ns, 0)
+                                              : kStampAheadLimitNs;
   }
   /// reference_ at simulated time now_ns: the step setpoints (or the trajectory).
   void update_reference(std::int64_t now_ns);

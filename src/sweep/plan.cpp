@@ -7,7 +7,9 @@
 #include <limits>
 #include <numbers>
 
+#include "control/controller_config.hpp"
 #include "control/parameters.hpp"
+#include "controllers/registry.hpp"
 #include "model/random.hpp"
 
 namespace quadcosim::sweep {
@@ -212,7 +214,14 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
   const std::vector<std::string> parts = split_path(v.name);
   k.nominal = get_at(root, parts, 0);
   if (parts[0] == "controller" && parts.size() > 1) {
-    const std::string name = join(parts, 1, parts.size());
+    // controller.<type>.<gain> names a type's gains section: only the flying type's can be varied.
+    const std::string type(nominal.controller.type());
+    const bool in_section = parts.size() > 2 && controllers::find_controller_type(parts[1]) != nullptr;
+    if (in_section && parts[1] != type) {
+      throw PlanError("--vary " + v.spec + ": the scenario flies '" + type + "', not '" + parts[1] +
+                      "' (its gains section is not used)");
+    }
+    const std::string name = join(parts, in_section ? 2 : 1, parts.size());
     const control::ParameterSpec* spec = control::find_parameter(nominal.controller, name);
     if (!spec) {
       throw PlanError("--vary " + v.spec + ": unknown controller parameter '" + name + "' (see `quadcosim params`)");
@@ -370,8 +379,18 @@ Vary parse_vary(const std::string& spec) {
 
 void set_key(YAML::Node root, const std::string& path, double value,
              const std::map<std::string, std::vector<double>>& lists) {
-  const std::vector<std::string> parts = split_path(path);
+  std::vector<std::string> parts = split_path(path);
   if (parts.empty()) throw PlanError("empty key");
+  // controller.<gain> of a scenario that keeps the flying type's gains in their own section is set
+  // there, so the run's file sets it once (the key keeps its name in the sweep's outputs).
+  if (parts.size() > 1 && parts[0] == "controller" && !controllers::find_controller_type(parts[1]) &&
+      !control::node_parameters().find(join(parts, 1, parts.size()))) {
+    const YAML::Node c = static_cast<const YAML::Node&>(root)["controller"];
+    const std::string type = c && c.IsMap() && c["type"] && c["type"].IsScalar() ? c["type"].Scalar() : "paper";
+    if (c && c.IsMap() && !c["python"] && !c["fmu"] && c[type] && c[type].IsMap()) {
+      parts.insert(parts.begin() + 1, type);
+    }
+  }
   set_at(root, parts, 0, value, path, "", lists);
 }
 

@@ -146,6 +146,7 @@ nlohmann::json failed_criteria(const nlohmann::json& metrics) {
     if (!section.is_object() || !section.contains("criteria") || !section.at("criteria").is_array()) return;
     for (const auto& c : section.at("criteria")) {
       if (!c.is_object() || c.value("passed", true) != false) continue;
+      if (c.value("judged", true) == false) continue;  // the other set's band (--judge): no verdict
       nlohmann::json f = c;
       f.erase("passed");
       f.erase("figure");

@@ -22,6 +22,7 @@ printf 'controller:\n  roll_des: 5\n' > param_range.yaml
 printf 'altitude: {kq: 3}\n' > params_unknown.yaml
 printf 'mass_kg: 1.0\nlayout: h\n' > vehicle_bad.yaml
 printf 'controller: {type: lqg}\n' > controller_type.yaml
+printf 'controller: {paper: {lqr: {roll: {q_angel: 2}}}}\n' > type_section_typo.yaml
 printf 'controller:\n  type: se3\n  lqr: {roll: {r: 1}}\n' > controller_foreign_key.yaml
 printf 'controller:\n  type: se3\n  k_R: {x: -1}\n' > controller_gain_range.yaml
 printf 'controller: {z_des: 1}\nschedule:\n  - at_s: 1\n    set: {type: se3}\n' > controller_type_change.yaml
@@ -80,10 +81,13 @@ expect 2 "controller_type.yaml: controller.type: got 'lqg', expected one of;;pap
 expect 2 "controller_foreign_key.yaml: controller.lqr.roll.r: unknown parameter 'lqr.roll.r' of the node or of controller type 'se3'" run controller_foreign_key.yaml --out o --no-plots
 expect 2 "controller_gain_range.yaml: controller.k_R.x: k_R.x must be in [0, 1e+09] N m/rad, got -1" run controller_gain_range.yaml --out o --no-plots
 expect 2 "controller_type_change.yaml: schedule[0].set.type: the controller's type cannot change during a run" run controller_type_change.yaml --out o --no-plots
-expect 2 "--controller: lqg not in {paper,se3,example_pd}" run "$ALT" --out o --controller lqg
-expect 2 "position_step.yaml: controller.lqr.roll.q_angle: unknown parameter 'lqr.roll.q_angle' of the node or of controller type 'se3'" run "$SRC/scenarios/examples/position_step.yaml" --out o --no-plots --controller se3
+expect 2 "--controller: got 'lqg', expected a controller type (paper, se3, example_pd), python:MODULE:CLASS" run "$ALT" --out o --controller lqg
+expect 2 "--controller: got 'python:nocolon', expected python:MODULE:CLASS" run "$ALT" --out o --controller python:nocolon
+expect 2 "--controller: got 'fmu:no_such.fmu': no such file 'no_such.fmu'" run "$ALT" --out o --controller fmu:no_such.fmu
+# A misspelt gain of a type that does not fly is still refused, at its key.
+expect 2 "type_section_typo.yaml: controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel' of the node or of controller type 'paper'" run type_section_typo.yaml --out o --no-plots --controller se3
 expect 2 "--controller: lqg not in {paper,se3,example_pd}" params --controller lqg
-expect 2 "--controller: lqg not in {paper,se3,example_pd}" controller --controller lqg
+expect 2 "--controller: got 'lqg', expected a controller type (paper, se3, example_pd)" controller --controller lqg
 expect 2 "--transport: carrier not in {inproc,dds}" run "$ALT" --out o --transport carrier
 expect 2 "--timeout: Value abc not in range 0.01" run "$ALT" --out o --timeout abc
 expect 2 "--rate-factor: Value 0 not in range 0.001" run "$ALT" --out o --rate-factor 0

@@ -301,7 +301,8 @@ PYEOF
     expect_error 2 "--out: '$TMP/x.zip' must end in .fmu" fmu export plant --out "$TMP/x.zip"
     expect_error 2 "--out is required" fmu export plant
     expect_error 2 "--controller: does nothing with plant" fmu export plant --controller se3 --out "$TMP/x.fmu"
-    expect_error 2 "--controller: warp not in" fmu export controller --controller warp --out "$TMP/x.fmu"
+    expect_error 2 "--controller: got 'warp', expected a controller type" fmu export controller --controller warp --out "$TMP/x.fmu"
+    expect_error 2 "fmu export packs one of quadcosim's controller types" fmu export controller --controller python:m:C --out "$TMP/x.fmu"
     expect_error 2 "--scenario: File does not exist: $TMP/none.yaml" fmu export plant --scenario "$TMP/none.yaml" \
       --out "$TMP/x.fmu"
     printf 'simulation:\n  plant_rate_hz: fast\n' > "$TMP/bad.yaml"

@@ -11,7 +11,12 @@ unset ROS_SECURITY_ENABLE ROS_SECURITY_STRATEGY ROS_SECURITY_KEYSTORE ROS_SECURI
 tmp="$(mktemp -d)"
 pids=()
 cleanup() {
-  for p in "${pids[@]}" $(jobs -p); do kill -KILL "$p" 2>/dev/null || true; done
+  # A job that runs a shell function (`secure ... &`) is a subshell whose command is its child: end the
+  # children first, or they outlive the case (two real-time controllers were found running minutes later).
+  for p in "${pids[@]}" $(jobs -p); do
+    pkill -KILL -P "$p" 2>/dev/null || true
+    kill -KILL "$p" 2>/dev/null || true
+  done
   wait 2>/dev/null || true
   rm -rf "$tmp"
 }
@@ -20,4 +25,15 @@ fail() {
   echo "FAIL [$case_name]: $*"
   for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -20 "$f"; }; done
   exit 1
+}
+
+# skip_without_python BINARY: exits 77 (SKIPPED), saying why, when that quadcosim was built without
+# Python controllers.
+skip_without_python() {
+  if "$1" controller --python "no_such_module_for_the_check:X" > "$tmp/check.log" 2>&1; then :; fi
+  if grep -q "built without Python" "$tmp/check.log"; then
+    echo "SKIP: this quadcosim was built without Python: $(cat "$tmp/check.log")"
+    exit 77
+  fi
+  rm -f "$tmp/check.log"
 }

@@ -9,24 +9,11 @@
 # A run passes when it ends with exit 0 or 1 (1: a criterion of the scenario failed, which a
 # controller that is not the scenario's own may do), with every tick of the run in trajectory.csv
 # and every number finite. Cases needing Python exit 77 on a CLI built without it.
-set -euo pipefail
-bin="$1"; src="$2"; case_name="$3"; domain="$4"; pydir="${5:-}"
-export ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
+bin="$1"; src="$2"; pydir="${5:-}"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 py=/usr/bin/python3
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
 export PYTHONPATH="$src/tests/newcomer${PYTHONPATH:+:$PYTHONPATH}"
 scenarios=("$src"/scenarios/*/*.yaml)
-fail() { echo "FAIL [$case_name]: $*"; exit 1; }
-
-need_python() {
-  if "$bin" controller --python "no_such_module_for_the_check:X" > "$tmp/check.log" 2>&1; then :; fi
-  if grep -q "built without Python" "$tmp/check.log"; then
-    echo "SKIP: this quadcosim was built without Python: $(cat "$tmp/check.log")"
-    exit 77
-  fi
-}
 
 # check_outputs SCENARIO FOLDER: every tick recorded (one vehicle's trajectory.csv, or each of a
 # swarm's vehicles), every number finite.
@@ -75,7 +62,7 @@ case "$case_name" in
     ;;
 
   cli_python)
-    need_python
+    skip_without_python "$bin"
     fly python:cascade:Cascade
     # Its altitude loop is a PD on a double integrator (thrust tilt-compensated, level flight):
     # z'' = kp (z_des - z) - kd z', damping kd / (2 sqrt(kp)) = 0.8 at the defaults, so a step
@@ -92,7 +79,7 @@ PY
     ;;
 
   python_module)
-    need_python
+    skip_without_python "$bin"
     [ -d "$pydir" ] || { echo "SKIP: the Python module was not built ($pydir)"; exit 77; }
     for s in "$src/scenarios/paper/altitude_step.yaml" "$src/scenarios/tracking/circle_se3.yaml" \
              "$src/scenarios/realism/hover_wind_gusts.yaml"; do
@@ -116,7 +103,7 @@ PY
     ;;
 
   dds_python)
-    need_python
+    skip_without_python "$bin"
     s="$src/scenarios/paper/altitude_step.yaml"
     set +e
     "$bin" run "$s" --controller python:cascade:Cascade --out "$tmp/in" --no-plots > "$tmp/in.log" 2>&1

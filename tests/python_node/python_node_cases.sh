@@ -8,15 +8,6 @@ source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 here="$src/tests/python_node"
 paper="$src/scenarios/paper"
 
-need_python() {
-  if "$bin" controller --python "no_such_module_for_the_check:X" > "$tmp/check.log" 2>&1; then :; fi
-  if grep -q "built without Python" "$tmp/check.log"; then
-    echo "SKIP: this quadcosim was built without Python: $(cat "$tmp/check.log")"
-    exit 77
-  fi
-  rm -f "$tmp/check.log"
-}
-
 # The paper's altitude step (z_des 0 -> 10 m at t = 0) without its paper criteria, flying the class
 # $1 of altitude_pd.py with the controller keys $2 (", key: value, ..."), $3 s long, written to $4
 # next to a copy of altitude_pd.py (found in the scenario's folder).
@@ -48,7 +39,7 @@ term_within() {
 
 case "$case_name" in
   lockstep_matches_run)  # the same Python controller in process and as a DDS lockstep node: same bytes
-    need_python
+    skip_without_python "$bin"
     scenario AltitudePD "" 10 "$tmp/pd.yaml"
     "$bin" run "$tmp/pd.yaml" --out "$tmp/run" --no-plots > "$tmp/run.log" 2>&1 || fail "run failed"
     reaches "$tmp/run/trajectory.csv" 0.05
@@ -69,7 +60,7 @@ case "$case_name" in
     ;;
 
   param_set)  # a declared Python parameter changed with `quadcosim param set` mid-run takes effect
-    need_python
+    skip_without_python "$bin"
     # kp_z 0: thrust m g only, the vehicle stays on the ground; kp_z 4 from about 3 s on: it climbs.
     scenario AltitudePD ", kp_z: 0" 6 "$tmp/pd.yaml"
     "$bin" controller --scenario "$tmp/pd.yaml" --realtime > "$tmp/controller.log" 2>&1 &
@@ -96,7 +87,7 @@ case "$case_name" in
     ;;
 
   raising_stops)  # a controller that raises ends the node with exit 5 and a message naming it
-    need_python
+    skip_without_python "$bin"
     scenario Raising "" 10 "$tmp/raise.yaml"
     "$bin" controller --scenario "$tmp/raise.yaml" > "$tmp/controller.log" 2>&1 &
     cpid=$!; pids+=("$cpid")
@@ -113,7 +104,7 @@ case "$case_name" in
     ;;
 
   raising_safety)  # --on-controller-error safety: the failed steps get the safety command, counted
-    need_python
+    skip_without_python "$bin"
     scenario Raising ", bad_count: 3" 10 "$tmp/raise.yaml"
     "$bin" controller --scenario "$tmp/raise.yaml" --on-controller-error safety > "$tmp/controller.log" 2>&1 &
     cpid=$!; pids+=("$cpid")
@@ -133,7 +124,7 @@ case "$case_name" in
     ;;
 
   blocking_realtime)  # a controller that sleeps 10 s: the node serves parameters, sends safety, ends on SIGTERM
-    need_python
+    skip_without_python "$bin"
     scenario Blocking "" 30 "$tmp/block.yaml"
     "$bin" controller --scenario "$tmp/block.yaml" --realtime > "$tmp/controller.log" 2>&1 &
     cpid=$!; pids+=("$cpid")
@@ -153,7 +144,7 @@ case "$case_name" in
     ;;
 
   blocking_lockstep)  # the same in lockstep: the plant's timeout policy applies; the node serves and stops
-    need_python
+    skip_without_python "$bin"
     scenario Blocking "" 10 "$tmp/block.yaml"
     "$bin" controller --scenario "$tmp/block.yaml" > "$tmp/controller.log" 2>&1 &
     cpid=$!; pids+=("$cpid")
@@ -174,7 +165,7 @@ case "$case_name" in
     ;;
 
   run_and_sweep)  # `run` and `sweep` of a scenario with controller: {python: ...}; sweep runs = single runs
-    need_python
+    skip_without_python "$bin"
     scenario AltitudePD "" 6 "$tmp/pd.yaml"
     # Something for the sweep to judge: the step's overshoot, loosely.
     printf 'analysis:\n  steps:\n    - channel: z\n      at_s: 0\n      criteria:\n        overshoot_pct: [null, 50]\n' >> "$tmp/pd.yaml"
