@@ -6,9 +6,14 @@ Usage: compare_runs.py RUN_A RUN_B [--out DIR]
 For each channel stepped in either run (the steps of metrics.json, or, without
 metrics.json, the setpoint changes found in trajectory.csv), writes
 DIR/compare_<channel>.png: the variable against time, run A solid, run B
-dashed, the setpoints grey. Prints a Markdown table of the step figures side
-by side (figure, A, B, difference B - A) to stdout and writes it to
-DIR/compare.md. Steps are paired by channel and order of occurrence.
+dashed, the setpoints grey. When either run tracked a trajectory (metrics.json
+has "tracking"), writes DIR/compare_tracking_path.png (both paths over their
+references, top view x-y) and DIR/compare_tracking_error.png (the error
+reference - measured of both runs over time: norm, x, y, z). Prints a Markdown
+table of the tracking and step figures side by side (figure, A, B, difference
+B - A) to stdout and writes it to DIR/compare.md. Steps are paired by channel
+and order of occurrence. Runs are labelled by folder name and the controller
+that flew (metrics.json "provenance").
 
 DIR defaults to RUN_B/compare_with_<name of RUN_A>. Loading helpers come from
 plot_run.py (imported as a module). Exit status: 0 on success, 1 when an input
@@ -44,10 +49,119 @@ def load_run(run_dir):
 
 
 def run_label(run_dir, metrics):
+    """The run folder's name and, in parentheses, the controller that flew (metrics.json provenance)
+    and the scenario when its name differs from the folder's: "a (example_pd, circle_se3)"."""
     name = os.path.basename(os.path.normpath(os.path.abspath(run_dir)))
+    extra = []
+    label = plot_run.controller_label(metrics)
+    if label:
+        extra.append(label)
     if metrics and metrics.get("scenario") and metrics["scenario"] != name:
-        return f"{name} ({metrics['scenario']})"
-    return name
+        extra.append(metrics["scenario"])
+    return f"{name} ({', '.join(extra)})" if extra else name
+
+
+def is_tracking(metrics):
+    return bool(metrics and metrics.get("tracking"))
+
+
+def plot_tracking_path(traj_a, traj_b, label_a, label_b, out_path):
+    """Top view x-y of both runs over their references (equal axes)."""
+    fig, ax = plt.subplots(figsize=(8.0, 7.0), dpi=plot_run.DPI)
+    ax.plot(traj_a["x_des"], traj_a["y_des"], color=plot_run.COLOR_SETPOINT, lw=1.0, ls="-", alpha=0.7,
+            label="reference A")
+    ax.plot(traj_b["x_des"], traj_b["y_des"], color=plot_run.COLOR_SETPOINT, lw=1.0, ls=":", alpha=0.9,
+            label="reference B")
+    ax.plot(traj_a["x"], traj_a["y"], color=COLOR_A, lw=1.4, ls="-", label=f"A: {label_a}")
+    ax.plot(traj_b["x"], traj_b["y"], color=COLOR_B, lw=1.4, ls="--", label=f"B: {label_b}")
+    ax.plot([traj_a["x"][0]], [traj_a["y"][0]], "o", color=COLOR_A, ms=4)
+    ax.plot([traj_b["x"][0]], [traj_b["y"][0]], "s", color=COLOR_B, ms=4, mfc="none")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("Tracking path, top view (x–y): A (solid) vs B (dashed)", fontsize=12, fontweight="bold")
+    ax.grid(True, color="0.88", lw=0.6)
+    ax.legend(fontsize=8, loc="best", framealpha=0.85)
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=plot_run.DPI)
+    plt.close(fig)
+
+
+def plot_tracking_error(traj_a, traj_b, metrics_a, metrics_b, label_a, label_b, out_path):
+    """The tracking error (reference − measured) of both runs over time, at the samples each run's
+    tracking figures count: its norm, then each axis. Axes scaled to the judged samples."""
+    ea = plot_run.tracking_errors(traj_a, plot_run._reference_period_s(metrics_a or {}))
+    eb = plot_run.tracking_errors(traj_b, plot_run._reference_period_s(metrics_b or {}))
+    after_a = plot_run._tracking_after_s(metrics_a or {})
+    after_b = plot_run._tracking_after_s(metrics_b or {})
+    fig, axes = plt.subplots(4, 1, figsize=(10.0, 10.0), dpi=plot_run.DPI, sharex=True)
+    fig.subplots_adjust(left=0.1, right=0.97, bottom=0.06, top=0.93, hspace=0.12)
+    rows = (("norm", "|e| (3D) [m]"), ("x", "e_x [m]"), ("y", "e_y [m]"), ("z", "e_z [m]"))
+    for ax, (key, ylabel) in zip(axes, rows):
+        ax.plot(ea["t"], ea[key], color=COLOR_A, lw=1.2, ls="-", label=f"A: {label_a}")
+        ax.plot(eb["t"], eb[key], color=COLOR_B, lw=1.2, ls="--", label=f"B: {label_b}")
+        if key != "norm":
+            ax.axhline(0.0, color="0.5", lw=0.8)
+        judged = [ea[key][ea["t"] >= after_a], eb[key][eb["t"] >= after_b]]
+        lo_hi = plot_run._finite_minmax(*judged) if any(len(v) for v in judged) else None
+        peaks = [float(np.nanmax(v)) for v in judged if len(v) and np.any(np.isfinite(v))]
+        if key == "norm" and len(peaks) == 2 and min(peaks) > 0 and max(peaks) > 20 * min(peaks):
+            # Errors an order of magnitude or more apart: on a log axis both stay readable.
+            ax.set_yscale("log")
+            floor = min(float(np.nanmin(v[v > 0])) for v in judged if np.any(v > 0))
+            ax.set_ylim(floor / 2, max(peaks) * 30)  # room for the legend above the curves
+            ax.set_ylabel("|e| (3D) [m], log", fontsize=9)
+        elif lo_hi is not None:
+            lo, hi = lo_hi
+            pad = 0.1 * (hi - lo) if hi > lo else max(1e-4, abs(hi) * 0.1)
+            ax.set_ylim(0.0 if key == "norm" else lo - pad, hi + pad + 0.3 * max(hi - lo, 2 * pad))
+        after = min(after_a, after_b)
+        t0 = min(float(ea["t"][0]), float(eb["t"][0])) if len(ea["t"]) and len(eb["t"]) else 0.0
+        if after > t0:
+            ax.axvspan(t0, after, color="0.88", lw=0, zorder=0)
+        if ax.get_yscale() != "log":
+            ax.set_ylabel(ylabel, fontsize=9)
+        ax.tick_params(labelsize=8)
+        ax.grid(True, color="0.88", lw=0.6)
+    axes[0].legend(fontsize=8, loc="upper right", framealpha=0.85)
+    axes[-1].set_xlabel("time t [s]", fontsize=9)
+    t_hi = max(float(traj_a["t"][-1]), float(traj_b["t"][-1]))
+    t_lo = min(float(traj_a["t"][0]), float(traj_b["t"][0]))
+    if t_hi > t_lo:
+        axes[-1].set_xlim(t_lo, t_hi)
+    fig.suptitle("Tracking error (reference − measured, at the controller's steps): A (solid) vs B (dashed); "
+                 "grey: not judged", fontsize=11, fontweight="bold")
+    fig.savefig(out_path, dpi=plot_run.DPI)
+    plt.close(fig)
+
+
+def tracking_table(metrics_a, metrics_b):
+    """Markdown lines: the tracking figures of both runs side by side ([] when neither tracked)."""
+    ta = (metrics_a or {}).get("tracking") or {}
+    tb = (metrics_b or {}).get("tracking") or {}
+    if not ta and not tb:
+        return []
+    fa, fb = ta.get("figures") or {}, tb.get("figures") or {}
+    after = [f"{float(t['after_s']):g} s" if plot_run._is_number(t.get("after_s")) else "—" for t in (ta, tb)]
+    lines = ["## Trajectory tracking", "",
+             f"judged from t = {after[0]} (A), {after[1]} (B)", "",
+             "| figure | A | B | difference (B − A) |", "|---|---:|---:|---:|"]
+    order = ["position_rmse_m", "position_max_m", "x_rmse_m", "x_max_m", "y_rmse_m", "y_max_m", "z_rmse_m",
+             "z_max_m", "yaw_rmse_rad", "attitude_error_rmse", "attitude_error_max"]
+    keys = [k for k in order if k in fa or k in fb]
+    keys += [k for k in list(fa) + list(fb) if k not in keys]
+    keys = list(dict.fromkeys(keys))
+    for k in keys:
+        a, b = fa.get(k), fb.get(k)
+        cell = (lambda v: "—" if not plot_run._is_number(v) else f"{float(v):.4g}")
+        if plot_run._is_number(a) and plot_run._is_number(b):
+            d = float(b) - float(a)
+            diff = f"{d:+.4g}"
+        else:
+            diff = "—"
+        lines.append(f"| {k} | {cell(a)} | {cell(b)} | {diff} |")
+    lines.append("")
+    return lines
 
 
 def channels_of(*step_lists):
@@ -108,11 +222,13 @@ def _diff_cell(key, a, b):
     return f"{s} {unit}".strip()
 
 
-def markdown_table(steps_a, steps_b, label_a, label_b):
-    lines = [f"# Step figures: A = {label_a}, B = {label_b}", ""]
+def markdown_table(steps_a, steps_b, label_a, label_b, metrics_a=None, metrics_b=None):
+    lines = [f"# Run figures: A = {label_a}, B = {label_b}", ""]
+    lines += tracking_table(metrics_a, metrics_b)
     pairs = _pair_steps(steps_a, steps_b)
     if not pairs:
-        lines.append("No steps in either run.")
+        if not (is_tracking(metrics_a) or is_tracking(metrics_b)):
+            lines.append("No steps in either run.")
         return "\n".join(lines) + "\n"
     for title, sa, sb in pairs:
         fa = sa["figures"] if sa else {}
@@ -161,7 +277,15 @@ def run(run_a, run_b, out_dir=None):
         plot_channel(ch, traj_a, traj_b, label_a, label_b, out)
         written.append(out)
 
-    table = markdown_table(steps_a, steps_b, label_a, label_b)
+    if is_tracking(metrics_a) or is_tracking(metrics_b):
+        out = os.path.join(out_dir, "compare_tracking_path.png")
+        plot_tracking_path(traj_a, traj_b, label_a, label_b, out)
+        written.append(out)
+        out = os.path.join(out_dir, "compare_tracking_error.png")
+        plot_tracking_error(traj_a, traj_b, metrics_a, metrics_b, label_a, label_b, out)
+        written.append(out)
+
+    table = markdown_table(steps_a, steps_b, label_a, label_b, metrics_a, metrics_b)
     md = os.path.join(out_dir, "compare.md")
     with open(md, "w", encoding="utf-8", newline="\n") as f:
         f.write(table)

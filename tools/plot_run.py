@@ -381,7 +381,43 @@ def load_metrics(path):
         "saturation": obj.get("saturation") if isinstance(obj.get("saturation"), dict) else None,
         # Tracking figures (a trajectory or analysis.tracking), passed through; None without them.
         "tracking": obj.get("tracking") if isinstance(obj.get("tracking"), dict) else None,
+        # What flew and how (docs/outputs.md, "Provenance"); None in files written before it.
+        "provenance": obj.get("provenance") if isinstance(obj.get("provenance"), dict) else None,
     }
+
+
+def controller_label(metrics):
+    """The label of the controller that flew (provenance.controller.label: "se3", "python mod:Class",
+    "fmu x.fmu"), or "" when metrics.json does not say (written before provenance)."""
+    c = ((metrics or {}).get("provenance") or {}).get("controller")
+    if not isinstance(c, dict):
+        return ""
+    for key in ("label", "type"):
+        if isinstance(c.get(key), str) and c[key]:
+            return c[key]
+    return ""
+
+
+def controller_replaced(metrics):
+    """True when another controller flew than the one the scenario file names (--controller, or a
+    Python object given to quadcosim.run()): the file's description then speaks of the wrong one."""
+    c = ((metrics or {}).get("provenance") or {}).get("controller")
+    if not isinstance(c, dict):
+        return False
+    if isinstance(c.get("scenario_type"), str) and isinstance(c.get("type"), str) and c["scenario_type"] != c["type"]:
+        return True
+    return isinstance(c.get("override"), str) and c.get("override") not in ("", c.get("scenario_type"))
+
+
+def run_subtitle_parts(metrics):
+    """["scenario NAME", "controller LABEL"] as known: the start of every plot's subtitle."""
+    parts = []
+    if metrics and metrics.get("scenario"):
+        parts.append(f"scenario {metrics['scenario']}")
+    label = controller_label(metrics)
+    if label:
+        parts.append(f"controller {label}")
+    return parts
 
 
 def detect_steps(traj):
@@ -685,9 +721,7 @@ def plot_step(traj, step, window, out_path, metrics, has_metrics):
 
     title = step_title(step)
     fig.text(0.085, 0.955, title, fontsize=13, fontweight="bold", ha="left", va="center")
-    sub = []
-    if metrics and metrics.get("scenario"):
-        sub.append(f"scenario {metrics['scenario']}")
+    sub = run_subtitle_parts(metrics)
     sub.append(f"step at t = {t_step:.2f} s")
     if step.get("passed") is not None:
         sub.append("criteria PASSED" if step["passed"] else "criteria FAILED")
@@ -824,11 +858,11 @@ def plot_overview(traj, out_path, metrics, run_dir):
     title = f"Run overview — {os.path.basename(os.path.abspath(run_dir))}"
     sub = [f"{len(t)} samples, t = {t[0]:.2f} … {t[-1]:.2f} s"]
     if metrics:
-        if metrics.get("scenario"):
-            sub.insert(0, f"scenario {metrics['scenario']}")
+        sub = run_subtitle_parts(metrics) + sub
         if metrics.get("passed") is not None:
             sub.append("PASSED" if metrics["passed"] else "FAILED")
-        if metrics.get("description"):
+        # The file's description names the controller it was written for: not when another flew.
+        if metrics.get("description") and not controller_replaced(metrics):
             d = metrics["description"]
             sub.append(d if len(d) <= 90 else d[:87] + "…")
     fig.text(0.05, 0.968, title, fontsize=14, fontweight="bold", ha="left", va="center")
@@ -852,7 +886,7 @@ def _tracking_after_s(metrics):
 def _tracking_subtitle(metrics):
     tr = metrics.get("tracking") or {}
     figs = tr.get("figures") or {}
-    parts = [f"judged from t = {_tracking_after_s(metrics):g} s"]
+    parts = run_subtitle_parts(metrics) + [f"judged from t = {_tracking_after_s(metrics):g} s"]
     if _is_number(figs.get("position_rmse_m")):
         parts.append(f"position RMSE {float(figs['position_rmse_m']):.4g} m")
     if _is_number(figs.get("position_max_m")):

@@ -6,17 +6,26 @@ Usage: report.py RUN_DIR [--version-text TEXT]
 Writes RUN_DIR/report.html: one page that opens offline (inline CSS, the PNGs
 embedded as base64 data URIs, no external URL) with
 
-  - the scenario name and description (from metrics.json),
-  - a verdict banner (PASSED / FAILED against the set judged, or FIGURES ONLY),
-  - per analysed step a table of the step figures: our value, the spec band
-    (the specification) and the paper band (the paper's controller's response),
-    each with its check (ok/FAIL for the judged set, in/out for the other), and
-    the reference value and its source when metrics.json has a "reference",
-  - the tracking figures and their criteria when metrics.json has "tracking",
-  - the step figure of each step of metrics.json, overview.png and, for a
-    tracking run, tracking_path.png, tracking_axes.png and tracking_error.png,
-    when present (other PNGs in RUN_DIR are not this run's and are left out),
-  - the scenario YAML (RUN_DIR/scenario.yaml) in a <pre>,
+  - the scenario name, the controller that flew (metrics.json "provenance")
+    and the scenario's description (marked as the file's when another
+    controller flew than the one it names),
+  - a verdict banner (PASSED / FAILED against the set judged, or FIGURES
+    ONLY) and the headline figure: the position tracking RMSE of a tracking
+    run, else the first step's overshoot and settling time,
+  - the provenance block: controller (with a Python class's module file and
+    SHA-256, an FMU's path and SHA-256, the parameter values), transport,
+    scenario file and its SHA-256, command line, version and git commit, host,
+  - the headline section first: for a tracking run the tracking figures
+    against their spec and paper bands with tracking_path.png,
+    tracking_axes.png and tracking_error.png; for a step run, per analysed
+    step a table of the step figures (our value, the spec band (the
+    specification) and the paper band (the paper's controller's response),
+    each with its check (ok/FAIL for the judged set, in/out for the other),
+    and the reference value and its source when metrics.json has a
+    "reference") with the step plots,
+  - the hold and saturation tables, then overview.png (other PNGs in RUN_DIR
+    are not this run's and are left out),
+  - the scenario as flown (RUN_DIR/scenario.yaml) in a <pre>,
   - versions: quadcosim (the text given with --version-text, e.g. the output of
     `quadcosim --version`), Python, numpy, matplotlib.
 
@@ -70,6 +79,9 @@ figcaption { color: #555; font-size: 0.9em; }
 pre { background: #f6f6f6; border: 1px solid #ddd; padding: 10px; overflow-x: auto;
       font-size: 0.85em; }
 .versions td { font-family: "DejaVu Sans Mono", monospace; }
+.flown { margin: 0.2em 0; }
+.headline { font-size: 1.3em; font-weight: bold; margin: 0.4em 0 0.8em 0; }
+.provenance td { font-family: "DejaVu Sans Mono", monospace; font-size: 0.85em; word-break: break-all; }
 """
 
 
@@ -209,40 +221,104 @@ def step_title(step, n):
     return f"{title} (#{n})" if n > 1 else title
 
 
-def build_html(run_dir, metrics, version_text):
-    verdict = overall_verdict(metrics)
-    name = metrics["scenario"] or os.path.basename(os.path.abspath(run_dir))
-    out = []
-    w = out.append
-    w("<!DOCTYPE html>")
-    w('<html lang="en">')
-    w("<head>")
-    w('<meta charset="utf-8">')
-    w(f"<title>quadcosim report: {esc(name)}</title>")
-    w(f"<style>{CSS}</style>")
-    w("</head>")
-    w("<body>")
-    w(f"<h1>quadcosim run report: {esc(name)}</h1>")
-    if metrics["description"]:
-        w(f'<p class="description">{esc(metrics["description"])}</p>')
-    judged = metrics.get("judged", "spec")
-    judged_text = {"spec": "against the spec (bounds a good controller must meet)",
-                   "paper": "against the paper bands (the paper's controller's measured response)"}
-    if judged == "none":
-        w('<div class="verdict none" id="verdict">FIGURES ONLY (not judged)</div>')
-    elif verdict is True:
-        w('<div class="verdict passed" id="verdict">PASSED</div>')
-    elif verdict is False:
-        w('<div class="verdict failed" id="verdict">FAILED</div>')
-    else:
-        w('<div class="verdict none" id="verdict">NO CRITERIA</div>')
-    if judged != "none":
-        w(f'<p class="source" id="judged">judged {esc(judged_text.get(judged, judged))}</p>')
-    w('<p class="source">spec: the scenario\'s specification, bounds a good controller must meet. paper: the '
-      "paper's controller's response, bands around its measured figures (not a specification). The judged "
-      "set's checks read ok/FAIL, the other's in/out.</p>")
+def _short_hash(h):
+    return h[:16] + "…" if isinstance(h, str) and len(h) > 16 else (h or "—")
 
-    w("<h2>Step figures</h2>")
+
+def provenance_rows(metrics):
+    """(label, value, full value for the title attribute or None) of the provenance block: what flew
+    and how, from metrics.json's "provenance" (docs/outputs.md)."""
+    p = metrics.get("provenance")
+    if not isinstance(p, dict):
+        return []
+    c = p.get("controller") if isinstance(p.get("controller"), dict) else {}
+    rows = []
+    label = plot_run.controller_label(metrics) or "?"
+    chosen = ""
+    if plot_run.controller_replaced(metrics):
+        chosen = f" (in place of the scenario file's {c.get('scenario_type') or '?'})"
+    elif c.get("scenario_type"):
+        chosen = " (the scenario file's)"
+    rows.append(("controller", label + chosen, None))
+    py = c.get("python") if isinstance(c.get("python"), dict) else None
+    if py:
+        rows.append(("Python class", py.get("target") or "?", None))
+        rows.append(("module file", py.get("module_file") or "unknown", None))
+        rows.append(("module SHA-256", py.get("sha256") or "unknown", None))
+    fmu = c.get("fmu") if isinstance(c.get("fmu"), dict) else None
+    if fmu:
+        rows.append(("FMU", fmu.get("path") or "?", None))
+        rows.append(("FMU SHA-256", fmu.get("sha256") or "unknown", None))
+    transport = str(p.get("transport", "?"))
+    rows.append(("transport", {"inproc": "in-process", "dds": "DDS (plant and controller as two processes)"}
+                 .get(transport, transport) + f", {p.get('clock', '?')}", None))
+    scen = p.get("scenario") if isinstance(p.get("scenario"), dict) else {}
+    rows.append(("scenario file", f"{scen.get('file') or '?'} (SHA-256 {_short_hash(scen.get('sha256'))})",
+                 scen.get("sha256")))
+    cmd = p.get("command_line")
+    if isinstance(cmd, list):
+        rows.append(("command line", " ".join(str(a) for a in cmd), None))
+    rows.append(("quadcosim", f"{p.get('quadcosim_version', '?')}, git commit {p.get('git_commit', 'unknown')}", None))
+    rows.append(("host", str(p.get("host", "?")), None))
+    return rows
+
+
+def provenance_block(w, metrics):
+    rows = provenance_rows(metrics)
+    if not rows:
+        return
+    w('<table class="provenance" id="provenance">')
+    for label, value, full in rows:
+        title = f' title="{esc(full)}"' if full else ""
+        w(f"<tr><th>{esc(label)}</th><td{title}>{esc(value)}</td></tr>")
+    w("</table>")
+    params = ((metrics["provenance"].get("controller") or {}).get("parameters"))
+    if isinstance(params, dict) and params:
+        w(f"<details><summary>controller parameters ({len(params)})</summary>")
+        w('<table class="parameters">')
+        for k, v in params.items():
+            w(f"<tr><td>{esc(k)}</td><td class=\"num\">{esc(v)}</td></tr>")
+        w("</table></details>")
+
+
+def headline(metrics):
+    """The run's headline figure as text: the tracking RMSE of a tracking run, else the first step's
+    overshoot and settling time; "" when there is none."""
+    tr = metrics.get("tracking")
+    if tr:
+        figs = tr.get("figures") or {}
+        rmse, mx = figs.get("position_rmse_m"), figs.get("position_max_m")
+        if plot_run._is_number(rmse):
+            after = tr.get("after_s")
+            text = f"position tracking RMSE {float(rmse):.4g} m"
+            if plot_run._is_number(mx):
+                text += f", max {float(mx):.4g} m"
+            if plot_run._is_number(after):
+                text += f" (from t = {float(after):g} s)"
+            return text
+        return "position tracking RMSE: not computable (no judged sample)"
+    for step in metrics["steps"]:
+        f = step["figures"]
+        parts = [plot_run.step_title(step)]
+        if plot_run._is_number(f.get("overshoot_pct")):
+            parts.append(f"overshoot {float(f['overshoot_pct']):.1f} %")
+        if plot_run._is_number(f.get("settling_time_2pct_s")):
+            parts.append(f"settling {float(f['settling_time_2pct_s']):.2f} s")
+        elif step.get("verdict") == "not settled":
+            parts.append("not settled")
+        return ", ".join(parts)
+    return ""
+
+
+def figure_block(w, paths):
+    for path in paths:
+        base = os.path.basename(path)
+        w(f'<figure><img src="{png_data_uri(path)}" alt="{esc(base)}">'
+          f"<figcaption>{esc(base)}</figcaption></figure>")
+
+
+def step_section(w, metrics):
+    w('<h2 id="steps">Step figures</h2>')
     if not metrics["steps"]:
         w("<p>metrics.json lists no steps.</p>")
     counts = {}
@@ -271,6 +347,81 @@ def build_html(run_dir, metrics, version_text):
         if step["reference"].get("source"):
             w(f'<p class="source">reference source: {esc(step["reference"]["source"])}</p>')
 
+
+def tracking_section(w, tr):
+    tp = tr.get("passed")
+    mark = "" if not tr.get("criteria") or tp is None else (" — ok" if tp else " — FAIL")
+    after = tr.get("after_s")
+    after = f"{float(after):g}" if plot_run._is_number(after) else "?"
+    w(f'<h2 id="tracking">Trajectory tracking from t = {esc(after)} s{esc(mark)}</h2>')
+    figure_table(w, tr, lambda key, v: f"{v:.4g}" + (" m" if key.endswith("_m") else
+                                                      (" rad" if key.endswith("_rad") else "")))
+    notes = [c.get("note") for c in tr.get("criteria", []) if isinstance(c, dict) and c.get("note")]
+    for note in dict.fromkeys(notes):
+        w(f'<p class="note">{esc(note)}</p>')
+
+
+def build_html(run_dir, metrics, version_text):
+    verdict = overall_verdict(metrics)
+    name = metrics["scenario"] or os.path.basename(os.path.abspath(run_dir))
+    out = []
+    w = out.append
+    w("<!DOCTYPE html>")
+    w('<html lang="en">')
+    w("<head>")
+    w('<meta charset="utf-8">')
+    w(f"<title>quadcosim report: {esc(name)}</title>")
+    w(f"<style>{CSS}</style>")
+    w("</head>")
+    w("<body>")
+    w(f"<h1>quadcosim run report: {esc(name)}</h1>")
+    label = plot_run.controller_label(metrics)
+    if label:
+        w(f'<p class="flown" id="flown">flown by controller <b>{esc(label)}</b></p>')
+    if metrics["description"]:
+        if plot_run.controller_replaced(metrics):
+            w(f'<p class="description">Scenario file\'s description (written for its own controller, not the '
+              f'one that flew): {esc(metrics["description"])}</p>')
+        else:
+            w(f'<p class="description">{esc(metrics["description"])}</p>')
+    judged = metrics.get("judged", "spec")
+    judged_text = {"spec": "against the spec (bounds a good controller must meet)",
+                   "paper": "against the paper bands (the paper's controller's measured response)"}
+    if judged == "none":
+        w('<div class="verdict none" id="verdict">FIGURES ONLY (not judged)</div>')
+    elif verdict is True:
+        w('<div class="verdict passed" id="verdict">PASSED</div>')
+    elif verdict is False:
+        w('<div class="verdict failed" id="verdict">FAILED</div>')
+    else:
+        w('<div class="verdict none" id="verdict">NO CRITERIA</div>')
+    if judged != "none":
+        w(f'<p class="source" id="judged">judged {esc(judged_text.get(judged, judged))}</p>')
+    w('<p class="source">spec: the scenario\'s specification, bounds a good controller must meet. paper: the '
+      "paper's controller's response, bands around its measured figures (not a specification). The judged "
+      "set's checks read ok/FAIL, the other's in/out.</p>")
+    head = headline(metrics)
+    if head:
+        w(f'<p class="headline" id="headline">{esc(head)}</p>')
+    provenance_block(w, metrics)
+
+    # The headline figure first: a tracking run's tracking, a step run's steps; each with its plots.
+    files = figure_files(run_dir, metrics)
+    step_names = set(plot_run.step_figure_names(metrics["steps"]))
+    step_files = [f for f in files if os.path.basename(f) in step_names]
+    tracking_files = [f for f in files if os.path.basename(f) in plot_run.TRACKING_FIGURE_NAMES]
+    other_files = [f for f in files if f not in step_files and f not in tracking_files]
+    tr = metrics.get("tracking")
+    if tr:
+        tracking_section(w, tr)
+        figure_block(w, tracking_files)
+        if metrics["steps"]:
+            step_section(w, metrics)
+            figure_block(w, step_files)
+    else:
+        step_section(w, metrics)
+        figure_block(w, step_files)
+
     hold = metrics.get("hold")
     if hold:
         hp = hold.get("passed")
@@ -285,29 +436,12 @@ def build_html(run_dir, metrics, version_text):
         w(f'<h2 id="saturation">Saturation and control effort{esc(mark)}</h2>')
         figure_table(w, sat, lambda key, v: f"{v:.3f} {'N' if key.endswith('_n') else 's'}")
 
-    tr = metrics.get("tracking")
-    if tr:
-        tp = tr.get("passed")
-        mark = "" if not tr.get("criteria") or tp is None else (" — ok" if tp else " — FAIL")
-        after = tr.get("after_s")
-        after = f"{float(after):g}" if plot_run._is_number(after) else "?"
-        w(f'<h2 id="tracking">Trajectory tracking from t = {esc(after)} s{esc(mark)}</h2>')
-        figure_table(w, tr, lambda key, v: f"{v:.4g}" + (" m" if key.endswith("_m") else
-                                                          (" rad" if key.endswith("_rad") else "")))
-        notes = [c.get("note") for c in tr.get("criteria", []) if isinstance(c, dict) and c.get("note")]
-        for note in dict.fromkeys(notes):
-            w(f'<p class="note">{esc(note)}</p>')
-
-    w("<h2>Figures</h2>")
-    files = figure_files(run_dir, metrics)
+    w("<h2>Figures</h2>" if not (step_files or tracking_files) else "<h2>Overview</h2>")
     if not files:
         w("<p>No figures in the run directory (run tools/plot_run.py first).</p>")
-    for path in files:
-        base = os.path.basename(path)
-        w(f'<figure><img src="{png_data_uri(path)}" alt="{esc(base)}">'
-          f"<figcaption>{esc(base)}</figcaption></figure>")
+    figure_block(w, other_files)
 
-    w("<h2>Scenario</h2>")
+    w("<h2>Scenario as flown (scenario.yaml)</h2>")
     scen = os.path.join(run_dir, "scenario.yaml")
     if os.path.isfile(scen):
         try:

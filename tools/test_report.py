@@ -85,6 +85,26 @@ class ReportTest(ToolTestBase):
         with open(os.path.join(run, "report.html"), encoding="utf-8") as f:
             return f.read()
 
+    def test_provenance_block_of_a_python_controller(self):
+        sha = "ab" * 32
+        prov = {"controller": {"label": "python pd:AltitudePD", "type": "python", "scenario_type": "python",
+                               "override": None, "parameters": {"kp_z": 4.0},
+                               "python": {"target": "pd:AltitudePD", "module_file": "/x/pd.py", "sha256": sha}},
+                "transport": "dds", "clock": "realtime", "command_line": ["quadcosim", "run", "s.yaml"],
+                "quadcosim_version": "1.2.3", "git_commit": "unknown", "host": "h<1>",
+                "scenario": {"file": "s.yaml", "name": "s", "sha256": None, "effective": "scenario.yaml"}}
+        page = self.report_with_metrics(lambda m: m.update(provenance=prov, description="my <PD>"))
+        self.assertIn('flown by controller <b>python pd:AltitudePD</b>', page)
+        self.assertIn("<td>python pd:AltitudePD (the scenario file&#x27;s)</td>", page)
+        self.assertIn(f"<td>{sha}</td>", page)  # the module's hash in full
+        self.assertIn("<td>/x/pd.py</td>", page)
+        self.assertIn("<td>DDS (plant and controller as two processes), realtime</td>", page)
+        self.assertIn("<td>1.2.3, git commit unknown</td>", page)
+        self.assertIn("<td>h&lt;1&gt;</td>", page)
+        self.assertIn('<p class="description">my &lt;PD&gt;</p>', page)  # its own controller flew
+        self.assertLess(page.index('id="verdict"'), page.index('id="provenance"'))
+        self.assertLess(page.index('id="provenance"'), page.index('id="steps"'))
+
     def test_report_contents(self):
         run, path, page, metrics = self.make_report()
         step = metrics["steps"][0]
@@ -143,11 +163,13 @@ class ReportTest(ToolTestBase):
         self.assertIn(">position_rmse_m<", page)
         self.assertIn(">0.03 m<", page)
         self.assertIn("≤ 0.05", page)
-        # overview and the three tracking figures, in that order
+        # the headline first: the tracking table and its three figures, then overview
         self.assertEqual(page.count("data:image/png;base64,"), 4)
-        order = [page.index(f">{n}<") for n in ("overview.png", "tracking_path.png", "tracking_axes.png",
-                                               "tracking_error.png")]
+        order = [page.index(f">{n}<") for n in ("tracking_path.png", "tracking_axes.png", "tracking_error.png",
+                                               "overview.png")]
         self.assertEqual(order, sorted(order))
+        self.assertLess(page.index('id="tracking"'), page.index('id="steps"') if 'id="steps"' in page else len(page))
+        self.assertIn('id="headline">position tracking RMSE 0.03 m', page)
 
     def test_failed_tracking_criterion_shows_fail(self):
         def fail_tracking(m):

@@ -6,6 +6,7 @@
 
 #include "app/signals.hpp"
 #include "io/mcap_recorder.hpp"
+#include "io/provenance.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
 
@@ -76,7 +77,7 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
   return true;
 }
 
-RunJudgement judge_run(const io::Scenario& sc, const fs::path& out, io::Judge judge) {
+RunJudgement judge_run(const io::Scenario& sc, const fs::path& out, io::Judge judge, const nlohmann::json& provenance) {
   RunJudgement j;
   j.judge = judge;
   const io::Series series = io::read_series((out / "trajectory.csv").string());
@@ -84,7 +85,12 @@ RunJudgement judge_run(const io::Scenario& sc, const fs::path& out, io::Judge ju
   if (sc.hold) j.hold = io::evaluate_hold(*sc.hold, series, judge);
   j.saturation = io::evaluate_saturation(sc, series, judge);
   if (sc.tracking) j.tracking = io::evaluate_tracking(*sc.tracking, series, judge);
-  io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking, judge);
+  if (provenance.is_null()) {
+    io::write_metrics_json((out / "metrics.json").string(), sc, j.steps, j.hold, j.saturation, j.tracking, judge);
+  } else {
+    io::write_metrics_with_provenance(
+        out / "metrics.json", io::metrics_json(sc, j.steps, j.hold, j.saturation, j.tracking, judge), provenance);
+  }
   j.table = io::format_step_table(sc, j.steps, j.hold, j.saturation, j.tracking, judge);
   std::ofstream((out / "metrics.txt").string()) << j.table;
   j.nothing_note = io::nothing_judged_note(sc, judge);

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -48,8 +49,9 @@ struct RunJudgement {
 
 /// Judges `out`/trajectory.csv (the exact doubles recorded) against the scenario's steps, hold, limits
 /// and tracking, on the criteria of the set `judge` names (every figure and band is written whatever
-/// the set), and writes `out`/metrics.json and `out`/metrics.txt. Throws std::runtime_error on I/O.
+/// the set), and writes `out`/metrics.json (with `provenance`, the run's io::describe_run record,
+/// under "provenance" when it is not null) and `out`/metrics.txt. Throws std::runtime_error on I/O.
 RunJudgement judge_run(const io::Scenario& scenario, const std::filesystem::path& out,
-                       io::Judge judge = io::Judge::kSpec);
+                       io::Judge judge = io::Judge::kSpec, const nlohmann::json& provenance = nullptr);
 
 }  // namespace quadcosim::app

@@ -30,6 +30,10 @@ std::shared_ptr<const control::Controller> make_python_controller(const std::str
                                                                   const model::VehicleParams& vehicle,
                                                                   const std::string& what);
 
+/// The source file of the module of a Python controller `target` ("module:Class") loaded in this process
+/// (for the run's provenance), or "" when none was loaded (or without Python).
+std::string python_module_file(const std::string& target);
+
 /// What a thread that calls Python controllers runs its loop in (sim::ControllerThread::ThreadHost):
 /// the loop keeps one Python thread state for the thread's life, the GIL released. Empty without
 /// Python.

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <yaml-cpp/yaml.h>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +25,7 @@
 #include "dds/peer_pairing.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
+#include "io/provenance.hpp"
 #include "io/scenario.hpp"
 #include "io/scenario_limits.hpp"
 #include "io/step_report.hpp"
@@ -118,6 +120,17 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
       plant_args.insert(plant_args.end(), {"--foxglove-linger", fmt::format("{}", opt.foxglove.linger_s)});
   }
   return run_plant_and_controller(plant_args, controller_args);
+}
+
+// The run's provenance record (io/provenance.hpp): made once, written into metadata.yaml, metrics.json
+// and (through them) the report and plots.
+nlohmann::json run_provenance(const RunOptions& opt, const io::Scenario& flown) {
+  YAML::Node root = YAML::LoadFile(opt.scenario);  // read by load_scenario already
+  if (!opt.controller.empty()) io::set_controller_type(root, opt.controller);
+  return io::describe_run(flown, {.transport = opt.transport,
+                                  .clock = opt.transport == "dds" && opt.realtime ? "realtime" : "lockstep",
+                                  .controller_override = opt.controller,
+                                  .python_target = io::python_target_of(root)});
 }
 
 // "run: FAILED against spec: z overshoot_pct 30.2 outside [-, 25]; ...": the judged criteria that failed,
@@ -221,11 +234,15 @@ int run_command(const RunOptions& opt) {
   const fs::path out(opt.out_dir);
 
   try {  // the model's and the controller's checks of the scenario name no file: say which
-    fs::copy_file(opt.scenario, out / "scenario.yaml", fs::copy_options::overwrite_existing);
-    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder);
+    // The scenario as flown: the file, or with --controller applied.
+    io::write_file_atomically(out / "scenario.yaml", io::effective_scenario_text(opt.scenario, opt.controller));
+    const nlohmann::json provenance = run_provenance(opt, sc);
+    if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder, provenance);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
-      if (int rc = run_over_dds(opt, csv_path); rc != 0) return rc;
+      const int rc = run_over_dds(opt, csv_path);
+      io::add_provenance_to_bag_metadata(out, provenance);  // the plant wrote it: what ran, also when stopped
+      if (rc != 0) return rc;
     } else {
       install_stop_handlers();
       Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
@@ -250,6 +267,7 @@ int run_command(const RunOptions& opt) {
           sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); },
           opt.foxglove.listen.empty() ? nullptr : std::function(attach));
       if (fox) finish_foxglove(opt.foxglove, "run", *fox);
+      io::add_provenance_to_bag_metadata(out, provenance);
       if (!completed) {
         // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.
         std::cerr << "\nrun: interrupted; " << csv_path << " and run.mcap hold what ran\n";
@@ -258,7 +276,7 @@ int run_command(const RunOptions& opt) {
     }
 
     // Both transports are judged from what was recorded: the exact doubles of trajectory.csv.
-    const RunJudgement judged = judge_run(sc, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec));
+    const RunJudgement judged = judge_run(sc, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec), provenance);
     std::cout << judged.table;  // says what was judged, and once when the scenario has none of that set
     if (judged.saturation) {
       if (const std::string w = io::saturation_warning(*judged.saturation); !w.empty()) {

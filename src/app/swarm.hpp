@@ -35,9 +35,10 @@ void write_swarm_summary(const std::filesystem::path& out, const io::Scenario& s
 
 /// `run` for a swarm into `out`, the folder `folder` has claimed: exit codes as `run` (0 all recorded
 /// vehicles pass their step criteria and the scenario's analysis.limits); adds "recorded" (each
-/// recorded vehicle's verdict and saturation figures) to summary.json.
+/// recorded vehicle's verdict and saturation figures) and `provenance` (the run's io::describe_run
+/// record, also in each recorded vehicle's metrics.json) to summary.json.
 int run_swarm(const RunOptions& options, const io::Scenario& sc, const std::filesystem::path& out,
-              io::OutputFolder& folder);
+              io::OutputFolder& folder, const nlohmann::json& provenance);
 
 /// `plant --vehicles N` / `controller --vehicles N`: N vehicles in one process over DDS.
 int swarm_plant_command(const PlantCommandOptions& options, io::Scenario sc);

@@ -23,6 +23,7 @@
 #include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "io/output_folder.hpp"
+#include "io/provenance.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
 
@@ -44,7 +45,7 @@ namespace {
 // `run` judges a single vehicle: writes its metrics.json and metrics.txt, warns when it saturated. Returns
 // one entry per vehicle for summary.json: vehicle, namespace, passed, saturation figures.
 nlohmann::json judge_recorded(const fs::path& out, const io::Scenario& sc, const std::vector<int>& vehicles,
-                              const std::vector<std::string>& dirs, io::Judge judge) {
+                              const std::vector<std::string>& dirs, io::Judge judge, const nlohmann::json& provenance) {
   nlohmann::json entries = nlohmann::json::array();
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     const fs::path dir = out / dirs[i];
@@ -52,7 +53,7 @@ nlohmann::json judge_recorded(const fs::path& out, const io::Scenario& sc, const
     const auto results = io::evaluate_steps(sc.steps, series, judge);
     const auto saturation = io::evaluate_saturation(sc, series, judge);
     const nlohmann::json metrics = io::metrics_json(sc, results, {}, saturation, {}, judge);
-    io::write_metrics_json((dir / "metrics.json").string(), sc, results, {}, saturation, {}, judge);
+    io::write_metrics_with_provenance(dir / "metrics.json", metrics, provenance);
     std::ofstream((dir / "metrics.txt").string()) << io::format_step_table(sc, results, {}, saturation, {}, judge);
     if (saturation) {
       if (const std::string w = io::saturation_warning(*saturation); !w.empty()) {
@@ -112,14 +113,16 @@ void write_swarm_summary(const fs::path& out, const io::Scenario& sc, const io::
       rows.size(), mean, pct(0.99), sorted.back(), safety);
 }
 
-int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out, io::OutputFolder& folder) {
+int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out, io::OutputFolder& folder,
+              const nlohmann::json& provenance) {
   const io::SwarmSpec spec = swarm_spec(sc, opt.vehicles, opt.threads);
   const int n = spec.layout.vehicles;
   std::vector<std::string> dirs;
   for (int i : spec.record_vehicles) {
     dirs.push_back(dir_of(sim::vehicle_namespace(spec.layout.ns_prefix, i, n)));
     fs::create_directories(out / dirs.back());
-    fs::copy_file(opt.scenario, out / dirs.back() / "scenario.yaml", fs::copy_options::overwrite_existing);
+    io::write_file_atomically(out / dirs.back() / "scenario.yaml",
+                              io::effective_scenario_text(opt.scenario, opt.controller));
   }
   if (opt.transport == "dds") {
     // The plant process records; the controller process answers.
@@ -177,7 +180,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
                              sim_s / wall_s, spec.threads);
   }
   const io::Judge judge = io::parse_judge(opt.judge).value_or(io::Judge::kSpec);  // --judge checked its value
-  const nlohmann::json recorded = judge_recorded(out, sc, spec.record_vehicles, dirs, judge);
+  const nlohmann::json recorded = judge_recorded(out, sc, spec.record_vehicles, dirs, judge, provenance);
   // A recorded vehicle's "passed" is null under --judge none: no verdict, nothing fails.
   const bool pass = std::all_of(recorded.begin(), recorded.end(), [](const nlohmann::json& e) {
     return e["passed"].is_null() || e["passed"].get<bool>();
@@ -186,6 +189,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
     nlohmann::json summary;
     std::ifstream(out / "summary.json") >> summary;
     summary["recorded"] = recorded;
+    summary["provenance"] = provenance;
     std::ofstream f(out / "summary.json");
     f << summary.dump(2) << '\n';
     if (!f) throw std::runtime_error("cannot write " + (out / "summary.json").string());

@@ -27,6 +27,7 @@
 #include "batch.hpp"
 #include "control/care.hpp"
 #include "io/output_folder.hpp"
+#include "io/provenance.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "io/yaml_reader.hpp"
@@ -50,6 +51,8 @@ struct PyScenario {
   YAML::Node root;     ///< the parsed document (a mapping)
   std::string source;  ///< the file it was read from, or "<dict>"
   bool from_file = false;
+  /// The controller type flown in place of the document's ("python" for a Python object), or "".
+  std::string controller_override;
 };
 
 /// `source` as text: Python's own shortest round-trip form for floats, YAML's spelling of infinities and
@@ -114,6 +117,7 @@ PyScenario load_file(const std::string& path, const std::string& controller) {
   if (!controller.empty()) io::set_controller_type(s.root, controller);
   s.source = path;
   s.from_file = true;
+  s.controller_override = controller;
   return s;
 }
 
@@ -122,6 +126,7 @@ PyScenario load_dict(const py::dict& d, const std::string& controller) {
   s.root = to_yaml(d, "");
   if (!controller.empty()) io::set_controller_type(s.root, controller);
   s.source = "<dict>";
+  s.controller_override = controller;
   {
     py::gil_scoped_release release;
     s.scenario = checked(s.source, [&] { return io::load_scenario(s.root, s.source); });
@@ -136,6 +141,7 @@ PyScenario with_controller(const PyScenario& s, const std::string& controller) {
   PyScenario r = s;
   r.root = YAML::Clone(s.root);
   io::set_controller_type(r.root, controller);
+  r.controller_override = controller;
   r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
   return r;
 }
@@ -176,6 +182,7 @@ PyScenario with_python_controller(const PyScenario& s, const py::object& control
   PyScenario r = s;
   r.root = s.from_file ? YAML::LoadFile(s.source) : YAML::Clone(s.root);
   io::set_controller_type(r.root, "python");
+  r.controller_override = "python";
   const std::string target = controller_target(controller);
   if (r.root["controller"].IsMap()) {
     r.root["controller"]["python"] = target;
@@ -327,12 +334,17 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
       dir = temp->path;
     }
     try {
-      if (s.from_file) {
-        fs::copy_file(s.source, dir / "scenario.yaml", fs::copy_options::overwrite_existing);
+      // The scenario as flown, as `quadcosim run` writes it: the file, or with the controller applied.
+      if (s.from_file && s.controller_override != "python") {
+        io::write_file_atomically(dir / "scenario.yaml", io::effective_scenario_text(s.source, s.controller_override));
       } else {
-        YAML::Emitter e;
-        e << s.root;
-        std::ofstream(dir / "scenario.yaml") << e.c_str() << '\n';
+        const std::string comment =
+            s.controller_override.empty()
+                ? ""
+                : "The scenario as flown: " + s.source + " with its controller replaced by the Python class " +
+                      io::python_target_of(s.root) +
+                      ".\n(Written by quadcosim from the parsed document; its comments are not kept.)";
+        io::write_file_atomically(dir / "scenario.yaml", io::scenario_text(s.root, comment));
       }
       // Ctrl-C (or any pending Python signal handler's exception) ends the run as it ends the CLI's:
       // what ran stays recorded. Checked every 4096 ticks (~50 µs of simulation).
@@ -342,10 +354,14 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
         py::gil_scoped_acquire acquire;
         return PyErr_CheckSignals() != 0;  // the exception stays set for the caller
       };
-      if (!app::fly_inprocess(s.scenario, dir, info, warn, on_tick)) {
+      const nlohmann::json provenance = io::describe_run(
+          s.scenario, {.controller_override = s.controller_override, .python_target = io::python_target_of(s.root)});
+      const bool completed = app::fly_inprocess(s.scenario, dir, info, warn, on_tick);
+      io::add_provenance_to_bag_metadata(dir, provenance);
+      if (!completed) {
         interrupted = true;
       } else {
-        judged = app::judge_run(s.scenario, dir, *judge);
+        judged = app::judge_run(s.scenario, dir, *judge, provenance);
       }
     } catch (const control::CareError& e) {
       throw io::ConfigError(s.source + ": controller design failed: " + e.what());
@@ -623,6 +639,7 @@ PYBIND11_MODULE(_quadcosim, m) {
     }
   });
   io::set_python_controller_factory(&resolve_python_controller);
+  io::set_python_module_locator(&loaded_module_file);
 
   py::class_<PyScenario>(m, "Scenario", R"(A validated scenario (see docs/scenarios.md for every key).
 

@@ -937,6 +937,16 @@ std::shared_ptr<PyController> load_python_controller(const std::string& target, 
   }
 }
 
+std::string loaded_module_file(const std::string& target) {
+  const std::size_t colon = target.rfind(':');
+  const std::string module_name = target.substr(0, colon == std::string::npos ? target.size() : colon);
+  py::gil_scoped_acquire gil;
+  const py::dict modules = py::module_::import("sys").attr("modules");
+  if (!modules.contains(module_name.c_str())) return "";
+  const py::object file = py::getattr(modules[module_name.c_str()], "__file__", py::none());
+  return py::isinstance<py::str>(file) ? file.cast<std::string>() : "";
+}
+
 void install_python_controller_factory() {
   io::set_python_controller_factory(
       [](const std::string& target, const std::filesystem::path& folder,

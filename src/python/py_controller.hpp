@@ -126,6 +126,10 @@ std::shared_ptr<PyController> make_python_controller(pybind11::object instance_o
 std::shared_ptr<PyController> load_python_controller(const std::string& target, const std::filesystem::path& folder,
                                                      const model::VehicleParams& vehicle);
 
+/// The source file of the module of `target` ("module:Class") as this interpreter imported it
+/// (sys.modules[module].__file__), or "" when it is not imported here or has no file. Takes the GIL.
+std::string loaded_module_file(const std::string& target);
+
 /// Installs load_python_controller as io's resolver of `controller: {python: ...}`. The caller must
 /// have an interpreter running (an extension module; an embedding executable initialises it first or
 /// installs its own function that does and then calls load_python_controller).

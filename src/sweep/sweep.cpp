@@ -17,6 +17,7 @@
 #include "control/care.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
+#include "io/provenance.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
 #include "sim/topics.hpp"
@@ -134,6 +135,8 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
   }
   s["vehicle"] = vehicle;
   j["sweep"] = s;
+  // What flew, as every run folder records it (io/provenance.hpp).
+  j["provenance"] = io::describe_run(flown, {.python_target = io::python_target_of(plan.root)});
   return j;
 }
 
@@ -280,6 +283,7 @@ RunResult rerun(const Plan& plan, int index, const fs::path& dir) {
   (void)simulate(sc, series, &csv, &dir);
   judge(sc, io::read_series(csv.string()), plan.judge, r);  // as `run` does: from the recorded doubles
   const nlohmann::json metrics = run_metrics_json(plan, sc, r);
+  io::add_provenance_to_bag_metadata(dir, metrics["provenance"]);
   write_json(dir / "metrics.json", metrics);
   if (!r.passed) r.failed_criteria = failed_criteria(metrics);
   io::write_file_atomically(dir / "metrics.txt",

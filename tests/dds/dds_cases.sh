@@ -5,6 +5,8 @@
 bin="$1"; src="$2"; stranger="${5:-}"  # tests/stranger, for the stranger_* cases
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 paper="$src/scenarios/paper"
+# Two metrics.json hold the same judgement (besides their provenance: transport, command line).
+same_metrics() { /usr/bin/python3 "$src/tests/lib/same_metrics.py" "$@"; }
 
 identical() {  # in-process and DDS lockstep give the same bytes
   local s="$1"
@@ -12,8 +14,16 @@ identical() {  # in-process and DDS lockstep give the same bytes
   "$bin" run "$paper/$s.yaml" --out "$tmp/dds" --no-plots --transport dds > "$tmp/dds.log" 2>&1 \
     || fail "DDS run failed"
   cmp "$tmp/in/trajectory.csv" "$tmp/dds/trajectory.csv" || fail "trajectories differ"
-  cmp "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "metrics differ"
+  same_metrics "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "metrics differ"
   cmp "$tmp/in/run.mcap" "$tmp/dds/run.mcap" || fail "MCAP recordings differ"
+  # Each records how it flew.
+  /usr/bin/python3 - "$tmp/in" "$tmp/dds" <<'PY' || fail "the transport is not recorded"
+import json, sys, yaml
+for run, transport in zip(sys.argv[1:], ("inproc", "dds")):
+    p = json.load(open(run + "/metrics.json"))["provenance"]
+    assert p["transport"] == transport and p["clock"] == "lockstep", (run, p["transport"])
+    assert yaml.safe_load(open(run + "/metadata.yaml"))["quadcosim_provenance"] == p, run
+PY
   [ "$(wc -l < "$tmp/dds/trajectory.csv")" -gt 500 ] || fail "trajectory too short"
 }
 
@@ -34,9 +44,11 @@ identical_all() {
     while IFS= read -r f; do
       local rel="${f#"$tmp/in/$name/"}"
       case " ${files[*]} " in *" $(basename "$rel") "*) ;; *) continue ;; esac
-      cmp "$f" "$tmp/dds/$name/$rel" || fail "$name: $rel differs over DDS"
+      local same=cmp
+      [ "$(basename "$rel")" = metrics.json ] && same=same_metrics
+      $same "$f" "$tmp/dds/$name/$rel" || fail "$name: $rel differs over DDS"
       if [ -n "${QUADCOSIM_REFERENCE_DIR:-}" ]; then
-        cmp "$f" "$QUADCOSIM_REFERENCE_DIR/$name/$rel" || fail "$name: $rel differs from the reference"
+        $same "$f" "$QUADCOSIM_REFERENCE_DIR/$name/$rel" || fail "$name: $rel differs from the reference"
       fi
       compared=$((compared + 1))
     done < <(find "$tmp/in/$name" -type f | sort)
@@ -60,7 +72,7 @@ with_stranger() {
     || fail "DDS run with a stranger failed"
   kill "$spid" 2> /dev/null || true
   cmp "$tmp/in/trajectory.csv" "$tmp/dds/trajectory.csv" || fail "the stranger changed the trajectory"
-  cmp "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "the stranger changed the metrics"
+  same_metrics "$tmp/in/metrics.json" "$tmp/dds/metrics.json" || fail "the stranger changed the metrics"
 }
 
 # Message count of TOPIC in a run folder's metadata.yaml.

@@ -23,7 +23,7 @@ for e in altitude_step roll_step pitch_step yaw_step; do
 done
 "$bin" summary "${dirs[@]}" --out "$tmp/paper_comparison.md" > /dev/null
 grep -q "overshoot" "$tmp/paper_comparison.md"
-grep -q "| altitude_step | paper | z 0 → 10 | overshoot % | 18.07 | 18.00 | ≤ 25 | 15 – 21 | pass |" \
+grep -qF "| $tmp/altitude_step | paper | paper | z step 0 → 10 | overshoot % | 18.07 | 18.00 | ≤ 25 | 15 – 21 | pass |" \
   "$tmp/paper_comparison.md" || { cat "$tmp/paper_comparison.md"; echo "FAIL: the summary does not label the paper bands"; exit 1; }
 if grep -q "FAIL" "$tmp/paper_comparison.md"; then echo "FAIL: a paper figure is outside its band"; exit 1; fi
 # Two runs compared (here: altitude against roll), as `quadcosim compare` promises.

@@ -5,6 +5,8 @@ controller bit for bit, parameters, schedules, every kind of bad return value, t
 determinism. Run by tests/python/run_pytest.sh (CTest python.pytest)."""
 
 import filecmp
+import hashlib
+import json
 import math
 import os
 import pathlib
@@ -718,3 +720,21 @@ def test_the_convenience_base_class():
     assert np.max(np.abs(r.trajectory["z"] - 1.0)) < 1e-9
     with pytest.raises(quadcosim.ControllerError, match=r"NotImplementedError"):
         quadcosim.run(hover_scenario(duration_s=1.0), controller=quadcosim.Controller)
+
+
+def test_a_run_records_the_python_class_and_its_module_hash(tmp_path):
+    """The provenance of a run flown by a Python class: module:Class, the module's file and its SHA-256
+    (hashed here from the file, independently), the parameter values; in RunResult, metrics.json and
+    metadata.yaml alike, and scenario.yaml names the class."""
+    import yaml
+    r = quadcosim.run(hover_scenario(duration_s=0.1, kp_z=2.5), controller=AltitudePD, out=tmp_path / "run")
+    c = r.provenance["controller"]
+    assert c["type"] == "python" and c["override"] == "python"
+    assert c["python"]["target"] == f"{__name__}:AltitudePD" and c["label"] == f"python {__name__}:AltitudePD"
+    assert pathlib.Path(c["python"]["module_file"]).resolve() == pathlib.Path(__file__).resolve()
+    assert c["python"]["sha256"] == hashlib.sha256(pathlib.Path(__file__).read_bytes()).hexdigest()
+    assert c["parameters"]["kp_z"] == 2.5 and c["parameters"]["kd_z"] == 1.4
+    assert json.loads((tmp_path / "run" / "metrics.json").read_text())["provenance"] == r.provenance
+    assert yaml.safe_load((tmp_path / "run" / "metadata.yaml").read_text())["quadcosim_provenance"] == r.provenance
+    assert yaml.safe_load((tmp_path / "run" / "scenario.yaml").read_text())["controller"]["python"] == \
+        f"{__name__}:AltitudePD"

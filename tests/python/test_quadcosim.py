@@ -103,8 +103,17 @@ def test_run_writes_the_bytes_of_the_cli(tmp_path):
                           text=True)
     assert done.returncode == 0, done.stderr
     result = quadcosim.run(ALTITUDE_STEP, out=py)
-    for name in ["trajectory.csv", "metrics.json", "metrics.txt", "scenario.yaml"]:
+    for name in ["trajectory.csv", "metrics.txt", "scenario.yaml"]:
         assert filecmp.cmp(cli / name, py / name, shallow=False), name
+    # metrics.json: the same judgement; the provenance differs only in the command line that ran it.
+    import json
+    m_cli, m_py = (json.loads((d / "metrics.json").read_text()) for d in (cli, py))
+    p_cli, p_py = m_cli.pop("provenance"), m_py.pop("provenance")
+    assert json.dumps(m_cli) == json.dumps(m_py)
+    assert p_cli["command_line"][1:3] == ["run", ALTITUDE_STEP] and p_py["command_line"] != p_cli["command_line"]
+    p_cli.pop("command_line"), p_py.pop("command_line")
+    assert p_cli == p_py and p_py["controller"]["type"] == "paper" and p_py["transport"] == "inproc"
+    assert result.provenance["controller"]["label"] == "paper"
     assert (py / "run.mcap").stat().st_size > 0 and (py / "metadata.yaml").exists()
     assert result.passed is True
     assert result.table == (cli / "metrics.txt").read_text()
@@ -147,8 +156,12 @@ def test_judge_chooses_the_criteria_set_as_the_cli_does(tmp_path):
     done = subprocess.run([QUADCOSIM, "run", ALTITUDE_STEP, "--controller", "se3", "--judge", "paper", "--out",
                            str(cli), "--no-plots"], capture_output=True, text=True)
     assert done.returncode == 1, done.stdout + done.stderr
-    for name in ["metrics.json", "metrics.txt"]:
-        assert filecmp.cmp(cli / name, tmp_path / "py" / name, shallow=False), name
+    assert filecmp.cmp(cli / "metrics.txt", tmp_path / "py" / "metrics.txt", shallow=False)
+    # metrics.json: the same judgement; only the provenance's command line tells the two apart.
+    import json
+    m_cli, m_py = (json.loads((d / "metrics.json").read_text()) for d in (cli, tmp_path / "py"))
+    m_cli.pop("provenance"), m_py.pop("provenance")
+    assert json.dumps(m_cli) == json.dumps(m_py)
     with pytest.raises(ValueError, match=r"judge: got 'strict', expected 'spec', 'paper' or 'none'"):
         quadcosim.run(ALTITUDE_STEP, judge="strict")
 

@@ -2,7 +2,8 @@
 # A sweep survives Ctrl-C (SIGINT) and SIGTERM (docs/sweeps.md, "Interrupting and resuming"): it
 # exits 130 having written the summary of its finished runs (marked partial) and a manifest listing
 # every file it wrote; `--resume` runs only the missing runs, and the final summary.json (or
-# shard.json) and every run's metrics.json are the bytes of an uninterrupted sweep's. `--force` after
+# shard.json) are the bytes of an uninterrupted sweep's, and every run's metrics.json its judgement
+# (the same JSON besides the provenance, which names the command line: --resume). `--force` after
 # an interruption leaves none of the interrupted sweep's runs. Every process the script starts is
 # killed by PID on exit, also on failure (tests/lib/process_case.sh). One case per CTest test.
 #   usage: interrupt_cases.sh QUADCOSIM_BINARY SOURCE_DIR CASE DOMAIN_ID
@@ -13,6 +14,15 @@ source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "sweep.$3" "$4"
 CASE=$3
 PY=${QUADCOSIM_PYTHON:-/usr/bin/python3}
 HOVER="$SRC/scenarios/realism/hover_wind_gusts.yaml"
+
+# same_runs REF_RUNS RUNS: the same run files, each metrics.json with the same judgement.
+same_runs() {
+  [ "$(cd "$1" && find . -type f | sort)" = "$(cd "$2" && find . -type f | sort)" ] || return 1
+  local f
+  for f in "$1"/*/metrics.json; do
+    "$PY" "$SRC/tests/lib/same_metrics.py" "$f" "$2/${f#"$1/"}" || return 1
+  done
+}
 RUNS=100
 A=(--runs $RUNS --vary mass=10% --vary controller.altitude.kd=uniform\(2,3.5\) --min-pass-rate 0 --no-plots)
 
@@ -77,7 +87,7 @@ PYEOF
       || fail "--resume: $(cat "$tmp/resume.log")"
     grep -q "resuming in $tmp/s: [0-9]* runs finished, [0-9]* to run" "$tmp/resume.log" || fail "resume message"
     cmp "$tmp/ref/summary.json" "$tmp/s/summary.json" || fail "the resumed summary.json differs from the uninterrupted one"
-    diff -r "$tmp/ref/runs" "$tmp/s/runs" > /dev/null || fail "the resumed runs' metrics.json differ"
+    same_runs "$tmp/ref/runs" "$tmp/s/runs" || fail "the resumed runs' metrics.json differ"
     cmp "$tmp/ref/.quadcosim-outputs.json" "$tmp/s/.quadcosim-outputs.json" || fail "the manifests differ"
     # Resuming a finished sweep: nothing to do.
     "$QC" sweep "$HOVER" "${A[@]}" --seed 11 --resume --out "$tmp/s" > "$tmp/o.log" 2>&1 || fail "--resume of a finished sweep"
@@ -100,7 +110,7 @@ PYEOF
     set -e
     "$QC" sweep "$HOVER" "${A[@]}" --seed 11 --shard 1/2 --jobs 2 --resume --out "$tmp/p1" > "$tmp/o.log" 2>&1 || fail "--resume"
     cmp "$tmp/ref/shard.json" "$tmp/p1/shard.json" || fail "the resumed shard.json differs from the uninterrupted one"
-    diff -r "$tmp/ref/runs" "$tmp/p1/runs" > /dev/null || fail "the resumed shard's runs differ"
+    same_runs "$tmp/ref/runs" "$tmp/p1/runs" || fail "the resumed shard's runs differ"
     "$QC" sweep merge "$tmp/m" "$tmp/p1" "$tmp/p2" --no-plots --min-pass-rate 0 > /dev/null || fail "merge"
     ;;
 
@@ -168,7 +178,8 @@ YAML
       || fail "--resume from another folder: $(cat "$tmp/resume.log")"
     grep -q "resuming in ../s: [0-9]* runs finished" "$tmp/resume.log" || fail "resume message: $(cat "$tmp/resume.log")"
     cmp "$tmp/ref/summary.json" "$tmp/s/summary.json" || fail "the resumed summary.json differs from the uninterrupted one"
-    diff -r "$tmp/ref/runs" "$tmp/s/runs" > /dev/null || fail "the resumed runs' metrics.json differ"
+    # Their provenance names the command lines (--resume, another folder): the same judgement.
+    same_runs "$tmp/ref/runs" "$tmp/s/runs" || fail "the resumed runs' metrics.json differ"
     "$QC" sweep rerun ../s 5 --out ../r5 --no-plots > "$tmp/rerun.log" 2>&1 || [ $? -eq 1 ] \
       || fail "rerun from another folder: $(cat "$tmp/rerun.log")"
     "$PY" - "$tmp/s/summary.json" "$tmp/r5/metrics.json" <<'PYEOF' || fail "the rerun differs from the sweep's run"

@@ -10,6 +10,7 @@
 
 #include "app/python/isolated_controller.hpp"
 #include "app/python_host.hpp"
+#include "io/provenance.hpp"
 #include "io/scenario.hpp"
 #include "python/py_controller.hpp"
 
@@ -60,6 +61,7 @@ std::shared_ptr<const control::Controller> load(const std::string& target, const
 bool built_with_python() { return true; }
 
 void install_python_controllers() {
+  io::set_python_module_locator(python_module_file);
   io::set_python_controller_factory(
       [](const std::string& target, const fs::path& folder,
          const model::VehicleParams& vehicle) -> std::shared_ptr<const control::Controller> {
@@ -75,6 +77,11 @@ std::shared_ptr<const control::Controller> make_python_controller(const std::str
   } catch (const std::exception& e) {
     throw io::ConfigError(what + ": " + e.what());
   }
+}
+
+std::string python_module_file(const std::string& target) {
+  if (!g_running) return "";  // no interpreter: no Python controller was loaded
+  return python::loaded_module_file(target);
 }
 
 std::function<void(const std::function<void()>&)> python_thread_host() {

@@ -17,6 +17,8 @@ std::shared_ptr<const control::Controller> make_python_controller(const std::str
                         "Debian: pybind11-dev python3-dev, and QUADCOSIM_BUILD_PYTHON=ON; docs/python.md)");
 }
 
+std::string python_module_file(const std::string&) { return ""; }
+
 std::function<void(const std::function<void()>&)> python_thread_host() { return {}; }
 
 void python_at_exit() {}

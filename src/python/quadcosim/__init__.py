@@ -73,6 +73,9 @@ class RunResult:
     messages: what the CLI would have printed besides the table (watchdog, injected faults, rejected
         commands, notes on an output folder), one line each.
     out: the output folder, or None.
+    provenance: what flew and how (metrics.json "provenance", docs/outputs.md): controller (label, type,
+        parameter values; for a Python class module:Class, its module file and SHA-256), transport,
+        command line, quadcosim version and git commit, host, scenario file and its SHA-256.
     judged: the criteria set the run was judged against: "spec", "paper" or "none" (run's judge=).
     """
 
@@ -83,6 +86,7 @@ class RunResult:
     table: str = field(repr=False)
     messages: str = field(repr=False)
     out: Optional[str] = None
+    provenance: Dict[str, Any] = field(default_factory=dict, repr=False)
     judged: str = "spec"
 
     def __repr__(self) -> str:
@@ -138,7 +142,7 @@ class Controller:
 
 # Keys of metrics.json that describe the run rather than judge it.
 _HEADER_KEYS = {"scenario", "scenario_file", "description", "passed", "controller", "schema", "version", "judged",
-                "judged_criteria", "judged_note"}
+                "judged_criteria", "judged_note", "provenance"}
 # What run(judge=...) takes, as `quadcosim run --judge`.
 _JUDGE_SETS = ("spec", "paper", "none")
 
@@ -179,4 +183,5 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
     metrics = json.loads(r["metrics_json"])
     figures = {k: v for k, v in metrics.items() if k not in _HEADER_KEYS}
     return RunResult(trajectory=r["trajectory"], figures=figures, passed=r["passed"], metrics=metrics,
-                     table=r["table"], messages=r["messages"], out=r["out"], judged=r["judged"])
+                     table=r["table"], messages=r["messages"], out=r["out"], judged=r["judged"],
+                     provenance=metrics.get("provenance", {}))
