@@ -41,6 +41,7 @@ const std::vector<ExitCodeRow>& exit_code_table() {
        "the controller's step failed: it raised, returned garbage, crashed, exited or did not return in time (the "
        "message names the controller, the step and its time)",
        "run controller margins"},
+      {kControllerFailed, "the controller's step failed in at least one run (summary.json names them)", "sweep"},
       {kPlantFailed,
        "the plant's FMU failed: it answered Error, gave a non-finite output, crashed or exited (the message names the "
        "FMU, the call, the tick and its time)",

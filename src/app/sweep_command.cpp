@@ -67,7 +67,18 @@ void print_summary(const nlohmann::json& j, std::ostream& os) {
   }
 }
 
+// A run whose controller failed makes the sweep exit as `run` would (5): the controller needs fixing
+// before its pass rate means anything. Otherwise 0 or 1 by the pass rate.
 int verdict(const nlohmann::json& j, double min_pass_rate) {
+  int controller_failures = 0;
+  for (const nlohmann::json& run : j.value("per_run", nlohmann::json::array())) {
+    if (run.value("error_cause", "") == "controller") ++controller_failures;
+  }
+  if (controller_failures > 0) {
+    std::cerr << fmt::format("sweep: the controller failed in {} run{} (their errors are above and in summary.json)\n",
+                             controller_failures, controller_failures == 1 ? "" : "s");
+    return exit_code::kControllerFailed;
+  }
   return j["passed"].get<int>() >= sweep::passes_needed(min_pass_rate, j["runs"].get<int>()) ? exit_code::kOk
                                                                                              : exit_code::kFailed;
 }

@@ -46,14 +46,11 @@ const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, c
       mcap->record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
   }
   series.clear(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
-  bool watchdog = false;
   simulation.run([&](const sim::TickRecord& r) {
     const io::ControlColumns c = io::ControlColumns::from(r.status);
-    series.add(r.t_s, r.state, c);  // the numbers trajectory.csv holds
-    if (writer) {
-      watchdog = simulation.plant().watchdog_active();
-      writer->write(r.t_s, r.state, r.latched_command, c, watchdog);
-    }
+    const bool watchdog = simulation.plant().watchdog_active();
+    series.add(r.t_s, r.state, r.latched_command, c, watchdog);  // the numbers trajectory.csv holds
+    if (writer) writer->write(r.t_s, r.state, r.latched_command, c, watchdog);
     if (mcap) mcap->flush_settled(sc.simulation.plant.clock.ns(r.tick));
   });
   if (writer) writer->close();
@@ -207,6 +204,9 @@ RunResult run_into(const Plan& plan, int index, const fs::path& run_dir, Keep ke
     if (!r.passed) r.failed_criteria = failed_criteria(metrics);
   } catch (const control::CareError& e) {
     r.error = std::string("controller design failed: ") + e.what();
+  } catch (const control::ControllerFailure& e) {
+    r.error = e.what();
+    r.controller_failed = true;
   } catch (const std::exception& e) {
     r.error = e.what();
   }
@@ -343,6 +343,7 @@ nlohmann::json per_run_json(const Plan& plan, const RunResult& r) {
   for (const auto& [name, v] : figures_of(r, plan.nominal)) figs[name] = v ? nlohmann::json(*v) : nlohmann::json();
   run["figures"] = figs;
   if (!r.error.empty()) run["error"] = r.error;
+  if (r.controller_failed) run["error_cause"] = "controller";
   if (!r.passed) run["failed_criteria"] = r.failed_criteria;
   return run;
 }

@@ -25,6 +25,9 @@ struct RunResult {
   std::optional<io::TrackingResult> tracking;      ///< analysis.tracking, or figures of a trajectory run
   bool passed = false;
   std::string error;  ///< non-empty when the run could not be done (a refused value, a failed design)
+  /// The error is the controller's own failure (its step raised, returned garbage, crashed or hung):
+  /// summary.json says "error_cause": "controller" and the sweep exits 5, as `run` does.
+  bool controller_failed = false;
   /// The criteria the run failed, read back from its metrics.json (failed_criteria below); empty for
   /// a passing run or one that could not be flown.
   nlohmann::json failed_criteria = nlohmann::json::array();

@@ -176,7 +176,7 @@ PY
     FAULTY_FAULT="$fault" FAULTY_AT=2 run_expect 5 "faulty_controller.Faulty.step at step 100 \(t = 2 s\)" \
       "${how[$fault]}" "faulty controller: $fault at t = 2 s"
     check_outputs 1.99 ;;  # every tick before the control step that failed
-  python_raise_one_exit_code)  # a raising step: exit 5 isolated, in quadcosim's process and over DDS
+  python_raise_one_exit_code)  # a raising step: exit 5 isolated, in quadcosim's process, over DDS and in a sweep
     python_scenario 5
     for how in isolated in_process dds; do
       flags=""; [ "$how" = dds ] && flags="--transport dds"
@@ -184,7 +184,23 @@ PY
       rm -rf "$tmp/out"
       QUADCOSIM_PYTHON_IN_PROCESS=$in_process FAULTY_FAULT=raise FAULTY_AT=2 RUN_FLAGS="$flags" \
         run_expect 5 "faulty_controller.Faulty.step at step 100 \(t = 2 s\): raised ValueError"
-    done ;;
+    done
+    # A sweep whose runs' controller raises exits 5 too, each run's error and its cause in summary.json.
+    sed 's/^  duration_s: 15$/  duration_s: 3/; s/^controller:$/controller:\n  python: "faulty_controller:Faulty"/' \
+      "$src/scenarios/paper/altitude_step.yaml" > "$tmp/sweep.yaml"
+    grep -q 'python: "faulty_controller:Faulty"' "$tmp/sweep.yaml" || fail "the sweep scenario was not made"
+    rc=0
+    FAULTY_FAULT=raise FAULTY_AT=2 "$bin" sweep "$tmp/sweep.yaml" --vary "mass=grid(1.9,2.0)" --out "$tmp/sweep" \
+      --no-plots > "$tmp/sweep.log" 2>&1 || rc=$?
+    [ "$rc" = 5 ] || { cat "$tmp/sweep.log"; fail "sweep: exit $rc, expected 5"; }
+    grep -q "the controller failed in 2 runs" "$tmp/sweep.log" || { cat "$tmp/sweep.log"; fail "sweep: no message"; }
+    python3 - "$tmp/sweep/summary.json" <<'PY' || fail "sweep: summary.json does not name the controller's failure"
+import json, sys
+runs = json.load(open(sys.argv[1]))["per_run"]
+assert len(runs) == 2 and all(r["error_cause"] == "controller" for r in runs), runs
+assert all("at step 100 (t = 2 s): raised ValueError" in r["error"] for r in runs), runs
+PY
+    echo "sweep: exit 5, both runs' controller failure in summary.json" ;;
   python_isolation_bit_identical)  # the same bytes with the controller in its own process and in quadcosim's
     python_scenario 5
     run_expect 0
