@@ -22,6 +22,10 @@ writes PNG figures into RUN_DIR, printing the path of every file written:
                       at max(15 s, 2.5 x settling time) after the step.
   overview.png        2x3 grid: 3D path, position, attitude, body rates,
                       rotor speeds, vertical speed.
+  outputs.png         when trajectory.csv has out.<name> columns (the
+                      figures the controller declares): one panel per
+                      group of names sharing a prefix ("e_x.x", "e_x.y",
+                      "e_x.z") or per name, against time.
   tracking_path.png   when metrics.json has "tracking" (the run tracked a
                       trajectory): the 3D path against the reference, and
                       the top view (x-y), side by side.
@@ -80,6 +84,10 @@ REQUIRED_COLUMNS = (
 # Read when present (saturation flags, the attitude error Psi; docs/outputs.md); older trajectories lack them.
 SATURATION_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
 OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err",)
+# The controller's own figures: trajectory.csv's columns out.<name>, read when present.
+OUTPUT_PREFIX = "out."
+# At most this many panels in outputs.png; the names beyond are listed in its title.
+MAX_OUTPUT_PANELS = 12
 # Angles are drawn unwrapped (no 2 pi jumps), their setpoints too.
 ANGLE_COLUMNS = ("roll", "pitch", "yaw", "roll_des", "pitch_des", "yaw_des")
 COLOR_SATURATED = "#d62728"
@@ -151,6 +159,10 @@ class Trajectory:
     def has(self, name):
         return name in self._index
 
+    def output_names(self):
+        """The controller's declared figures (the out.<name> columns), in the file's order."""
+        return [c[len(OUTPUT_PREFIX):] for c in self._index if c.startswith(OUTPUT_PREFIX)]
+
     def __len__(self):
         return self._data.shape[0]
 
@@ -194,7 +206,8 @@ def load_trajectory(path):
                     f"{path}: missing required column{'s' if len(missing) > 1 else ''} "
                     + ", ".join(repr(c) for c in missing)
                     + f" (header has: {', '.join(names)})")
-            loaded = REQUIRED_COLUMNS + tuple(c for c in OPTIONAL_COLUMNS if c in index)
+            outputs = tuple(n for n in index if n.startswith(OUTPUT_PREFIX))
+            loaded = REQUIRED_COLUMNS + tuple(c for c in OPTIONAL_COLUMNS if c in index) + outputs
             usecols = [index[c] for c in loaded]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # "input contained no data"
@@ -878,6 +891,49 @@ TRACKING_FIGSIZE = (13.0, 5.5)
 XYZ_COLORS = ("#d62728", "#2ca02c", "#1f4fd6")
 
 
+def output_groups(names):
+    """The panels of outputs.png: names sharing the part before their last dot ("e_x" of "e_x.x") share
+    one, the others have their own; in the order the names first appear. [(title, [names])]."""
+    groups = {}
+    for name in names:
+        prefix = name.rsplit(".", 1)[0] if "." in name else name
+        if sum(1 for n in names if "." in n and n.rsplit(".", 1)[0] == prefix) < 2:
+            prefix = name
+        groups.setdefault(prefix, []).append(name)
+    return list(groups.items())
+
+
+def plot_outputs(traj, out_path, metrics):
+    """The controller's declared figures against time, a panel per group (output_groups)."""
+    t = traj["t"]
+    groups = output_groups(traj.output_names())
+    shown, left_out = groups[:MAX_OUTPUT_PANELS], groups[MAX_OUTPUT_PANELS:]
+    ncols = 1 if len(shown) == 1 else 2 if len(shown) <= 4 else 3
+    nrows = math.ceil(len(shown) / ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.0 * ncols, 2.6 * nrows + 0.9), squeeze=False, sharex=True)
+    for ax, (title, names) in zip(axes.flat, shown):
+        for name in names:
+            label = name[len(title) + 1:] if name != title else name
+            ax.plot(t, traj[OUTPUT_PREFIX + name], lw=1.2, label=label)
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, alpha=0.3)
+        if len(names) > 1:
+            ax.legend(fontsize=8, loc="best")
+        shade_saturation(ax, traj)
+    for ax in axes.flat[len(shown):]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    title = "The controller's own figures (trajectory.csv out.* columns)"
+    if left_out:
+        title += f"; not drawn: {', '.join(n for _, names in left_out for n in names)}"
+    parts = run_subtitle_parts(metrics) if metrics is not None else []
+    fig.suptitle(title + ("\n" + " · ".join(parts) if parts else ""), fontsize=11)
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
 def _tracking_after_s(metrics):
     v = (metrics.get("tracking") or {}).get("after_s")
     return float(v) if _is_number(v) and math.isfinite(float(v)) else 0.0
@@ -1109,6 +1165,12 @@ def run(run_dir):
     plot_overview(traj, out, metrics, run_dir)
     written.append(out)
     print(out, flush=True)
+
+    if traj.output_names():
+        out = os.path.join(run_dir, "outputs.png")
+        plot_outputs(traj, out, metrics)
+        written.append(out)
+        print(out, flush=True)
 
     if metrics is not None and metrics.get("tracking") is not None:
         for name, plot in zip(TRACKING_FIGURE_NAMES, (plot_tracking_path, plot_tracking_axes, plot_tracking_error)):

@@ -208,7 +208,7 @@ def figure_files(run_dir, metrics):
     """The figures of this run that are present: the step figures of metrics.json's steps (named as
     plot_run.py names them) and overview.png. Any other PNG in RUN_DIR (left by another run) is not
     this run's and is left out. A tracking run (metrics.json has "tracking") adds its tracking figures."""
-    names = plot_run.step_figure_names(metrics["steps"]) + ["overview.png"]
+    names = plot_run.step_figure_names(metrics["steps"]) + ["overview.png", "outputs.png"]
     if metrics.get("tracking") is not None:
         names += list(plot_run.TRACKING_FIGURE_NAMES)
     files = [os.path.join(run_dir, n) for n in names if os.path.isfile(os.path.join(run_dir, n))]
@@ -361,6 +361,42 @@ def tracking_section(w, tr):
         w(f'<p class="note">{esc(note)}</p>')
 
 
+def output_summary(run_dir):
+    """The controller's declared figures (trajectory.csv's out.<name> columns) as
+    [(name, final, min, max)] over their finite samples (None when it has none); [] without any, or
+    without trajectory.csv."""
+    path = os.path.join(run_dir, "trajectory.csv")
+    if not os.path.isfile(path):
+        return []
+    try:
+        traj = plot_run.load_trajectory(path)
+    except plot_run.InputError:
+        return []
+    rows = []
+    for name in traj.output_names():
+        v = traj[plot_run.OUTPUT_PREFIX + name]
+        finite = v[np.isfinite(v)]
+        if finite.size == 0:
+            rows.append((name, None, None, None))
+        else:
+            rows.append((name, float(finite[-1]), float(finite.min()), float(finite.max())))
+    return rows
+
+
+def outputs_section(w, run_dir):
+    rows = output_summary(run_dir)
+    if not rows:
+        return
+    w('<h2 id="outputs">The controller\'s own figures</h2>')
+    w("<p>What the controller declared and reported at each step (trajectory.csv columns out.&lt;name&gt;; "
+      "NaN while it did not report, e.g. under the safety command).</p>")
+    w('<table class="outputs"><tr><th>output</th><th>final</th><th>min</th><th>max</th></tr>')
+    for name, final, lo, hi in rows:
+        cells = "".join(f"<td>{'—' if v is None else esc(f'{v:.6g}')}</td>" for v in (final, lo, hi))
+        w(f"<tr><th>{esc(name)}</th>{cells}</tr>")
+    w("</table>")
+
+
 def build_html(run_dir, metrics, version_text):
     verdict = overall_verdict(metrics)
     name = metrics["scenario"] or os.path.basename(os.path.abspath(run_dir))
@@ -410,7 +446,8 @@ def build_html(run_dir, metrics, version_text):
     step_names = set(plot_run.step_figure_names(metrics["steps"]))
     step_files = [f for f in files if os.path.basename(f) in step_names]
     tracking_files = [f for f in files if os.path.basename(f) in plot_run.TRACKING_FIGURE_NAMES]
-    other_files = [f for f in files if f not in step_files and f not in tracking_files]
+    output_files = [f for f in files if os.path.basename(f) == "outputs.png"]
+    other_files = [f for f in files if f not in step_files and f not in tracking_files and f not in output_files]
     tr = metrics.get("tracking")
     if tr:
         tracking_section(w, tr)
@@ -435,6 +472,9 @@ def build_html(run_dir, metrics, version_text):
         mark = "" if not sat.get("criteria") or sp is None else (" — ok" if sp else " — FAIL")
         w(f'<h2 id="saturation">Saturation and control effort{esc(mark)}</h2>')
         figure_table(w, sat, lambda key, v: f"{v:.3f} {'N' if key.endswith('_n') else 's'}")
+
+    outputs_section(w, run_dir)
+    figure_block(w, output_files)
 
     w("<h2>Figures</h2>" if not (step_files or tracking_files) else "<h2>Overview</h2>")
     if not files:

@@ -26,6 +26,7 @@
 #include "controllers/paper/paper_controller.hpp"
 #include "controllers/registry.hpp"
 #include "model/mixer.hpp"
+#include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 
 namespace {
@@ -896,6 +897,64 @@ TEST(Parameters, TableIsWellFormedAndDefaultsAreInRange) {
     EXPECT_NE(find_parameter(defaults, n), nullptr) << n;
   }
   EXPECT_EQ(find_parameter(defaults, "no_such"), nullptr);
+}
+
+}  // namespace
+
+namespace {
+
+// A controller that decides only rotor speeds (Python, FMU) says what it tracks through the outputs it
+// declares; without them, roll and pitch in position mode are unknown (NaN), not a level 0.
+TEST(RotorSpeedsOutput, ReportedOutputsFillTheTrackedAttitudeAndTiltFlag) {
+  VehicleParams v;
+  const quadcosim::model::Quadrotor model(v);
+  const std::vector<std::string> names = {"thrust_N", "pitch_des", "tilt_saturated", "roll_des"};
+  const ReportedOutputs reported = ReportedOutputs::find(names);
+  EXPECT_EQ(reported.roll_des, 3);
+  EXPECT_EQ(reported.pitch_des, 1);
+  EXPECT_EQ(reported.yaw_des, -1);
+  EXPECT_EQ(reported.tilt_saturated, 2);
+
+  Reference position;
+  position.mode = Mode::kPosition;
+  position.yaw_rad = 0.3;
+  ControllerOutput out;
+  out.outputs = {19.2, -0.05, 1.0, 0.08};
+  const Eigen::Vector4d omega = Eigen::Vector4d::Constant(5000.0);
+  rotor_speeds_output(model, position, omega, reported, out);
+  EXPECT_EQ(out.roll_des_rad, 0.08);
+  EXPECT_EQ(out.pitch_des_rad, -0.05);
+  EXPECT_EQ(out.yaw_des_rad, 0.3);  // not declared: the reference's
+  EXPECT_TRUE(out.tilt_saturated);
+  // U is the wrench of the commanded speeds: 4 k_t omega^2 of thrust, no torque at equal speeds.
+  EXPECT_NEAR(out.U[0], 4.0 * v.kt_N_per_rad2_s2 * 5000.0 * 5000.0, 1e-9 * out.U[0]);
+
+  ControllerOutput silent;
+  rotor_speeds_output(model, position, omega, ReportedOutputs::find({}), silent);
+  EXPECT_TRUE(std::isnan(silent.roll_des_rad));
+  EXPECT_TRUE(std::isnan(silent.pitch_des_rad));
+  EXPECT_EQ(silent.yaw_des_rad, 0.3);
+  EXPECT_FALSE(silent.tilt_saturated);
+
+  Reference attitude;  // attitude mode: the reference's setpoints are what is tracked
+  attitude.roll_rad = 0.1;
+  attitude.pitch_rad = -0.2;
+  rotor_speeds_output(model, attitude, omega, ReportedOutputs::find({}), silent);
+  EXPECT_EQ(silent.roll_des_rad, 0.1);
+  EXPECT_EQ(silent.pitch_des_rad, -0.2);
+}
+
+TEST(RotorSpeedsOutput, ARotorCommandedAtOrBeyondItsLimitsIsSaturated) {
+  VehicleParams v;
+  v.motor.omega_min_rad_s = 100.0;
+  v.motor.omega_max_rad_s = 9000.0;
+  const quadcosim::model::Quadrotor model(v);
+  ControllerOutput out;
+  const Eigen::Vector4d omega(9000.0, 8999.999, 100.0, 100.001);
+  rotor_speeds_output(model, Reference{}, omega, ReportedOutputs{}, out);
+  EXPECT_EQ(out.rotor_saturated, (std::array<bool, 4>{true, false, true, false}));
+  rotor_speeds_output(model, Reference{}, Eigen::Vector4d(1e4, 0.0, 5000.0, 5000.0), ReportedOutputs{}, out);
+  EXPECT_EQ(out.rotor_saturated, (std::array<bool, 4>{true, true, false, false}));
 }
 
 }  // namespace

@@ -7,17 +7,38 @@
 
 namespace quadcosim::control {
 
+ReportedOutputs ReportedOutputs::find(std::span<const std::string> output_names) {
+  ReportedOutputs r;
+  for (std::size_t i = 0; i < output_names.size(); ++i) {
+    const std::string& name = output_names[i];
+    int* place = name == kRollDes         ? &r.roll_des
+                 : name == kPitchDes      ? &r.pitch_des
+                 : name == kYawDes        ? &r.yaw_des
+                 : name == kTiltSaturated ? &r.tilt_saturated
+                                          : nullptr;
+    if (place) *place = static_cast<int>(i);
+  }
+  return r;
+}
+
 void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference, const Eigen::Vector4d& omega_rad_s,
-                         ControllerOutput& out) {
+                         const ReportedOutputs& reported, ControllerOutput& out) {
   out.omega_rad_s = omega_rad_s;
   const model::Wrench u = model.wrench(omega_rad_s);
   out.U = {u.thrust_N, u.torque_B_Nm.x(), u.torque_B_Nm.y(), u.torque_B_Nm.z()};
-  out.roll_des_rad = reference.roll_rad;
-  out.pitch_des_rad = reference.pitch_rad;
-  out.yaw_des_rad = reference.yaw_rad;
-  out.attitude_error = std::numeric_limits<double>::quiet_NaN();
-  out.rotor_saturated = {};
-  out.tilt_saturated = false;
+  const bool attitude_mode = reference.mode == Mode::kAttitude;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto figure = [&](int place, double otherwise) {
+    return place >= 0 && static_cast<std::size_t>(place) < out.outputs.size() ? out.outputs[place] : otherwise;
+  };
+  out.roll_des_rad = figure(reported.roll_des, attitude_mode ? reference.roll_rad : nan);
+  out.pitch_des_rad = figure(reported.pitch_des, attitude_mode ? reference.pitch_rad : nan);
+  out.yaw_des_rad = figure(reported.yaw_des, reference.yaw_rad);
+  out.attitude_error = nan;
+  const model::MotorParams& motor = model.params().motor;
+  for (int i = 0; i < 4; ++i)
+    out.rotor_saturated[i] = omega_rad_s[i] >= motor.omega_max_rad_s || omega_rad_s[i] <= motor.omega_min_rad_s;
+  out.tilt_saturated = figure(reported.tilt_saturated, 0.0) != 0.0;
 }
 
 double attitude_error(const Eigen::Quaterniond& q_des, const Eigen::Quaterniond& q) {

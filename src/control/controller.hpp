@@ -166,11 +166,25 @@ class ControllerWith : public Controller {
   P params_;
 };
 
+/// The outputs a controller that decides only rotor speeds (a Python class, an FMU) may declare to say
+/// what it does (docs/controllers.md): "roll_des", "pitch_des", "yaw_des" [rad], the attitude it tracks,
+/// and "tilt_saturated" (non-zero while its tilt limit acts). Their places among its output names, -1 for
+/// one it does not declare; found once, read every step.
+struct ReportedOutputs {
+  static constexpr std::string_view kRollDes = "roll_des", kPitchDes = "pitch_des", kYawDes = "yaw_des",
+                                    kTiltSaturated = "tilt_saturated";
+  static ReportedOutputs find(std::span<const std::string> output_names);
+  int roll_des = -1, pitch_des = -1, yaw_des = -1, tilt_saturated = -1;
+};
+
 /// The output of a controller that decides only rotor speeds (an FMU, a Python class): `omega_rad_s`, U
-/// = the wrench those speeds make on `model` (eq. (4)), the reference's attitude as the tracked one,
-/// attitude_error NaN, no saturation flags. Leaves `out.outputs` as it is.
+/// = the wrench those speeds make on `model` (eq. (4)), attitude_error NaN. The tracked attitude is the
+/// one the controller reports in `out.outputs` (ReportedOutputs); else the reference's in attitude mode
+/// and its yaw in position mode, with roll and pitch NaN there (unknown, not 0). A rotor is saturated
+/// when its command is at or beyond the vehicle's speed limits (omega_min, omega_max); the tilt flag is
+/// the reported one, else false. Leaves `out.outputs` as it is.
 void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference, const Eigen::Vector4d& omega_rad_s,
-                         ControllerOutput& out);
+                         const ReportedOutputs& reported, ControllerOutput& out);
 
 /// Psi = 1/2 tr(I - R_d^T R), the attitude error of Lee, Leok and McClamroch (2010), in [0, 2]:
 /// 1 - cos(angle of the rotation between them).

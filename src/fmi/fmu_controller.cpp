@@ -104,6 +104,7 @@ struct FmuController::Shared {
   std::vector<ValueReference> out_vrs;  ///< omega_cmd[1..4], then the figures
   std::vector<std::string> out_names;   ///< the FMU variable of each out_vrs entry
   std::vector<std::string> figure_names;
+  control::ReportedOutputs reported;             ///< where among figure_names the FMU reports its attitude setpoint
   std::vector<ParameterSetting> fixed_settings;  ///< the scenario's `parameters:` that are not in the table
   std::deque<std::string> strings;               ///< owns what the specs' string_views show
   std::vector<control::ParameterSpec> specs;
@@ -151,6 +152,7 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
     sh->out_names.push_back(v.name);
     sh->figure_names.push_back(v.name);
   }
+  sh->reported = control::ReportedOutputs::find(sh->figure_names);
   // The parameter table: Real parameters that may be set (tunable, or fixed until initialisation).
   const std::string prefix(names::kControllerPrefix);
   for (const Variable& v : md.variables) {
@@ -332,8 +334,8 @@ void FmuController::step(const control::Observation& o, const control::Reference
     }
   }
   ++steps_;
-  control::rotor_speeds_output(model_, r, Eigen::Vector4d(out_[0], out_[1], out_[2], out_[3]), out);
   for (std::size_t i = 0; i < shared_->figure_names.size() && i < out.outputs.size(); ++i) out.outputs[i] = out_[4 + i];
+  control::rotor_speeds_output(model_, r, Eigen::Vector4d(out_[0], out_[1], out_[2], out_[3]), shared_->reported, out);
 }
 
 const std::shared_ptr<Fmu>& FmuController::fmu() const { return shared_->fmu; }

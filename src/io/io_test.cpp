@@ -855,8 +855,9 @@ TEST(SeriesRecorderTest, HoldsWhatReadSeriesReadsFromTheWrittenCsvBitForBit) {
                                                      {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3},
                                                      k % 3 == 1};
       const double t = static_cast<double>(k) * 1e7 / 1e9;
-      w.write(t, x, Eigen::Vector4d::Zero(), c);
-      recorder.add(t, x, c);
+      const Eigen::Vector4d command(a(2), a(3), 0.0, -a(4));
+      w.write(t, x, command, c, k % 5 == 1);
+      recorder.add(t, x, command, c, k % 5 == 1);
     }
     w.close();
   }
@@ -1462,6 +1463,88 @@ TEST(SaturationTest, ColumnsRoundTripThroughTrajectoryCsv) {
                                          "t,x,y,z,roll,pitch,yaw,x_des,y_des,z_des,roll_des,pitch_des,yaw_des\n"
                                          "0,0,0,0,0,0,0,0,0,0,0,0,0\n");
   EXPECT_FALSE(evaluate_saturation(sc, read_series(old_path)).has_value());
+}
+
+TEST(SaturationTest, CommandAtLimitIsMeasuredFromTheCommandsAtThePlant) {
+  // 100 Hz, 101 rows; the vehicle's limits 0..12000 rad/s. Rotor 3's command reaches omega_max on rows
+  // 20..29 (10 rows), rotor 1's goes beyond it on rows 25..34 (overlapping: rows 20..34, 15 in all);
+  // rotor 2 is commanded 0 (omega_min) on rows 60..64 (5), but rows 62..64 are the safety command and
+  // row 63 the watchdog's too: 2 rows count. Rows 0..1 have no controller status yet (U1 NaN) and
+  // commands of 0: not counted. The controller reported nothing (its flags all 0).
+  Scenario sc;
+  ASSERT_EQ(sc.vehicle.motor.omega_min_rad_s, 0.0);
+  ASSERT_EQ(sc.vehicle.motor.omega_max_rad_s, 12000.0);
+  Series s;
+  for (int k = 0; k <= 100; ++k) {
+    s.t_s.push_back(k / 100.0);
+    for (const char* flag : {"sat1", "sat2", "sat3", "sat4", "tilt_sat"}) s.append(flag, 0.0);
+    const bool started = k >= 2;
+    s.append("U1", started ? 19.0 : std::numeric_limits<double>::quiet_NaN());
+    s.append("cmd1", !started ? 0.0 : k >= 25 && k < 35 ? 12500.0 : 5000.0);
+    s.append("cmd2", !started ? 0.0 : k >= 60 && k < 65 ? 0.0 : 5000.0);
+    s.append("cmd3", !started ? 0.0 : k >= 20 && k < 30 ? 12000.0 : 11999.999);
+    s.append("cmd4", !started ? 0.0 : 5000.0);
+    s.append("safety", k >= 62 && k < 65 ? 1.0 : 0.0);
+    s.append("watchdog", k == 63 ? 1.0 : 0.0);
+  }
+  const auto r = evaluate_saturation(sc, s);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_NEAR(r->figures.at("command_at_limit_s"), 0.17, 1e-12);
+  EXPECT_EQ(r->saturated_s(), 0.0);
+  const std::string w = saturation_warning(*r);
+  EXPECT_NE(w.find("at the plant was at omega_min/omega_max for 0.170 s (the controller reports no saturation)"),
+            std::string::npos)
+      << w;
+}
+
+TEST(TrajectoryCsvTest, TheControllersOwnFiguresAreNamedColumns) {
+  // The first row's status fixes the out.<name> columns; a row whose status declares other names (a
+  // replaced controller) or none (before the first step) has NaN there.
+  TempDir dir;
+  const std::string path = dir.file("trajectory.csv");
+  const std::vector<std::string> names = {"error.z", "rate_des.p", "bad,name"};
+  const std::vector<std::string> other = {"thrust_N"};
+  {
+    TrajectoryWriter w(path);
+    for (int k = 0; k < 4; ++k) {
+      ControlColumns c = ControlColumns::none();
+      const std::vector<double> values = {0.25 * k, -1.0 / 3.0, 7.0};
+      const std::vector<double> one = {9.5};
+      if (k != 2) {
+        c.output_names = names;
+        c.outputs = values;
+      } else {
+        c.output_names = other;
+        c.outputs = one;
+      }
+      w.write(k / 100.0, model::State{}, Eigen::Vector4d::Zero(), c);
+    }
+    w.close();
+  }
+  const std::vector<std::string> lines = lines_of(read_text(path));
+  ASSERT_EQ(lines.size(), 5u);
+  const std::vector<std::string> header = split(lines[0]);
+  ASSERT_EQ(header.size(), TrajectoryWriter::columns().size() + 3);
+  EXPECT_EQ(header[header.size() - 3], "out.error.z");
+  EXPECT_EQ(header[header.size() - 2], "out.rate_des.p");
+  EXPECT_EQ(header[header.size() - 1], "out.bad_name");  // a comma would split the column
+  const auto last3 = [&](int row) {
+    const std::vector<std::string> cells = split(lines[row + 1]);
+    EXPECT_EQ(cells.size(), header.size()) << row;
+    return std::vector<std::string>(cells.end() - 3, cells.end());
+  };
+  EXPECT_EQ(last3(1), (std::vector<std::string>{"0.25", "-0.3333333333333333", "7"}));
+  EXPECT_EQ(last3(2), (std::vector<std::string>{"nan", "nan", "nan"}));
+  EXPECT_EQ(last3(3), (std::vector<std::string>{"0.75", "-0.3333333333333333", "7"}));
+
+  // Open loop (no status, no names): the fixed columns only.
+  const std::string plain = dir.file("plain.csv");
+  {
+    TrajectoryWriter w(plain);
+    w.write(0.0, model::State{}, Eigen::Vector4d::Zero(), ControlColumns::none());
+    w.close();
+  }
+  EXPECT_EQ(split(lines_of(read_text(plain))[0]), TrajectoryWriter::columns());
 }
 
 TEST(StepReportTest, MissingChannelIsALogicError) {

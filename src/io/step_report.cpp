@@ -25,7 +25,8 @@ constexpr std::ptrdiff_t kJudgedColumns = 12;  // x .. yaw_des, the first of ser
 const std::vector<std::string>& series_columns() {
   static const std::vector<std::string> names = {"x",     "y",     "z",        "roll",      "pitch",   "yaw",  "x_des",
                                                  "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "sat1", "sat2",
-                                                 "sat3",  "sat4",  "tilt_sat", "U1",        "att_err"};
+                                                 "sat3",  "sat4",  "tilt_sat", "U1",        "att_err", "cmd1", "cmd2",
+                                                 "cmd3",  "cmd4",  "safety",   "watchdog"};
   return names;
 }
 
@@ -150,7 +151,7 @@ std::vector<StepResult> evaluate_steps(const std::vector<StepSpec>& steps, const
 const std::vector<std::string>& saturation_figure_names() {
   static const std::vector<std::string> names = {"saturated_s",        "rotor1_saturated_s", "rotor2_saturated_s",
                                                  "rotor3_saturated_s", "rotor4_saturated_s", "tilt_saturated_s",
-                                                 "rms_u1_deviation_n"};
+                                                 "rms_u1_deviation_n", "command_at_limit_s"};
   return names;
 }
 
@@ -171,6 +172,17 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
   std::size_t n_u = 0;
   const double hover_n = sc.vehicle.mass_kg * sc.vehicle.gravity_m_s2;
   const auto u1 = v.find("U1");
+  // Measured at the plant: the command acting over each tick against the vehicle's limits.
+  std::array<const std::vector<double>*, 4> command{};
+  for (int k = 0; k < 4; ++k) {
+    const auto it = v.find("cmd" + std::to_string(k + 1));
+    command[k] = it == v.end() ? nullptr : &it->second;
+  }
+  const auto safety = v.find("safety"), watchdog = v.find("watchdog");
+  const bool measured =
+      command[0] && command[1] && command[2] && command[3] && safety != v.end() && watchdog != v.end() && u1 != v.end();
+  const model::MotorParams& motor = sc.vehicle.motor;
+  double at_limit = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double dt = period(i);
     bool some = false;
@@ -182,6 +194,17 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
     }
     if (some) any += dt;
     if (v.at("tilt_sat")[i] != 0.0) tilt += dt;
+    // The controller's commands only: not before its first step (no U1 yet), nor the stale-data safety
+    // command or the plant watchdog's (they stop the rotors on purpose).
+    if (measured && std::isfinite(u1->second[i]) && safety->second[i] == 0.0 && watchdog->second[i] == 0.0) {
+      for (int k = 0; k < 4; ++k) {
+        const double w = (*command[k])[i];
+        if (w >= motor.omega_max_rad_s || w <= motor.omega_min_rad_s) {
+          at_limit += dt;
+          break;
+        }
+      }
+    }
     if (u1 != v.end() && std::isfinite(u1->second[i])) {
       sum_du2 += (u1->second[i] - hover_n) * (u1->second[i] - hover_n);
       ++n_u;
@@ -191,27 +214,38 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
   for (int k = 0; k < 4; ++k) r.figures[SaturationResult::fmt_rotor(k + 1)] = rotor[k];
   r.figures["tilt_saturated_s"] = tilt;
   if (n_u > 0) r.figures["rms_u1_deviation_n"] = std::sqrt(sum_du2 / static_cast<double>(n_u));
+  if (measured) r.figures["command_at_limit_s"] = at_limit;
   if (sc.limits) judge_figures(sc.limits->criteria, r, judge, no_note);
   return r;
 }
 
 std::string saturation_warning(const SaturationResult& s) {
-  if (s.saturated_s() <= 0.0 && s.tilt_saturated_s() <= 0.0) return "";
+  const auto measured = s.figures.find("command_at_limit_s");
+  const double at_limit = measured == s.figures.end() ? 0.0 : measured->second;
+  if (s.saturated_s() <= 0.0 && s.tilt_saturated_s() <= 0.0 && at_limit <= 0.0) return "";
   std::string rotors, times;
   for (int k = 1; k <= 4; ++k) {
     if (s.rotor_saturated_s(k) > 0.0) rotors += (rotors.empty() ? "" : ", ") + std::to_string(k);
     times += fmt::format("{}{:.3f}", k == 1 ? "" : "/", s.rotor_saturated_s(k));
   }
   std::string line = "warning: rotor saturation: ";
+  std::string said;
   if (s.saturated_s() > 0.0) {
-    line += fmt::format(
-        "rotor{} {} clamped at omega_min/omega_max by the allocation for {:.3f} s in total (rotors 1/2/3/4: {} s)",
-        rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), times);
+    said = fmt::format("rotor{} {} at omega_min/omega_max for {:.3f} s in total (rotors 1/2/3/4: {} s)",
+                       rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), times);
+  } else if (at_limit > 0.0) {
+    // The controller reported nothing, but the commands the plant received say otherwise.
+    said = fmt::format(
+        "a rotor command acting at the plant was at omega_min/omega_max for {:.3f} s (the controller "
+        "reports no saturation)",
+        at_limit);
   }
+  line += said;
   if (s.tilt_saturated_s() > 0.0) {
-    line += fmt::format("{}tilt limit acted for {:.3f} s", s.saturated_s() > 0.0 ? "; " : "", s.tilt_saturated_s());
+    line += fmt::format("{}tilt limit acted for {:.3f} s", said.empty() ? "" : "; ", s.tilt_saturated_s());
   }
-  return line + "; the response is the limits', not the controller's alone (sat1..4, tilt_sat in trajectory.csv)";
+  return line +
+         "; the response is the limits', not the controller's alone (sat1..4, tilt_sat, cmd1..4 in trajectory.csv)";
 }
 
 bool all_passed(const std::vector<StepResult>& results) {

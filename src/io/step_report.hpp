@@ -69,12 +69,16 @@ struct SaturationResult {
   static std::string fmt_rotor(int rotor) { return "rotor" + std::to_string(rotor) + "_saturated_s"; }
 };
 
-/// "saturated_s", "rotor1_saturated_s" .. "rotor4_saturated_s", "tilt_saturated_s", "rms_u1_deviation_n".
+/// "saturated_s", "rotor1_saturated_s" .. "rotor4_saturated_s", "tilt_saturated_s" (as the controller
+/// reports them), "rms_u1_deviation_n", then "command_at_limit_s": how long some rotor's command acting
+/// at the plant was at or beyond the vehicle's speed limits, measured by quadcosim whatever the
+/// controller reports (absent for a trajectory without the cmd columns).
 const std::vector<std::string>& saturation_figure_names();
 
 /// The columns a Series holds besides t, in this order: the judged channels and their setpoints (x .. yaw,
-/// x_des .. yaw_des), then the saturation flags sat1..sat4, tilt_sat, U1 and the attitude error att_err
-/// (absent from a trajectory.csv written before they existed).
+/// x_des .. yaw_des), then the saturation flags sat1..sat4, tilt_sat, U1, the attitude error att_err and
+/// the rotor commands acting at the plant cmd1..cmd4 (absent from a trajectory.csv written before they
+/// existed).
 const std::vector<std::string>& series_columns();
 
 /// The series of a trajectory.csv (columns t, x, y, z, roll, pitch, yaw and their *_des; the

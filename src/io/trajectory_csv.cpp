@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <fstream>
@@ -35,7 +36,9 @@ ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
           m.safety,
           m.rotor_saturated,
           m.tilt_saturated,
-          m.attitude_error};
+          m.attitude_error,
+          m.output_names,
+          m.outputs};
 }
 
 std::array<int, 5> ControlColumns::saturation_columns() const {
@@ -52,16 +55,36 @@ const std::vector<std::string>& TrajectoryWriter::columns() {
   return c;
 }
 
+std::string TrajectoryWriter::output_column(std::string_view name) { return "out." + std::string(name); }
+
 TrajectoryWriter::TrajectoryWriter(const std::string& path) : path_(path) {
   file_ = open_output_file(path);  // never through a link planted at `path`
+}
+
+void TrajectoryWriter::write_header(std::span<const std::string> output_names) {
+  output_names_.assign(output_names.begin(), output_names.end());
   std::string header;
   for (const auto& c : columns()) header += (header.empty() ? "" : ",") + c;
+  // A name with a comma or a line break would break the CSV's columns: those are written with "_".
+  for (const std::string& name : output_names_) {
+    std::string column = output_column(name);
+    for (char& ch : column) {
+      if (ch == ',' || ch == '\n' || ch == '\r' || ch == '"') ch = '_';
+    }
+    header += "," + column;
+  }
   header += '\n';
-  std::fwrite(header.data(), 1, header.size(), file_);
+  buffer_.insert(0, header);
+  header_written_ = true;
+}
+
+bool TrajectoryWriter::same_outputs(std::span<const std::string> names) const {
+  return std::equal(names.begin(), names.end(), output_names_.begin(), output_names_.end());
 }
 
 TrajectoryWriter::~TrajectoryWriter() {
   if (file_) {
+    if (!header_written_) write_header({});
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     std::fclose(file_);
   }
@@ -69,6 +92,7 @@ TrajectoryWriter::~TrajectoryWriter() {
 
 void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vector4d& cmd, const ControlColumns& c,
                              bool watchdog) {
+  if (!header_written_) write_header(c.output_names);
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   auto out = std::back_inserter(buffer_);
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},", t, x.p_W.x(), x.p_W.y(), x.p_W.z(),
@@ -79,7 +103,14 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des, c.pitch_des,
                  c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
   const auto sat = c.saturation_columns();
-  fmt::format_to(out, "{},{},{},{},{},{}\n", sat[0], sat[1], sat[2], sat[3], sat[4], c.attitude_error);
+  fmt::format_to(out, "{},{},{},{},{},{}", sat[0], sat[1], sat[2], sat[3], sat[4], c.attitude_error);
+  if (!output_names_.empty()) {
+    const bool known = same_outputs(c.output_names) && c.outputs.size() == output_names_.size();
+    for (std::size_t i = 0; i < output_names_.size(); ++i) {
+      fmt::format_to(out, ",{}", known ? c.outputs[i] : std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  buffer_.push_back('\n');
   if (buffer_.size() > (1 << 16)) {
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     buffer_.clear();
@@ -88,6 +119,7 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
 
 void TrajectoryWriter::close() {
   if (!file_) return;
+  if (!header_written_) write_header({});
   const bool ok = std::fwrite(buffer_.data(), 1, buffer_.size(), file_) == buffer_.size();
   int err = ok ? 0 : errno;
   buffer_.clear();
@@ -111,7 +143,8 @@ void SeriesRecorder::clear(std::size_t rows) {
   }
 }
 
-void SeriesRecorder::add(double t_s, const model::State& x, const ControlColumns& c) {
+void SeriesRecorder::add(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
+                         bool watchdog) {
   // The values of TrajectoryWriter::write's columns of the same names.
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   const auto sat = c.saturation_columns();
@@ -133,8 +166,14 @@ void SeriesRecorder::add(double t_s, const model::State& x, const ControlColumns
                         static_cast<double>(sat[3]),
                         static_cast<double>(sat[4]),
                         c.U[0],
-                        c.attitude_error};
-  static_assert(std::size(row) == 19);
+                        c.attitude_error,
+                        command[0],
+                        command[1],
+                        command[2],
+                        command[3],
+                        c.safety ? 1.0 : 0.0,
+                        watchdog ? 1.0 : 0.0};
+  static_assert(std::size(row) == 25);
   assert(columns_.size() == std::size(row));
   series_.t_s.push_back(t_s);
   for (std::size_t i = 0; i < columns_.size(); ++i) columns_[i]->push_back(row[i]);

@@ -6,7 +6,9 @@
 #include <array>
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/step_report.hpp"
@@ -27,6 +29,10 @@ struct ControlColumns {
   /// The controller's attitude error Psi = 1/2 tr(I - R_d^T R) (ControllerStatus.attitude_error; NaN
   /// when it has no desired attitude, and in open loop): the column att_err.
   double attitude_error = std::numeric_limits<double>::quiet_NaN();
+  /// The controller's own figures (ControllerStatus.output_names, .outputs; empty in open loop): the
+  /// columns out.<name>. They view the status they came from.
+  std::span<const std::string> output_names;
+  std::span<const double> outputs;
   /// The columns sat1..sat4, tilt_sat: 1 where the flag is set, else 0.
   std::array<int, 5> saturation_columns() const;
   static ControlColumns none();
@@ -42,19 +48,29 @@ class TrajectoryWriter {
   TrajectoryWriter(const TrajectoryWriter&) = delete;
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
 
+  /// The columns every trajectory.csv has, in order; the controller's own figures follow them.
   static const std::vector<std::string>& columns();
+  /// The column of a controller's own figure: "out." + its name ("out.error.z").
+  static std::string output_column(std::string_view name);
 
   /// `command` is the rotor command acting over the next interval [rad/s]; `watchdog`: the plant's
-  /// watchdog set it (no valid command for its limit).
+  /// watchdog set it (no valid command for its limit). The first row fixes the columns: columns() and
+  /// one out.<name> for each of c.output_names; a later row whose controller declares other names (or
+  /// none: a restarted or replaced controller, the safety command) has NaN in them.
   void write(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
              bool watchdog = false);
   /// Flushes and closes; throws std::runtime_error on a write error.
   void close();
 
  private:
+  void write_header(std::span<const std::string> output_names);
+  bool same_outputs(std::span<const std::string> names) const;
+
   std::FILE* file_ = nullptr;
   std::string path_;
   std::string buffer_;
+  bool header_written_ = false;
+  std::vector<std::string> output_names_;  ///< the out.<name> columns, fixed by the first row
 };
 
 /// Builds in memory the Series that read_series() gives for the trajectory.csv TrajectoryWriter writes from
@@ -63,8 +79,9 @@ class TrajectoryWriter {
 class SeriesRecorder {
  public:
   SeriesRecorder();
-  /// Adds the row TrajectoryWriter::write(t_s, x, ..., c) writes.
-  void add(double t_s, const model::State& x, const ControlColumns& c);
+  /// Adds the row TrajectoryWriter::write(t_s, x, command, c, watchdog) writes.
+  void add(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
+           bool watchdog = false);
   const Series& series() const { return series_; }
   /// Empties the series for another run of `rows` ticks, keeping its memory (a sweep's worker
   /// records every run it flies in one recorder instead of allocating the columns again per run).

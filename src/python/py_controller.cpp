@@ -309,6 +309,7 @@ struct PyController::Shared {
   std::vector<control::ParameterSpec> specs;  ///< the declared ones, then step_timeout_s
   std::vector<std::string> declared;          ///< their names (attributes of the object)
   std::vector<std::string> output_names;
+  control::ReportedOutputs reported;  ///< where among output_names the class reports its attitude setpoint
   bool has_reset = false, has_set_parameters = false;
 };
 
@@ -672,8 +673,9 @@ void PyController::step(const control::Observation& o, const control::Reference&
               t);
   }
   ++steps_;
-  control::rotor_speeds_output(
-      model_, r, Eigen::Vector4d(omega_values[0], omega_values[1], omega_values[2], omega_values[3]), out);
+  control::rotor_speeds_output(model_, r,
+                               Eigen::Vector4d(omega_values[0], omega_values[1], omega_values[2], omega_values[3]),
+                               shared_->reported, out);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -867,6 +869,7 @@ std::shared_ptr<PyController> make_python_controller(py::object given, const mod
       }
       shared->output_names.push_back(o.cast<std::string>());
     }
+    shared->reported = control::ReportedOutputs::find(shared->output_names);
   }
 
   double timeout = 0.0;

@@ -61,8 +61,8 @@ class RunResult:
 
     trajectory: dict of numpy float64 arrays keyed by the columns of trajectory.csv (t, x, y, z, vx,
         ..., qw, ..., roll, pitch, yaw, p, q, r, w1..w4, cmd1..cmd4, x_des..yaw_des, U1..U4, safety,
-        watchdog, sat1..sat4, tilt_sat, att_err; docs/outputs.md), one value per plant tick: the same
-        doubles as the file.
+        watchdog, sat1..sat4, tilt_sat, att_err, then out.<name> for each figure the controller declares;
+        docs/outputs.md), one value per plant tick: the same doubles as the file.
     figures: the figures and verdicts of metrics.json besides its header: "steps" (one dict per
         analysed step: channel, figures, criteria, passed, ...), and "hold", "saturation", "tracking"
         when the run has them.
@@ -77,6 +77,7 @@ class RunResult:
         parameter values; for a Python class module:Class, its module file and SHA-256), transport,
         command line, quadcosim version and git commit, host, scenario file and its SHA-256.
     judged: the criteria set the run was judged against: "spec", "paper" or "none" (run's judge=).
+    outputs (property): the controller's own figures, name -> array (the out.<name> columns of trajectory).
     """
 
     trajectory: Dict[str, Any]
@@ -88,6 +89,11 @@ class RunResult:
     out: Optional[str] = None
     provenance: Dict[str, Any] = field(default_factory=dict, repr=False)
     judged: str = "spec"
+
+    @property
+    def outputs(self) -> Dict[str, Any]:
+        """The figures the controller declares (its `outputs`), by name: trajectory's out.<name> columns."""
+        return {k[len("out."):]: v for k, v in self.trajectory.items() if k.startswith("out.")}
 
     def __repr__(self) -> str:
         n = len(self.trajectory.get("t", []))
