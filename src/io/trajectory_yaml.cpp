@@ -130,7 +130,7 @@ std::optional<trajectory::TrajectorySpec> read_trajectory_spec(YamlSection& s, c
         s.fail("path", "got '" + name + "': " + e.what());
       }
     }
-    // Made here once, so that a description the trajectory code refuses is refused with the key path.
+    // Made here as a check, so that a description the trajectory code refuses is refused with the key path.
     if (out) trajectory::make_trajectory(*out);
   } catch (const std::invalid_argument& e) {  // the keys are checked above; this is a backstop
     s.fail("", std::string("got an invalid ") + kind + ": " + e.what());
