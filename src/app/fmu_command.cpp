@@ -29,6 +29,7 @@
 #include "controllers/registry.hpp"
 #include "fmi/export/fmu_config.hpp"
 #include "fmi/model_description.hpp"
+#include "fmi/quadrotor_variables.hpp"
 #include "fmi/unzip.hpp"
 #include "fmi/zip_writer.hpp"
 #include "io/scenario.hpp"
@@ -128,14 +129,22 @@ fmi::FmuConfig config_from(const FmuOptions& o, std::vector<std::string>& notes)
       c.controller_parameters.push_back({std::string(p.name), *value});
   }
 
+  // The trajectory travels inside a controller FMU (its configuration) and is its reference by
+  // default: an FMU that flew the setpoint instead would fly a different experiment without a word.
+  if (cc.trajectory && c.kind == fmi::FmuKind::kController) {
+    if (!sc.trajectory_spec)
+      throw io::ConfigError(o.scenario +
+                            ": trajectory: this trajectory has no description the FMU can carry, so the controller "
+                            "FMU would not fly it; export from a scenario whose trajectory: section describes it");
+    c.trajectory = sc.trajectory_spec;
+  }
+
   // What a scenario can say that an FMU does not carry.
   if (later > 0 && c.kind == fmi::FmuKind::kController)
     notes.push_back(
         fmt::format("the scenario's schedule after t = 0 ({} change{}) is not part of the FMU: set the "
                     "controller.* parameters or ref.* inputs from the importer instead",
                     later, later == 1 ? "" : "s"));
-  if (cc.trajectory && c.kind == fmi::FmuKind::kController)
-    notes.push_back("the scenario's trajectory is not part of the FMU: feed it through the ref.* inputs");
   if (sim.plant.command_delay_ticks > 0 && c.kind == fmi::FmuKind::kPlant)
     notes.push_back("simulation.command_delay_ticks is not part of the FMU: the importer decides when commands act");
   if (sim.faults.active()) notes.push_back("the scenario's message faults act on DDS topics, not in the FMU");
@@ -183,6 +192,9 @@ int export_fmu(const FmuOptions& o) {
                            outputs, parameters, md.step_size.value_or(0.0),
                            md.can_handle_variable_step ? "any step" : "whole multiples of it");
   std::cout << fmt::format("  binary binaries/{}/{}.so from {}\n", platform, md.model_identifier, library.string());
+  if (config.trajectory)
+    std::cout << fmt::format("  reference: {} (carried in the FMU; {} = true takes the ref.* inputs instead)\n",
+                             trajectory::make_trajectory(*config.trajectory)->describe(), fmi::names::kRefExternal);
   for (const std::string& n : notes) std::cout << "  note: " << n << '\n';
   return exit_code::kOk;
 }

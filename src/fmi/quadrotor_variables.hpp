@@ -43,6 +43,9 @@ inline constexpr std::array<std::string_view, 3> kRefVelocity = {"ref.v_W[1]", "
 inline constexpr std::array<std::string_view, 3> kRefAcceleration = {"ref.a_W[1]", "ref.a_W[2]",
                                                                      "ref.a_W[3]"};  ///< [m/s2]
 inline constexpr std::string_view kRefYaw = "ref.yaw";                               ///< [rad]
+/// Controller FMU exported with a trajectory: the Boolean parameter that makes the ref.* inputs the
+/// reference instead of the trajectory it carries.
+inline constexpr std::string_view kRefExternal = "ref.external";
 // Controller FMU parameters: this prefix + the controller's parameter name ("controller.kp_z").
 inline constexpr std::string_view kControllerPrefix = "controller.";
 

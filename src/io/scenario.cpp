@@ -817,7 +817,8 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   if (auto a = root.section("analysis")) read_steps(*a, sc, duration_s);
   if (auto w = root.section("swarm")) read_swarm(*w, sc.swarm.emplace());
   if (auto t = root.section("trajectory")) {
-    sc.controller.trajectory = read_trajectory(*t, std::filesystem::path(path).parent_path());
+    sc.trajectory_spec = read_trajectory_spec(*t, std::filesystem::path(path).parent_path());
+    if (sc.trajectory_spec) sc.controller.trajectory = trajectory::make_trajectory(*sc.trajectory_spec);
   }
   if (sc.controller.trajectory && !sc.tracking) sc.tracking.emplace();  // figures without criteria
   if (sc.tracking) {

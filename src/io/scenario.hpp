@@ -19,6 +19,7 @@
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
+#include "trajectory/spec.hpp"
 #include "trajectory/trajectory.hpp"
 
 namespace YAML {
@@ -134,6 +135,9 @@ struct Scenario {
   /// The controller, its parameters and the node's setpoints (the paper's controller by default), and
   /// the `trajectory:` to track (controller.trajectory; none for kind steps, the default).
   control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  /// The `trajectory:` section's description, from which controller.trajectory was made (what an
+  /// exported controller FMU carries); nothing without a trajectory.
+  std::optional<trajectory::TrajectorySpec> trajectory_spec;
   sim::SimulationConfig simulation;
   InitialState initial;
   std::vector<sim::ScheduledParameter> schedule;

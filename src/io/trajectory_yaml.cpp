@@ -48,7 +48,7 @@ void read_start(YamlSection& s, Eigen::Vector2d& centre, double& altitude, doubl
   ramp = s.number("ramp_s", ramp, 0.0, kFar);
 }
 
-std::shared_ptr<const trajectory::Trajectory> read_waypoints(YamlSection& s) {
+trajectory::WaypointsSpec read_waypoints(YamlSection& s) {
   const std::string method = s.choice("method", "min_snap", {"min_snap", "min_jerk"});
   std::vector<trajectory::Waypoint> points;
   int index = 0;
@@ -77,15 +77,15 @@ std::shared_ptr<const trajectory::Trajectory> read_waypoints(YamlSection& s) {
   if (points.size() < 2) {
     s.fail("points", "got " + std::to_string(points.size()) + " waypoints, expected at least two");
   }
-  return std::make_shared<const trajectory::PiecewisePolynomial>(trajectory::plan_waypoints(
-      points, method == "min_snap" ? trajectory::WaypointMethod::kMinSnap : trajectory::WaypointMethod::kMinJerk));
+  return {std::move(points),
+          method == "min_snap" ? trajectory::WaypointMethod::kMinSnap : trajectory::WaypointMethod::kMinJerk};
 }
 
 }  // namespace
 
-std::shared_ptr<const trajectory::Trajectory> read_trajectory(YamlSection& s, const std::string& scenario_dir) {
+std::optional<trajectory::TrajectorySpec> read_trajectory_spec(YamlSection& s, const std::string& scenario_dir) {
   const std::string kind = s.choice("kind", "steps", {"steps", "circle", "lissajous", "figure8", "waypoints", "file"});
-  std::shared_ptr<const trajectory::Trajectory> out;
+  std::optional<trajectory::TrajectorySpec> out;
   try {
     if (kind == "circle") {
       trajectory::CircleParams c;
@@ -95,7 +95,7 @@ std::shared_ptr<const trajectory::Trajectory> read_trajectory(YamlSection& s, co
       c.clockwise = s.choice("direction", "ccw", {"ccw", "cw"}) == "cw";
       c.phase_rad = s.number("phase_rad", 0.0, -100.0, 100.0);
       read_yaw(s, true, c.yaw_mode, c.yaw_rad);
-      out = trajectory::make_circle(c);
+      out = c;
     } else if (kind == "lissajous") {
       trajectory::LissajousParams l;
       read_start(s, l.centre_m, l.altitude_m, l.start_s, l.ramp_s);
@@ -108,14 +108,14 @@ std::shared_ptr<const trajectory::Trajectory> read_trajectory(YamlSection& s, co
                "a zero amplitude with yaw_mode 'tangent': expected both > 0 (on a line the direction "
                "of travel flips)");
       }
-      out = trajectory::make_lissajous(l);
+      out = l;
     } else if (kind == "figure8") {
       trajectory::Figure8Params f;
       read_start(s, f.centre_m, f.altitude_m, f.start_s, f.ramp_s);
       f.amplitude_m = vec2(s, "amplitude_m", f.amplitude_m, kPositive);
       f.period_s = s.number("period_s", f.period_s, kPositive);
       read_yaw(s, false, f.yaw_mode, f.yaw_rad);
-      out = trajectory::make_figure8(f);
+      out = f;
     } else if (kind == "waypoints") {
       out = read_waypoints(s);
     } else if (kind == "file") {
@@ -125,16 +125,23 @@ std::shared_ptr<const trajectory::Trajectory> read_trajectory(YamlSection& s, co
       const std::filesystem::path p(name);
       const std::string full = p.is_absolute() ? name : (std::filesystem::path(scenario_dir) / p).string();
       try {
-        out = std::make_shared<const trajectory::PiecewisePolynomial>(trajectory::read_polynomial_csv(full, start_s));
+        out = trajectory::read_polynomial_csv(full, start_s);
       } catch (const trajectory::FileError& e) {
         s.fail("path", "got '" + name + "': " + e.what());
       }
     }
+    // Made here as a check, so that a description the trajectory code refuses is refused with the key path.
+    if (out) trajectory::make_trajectory(*out);
   } catch (const std::invalid_argument& e) {  // the keys are checked above; this is a backstop
     s.fail("", std::string("got an invalid ") + kind + ": " + e.what());
   }
   s.reject_unknown_keys();
   return out;
+}
+
+std::shared_ptr<const trajectory::Trajectory> read_trajectory(YamlSection& s, const std::string& scenario_dir) {
+  const std::optional<trajectory::TrajectorySpec> spec = read_trajectory_spec(s, scenario_dir);
+  return spec ? trajectory::make_trajectory(*spec) : nullptr;
 }
 
 }  // namespace quadcosim::io

@@ -39,6 +39,8 @@ class PiecewisePolynomial : public Trajectory {
 
   const std::vector<Segment>& segments() const { return segments_; }
   double start_s() const { return start_s_; }
+  /// What describe() starts with ("polynomial file fig8.csv", "min_snap through 4 waypoints").
+  const std::string& label() const { return label_; }
 
   /// d^order/dtau^order of one segment's polynomials at tau [s] (Horner); zero for order > 7.
   static Eigen::Vector4d evaluate(const Coefficients& c, double tau_s, int order);

@@ -226,6 +226,66 @@ case "$CASE" in
   export_controller_fmi2) export_and_check controller 2 "$P/altitude_step.yaml" ;;
   export_controller_fmi3) export_and_check controller 3 ;;
 
+  export_controller_trajectory)  # a controller exported from a scenario with a trajectory carries it
+    T="$SRC/scenarios/tracking"
+    # kind: file, written here: one segment from (1, 0, 2) moving +0.5 m/s in x for 4 s, from t = 1 s.
+    {
+      printf 'Duration'; for a in x y z yaw; do for i in 0 1 2 3 4 5 6 7; do printf ',%s^%s' $a $i; done; done; echo
+      echo "4,1,0.5,0,0,0,0,0,0,0,0,0,0,0,0,0,0,2,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0"
+    } > "$TMP/line.csv"
+    sed '/^trajectory:/,/^analysis:/c\trajectory:\n  kind: file\n  path: line.csv\n  start_s: 1\nanalysis:' \
+      "$T/circle_se3.yaml" > "$TMP/file.yaml"
+    grep -q 'path: line.csv' "$TMP/file.yaml" || fail "could not write file.yaml"
+    for s in "$T/circle_se3.yaml" "$T/figure8_paper.yaml" "$T/waypoints_se3.yaml" "$TMP/file.yaml"; do
+      name=$(basename "$s" .yaml)
+      "$QC" fmu export controller --scenario "$s" --fmi 3 --out "$TMP/$name.fmu" > "$TMP/$name.txt" \
+        || fail "fmu export controller --scenario $s exited $?"
+      grep -q "^  reference: " "$TMP/$name.txt" || fail "$name: the export names no reference: $(cat "$TMP/$name.txt")"
+    done
+    "$QC" fmu export plant --scenario "$T/circle_se3.yaml" --out "$TMP/plant.fmu" > /dev/null || fail "plant export exited $?"
+    "$QC" fmu export controller --scenario "$P/altitude_step.yaml" --out "$TMP/steps.fmu" > /dev/null || fail "export exited $?"
+    "$PY" - "$TMP" <<'PYEOF' || fail "the FMUs do not carry their trajectories as promised"
+import json, sys, zipfile, xml.etree.ElementTree as E
+tmp = sys.argv[1]
+def read(name):
+    z = zipfile.ZipFile(f"{tmp}/{name}.fmu")
+    variables = {v.get("name"): v for v in E.fromstring(z.read("modelDescription.xml")).iter("*")
+                 if v.get("valueReference") is not None}
+    return json.loads(z.read("resources/quadcosim.json")), variables
+def start(variables, name):
+    v = variables[name]
+    return float(v.get("start") if v.get("start") is not None else v[0].get("start"))
+# The scenario's keys and values (scenarios/tracking/*.yaml), and where each trajectory starts.
+expected = {
+    "circle_se3": ({"kind": "circle", "radius_m": 2.0, "period_s": 10.0, "altitude_m": 5.0, "ramp_s": 2.0}, (2, 0, 5)),
+    "figure8_paper": ({"kind": "figure8", "amplitude_m": [2.0, 1.0]}, (0, 0, 3)),  # starts at its centre
+    "waypoints_se3": ({"kind": "waypoints", "method": "min_snap"}, (0, 0, 0)),
+    "file": ({"kind": "polynomial", "start_s": 1.0}, (1, 0, 2)),
+}
+for name, (keys, p0) in expected.items():
+    config, variables = read(name)
+    t = config.get("trajectory")
+    assert t is not None, f"{name}: no trajectory in quadcosim.json"
+    for k, v in keys.items():
+        assert t[k] == v, f"{name}: trajectory.{k} = {t[k]}, expected {v}"
+    ext = variables.get("ref.external")
+    assert ext is not None and ext.tag == "Boolean", f"{name}: no Boolean ref.external"
+    assert (ext.get("causality"), ext.get("variability"), ext.get("start")) == ("parameter", "fixed", "false"), ext.attrib
+    if p0 is not None:
+        got = tuple(start(variables, f"ref.p_W[{i}]") for i in (1, 2, 3))
+        assert got == p0, f"{name}: ref.p_W starts at {got}, expected {p0}"
+config, _ = read("waypoints_se3")
+assert len(config["trajectory"]["points"]) == 6 and config["trajectory"]["points"][3]["position_m"] == [4.0, 4.0, 4.0]
+config, _ = read("file")
+seg = config["trajectory"]["segments"]
+assert len(seg) == 1 and seg[0]["duration_s"] == 4.0 and seg[0]["x"][:2] == [1.0, 0.5] and seg[0]["z"][0] == 2.0, seg
+for name in ("plant", "steps"):  # no trajectory: no key, no switch
+    config, variables = read(name)
+    assert "trajectory" not in config and "ref.external" not in variables, name
+print("ok: circle, figure8, waypoints and file carried; plant and step FMUs without")
+PYEOF
+    ;;
+
   # The exported FMUs run by an importer written here (Python ctypes over the FMI C API, nothing of
   # quadcosim but the .fmu), against closed forms: plant under constant rotor speeds, controller's first command.
   run_plant_fmi2 | run_plant_fmi3 | run_controller_fmi2 | run_controller_fmi3)

@@ -54,6 +54,97 @@ controller_round_trip() {
   echo "altitude_step: columns $cols byte-identical with the exported controller FMU"
 }
 
+
+# The columns of trajectory.csv that the plant and the controller's command make (t .. cmd4) and the
+# node's flags: what must match when only the controller is an FMU (see controller_round_trip).
+state_columns() {
+  head -1 "$1" | tr ',' '\n' | grep -n -E '^(t|x|y|z|vx|vy|vz|qw|qx|qy|qz|roll|pitch|yaw|p|q|r|w[1-4]|cmd[1-4]|safety|watchdog)$' \
+    | cut -d: -f1 | paste -sd,
+}
+
+# The tracking figure $2 (position_rmse_m, position_max_m) [m] in $1/metrics.json, with all 17 digits.
+tracking_figure() {
+  python3 -c 'import json,sys; print(repr(json.load(open(sys.argv[1]))["tracking"]["figures"][sys.argv[2]]))' \
+    "$1/metrics.json" "$2"
+}
+
+# A tracking scenario $1 (scenarios/tracking/NAME) exported as a controller FMU (further export flags
+# after it) and flown back with --controller fmu:...: the FMU carries the trajectory and flies it as
+# the native controller does, so trajectory.csv is byte-identical (the reference columns x_des ..
+# included: the master's node computes them from the same scenario) and so is the tracking RMSE in
+# metrics.json. Before the FMU carried the trajectory it flew the circle in attitude mode: RMSE 2.97 m.
+controller_trajectory_round_trip() {
+  local s="$1"; shift
+  need_export
+  export_fmu "$src/scenarios/tracking/$s.yaml" controller "$tmp/controller.fmu" "$@"
+  grep -q "reference: .* (carried in the FMU; ref.external = true takes the ref.\* inputs instead)" \
+    "$tmp/export_controller.log" || fail "the export did not say it carries the trajectory"
+  ! grep -q "not part of the FMU" "$tmp/export_controller.log" || fail "the export still says the trajectory is left out"
+  "$bin" run "$src/scenarios/tracking/$s.yaml" --out "$tmp/native" --no-plots > "$tmp/native.log" 2>&1 \
+    || fail "native run failed"
+  "$bin" run "$src/scenarios/tracking/$s.yaml" --controller "fmu:$tmp/controller.fmu" --out "$tmp/fmu" --no-plots \
+    > "$tmp/fmu.log" 2>&1 || fail "FMU controller run failed"
+  [ "$(wc -l < "$tmp/fmu/trajectory.csv")" -gt 1000 ] || fail "trajectory too short"
+  local cols; cols="$(state_columns "$tmp/native/trajectory.csv"),$(head -1 "$tmp/native/trajectory.csv" | tr ',' '\n' | grep -n -E '^(x_des|y_des|z_des)$' | cut -d: -f1 | paste -sd,)"
+  cmp <(cut -d, -f"$cols" "$tmp/native/trajectory.csv") <(cut -d, -f"$cols" "$tmp/fmu/trajectory.csv") \
+    || fail "$s: columns $cols differ with the exported controller FMU"
+  local figure native fmu
+  for figure in position_max_m position_rmse_m; do
+    native="$(tracking_figure "$tmp/native" $figure)"; fmu="$(tracking_figure "$tmp/fmu" $figure)"
+    [ "$native" = "$fmu" ] || fail "$s: tracking $figure $fmu with the FMU, $native natively"
+  done
+  # The scenario's own specification (5 cm RMSE): the attitude-mode FMU missed it by metres.
+  python3 -c 'import sys; sys.exit(0 if float(sys.argv[1]) < 0.05 else 1)' "$fmu" || fail "$s: RMSE $fmu m >= 0.05 m"
+  echo "$s: columns $cols byte-identical with the exported controller FMU ${*:-(FMI 2)}; tracking RMSE $fmu m both"
+}
+
+# What wins: the trajectory the FMU carries, unless ref.external is true. The FMU exported from
+# circle_se3 (r = 2 m) flies in a scenario whose circle is r = 3 m: by default it flies its own r = 2 m
+# circle (the master's r = 3 m reference inputs are ignored); with parameters {ref.external: true} it flies the master's r = 3 m reference (the columns
+# of the native r = 3 m run, reference columns included).
+controller_trajectory_external() {
+  need_export
+  local circle="$src/scenarios/tracking/circle_se3.yaml"
+  export_fmu "$circle" controller "$tmp/controller.fmu"
+  sed 's/^  radius_m: 2$/  radius_m: 3/; s/^  position_m: \[2, 0, 5\]$/  position_m: [3, 0, 5]/' "$circle" > "$tmp/r3.yaml"
+  grep -q 'radius_m: 3' "$tmp/r3.yaml" && grep -q 'position_m: \[3, 0, 5\]' "$tmp/r3.yaml" || fail "could not write r3.yaml"
+  sed 's/^  type: se3$/  fmu: controller.fmu/' "$tmp/r3.yaml" > "$tmp/r3_embedded.yaml"
+  sed 's/^  type: se3$/  fmu: controller.fmu\n  parameters: {ref.external: true}/' "$tmp/r3.yaml" > "$tmp/r3_external.yaml"
+  grep -q 'ref.external: true' "$tmp/r3_external.yaml" || fail "could not write r3_external.yaml"
+  for run in native_r3:"$tmp/r3.yaml" external:"$tmp/r3_external.yaml"; do
+    "$bin" run "${run#*:}" --out "$tmp/${run%%:*}" --no-plots > "$tmp/${run%%:*}.log" 2>&1 || fail "run ${run%%:*} failed"
+  done
+  # Judged against the scenario's r = 3 m circle, the FMU's own r = 2 m one fails the 5 cm spec: exit 1.
+  local rc=0
+  "$bin" run "$tmp/r3_embedded.yaml" --out "$tmp/embedded" --no-plots > "$tmp/embedded.log" 2>&1 || rc=$?
+  [ "$rc" = 1 ] || fail "the embedded run exited $rc, expected 1 (its r = 2 m circle fails the r = 3 m spec)"
+  # With ref.external the FMU flies what the master feeds: the native r = 3 m run's columns. By default
+  # it flies its own circle from the r = 3 m scenario's start (3, 0, 5): the state differs from the
+  # native r = 3 m run's, and after the spin-up and the first lap the vehicle is on the r = 2 m circle.
+  local cols; cols="$(state_columns "$tmp/native_r3/trajectory.csv")"
+  local all; all="$cols,$(head -1 "$tmp/native_r3/trajectory.csv" | tr ',' '\n' | grep -n -E '^(x_des|y_des|z_des)$' | cut -d: -f1 | paste -sd,)"
+  cmp <(cut -d, -f"$all" "$tmp/native_r3/trajectory.csv") <(cut -d, -f"$all" "$tmp/external/trajectory.csv") \
+    || fail "ref.external: true did not fly the master's reference as the native run does"
+  if cmp -s <(cut -d, -f"$cols" "$tmp/native_r3/trajectory.csv") <(cut -d, -f"$cols" "$tmp/embedded/trajectory.csv"); then
+    fail "the FMU flew the master's r = 3 m reference: its own trajectory did not win"
+  fi
+  python3 - "$tmp/embedded/trajectory.csv" <<'PYEOF' || fail "the embedded run did not fly the r = 2 m circle"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+late = [r for r in rows if float(r["t"]) >= 12.0]  # after the spin-up and the first lap
+radii = [math.hypot(float(r["x"]), float(r["y"])) for r in late]
+worst = max(abs(radius - 2.0) for radius in radii)
+print(f"embedded: distance from the centre {min(radii):.4f} .. {max(radii):.4f} m over t >= 12 s")
+sys.exit(0 if worst < 0.05 else 1)
+PYEOF
+  # The two circles share centre, phase and period: 1 m apart, which is what tracking measures.
+  local rmse; rmse="$(tracking_figure "$tmp/embedded" position_rmse_m)"
+  python3 -c 'import sys; sys.exit(0 if abs(float(sys.argv[1]) - 1.0) < 0.05 else 1)' "$rmse" \
+    || fail "the embedded run's RMSE against the r = 3 m circle is $rmse m, expected 1 m"
+  echo "ref.external true: the master's r = 3 m reference, columns byte-identical with the native run;"
+  echo "default: the FMU's own r = 2 m circle (RMSE $rmse m against the master's r = 3 m reference)"
+}
+
 case "$case_name" in
   plant_round_trip_altitude) plant_round_trip altitude_step ;;
   plant_round_trip_roll) plant_round_trip roll_step ;;
@@ -62,6 +153,9 @@ case "$case_name" in
   plant_round_trip_dds) plant_round_trip altitude_step --transport dds ;;
   plant_round_trip_fmi3) QUADCOSIM_EXPORT_FLAGS="--fmi 3" plant_round_trip pitch_step ;;  # FMI 3.0 through the master
   controller_round_trip) controller_round_trip ;;
+  controller_trajectory_circle) controller_trajectory_round_trip circle_se3 ;;
+  controller_trajectory_waypoints_fmi3) controller_trajectory_round_trip waypoints_se3 --fmi 3 ;;
+  controller_trajectory_external) controller_trajectory_external ;;
   node_fmu_flags)  # `plant --fmu` and `controller --fmu` over DDS lockstep: the native trajectory again
     need_export
     export_fmu "$paper/altitude_step.yaml" plant "$tmp/plant.fmu"

@@ -7,9 +7,16 @@
 //
 // The observation is built as the node builds it (the attitude's Z-Y-X angles from q_WB by
 // model::euler_from_quaternion) and is always fresh: the node's stale-data safety has no counterpart
-// here (inputs cannot be missing; a NaN input is refused when it is set). The reference is the
-// inputs ref.*, in the mode of the configured setpoint.
+// here (inputs cannot be missing; a NaN input is refused when it is set).
+//
+// The reference: with a trajectory in the configuration (an export from a scenario that has one), the
+// trajectory's flat outputs at each control step's own time, (k + i) * period for the i-th step of a
+// doStep from period k, in position mode, as sim::ControllerCore computes them from the step's
+// time; the ref.* inputs are then ignored unless the parameter ref.external is true, which makes them
+// the reference (position mode) for the whole run. Without a trajectory, the ref.* inputs in the mode
+// of the configured setpoint.
 #include <cmath>
+#include <optional>
 
 #include "controllers/registry.hpp"
 #include "fmi/export/slave.hpp"
@@ -41,6 +48,15 @@ class ControllerModel final : public Model {
         ref_roll_(find_vr(md, "ref.roll")),
         ref_pitch_(find_vr(md, "ref.pitch")),
         omega_cmd_(find_vrs(md, names::kOmegaCmd)) {
+    if (c.trajectory) {
+      try {
+        trajectory_ = trajectory::make_trajectory(*c.trajectory);
+      } catch (const std::invalid_argument& e) {
+        throw FmuError(std::string("trajectory: ") + e.what());
+      }
+      mode_ = control::Mode::kPosition;
+      ref_external_ = find_vr(md, names::kRefExternal);
+    }
     try {
       controller_ = controllers::make_config(c.controller_type, c.vehicle).controller->clone();
     } catch (const std::exception& e) {
@@ -73,6 +89,9 @@ class ControllerModel final : public Model {
         ref_roll_(o.ref_roll_),
         ref_pitch_(o.ref_pitch_),
         omega_cmd_(o.omega_cmd_),
+        trajectory_(o.trajectory_),
+        ref_external_(o.ref_external_),
+        external_(o.external_),
         parameters_(o.parameters_),
         controller_(o.controller_->clone()),
         output_(o.output_) {}
@@ -82,6 +101,7 @@ class ControllerModel final : public Model {
 
   std::string initialize(sim::Tick, Values& v) override {
     for (const ValueReference vr : omega_cmd_) v.number[vr] = 0.0;  // no command before the first step
+    external_ = ref_external_ && v.number[*ref_external_] != 0.0;
     return {};
   }
 
@@ -93,7 +113,7 @@ class ControllerModel final : public Model {
     return {};
   }
 
-  std::string step(sim::Tick, std::int64_t n, Values& v) override {
+  std::string step(sim::Tick k, std::int64_t n, Values& v) override {
     control::Observation o;
     o.p_W = vector<3>(v, p_);
     o.v_W = vector<3>(v, v_);
@@ -117,8 +137,21 @@ class ControllerModel final : public Model {
     r.yaw_rate_rad_s = v.number[ref_yaw_rate_];
     r.roll_rad = v.number[ref_roll_];
     r.pitch_rad = v.number[ref_pitch_];
+    if (trajectory_ && !external_) r.roll_rad = r.pitch_rad = 0.0;
 
-    for (std::int64_t i = 0; i < n; ++i) controller_->step(o, r, dt_s_, output_);
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (trajectory_ && !external_) {
+        // The step's time in integer nanoseconds, then seconds: the same double the node computes.
+        const trajectory::FlatOutput f = trajectory_->at(static_cast<double>((k + i) * period_ns_) / 1e9);
+        r.p_W = f.p_W;
+        r.v_W = f.v_W;
+        r.a_W = f.a_W;
+        r.j_W = f.j_W;
+        r.yaw_rad = f.yaw_rad;
+        r.yaw_rate_rad_s = f.yaw_rate_rad_s;
+      }
+      controller_->step(o, r, dt_s_, output_);
+    }
     for (std::size_t i = 0; i < 4; ++i) v.number[omega_cmd_[i]] = output_.omega_rad_s[static_cast<Eigen::Index>(i)];
     if (!output_.omega_rad_s.allFinite()) return "the controller's command is not finite";
     return {};
@@ -155,6 +188,11 @@ class ControllerModel final : public Model {
   std::array<ValueReference, 3> w_, f_, ref_p_, ref_v_, ref_a_, ref_j_;
   ValueReference ref_yaw_, ref_yaw_rate_, ref_roll_, ref_pitch_;
   std::array<ValueReference, 4> omega_cmd_;
+  /// The trajectory the configuration carries (null: none), and the parameter ref.external: its
+  /// value reference and its value at initialisation.
+  std::shared_ptr<const trajectory::Trajectory> trajectory_;
+  std::optional<ValueReference> ref_external_;
+  bool external_ = false;
   struct Parameter {
     ValueReference vr;
     std::string name;  ///< without the prefix

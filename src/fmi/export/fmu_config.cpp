@@ -79,6 +79,78 @@ json vehicle_json(const model::VehicleParams& v) {
   return j;
 }
 
+const char* yaw_mode_name(trajectory::YawMode m) {
+  switch (m) {
+    case trajectory::YawMode::kFixed: return "fixed";
+    case trajectory::YawMode::kTangent: return "tangent";
+    case trajectory::YawMode::kCentre: return "centre";
+  }
+  return "fixed";
+}
+
+// The trajectory in the keys of the scenario's `trajectory:` section (docs/scenarios.md); a polynomial
+// file as its segments, since the FMU cannot reach the file.
+json trajectory_json(const trajectory::TrajectorySpec& spec) {
+  const auto yaw = [](json& j, trajectory::YawMode mode, double yaw_rad) {
+    j["yaw_mode"] = yaw_mode_name(mode);
+    j["yaw_rad"] = yaw_rad;
+  };
+  const auto start = [](json& j, const Eigen::Vector2d& centre, double altitude, double start_s, double ramp_s) {
+    j["centre_m"] = vec(centre);
+    j["altitude_m"] = altitude;
+    j["start_s"] = start_s;
+    j["ramp_s"] = ramp_s;
+  };
+  json j = json::object();
+  if (const auto* c = std::get_if<trajectory::CircleParams>(&spec)) {
+    j["kind"] = "circle";
+    start(j, c->centre_m, c->altitude_m, c->start_s, c->ramp_s);
+    j["radius_m"] = c->radius_m;
+    j["period_s"] = c->period_s;
+    j["direction"] = c->clockwise ? "cw" : "ccw";
+    j["phase_rad"] = c->phase_rad;
+    yaw(j, c->yaw_mode, c->yaw_rad);
+  } else if (const auto* l = std::get_if<trajectory::LissajousParams>(&spec)) {
+    j["kind"] = "lissajous";
+    start(j, l->centre_m, l->altitude_m, l->start_s, l->ramp_s);
+    j["amplitude_m"] = vec(l->amplitude_m);
+    j["period_s"] = vec(l->period_s);
+    j["phase_rad"] = vec(l->phase_rad);
+    yaw(j, l->yaw_mode, l->yaw_rad);
+  } else if (const auto* f = std::get_if<trajectory::Figure8Params>(&spec)) {
+    j["kind"] = "figure8";
+    start(j, f->centre_m, f->altitude_m, f->start_s, f->ramp_s);
+    j["amplitude_m"] = vec(f->amplitude_m);
+    j["period_s"] = f->period_s;
+    yaw(j, f->yaw_mode, f->yaw_rad);
+  } else if (const auto* w = std::get_if<trajectory::WaypointsSpec>(&spec)) {
+    j["kind"] = "waypoints";
+    j["method"] = trajectory::method_name(w->method);
+    json points = json::array();
+    for (const trajectory::Waypoint& p : w->points) {
+      json point = {{"t_s", p.t_s}, {"position_m", vec(p.p_W)}};
+      if (p.yaw_rad) point["yaw_rad"] = *p.yaw_rad;
+      points.push_back(point);
+    }
+    j["points"] = points;
+  } else {
+    const auto& poly = std::get<trajectory::PiecewisePolynomial>(spec);
+    j["kind"] = "polynomial";
+    j["label"] = poly.label();
+    j["start_s"] = poly.start_s();
+    json segments = json::array();
+    for (const trajectory::PiecewisePolynomial::Segment& seg : poly.segments()) {
+      segments.push_back({{"duration_s", seg.duration_s},
+                          {"x", vec(seg.c.row(0).transpose())},
+                          {"y", vec(seg.c.row(1).transpose())},
+                          {"z", vec(seg.c.row(2).transpose())},
+                          {"yaw", vec(seg.c.row(3).transpose())}});
+    }
+    j["segments"] = segments;
+  }
+  return j;
+}
+
 // Reading: every accessor names the key path it was looking at.
 class Reader {
  public:
@@ -129,6 +201,7 @@ class Reader {
   }
   const json& raw() const { return j_; }
   const std::string& path() const { return path_; }
+  const std::string& source() const { return source_; }
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw FmuError(source_ + ": '" + join(key) + "' " + what);
   }
@@ -179,6 +252,97 @@ model::VehicleParams read_vehicle(const Reader& r) {
   return v;
 }
 
+trajectory::YawMode read_yaw_mode(const Reader& r, bool centre_allowed) {
+  const std::string m = r.text();
+  if (m == "fixed") return trajectory::YawMode::kFixed;
+  if (m == "tangent") return trajectory::YawMode::kTangent;
+  if (m == "centre" && centre_allowed) return trajectory::YawMode::kCentre;
+  r.fail("", "is '" + m + "', not " + (centre_allowed ? "fixed, tangent or centre" : "fixed or tangent"));
+}
+
+trajectory::TrajectorySpec read_trajectory(const Reader& r) {
+  const std::string kind = r.at("kind").text();
+  const auto start = [&r](Eigen::Vector2d& centre, double& altitude, double& start_s, double& ramp_s) {
+    centre = r.at("centre_m").vector<2>();
+    altitude = r.at("altitude_m").number();
+    start_s = r.at("start_s").number();
+    ramp_s = r.at("ramp_s").number();
+  };
+  if (kind == "circle") {
+    trajectory::CircleParams c;
+    start(c.centre_m, c.altitude_m, c.start_s, c.ramp_s);
+    c.radius_m = r.at("radius_m").number();
+    c.period_s = r.at("period_s").number();
+    const std::string direction = r.at("direction").text();
+    if (direction != "ccw" && direction != "cw") r.at("direction").fail("", "is '" + direction + "', not ccw or cw");
+    c.clockwise = direction == "cw";
+    c.phase_rad = r.at("phase_rad").number();
+    c.yaw_mode = read_yaw_mode(r.at("yaw_mode"), true);
+    c.yaw_rad = r.at("yaw_rad").number();
+    return c;
+  }
+  if (kind == "lissajous") {
+    trajectory::LissajousParams l;
+    start(l.centre_m, l.altitude_m, l.start_s, l.ramp_s);
+    l.amplitude_m = r.at("amplitude_m").vector<2>();
+    l.period_s = r.at("period_s").vector<2>();
+    l.phase_rad = r.at("phase_rad").vector<2>();
+    l.yaw_mode = read_yaw_mode(r.at("yaw_mode"), false);
+    l.yaw_rad = r.at("yaw_rad").number();
+    return l;
+  }
+  if (kind == "figure8") {
+    trajectory::Figure8Params f;
+    start(f.centre_m, f.altitude_m, f.start_s, f.ramp_s);
+    f.amplitude_m = r.at("amplitude_m").vector<2>();
+    f.period_s = r.at("period_s").number();
+    f.yaw_mode = read_yaw_mode(r.at("yaw_mode"), false);
+    f.yaw_rad = r.at("yaw_rad").number();
+    return f;
+  }
+  if (kind == "waypoints") {
+    trajectory::WaypointsSpec w;
+    const std::string method = r.at("method").text();
+    if (method != "min_snap" && method != "min_jerk") {
+      r.at("method").fail("", "is '" + method + "', not min_snap or min_jerk");
+    }
+    w.method = method == "min_snap" ? trajectory::WaypointMethod::kMinSnap : trajectory::WaypointMethod::kMinJerk;
+    const Reader points = r.at("points");
+    if (!points.raw().is_array()) points.fail("", "not an array");
+    for (std::size_t i = 0; i < points.raw().size(); ++i) {
+      const Reader p = Reader(points.raw()[i], points.path() + "[" + std::to_string(i) + "]").with_source(r.source());
+      trajectory::Waypoint point;
+      point.t_s = p.at("t_s").number();
+      point.p_W = p.at("position_m").vector<3>();
+      if (p.has("yaw_rad")) point.yaw_rad = p.at("yaw_rad").number();
+      w.points.push_back(point);
+    }
+    return w;
+  }
+  if (kind == "polynomial") {
+    const Reader segments = r.at("segments");
+    if (!segments.raw().is_array()) segments.fail("", "not an array");
+    std::vector<trajectory::PiecewisePolynomial::Segment> out;
+    for (std::size_t i = 0; i < segments.raw().size(); ++i) {
+      const Reader s =
+          Reader(segments.raw()[i], segments.path() + "[" + std::to_string(i) + "]").with_source(r.source());
+      trajectory::PiecewisePolynomial::Segment seg;
+      seg.duration_s = s.at("duration_s").number();
+      seg.c.row(0) = s.at("x").vector<8>().transpose();
+      seg.c.row(1) = s.at("y").vector<8>().transpose();
+      seg.c.row(2) = s.at("z").vector<8>().transpose();
+      seg.c.row(3) = s.at("yaw").vector<8>().transpose();
+      out.push_back(seg);
+    }
+    try {
+      return trajectory::PiecewisePolynomial(std::move(out), r.at("start_s").number(), r.at("label").text());
+    } catch (const std::invalid_argument& e) {
+      r.fail("", std::string("is not a valid polynomial: ") + e.what());
+    }
+  }
+  r.at("kind").fail("", "is '" + kind + "', not circle, lissajous, figure8, waypoints or polynomial");
+}
+
 }  // namespace
 
 std::string to_json(const FmuConfig& c) {
@@ -216,6 +380,8 @@ std::string to_json(const FmuConfig& c) {
         {"yaw_des_rad", c.setpoint.yaw_des_rad}}},
   };
   if (c.stop_time_s) j["stop_time_s"] = *c.stop_time_s;
+  // Only with one: the configuration (and so the GUID) of an FMU without a trajectory stays as it was.
+  if (c.trajectory) j["trajectory"] = trajectory_json(*c.trajectory);
   return j.dump(2) + "\n";
 }
 
@@ -313,6 +479,15 @@ FmuConfig config_from_json(std::string_view text, const std::string& source) {
   c.setpoint.roll_des_rad = sp.at("roll_des_rad").number();
   c.setpoint.pitch_des_rad = sp.at("pitch_des_rad").number();
   c.setpoint.yaw_des_rad = sp.at("yaw_des_rad").number();
+  if (r.has("trajectory")) {
+    const Reader t = r.at("trajectory");
+    c.trajectory = read_trajectory(t);
+    try {
+      trajectory::make_trajectory(*c.trajectory);
+    } catch (const std::invalid_argument& e) {
+      t.fail("", std::string("is not a valid trajectory: ") + e.what());
+    }
+  }
   return c;
 }
 
@@ -474,18 +649,47 @@ void controller_variables(const FmuConfig& c, Builder& b) {
   b.inputs(names::kAttitude, "1", "measured attitude quaternion body to world, w x y z", wxyz(y.q_WB));
   b.inputs(names::kRates, "rad/s", "measured body angular velocity", y.w_B);
   b.inputs(names::kSpecificForce, "m/s2", "measured specific force, body frame", y.specific_force_B);
+  // The reference inputs start at the reference the FMU flies at t = 0: the setpoint, or the
+  // trajectory's first point (which they are then only used for with ref.external).
   const control::Setpoint& s = c.setpoint;
-  b.inputs(names::kRefPosition, "m", "reference position (attitude mode: only z is held)", s.p_des_W);
-  b.inputs(names::kRefVelocity, "m/s", "reference velocity", Eigen::Vector3d::Zero().eval());
-  b.inputs(names::kRefAcceleration, "m/s2", "reference acceleration", Eigen::Vector3d::Zero().eval());
+  trajectory::FlatOutput start;
+  start.p_W = s.p_des_W;
+  start.yaw_rad = s.yaw_des_rad;
+  double roll = s.roll_des_rad, pitch = s.pitch_des_rad;
+  std::string used;
+  if (c.trajectory) {
+    try {
+      start = trajectory::make_trajectory(*c.trajectory)->at(0.0);
+    } catch (const std::invalid_argument& e) {
+      throw FmuError(std::string("trajectory: ") + e.what());
+    }
+    roll = pitch = 0.0;
+    used = " (used when ref.external is true; otherwise the FMU's trajectory is the reference)";
+  }
+  b.inputs(
+      names::kRefPosition, "m",
+      (c.trajectory ? std::string("reference position") : "reference position (attitude mode: only z is held)") + used,
+      start.p_W);
+  b.inputs(names::kRefVelocity, "m/s", "reference velocity" + used, start.v_W);
+  b.inputs(names::kRefAcceleration, "m/s2", "reference acceleration" + used, start.a_W);
   const std::array<std::string_view, 3> jerk = {"ref.j_W[1]", "ref.j_W[2]", "ref.j_W[3]"};
-  b.inputs(jerk, "m/s3", "reference jerk", Eigen::Vector3d::Zero().eval());
-  b.input(names::kRefYaw, "rad", "reference yaw", s.yaw_des_rad);
-  b.input("ref.yaw_rate", "rad/s", "reference yaw rate", 0.0);
-  b.input("ref.roll", "rad", "roll setpoint (attitude mode)", s.roll_des_rad);
-  b.input("ref.pitch", "rad", "pitch setpoint (attitude mode)", s.pitch_des_rad);
+  b.inputs(jerk, "m/s3", "reference jerk" + used, start.j_W);
+  b.input(names::kRefYaw, "rad", "reference yaw" + used, start.yaw_rad);
+  b.input("ref.yaw_rate", "rad/s", "reference yaw rate" + used, start.yaw_rate_rad_s);
+  b.input("ref.roll", "rad", c.trajectory ? "unused (position mode)" : "roll setpoint (attitude mode)", roll);
+  b.input("ref.pitch", "rad", c.trajectory ? "unused (position mode)" : "pitch setpoint (attitude mode)", pitch);
   b.outputs(names::kOmegaCmd, Variability::kDiscrete, "rad/s",
             "rotor speed command of the latest control step (0 before the first step)");
+
+  if (c.trajectory) {
+    b.parameter(names::kRefExternal, Variability::kFixed, "",
+                "false: the reference is the trajectory this FMU carries (" +
+                    trajectory::make_trajectory(*c.trajectory)->describe() +
+                    "), at the FMU's own time; true: the inputs ref.* are, in position mode (takes effect at "
+                    "initialisation)",
+                "false")
+        .type = VariableType::kBoolean;
+  }
 
   const control::ControllerConfig cc = controllers::make_config(c.controller_type, c.vehicle);
   std::unique_ptr<control::Controller> ctl = cc.controller->clone();

@@ -10,7 +10,8 @@
 // plant_period_ns, substeps and controller_divider from the scenario's timing, vehicle and initial
 // from its vehicle and initial state, realism and realism_namespace from its realism section and
 // namespace, controller_type, controller_parameters and setpoint from its controller section,
-// stop_time_s from its duration, and guid from make_guid(). This library reads no scenario file.
+// trajectory from its trajectory section, stop_time_s from its duration, and guid from make_guid().
+// This library reads no scenario file.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +26,7 @@
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/realism.hpp"
+#include "trajectory/spec.hpp"
 
 namespace quadcosim::fmi {
 
@@ -70,6 +72,9 @@ struct FmuConfig {
   std::vector<control::Setting> controller_parameters;
   /// Controller FMU: the reference inputs' start values (and the mode: attitude or position).
   control::Setpoint setpoint;
+  /// Controller FMU: the scenario's trajectory, flown in position mode from the FMU's own time (the
+  /// setpoint is then unused); the Boolean parameter ref.external switches to the ref.* inputs.
+  std::optional<trajectory::TrajectorySpec> trajectory;
 };
 
 /// The JSON text of `config` (numbers in shortest round-trip form: reading it back gives the same bits).
@@ -100,10 +105,12 @@ std::string make_guid(const FmuConfig& config);
 ///                realism.seed (Integer)
 /// Controller FMU (period: the controller period):
 ///   inputs       p_W, v_W, q_WB, w_B, f_B (the plant's outputs), ref.p_W, ref.v_W, ref.a_W, ref.j_W,
-///                ref.yaw, ref.yaw_rate, ref.roll, ref.pitch (start: the setpoint)
+///                ref.yaw, ref.yaw_rate, ref.roll, ref.pitch (start: the setpoint, or the trajectory at
+///                t = 0)
 ///   outputs      omega_cmd[1..4] [rad/s] (discrete)
 ///   parameters   (tunable) controller.<name> for every declared controller parameter (Real, or String
-///                for a choice)
+///                for a choice); with a trajectory, (fixed) ref.external (Boolean, start false: the
+///                trajectory is the reference; true: the ref.* inputs are, in position mode)
 /// Throws FmuError when the controller type is unknown or its parameters are refused.
 ModelDescription describe(const FmuConfig& config);
 

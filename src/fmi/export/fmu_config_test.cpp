@@ -1,10 +1,14 @@
 // The FMU's configuration file and its variables.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
 #include <set>
+#include <vector>
 
 #include "fmi/export/fmu_config.hpp"
 #include "fmi/quadrotor_variables.hpp"
+#include "trajectory/spec.hpp"
 
 namespace quadcosim::fmi {
 namespace {
@@ -148,6 +152,112 @@ TEST(FmuConfig, ControllerVariablesAreTheTypesParameters) {
   EXPECT_THROW(describe(bad), FmuError);
   bad.controller_type = "nonesuch";
   EXPECT_THROW(describe(bad), std::exception);
+}
+
+// One description of each kind a scenario's trajectory: section can give.
+std::vector<trajectory::TrajectorySpec> every_kind() {
+  trajectory::CircleParams circle;
+  circle.centre_m = {1.0, 0.0};
+  circle.altitude_m = 5.0;
+  circle.radius_m = 2.0;
+  circle.period_s = 1.0 / 3.0;  // needs all 17 digits
+  circle.clockwise = true;
+  circle.yaw_mode = trajectory::YawMode::kCentre;
+  trajectory::LissajousParams lissajous;
+  lissajous.phase_rad = {0.1, 0.2};
+  lissajous.yaw_mode = trajectory::YawMode::kTangent;
+  trajectory::Figure8Params figure8;
+  figure8.start_s = 1.5;
+  figure8.yaw_rad = 0.25;
+  trajectory::WaypointsSpec waypoints;
+  waypoints.method = trajectory::WaypointMethod::kMinJerk;
+  waypoints.points = {{0.0, {0.0, 0.0, 0.0}, std::nullopt}, {2.0, {1.0, 2.0, 3.0}, 0.5}, {5.0, {0.0, 1.0, 1.0}, {}}};
+  trajectory::PiecewisePolynomial::Segment a, b;
+  a.duration_s = 0.7;
+  a.c.setConstant(0.1);
+  a.c(2, 0) = 1.0 / 7.0;
+  b.duration_s = 2.0;
+  b.c(0, 3) = -3.25;
+  const trajectory::PiecewisePolynomial polynomial({a, b}, 0.5, "polynomial file fig8.csv");
+  return {circle, lissajous, figure8, waypoints, polynomial};
+}
+
+TEST(FmuConfig, TrajectoryRoundTripIsExact) {
+  const FmuConfig without = unusual();
+  for (const trajectory::TrajectorySpec& spec : every_kind()) {
+    FmuConfig c = unusual();
+    c.trajectory = spec;
+    const std::string text = to_json(c);
+    const FmuConfig back = config_from_json(text, "test");
+    EXPECT_EQ(to_json(back), text);
+    EXPECT_NE(make_guid(c), make_guid(without));
+    ASSERT_TRUE(back.trajectory.has_value());
+    EXPECT_EQ(back.trajectory->index(), spec.index());
+    const auto original = trajectory::make_trajectory(spec);
+    const auto read = trajectory::make_trajectory(*back.trajectory);
+    EXPECT_EQ(read->describe(), original->describe());
+    for (double t : {0.0, 0.3, 1.0 / 3.0, 1.7, 2.5, 4.9, 12.0}) {
+      const trajectory::FlatOutput x = original->at(t), y = read->at(t);
+      EXPECT_EQ(x.p_W, y.p_W) << original->describe() << " at " << t;
+      EXPECT_EQ(x.v_W, y.v_W);
+      EXPECT_EQ(x.a_W, y.a_W);
+      EXPECT_EQ(x.j_W, y.j_W);
+      EXPECT_EQ(x.yaw_rad, y.yaw_rad);
+      EXPECT_EQ(x.yaw_rate_rad_s, y.yaw_rate_rad_s);
+    }
+  }
+  // No trajectory: no key, so an FMU exported without one keeps its configuration and GUID.
+  EXPECT_EQ(to_json(without).find("\"trajectory\""), std::string::npos);
+}
+
+TEST(FmuConfig, TrajectoryErrorsNameTheKey) {
+  FmuConfig c = unusual();
+  c.trajectory = every_kind()[0];
+  const std::string text = to_json(c);
+  auto refused = [](const std::string& t) {
+    try {
+      config_from_json(t, "cfg.json");
+    } catch (const FmuError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  std::string bad = text;
+  bad.replace(bad.find("\"circle\""), 8, "\"spiral\"");
+  EXPECT_EQ(refused(bad),
+            "cfg.json: 'trajectory.kind' is 'spiral', not circle, lissajous, figure8, waypoints or polynomial");
+  bad = text;
+  bad.replace(bad.find("\"radius_m\": 2.0"), 15, "\"radius_m\": -2.0");
+  EXPECT_EQ(refused(bad), "cfg.json: 'trajectory' is not a valid trajectory: radius must be finite and > 0");
+  bad = text;
+  bad.replace(bad.find("\"centre\""), 8, "\"middle\"");
+  EXPECT_EQ(refused(bad), "cfg.json: 'trajectory.yaw_mode' is 'middle', not fixed, tangent or centre");
+}
+
+TEST(FmuConfig, ControllerWithATrajectoryStartsOnIt) {
+  FmuConfig c = unusual();
+  const ModelDescription plain = describe(c);  // no trajectory: no switch
+  EXPECT_TRUE(std::none_of(plain.variables.begin(), plain.variables.end(),
+                           [](const Variable& v) { return v.name == names::kRefExternal; }));
+  trajectory::CircleParams circle;  // r = 2 about (1, 0) at 5 m, phase 0: starts at (3, 0, 5)
+  circle.centre_m = {1.0, 0.0};
+  circle.altitude_m = 5.0;
+  circle.radius_m = 2.0;
+  c.trajectory = circle;
+  const ModelDescription md = describe(c);
+  std::map<std::string, const Variable*> by_name;
+  for (const Variable& v : md.variables) by_name[v.name] = &v;
+  ASSERT_TRUE(by_name.count(std::string(names::kRefExternal)));
+  const Variable& external = *by_name[std::string(names::kRefExternal)];
+  EXPECT_EQ(external.type, VariableType::kBoolean);
+  EXPECT_EQ(external.causality, Causality::kParameter);
+  EXPECT_EQ(external.variability, Variability::kFixed);
+  EXPECT_EQ(external.start, "false");
+  EXPECT_EQ(by_name["ref.p_W[1]"]->start, "3");
+  EXPECT_EQ(by_name["ref.p_W[2]"]->start, "0");
+  EXPECT_EQ(by_name["ref.p_W[3]"]->start, "5");
+  EXPECT_EQ(by_name["ref.yaw"]->start, "0");     // the circle's fixed yaw, not the setpoint's 0.5
+  EXPECT_EQ(by_name["ref.v_W[1]"]->start, "0");  // at rest before the spin-up
 }
 
 }  // namespace

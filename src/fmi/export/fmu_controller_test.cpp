@@ -1,6 +1,7 @@
 // The controller FMU through FMI 2.0, loaded with dlopen, flying model::Quadrotor: the paper's
 // altitude step (its commands equal a natively stepped controller's bit for bit, and the step
-// response meets the paper's figures), and its parameters.
+// response meets the paper's figures), a circle it carries (flown from its own time, bit for bit as
+// the native controller flies it; its ref.* inputs count only with ref.external), and its parameters.
 #include <cmath>
 #include <cstring>
 #include <iostream>
@@ -12,17 +13,24 @@
 #include "model/attitude.hpp"
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
+#include "trajectory/spec.hpp"
 
 namespace quadcosim::fmi::test {
 namespace {
 
 class Controller {
  public:
-  explicit Controller(const FmuConfig& config) : md_(describe(config)), resources_(config) {
+  /// `external`: sets the parameter ref.external (an FMU with a trajectory) true before initialisation.
+  explicit Controller(const FmuConfig& config, bool external = false) : md_(describe(config)), resources_(config) {
     callbacks_ = log_.fmi2_callbacks();
     c_ = QC_FMI(fmi2Instantiate)("controller", fmi2CoSimulation, config.guid.c_str(), resources_.uri().c_str(),
                                  &callbacks_, fmi2False, fmi2False);
     if (!c_) throw std::runtime_error("instantiate failed: " + log_.last());
+    if (external) {
+      const fmi2ValueReference r = vr(names::kRefExternal);
+      const fmi2Boolean on = fmi2True;
+      EXPECT_EQ(QC_FMI(fmi2SetBoolean)(c_, &r, 1, &on), fmi2OK) << log_.last();
+    }
     EXPECT_EQ(QC_FMI(fmi2SetupExperiment)(c_, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK) << log_.last();
     EXPECT_EQ(QC_FMI(fmi2EnterInitializationMode)(c_), fmi2OK) << log_.last();
     EXPECT_EQ(QC_FMI(fmi2ExitInitializationMode)(c_), fmi2OK) << log_.last();
@@ -137,6 +145,108 @@ TEST(FmuController, FliesThePapersAltitudeStepAsTheNativeControllerDoes) {
   EXPECT_GT(t_peak, 2.0);
   EXPECT_LT(t_peak, 3.0);
   EXPECT_NEAR(x.p_W.z(), 10.0, 0.2);
+}
+
+/// The observation sim::ControllerNode builds from the plant's outputs `y`.
+control::Observation observe(const model::Outputs& y) {
+  control::Observation o;
+  o.p_W = y.p_W;
+  o.v_W = y.v_W;
+  o.q_WB = y.q_WB;
+  const model::Euler e = model::euler_from_quaternion(y.q_WB);
+  o.roll_rad = e.roll_rad;
+  o.pitch_rad = e.pitch_rad;
+  o.yaw_rad = e.yaw_rad;
+  o.w_B = y.w_B;
+  o.specific_force_B = y.specific_force_B;
+  o.age_s = 0.0;
+  return o;
+}
+
+control::Reference position_reference(const trajectory::FlatOutput& f) {
+  control::Reference r;
+  r.mode = control::Mode::kPosition;
+  r.p_W = f.p_W;
+  r.v_W = f.v_W;
+  r.a_W = f.a_W;
+  r.j_W = f.j_W;
+  r.yaw_rad = f.yaw_rad;
+  r.yaw_rate_rad_s = f.yaw_rate_rad_s;
+  return r;
+}
+
+TEST(FmuController, FliesTheCircleItCarriesFromItsOwnTime) {
+  // scenarios/tracking/circle_se3.yaml: r = 2 m, 10 s a lap at 5 m, 2 s spin-up, from hover at (2, 0, 5).
+  FmuConfig c = config_for(FmuKind::kController);
+  c.controller_type = "se3";
+  trajectory::CircleParams circle;
+  circle.altitude_m = 5.0;
+  circle.radius_m = 2.0;
+  c.trajectory = circle;
+  c.initial.p_W = {2.0, 0.0, 5.0};
+  c.initial.omega_rad_s.setConstant(c.vehicle.hover_omega_rad_s());
+  c.guid = make_guid(c);
+  const std::shared_ptr<const trajectory::Trajectory> path = trajectory::make_trajectory(*c.trajectory);
+
+  // `own` flies its circle; `external` (ref.external) the ref.* inputs, which both get: the circle
+  // moved 1 m along x. Each doStep is two controller periods on held inputs.
+  Controller own(c), external(c, true);
+  const auto make = [&] {
+    std::unique_ptr<control::Controller> n = controllers::make_config("se3", c.vehicle).controller->clone();
+    return n;
+  };
+  std::unique_ptr<control::Controller> native_own = make(), native_external = make();
+  control::ControllerOutput out_own, out_external;
+  out_own.outputs.assign(native_own->output_names().size(), 0.0);
+  out_external.outputs = out_own.outputs;
+
+  const model::Quadrotor quad(c.vehicle);
+  const sim::TickClock clock{c.plant_period_ns};
+  const double dt = clock.period_s() * c.controller_divider;
+  const int periods = 2;
+  model::State x = c.initial;
+  model::RotorInput input = quad.rotor_input(x.omega_rad_s);
+  sim::Tick k = 0;
+  for (; clock.seconds(k) < 14.0 - 1e-9; k += periods * c.controller_divider) {
+    const model::Outputs y = quad.outputs(clock.seconds(k), x, input);
+    const control::Observation o = observe(y);
+    trajectory::FlatOutput moved = path->at(clock.seconds(k));
+    moved.p_W.x() += 1.0;
+    for (Controller* fmu : {&own, &external}) {
+      fmu->sense(y);
+      fmu->set_all(names::kRefPosition, moved.p_W);
+      fmu->set_all(names::kRefVelocity, moved.v_W);
+      fmu->set_all(names::kRefAcceleration, moved.a_W);
+      fmu->set_all(std::array<std::string_view, 3>{"ref.j_W[1]", "ref.j_W[2]", "ref.j_W[3]"}, moved.j_W);
+      ASSERT_EQ(fmu->set(names::kRefYaw, moved.yaw_rad), fmi2OK);
+      ASSERT_EQ(fmu->set("ref.yaw_rate", moved.yaw_rate_rad_s), fmi2OK);
+      ASSERT_EQ(fmu->step(clock.seconds(k), periods * dt), fmi2OK) << fmu->log_.last();
+    }
+    for (int i = 0; i < periods; ++i) {
+      // Each control step's own time, from integer nanoseconds as sim::ControllerCore takes it.
+      const std::int64_t now_ns = (k + i * c.controller_divider) * c.plant_period_ns;
+      native_own->step(o, position_reference(path->at(static_cast<double>(now_ns) / 1e9)), dt, out_own);
+      native_external->step(o, position_reference(moved), dt, out_external);
+    }
+    const model::Vector4 cmd = own.command(), cmd_external = external.command();
+    for (int i = 0; i < 4; ++i) {
+      ASSERT_EQ(std::memcmp(&cmd[i], &out_own.omega_rad_s[i], sizeof(double)), 0)
+          << "rotor " << i + 1 << " at t = " << clock.seconds(k) << ": " << cmd[i] << " vs " << out_own.omega_rad_s[i];
+      ASSERT_EQ(std::memcmp(&cmd_external[i], &out_external.omega_rad_s[i], sizeof(double)), 0)
+          << "ref.external, rotor " << i + 1 << " at t = " << clock.seconds(k);
+    }
+    input = quad.rotor_input(cmd);
+    for (int i = 0; i < periods * c.controller_divider; ++i) {
+      quad.step(x, clock.seconds(k + i), input, clock.period_s(), c.substeps);
+    }
+  }
+  // Flown by `own`, the vehicle is on the circle after the spin-up and more than a lap: within 5 cm of
+  // where the circle is at 14 s, and 2 m from its centre.
+  const Eigen::Vector3d target = path->at(clock.seconds(k)).p_W;
+  std::cout << "at " << clock.seconds(k) << " s: " << (x.p_W - target).norm() << " m from the circle's point\n";
+  EXPECT_LT((x.p_W - target).norm(), 0.05);
+  EXPECT_NEAR(std::hypot(x.p_W.x(), x.p_W.y()), 2.0, 0.05);
+  EXPECT_NEAR(x.p_W.z(), 5.0, 0.05);
 }
 
 TEST(FmuController, LongerStepsRunOneControlStepPerPeriodOnHeldInputs) {
