@@ -156,12 +156,31 @@ def varied_specs(summary):
     return [(v.get("spec", ""), [k["path"] for k in v.get("keys", [])]) for v in summary.get("vary", [])]
 
 
+JUDGED_TEXT = {"spec": "judged against the scenario's spec (bounds a good controller must meet)",
+               "paper": "judged against the paper bands (the paper's controller's measured response)",
+               "none": "figures only (not judged)"}
+
+
+def flown_text(metrics, summary):
+    """"flown by controller LABEL (transport inproc, quadcosim VERSION); judged against ...": what every
+    run of the sweep flew, from a run's metrics.json provenance, and the set judged."""
+    judged = JUDGED_TEXT.get(summary.get("judge", "spec"), summary.get("judge", "spec"))
+    p = (metrics or {}).get("provenance") or {}
+    label = (p.get("controller") or {}).get("label")
+    if not label:
+        return judged[0].upper() + judged[1:]
+    how = ", ".join(x for x in (f"transport {p['transport']}" if p.get("transport") else "",
+                                f"quadcosim {p['quadcosim_version']}" if p.get("quadcosim_version") else "") if x)
+    return f"flown by controller {label}{f' ({how})' if how else ''}; {judged}"
+
+
 def build(sweep_dir, summary):
     runs = summary["per_run"]
     keys = sweep_results.varied_keys(summary)
     headline = sweep_results.headline_figures(sweep_dir, summary)
     n_runs, n_done = summary["runs"], len(runs)
     rows = []
+    flown = None  # the first run's metrics.json: what flew (its provenance) and the set judged
     for r in runs:
         i = r["index"]
         m = read_metrics(sweep_dir, i)
@@ -171,6 +190,8 @@ def build(sweep_dir, summary):
         else:
             passed, failed = bool(r.get("passed")), r.get("failed_criteria", [])
         rows.append((r, m is not None, passed, failed))
+        if m is not None and flown is None:
+            flown = m
     passed_runs = sum(1 for row in rows if row[2])
 
     out = []
@@ -186,6 +207,7 @@ def build(sweep_dir, summary):
             else f"interrupted: {n_done} of {n_runs} runs finished, {passed_runs} of them passed")
     w(f'<div class="verdict {cls}">{esc(text)}'
       f"{'' if n_done == 0 else f' ({100.0 * passed_runs / n_done:.1f} %)'}</div>")
+    w(f'<p class="flown" id="flown">{esc(flown_text(flown, summary))}</p>')
     w(f'<p class="small">seed {esc(summary.get("seed"))}, sampler {esc(summary.get("sampler", "random"))}, '
       f'{esc(summary.get("runs_per_point", 1))} runs per point; scenario '
       f'<a href="scenario.yaml">scenario.yaml</a> (a copy of <code>{esc(summary.get("scenario_file", ""))}</code>); '

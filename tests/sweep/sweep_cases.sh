@@ -392,7 +392,13 @@ class Page(html.parser.HTMLParser):
         if self.cell is not None: self.cell.append(data)
 
 page = Page()
-page.feed(open(os.path.join(d, "index.html")).read())
+text = open(os.path.join(d, "index.html")).read()
+page.feed(text)
+# What flew and what it was judged against, as each run's provenance records it.
+label = json.load(open(os.path.join(d, "runs", "0000", "metrics.json")))["provenance"]["controller"]["label"]
+assert label == "paper", label
+assert re.search(r'id="flown">flown by controller paper \(transport inproc, quadcosim [^)]+\); judged against the '
+                 r"paper bands", text), re.search(r'id="flown">[^<]*', text)
 assert not page.external, page.external
 assert not any(re.match(r"[a-z]+://", l) for l in page.links), page.links
 for l in page.links:  # every link is a file or folder of the sweep
