@@ -1,4 +1,4 @@
-// `quadcosim lqr` and `quadcosim params [--vehicle]`.
+// `quadcosim lqr` and `quadcosim params [--vehicle] [--controller TYPE|python:MODULE:CLASS|fmu:PATH]`.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
@@ -33,8 +33,18 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
       "params", "list the controller node's and a controller's parameters (or the vehicle's), and the controllers");
   params_cmd
       ->add_option("--controller", params.controller,
-                   "the controller type whose parameters follow the node's (default paper; see --list)")
-      ->check(CLI::IsMember(controllers::controller_type_list()));
+                   "the controller whose parameters follow the node's: a type (default paper; see --list), "
+                   "python:MODULE:CLASS (a class's declared parameters) or fmu:PATH (an FMU's)")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            try {
+              (void)io::parse_controller_choice(value);
+              return "";
+            } catch (const std::invalid_argument& e) {
+              return e.what();
+            }
+          },
+          "TYPE|python:MODULE:CLASS|fmu:PATH"));
   params_cmd->add_flag("--list", params.list, "list the registered controller types instead");
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
@@ -120,7 +130,9 @@ int params_command(const ParamsOptions& options) {
       std::cout << fmt::format("{:<10} {}\n", t.name, t.description);
     return exit_code::kOk;
   }
-  const control::ControllerConfig defaults = controllers::make_config(options.controller, model::VehicleParams{});
+  // A Python class or an FMU is loaded as a scenario naming it would load it: its declared parameters
+  // and their defaults are known only then.
+  const control::ControllerConfig defaults = io::defaults_flown_by(options.controller).controller;
   std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", "name", "unit", "range", "default", "meaning");
   for (const control::ParameterSpec* spec : control::all_parameters(defaults)) {
     const control::ParameterSpec& p = *spec;

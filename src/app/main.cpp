@@ -3,6 +3,7 @@
 // mapping of errors to exit codes (exit_codes.hpp).
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <functional>
 #include <iostream>
 #include <string>
@@ -11,6 +12,7 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/python_host.hpp"
+#include "io/did_you_mean.hpp"
 #include "io/scenario_limits.hpp"
 
 namespace {
@@ -25,6 +27,39 @@ std::string unknown_first_argument(const CLI::App& app, int argc, char** argv) {
     if (sub->get_name() == first) return {};
   }
   return first;
+}
+
+// The first option on the command line that the chosen command does not know, as an error naming the
+// nearest option it does know ("" when every option is known). CLI11 checks required options and
+// arguments before leftovers, so `run S --outt o` would otherwise say "--out is required" and hide the
+// typo.
+std::string unknown_option(const CLI::App& app) {
+  const CLI::App* command = &app;
+  while (!command->get_subcommands().empty()) command = command->get_subcommands().front();
+  for (const std::string& arg : app.remaining(true)) {
+    // Not options: the end-of-options mark, a lone dash, a negative number.
+    if (arg.size() < 2 || arg[0] != '-' || arg == "--" || std::isdigit(static_cast<unsigned char>(arg[1]))) continue;
+    const std::string given = arg.substr(0, arg.find('='));
+    const std::size_t dashes = given.find_first_not_of('-');
+    std::vector<std::string> known;
+    for (const CLI::Option* o : command->get_options()) {
+      for (const std::string& name : o->get_lnames()) known.push_back("--" + name);
+      for (const std::string& name : o->get_snames()) known.push_back("-" + name);
+    }
+    // Compared without their dashes: "--outt" is one letter from "--out", not one in six.
+    std::vector<std::string> bare;
+    for (const std::string& k : known) bare.push_back(k.substr(k.find_first_not_of('-')));
+    const std::string near = quadcosim::io::nearest_name(given.substr(dashes == std::string::npos ? 0 : dashes), bare);
+    std::string hint;
+    for (std::size_t i = 0; i < bare.size() && !near.empty(); ++i) {
+      if (bare[i] == near) {
+        hint = "; did you mean '" + known[i] + "'?";
+        break;
+      }
+    }
+    return command->get_name() + ": unknown option '" + given + "'" + hint;
+  }
+  return {};
 }
 
 }  // namespace
@@ -102,6 +137,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (const std::string unknown = unknown_option(app); e.get_exit_code() != 0 && !unknown.empty()) {
+      std::cerr << "error: " << unknown << "\nRun with --help for more information.\n";
+      return exit_code::kBadInput;
+    }
     return app.exit(e) == 0 ? exit_code::kOk : exit_code::kBadInput;
   }
   {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "io/did_you_mean.hpp"
+
 namespace quadcosim::control {
 
 std::string to_string(const ParameterValue& value) {
@@ -14,6 +16,12 @@ std::string to_string(const ParameterValue& value) {
 }
 
 std::string unknown_parameter(std::string_view name) { return "unknown parameter '" + std::string(name) + "'"; }
+
+std::string unknown_parameter(std::string_view name, std::span<const ParameterSpec> known) {
+  std::vector<std::string> names;
+  for (const ParameterSpec& s : known) names.emplace_back(s.name);
+  return unknown_parameter(name) + io::did_you_mean(name, names);
+}
 
 std::string check_value(const ParameterSpec& spec, const ParameterValue& value) {
   std::ostringstream err;

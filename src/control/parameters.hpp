@@ -40,6 +40,8 @@ std::string to_string(const ParameterValue& value);
 
 /// "unknown parameter 'z_dse'".
 std::string unknown_parameter(std::string_view name);
+/// "unknown parameter 'z_dse'; did you mean 'z_des'?" when one of `known` is close.
+std::string unknown_parameter(std::string_view name, std::span<const ParameterSpec> known);
 
 /// A parameter table over a parameter struct P: each declaration with how to read and write its value.
 template <class P>
@@ -83,7 +85,7 @@ class ParameterTable {
   /// Checks and applies one value; "" on success, else why it was refused (then `p` is unchanged).
   std::string set(P& p, std::string_view name, const ParameterValue& value) const {
     const Entry* e = find(name);
-    if (!e) return unknown_parameter(name);
+    if (!e) return unknown_parameter(name, specs_);
     if (std::string err = check_value(e->spec, value); !err.empty()) return err;
     e->set(p, value);
     return {};

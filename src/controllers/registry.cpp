@@ -2,6 +2,8 @@
 
 #include <array>
 
+#include "io/did_you_mean.hpp"
+
 #include "controllers/example_pd/example_pd_controller.hpp"
 #include "controllers/paper/paper_controller.hpp"
 #include "controllers/se3/geometric_controller.hpp"
@@ -49,8 +51,10 @@ const ControllerType* find_controller_type(std::string_view name) {
 control::ControllerConfig make_config(std::string_view type, const model::VehicleParams& vehicle) {
   const ControllerType* t = find_controller_type(type);
   if (!t) {
+    std::vector<std::string> known;
+    for (const auto& k : kTypes) known.emplace_back(k.name);
     throw std::invalid_argument("unknown controller type '" + std::string(type) +
-                                "' (known: " + controller_type_names() + ")");
+                                "' (known: " + controller_type_names() + ")" + io::did_you_mean(type, known));
   }
   control::ControllerConfig c;
   c.vehicle = vehicle;

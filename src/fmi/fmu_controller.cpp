@@ -252,7 +252,7 @@ std::string FmuController::set_parameters(std::span<const control::Setting> sett
   for (const control::Setting& s : settings) {
     std::size_t i = 0;
     while (i < shared_->specs.size() && shared_->specs[i].name != s.name) ++i;
-    if (i == shared_->specs.size()) return control::unknown_parameter(s.name);
+    if (i == shared_->specs.size()) return control::unknown_parameter(s.name, shared_->specs);
     if (std::string err = control::check_value(shared_->specs[i], s.value); !err.empty()) return err;
     if (initialised_ && shared_->parameter_vars[i]->variability == Variability::kFixed) {
       return fmt::format("{}: the FMU declares it fixed: it can be set before the first step only", s.name);

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "io/did_you_mean.hpp"
+
 namespace quadcosim::fmi {
 
 namespace {
@@ -89,11 +91,16 @@ void check_signal_keys(const std::map<std::string, std::vector<std::string>, std
   for (const auto& [name, names] : given) {
     bool known = false;
     std::string expected;
+    std::vector<std::string> signal_names;
     for (const Signal& s : signals) {
       known = known || s.name == name;
       expected += (expected.empty() ? "" : ", ") + std::string(s.name);
+      signal_names.emplace_back(s.name);
     }
-    if (!known) throw MappingError(section + "." + name, "unknown signal; expected one of " + expected);
+    if (!known) {
+      throw MappingError(section + "." + name,
+                         "unknown signal; expected one of " + expected + io::did_you_mean(name, signal_names));
+    }
   }
 }
 

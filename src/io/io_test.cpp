@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "controllers/paper/paper_controller.hpp"
+#include "io/did_you_mean.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
@@ -617,11 +618,68 @@ INSTANTIATE_TEST_SUITE_P(
         BadScenario{"parameter_a_list",
                     "controller:\n  z_des: [1, 2]\n",
                     {"controller.z_des: ", "got a list, expected a single value"}},
+        // A number or boolean in quotes is YAML text: refused where a number (or true/false) belongs,
+        // with the value as written.
+        BadScenario{"quoted_mass",
+                    "vehicle: {mass_kg: \"1.2\"}\n",
+                    {"vehicle.mass_kg: \"1.2\" is a string; write 1.2 without quotes"}},
+        BadScenario{"single_quoted_duration",
+                    "simulation: {duration_s: '10'}\n",
+                    {"simulation.duration_s: \"10\" is a string; write 10 without quotes"}},
+        BadScenario{"str_tagged_rate",
+                    "simulation: {plant_rate_hz: !!str 100}\n",
+                    {"simulation.plant_rate_hz: \"100\" is a string"}},
+        BadScenario{"quoted_integer", "simulation: {substeps: \"4\"}\n", {"simulation.substeps: \"4\" is a string"}},
+        BadScenario{"quoted_list_entry",
+                    "initial: {position_m: [0, \"1\", 2]}\n",
+                    {"initial.position_m: \"1\" is a string; write 1 without quotes"}},
+        BadScenario{"quoted_controller_parameter",
+                    "controller:\n  altitude.kp: \"4\"\n",
+                    {"controller.altitude.kp: \"4\" is a string; write 4 without quotes"}},
+        BadScenario{"quoted_criterion_bound",
+                    "analysis:\n  steps:\n    - channel: z\n      spec: {t95_s: [null, \"5\"]}\n",
+                    {"analysis.steps[0].spec.t95_s: \"5\" is a string"}},
+        BadScenario{"quoted_realism_number",
+                    "sensors:\n  pose: {position_sigma_m: \"0.01\"}\n",
+                    {"sensors.pose.position_sigma_m: \"0.01\" is a string"}},
+        // An unknown key or parameter names the nearest known one when one is close.
+        BadScenario{
+            "misspelt_section", "simulaton: {duration_s: 1}\n", {"simulaton: unknown key; did you mean 'simulation'?"}},
+        BadScenario{"misspelt_vehicle_key", "vehicle: {mas_kg: 2}\n", {"did you mean 'mass_kg'?"}},
+        BadScenario{"unit_left_off", "simulation: {duration: 2}\n", {"did you mean 'duration_s'?"}},
+        BadScenario{"misspelt_gain", "controller:\n  altitude: {kq: 3}\n", {"did you mean 'altitude.kp'?"}},
+        BadScenario{"swapped_letters",
+                    "controller: {paper: {lqr: {roll: {q_angel: 2}}}}\n",
+                    {"did you mean 'lqr.roll.q_angle'?"}},
+        BadScenario{"misspelt_figure",
+                    "analysis:\n  steps:\n    - channel: z\n      spec: {overshot_pct: [0, 1]}\n",
+                    {"unknown step figure", "did you mean 'overshoot_pct'?"}},
+        BadScenario{"misspelt_realism_key",
+                    "sensors:\n  pose: {positon_sigma_m: 0.01}\n",
+                    {"sensors.pose.positon_sigma_m: unknown key; did you mean 'position_sigma_m'?"}},
+        BadScenario{"misspelt_controller_type",
+                    "controller: {type: se4}\n",
+                    {"controller.type: ", "'se4'", "did you mean 'se3'?"}},
         BadScenario{"yaml_syntax_error",
                     "name: broken\nsimulation:\n  plant_rate_hz: 100\n  duration_s: 15: 3\n"
                     "controller:\n  mode: attitude\n",
                     {"line 4", "YAML syntax error"}}),
     [](const auto& info) { return info.param.label; });
+
+TEST(DidYouMeanTest, SuggestsTheNearestKnownNameOnlyWhenItIsClose) {
+  EXPECT_EQ(edit_distance("simulaton", "simulation"), 1u);
+  EXPECT_EQ(edit_distance("q_angel", "q_angle"), 1u);  // two letters swapped: one slip
+  EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
+  EXPECT_EQ(edit_distance("", "abc"), 3u);
+  const std::vector<std::string> known = {"duration_s", "plant_rate_hz", "controller_rate_hz", "substeps"};
+  EXPECT_EQ(nearest_name("duraton_s", known), "duration_s");
+  EXPECT_EQ(nearest_name("duration", known), "duration_s");  // the unit left off
+  EXPECT_EQ(nearest_name("plant_rate", known), "plant_rate_hz");
+  EXPECT_EQ(nearest_name("colour", known), "");  // nothing close: no guess
+  EXPECT_EQ(nearest_name("x", {"y"}), "");       // one letter for one letter is no resemblance
+  EXPECT_EQ(did_you_mean("substep", known), "; did you mean 'substeps'?");
+  EXPECT_EQ(did_you_mean("colour", known), "");
+}
 
 TEST(ScenarioTest, MissingFileIsAConfigErrorNamingIt) {
   TempDir dir;

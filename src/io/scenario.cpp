@@ -15,6 +15,7 @@
 #include "fmi/fmu_controller.hpp"
 #include "fmi/fmu_plant.hpp"
 #include "io/criteria_yaml.hpp"
+#include "io/did_you_mean.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/scenario_limits.hpp"
 #include "io/trajectory_yaml.hpp"
@@ -99,6 +100,7 @@ control::ParameterValue parameter_value(YamlSection& s, const std::string& key, 
                                         const YAML::Node& n) {
   if (!n.IsScalar()) s.fail(key, "got " + YamlSection::describe(n) + ", expected a single value");
   if (spec.is_choice()) return n.Scalar();
+  s.refuse_quoted_number(key, n);
   try {
     return n.as<double>();
   } catch (const YAML::Exception&) {
@@ -154,8 +156,11 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
     }
     const control::ParameterSpec* spec = control::find_parameter(c, name);
     if (!spec) {
+      std::vector<std::string> known;
+      for (const control::ParameterSpec* p : control::all_parameters(c)) known.emplace_back(p->name);
       s.fail(key, "unknown parameter '" + name + "' of the node or of controller type '" + std::string(c.type()) +
-                      "' (see `quadcosim params --controller " + std::string(c.type()) + "`)");
+                      "' (see `quadcosim params --controller " + std::string(c.type()) + "`)" +
+                      did_you_mean(name, known));
     }
     const control::ParameterValue value = parameter_value(s, key, *spec, n);
     if (node) {
@@ -436,7 +441,10 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
     for (const std::string& key : per->keys()) {
       const auto it = by_name.find(key);
       if (it == by_name.end()) {
-        per->fail(key, "unknown topic; expected motor_commands, Pose, Velocity, Imu, clock or controller_status");
+        std::vector<std::string> known;
+        for (const auto& [name, topic] : by_name) known.push_back(name);
+        per->fail(key, "unknown topic; expected motor_commands, Pose, Velocity, Imu, clock or controller_status" +
+                           did_you_mean(key, known));
       }
       auto one = per->section(key);
       if (!one) per->fail(key, "expected a mapping with drop_probability and/or delay_ticks");
@@ -583,6 +591,7 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
   for (const YAML::Node& n : s.sequence("record_vehicles")) {
     const std::string where = "record_vehicles[" + std::to_string(index++) + "]";
     long long v = -1;
+    s.refuse_quoted_number(where, n);
     try {
       v = n.as<long long>();
     } catch (const YAML::Exception&) {
@@ -669,9 +678,11 @@ ControllerChoice parse_controller_choice(const std::string& text) {
     c.kind = ControllerChoice::Kind::kPython;  // the class is named by the caller (controller.python)
   } else {
     if (!controllers::find_controller_type(text)) {
-      throw std::invalid_argument("got '" + text + "', expected a controller type (" +
-                                  controllers::controller_type_names() +
-                                  "), python:MODULE:CLASS (a class written in Python) or fmu:PATH (an FMU)");
+      std::vector<std::string> types;
+      for (const auto& t : controllers::controller_types()) types.emplace_back(t.name);
+      throw std::invalid_argument(
+          "got '" + text + "', expected a controller type (" + controllers::controller_type_names() +
+          "), python:MODULE:CLASS (a class written in Python) or fmu:PATH (an FMU)" + did_you_mean(text, types));
     }
     c.target = text;
   }

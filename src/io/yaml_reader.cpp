@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "io/did_you_mean.hpp"
 #include "io/scenario_limits.hpp"
 
 namespace quadcosim::io {
@@ -60,6 +61,7 @@ std::pair<std::optional<double>, std::optional<double>> YamlSection::bounds(cons
   std::optional<double> bound[2];
   for (int i = 0; i < 2; ++i) {
     if (b[i].IsNull()) continue;
+    refuse_quoted_number(key, b[i]);
     try {
       bound[i] = b[i].as<double>();
     } catch (const YAML::Exception&) {
@@ -70,7 +72,22 @@ std::pair<std::optional<double>, std::optional<double>> YamlSection::bounds(cons
   return {bound[0], bound[1]};
 }
 
-bool YamlSection::has(const std::string& key) const { return node_[key].IsDefined(); }
+bool YamlSection::has(const std::string& key) const {
+  asked_.insert(key);
+  return node_[key].IsDefined();
+}
+
+bool YamlSection::written_as_text(const YAML::Node& n) {
+  // yaml-cpp tags a quoted (or block) scalar "!" and a plain one "?"; nodes built in code have none.
+  return n.IsScalar() && (n.Tag() == "!" || n.Tag() == "tag:yaml.org,2002:str");
+}
+
+void YamlSection::refuse_quoted_number(const std::string& key, const YAML::Node& n) const {
+  double unused = 0.0;
+  if (written_as_text(n) && YAML::convert<double>::decode(n, unused)) {
+    fail(key, "\"" + n.Scalar() + "\" is a string; write " + n.Scalar() + " without quotes");
+  }
+}
 
 YAML::Node YamlSection::get(const std::string& key) {
   used_.insert(key);
@@ -87,6 +104,7 @@ double YamlSection::number(const std::string& key, double fallback, const model:
   const YAML::Node n = get(key);
   if (!n.IsDefined()) return fallback;
   const std::string expected = "expected a number in " + range.text();
+  refuse_quoted_number(key, n);
   double v = 0.0;
   try {
     if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
@@ -102,6 +120,7 @@ long long YamlSection::integer(const std::string& key, long long fallback, long 
   const YAML::Node n = get(key);
   if (!n.IsDefined()) return fallback;
   const std::string expected = "expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  refuse_quoted_number(key, n);
   long long v = 0;
   try {
     if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
@@ -116,6 +135,9 @@ long long YamlSection::integer(const std::string& key, long long fallback, long 
 bool YamlSection::boolean(const std::string& key, bool fallback) {
   const YAML::Node n = get(key);
   if (!n.IsDefined()) return fallback;
+  if (bool unused = false; written_as_text(n) && YAML::convert<bool>::decode(n, unused)) {
+    fail(key, "\"" + n.Scalar() + "\" is a string; write " + n.Scalar() + " without quotes");
+  }
   try {
     if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
     return n.as<bool>();
@@ -141,6 +163,7 @@ std::string YamlSection::choice(const std::string& key, const std::string& fallb
     for (const auto& c : choices) {
       if (n.Scalar() == c) return c;
     }
+    fail(key, "got " + shown(n) + ", " + expected + did_you_mean(n.Scalar(), choices));
   }
   fail(key, "got " + shown(n) + ", " + expected);
 }
@@ -152,6 +175,7 @@ std::vector<double> YamlSection::numbers(const std::string& key, std::vector<dou
   if (!n.IsSequence() || n.size() != count) fail(key, "got " + shown(n) + ", " + expected);
   std::vector<double> out;
   for (const auto& e : n) {
+    refuse_quoted_number(key, e);
     double v = 0.0;
     try {
       if (!e.IsScalar()) throw YAML::Exception(e.Mark(), "");
@@ -197,7 +221,10 @@ std::vector<std::string> YamlSection::keys() {
 void YamlSection::reject_unknown_keys() const {
   for (const auto& kv : node_) {
     const std::string key = key_text(kv.first);
-    if (!used_.count(key)) fail(key, "unknown key");
+    if (used_.count(key)) continue;
+    std::vector<std::string> known(used_.begin(), used_.end());
+    known.insert(known.end(), asked_.begin(), asked_.end());
+    fail(key, "unknown key" + did_you_mean(key, known));
   }
 }
 

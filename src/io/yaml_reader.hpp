@@ -1,5 +1,7 @@
-// A thin checked view of a YAML mapping: every read names file and key path in its error, and
-// keys nobody asked for are reported as unknown (catches typos such as `mas_kg`).
+// A thin checked view of a YAML mapping: every read names file and key path in its error, keys
+// nobody asked for are reported as unknown with the nearest known one (catches typos such as
+// `mas_kg`), and a number or boolean written in quotes (`mass_kg: "1.2"`) is refused: YAML makes it
+// text, and taking text for a number would hide a value some other reader takes as text.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -47,7 +49,14 @@ class YamlSection {
   /// All keys, in file order (marks them used).
   std::vector<std::string> keys();
 
-  /// Throws ConfigError naming the first key that no read asked for.
+  /// Throws ConfigError at `key` when `n` is a number written in quotes ("1.2" is a string; write 1.2
+  /// without quotes); for readers that take numbers from raw nodes.
+  void refuse_quoted_number(const std::string& key, const YAML::Node& n) const;
+  /// True for a scalar written in quotes or tagged !!str: YAML's text, whatever it spells.
+  static bool written_as_text(const YAML::Node& n);
+
+  /// Throws ConfigError naming the first key that no read asked for, and the asked-for key nearest
+  /// to it when one is close.
   void reject_unknown_keys() const;
 
   /// "file: path.key: message".
@@ -67,6 +76,8 @@ class YamlSection {
   std::string file_;
   std::string path_;
   std::set<std::string> used_;
+  /// Keys asked about by has() (known names too, for "did you mean").
+  mutable std::set<std::string> asked_;
 };
 
 }  // namespace quadcosim::io

@@ -60,7 +60,12 @@ struct PyScenario {
 YAML::Node to_yaml(const py::handle& value, const std::string& key) {
   if (value.is_none()) return YAML::Node(YAML::NodeType::Null);
   if (py::isinstance<py::bool_>(value)) return YAML::Node(value.cast<bool>() ? "true" : "false");
-  if (py::isinstance<py::str>(value)) return YAML::Node(value.cast<std::string>());
+  if (py::isinstance<py::str>(value)) {
+    // Tagged as a quoted scalar is: a str where a number belongs is refused, as `"1.2"` in a file is.
+    YAML::Node text(value.cast<std::string>());
+    text.SetTag("!");
+    return text;
+  }
   if (py::isinstance<py::dict>(value)) {
     YAML::Node map(YAML::NodeType::Map);
     for (const auto& [k, v] : value.cast<py::dict>()) {

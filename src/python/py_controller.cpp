@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "control/controller_config.hpp"
+#include "io/did_you_mean.hpp"
 #include "io/scenario.hpp"
 #include "model/mixer.hpp"
 
@@ -412,7 +413,7 @@ std::string PyController::set_parameters(std::span<const control::Setting> setti
   for (const control::Setting& s : settings) {
     std::size_t i = 0;
     while (i < shared_->specs.size() && shared_->specs[i].name != s.name) ++i;
-    if (i == shared_->specs.size()) return control::unknown_parameter(s.name);
+    if (i == shared_->specs.size()) return control::unknown_parameter(s.name, shared_->specs);
     if (std::string err = control::check_value(shared_->specs[i], s.value); !err.empty()) return err;
     if (i == shared_->declared.size()) {
       timeout = std::get<double>(s.value);
@@ -816,7 +817,8 @@ std::shared_ptr<PyController> make_python_controller(py::object given, const mod
             (field == "unit" ? unit : description) = v.cast<std::string>();
           } else {
             throw std::invalid_argument(
-                fmt::format("{}: unknown key '{}'; expected default, unit, min, max, description", where, field));
+                fmt::format("{}: unknown key '{}'; expected default, unit, min, max, description{}", where, field,
+                            io::did_you_mean(field, {"default", "unit", "min", "max", "description"})));
           }
         }
         if (!s.contains("default")) {

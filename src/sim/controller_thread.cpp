@@ -86,9 +86,15 @@ bool ControllerThread::start(std::shared_ptr<Step> step, std::function<void(Step
       step->error = std::current_exception();
     }
     // The continuation runs before the thread counts as free (under the lock, so an owner that
-    // gave up waiting does not go away during it), and not at all once the owner is gone.
+    // gave up waiting does not go away during it), and not at all once the owner is gone. The thread
+    // counts as free as the continuation returns, in the same hold of the lock: a start() waiting on
+    // the lock (the next tick, asked for by the answer the continuation published) then finds it free.
+    // Freed only when the loop took the lock back, that start() lost the race about one run in two
+    // over DDS, and its tick went unanswered until the plant asked again 50 ms later.
     const std::lock_guard lock(s->mutex);
     if (then && !s->abandoned) then(*step);
+    s->running = false;
+    s->changed.notify_all();
   };
   shared_->changed.notify_all();
   return true;

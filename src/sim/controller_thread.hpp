@@ -55,8 +55,8 @@ class ControllerThread final : public control::Controller {
 
   /// Starts `step` on the thread unless a call is queued or running there (then false, nothing
   /// started). `then`, when set, runs on the controller's thread after the step returned or threw,
-  /// before the thread counts as free, and not once this object is gone; it must not call back
-  /// into this object.
+  /// before the thread counts as free (it is free once `then` returns: a start() waiting meanwhile
+  /// succeeds), and not once this object is gone; it must not call back into this object.
   bool start(std::shared_ptr<Step> step, std::function<void(Step&)> then = {});
   /// Waits up to timeout_ns for the thread to be free; true when it is (a started step returned).
   bool wait_free(std::int64_t timeout_ns);

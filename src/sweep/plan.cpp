@@ -10,6 +10,7 @@
 #include "control/controller_config.hpp"
 #include "control/parameters.hpp"
 #include "controllers/registry.hpp"
+#include "io/did_you_mean.hpp"
 #include "model/random.hpp"
 
 namespace quadcosim::sweep {
@@ -204,9 +205,13 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
     if (const auto* f = find_vehicle_field(v.name.substr(8))) return {vehicle_key(*f)};
   }
   if (v.name.find('.') == std::string::npos) {
+    std::vector<std::string> known;
+    for (const auto& [alias, fields] : vehicle_aliases()) known.push_back(alias);
+    for (const model::VehicleParameter& f : model::vehicle_parameters()) known.emplace_back(f.name);
     throw PlanError("--vary " + v.spec + ": unknown parameter '" + v.name + "' (expected an alias (" + known_aliases() +
                     "), a vehicle field such as mass_kg or motor.tau_up_s, or a scenario key by its YAML path such as "
-                    "controller.altitude.kp or initial.position_m[2]; see docs/sweeps.md)");
+                    "controller.altitude.kp or initial.position_m[2]; see docs/sweeps.md)" +
+                    io::did_you_mean(v.name, known));
   }
   Key k;
   k.path = v.name;
@@ -224,7 +229,10 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
     const std::string name = join(parts, in_section ? 2 : 1, parts.size());
     const control::ParameterSpec* spec = control::find_parameter(nominal.controller, name);
     if (!spec) {
-      throw PlanError("--vary " + v.spec + ": unknown controller parameter '" + name + "' (see `quadcosim params`)");
+      std::vector<std::string> known;
+      for (const control::ParameterSpec* p : control::all_parameters(nominal.controller)) known.emplace_back(p->name);
+      throw PlanError("--vary " + v.spec + ": unknown controller parameter '" + name + "' (see `quadcosim params`)" +
+                      io::did_you_mean(name, known));
     }
     if (spec->is_choice()) {
       throw PlanError("--vary " + v.spec + ": controller parameter '" + name + "' is a choice, not a number");

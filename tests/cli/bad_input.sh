@@ -27,6 +27,8 @@ printf 'controller:\n  type: se3\n  lqr: {roll: {r: 1}}\n' > controller_foreign_
 printf 'controller:\n  type: se3\n  k_R: {x: -1}\n' > controller_gain_range.yaml
 printf 'controller: {z_des: 1}\nschedule:\n  - at_s: 1\n    set: {type: se3}\n' > controller_type_change.yaml
 printf 'mass_kg: .nan\n' > vehicle_nan.yaml
+printf 'vehicle: {mass_kg: "1.2"}\n' > quoted_mass.yaml
+printf "simulation: {duration_s: '10'}\n" > quoted_duration.yaml
 printf '? [a, b]\n: 1\n' > list_key.yaml
 printf 't,w1,w2,w3,w4\n0,1,2,3\n' > short.csv
 printf 't,w1,w2,w3,w4\n0,1,nan,3,4\n' > nan.csv
@@ -86,12 +88,27 @@ expect 2 "--controller: got 'python:nocolon', expected python:MODULE:CLASS" run 
 expect 2 "--controller: got 'fmu:no_such.fmu': no such file 'no_such.fmu'" run "$ALT" --out o --controller fmu:no_such.fmu
 # A misspelt gain of a type that does not fly is still refused, at its key.
 expect 2 "type_section_typo.yaml: controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel' of the node or of controller type 'paper'" run type_section_typo.yaml --out o --no-plots --controller se3
-expect 2 "--controller: lqg not in {paper,se3,example_pd}" params --controller lqg
+expect 2 "--controller: got 'lqg', expected a controller type (paper, se3, example_pd), python:MODULE:CLASS" params --controller lqg
+expect 2 "--controller: got 'se4';;did you mean 'se3'?" params --controller se4
 expect 2 "--controller: got 'lqg', expected a controller type (paper, se3, example_pd)" controller --controller lqg
 expect 2 "--transport: carrier not in {inproc,dds}" run "$ALT" --out o --transport carrier
 expect 2 "--timeout: Value abc not in range 0.01" run "$ALT" --out o --timeout abc
 expect 2 "--rate-factor: Value 0 not in range 0.001" run "$ALT" --out o --rate-factor 0
-expect 2 "The following argument was not expected: --fast" run "$ALT" --out o --fast
+expect 2 "run: unknown option '--fast'" run "$ALT" --out o --fast
+# An unknown option is named as unknown, with the nearest known one, also when a required option or
+# argument is missing too (CLI11 alone reports the missing one: "--out is required").
+expect 2 "run: unknown option '--outt'; did you mean '--out'?" run "$ALT" --outt o
+expect 2 "run: unknown option '--outt'; did you mean '--out'?" run --outt o
+expect 2 "run: unknown option '--no-plot'; did you mean '--no-plots'?" run "$ALT" --out o --no-plot
+expect 2 "params: unknown option '--contrler'; did you mean '--controller'?" params --contrler se3
+expect 2 "plant: unknown option '--sceanrio'; did you mean '--scenario'?" plant --sceanrio "$ALT"
+expect 2 "get: unknown option '--timout'; did you mean '--timeout'?" param get /attitude_controller z_des --timout 1
+# A number in quotes is text, refused with the key, the file and the value as written.
+expect 2 "quoted_mass.yaml: vehicle.mass_kg: \"1.2\" is a string; write 1.2 without quotes" run quoted_mass.yaml --out o --no-plots
+expect 2 "quoted_duration.yaml: simulation.duration_s: \"10\" is a string; write 10 without quotes" run quoted_duration.yaml --out o --no-plots
+# A misspelt key or parameter: the nearest known name.
+expect 2 "unknown_key.yaml: simulaton: unknown key; did you mean 'simulation'?" run unknown_key.yaml --out o --no-plots
+expect 2 "params_unknown.yaml: altitude.kq: unknown parameter 'altitude.kq';;did you mean 'altitude.kp'?" controller --params params_unknown.yaml
 expect 3 "cannot create output directory /proc/quadcosim_no" run "$ALT" --out /proc/quadcosim_no --no-plots
 for f in --realtime --pin "--timeout 5" "--keystore ks"; do
   # shellcheck disable=SC2086
