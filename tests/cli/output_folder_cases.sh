@@ -76,13 +76,13 @@ case "$CASE" in
     [ ! -e "$TMP/d/step_x.png" ] && [ ! -e "$TMP/d/step_y.png" ] || fail "plot left the figures of the old steps"
     [ -s "$TMP/d/step_z.png" ] && [ -s "$TMP/d/report.html" ] || fail "plot wrote no step_z.png or report"
     [ -s "$TMP/d/trajectory.csv" ] && [ -e "$TMP/d/notes.txt" ] || fail "plot removed a file that is no figure"
-    [ "$(grep -o 'alt="[a-z_0-9]*\.png"' "$TMP/d/report.html" | tr '\n' ' ')" = 'alt="step_z.png" alt="overview.png" ' ] \
+    [ "$(grep -o 'alt="[a-z_0-9]*\.png"' "$TMP/d/report.html" | tr '\n' ' ')" = 'alt="step_z.png" alt="outputs.png" alt="overview.png" ' ] \
       || fail "report.html lists other figures: $(grep -o 'alt="[^"]*"' "$TMP/d/report.html")"
     "$PY" - "$TMP/d/$MANIFEST" <<'PYEOF' || fail "manifest"
 import json, sys
 m = json.load(open(sys.argv[1]))
 assert m["command"] == "run", m
-assert m["files"]["figures"] == ["overview.png", "report.html", "step_z.png"], m["files"]["figures"]
+assert m["files"]["figures"] == ["outputs.png", "overview.png", "report.html", "step_z.png"], m["files"]["figures"]
 assert "notes.txt" not in m["files"]["outputs"] and "trajectory.csv" in m["files"]["outputs"], m["files"]["outputs"]
 PYEOF
     ;;

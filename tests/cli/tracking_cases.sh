@@ -27,7 +27,11 @@ assert [c["figure"] for c in tr["criteria"]] == ["position_rmse_m", "position_ma
 assert all(c["passed"] for c in tr["criteria"]) and tr["passed"] is True and m["passed"] is True
 # Recompute the RMSE from trajectory.csv: rows at t >= 12 s on the controller's 50 Hz steps.
 rows = list(csv.DictReader(open(run + "/trajectory.csv")))
-assert list(rows[0])[-1] == "att_err", "att_err is not the last column"
+columns = list(rows[0])
+own = [c for c in columns if c.startswith("out.")]  # the controller's own figures come last
+assert columns[len(columns) - len(own) - 1] == "att_err", "att_err is not the last column before out.*"
+assert own == ["out." + n for n in ("e_x.x", "e_x.y", "e_x.z", "e_v.x", "e_v.y", "e_v.z", "e_R.x", "e_R.y", "e_R.z",
+                                    "e_Omega.x", "e_Omega.y", "e_Omega.z", "thrust", "yaw_torque_cut")], own
 sq = [sum((float(r[a + "_des"]) - float(r[a])) ** 2 for a in "xyz") for r in rows
       if float(r["t"]) >= 12 and round(float(r["t"]) * 100) % 2 == 0]
 assert len(sq) == 901
