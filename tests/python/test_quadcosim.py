@@ -320,3 +320,16 @@ def test_help_teaches_the_api():
         assert word in text
     assert "ConfigError" in quadcosim.load_scenario.__doc__
     assert "trajectory.csv" in quadcosim.run.__doc__
+
+
+def test_run_result_outputs_are_the_controllers_own_figures():
+    # The paper controller declares its errors; RunResult.outputs holds them by name, as trajectory.csv's
+    # out.<name> columns. At t = 0 the vehicle is on the ground and z_des is 10 m: e_z = 10 exactly.
+    result = quadcosim.run(ALTITUDE_STEP)
+    assert list(result.outputs) == ["error.z", "error.roll", "error.pitch", "error.yaw"]
+    e_z = result.outputs["error.z"]
+    assert e_z.shape == result.trajectory["t"].shape
+    assert np.array_equal(e_z, result.trajectory["out.error.z"], equal_nan=True)
+    assert e_z[0] == 10.0
+    assert abs(e_z[-1]) < 0.1  # settled by 15 s
+    assert np.all(result.outputs["error.roll"] == 0.0)  # level flight: nothing disturbs roll
