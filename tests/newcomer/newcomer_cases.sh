@@ -5,7 +5,8 @@
 # Usage: newcomer_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID PYTHON_PACKAGE_DIR
 # Cases: cli_types (every scenario x every registered type), cli_python (every scenario x the
 # newcomer's class), python_module (the same from `import quadcosim`, trajectories identical to the
-# CLI's), dds_python (the class as the DDS controller node in lockstep: identical to in-process),
+# CLI's, every shipped scenario but the swarm, which Python refuses), dds_python (the class as the DDS
+# controller node in lockstep: identical to in-process),
 # reports (what the class does, its declared outputs, tilt setpoint and saturation, is in the record).
 # A run passes when it ends with exit 0 or 1 (1: a criterion of the scenario failed, which a
 # controller that is not the scenario's own may do), with every tick of the run in trajectory.csv
@@ -82,9 +83,23 @@ PY
   python_module)
     skip_without_python "$bin"
     [ -d "$pydir" ] || { echo "SKIP: the Python module was not built ($pydir)"; exit 77; }
-    for s in "$src/scenarios/paper/altitude_step.yaml" "$src/scenarios/tracking/circle_se3.yaml" \
-             "$src/scenarios/realism/hover_wind_gusts.yaml"; do
+    for s in "${scenarios[@]}"; do
       name="$(basename "$s" .yaml)"
+      if grep -q "^swarm:" "$s"; then  # quadcosim.run flies one vehicle: a swarm is refused, with the reason
+        PYTHONPATH="$pydir:$PYTHONPATH" "$py" - "$s" <<'PY' || fail "$s from Python: no clear refusal"
+import sys
+import quadcosim
+from cascade import Cascade
+try:
+    quadcosim.run(sys.argv[1], controller=Cascade)
+except ValueError as e:
+    assert "cannot be run from Python yet; use `quadcosim run`" in str(e), e
+    print("refused as documented:", e)
+else:
+    raise AssertionError("a swarm scenario ran from Python")
+PY
+        continue
+      fi
       set +e
       "$bin" run "$s" --controller python:cascade:Cascade --out "$tmp/cli_$name" --no-plots > "$tmp/cli_$name.log" 2>&1
       rc=$?
