@@ -14,6 +14,12 @@ namespace quadcosim::fmi::names {
 inline constexpr std::array<std::string_view, 4> kOmegaCmd = {"omega_cmd[1]", "omega_cmd[2]", "omega_cmd[3]",
                                                               "omega_cmd[4]"};
 
+// Controller FMU outputs besides the command: what the latest control step tracked, under the names
+// control::ReportedOutputs reads (roll, pitch, yaw of the desired attitude [rad]; the tilt flag [1]),
+// then the controller's own figures by their names.
+inline constexpr std::array<std::string_view, 3> kReportedAttitude = {"roll_des", "pitch_des", "yaw_des"};
+inline constexpr std::string_view kTiltSaturated = "tilt_saturated";
+
 // Plant FMU outputs, controller FMU inputs.
 inline constexpr std::array<std::string_view, 3> kPosition = {"p_W[1]", "p_W[2]", "p_W[3]"};  ///< [m]
 inline constexpr std::array<std::string_view, 3> kVelocity = {"v_W[1]", "v_W[2]", "v_W[3]"};  ///< [m/s]

@@ -88,6 +88,18 @@ controller_trajectory_round_trip() {
   local cols; cols="$(state_columns "$tmp/native/trajectory.csv"),$(head -1 "$tmp/native/trajectory.csv" | tr ',' '\n' | grep -n -E '^(x_des|y_des|z_des)$' | cut -d: -f1 | paste -sd,)"
   cmp <(cut -d, -f"$cols" "$tmp/native/trajectory.csv") <(cut -d, -f"$cols" "$tmp/fmu/trajectory.csv") \
     || fail "$s: columns $cols differ with the exported controller FMU"
+  # What the controller tracked and its own figures: the FMU outputs them, quadcosim reads them by name.
+  python3 - "$tmp/native/trajectory.csv" "$tmp/fmu/trajectory.csv" <<'PY' || fail "$s: tracked attitude or figures differ"
+import csv, sys
+native, fmu = (list(csv.DictReader(open(f))) for f in sys.argv[1:3])
+figures = [c for c in native[0] if c.startswith("out.")]
+assert figures and all(c in fmu[0] for c in figures), (figures, list(fmu[0]))
+assert len(native) == len(fmu)
+for a, b in zip(native, fmu):
+    for c in ["roll_des", "pitch_des", "yaw_des", "tilt_sat"] + figures:
+        assert a[c] == b[c], (a["t"], c, a[c], b[c])
+print(f"roll_des, pitch_des, yaw_des, tilt_sat and {len(figures)} figures of the controller identical")
+PY
   local figure native fmu
   for figure in position_max_m position_rmse_m; do
     native="$(tracking_figure "$tmp/native" $figure)"; fmu="$(tracking_figure "$tmp/fmu" $figure)"

@@ -3,7 +3,9 @@
 // dt = plant period (s) * divider on the inputs as they were set before the call (held over the
 // step), and the outputs after it are the command of the last of them. A master that sets the
 // sensor inputs at t, steps the controller, then passes its command to the plant for [t, t + h)
-// (Gauss-Seidel) flies it as a quadcosim run does.
+// (Gauss-Seidel) flies it as a quadcosim run does. Beside the command it outputs what the last step
+// tracked (roll_des, pitch_des, yaw_des, tilt_saturated) and the controller's own figures, by the names
+// a controller that decides rotor speeds reports them (control::ReportedOutputs).
 //
 // The observation is built as the node builds it (the attitude's Z-Y-X angles from q_WB by
 // model::euler_from_quaternion) and is always fresh: the node's stale-data safety has no counterpart
@@ -17,6 +19,7 @@
 // of the configured setpoint.
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "controllers/registry.hpp"
 #include "fmi/export/slave.hpp"
@@ -47,7 +50,9 @@ class ControllerModel final : public Model {
         ref_yaw_rate_(find_vr(md, "ref.yaw_rate")),
         ref_roll_(find_vr(md, "ref.roll")),
         ref_pitch_(find_vr(md, "ref.pitch")),
-        omega_cmd_(find_vrs(md, names::kOmegaCmd)) {
+        omega_cmd_(find_vrs(md, names::kOmegaCmd)),
+        attitude_des_(find_vrs(md, names::kReportedAttitude)),
+        tilt_saturated_(find_vr(md, names::kTiltSaturated)) {
     if (c.trajectory) {
       try {
         trajectory_ = trajectory::make_trajectory(*c.trajectory);
@@ -70,6 +75,7 @@ class ControllerModel final : public Model {
                              std::string(s.name), s.is_choice()});
     }
     output_.outputs.assign(controller_->output_names().size(), 0.0);
+    for (const std::string& name : controller_->output_names()) figures_.push_back(find_vr(md, name));
   }
   ControllerModel(const ControllerModel& o)
       : period_ns_(o.period_ns_),
@@ -89,6 +95,9 @@ class ControllerModel final : public Model {
         ref_roll_(o.ref_roll_),
         ref_pitch_(o.ref_pitch_),
         omega_cmd_(o.omega_cmd_),
+        attitude_des_(o.attitude_des_),
+        tilt_saturated_(o.tilt_saturated_),
+        figures_(o.figures_),
         trajectory_(o.trajectory_),
         ref_external_(o.ref_external_),
         external_(o.external_),
@@ -101,6 +110,9 @@ class ControllerModel final : public Model {
 
   std::string initialize(sim::Tick, Values& v) override {
     for (const ValueReference vr : omega_cmd_) v.number[vr] = 0.0;  // no command before the first step
+    for (const ValueReference vr : attitude_des_) v.number[vr] = 0.0;
+    v.number[tilt_saturated_] = 0.0;
+    for (const ValueReference vr : figures_) v.number[vr] = 0.0;
     external_ = ref_external_ && v.number[*ref_external_] != 0.0;
     return {};
   }
@@ -153,6 +165,11 @@ class ControllerModel final : public Model {
       controller_->step(o, r, dt_s_, output_);
     }
     for (std::size_t i = 0; i < 4; ++i) v.number[omega_cmd_[i]] = output_.omega_rad_s[static_cast<Eigen::Index>(i)];
+    v.number[attitude_des_[0]] = output_.roll_des_rad;
+    v.number[attitude_des_[1]] = output_.pitch_des_rad;
+    v.number[attitude_des_[2]] = output_.yaw_des_rad;
+    v.number[tilt_saturated_] = output_.tilt_saturated ? 1.0 : 0.0;
+    for (std::size_t i = 0; i < figures_.size(); ++i) v.number[figures_[i]] = output_.outputs[i];
     if (!output_.omega_rad_s.allFinite()) return "the controller's command is not finite";
     return {};
   }
@@ -188,6 +205,9 @@ class ControllerModel final : public Model {
   std::array<ValueReference, 3> w_, f_, ref_p_, ref_v_, ref_a_, ref_j_;
   ValueReference ref_yaw_, ref_yaw_rate_, ref_roll_, ref_pitch_;
   std::array<ValueReference, 4> omega_cmd_;
+  std::array<ValueReference, 3> attitude_des_;  ///< roll_des, pitch_des, yaw_des
+  ValueReference tilt_saturated_;
+  std::vector<ValueReference> figures_;  ///< the controller's output_names(), in order
   /// The trajectory the configuration carries (null: none), and the parameter ref.external: its
   /// value reference and its value at initialisation.
   std::shared_ptr<const trajectory::Trajectory> trajectory_;

@@ -681,6 +681,25 @@ void controller_variables(const FmuConfig& c, Builder& b) {
   b.outputs(names::kOmegaCmd, Variability::kDiscrete, "rad/s",
             "rotor speed command of the latest control step (0 before the first step)");
 
+  const control::ControllerConfig cc = controllers::make_config(c.controller_type, c.vehicle);
+  std::unique_ptr<control::Controller> ctl = cc.controller->clone();
+  if (std::string err = ctl->set_parameters(c.controller_parameters); !err.empty()) {
+    throw FmuError("controller '" + c.controller_type + "': " + err);
+  }
+  // What the controller tracks and its own figures, under the names a controller that decides rotor
+  // speeds reports them by (control::ReportedOutputs): an importer shows its attitude setpoint, tilt
+  // flag and figures as quadcosim shows the native controller's.
+  for (const std::string_view name : names::kReportedAttitude) {
+    b.output(name, Variability::kDiscrete, "rad",
+             "attitude the latest control step tracked (Z-Y-X angles of its desired attitude; 0 before the first "
+             "step)");
+  }
+  b.output(names::kTiltSaturated, Variability::kDiscrete, "1",
+           "1 when the latest control step's tilt limit cut the attitude it asked for, else 0");
+  for (const std::string& name : ctl->output_names()) {
+    b.output(name, Variability::kDiscrete, "", "the controller's own figure " + name + " at the latest control step");
+  }
+
   if (c.trajectory) {
     b.parameter(names::kRefExternal, Variability::kFixed, "",
                 "false: the reference is the trajectory this FMU carries (" +
@@ -691,11 +710,6 @@ void controller_variables(const FmuConfig& c, Builder& b) {
         .type = VariableType::kBoolean;
   }
 
-  const control::ControllerConfig cc = controllers::make_config(c.controller_type, c.vehicle);
-  std::unique_ptr<control::Controller> ctl = cc.controller->clone();
-  if (std::string err = ctl->set_parameters(c.controller_parameters); !err.empty()) {
-    throw FmuError("controller '" + c.controller_type + "': " + err);
-  }
   for (const control::ParameterSpec& p : ctl->parameters()) {
     const control::ParameterValue value = *ctl->get_parameter(p.name);
     const std::string name = std::string(names::kControllerPrefix) + std::string(p.name);

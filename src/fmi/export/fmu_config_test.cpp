@@ -135,7 +135,15 @@ TEST(FmuConfig, ControllerVariablesAreTheTypesParameters) {
   const ModelDescription md = describe(c);
   EXPECT_EQ(md.model_identifier, "quadcosim_controller");
   EXPECT_EQ(md.step_size, 0.01);  // 4 x 2.5 ms
-  ASSERT_EQ(md.outputs.size(), 4u);
+  // The command, what the step tracked, then se3's 14 figures by their names.
+  std::vector<std::string> outputs;
+  for (const std::size_t i : md.outputs) outputs.push_back(md.variables[i].name);
+  const std::vector<std::string> expected = {
+      "omega_cmd[1]", "omega_cmd[2]",   "omega_cmd[3]", "omega_cmd[4]",  "roll_des", "pitch_des",
+      "yaw_des",      "tilt_saturated", "e_x.x",        "e_x.y",         "e_x.z",    "e_v.x",
+      "e_v.y",        "e_v.z",          "e_R.x",        "e_R.y",         "e_R.z",    "e_Omega.x",
+      "e_Omega.y",    "e_Omega.z",      "thrust",       "yaw_torque_cut"};
+  EXPECT_EQ(outputs, expected);
   bool k_x = false;
   for (const Variable& v : md.variables) {
     if (v.name == "controller.k_x.x") {
