@@ -7,9 +7,10 @@
 // It does not read the command's layout (a Simulink model uses the data only), so it is matched by
 // arrival. The vehicle model is quadcosim's (sim::PlantNode on the DDS transport, labels ignored).
 //
-// Beyond Simulink, for the test: it waits until a controller is matched before step 0 and publishes
-// a step again when its command has not come within 0.5 s (discovery may lose the first samples); it
-// reads each command's label only to count whether it answered the step it was taken for.
+// Beyond Simulink, for the test: it waits until a controller is matched before step 0 and, until the
+// first command came, publishes a step again when its command has not come within 0.5 s (discovery
+// may lose the first samples); it reads each command's label only to count whether it answered the
+// step it was taken for.
 //
 //   usage: waiting_plant SCENARIO TRAJECTORY_CSV [TIMEOUT_S]
 // Writes the trajectory as quadcosim's trajectory.csv (no controller columns) and one JSON line:
@@ -80,7 +81,10 @@ int main(int argc, char** argv) try {
                        clock.seconds(k));
           return 4;
         }
-        if (now - last_ask > std::chrono::milliseconds(500)) {
+        // Asked again only until the first command came: discovery may lose the first samples, but
+        // once commands flow the samples are delivered (reliable), and a step asked twice under load
+        // got two answers, the late one taken for the next step's (seen once under load: 4 of 751 off).
+        if (commands == 0 && now - last_ask > std::chrono::milliseconds(500)) {
           plant.publish_outputs(k);
           last_ask = now;
         }
