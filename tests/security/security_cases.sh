@@ -257,8 +257,15 @@ EOF
     grep -q "rq/attitude_controller/set_parametersRequest failed: Not Allowed By Security" "$tmp/station_set.log" \
       || fail "the parameter change was not refused by access control"
     # Reading parameters and the denied topic itself stays allowed.
-    in_station "'$bin' param get /attitude_controller z_des" > "$tmp/station_get.log" 2>&1 \
-      || fail "the station cannot read a parameter"
+    # z_des is 0 until the scenario's schedule sets 10 m at the start of the run (a read under load can
+    # come first); it must become 10 and never be the station's 8.
+    for attempt in 1 2 3 4 5 6; do
+      in_station "'$bin' param get /attitude_controller z_des" > "$tmp/station_get.log" 2>&1 \
+        || fail "the station cannot read a parameter"
+      ! grep -qx "Double value is: 8.0" "$tmp/station_get.log" || fail "the station changed z_des"
+      grep -qx "Double value is: 10.0" "$tmp/station_get.log" && break
+      sleep 0.5
+    done
     grep -qx "Double value is: 10.0" "$tmp/station_get.log" || fail "z_des changed: $(cat "$tmp/station_get.log")"
     in_station "'$bin' topic echo /drone/motor_commands --count 1 --wait 5" > "$tmp/station_cmd.log" 2>&1 \
       || fail "the station cannot read /drone/motor_commands"
