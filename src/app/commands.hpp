@@ -11,7 +11,8 @@
 
 namespace CLI {
 class App;
-}
+class Option;
+}  // namespace CLI
 namespace quadcosim::io {
 class OutputFolder;
 }
@@ -83,6 +84,10 @@ struct ParamsOptions {
 /// meaning.
 int params_command(const ParamsOptions& options);
 CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& options);
+
+/// Checks a --controller value as io::parse_controller_choice reads it (a registered type,
+/// python:MODULE:CLASS or fmu:PATH); a refused value's message is the parser's.
+void check_controller_choice(CLI::Option& option);
 
 struct SummaryOptions {
   std::vector<std::string> run_dirs;

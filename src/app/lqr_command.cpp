@@ -31,20 +31,10 @@ CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& lqr) {
 CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
   auto* params_cmd = app.add_subcommand(
       "params", "list the controller node's and a controller's parameters (or the vehicle's), and the controllers");
-  params_cmd
-      ->add_option("--controller", params.controller,
-                   "the controller whose parameters follow the node's: a type (default paper; see --list), "
-                   "python:MODULE:CLASS (a class's declared parameters) or fmu:PATH (an FMU's)")
-      ->check(CLI::Validator(
-          [](std::string& value) -> std::string {
-            try {
-              (void)io::parse_controller_choice(value);
-              return "";
-            } catch (const std::invalid_argument& e) {
-              return e.what();
-            }
-          },
-          "TYPE|python:MODULE:CLASS|fmu:PATH"));
+  check_controller_choice(
+      *params_cmd->add_option("--controller", params.controller,
+                              "the controller whose parameters follow the node's: a type (default paper; see "
+                              "--list), python:MODULE:CLASS (a class's declared parameters) or fmu:PATH (an FMU's)"));
   params_cmd->add_flag("--list", params.list, "list the registered controller types instead");
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")

@@ -52,20 +52,24 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
   return sc;
 }
 
+void check_controller_choice(CLI::Option& option) {
+  option.check(CLI::Validator(
+      [](std::string& value) -> std::string {
+        try {
+          (void)io::parse_controller_choice(value);
+          return "";
+        } catch (const std::invalid_argument& e) {
+          return e.what();
+        }
+      },
+      "TYPE|python:MODULE:CLASS|fmu:PATH"));
+}
+
 void add_controller_type_option(CLI::App& cmd, std::string& type) {
-  cmd.add_option("--controller", type,
-                 "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
-                 "python:MODULE:CLASS or fmu:PATH; the scenario's setpoints, reference and criteria stay")
-      ->check(CLI::Validator(
-          [](std::string& value) -> std::string {
-            try {
-              (void)io::parse_controller_choice(value);
-              return "";
-            } catch (const std::invalid_argument& e) {
-              return e.what();
-            }
-          },
-          "TYPE|python:MODULE:CLASS|fmu:PATH"));
+  check_controller_choice(
+      *cmd.add_option("--controller", type,
+                      "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
+                      "python:MODULE:CLASS or fmu:PATH; the scenario's setpoints, reference and criteria stay"));
 }
 
 void add_judge_option(CLI::App& cmd, std::string& judge) {
