@@ -107,4 +107,16 @@ std::string set_parameter(ControllerConfig& config, std::string_view name, const
 
 const char* to_string(SafetyMode mode) { return mode == SafetyMode::kStop ? "stop" : "hover"; }
 
+Reference trajectory_reference(const trajectory::FlatOutput& f, const Eigen::Vector3d& offset_W) {
+  Reference r;
+  r.mode = Mode::kPosition;
+  r.p_W = f.p_W + offset_W;
+  r.v_W = f.v_W;
+  r.a_W = f.a_W;
+  r.j_W = f.j_W;
+  r.yaw_rad = f.yaw_rad;
+  r.yaw_rate_rad_s = f.yaw_rate_rad_s;
+  return r;
+}
+
 }  // namespace quadcosim::control

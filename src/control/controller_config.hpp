@@ -90,4 +90,10 @@ std::string set_parameter(ControllerConfig& config, std::string_view name, const
 
 const char* to_string(SafetyMode mode);
 
+/// The position-mode reference of a trajectory's flat outputs `f`, shifted by `offset_W` (a swarm
+/// vehicle's place on its grid), roll and pitch setpoints 0: what a controller flies at each step of a
+/// trajectory, in the node (sim::ControllerCore) and in a controller FMU that carries one.
+Reference trajectory_reference(const trajectory::FlatOutput& f,
+                               const Eigen::Vector3d& offset_W = Eigen::Vector3d::Zero());
+
 }  // namespace quadcosim::control

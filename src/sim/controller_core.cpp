@@ -67,16 +67,8 @@ void ControllerCore::safety_output(const control::Reference& ref, control::Contr
 
 void ControllerCore::update_reference(std::int64_t now_ns) {
   if (trajectory_) {
-    const trajectory::FlatOutput f = trajectory_->at(static_cast<double>(now_ns) / 1e9);
-    reference_.mode = control::Mode::kPosition;
-    reference_.p_W = f.p_W + trajectory_offset_W_;
-    reference_.v_W = f.v_W;
-    reference_.a_W = f.a_W;
-    reference_.j_W = f.j_W;
-    reference_.yaw_rad = f.yaw_rad;
-    reference_.yaw_rate_rad_s = f.yaw_rate_rad_s;
-    reference_.roll_rad = 0.0;
-    reference_.pitch_rad = 0.0;
+    reference_ =
+        control::trajectory_reference(trajectory_->at(static_cast<double>(now_ns) / 1e9), trajectory_offset_W_);
     return;
   }
   const control::Setpoint& sp = settings_.setpoint;

@@ -149,18 +149,11 @@ class ControllerModel final : public Model {
     r.yaw_rate_rad_s = v.number[ref_yaw_rate_];
     r.roll_rad = v.number[ref_roll_];
     r.pitch_rad = v.number[ref_pitch_];
-    if (trajectory_ && !external_) r.roll_rad = r.pitch_rad = 0.0;
 
     for (std::int64_t i = 0; i < n; ++i) {
       if (trajectory_ && !external_) {
         // The step's time in integer nanoseconds, then seconds: the same double the node computes.
-        const trajectory::FlatOutput f = trajectory_->at(static_cast<double>((k + i) * period_ns_) / 1e9);
-        r.p_W = f.p_W;
-        r.v_W = f.v_W;
-        r.a_W = f.a_W;
-        r.j_W = f.j_W;
-        r.yaw_rad = f.yaw_rad;
-        r.yaw_rate_rad_s = f.yaw_rate_rad_s;
+        r = control::trajectory_reference(trajectory_->at(static_cast<double>((k + i) * period_ns_) / 1e9));
       }
       controller_->step(o, r, dt_s_, output_);
     }

@@ -88,6 +88,22 @@ FmuConfig altitude_step() {
   return c;
 }
 
+/// The observation sim::ControllerNode builds from the plant's outputs `y`.
+control::Observation observe(const model::Outputs& y) {
+  control::Observation o;
+  o.p_W = y.p_W;
+  o.v_W = y.v_W;
+  o.q_WB = y.q_WB;
+  const model::Euler e = model::euler_from_quaternion(y.q_WB);
+  o.roll_rad = e.roll_rad;
+  o.pitch_rad = e.pitch_rad;
+  o.yaw_rad = e.yaw_rad;
+  o.w_B = y.w_B;
+  o.specific_force_B = y.specific_force_B;
+  o.age_s = 0.0;
+  return o;
+}
+
 TEST(FmuController, FliesThePapersAltitudeStepAsTheNativeControllerDoes) {
   const FmuConfig c = altitude_step();
   Controller fmu(c);
@@ -111,18 +127,7 @@ TEST(FmuController, FliesThePapersAltitudeStepAsTheNativeControllerDoes) {
     ASSERT_EQ(fmu.step(clock.seconds(k), dt), fmi2OK) << fmu.log_.last();
     const model::Vector4 cmd = fmu.command();
 
-    control::Observation o;
-    o.p_W = y.p_W;
-    o.v_W = y.v_W;
-    o.q_WB = y.q_WB;
-    const model::Euler e = model::euler_from_quaternion(y.q_WB);
-    o.roll_rad = e.roll_rad;
-    o.pitch_rad = e.pitch_rad;
-    o.yaw_rad = e.yaw_rad;
-    o.w_B = y.w_B;
-    o.specific_force_B = y.specific_force_B;
-    o.age_s = 0.0;
-    native->step(o, ref, dt, out);
+    native->step(observe(y), ref, dt, out);
     for (int i = 0; i < 4; ++i) {
       ASSERT_EQ(std::memcmp(&cmd[i], &out.omega_rad_s[i], sizeof(double)), 0)
           << "rotor " << i + 1 << " at t = " << clock.seconds(k) << ": " << cmd[i] << " vs " << out.omega_rad_s[i];
@@ -145,34 +150,6 @@ TEST(FmuController, FliesThePapersAltitudeStepAsTheNativeControllerDoes) {
   EXPECT_GT(t_peak, 2.0);
   EXPECT_LT(t_peak, 3.0);
   EXPECT_NEAR(x.p_W.z(), 10.0, 0.2);
-}
-
-/// The observation sim::ControllerNode builds from the plant's outputs `y`.
-control::Observation observe(const model::Outputs& y) {
-  control::Observation o;
-  o.p_W = y.p_W;
-  o.v_W = y.v_W;
-  o.q_WB = y.q_WB;
-  const model::Euler e = model::euler_from_quaternion(y.q_WB);
-  o.roll_rad = e.roll_rad;
-  o.pitch_rad = e.pitch_rad;
-  o.yaw_rad = e.yaw_rad;
-  o.w_B = y.w_B;
-  o.specific_force_B = y.specific_force_B;
-  o.age_s = 0.0;
-  return o;
-}
-
-control::Reference position_reference(const trajectory::FlatOutput& f) {
-  control::Reference r;
-  r.mode = control::Mode::kPosition;
-  r.p_W = f.p_W;
-  r.v_W = f.v_W;
-  r.a_W = f.a_W;
-  r.j_W = f.j_W;
-  r.yaw_rad = f.yaw_rad;
-  r.yaw_rate_rad_s = f.yaw_rate_rad_s;
-  return r;
 }
 
 TEST(FmuController, FliesTheCircleItCarriesFromItsOwnTime) {
@@ -225,8 +202,8 @@ TEST(FmuController, FliesTheCircleItCarriesFromItsOwnTime) {
     for (int i = 0; i < periods; ++i) {
       // Each control step's own time, from integer nanoseconds as sim::ControllerCore takes it.
       const std::int64_t now_ns = (k + i * c.controller_divider) * c.plant_period_ns;
-      native_own->step(o, position_reference(path->at(static_cast<double>(now_ns) / 1e9)), dt, out_own);
-      native_external->step(o, position_reference(moved), dt, out_external);
+      native_own->step(o, control::trajectory_reference(path->at(static_cast<double>(now_ns) / 1e9)), dt, out_own);
+      native_external->step(o, control::trajectory_reference(moved), dt, out_external);
     }
     const model::Vector4 cmd = own.command(), cmd_external = external.command();
     for (int i = 0; i < 4; ++i) {
