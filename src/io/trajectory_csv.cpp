@@ -74,7 +74,7 @@ void TrajectoryWriter::write_header(std::span<const std::string> output_names) {
     header += "," + column;
   }
   header += '\n';
-  buffer_.insert(0, header);
+  buffer_ += header;  // before any row: the first write() or close() calls this first
   header_written_ = true;
 }
 
