@@ -9,29 +9,10 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/swarm_inprocess.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {
-
-/// In-process swarms advance each vehicle 100 ticks (1 s at 100 Hz) at a time (sim::Swarm::run).
-constexpr sim::Tick kSwarmBlockTicks = 100;
-
-/// The scenario's swarm section (defaults when it has none) with --vehicles / --threads applied
-/// (values <= 0 leave the scenario's); recorded vehicles beyond N are dropped.
-io::SwarmSpec swarm_spec(const io::Scenario& sc, int vehicles, int threads);
-
-/// One vehicle at the end of a swarm run.
-struct SwarmFinal {
-  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();      ///< final position [m]
-  Eigen::Vector3d p_des_W = Eigen::Vector3d::Zero();  ///< its setpoint [m]
-  bool safety = false;                                ///< its last command was the safety command
-  std::uint64_t rejected = 0;                         ///< motor commands its plant rejected
-};
-
-/// Writes out/summary.json (run_figures + layout + error spread) and out/vehicles.csv.
-void write_swarm_summary(const std::filesystem::path& out, const io::Scenario& sc, const io::SwarmSpec& spec,
-                         const std::vector<std::string>& namespaces, const std::vector<SwarmFinal>& rows,
-                         const nlohmann::json& run_figures);
 
 /// `run` for a swarm into `out`, the folder `folder` has claimed: exit codes as `run` (0 all recorded
 /// vehicles pass their step criteria and the scenario's analysis.limits); adds "recorded" (each

@@ -308,7 +308,8 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
     }
     write_swarm_summary(
         o.swarm.out, sc, spec, namespaces, rows,
-        {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
+        {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}},
+        std::cout);
   }
   return exit_code::kOk;
 }

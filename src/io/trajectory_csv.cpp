@@ -21,7 +21,7 @@ namespace quadcosim::io {
 
 ControlColumns ControlColumns::none() {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  return {nan, nan, nan, nan, nan, nan, Eigen::Vector4d::Constant(nan), false, {}, false, nan};
+  return {nan, nan, nan, nan, nan, nan, Eigen::Vector4d::Constant(nan), false, {}, false, nan, {}, {}};
 }
 
 ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {

@@ -24,11 +24,13 @@
 #include <vector>
 
 #include "app/inprocess_run.hpp"
+#include "app/swarm_inprocess.hpp"
 #include "batch.hpp"
 #include "control/care.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
 #include "io/scenario.hpp"
+#include "io/scenario_limits.hpp"
 #include "io/trajectory_csv.hpp"
 #include "io/yaml_reader.hpp"
 #include "python/py_controller.hpp"
@@ -310,24 +312,52 @@ struct TempDir {
   }
 };
 
-/// Flies `s` as `quadcosim run` does in process; the parts the Python RunResult is made of.
-py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool force, const std::string& judge_name) {
+/// The scenario as flown, as `quadcosim run` writes it: the file, or with the controller applied.
+std::string flown_scenario_text(const PyScenario& s) {
+  if (s.from_file && s.controller_override != "python") {
+    return io::effective_scenario_text(s.source, s.controller_override);
+  }
+  const std::string comment =
+      s.controller_override.empty()
+          ? ""
+          : "The scenario as flown: " + s.source + " with its controller replaced by the Python class " +
+                io::python_target_of(s.root) +
+                ".\n(Written by quadcosim from the parsed document; its comments are not kept.)";
+  return io::scenario_text(s.root, comment);
+}
+
+py::dict columns_dict(std::vector<std::pair<std::string, std::vector<double>>>& columns) {
+  py::dict d;
+  for (auto& [name, values] : columns) {
+    py::array_t<double> a(static_cast<py::ssize_t>(values.size()));
+    std::copy(values.begin(), values.end(), a.mutable_data());
+    d[py::str(name)] = std::move(a);
+  }
+  return d;
+}
+
+/// Flies `s` as `quadcosim run` does in process; the parts the Python RunResult (or, for a swarm: a
+/// scenario with a swarm section or vehicles > 0, the SwarmResult) is made of.
+py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool force, const std::string& judge_name,
+             int vehicles, int threads) {
   const std::optional<io::Judge> judge = io::parse_judge(judge_name);
   if (!judge) {
     throw py::value_error("judge: got '" + judge_name + "', expected 'spec', 'paper' or 'none'");
   }
-  if (s.scenario.swarm) {
-    throw py::value_error(s.source +
-                          ": swarm: scenarios with a swarm section cannot be run from Python yet; use "
-                          "`quadcosim run`");
-  }
+  const bool swarm = vehicles > 0 || s.scenario.swarm.has_value();
+  const io::SwarmSpec spec = app::swarm_spec(s.scenario, vehicles, threads);
+  if (swarm) io::check_swarm_fits(spec.layout.vehicles);
   std::optional<TempDir> temp;
   std::optional<io::OutputFolder> folder;
   fs::path dir;
   std::ostringstream notes, info, warn;
   app::RunJudgement judged;
+  app::SwarmJudgement swarm_judged;
   std::vector<std::pair<std::string, std::vector<double>>> columns;
-  std::string metrics;
+  std::vector<std::string> recorded_dirs;
+  std::vector<std::vector<std::pair<std::string, std::vector<double>>>> recorded_columns;
+  std::vector<std::string> recorded_metrics, recorded_tables;
+  std::string metrics, vehicles_csv;
   bool interrupted = false;
   {
     py::gil_scoped_release release;
@@ -339,62 +369,76 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
       dir = temp->path;
     }
     try {
-      // The scenario as flown, as `quadcosim run` writes it: the file, or with the controller applied.
-      if (s.from_file && s.controller_override != "python") {
-        io::write_file_atomically(dir / "scenario.yaml", io::effective_scenario_text(s.source, s.controller_override));
-      } else {
-        const std::string comment =
-            s.controller_override.empty()
-                ? ""
-                : "The scenario as flown: " + s.source + " with its controller replaced by the Python class " +
-                      io::python_target_of(s.root) +
-                      ".\n(Written by quadcosim from the parsed document; its comments are not kept.)";
-        io::write_file_atomically(dir / "scenario.yaml", io::scenario_text(s.root, comment));
-      }
+      const std::string flown = flown_scenario_text(s);
+      io::write_file_atomically(dir / "scenario.yaml", flown);
       // Ctrl-C (or any pending Python signal handler's exception) ends the run as it ends the CLI's:
-      // what ran stays recorded. Checked every 4096 ticks (~50 µs of simulation).
-      sim::Tick ticks = 0;
-      const auto on_tick = [&](double) {
-        if (++ticks % 4096 != 0) return false;
+      // what ran stays recorded. Checked every 4096 ticks (~50 µs of simulation) of one vehicle, after
+      // each block of ticks of a swarm.
+      const auto signalled = [] {
         py::gil_scoped_acquire acquire;
         return PyErr_CheckSignals() != 0;  // the exception stays set for the caller
       };
       const nlohmann::json provenance = io::describe_run(
           s.scenario, {.controller_override = s.controller_override, .python_target = io::python_target_of(s.root)});
-      const bool completed = app::fly_inprocess(s.scenario, dir, info, warn, on_tick);
-      io::add_provenance_to_bag_metadata(dir, provenance);
-      if (!completed) {
-        interrupted = true;
+      if (swarm) {
+        recorded_dirs = app::make_recorded_dirs(dir, spec, flown);
+        interrupted = !app::fly_swarm_inprocess(s.scenario, spec, dir, info, [&](double) { return signalled(); });
+        if (!interrupted) swarm_judged = app::judge_swarm(s.scenario, spec, dir, *judge, provenance);
       } else {
-        judged = app::judge_run(s.scenario, dir, *judge, provenance);
+        sim::Tick ticks = 0;
+        const auto on_tick = [&](double) { return ++ticks % 4096 == 0 && signalled(); };
+        interrupted = !app::fly_inprocess(s.scenario, dir, info, warn, on_tick);
+        io::add_provenance_to_bag_metadata(dir, provenance);
+        if (!interrupted) judged = app::judge_run(s.scenario, dir, *judge, provenance);
       }
     } catch (const control::CareError& e) {
       throw io::ConfigError(s.source + ": controller design failed: " + e.what());
     } catch (const std::invalid_argument& e) {
       throw io::ConfigError(s.source + ": " + e.what());
     }
-    if (!interrupted) {
+    if (!interrupted && swarm) {
+      for (const std::string& d : recorded_dirs) {
+        recorded_columns.push_back(read_csv_columns(dir / d / "trajectory.csv"));
+        recorded_metrics.push_back(read_text(dir / d / "metrics.json"));
+        recorded_tables.push_back(read_text(dir / d / "metrics.txt"));
+      }
+      metrics = read_text(dir / "summary.json");
+      vehicles_csv = read_text(dir / "vehicles.csv");
+      for (const std::string& w : swarm_judged.warnings) warn << w << '\n';
+    } else if (!interrupted) {
       columns = read_csv_columns(dir / "trajectory.csv");
       metrics = read_text(dir / "metrics.json");
     }
   }
   if (interrupted) throw py::error_already_set();
-  py::dict trajectory;
-  for (auto& [name, values] : columns) {
-    py::array_t<double> a(static_cast<py::ssize_t>(values.size()));
-    std::copy(values.begin(), values.end(), a.mutable_data());
-    trajectory[py::str(name)] = std::move(a);
-  }
   py::dict r;
-  r["trajectory"] = trajectory;
+  r["judged"] = io::to_string(*judge);
+  r["messages"] = notes.str() + warn.str() + info.str();
+  r["out"] = out ? py::object(py::str(*out)) : py::object(py::none());
+  if (swarm) {
+    py::list recorded;
+    for (std::size_t i = 0; i < recorded_dirs.size(); ++i) {
+      py::dict v;
+      v["namespace"] = "/" + recorded_dirs[i];
+      v["trajectory"] = columns_dict(recorded_columns[i]);
+      v["metrics_json"] = recorded_metrics[i];
+      v["table"] = recorded_tables[i];
+      recorded.append(v);
+    }
+    r["swarm"] = true;
+    r["summary_json"] = metrics;
+    r["vehicles_csv"] = vehicles_csv;
+    r["recorded"] = recorded;
+    r["passed"] = *judge == io::Judge::kNone ? py::object(py::none()) : py::object(py::bool_(swarm_judged.passed));
+    return r;
+  }
+  r["swarm"] = false;
+  r["trajectory"] = columns_dict(columns);
   r["metrics_json"] = metrics;
   // No verdict under judge="none" (metrics.json's "passed" is null there too).
   r["passed"] = *judge == io::Judge::kNone ? py::object(py::none()) : py::object(py::bool_(judged.passed));
-  r["judged"] = io::to_string(*judge);
   r["judged_note"] = judged.nothing_note;
   r["table"] = judged.table;
-  r["messages"] = notes.str() + warn.str() + info.str();
-  r["out"] = out ? py::object(py::str(*out)) : py::object(py::none());
   return r;
 }
 
@@ -702,7 +746,8 @@ Made by quadcosim.load_scenario(path_or_dict); pass it to quadcosim.run() or qua
         "A scenario (a Scenario, file or dict) flown by its controller, a controller type (str) or a Python "
         "controller (instance or class).");
   m.def("_run", &run, py::arg("scenario"), py::arg("out"), py::arg("force") = false, py::arg("judge") = "spec",
-        "Runs a scenario in process as `quadcosim run` does; the parts of a RunResult.");
+        py::arg("vehicles") = 0, py::arg("threads") = 0,
+        "Runs a scenario in process as `quadcosim run` does; the parts of a RunResult (a SwarmResult for a swarm).");
 
   py::class_<PySimulation>(m, "Simulation", R"(One vehicle of a scenario, stepped one control period at a time.
 

@@ -1,6 +1,7 @@
 #include "sim/swarm.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
 #include <mutex>
@@ -56,17 +57,20 @@ Swarm::Swarm(const SimulationConfig& simulation, const model::VehicleParams& veh
   }
 }
 
-void Swarm::run(int threads, Tick block_ticks, const std::vector<bool>& recorded, const Recorder& recorder) {
-  run_ticks(0, duration_ticks_, threads, block_ticks, recorded, recorder);
+bool Swarm::run(int threads, Tick block_ticks, const std::vector<bool>& recorded, const Recorder& recorder,
+                const StopCheck& stop) {
+  return run_ticks(0, duration_ticks_, threads, block_ticks, recorded, recorder, stop);
 }
 
-void Swarm::run_ticks(Tick first_tick, Tick last_tick, int threads, Tick block_ticks, const std::vector<bool>& recorded,
-                      const Recorder& recorder) {
+bool Swarm::run_ticks(Tick first_tick, Tick last_tick, int threads, Tick block_ticks, const std::vector<bool>& recorded,
+                      const Recorder& recorder, const StopCheck& stop) {
   last_tick = std::min(last_tick, duration_ticks_);
   threads = std::clamp(threads, 1, std::max(1, size()));
   block_ticks = std::max<Tick>(block_ticks, 1);
   std::exception_ptr failure;
   std::mutex failure_mutex;
+  std::atomic<bool> stopped{false};
+  const std::thread::id caller = std::this_thread::get_id();
   // Each thread owns a contiguous range of vehicles and runs it through every block; the vehicles do
   // not interact, so threads need no synchronisation beyond the final join.
   auto work = [&](int first, int last) {
@@ -84,6 +88,8 @@ void Swarm::run_ticks(Tick first_tick, Tick last_tick, int threads, Tick block_t
             }
           }
         }
+        if (stop && std::this_thread::get_id() == caller && stop(end)) stopped = true;
+        if (stopped) return;
         std::lock_guard lock(failure_mutex);
         if (failure) return;
       }
@@ -98,6 +104,7 @@ void Swarm::run_ticks(Tick first_tick, Tick last_tick, int threads, Tick block_t
   work(0, n / threads);
   for (auto& th : pool) th.join();
   if (failure) std::rethrow_exception(failure);
+  return !stopped;
 }
 
 }  // namespace quadcosim::sim

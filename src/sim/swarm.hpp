@@ -57,18 +57,25 @@ class Swarm {
   /// Called after the tick's latch for recorded vehicles only (on the thread that owns the vehicle).
   using Recorder = std::function<void(int vehicle, const TickRecord&)>;
 
+  /// Asked on the calling thread after each of its blocks, with the last tick that block flew: true
+  /// stops the run (every thread stops at the end of its current block).
+  using StopCheck = std::function<bool(Tick last_tick)>;
+
   /// Runs ticks 0..duration_ticks of every vehicle on `threads` threads (vehicles split in
-  /// contiguous ranges). Each thread takes its vehicles through the run in blocks of `block_ticks`:
-  /// within a block each vehicle runs its ticks back to back (its data stays in the cache), and at
-  /// the end of a block all of the thread's vehicles are at the same tick. `recorded[i]` (when not empty) selects
-  /// vehicles whose ticks go to `recorder`. Rethrows the first exception a vehicle raised (e.g. a refused scheduled
-  /// parameter).
-  void run(int threads, Tick block_ticks, const std::vector<bool>& recorded = {}, const Recorder& recorder = {});
+  /// contiguous ranges; the calling thread flies the first range). Each thread takes its vehicles
+  /// through the run in blocks of `block_ticks`: within a block each vehicle runs its ticks back to back
+  /// (its data stays in the cache), and at the end of a block all of the thread's vehicles are at the
+  /// same tick. `recorded[i]` (when not empty) selects vehicles whose ticks go to `recorder`. Every
+  /// thread lives until the run ends (what a vehicle starts on its thread, such as a controller's own
+  /// process, stays). Returns false when `stop` stopped the run. Rethrows the first exception a vehicle
+  /// raised (e.g. a refused scheduled parameter).
+  bool run(int threads, Tick block_ticks, const std::vector<bool>& recorded = {}, const Recorder& recorder = {},
+           const StopCheck& stop = {});
 
   /// The same for ticks first..last only (0 <= first, last <= duration_ticks); successive calls
   /// continue where the last one stopped (run() is run_ticks(0, duration_ticks, ...)).
-  void run_ticks(Tick first, Tick last, int threads, Tick block_ticks, const std::vector<bool>& recorded = {},
-                 const Recorder& recorder = {});
+  bool run_ticks(Tick first, Tick last, int threads, Tick block_ticks, const std::vector<bool>& recorded = {},
+                 const Recorder& recorder = {}, const StopCheck& stop = {});
 
   int size() const { return static_cast<int>(vehicles_.size()); }
   const Simulation& vehicle(int i) const { return *vehicles_[static_cast<std::size_t>(i)]; }

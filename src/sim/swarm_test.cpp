@@ -122,5 +122,29 @@ TEST(SwarmTest, ARefusedScheduledChangeStopsTheRunWithItsReason) {
   EXPECT_THROW(s.run(2, 100), std::invalid_argument);
 }
 
+TEST(SwarmTest, AStopCheckEndsEveryThreadAtABlockBoundary) {
+  SwarmLayout l;
+  l.vehicles = 4;  // 2 threads: the caller flies vehicles 0 and 1
+  Swarm s(config(), model::VehicleParams{}, model::State{}, position_mode(), schedule(), l);
+  std::vector<Tick> asked;
+  std::vector<int> ticks(4, 0);
+  const bool completed = s.run(
+      2, 50, std::vector<bool>(4, true), [&](int i, const TickRecord&) { ++ticks[static_cast<std::size_t>(i)]; },
+      [&](Tick last) {
+        asked.push_back(last);
+        return asked.size() == 3;
+      });
+  EXPECT_FALSE(completed);
+  EXPECT_EQ(asked, (std::vector<Tick>{49, 99, 149}));  // on the calling thread, after each of its blocks
+  EXPECT_EQ(ticks[0], 150);
+  EXPECT_EQ(ticks[1], 150);
+  for (int i : {2, 3}) {  // the other thread ends the block it is in (whole blocks), or had finished
+    const int n = ticks[static_cast<std::size_t>(i)];
+    EXPECT_TRUE(n == 601 || (n >= 50 && n % 50 == 0)) << "vehicle " << i << ": " << n << " ticks";
+  }
+  Swarm whole(config(), model::VehicleParams{}, model::State{}, position_mode(), schedule(), l);
+  EXPECT_TRUE(whole.run(2, 50, {}, {}, [](Tick) { return false; }));
+}
+
 }  // namespace
 }  // namespace quadcosim::sim

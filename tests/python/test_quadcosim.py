@@ -203,6 +203,71 @@ def test_ctrl_c_ends_a_run_keeping_what_ran(tmp_path):
     assert time.perf_counter() - start < 30.0
 
 
+# --- swarms -----------------------------------------------------------------------------------------------
+
+GRID_TAKEOFF = "scenarios/swarm/grid_takeoff.yaml"
+
+
+def test_a_swarm_flies_as_the_cli_flies_it(tmp_path):
+    """9 vehicles of the shipped swarm from Python (1 thread) and from the CLI (2 threads): the same
+    vehicles.csv and recorded trajectory, bit for bit; each vehicle's setpoint is the scenario's shifted
+    by its grid cell (docs/scenarios.md: 3 columns of 2 m, z_des 5 m + (i mod 3) x 1 m)."""
+    cli, py = tmp_path / "cli", tmp_path / "py"
+    done = subprocess.run([QUADCOSIM, "run", GRID_TAKEOFF, "--vehicles", "9", "--threads", "2", "--out", str(cli),
+                           "--no-plots"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+    result = quadcosim.run(GRID_TAKEOFF, out=py, vehicles=9, threads=1)
+    assert isinstance(result, quadcosim.SwarmResult) and result.passed is True
+    for name in ["vehicles.csv", "uav0000/trajectory.csv", "uav0000/metrics.txt", "uav0000/scenario.yaml"]:
+        assert filecmp.cmp(cli / name, py / name, shallow=False), name
+    assert not (py / "uav0063").exists()  # record_vehicles [0, 63]: 63 is beyond 9 vehicles
+    v = result.vehicles
+    assert v["namespace"] == [f"/uav{i:04d}" for i in range(9)]
+    i = np.arange(9)
+    assert np.array_equal(v["x_des_m"], (i % 3) * 2.0) and np.array_equal(v["y_des_m"], (i // 3) * 2.0)
+    assert np.array_equal(v["z_des_m"], 5.0 + (i % 3) * 1.0)
+    error = np.sqrt((v["x_m"] - v["x_des_m"]) ** 2 + (v["y_m"] - v["y_des_m"]) ** 2 + (v["z_m"] - v["z_des_m"]) ** 2)
+    assert np.allclose(error, v["error_m"], rtol=1e-12, atol=0) and v["error_m"].max() < 0.01
+    assert result.summary["vehicles"] == 9 and result.summary["final_error_m"]["max"] == v["error_m"].max()
+    assert result.summary["recorded"][0]["passed"] is True and result.summary["threads"] == 1
+    own = result.recorded["/uav0000"]
+    assert own.passed is True and own.out == str(py / "uav0000") and own.figures["steps"][0]["channel"] == "z"
+    assert own.trajectory["z"][-1] == v["z_m"][0] and own.trajectory["x"][-1] == v["x_m"][0]
+    assert own.table == (cli / "uav0000" / "metrics.txt").read_text()
+    assert result.provenance["controller"]["label"] == "paper" and "swarm: 9 vehicles" in result.messages
+
+
+def test_a_swarm_judged_none_and_bad_sizes(tmp_path):
+    none = quadcosim.run(GRID_TAKEOFF, vehicles=2, judge="none")
+    assert none.passed is None and none.recorded["/uav0000"].passed is None and none.out is None
+    one = quadcosim.run(hover_scenario(duration_s=1.0), vehicles=2)  # no swarm: section: records none
+    assert list(one.vehicles["index"]) == [0.0, 1.0] and one.recorded == {} and one.passed is True
+    for bad in (0, -3, 1.5, True):
+        with pytest.raises(ValueError, match=r"vehicles: got .*, expected a whole number >= 1"):
+            quadcosim.run(GRID_TAKEOFF, vehicles=bad)
+    with pytest.raises(ValueError, match=r"threads: got 0"):
+        quadcosim.run(GRID_TAKEOFF, threads=0)
+
+
+def test_ctrl_c_ends_a_swarm_keeping_what_ran(tmp_path):
+    """4 vehicles for an hour: a SIGINT 0.2 s in ends it with KeyboardInterrupt after the block being
+    flown; the recorded vehicle's trajectory.csv holds whole rows, and no summary claims an end."""
+    import _thread
+    import threading
+    long = dict(hover_scenario(duration_s=3600.0), swarm={"vehicles": 4, "record_vehicles": [1]})
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            quadcosim.run(long, out=tmp_path / "long")
+    finally:
+        timer.cancel()
+    lines = (tmp_path / "long" / "uav0001" / "trajectory.csv").read_text().splitlines()
+    assert 2 < len(lines) < 360_002
+    assert all(len(line.split(",")) == len(lines[0].split(",")) for line in lines)
+    assert not (tmp_path / "long" / "summary.json").exists()
+
+
 # --- stepping -------------------------------------------------------------------------------------------
 
 

@@ -27,7 +27,7 @@ from . import _quadcosim
 from .batch import Batch  # noqa: E402  (N vehicles stepped together; docs/python.md)
 from . import envs  # noqa: E402  (Gymnasium-style environments: HoverEnv, TrackingEnv, VectorHoverEnv, ...)
 
-__all__ = ["ConfigError", "Controller", "ControllerError", "Observation", "Reference", "StepTimeout", "Scenario",
+__all__ = ["ConfigError", "Controller", "ControllerError", "Observation", "Reference", "StepTimeout", "Scenario", "SwarmResult",
            "Simulation", "RunResult", "load_scenario", "run"]
 
 ScenarioLike = Union[Scenario, dict, str, "os.PathLike[str]"]
@@ -100,6 +100,45 @@ class RunResult:
         return f"RunResult(passed={self.passed}, {n} ticks, figures={sorted(self.figures)}, out={self.out!r})"
 
 
+@dataclass
+class SwarmResult:
+    """What quadcosim.run() returns for a swarm (a scenario with a swarm: section, or vehicles=N).
+
+    vehicles: vehicles.csv as a dict of numpy arrays (index, x_m, y_m, z_m, x_des_m, y_des_m, z_des_m,
+        error_m, safety, commands_rejected: one value per vehicle) and "namespace" (a list of str).
+    recorded: namespace -> RunResult for each vehicle of swarm.record_vehicles ("/uav0000": its
+        trajectory, figures, passed, metrics, table), the same doubles as its <ns>/trajectory.csv.
+    passed: no recorded vehicle failed a judged criterion (`quadcosim run` exits 0 exactly when it is not
+        False); None with judge="none".
+    summary: summary.json as a dict (layout, final_error_m spread, vehicles_in_safety, wall_s, ...,
+        "recorded" verdicts, "provenance").
+    messages, out, provenance, judged: as RunResult's.
+    """
+
+    vehicles: Dict[str, Any]
+    recorded: Dict[str, RunResult]
+    passed: Optional[bool]
+    summary: Dict[str, Any] = field(repr=False)
+    messages: str = field(repr=False)
+    out: Optional[str] = None
+    provenance: Dict[str, Any] = field(default_factory=dict, repr=False)
+    judged: str = "spec"
+
+    def __repr__(self) -> str:
+        n = len(self.vehicles.get("index", []))
+        return (f"SwarmResult(passed={self.passed}, {n} vehicles, recorded={sorted(self.recorded)}, "
+                f"out={self.out!r})")
+
+
+def _vehicles_columns(text: str) -> Dict[str, Any]:
+    """vehicles.csv as columns: numpy float64 arrays, the namespace as a list of str."""
+    lines = text.splitlines()
+    names = lines[0].split(",")
+    rows = [line.split(",") for line in lines[1:]]
+    return {name: ([r[i] for r in rows] if name == "namespace" else numpy.array([float(r[i]) for r in rows]))
+            for i, name in enumerate(names)}
+
+
 class Controller:
     """A convenience base class for controllers written in Python (any object with step() flies).
 
@@ -155,7 +194,8 @@ _JUDGE_SETS = ("spec", "paper", "none")
 
 def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = None,
         controller: Any = None, force: bool = False, step_timeout_s: Optional[float] = None,
-        judge: str = "spec") -> RunResult:
+        judge: str = "spec", vehicles: Optional[int] = None,
+        threads: Optional[int] = None) -> Union[RunResult, SwarmResult]:
     """Runs a scenario in process, as `quadcosim run SCENARIO --out OUT --no-plots` does.
 
     scenario: a Scenario, a scenario file or a dict (see load_scenario).
@@ -176,18 +216,44 @@ def run(scenario: ScenarioLike, out: Optional[Union[str, "os.PathLike[str]"]] = 
         measured response bands) or "none" (figures only: every figure computed, passed is None).
         Every figure and both sets' bands are in metrics.json whatever is judged.
 
-    Ctrl-C raises KeyboardInterrupt within a few thousand plant ticks; out then holds what ran, as
-    after an interrupted `quadcosim run`.
+    vehicles: a swarm of N vehicles on a grid, as `quadcosim run --vehicles N` (None: the scenario's
+        swarm: section, or one vehicle when it has none). threads: the swarm's worker threads, as
+        --threads (None: swarm.threads, 2). A swarm returns a SwarmResult and writes what the CLI's
+        in-process swarm writes: vehicles.csv, summary.json, and trajectory.csv, metrics.json,
+        metrics.txt and scenario.yaml of each recorded vehicle in <out>/<namespace>.
 
-    Returns a RunResult (trajectory, figures, passed, ...). Raises ConfigError for a bad scenario,
-    ValueError when out cannot be used (it holds other outputs), RuntimeError on an I/O error.
+    Ctrl-C raises KeyboardInterrupt within a few thousand plant ticks (a swarm: after the block of 100
+    ticks being flown); out then holds what ran, as after an interrupted `quadcosim run`.
+
+    Returns a RunResult (trajectory, figures, passed, ...), or a SwarmResult for a swarm. Raises
+    ConfigError for a bad scenario, ValueError when out cannot be used (it holds other outputs) or for
+    a bad judge, vehicles or threads, RuntimeError on an I/O error.
     """
     if judge not in _JUDGE_SETS:
         raise ValueError(f"judge: got {judge!r}, expected 'spec', 'paper' or 'none'")
+    for name, value in (("vehicles", vehicles), ("threads", threads)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
+            raise ValueError(f"{name}: got {value!r}, expected a whole number >= 1 (or None)")
     sc = load_scenario(scenario, controller, step_timeout_s)
-    r = _quadcosim._run(sc, None if out is None else os.fspath(out), force, judge)
-    metrics = json.loads(r["metrics_json"])
+    r = _quadcosim._run(sc, None if out is None else os.fspath(out), force, judge, vehicles or 0, threads or 0)
+    if r["swarm"]:
+        summary = json.loads(r["summary_json"])
+        recorded = {}
+        for v in r["recorded"]:
+            folder = None if r["out"] is None else os.path.join(r["out"], v["namespace"][1:])
+            metrics = json.loads(v["metrics_json"])
+            recorded[v["namespace"]] = _run_result(v["trajectory"], metrics, metrics["passed"], v["table"], "",
+                                                   folder, r["judged"])
+        return SwarmResult(vehicles=_vehicles_columns(r["vehicles_csv"]), recorded=recorded, passed=r["passed"],
+                           summary=summary, messages=r["messages"], out=r["out"], judged=r["judged"],
+                           provenance=summary.get("provenance", {}))
+    return _run_result(r["trajectory"], json.loads(r["metrics_json"]), r["passed"], r["table"], r["messages"],
+                       r["out"], r["judged"])
+
+
+def _run_result(trajectory: Dict[str, Any], metrics: Dict[str, Any], passed: Optional[bool], table: str,
+                messages: str, out: Optional[str], judged: str) -> RunResult:
+    """A RunResult from a recorded vehicle's trajectory columns and its metrics.json."""
     figures = {k: v for k, v in metrics.items() if k not in _HEADER_KEYS}
-    return RunResult(trajectory=r["trajectory"], figures=figures, passed=r["passed"], metrics=metrics,
-                     table=r["table"], messages=r["messages"], out=r["out"], judged=r["judged"],
-                     provenance=metrics.get("provenance", {}))
+    return RunResult(trajectory=trajectory, figures=figures, passed=passed, metrics=metrics, table=table,
+                     messages=messages, out=out, judged=judged, provenance=metrics.get("provenance", {}))
