@@ -43,9 +43,10 @@ std::pair<const std::string, Subscriber> entry() {
 
 const std::map<std::string, Subscriber>& known_types() {
   static const std::map<std::string, Subscriber> table = {
-      entry<msg::PoseStamped>(),       entry<msg::TwistStamped>(), entry<msg::Imu>(),
-      entry<msg::Float64MultiArray>(), entry<msg::Clock>(),        entry<msg::ControllerStatus>(),
-      entry<msg::PlantStatus>(),       entry<msg::TFMessage>(),    entry<msg::String>()};
+      entry<msg::PoseStamped>(),       entry<msg::TwistStamped>(),  entry<msg::Imu>(),
+      entry<msg::Float64MultiArray>(), entry<msg::Clock>(),         entry<msg::ControllerStatus>(),
+      entry<msg::PlantStatus>(),       entry<msg::TFMessage>(),     entry<msg::String>(),
+      entry<msg::MagneticField>(),     entry<msg::FluidPressure>(), entry<msg::NavSatFix>()};
   return table;
 }
 

@@ -132,6 +132,9 @@ TEST(DdsTransportTest, RoundTripsEveryMessageTypeFieldForField) {
   expect_round_trip<msg::PoseStamped>("/t/Pose");
   expect_round_trip<msg::TwistStamped>("/t/Velocity");
   expect_round_trip<msg::Imu>("/t/Imu");
+  expect_round_trip<msg::MagneticField>("/t/mag");
+  expect_round_trip<msg::FluidPressure>("/t/baro");
+  expect_round_trip<msg::NavSatFix>("/t/fix");
   expect_round_trip<msg::Float64MultiArray>("/t/cmd");
   expect_round_trip<msg::Clock>("/t/clock");
   expect_round_trip<msg::ControllerStatus>("/t/status");
@@ -518,6 +521,9 @@ TEST(DdsTransportTest, TopicAndTypeNamesFollowRos2) {
   EXPECT_EQ(dds_topic_name("/drone/Pose"), "rt/drone/Pose");
   EXPECT_STREQ(type_ops(typeid(msg::PoseStamped))->descriptor->m_typename, "geometry_msgs::msg::dds_::PoseStamped_");
   EXPECT_STREQ(type_ops(typeid(msg::Imu))->descriptor->m_typename, "sensor_msgs::msg::dds_::Imu_");
+  EXPECT_STREQ(type_ops(typeid(msg::MagneticField))->descriptor->m_typename, "sensor_msgs::msg::dds_::MagneticField_");
+  EXPECT_STREQ(type_ops(typeid(msg::FluidPressure))->descriptor->m_typename, "sensor_msgs::msg::dds_::FluidPressure_");
+  EXPECT_STREQ(type_ops(typeid(msg::NavSatFix))->descriptor->m_typename, "sensor_msgs::msg::dds_::NavSatFix_");
   EXPECT_STREQ(type_ops(typeid(msg::Float64MultiArray))->descriptor->m_typename,
                "std_msgs::msg::dds_::Float64MultiArray_");
   EXPECT_STREQ(type_ops(typeid(msg::Clock))->descriptor->m_typename, "rosgraph_msgs::msg::dds_::Clock_");

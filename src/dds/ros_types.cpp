@@ -46,6 +46,18 @@ const dds_topic_descriptor_t& idl<msg::Imu>() {
   return sensor_msgs_msg_dds__Imu__desc;
 }
 template <>
+const dds_topic_descriptor_t& idl<msg::MagneticField>() {
+  return sensor_msgs_msg_dds__MagneticField__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::FluidPressure>() {
+  return sensor_msgs_msg_dds__FluidPressure__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::NavSatFix>() {
+  return sensor_msgs_msg_dds__NavSatFix__desc;
+}
+template <>
 const dds_topic_descriptor_t& idl<msg::Float64MultiArray>() {
   return std_msgs_msg_dds__Float64MultiArray__desc;
 }
@@ -109,6 +121,9 @@ const TypeOps* type_ops(std::type_index type) {
       {typeid(msg::PoseStamped), ops_for<msg::PoseStamped>()},
       {typeid(msg::TwistStamped), ops_for<msg::TwistStamped>()},
       {typeid(msg::Imu), ops_for<msg::Imu>()},
+      {typeid(msg::MagneticField), ops_for<msg::MagneticField>()},
+      {typeid(msg::FluidPressure), ops_for<msg::FluidPressure>()},
+      {typeid(msg::NavSatFix), ops_for<msg::NavSatFix>()},
       {typeid(msg::Float64MultiArray), ops_for<msg::Float64MultiArray>()},
       {typeid(msg::Clock), ops_for<msg::Clock>()},
       {typeid(msg::ControllerStatus), ops_for<msg::ControllerStatus>()},

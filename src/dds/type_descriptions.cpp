@@ -68,6 +68,25 @@ const std::vector<MessageDescription>& message_descriptions() {
        "float64[9] angular_velocity_covariance\n"
        "geometry_msgs/msg/Vector3 linear_acceleration\n"
        "float64[9] linear_acceleration_covariance"},
+      {"sensor_msgs/msg/MagneticField",
+       "std_msgs/msg/Header header\n"
+       "geometry_msgs/msg/Vector3 magnetic_field\n"
+       "float64[9] magnetic_field_covariance"},
+      {"sensor_msgs/msg/FluidPressure",
+       "std_msgs/msg/Header header\n"
+       "float64 fluid_pressure\n"
+       "float64 variance"},
+      {"sensor_msgs/msg/NavSatStatus",
+       "int8 status\n"
+       "uint16 service"},
+      {"sensor_msgs/msg/NavSatFix",
+       "std_msgs/msg/Header header\n"
+       "sensor_msgs/msg/NavSatStatus status\n"
+       "float64 latitude\n"
+       "float64 longitude\n"
+       "float64 altitude\n"
+       "float64[9] position_covariance\n"
+       "uint8 position_covariance_type"},
       {"rosgraph_msgs/msg/Clock", "builtin_interfaces/msg/Time clock"},
       {"quadcosim_msgs/msg/ControllerStatus",
        "std_msgs/msg/Header header\n"

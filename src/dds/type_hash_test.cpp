@@ -43,6 +43,13 @@ namespace {
 //       "type_hashes"; every other value above agrees with that build too
 //  [B2] the same build's rosidl_adapter and rosidl_generator_type_description run on tf2_msgs'
 //       TFMessage.msg (geometry_msgs/TransformStamped[] transforms) against its installed geometry_msgs
+//  [K2] the same hpm_sdk tree, sensor_msgs/.../magnetic_field__description.c, fluid_pressure__description.c,
+//       nav_sat_status__description.c, nav_sat_fix__description.c. The field lists of these four .msg
+//       files are the same on ros2/common_interfaces' jazzy branch and in Kilted (jazzy..rolling
+//       changes neither), and a hash covers field names and types only (no constants, no defaults:
+//       NavSatStatus's STATUS_UNKNOWN = -2 and its default `int8 status -2` leave it unchanged), so
+//       Jazzy's values are these. A rosbag2 recording's metadata.yaml (type_description_hash of
+//       /fluid_pressure) and several ROS 2 client libraries list the same four values.
 //  [E1] eclipse-zenoh/zenoh-plugin-ros2dds@f4990b12, zenoh-plugin-ros2dds/src/ros_discovery.rs:
 //       ROS_DISCOVERY_INFO_TYPE_HASH, "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_ in Iron and Jazzy"
 struct Expected {
@@ -72,6 +79,12 @@ const std::vector<Expected>& expected_hashes() {
        "K1 Z1"},
       {"sensor_msgs/msg/Imu", "RIHS01_7d9a00ff131080897a5ec7e26e315954b8eae3353c3f995c55faf71574000b5b", "K1 Z1"},
       {"rosgraph_msgs/msg/Clock", "RIHS01_692f7a66e93a3c83e71765d033b60349ba68023a8c689a79e48078bcb5c58564", "K1"},
+      {"sensor_msgs/msg/MagneticField", "RIHS01_e80f32f56a20486c9923008fc1a1db07bbb273cbbf6a5b3bfa00835ee00e4dff",
+       "K2"},
+      {"sensor_msgs/msg/FluidPressure", "RIHS01_22dfb2b145a0bd5a31a1ac3882a1b32148b51d9b2f3bab250290d66f3595bc32",
+       "K2"},
+      {"sensor_msgs/msg/NavSatStatus", "RIHS01_d1ed3befa628e09571bd273b888ba1c1fd187c9a5e0006b385d7e5e9095a3204", "K2"},
+      {"sensor_msgs/msg/NavSatFix", "RIHS01_62223ab3fe210a15976021da7afddc9e200dc9ec75231c1b6a557fc598a65404", "K2"},
       {"rmw_dds_common/msg/ParticipantEntitiesInfo",
        "RIHS01_91a0593bacdcc50ea9bdcf849a938b128412cc1ea821245c663bcd26f83c295e", "E1"},
       {"service_msgs/msg/ServiceEventInfo", "RIHS01_41bcbbe07a75c9b52bc96bfd5c24d7f0fc0a08c0cb7921b3373c5732345a6f45",
@@ -222,10 +235,12 @@ TEST(TypeHashTest, UndescribedTypesAreRefusedByName) {
 TEST(TypeHashTest, EveryTypeOnTheWireIsDescribed) {
   std::vector<const dds_topic_descriptor_t*> types = {&rcl_interfaces_msg_dds__ParameterEvent__desc,
                                                       &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc};
-  for (const std::type_index t : {std::type_index(typeid(msg::PoseStamped)), std::type_index(typeid(msg::TwistStamped)),
-                                  std::type_index(typeid(msg::Imu)), std::type_index(typeid(msg::Float64MultiArray)),
-                                  std::type_index(typeid(msg::Clock)), std::type_index(typeid(msg::ControllerStatus)),
-                                  std::type_index(typeid(msg::PlantStatus))}) {
+  for (const std::type_index t :
+       {std::type_index(typeid(msg::PoseStamped)), std::type_index(typeid(msg::TwistStamped)),
+        std::type_index(typeid(msg::Imu)), std::type_index(typeid(msg::Float64MultiArray)),
+        std::type_index(typeid(msg::Clock)), std::type_index(typeid(msg::ControllerStatus)),
+        std::type_index(typeid(msg::PlantStatus)), std::type_index(typeid(msg::MagneticField)),
+        std::type_index(typeid(msg::FluidPressure)), std::type_index(typeid(msg::NavSatFix))}) {
     ASSERT_NE(type_ops(t), nullptr);
     types.push_back(type_ops(t)->descriptor);
   }

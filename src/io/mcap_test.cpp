@@ -222,6 +222,45 @@ TEST_F(CdrTest, StringMatchesCyclone) {
   check(msg::String{std::string(5000, 'u') + "<robot/>\n"}, "long");
 }
 
+// The sensor types with magnitudes a plant puts in them (Earth's field in tesla, sea-level pressure,
+// a fix in degrees), stamps and frames of every length mod 8.
+TEST_F(CdrTest, MagneticFieldMatchesCyclone) {
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::MagneticField m;
+    m.header = {{static_cast<std::int32_t>(k), static_cast<std::uint32_t>(k * 999)}, kFrames[k]};
+    m.magnetic_field = {2.1e-5, -1.3e-6 * static_cast<double>(k), 4.4e-5};
+    for (std::size_t j = 0; j < 9; j += 4) m.magnetic_field_covariance[j] = 1e-14 * static_cast<double>(j + k + 1);
+    check(m, "frame '" + kFrames[k] + "'");
+  }
+}
+
+TEST_F(CdrTest, FluidPressureMatchesCyclone) {
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {
+    msg::FluidPressure m;
+    m.header = {{7, static_cast<std::uint32_t>(k)}, kFrames[k]};
+    m.fluid_pressure = 101325.0 - 12.0 * static_cast<double>(k);
+    m.variance = 0.25 * static_cast<double>(k);
+    check(m, "frame '" + kFrames[k] + "'");
+  }
+}
+
+TEST_F(CdrTest, NavSatFixMatchesCyclone) {
+  const std::vector<std::int8_t> statuses = {msg::NavSatStatus::kStatusUnknown, msg::NavSatStatus::kStatusNoFix,
+                                             msg::NavSatStatus::kStatusFix, msg::NavSatStatus::kStatusGbasFix};
+  for (std::size_t k = 0; k < kFrames.size(); ++k) {  // int8 and uint16 after strings of each length mod 8
+    msg::NavSatFix m;
+    m.header = {{1700000000, static_cast<std::uint32_t>(k * 12345)}, kFrames[k]};
+    m.status.status = statuses[k % statuses.size()];
+    m.status.service = static_cast<std::uint16_t>(msg::NavSatStatus::kServiceGps | (k << 1));
+    m.latitude = 47.3977419 + 1e-7 * static_cast<double>(k);
+    m.longitude = 8.5455938;
+    m.altitude = k == 3 ? std::numeric_limits<double>::quiet_NaN() : 488.1;
+    for (std::size_t j = 0; j < 9; j += 4) m.position_covariance[j] = j == 8 ? 2.25 : 0.5625;
+    m.position_covariance_type = static_cast<std::uint8_t>(k % 4);
+    check(m, "frame '" + kFrames[k] + "'");
+  }
+}
+
 TEST(CdrLayoutTest, ClockIsTheHeaderAndTwoIntegers) {
   const std::vector<std::uint8_t> want = {0x00, 0x01, 0x00, 0x00, 0x02, 0, 0, 0, 0x03, 0, 0, 0};
   EXPECT_EQ(to_cdr(msg::Clock{{2, 3}}), want);
@@ -238,8 +277,118 @@ TEST(CdrLayoutTest, StringsCountTheirNulAndDoublesAlignAfterTheHeader) {
   EXPECT_EQ(b[17], 0);
 }
 
+// Bytes laid out by hand (XCDR1 little endian, alignment counted after the 4-byte encapsulation
+// header; doubles written as their IEEE 754 bit patterns).
+class Bytes {
+ public:
+  Bytes& raw(std::initializer_list<std::uint8_t> b) {
+    v_.insert(v_.end(), b);
+    return *this;
+  }
+  Bytes& u32(std::uint32_t x) {
+    return raw({std::uint8_t(x), std::uint8_t(x >> 8), std::uint8_t(x >> 16), std::uint8_t(x >> 24)});
+  }
+  Bytes& f64(std::uint64_t bits) {
+    for (int i = 0; i < 8; ++i) v_.push_back(static_cast<std::uint8_t>(bits >> (8 * i)));
+    return *this;
+  }
+  Bytes& zeros(std::size_t n) {
+    v_.insert(v_.end(), n, 0);
+    return *this;
+  }
+  const std::vector<std::uint8_t>& get() const { return v_; }
+
+ private:
+  std::vector<std::uint8_t> v_{0x00, 0x01, 0x00, 0x00};
+};
+constexpr std::uint64_t kOne = 0x3ff0000000000000;           // 1.0
+constexpr std::uint64_t kHalf = 0x3fe0000000000000;          // 0.5
+constexpr std::uint64_t kMinusQuarter = 0xbfd0000000000000;  // -0.25
+constexpr std::uint64_t kTwo = 0x4000000000000000;           // 2.0
+constexpr std::uint64_t kFour = 0x4010000000000000;          // 4.0
+
+TEST(CdrLayoutTest, MagneticFieldIsHeaderVectorAndNineDoubles) {
+  msg::MagneticField m;
+  m.header = {{1, 2}, "xyz"};
+  m.magnetic_field = {0.5, -0.25, 1.0};
+  m.magnetic_field_covariance[0] = 2.0;
+  m.magnetic_field_covariance[8] = 4.0;
+  // sec 0..3 | nanosec 4..7 | length 4 at 8..11 | "xyz\0" 12..15 | the vector from 16 (aligned) | covariance
+  Bytes want;
+  want.u32(1)
+      .u32(2)
+      .u32(4)
+      .raw({'x', 'y', 'z', 0})
+      .f64(kHalf)
+      .f64(kMinusQuarter)
+      .f64(kOne)
+      .f64(kTwo)
+      .zeros(7 * 8)
+      .f64(kFour);
+  EXPECT_EQ(to_cdr(m), want.get());
+  EXPECT_EQ(want.get().size(), 4u + 16u + 24u + 72u);
+}
+
+TEST(CdrLayoutTest, FluidPressureAlignsItsDoublesAfterTheFrame) {
+  msg::FluidPressure m;
+  m.header = {{3, 4}, "b"};
+  m.fluid_pressure = 101325.0;
+  m.variance = 4.0;
+  // ... length 2 at 8..11 | 'b' 0 at 12..13 | 2 pad bytes | pressure at 16 | variance at 24
+  Bytes want;
+  want.u32(3).u32(4).u32(2).raw({'b', 0}).zeros(2).f64(0x40f8bcd000000000).f64(kFour);
+  EXPECT_EQ(to_cdr(m), want.get());
+}
+
+TEST(CdrLayoutTest, NavSatFixPacksStatusServiceAndTheCovarianceType) {
+  msg::NavSatFix m;
+  m.header = {{5, 6}, "ab"};
+  m.status.status = msg::NavSatStatus::kStatusNoFix;                                       // -1: 0xff
+  m.status.service = msg::NavSatStatus::kServiceGps | msg::NavSatStatus::kServiceGalileo;  // 9
+  m.latitude = 52.5;
+  m.longitude = 13.25;
+  m.altitude = 480.0;
+  m.position_covariance[0] = 0.5;
+  m.position_covariance[4] = 0.5;
+  m.position_covariance[8] = 2.0;
+  m.position_covariance_type = msg::NavSatFix::kCovarianceTypeDiagonalKnown;  // 2
+  // length 3 at 8..11 | "ab\0" 12..14 | status (int8) at 15 | service (uint16) at 16..17 | 6 pad bytes |
+  // latitude at 24, longitude 32, altitude 40 | covariance 48..119 | covariance type at 120, nothing after
+  Bytes want;
+  want.u32(5).u32(6).u32(3).raw({'a', 'b', 0, 0xff, 0x09, 0x00}).zeros(6);
+  want.f64(0x404a400000000000).f64(0x402a800000000000).f64(0x407e000000000000);
+  want.f64(kHalf).zeros(3 * 8).f64(kHalf).zeros(3 * 8).f64(kTwo).raw({0x02});
+  EXPECT_EQ(to_cdr(m), want.get());
+  EXPECT_EQ(want.get().size(), 4u + 121u);
+}
+
 // ---------------------------------------------------------------------------------------------
 // ros2msg schema text
+
+// The sensor types' schema texts, written out from the Jazzy .msg files (sensor_msgs/msg/*.msg of
+// ros2/common_interfaces, branch jazzy): constants first, then the fields (defaults after them), then
+// each dependency once.
+TEST(Ros2MsgTest, SensorTypesAsTheirJazzyMsgFilesDeclareThem) {
+  const std::string sep = std::string(80, '=') + "\n";
+  const std::string header = sep + "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n" + sep +
+                             "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n";
+  EXPECT_EQ(ros2msg_definition("sensor_msgs/msg/MagneticField"),
+            "std_msgs/Header header\ngeometry_msgs/Vector3 magnetic_field\nfloat64[9] magnetic_field_covariance\n" +
+                header + sep + "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n");
+  EXPECT_EQ(ros2msg_definition("sensor_msgs/msg/FluidPressure"),
+            "std_msgs/Header header\nfloat64 fluid_pressure\nfloat64 variance\n" + header);
+  const std::string status =
+      "int8 STATUS_UNKNOWN=-2\nint8 STATUS_NO_FIX=-1\nint8 STATUS_FIX=0\nint8 STATUS_SBAS_FIX=1\n"
+      "int8 STATUS_GBAS_FIX=2\nuint16 SERVICE_UNKNOWN=0\nuint16 SERVICE_GPS=1\nuint16 SERVICE_GLONASS=2\n"
+      "uint16 SERVICE_COMPASS=4\nuint16 SERVICE_GALILEO=8\nint8 status -2\nuint16 service\n";
+  EXPECT_EQ(ros2msg_definition("sensor_msgs/msg/NavSatStatus"), status);
+  EXPECT_EQ(ros2msg_definition("sensor_msgs/msg/NavSatFix"),
+            "uint8 COVARIANCE_TYPE_UNKNOWN=0\nuint8 COVARIANCE_TYPE_APPROXIMATED=1\n"
+            "uint8 COVARIANCE_TYPE_DIAGONAL_KNOWN=2\nuint8 COVARIANCE_TYPE_KNOWN=3\n"
+            "std_msgs/Header header\nNavSatStatus status\nfloat64 latitude\nfloat64 longitude\nfloat64 altitude\n"
+            "float64[9] position_covariance\nuint8 position_covariance_type\n" +
+                header + sep + "MSG: sensor_msgs/NavSatStatus\n" + status);
+}
 
 TEST(Ros2MsgTest, PoseStampedHasItsFieldsThenEachDependencyOnce) {
   const std::string sep = std::string(80, '=') + "\n";

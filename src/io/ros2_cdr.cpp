@@ -19,6 +19,8 @@ class CdrWriter {
   CdrWriter() { bytes_ = {0x00, 0x01, 0x00, 0x00}; }
 
   void u8(std::uint8_t v) { bytes_.push_back(v); }
+  void i8(std::int8_t v) { bytes_.push_back(static_cast<std::uint8_t>(v)); }
+  void u16(std::uint16_t v) { primitive(v); }
   void boolean(bool v) { u8(v ? 1 : 0); }
   void u32(std::uint32_t v) { primitive(v); }
   void u64(std::uint64_t v) { primitive(v); }
@@ -69,6 +71,10 @@ struct CdrFields {
       w.boolean(v);
     } else if constexpr (std::is_same_v<T, std::uint8_t>) {
       w.u8(v);
+    } else if constexpr (std::is_same_v<T, std::int8_t>) {
+      w.i8(v);
+    } else if constexpr (std::is_same_v<T, std::uint16_t>) {
+      w.u16(v);
     } else if constexpr (std::is_same_v<T, std::string>) {
       w.str(v);
     } else if constexpr (std::is_same_v<T, double>) {
@@ -118,11 +124,26 @@ struct MsgFields {
   MsgTypes& types;
   MsgType out;
 
+  /// The .msg text of message `m`'s type, named `type_name`: its constants (when it declares any),
+  /// then its fields.
+  template <class M>
+  static MsgType of(const std::string& type_name, MsgTypes& types, const M& m) {
+    MsgFields f{type_name, types, {}};
+    if constexpr (requires { M::constants(f); }) M::constants(f);
+    M::fields(m, f);
+    return f.out;
+  }
+
   template <class T>
   void field(std::string_view field_name, const T& v, msg::FieldNote note = {}) {
     out.text += type_text(v, note.ros_type) + " " + std::string(field_name);
     if (!note.default_value.empty()) out.text += " " + std::string(note.default_value);
     out.text += "\n";
+  }
+  // "TYPE NAME=VALUE", as a .msg file declares a constant.
+  template <class T>
+  void constant(std::string_view constant_name, T value) {
+    out.text += type_text(value, {}) + " " + std::string(constant_name) + "=" + std::to_string(value) + "\n";
   }
   template <class F>
   void group(std::string_view field_name, std::string_view ros_type, F&& visit) {
@@ -147,6 +168,10 @@ struct MsgFields {
       return "bool";
     } else if constexpr (std::is_same_v<T, std::uint8_t>) {
       return "uint8";
+    } else if constexpr (std::is_same_v<T, std::int8_t>) {
+      return "int8";
+    } else if constexpr (std::is_same_v<T, std::uint16_t>) {
+      return "uint16";
     } else if constexpr (std::is_same_v<T, std::string>) {
       return "string";
     } else if constexpr (std::is_same_v<T, double>) {
@@ -164,11 +189,7 @@ struct MsgFields {
     } else {
       const std::string dep = short_name(ros_type.empty() ? T::kRosType : ros_type);
       out.deps.push_back(dep);
-      if (types.count(dep) == 0) {
-        MsgFields sub{dep, types, {}};
-        T::fields(v, sub);
-        types[dep] = sub.out;
-      }
+      if (types.count(dep) == 0) types[dep] = of(dep, types, v);
       return local(dep);
     }
   }
@@ -177,10 +198,7 @@ struct MsgFields {
 template <class M>
 void add_type(MsgTypes& types) {
   const std::string name = short_name(M::kRosType);
-  MsgFields f{name, types, {}};
-  const M m{};
-  M::fields(m, f);
-  types[name] = f.out;
+  types[name] = MsgFields::of(name, types, M{});
 }
 
 // Every .msg definition the recorded message types need, keyed "pkg/Type".
@@ -190,6 +208,9 @@ const MsgTypes& msg_types() {
     add_type<msg::PoseStamped>(t);
     add_type<msg::TwistStamped>(t);
     add_type<msg::Imu>(t);
+    add_type<msg::MagneticField>(t);
+    add_type<msg::FluidPressure>(t);
+    add_type<msg::NavSatFix>(t);
     add_type<msg::Float64MultiArray>(t);
     add_type<msg::Clock>(t);
     add_type<msg::ControllerStatus>(t);
@@ -222,6 +243,9 @@ std::string full_definition(const std::string& key) {
 std::vector<std::uint8_t> to_cdr(const msg::PoseStamped& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::TwistStamped& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::Imu& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::MagneticField& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::FluidPressure& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::NavSatFix& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::Clock& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m) { return cdr_of(m); }

@@ -23,6 +23,9 @@ namespace quadcosim::io {
 std::vector<std::uint8_t> to_cdr(const msg::PoseStamped& m);
 std::vector<std::uint8_t> to_cdr(const msg::TwistStamped& m);
 std::vector<std::uint8_t> to_cdr(const msg::Imu& m);
+std::vector<std::uint8_t> to_cdr(const msg::MagneticField& m);
+std::vector<std::uint8_t> to_cdr(const msg::FluidPressure& m);
+std::vector<std::uint8_t> to_cdr(const msg::NavSatFix& m);
 std::vector<std::uint8_t> to_cdr(const msg::Float64MultiArray& m);
 std::vector<std::uint8_t> to_cdr(const msg::Clock& m);
 std::vector<std::uint8_t> to_cdr(const msg::ControllerStatus& m);
@@ -35,8 +38,8 @@ std::vector<std::uint8_t> to_cdr(const msg::SceneUpdate& m);
 /// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType): the type's own .msg fields,
 /// then every type it depends on, depth first in field order, each once, as a line of 80 '=', a line
 /// "MSG: pkg/Type" and that type's fields (the ros1msg/ros2msg convention of the MCAP registry and
-/// rosbag2). Known: the message types of sim/messages.hpp, foxglove_msgs/msg/SceneUpdate
-/// (sim/scene_messages.hpp) and the types they contain. Throws
+/// rosbag2); a type's .msg constants come before its fields, one "TYPE NAME=VALUE" line each. Known: the message types
+/// of sim/messages.hpp, foxglove_msgs/msg/SceneUpdate (sim/scene_messages.hpp) and the types they contain. Throws
 /// std::invalid_argument naming `ros_type` for any other.
 const std::string& ros2msg_definition(std::string_view ros_type);
 

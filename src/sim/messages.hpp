@@ -10,6 +10,10 @@
 // `topic echo` prints (dds/topic_tools.hpp) and the copies to and from the C types idlc generates (dds/idl_walk.hpp),
 // which walk a list in step with idlc's instructions and refuse, naming it, a field whose type differs or that only
 // one side has. A new field: one line here plus its .idl member.
+//
+// A message whose .msg file declares constants states them once too, as typed members (kStatusFix) that
+// `constants(v)` hands over as v.constant("STATUS_FIX", kStatusFix): the .msg schema text of recordings
+// lists them, so a reader can name a status; they are neither on the wire nor part of the type hash.
 #pragma once
 
 #include <array>
@@ -143,6 +147,102 @@ struct Imu {
     v.field("angular_velocity_covariance", m.angular_velocity_covariance);
     v.field("linear_acceleration", m.linear_acceleration);
     v.field("linear_acceleration_covariance", m.linear_acceleration_covariance);
+  }
+};
+
+/// sensor_msgs/msg/MagneticField: the field vector [T] in header.frame_id's axes.
+struct MagneticField {
+  static constexpr std::string_view kRosType = "sensor_msgs/msg/MagneticField";
+  Header header;
+  Vector3 magnetic_field;                             ///< [T]
+  std::array<double, 9> magnetic_field_covariance{};  ///< [T^2], row major x, y, z; all 0: unknown
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("magnetic_field", m.magnetic_field);
+    v.field("magnetic_field_covariance", m.magnetic_field_covariance);
+  }
+};
+
+/// sensor_msgs/msg/FluidPressure: an absolute pressure (a barometer's static pressure).
+struct FluidPressure {
+  static constexpr std::string_view kRosType = "sensor_msgs/msg/FluidPressure";
+  Header header;
+  double fluid_pressure = 0;  ///< [Pa]
+  double variance = 0;        ///< [Pa^2], 0: unknown
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("fluid_pressure", m.fluid_pressure);
+    v.field("variance", m.variance);
+  }
+};
+
+/// sensor_msgs/msg/NavSatStatus (Jazzy): the kind of fix and the satellite systems used.
+struct NavSatStatus {
+  static constexpr std::string_view kRosType = "sensor_msgs/msg/NavSatStatus";
+  static constexpr std::int8_t kStatusUnknown = -2;  ///< not yet set
+  static constexpr std::int8_t kStatusNoFix = -1;
+  static constexpr std::int8_t kStatusFix = 0;         ///< unaugmented
+  static constexpr std::int8_t kStatusSbasFix = 1;     ///< satellite-based augmentation
+  static constexpr std::int8_t kStatusGbasFix = 2;     ///< ground-based augmentation
+  static constexpr std::uint16_t kServiceUnknown = 0;  ///< `service` is a bit set: compare with ==
+  static constexpr std::uint16_t kServiceGps = 1;
+  static constexpr std::uint16_t kServiceGlonass = 2;
+  static constexpr std::uint16_t kServiceCompass = 4;  ///< BeiDou included
+  static constexpr std::uint16_t kServiceGalileo = 8;
+  std::int8_t status = kStatusUnknown;  // the .msg default
+  std::uint16_t service = kServiceUnknown;
+  template <class V>
+  static void constants(V& v) {
+    v.constant("STATUS_UNKNOWN", kStatusUnknown);
+    v.constant("STATUS_NO_FIX", kStatusNoFix);
+    v.constant("STATUS_FIX", kStatusFix);
+    v.constant("STATUS_SBAS_FIX", kStatusSbasFix);
+    v.constant("STATUS_GBAS_FIX", kStatusGbasFix);
+    v.constant("SERVICE_UNKNOWN", kServiceUnknown);
+    v.constant("SERVICE_GPS", kServiceGps);
+    v.constant("SERVICE_GLONASS", kServiceGlonass);
+    v.constant("SERVICE_COMPASS", kServiceCompass);
+    v.constant("SERVICE_GALILEO", kServiceGalileo);
+  }
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("status", m.status, FieldNote{"", "-2"});
+    v.field("service", m.service);
+  }
+};
+
+/// sensor_msgs/msg/NavSatFix: a GNSS fix on the WGS 84 ellipsoid.
+struct NavSatFix {
+  static constexpr std::string_view kRosType = "sensor_msgs/msg/NavSatFix";
+  static constexpr std::uint8_t kCovarianceTypeUnknown = 0;
+  static constexpr std::uint8_t kCovarianceTypeApproximated = 1;
+  static constexpr std::uint8_t kCovarianceTypeDiagonalKnown = 2;
+  static constexpr std::uint8_t kCovarianceTypeKnown = 3;
+  Header header;
+  NavSatStatus status;
+  double latitude = 0;                          ///< [deg], north positive
+  double longitude = 0;                         ///< [deg], east positive
+  double altitude = 0;                          ///< [m] above the ellipsoid (NaN: none)
+  std::array<double, 9> position_covariance{};  ///< [m^2], East, North, Up, row major
+  std::uint8_t position_covariance_type = kCovarianceTypeUnknown;
+  template <class V>
+  static void constants(V& v) {
+    v.constant("COVARIANCE_TYPE_UNKNOWN", kCovarianceTypeUnknown);
+    v.constant("COVARIANCE_TYPE_APPROXIMATED", kCovarianceTypeApproximated);
+    v.constant("COVARIANCE_TYPE_DIAGONAL_KNOWN", kCovarianceTypeDiagonalKnown);
+    v.constant("COVARIANCE_TYPE_KNOWN", kCovarianceTypeKnown);
+  }
+  template <class M, class V>
+  static void fields(M& m, V& v) {
+    v.field("header", m.header);
+    v.field("status", m.status);
+    v.field("latitude", m.latitude);
+    v.field("longitude", m.longitude);
+    v.field("altitude", m.altitude);
+    v.field("position_covariance", m.position_covariance);
+    v.field("position_covariance_type", m.position_covariance_type);
   }
 };
 
