@@ -1,11 +1,11 @@
-// Test-only: writes an MCAP file of a simulated 100 Hz run the way the recorder does (all six
-// recorded topics, ros2 profile, CDR) and a JSON file of what it wrote, for mcap_interop_test.sh to
-// compare with what the MCAP reference reader decodes.
+// Test-only: writes an MCAP file of a simulated 100 Hz run the way the recorder does (the recorded
+// topics and three of the sensor types (MagneticField, FluidPressure, NavSatFix), ros2 profile, CDR) and a JSON file of
+// what it wrote, for mcap_interop_test.sh to compare with what the MCAP reference reader decodes.
 //
 //   mcap_sample full|plain|empty|killed OUT.mcap EXPECTED.json
 //     full    200 ticks, 16 KiB zstd chunks (several chunks), closed normally
 //     plain   the same, chunks uncompressed
-//     empty   the six channels and no message
+//     empty   the channels and no message
 //     killed  1 MiB chunks; ticks 0..99, flush(), ticks 100..149 (still in the open chunk), then the
 //             process SIGKILLs itself without close(): EXPECTED.json describes ticks 0..99
 //
@@ -90,6 +90,56 @@ json j(const msg::PlantStatus& m) {
           {"commands_foreign", std::to_string(m.commands_foreign)}};
 }
 
+json j(const msg::MagneticField& m) {
+  return {{"header", j(m.header)},
+          {"magnetic_field", j(m.magnetic_field)},
+          {"magnetic_field_covariance", m.magnetic_field_covariance}};
+}
+json j(const msg::FluidPressure& m) {
+  return {{"header", j(m.header)}, {"fluid_pressure", m.fluid_pressure}, {"variance", m.variance}};
+}
+json j(const msg::NavSatFix& m) {
+  return {{"header", j(m.header)},
+          {"status", {{"status", m.status.status}, {"service", m.status.service}}},
+          {"latitude", m.latitude},
+          {"longitude", m.longitude},
+          {"altitude", m.altitude},
+          {"position_covariance", m.position_covariance},
+          {"position_covariance_type", m.position_covariance_type}};
+}
+
+// The sensor types at the rates and magnitudes of a magnetometer (50 Hz), a barometer (25 Hz) and a
+// GNSS receiver (5 Hz); their topic names here are the sample's own.
+const std::string kMagTopic = "/drone/sample/magnetic_field";
+const std::string kBaroTopic = "/drone/sample/fluid_pressure";
+const std::string kFixTopic = "/drone/sample/fix";
+msg::MagneticField sample_mag(int i) {
+  msg::MagneticField m;
+  m.header = t::sample_header(i, "base_link");
+  m.magnetic_field = {2.1e-5 + 1e-9 * i, -1.3e-6, 4.4e-5 - 2e-9 * i};
+  for (int k = 0; k < 3; ++k) m.magnetic_field_covariance[4 * k] = 1e-14 * (k + 1);
+  return m;
+}
+msg::FluidPressure sample_baro(int i) {
+  msg::FluidPressure m;
+  m.header = t::sample_header(i, "base_link");
+  m.fluid_pressure = 101325.0 - 0.12 * i;
+  m.variance = 0.25;
+  return m;
+}
+msg::NavSatFix sample_fix(int i) {
+  msg::NavSatFix m;
+  m.header = t::sample_header(i, "gnss");
+  m.status.status = i < 40 ? msg::NavSatStatus::kStatusNoFix : msg::NavSatStatus::kStatusSbasFix;
+  m.status.service = msg::NavSatStatus::kServiceGps | msg::NavSatStatus::kServiceGalileo;
+  m.latitude = 47.3977419 + 1e-8 * i;
+  m.longitude = 8.5455938 - 1e-8 * i;
+  m.altitude = 488.1 + 0.01 * i;
+  m.position_covariance = {0.5625, 0, 0, 0, 0.5625, 0, 0, 0, 2.25};
+  m.position_covariance_type = msg::NavSatFix::kCovarianceTypeDiagonalKnown;
+  return m;
+}
+
 // One recorded topic: its channel and what has been written on it.
 struct Topic {
   std::uint16_t channel = 0;
@@ -135,6 +185,9 @@ class Recorder {
       write(topics.velocity, t::sample_twist(i), ns);
       write(topics.imu, t::sample_imu(i), ns);
       if (i % 100 == 0 || i % 37 == 5) write(topics.plant_status, t::sample_plant_status(i), ns);
+      if (i % 2 == 0) write(kMagTopic, sample_mag(i), ns);
+      if (i % 4 == 1) write(kBaroTopic, sample_baro(i), ns);
+      if (i % 20 == 3) write(kFixTopic, sample_fix(i), ns);
       if (i % 2 == 0) {  // the controller at 50 Hz
         write(topics.controller_status, t::sample_status(i), ns);
         write(topics.motor_commands, t::sample_command(i), ns);
@@ -188,6 +241,9 @@ int main(int argc, char** argv) {
     rec.add<msg::ControllerStatus>(topics.controller_status);
     rec.add<msg::PlantStatus>(topics.plant_status);
     rec.add<msg::Float64MultiArray>(topics.motor_commands);
+    rec.add<msg::MagneticField>(kMagTopic);
+    rec.add<msg::FluidPressure>(kBaroTopic);
+    rec.add<msg::NavSatFix>(kFixTopic);
     if (mode == "killed") {
       rec.ticks(topics, 0, 100);
       rec.writer().flush();
