@@ -1032,6 +1032,42 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "commands_foreign: 1\n");
 }
 
+// The sensor types, written out by hand as `ros2 topic echo` prints them (int8 and uint16 as plain
+// integers, the NavSatStatus a nested mapping).
+TEST(TopicToolsTest, SensorTypesAsRos2TopicEcho) {
+  msg::FluidPressure b;
+  b.header = {{7, 5}, "baro"};
+  b.fluid_pressure = 101325.0;
+  b.variance = 0.25;
+  EXPECT_EQ(to_yaml(b),
+            "header:\n  stamp:\n    sec: 7\n    nanosec: 5\n  frame_id: baro\n"
+            "fluid_pressure: 101325.0\nvariance: 0.25\n");
+
+  msg::MagneticField m;
+  m.magnetic_field = {2.1e-05, -1.5e-06, 4.4e-05};
+  m.magnetic_field_covariance[4] = 1e-14;
+  EXPECT_EQ(to_yaml(m),
+            "header:\n  stamp:\n    sec: 0\n    nanosec: 0\n  frame_id: ''\n"
+            "magnetic_field:\n  x: 2.1e-05\n  y: -1.5e-06\n  z: 4.4e-05\n"
+            "magnetic_field_covariance:\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 1.0e-14\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n");
+
+  msg::NavSatFix f;
+  f.header = {{1700000000, 250000000}, "gnss"};
+  f.status.status = msg::NavSatStatus::kStatusNoFix;
+  f.status.service = msg::NavSatStatus::kServiceGps | msg::NavSatStatus::kServiceCompass;
+  f.latitude = 47.5;
+  f.longitude = -8.25;
+  f.altitude = 488.0;
+  f.position_covariance_type = msg::NavSatFix::kCovarianceTypeApproximated;
+  EXPECT_EQ(to_yaml(f),
+            "header:\n  stamp:\n    sec: 1700000000\n    nanosec: 250000000\n  frame_id: gnss\n"
+            "status:\n  status: -1\n  service: 5\n"
+            "latitude: 47.5\nlongitude: -8.25\naltitude: 488.0\n"
+            "position_covariance:\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n- 0.0\n"
+            "position_covariance_type: 1\n");
+  EXPECT_EQ(to_yaml(msg::NavSatStatus{}), "status: -2\nservice: 0\n");  // the .msg defaults
+}
+
 TEST(TopicToolsTest, RateWindowAsRos2TopicHz) {
   RateWindow w(3);
   EXPECT_FALSE(w.stats());
