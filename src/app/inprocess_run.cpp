@@ -25,6 +25,7 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
                         sim::Topics::for_namespace(sc.simulation.ns));
   if (sc.simulation.plant.publish_tf)
     mcap.record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
+  mcap.record_sensors(simulation.transport(), sc.simulation.ns, sc.simulation.plant.realism.extra_sensors);
   if (attach) attach(simulation.transport(), sim::Topics::for_namespace(sc.simulation.ns));
   bool watchdog = false;
   bool completed = true;

@@ -81,6 +81,7 @@ class PlantProcess {
     if (!o_.one_vehicle.mcap.empty()) {
       mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
       if (sc_.simulation.plant.publish_tf) mcap_->record_vehicle(sc_.vehicle, sc_.simulation.ns, clock_.ns(0));
+      mcap_->record_sensors(transport_, sc_.simulation.ns, sc_.simulation.plant.realism.extra_sensors);
     }
     foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_, sc_);
     if (!o_.one_vehicle.schedule_node.empty()) {

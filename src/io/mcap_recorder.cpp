@@ -8,6 +8,7 @@
 #include "io/output_folder.hpp"
 #include "io/ros2_cdr.hpp"
 #include "sim/messages.hpp"
+#include "sim/sensor_wire.hpp"
 #include "sim/vehicle_description.hpp"
 
 namespace quadcosim::io {
@@ -171,6 +172,10 @@ void McapRecorder::write_bag_metadata(const std::string& dir, const std::string&
     << "      duration:\n        nanoseconds: " << duration << "\n"
     << "      message_count: " << written_ << "\n";
   write_file_atomically(dir + "/metadata.yaml", y.str());  // throws "…/metadata.yaml: write failed (why)"
+}
+
+void McapRecorder::record_sensors(sim::Transport& transport, const std::string& ns, const sensors::SensorSet& set) {
+  sim::for_each_sensor_topic(set, ns, [&]<class T>(const std::string& topic) { add<T>(transport, topic); });
 }
 
 }  // namespace quadcosim::io

@@ -12,6 +12,7 @@
 
 #include "io/mcap_writer.hpp"
 #include "model/vehicle_params.hpp"
+#include "sensors/sensor_set.hpp"
 #include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
@@ -81,6 +82,10 @@ class McapRecorder {
   /// sample arrives, so in-process and DDS recordings stay identical. Call once, before the first
   /// flush; topics outside `only` (constructor) are skipped.
   void record_vehicle(const model::VehicleParams& vehicle, const std::string& ns, std::int64_t t_ns);
+
+  /// Also records the topics of the extra sensors `set` configures (magnetometer, barometer, GNSS:
+  /// sim/sensor_wire.hpp) under `ns`. Call before the first tick; topics outside `only` are skipped.
+  void record_sensors(sim::Transport& transport, const std::string& ns, const sensors::SensorSet& set);
 
   /// Newest message time seen so far [ns] (0 before any).
   std::int64_t newest_ns() const { return last_stamp_ns_; }

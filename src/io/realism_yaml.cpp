@@ -42,12 +42,96 @@ sim::SensorTiming read_timing(YamlSection& s, const sim::SimulationConfig& cfg) 
   return t;
 }
 
+// The extra sensors' rate_hz: the plant rate divided by a whole number n that divides the controller
+// period or is a whole multiple of it (a sample lands on a control tick; GNSS at 5-10 Hz is slower than
+// the controller). Default `default_hz`, or the plant rate when it is above it.
+sim::SensorTiming read_extra_timing(YamlSection& s, const sim::SimulationConfig& cfg, double default_hz) {
+  sim::SensorTiming t;
+  const double plant_hz = 1e9 / static_cast<double>(cfg.plant.clock.period_ns);
+  const double rate = s.number("rate_hz", std::min(default_hz, plant_hz), 1e-6, plant_hz);
+  const double div = plant_hz / rate;
+  const long n = std::lround(div);
+  const long c = cfg.controller_divider;
+  if (std::abs(div - static_cast<double>(n)) > 1e-9 || n < 1 || (c % n != 0 && n % c != 0)) {
+    s.fail("rate_hz",
+           fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
+                       "divides the controller period ({} plant ticks) or is a multiple of it, e.g. "
+                       "{:g} or {:g}",
+                       rate, plant_hz, c, plant_hz / static_cast<double>(c), plant_hz / static_cast<double>(5 * c)));
+  }
+  t.divider = static_cast<int>(n);
+  t.latency_ticks = static_cast<int>(s.integer("latency_ticks", 0, 0, 1000));
+  return t;
+}
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+// environment.site: where the world origin is on the Earth (GNSS, barometer).
+sensors::Geodetic read_site(YamlSection& g) {
+  sensors::Geodetic site;
+  site.latitude_rad = g.number("latitude_deg", 0.0, -90.0, 90.0) * kDeg;
+  site.longitude_rad = g.number("longitude_deg", 0.0, -180.0, 180.0) * kDeg;
+  site.height_m = g.number("altitude_m", 0.0, -500.0, 10000.0);
+  g.reject_unknown_keys();
+  return site;
+}
+
+void read_extra_sensors(YamlSection& s, const sim::SimulationConfig& cfg, const sensors::Geodetic& site,
+                        sensors::SensorSet& set) {
+  if (auto m = s.section("magnetometer")) {
+    sensors::MagnetometerConfig c;
+    c.timing = read_extra_timing(*m, cfg, 100.0);
+    c.field_T = m->number("field_uT", c.field_T * 1e6, 1.0, 100.0) * 1e-6;
+    c.inclination_rad = m->number("inclination_deg", c.inclination_rad / kDeg, -90.0, 90.0) * kDeg;
+    c.declination_rad = m->number("declination_deg", c.declination_rad / kDeg, -180.0, 180.0) * kDeg;
+    c.noise_sigma_T = m->number("noise_sigma_uT", 0.0, 0.0, 100.0) * 1e-6;
+    c.hard_iron_T = vec3(*m, "hard_iron_uT", Eigen::Vector3d::Zero(), -1000.0, 1000.0) * 1e-6;
+    m->reject_unknown_keys();
+    set.magnetometer = c;
+  }
+  if (auto b = s.section("barometer")) {
+    sensors::BarometerConfig c;
+    c.timing = read_extra_timing(*b, cfg, 50.0);
+    c.site_altitude_m = site.height_m;
+    c.sea_level_pressure_Pa = b->number("sea_level_pressure_Pa", c.sea_level_pressure_Pa, 80000.0, 110000.0);
+    c.noise_sigma_Pa = b->number("noise_sigma_Pa", 0.0, 0.0, 1000.0);
+    c.drift_Pa_sqrt_s = b->number("drift_Pa_sqrt_s", 0.0, 0.0, 100.0);
+    c.bias_initial_Pa = b->number("bias_initial_Pa", 0.0, 0.0, 1000.0);
+    b->reject_unknown_keys();
+    set.barometer = c;
+  }
+  if (auto g = s.section("gnss")) {
+    sensors::GnssConfig c;
+    c.timing = read_extra_timing(*g, cfg, 10.0);
+    c.site = site;
+    c.horizontal_sigma_m = g->number("horizontal_sigma_m", 0.0, 0.0, 1000.0);
+    c.vertical_sigma_m = g->number("vertical_sigma_m", 0.0, 0.0, 1000.0);
+    c.velocity_sigma_m_s = g->number("velocity_sigma_m_s", 0.0, 0.0, 100.0);
+    c.fix_after_s = g->number("fix_after_s", 0.0, 0.0, 1e6);
+    g->reject_unknown_keys();
+    set.gnss = c;
+  }
+}
+
 }  // namespace
 
 void read_realism(YamlSection& root, Scenario& sc) {
   sim::RealismConfig& r = sc.simulation.plant.realism;
   const auto& cfg = sc.simulation;
   r.seed = static_cast<std::uint64_t>(root.integer("seed", 0, 0, std::numeric_limits<long long>::max()));
+  sensors::Geodetic site;  // the world origin on the Earth (environment.site)
+  if (auto e = root.section("environment")) {
+    r.wind.mean_W_m_s = vec3(*e, "wind_m_s", r.wind.mean_W_m_s, -200.0, 200.0);
+    if (auto g = e->section("site")) site = read_site(*g);
+    if (auto g = e->section("gusts")) {
+      r.wind.gusts.enabled = true;
+      r.wind.gusts.w20_m_s = g->number("w20_m_s", r.wind.gusts.w20_m_s, 0.0, 100.0);
+      r.wind.gusts.altitude_m = g->number("altitude_m", r.wind.gusts.altitude_m, 1e-3, 1e4);
+      r.wind.gusts.airspeed_m_s = g->number("airspeed_m_s", r.wind.gusts.airspeed_m_s, 0.0, 200.0);
+      g->reject_unknown_keys();
+    }
+    e->reject_unknown_keys();
+  }
   if (auto s = root.section("sensors")) {
     if (auto i = s->section("imu")) {
       r.imu.timing = read_timing(*i, cfg);
@@ -72,18 +156,8 @@ void read_realism(YamlSection& root, Scenario& sc) {
       r.velocity.angular_sigma_rad_s = v->number("angular_sigma_rad_s", 0.0, 0.0, 100.0);
       v->reject_unknown_keys();
     }
+    read_extra_sensors(*s, cfg, site, r.extra_sensors);
     s->reject_unknown_keys();
-  }
-  if (auto e = root.section("environment")) {
-    r.wind.mean_W_m_s = vec3(*e, "wind_m_s", r.wind.mean_W_m_s, -200.0, 200.0);
-    if (auto g = e->section("gusts")) {
-      r.wind.gusts.enabled = true;
-      r.wind.gusts.w20_m_s = g->number("w20_m_s", r.wind.gusts.w20_m_s, 0.0, 100.0);
-      r.wind.gusts.altitude_m = g->number("altitude_m", r.wind.gusts.altitude_m, 1e-3, 1e4);
-      r.wind.gusts.airspeed_m_s = g->number("airspeed_m_s", r.wind.gusts.airspeed_m_s, 0.0, 200.0);
-      g->reject_unknown_keys();
-    }
-    e->reject_unknown_keys();
   }
   const double duration_s = cfg.plant.clock.seconds(cfg.duration_ticks);
   int index = 0;

@@ -14,6 +14,7 @@
 #include "sim/messages.hpp"
 #include "sim/plant_core.hpp"
 #include "sim/realism.hpp"
+#include "sim/sensor_channels.hpp"
 #include "sim/steppable_plant.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
@@ -192,6 +193,9 @@ class PlantNode final : public SteppablePlant {
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;
   Publisher<msg::Imu> imu_pub_;
+  /// The magnetometer, barometer, GNSS the scenario configures (options.realism.extra_sensors); null
+  /// when it configures none.
+  std::unique_ptr<SensorChannels> extra_sensors_;
   msg::TFMessage tf_;  ///< one transform, frame ids set once
   Publisher<msg::TFMessage> tf_pub_;
   // Published at the first publish_outputs (built in the constructor: no allocation on a tick).

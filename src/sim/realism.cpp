@@ -12,17 +12,15 @@ void set_diagonal(std::array<double, 9>& cov, double sigma) {
   cov = {};
   if (sigma > 0.0) cov[0] = cov[4] = cov[8] = sigma * sigma;
 }
-
-bool timing_active(const SensorTiming& t) { return t.divider != 1 || t.latency_ticks != 0; }
 }  // namespace
 
 bool RealismConfig::active() const {
   const auto& i = imu;
   return i.gyro_noise_density > 0.0 || i.gyro_bias_random_walk > 0.0 || i.gyro_bias_initial > 0.0 ||
          i.accel_noise_density > 0.0 || i.accel_bias_random_walk > 0.0 || i.accel_bias_initial > 0.0 ||
-         i.orientation_sigma_rad > 0.0 || timing_active(i.timing) || pose.position_sigma_m > 0.0 ||
-         pose.orientation_sigma_rad > 0.0 || timing_active(pose.timing) || velocity.linear_sigma_m_s > 0.0 ||
-         velocity.angular_sigma_rad_s > 0.0 || timing_active(velocity.timing) || wind.active() || !faults.empty();
+         i.orientation_sigma_rad > 0.0 || i.timing.active() || pose.position_sigma_m > 0.0 ||
+         pose.orientation_sigma_rad > 0.0 || pose.timing.active() || velocity.linear_sigma_m_s > 0.0 ||
+         velocity.angular_sigma_rad_s > 0.0 || velocity.timing.active() || wind.active() || !faults.empty();
 }
 
 PlantRealism::PlantRealism(const RealismConfig& c, const model::VehicleParams& /*vehicle*/, const std::string& ns,

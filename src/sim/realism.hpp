@@ -15,18 +15,15 @@
 #include "model/quadrotor.hpp"
 #include "model/sensor_noise.hpp"
 #include "model/wind.hpp"
+#include "sensors/sensor_set.hpp"
+#include "sensors/timing.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::sim {
 
-/// When a sensor samples and how old its sample is when published. A sensor publishes on ticks
-/// k with k % divider == 0; the sample published at tick k is the state of tick max(k - latency, 0).
-/// The header stamp is the publication tick (lockstep pairs commands with it); the age is in the data.
-struct SensorTiming {
-  int divider = 1;        ///< sensor period in plant ticks (rate = plant rate / divider)
-  int latency_ticks = 0;  ///< age of the sample when published [plant ticks]
-};
+/// When a sensor samples and how old its sample is when published (sensors/timing.hpp).
+using SensorTiming = sensors::Timing;
 
 struct ImuConfig {
   SensorTiming timing;
@@ -66,6 +63,9 @@ struct RealismConfig {
   VelocityConfig velocity;
   model::WindParams wind;
   std::vector<RotorFault> faults;  ///< in tick order
+  /// Magnetometer, barometer, GNSS (sensors/sensor_set.hpp): each off unless configured; published
+  /// by the plant's sensor channels (sim/sensor_channels.hpp), not part of active().
+  sensors::SensorSet extra_sensors;
 
   /// True when any sensor, wind or fault setting differs from the ideal plant.
   bool active() const;

@@ -44,6 +44,7 @@ const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, c
                  sim::Topics::for_namespace(sc.simulation.ns));
     if (sc.simulation.plant.publish_tf)
       mcap->record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
+    mcap->record_sensors(simulation.transport(), sc.simulation.ns, sc.simulation.plant.realism.extra_sensors);
   }
   series.clear(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
   simulation.run([&](const sim::TickRecord& r) {
