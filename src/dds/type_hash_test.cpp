@@ -48,8 +48,10 @@ namespace {
 //       files are the same on ros2/common_interfaces' jazzy branch and in Kilted (jazzy..rolling
 //       changes neither), and a hash covers field names and types only (no constants, no defaults:
 //       NavSatStatus's STATUS_UNKNOWN = -2 and its default `int8 status -2` leave it unchanged), so
-//       Jazzy's values are these. A rosbag2 recording's metadata.yaml (type_description_hash of
-//       /fluid_pressure) and several ROS 2 client libraries list the same four values.
+//       Jazzy's values are these. Public code lists the same values too: a rosbag2 recording's
+//       metadata.yaml (type_description_hash of /fluid_pressure: FluidPressure), and client libraries
+//       that put them on the wire (MagneticField, FluidPressure and NavSatFix in several, NavSatStatus
+//       in one).
 //  [E1] eclipse-zenoh/zenoh-plugin-ros2dds@f4990b12, zenoh-plugin-ros2dds/src/ros_discovery.rs:
 //       ROS_DISCOVERY_INFO_TYPE_HASH, "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_ in Iron and Jazzy"
 struct Expected {
