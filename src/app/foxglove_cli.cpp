@@ -87,6 +87,7 @@ std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveCliOptions& o, co
   so.allowed_origins = o.allow_origins;
   auto server = std::make_unique<foxglove::Server>(so);
   foxglove::serve_vehicle_topics(*server, transport, topics);
+  foxglove::serve_sensor_topics(*server, transport, sc.simulation.ns, sc.simulation.plant.realism.extra_sensors);
   // As the recorders of run.mcap do (app/inprocess_run.cpp, the plant's --mcap): the vehicle drawn
   // where its plant publishes its /tf.
   if (sc.simulation.plant.publish_tf)

@@ -7,6 +7,7 @@
 #include "io/mcap_recorder.hpp"
 #include "io/ros2_cdr.hpp"
 #include "sim/messages.hpp"
+#include "sim/sensor_wire.hpp"
 
 namespace quadcosim::foxglove {
 
@@ -44,6 +45,13 @@ void serve_vehicle_topics(Server& server, sim::Transport& transport, const sim::
   serve<msg::PlantStatus>(server, transport, topics.plant_status, newest);
   serve<msg::Float64MultiArray>(server, transport, topics.motor_commands, newest);
   serve<msg::TFMessage>(server, transport, topics.tf, newest);
+}
+
+void serve_sensor_topics(Server& server, sim::Transport& transport, const std::string& ns,
+                         const sensors::SensorSet& set) {
+  auto newest = std::make_shared<std::atomic<std::int64_t>>(0);
+  sim::for_each_sensor_topic(set, ns,
+                             [&]<class T>(const std::string& topic) { serve<T>(server, transport, topic, newest); });
 }
 
 void serve_vehicle_description(Server& server, const model::VehicleParams& vehicle, const std::string& ns,

@@ -9,6 +9,7 @@
 
 #include "foxglove/server.hpp"
 #include "model/vehicle_params.hpp"
+#include "sensors/sensor_set.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
@@ -19,6 +20,11 @@ namespace quadcosim::foxglove {
 /// `transport`. The subscriptions cost one relaxed atomic load per message while no client subscribes
 /// (unless ServerOptions::keep_last). `server` must outlive the transport's deliveries.
 void serve_vehicle_topics(Server& server, sim::Transport& transport, const sim::Topics& topics);
+
+/// The same for the topics of the extra sensors `set` configures (magnetometer, barometer, GNSS:
+/// sim/sensor_wire.hpp) under the vehicle's namespace `ns`.
+void serve_sensor_topics(Server& server, sim::Transport& transport, const std::string& ns,
+                         const sensors::SensorSet& set);
 
 /// Adds the latched channels a 3D panel draws the vehicle in namespace `ns` from: <ns>/robot_description,
 /// /tf_static and <ns>/scene, each holding its one message stamped `t_ns` (the run's start) and given
