@@ -17,7 +17,7 @@ fi
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" -DQUADCOSIM_FUZZ=ON \
   -DQUADCOSIM_TEST_DOMAIN_OFFSET="${QUADCOSIM_TEST_DOMAIN_OFFSET:-0}" "${launcher[@]}" > /dev/null
-unit_tests=(model_test control_test analysis_test sim_test io_test security_test fmi_test worker_pool_test isolation_test)
+unit_tests=(util_test model_test control_test analysis_test sim_test io_test security_test fmi_test worker_pool_test isolation_test)
 targets=()
 for t in "${unit_tests[@]}" fuzz_config fuzz_messages fuzz_parameters fuzz_model_description; do targets+=(--target "$t"); done
 cmake --build build-asan -j"$jobs" "${targets[@]}"

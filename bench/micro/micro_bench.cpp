@@ -1,6 +1,6 @@
 // Micro-benchmarks (Google Benchmark): the plant step per RK4 sub-step count, one controller step, the
 // CARE solve, the allocation, one tick of the full in-process co-simulation, and the BASELINE minimal
-// loop (src/baseline/baseline_loop.hpp). Built with the project, never run by CTest:
+// loop (bench/baseline/baseline_loop.hpp). Built with the project, never run by CTest:
 //   build/bench/quadcosim_bench [--benchmark_filter=REGEX]
 #include <benchmark/benchmark.h>
 

@@ -1,7 +1,7 @@
 // `quadcosim bench [--json] [--quick]`: the framework's speed on this machine, measured end to end
 // (docs/performance.md). Prints figures; asserts nothing.
 //   inproc_rtf                 one vehicle in-process (paper altitude scenario, recording off)
-//   baseline_rtf               the BASELINE minimal loop (src/baseline/baseline_loop.hpp) on the same
+//   baseline_rtf               the BASELINE minimal loop (bench/baseline/baseline_loop.hpp) on the same
 //                              vehicle and gains: the machine's floor for this model
 //   dds_lockstep_rtf, dds_cmd_roundtrip_us_p50/p99
 //                              plant and controller as two processes over DDS, lockstep

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "controllers/registry.hpp"
+
 namespace CLI {
 class App;
 class Option;
@@ -75,10 +77,10 @@ int lqr_command(const LqrOptions& options);
 CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& options);
 
 struct ParamsOptions {
-  std::string controller = "paper";  ///< the controller type whose parameters are listed
-  bool list = false;                 ///< list the controller types instead
-  bool vehicle = false;              ///< the vehicle's parameters instead of the controller's
-  bool markdown = false;             ///< the vehicle table as Markdown (docs/model.md)
+  std::string controller{controllers::kDefaultControllerType};  ///< the controller type whose parameters are listed
+  bool list = false;                                            ///< list the controller types instead
+  bool vehicle = false;   ///< the vehicle's parameters instead of the controller's
+  bool markdown = false;  ///< the vehicle table as Markdown (docs/model.md)
 };
 /// Lists the controller's (or with `vehicle`, the vehicle's) parameters: name, unit, range, default,
 /// meaning.

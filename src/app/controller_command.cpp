@@ -161,9 +161,9 @@ int controller_command(const ControllerCommandOptions& o) {
     from_plant = [&pairing](const std::string& topic, sim::SenderId s) { return pairing.accepts(topic, s); };
   }
   sim::ControllerNode node(transport, topics, sc.controller, std::move(from_plant));
-  // A controller written in Python runs on a thread of its own (docs/python.md): one that blocks holds
-  // up neither the DDS threads (discovery, parameter services) nor a stop.
-  const bool on_thread = sc.controller.type() == "python";
+  // A controller that asks for it (one written in Python, docs/python.md) runs on a thread of its own:
+  // one that blocks holds up neither the DDS threads (discovery, parameter services) nor a stop.
+  const bool on_thread = sc.controller.wants_own_thread();
   if (on_thread) {
     sim::ControllerThreading threading;
     threading.asynchronous = o.lockstep;

@@ -2,10 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <iostream>
-#include <thread>
 
 #include "app/signals.hpp"
 #include "foxglove/topic_tap.hpp"
@@ -104,11 +104,17 @@ void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& wh
   if (o.wait_s <= 0.0) return;
   std::cerr << fmt::format("{}: foxglove: waiting up to {:g} s for a client to subscribe\n", who, o.wait_s)
             << std::flush;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.wait_s);
-  while (server.subscriptions() == 0 && !stop_requested() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  using Clock = std::chrono::steady_clock;
+  // The server wakes these waits as subscriptions change; a stop (a signal's flag, which cannot wake
+  // the server's condition variable) is looked at every kStopCheck.
+  constexpr auto kStopCheck = std::chrono::milliseconds(50);
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.wait_s));
+  std::size_t seen = server.subscriptions();
+  while (seen == 0 && !stop_requested() && Clock::now() < deadline) {
+    seen = server.wait_subscriptions_change(seen, std::min(deadline, Clock::now() + kStopCheck));
   }
-  if (server.subscriptions() == 0) {
+  if (seen == 0) {
     std::cerr << fmt::format("{}: foxglove: no client subscribed; running\n", who);
     return;
   }
@@ -116,12 +122,13 @@ void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& wh
   // run starts once its subscriptions have stopped coming (200 ms without a new one, at most 2 s), so
   // none of them misses the first messages.
   const auto quiet = std::chrono::milliseconds(200);
-  const auto last = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  auto changed = std::chrono::steady_clock::now();
-  for (std::size_t seen = server.subscriptions(); !stop_requested();) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    const auto now = std::chrono::steady_clock::now();
-    if (const std::size_t n = server.subscriptions(); n != seen) {
+  const auto last = Clock::now() + std::chrono::seconds(2);
+  auto changed = Clock::now();
+  while (!stop_requested()) {
+    const auto quiet_until = std::min(changed + quiet, last);
+    const std::size_t n = server.wait_subscriptions_change(seen, std::min(quiet_until, Clock::now() + kStopCheck));
+    const auto now = Clock::now();
+    if (n != seen) {
       seen = n;
       changed = now;
     }
@@ -134,10 +141,8 @@ void finish_foxglove(const FoxgloveCliOptions& o, const std::string& who, foxglo
     std::cerr << fmt::format("{}: foxglove: run ended; serving its last state for {:g} s (Ctrl-C ends)\n", who,
                              o.linger_s)
               << std::flush;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.linger_s);
-    while (!stop_requested() && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    wait_for_stop(std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                         std::chrono::duration<double>(o.linger_s)));
   }
   server.stop();
   std::cerr << fmt::format("{}: foxglove: {}\n", who, server.summary());

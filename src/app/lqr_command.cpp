@@ -31,10 +31,11 @@ CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& lqr) {
 CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
   auto* params_cmd = app.add_subcommand(
       "params", "list the controller node's and a controller's parameters (or the vehicle's), and the controllers");
-  check_controller_choice(
-      *params_cmd->add_option("--controller", params.controller,
-                              "the controller whose parameters follow the node's: a type (default paper; see "
-                              "--list), python:MODULE:CLASS (a class's declared parameters) or fmu:PATH (an FMU's)"));
+  check_controller_choice(*params_cmd->add_option(
+      "--controller", params.controller,
+      fmt::format("the controller whose parameters follow the node's: a type (default {}; see "
+                  "--list), python:MODULE:CLASS (a class's declared parameters) or fmu:PATH (an FMU's)",
+                  controllers::kDefaultControllerType)));
   params_cmd->add_flag("--list", params.list, "list the registered controller types instead");
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
@@ -45,8 +46,9 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
 int lqr_command(const LqrOptions& opt) {
   model::VehicleParams vehicle;
   if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
-  const control::ControllerConfig cfg =
-      opt.params.empty() ? controllers::make_config("paper", vehicle) : io::load_controller(opt.params, vehicle);
+  const control::ControllerConfig cfg = opt.params.empty()
+                                            ? controllers::make_config(controllers::kDefaultControllerType, vehicle)
+                                            : io::load_controller(opt.params, vehicle);
   const controllers::PaperController* paper = controllers::paper_controller(cfg);
   if (!paper) {
     // Only the paper controller's attitude loops are LQR designs; other controllers have no A, B,

@@ -608,9 +608,9 @@ class PlantProcess {
 
   void report() {
     nlohmann::json stats;
-    // lockstep: sensor publication -> command back, percentiles within 1.6 % (analysis/log_histogram.hpp)
+    // lockstep: sensor publication -> command back, percentiles within 1.6 % (util/log_histogram.hpp)
     if (lockstep_ && !lockstep_->round_trips_ns().empty()) {
-      const analysis::LogHistogram& round_trip_ns = lockstep_->round_trips_ns();
+      const util::LogHistogram& round_trip_ns = lockstep_->round_trips_ns();
       auto pct = [&](double q) { return static_cast<double>(round_trip_ns.percentile_lower(q)) / 1e3; };
       std::cerr << fmt::format(
           "plant: lockstep round trip (outputs published -> command received) over {} "

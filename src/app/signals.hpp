@@ -1,6 +1,8 @@
 // SIGINT/SIGTERM for long-running commands: the handler only sets a flag that loops poll.
 #pragma once
 
+#include <chrono>
+
 namespace quadcosim::app {
 
 /// Routes SIGINT and SIGTERM to stop_requested(), which is also what a wait on an FMU's process polls
@@ -18,5 +20,8 @@ bool stop_requested();
 bool stop_signalled();
 /// Asks the command's loops to stop, as a signal does (from any thread), without the deadline.
 void request_stop();
+/// Waits until a stop is requested or `deadline` passed; returns stop_requested(). Woken by
+/// request_stop() and, once install_stop_handlers() ran, by SIGINT/SIGTERM (no polling).
+bool wait_for_stop(std::chrono::steady_clock::time_point deadline);
 
 }  // namespace quadcosim::app

@@ -101,6 +101,11 @@ class Controller {
 
   /// The registry name of its type ("paper", "se3", ...).
   virtual std::string_view type() const = 0;
+  /// True for a controller whose step can block or run long in ways its host cannot bound (one written
+  /// in Python: the interpreter's lock, a step that never returns). A host whose thread also serves
+  /// other work (DDS discovery, parameter services, a stop) then runs it on a thread of its own
+  /// (sim::ControllerNode::run_controller_on_thread). Compiled controllers step in bounded time.
+  virtual bool wants_own_thread() const { return false; }
   /// A copy with the same parameters and state (each node flies its own copy of a configured one).
   virtual std::unique_ptr<Controller> clone() const = 0;
 

@@ -62,6 +62,8 @@ struct ControllerConfig {
 
   /// The registry name of the controller's type.
   std::string_view type() const { return controller->type(); }
+  /// The controller asks to run on a thread of its own (Controller::wants_own_thread).
+  bool wants_own_thread() const { return controller->wants_own_thread(); }
 };
 
 /// The parameters of a node flying `controller`: the node's, then the controller's.

@@ -20,6 +20,7 @@ constexpr ControllerType entry() {
 }
 
 // One line per controller; the first is the default.
+static_assert(PaperController::kType == kDefaultControllerType, "kTypes starts with the default type");
 const std::array kTypes = {
     entry<PaperController>(),
     entry<GeometricController>(),

@@ -24,10 +24,14 @@ struct ControllerType {
   std::unique_ptr<control::Controller> (*make)(const model::VehicleParams& vehicle);
 };
 
-/// Every registered controller type, "paper" first (the default).
+/// The type flown where none is named (a scenario's `controller:` without `type:`, the commands'
+/// --controller, an exported FMU's configuration): the paper's controller, first in the registry.
+inline constexpr std::string_view kDefaultControllerType = "paper";
+
+/// Every registered controller type, the default first.
 std::span<const ControllerType> controller_types();
 
-/// The registered names, "paper" first (for choices and flag checks).
+/// The registered names, the default first (for choices and flag checks).
 std::vector<std::string> controller_type_list();
 
 /// "paper, se3, ...": the registered names, for messages.

@@ -9,16 +9,15 @@ namespace quadcosim::dds {
 
 ArrivalExecutor::ArrivalExecutor(DdsTransport& transport) : transport_(transport), owner_(std::this_thread::get_id()) {
   if (transport_.arrival_sink_) throw std::logic_error("ArrivalExecutor: a second executor on one transport");
-  wake_ = check(dds_create_guardcondition(transport_.participant().handle()), "dds_create_guardcondition");
+  wake_ = Entity(check(dds_create_guardcondition(transport_.participant().handle()), "dds_create_guardcondition"));
   // wait() resets the guard itself, right after its wait.
-  wake_work_ = transport_.add_extra_work({wake_}, [] {});
+  wake_work_ = transport_.add_extra_work({wake_.get()}, [] {});
   mutex_.lock();  // held by the owner but in its waits
   try {
     transport_.set_arrival_sink([this](std::size_t i) { on_data(i); });
-  } catch (...) {  // no executor then: undo what was set up (the destructor will not run)
+  } catch (...) {  // no executor then: undo what was set up (the destructor will not run; wake_ goes)
     mutex_.unlock();
     transport_.remove_extra_work(wake_work_);
-    dds_delete(wake_);
     throw;
   }
   // What came before the listeners. A delivery that throws is kept as on_data keeps it (the sink
@@ -38,8 +37,7 @@ ArrivalExecutor::~ArrivalExecutor() {
     transport_.set_arrival_sink(nullptr);
   } catch (const std::exception&) {  // DdsError: the participant's deletion removes the listeners too
   }
-  transport_.remove_extra_work(wake_work_);
-  dds_delete(wake_);
+  transport_.remove_extra_work(wake_work_);  // then wake_ goes, with the members
 }
 
 void ArrivalExecutor::check_owner(const char* what) const {

@@ -74,8 +74,8 @@ class ArrivalExecutor {
   DdsTransport& transport_;
   std::thread::id owner_;
   std::recursive_mutex mutex_;
-  dds_entity_t wake_ = 0;  ///< guard condition on the transport's waitset: a delivery wakes wait()
-  int wake_work_ = 0;      ///< its extra-work id
+  Entity wake_;        ///< guard condition on the transport's waitset: a delivery wakes wait()
+  int wake_work_ = 0;  ///< its extra-work id
   // Under mutex_:
   int delivered_ = 0;
   std::exception_ptr failure_;

@@ -53,11 +53,10 @@ dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const s
                                            const TypeOps*& ops) {
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
   const QosProfile p = qos_for(ros_topic);
-  dds_qos_t* qos = ros_qos(p.depth, p.reliable, p.transient_local);
-  set_endpoint_user_data(qos, ops->descriptor->m_typename, user_data_keys_);
-  const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos, nullptr)
-                                : dds_create_reader(participant_.handle(), topic, qos, nullptr);
-  dds_delete_qos(qos);
+  const Qos qos(ros_qos(p.depth, p.reliable, p.transient_local));
+  set_endpoint_user_data(qos.get(), ops->descriptor->m_typename, user_data_keys_);
+  const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos.get(), nullptr)
+                                : dds_create_reader(participant_.handle(), topic, qos.get(), nullptr);
   check(e, ((writer ? "dds_create_writer " : "dds_create_reader ") + ros_topic).c_str());
   // Matching changes wake spin_once, so waits for a peer need no polling.
   const std::uint32_t matched = writer ? DDS_PUBLICATION_MATCHED_STATUS : DDS_SUBSCRIPTION_MATCHED_STATUS;

@@ -156,39 +156,28 @@ std::vector<Endpoint> discover_endpoints(dds_entity_t participant, std::int64_t 
 
   // Built-in topic readers default to RELIABLE TRANSIENT_LOCAL: they start with everything already
   // discovered, then receive changes.
-  const dds_entity_t pubs = check(dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
-                                  "dds_create_reader (DCPSPublication)");
-  const dds_entity_t subs = dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr);
-  const dds_entity_t waitset = dds_create_waitset(participant);
-  auto cleanup = [&] {
-    if (waitset > 0) dds_delete(waitset);
-    if (subs > 0) dds_delete(subs);
-    dds_delete(pubs);  // deletes its read condition too
-  };
+  // Deleted on every way out (the readers take their read conditions with them).
+  const Entity pubs(check(dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
+                          "dds_create_reader (DCPSPublication)"));
+  const Entity subs(check(dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr),
+                          "dds_create_reader (DCPSSubscription)"));
+  const Entity waitset(check(dds_create_waitset(participant), "dds_create_waitset"));
   std::map<Key, Endpoint> known;
   std::vector<Endpoint> list;
-  try {
-    check(subs, "dds_create_reader (DCPSSubscription)");
-    check(waitset, "dds_create_waitset");
-    for (const dds_entity_t reader : {pubs, subs}) {
-      const dds_entity_t cond = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
-      check(dds_waitset_attach(waitset, cond, reader), "dds_waitset_attach");
-    }
-    const dds_time_t deadline = dds_time() + wait_ns;
-    for (;;) {
-      take_endpoints(pubs, true, own, known);
-      take_endpoints(subs, false, own, known);
-      list.clear();
-      for (const auto& [key, e] : known) list.push_back(e);
-      if ((done && done(list)) || dds_time() >= deadline) break;
-      const dds_return_t rc = dds_waitset_wait_until(waitset, nullptr, 0, deadline);
-      check(rc, "dds_waitset_wait_until");
-    }
-  } catch (...) {
-    cleanup();
-    throw;
+  for (const dds_entity_t reader : {pubs.get(), subs.get()}) {
+    const dds_entity_t cond = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
+    check(dds_waitset_attach(waitset, cond, reader), "dds_waitset_attach");
   }
-  cleanup();
+  const dds_time_t deadline = dds_time() + wait_ns;
+  for (;;) {
+    take_endpoints(pubs, true, own, known);
+    take_endpoints(subs, false, own, known);
+    list.clear();
+    for (const auto& [key, e] : known) list.push_back(e);
+    if ((done && done(list)) || dds_time() >= deadline) break;
+    const dds_return_t rc = dds_waitset_wait_until(waitset, nullptr, 0, deadline);
+    check(rc, "dds_waitset_wait_until");
+  }
   return list;
 }
 

@@ -44,11 +44,10 @@ NodeAnnouncer::NodeAnnouncer(dds_entity_t participant, std::string name, std::st
       check(dds_create_topic(participant_, &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc, "ros_discovery_info",
                              nullptr, nullptr),
             "dds_create_topic ros_discovery_info");
-  dds_qos_t* qos = ros_qos(1, true);
-  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-  set_endpoint_user_data(qos, rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc.m_typename);
-  writer_ = dds_create_writer(participant_, topic, qos, nullptr);
-  dds_delete_qos(qos);
+  const Qos qos(ros_qos(1, true));
+  dds_qset_durability(qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+  set_endpoint_user_data(qos.get(), rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc.m_typename);
+  writer_ = dds_create_writer(participant_, topic, qos.get(), nullptr);
   check(writer_, "dds_create_writer ros_discovery_info");
 }
 

@@ -25,53 +25,49 @@ ParameterClient::ParameterClient(const RosEnvironment& env, NodeName node)
     : own_participant_(std::make_unique<Participant>(env)),
       participant_(own_participant_->handle()),
       node_(std::move(node)) {
-  waitset_ = check(dds_create_waitset(participant_), "dds_create_waitset");
+  waitset_ = Entity(check(dds_create_waitset(participant_), "dds_create_waitset"));
 }
 
 ParameterClient::ParameterClient(dds_entity_t participant, NodeName node)
     : participant_(participant), node_(std::move(node)) {
-  waitset_ = check(dds_create_waitset(participant_), "dds_create_waitset");
+  waitset_ = Entity(check(dds_create_waitset(participant_), "dds_create_waitset"));
 }
 
-ParameterClient::~ParameterClient() {
-  if (own_participant_) return;  // its entities go with it
-  for (const Endpoints& e : ep_) {
-    if (e.read_condition > 0) dds_delete(e.read_condition);
-    if (e.reader > 0) dds_delete(e.reader);
-    if (e.writer > 0) dds_delete(e.writer);
-  }
-  dds_delete(waitset_);
-}
+// The endpoints, then the waitset, then an own participant go with the members (in that order).
+ParameterClient::~ParameterClient() = default;
 
 ParameterClient::Endpoints& ParameterClient::endpoints(ParamService service) {
-  Endpoints& e = ep_[index(service)];
-  if (e.writer > 0) return e;
+  Endpoints& kept = ep_[index(service)];
+  if (kept.writer > 0) return kept;
+  // Built in a local set, kept only once complete: a failure part way deletes what was created and
+  // leaves the service's slot empty (the next call tries again).
+  Endpoints e;
   const wire::ServiceTypes types = wire::service_types(service);
   const std::string rq = request_topic(node_, service), rr = reply_topic(node_, service);
-  const dds_entity_t rq_topic = check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr),
-                                      ("dds_create_topic " + rq).c_str());
-  const dds_entity_t rr_topic = check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
-                                      ("dds_create_topic " + rr).c_str());
+  e.request_topic = Entity(check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr),
+                                 ("dds_create_topic " + rq).c_str()));
+  e.reply_topic = Entity(check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
+                               ("dds_create_topic " + rr).c_str()));
   // rclpy's parameter client uses the parameter-service profile: KEEP_LAST 1000, RELIABLE, VOLATILE.
   // One client id on both endpoints, each followed by the hash of its own message type (rmw_cyclonedds).
-  dds_qos_t* qos = ros_qos(1000, true);
+  const Qos qos(ros_qos(1000, true));
   const std::string client_id = "clientid=" + wire::new_endpoint_id(participant_) + ";";
-  set_endpoint_user_data(qos, types.request->m_typename, client_id);
-  e.writer = dds_create_writer(participant_, rq_topic, qos, nullptr);
-  set_endpoint_user_data(qos, types.response->m_typename, client_id);
-  e.reader = dds_create_reader(participant_, rr_topic, qos, nullptr);
-  dds_delete_qos(qos);
-  check(e.writer, ("dds_create_writer " + rq).c_str());
-  check(e.reader, ("dds_create_reader " + rr).c_str());
+  set_endpoint_user_data(qos.get(), types.request->m_typename, client_id);
+  e.writer = Entity(
+      check(dds_create_writer(participant_, e.request_topic, qos.get(), nullptr), ("dds_create_writer " + rq).c_str()));
+  set_endpoint_user_data(qos.get(), types.response->m_typename, client_id);
+  e.reader = Entity(
+      check(dds_create_reader(participant_, e.reply_topic, qos.get(), nullptr), ("dds_create_reader " + rr).c_str()));
   check(dds_get_instance_handle(e.writer, &e.writer_handle), "dds_get_instance_handle");
-  e.read_condition = check(dds_create_readcondition(e.reader, DDS_ANY_STATE), "dds_create_readcondition");
+  e.read_condition = Entity(check(dds_create_readcondition(e.reader, DDS_ANY_STATE), "dds_create_readcondition"));
   // Matching wakes the waitset, so waiting for the service needs no polling.
   check(dds_set_status_mask(e.writer, DDS_PUBLICATION_MATCHED_STATUS), "dds_set_status_mask");
   check(dds_set_status_mask(e.reader, DDS_SUBSCRIPTION_MATCHED_STATUS), "dds_set_status_mask");
   check(dds_waitset_attach(waitset_, e.writer, 0), "dds_waitset_attach");
   check(dds_waitset_attach(waitset_, e.reader, 0), "dds_waitset_attach");
   check(dds_waitset_attach(waitset_, e.read_condition, 0), "dds_waitset_attach");
-  return e;
+  kept = std::move(e);
+  return kept;
 }
 
 namespace {

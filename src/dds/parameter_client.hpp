@@ -87,8 +87,10 @@ class ParameterClient {
   const NodeName& node() const { return node_; }
 
  private:
+  // Owned in creation order, so deleted children first (dds/entity.hpp).
   struct Endpoints {
-    dds_entity_t writer = 0, reader = 0, read_condition = 0;
+    Entity request_topic, reply_topic;
+    Entity writer, reader, read_condition;
     dds_instance_handle_t writer_handle = 0;
     mutable bool peer_matched = false;  ///< only_from(): the peer's service found matched
   };
@@ -110,7 +112,7 @@ class ParameterClient {
   std::unique_ptr<Participant> own_participant_;
   dds_entity_t participant_;
   NodeName node_;
-  dds_entity_t waitset_ = 0;
+  Entity waitset_;
   std::array<Endpoints, 6> ep_{};
   std::int64_t next_seq_ = 0;
   Header last_;

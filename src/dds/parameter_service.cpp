@@ -37,34 +37,32 @@ ParameterServer::ParameterServer(dds_entity_t participant, NodeName node, Parame
   for (ParamService s : kParamServices) {
     const wire::ServiceTypes types = wire::service_types(s);
     const std::string rq = request_topic(node_, s), rr = reply_topic(node_, s);
-    const dds_entity_t rq_topic = check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr),
-                                        ("dds_create_topic " + rq).c_str());
-    const dds_entity_t rr_topic = check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
-                                        ("dds_create_topic " + rr).c_str());
-    // One service id on both endpoints, each followed by the hash of its own message type (rmw_cyclonedds).
-    dds_qos_t* qos = ros_qos(options_.depth, true);
-    const std::string service_id = "serviceid=" + wire::new_endpoint_id(participant_) + ";";
     Endpoints& e = ep_[index(s)];
-    set_endpoint_user_data(qos, types.request->m_typename, service_id);
-    e.reader = dds_create_reader(participant_, rq_topic, qos, nullptr);
-    set_endpoint_user_data(qos, types.response->m_typename, service_id);
-    e.writer = dds_create_writer(participant_, rr_topic, qos, nullptr);
-    dds_delete_qos(qos);
-    check(e.reader, ("dds_create_reader " + rq).c_str());
-    check(e.writer, ("dds_create_writer " + rr).c_str());
-    e.read_condition = check(dds_create_readcondition(e.reader, DDS_ANY_STATE), "dds_create_readcondition");
+    e.request_topic = Entity(check(dds_create_topic(participant_, types.request, rq.c_str(), nullptr, nullptr),
+                                   ("dds_create_topic " + rq).c_str()));
+    e.reply_topic = Entity(check(dds_create_topic(participant_, types.response, rr.c_str(), nullptr, nullptr),
+                                 ("dds_create_topic " + rr).c_str()));
+    // One service id on both endpoints, each followed by the hash of its own message type (rmw_cyclonedds).
+    const Qos qos(ros_qos(options_.depth, true));
+    const std::string service_id = "serviceid=" + wire::new_endpoint_id(participant_) + ";";
+    set_endpoint_user_data(qos.get(), types.request->m_typename, service_id);
+    e.reader = Entity(check(dds_create_reader(participant_, e.request_topic, qos.get(), nullptr),
+                            ("dds_create_reader " + rq).c_str()));
+    set_endpoint_user_data(qos.get(), types.response->m_typename, service_id);
+    e.writer = Entity(
+        check(dds_create_writer(participant_, e.reply_topic, qos.get(), nullptr), ("dds_create_writer " + rr).c_str()));
+    e.read_condition = Entity(check(dds_create_readcondition(e.reader, DDS_ANY_STATE), "dds_create_readcondition"));
     // A client's reply reader being matched wakes the server, so a waiting reply goes out at once.
     check(dds_set_status_mask(e.writer, DDS_PUBLICATION_MATCHED_STATUS), "dds_set_status_mask");
   }
   if (options_.publish_events) {
-    const dds_entity_t topic = check(dds_create_topic(participant_, &rcl_interfaces_msg_dds__ParameterEvent__desc,
-                                                      "rt/parameter_events", nullptr, nullptr),
-                                     "dds_create_topic rt/parameter_events");
-    dds_qos_t* qos = ros_qos(1000, true);
-    set_endpoint_user_data(qos, rcl_interfaces_msg_dds__ParameterEvent__desc.m_typename);
-    events_writer_ = dds_create_writer(participant_, topic, qos, nullptr);
-    dds_delete_qos(qos);
-    check(events_writer_, "dds_create_writer rt/parameter_events");
+    events_topic_ = Entity(check(dds_create_topic(participant_, &rcl_interfaces_msg_dds__ParameterEvent__desc,
+                                                  "rt/parameter_events", nullptr, nullptr),
+                                 "dds_create_topic rt/parameter_events"));
+    const Qos qos(ros_qos(1000, true));
+    set_endpoint_user_data(qos.get(), rcl_interfaces_msg_dds__ParameterEvent__desc.m_typename);
+    events_writer_ = Entity(check(dds_create_writer(participant_, events_topic_, qos.get(), nullptr),
+                                  "dds_create_writer rt/parameter_events"));
   }
 }
 
@@ -78,13 +76,7 @@ ParameterServer::ParameterServer(DdsTransport& transport, NodeName node, Paramet
 ParameterServer::~ParameterServer() {
   if (transport_) transport_->remove_extra_work(transport_work_id_);
   pending_.clear();
-  // Deleting the readers and writers is enough: topics go with the participant.
-  for (const Endpoints& e : ep_) {
-    if (e.read_condition > 0) dds_delete(e.read_condition);
-    if (e.reader > 0) dds_delete(e.reader);
-    if (e.writer > 0) dds_delete(e.writer);
-  }
-  if (events_writer_ > 0) dds_delete(events_writer_);
+  // Then the endpoints and their topics go with the members (dds/entity.hpp).
 }
 
 std::vector<dds_entity_t> ParameterServer::wake_entities() const {

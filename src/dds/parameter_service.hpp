@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "dds/entity.hpp"
 #include "dds/parameter_types.hpp"
 
 namespace quadcosim::dds {
@@ -92,7 +93,8 @@ class ParameterServer {
 
  private:
   struct Endpoints {
-    dds_entity_t reader = 0, read_condition = 0, writer = 0;
+    Entity request_topic, reply_topic;  // owned in creation order, so deleted children first
+    Entity reader, read_condition, writer;
   };
   struct PendingReply {
     ParamService service;
@@ -114,7 +116,8 @@ class ParameterServer {
   ParameterCallbacks cb_;
   ParameterServerOptions options_;
   std::array<Endpoints, 6> ep_{};
-  dds_entity_t events_writer_ = 0;
+  Entity events_topic_;
+  Entity events_writer_;
   std::deque<PendingReply> pending_;
   Stats stats_;
   DdsTransport* transport_ = nullptr;

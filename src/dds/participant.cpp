@@ -86,34 +86,25 @@ Participant::Participant(const RosEnvironment& env) : domain_id_(env.domain_id) 
   const SecurityPlan security = plan_security(env.security, env.enclave);  // throws under Enforce
   if (!security.note.empty()) std::cerr << security.note << '\n';
   const std::string config = cyclone_config(env);
-  domain_ = dds_create_domain(env.domain_id, config.c_str());
+  const dds_entity_t domain = dds_create_domain(env.domain_id, config.c_str());
   // A domain with this id may already exist in this process (e.g. two nodes in one test): then the
   // participant joins it with the configuration it already has.
-  if (domain_ < 0 && domain_ != DDS_RETCODE_PRECONDITION_NOT_MET) check(domain_, "dds_create_domain");
-  dds_qos_t* qos = dds_create_qos();
+  if (domain < 0 && domain != DDS_RETCODE_PRECONDITION_NOT_MET) check(domain, "dds_create_domain");
+  domain_ = Entity(domain);  // deleted again if what follows throws
+  const Qos qos(dds_create_qos());
   // As rmw: the enclave given to the node (not the override, which only selects the files).
   const std::string user_data = "enclave=" + env.enclave + ";";
-  dds_qset_userdata(qos, user_data.data(), user_data.size());
-  if (security.secured) set_security_qos(qos, security.root);
-  participant_ = dds_create_participant(env.domain_id, qos, nullptr);
-  dds_delete_qos(qos);
-  if (participant_ < 0 && domain_ > 0) {
-    dds_delete(domain_);
-    domain_ = 0;
-  }
-  if (participant_ < 0 && security.secured) {
+  dds_qset_userdata(qos.get(), user_data.data(), user_data.size());
+  if (security.secured) set_security_qos(qos.get(), security.root);
+  const dds_entity_t participant = dds_create_participant(env.domain_id, qos.get(), nullptr);
+  if (participant < 0 && security.secured) {
     throw DdsError("dds_create_participant with security (enclave " + security.enclave_used + ", " +
-                   security.root.string() + ") failed: " + dds_strretcode(participant_) +
+                   security.root.string() + ") failed: " + dds_strretcode(participant) +
                    "; Cyclone's reason is in its log above (a domain id the governance or permissions do "
                    "not cover, or a plugin that cannot be loaded, are common causes)");
   }
-  check(participant_, "dds_create_participant");
+  participant_ = Entity(check(participant, "dds_create_participant"));
   secured_ = security.secured;
-}
-
-Participant::~Participant() {
-  if (participant_ > 0) dds_delete(participant_);
-  if (domain_ > 0) dds_delete(domain_);
 }
 
 dds_qos_t* ros_qos(int depth, bool reliable, bool transient_local) {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "dds/entity.hpp"
 #include "dds/security.hpp"
 
 namespace quadcosim::dds {
@@ -53,25 +54,24 @@ class Participant {
   /// what is missing or unusable; Permissive: a warning on stderr and no security). A one-line note
   /// on stderr says what was decided whenever security is on.
   explicit Participant(const RosEnvironment& env);
-  ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
-  dds_entity_t handle() const { return participant_; }
+  dds_entity_t handle() const { return participant_.get(); }
   std::uint32_t domain_id() const { return domain_id_; }
   /// True when the participant runs with DDS Security (authenticated, access-controlled).
   bool secured() const { return secured_; }
 
  private:
-  dds_entity_t domain_ = 0;
-  dds_entity_t participant_ = 0;
+  Entity domain_;       ///< when this participant created its domain
+  Entity participant_;  ///< deleted before the domain (declared after it)
   std::uint32_t domain_id_ = 0;
   bool secured_ = false;
 };
 
 /// The QoS rmw uses for `depth` KEEP_LAST, RELIABLE (or BEST_EFFORT), VOLATILE (or TRANSIENT_LOCAL:
 /// a writer keeps its last `depth` samples for readers that join later, as robot_state_publisher's
-/// robot_description and tf2's /tf_static), XCDR1 only. Caller owns the result (dds_delete_qos).
+/// robot_description and tf2's /tf_static), XCDR1 only. Caller owns the result (hold it in a dds::Qos).
 dds_qos_t* ros_qos(int depth, bool reliable, bool transient_local = false);
 
 }  // namespace quadcosim::dds

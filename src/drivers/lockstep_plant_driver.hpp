@@ -64,7 +64,7 @@ class LockstepPlantDriver {
   /// Ticks completed (latched, recorded, integrated but for the last).
   sim::Tick ticks_run() const { return core_.ticks_run(); }
   /// Outputs published -> every answer in, per awaited control tick [ns, wall clock].
-  const analysis::LogHistogram& round_trips_ns() const { return core_.round_trips_ns(); }
+  const util::LogHistogram& round_trips_ns() const { return core_.round_trips_ns(); }
 
  private:
   /// LockstepHooks and the plants' status functions as sim::LockstepCore calls them (empty: nothing).

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cctype>
 #include <chrono>
+#include <condition_variable>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -134,6 +135,14 @@ struct Server::Impl {
   std::uint64_t n_refused_in_a_row = 0;  // refusals for the client limit since a connection last opened
 
   std::atomic<std::size_t> open{0};
+  // Wakes Server::wait_subscriptions_change: notified (under the mutex, so no waiter misses it) after
+  // the server thread changed a channel's subscriber count.
+  mutable std::mutex subscriptions_mutex;
+  mutable std::condition_variable subscriptions_changed;
+  void notify_subscriptions_changed() {
+    { const std::lock_guard<std::mutex> lock(subscriptions_mutex); }
+    subscriptions_changed.notify_all();
+  }
   std::atomic<std::uint64_t> n_clients{0}, n_refused{0}, n_sent{0}, n_dropped{0}, n_handoff_dropped{0}, n_time{0},
       n_bad{0}, n_disconnected{0};
 
@@ -225,6 +234,7 @@ struct Server::Impl {
                       options.max_client_frame_bytes));
     }
     for (const auto& [sub, channel] : cl.subscriptions) --channels[channel]->subscribers;
+    if (!cl.subscriptions.empty()) notify_subscriptions_changed();
     if (cl.dropped > 0)
       log(fmt::format("client {} ({}) left; {} messages dropped for it", cl.id, cl.remote, cl.dropped));
     clients.erase(it);
@@ -309,6 +319,7 @@ struct Server::Impl {
       cl.subscription_of[*channel] = *id;
       Channel& ch = *channels[*channel];
       ++ch.subscribers;
+      notify_subscriptions_changed();
       if (ch.last_t_ns >= 0) send_message(h, cl, *id, ch.last_t_ns, ch.last);
     }
   }
@@ -329,6 +340,7 @@ struct Server::Impl {
       --channels[it->second]->subscribers;
       cl.subscription_of[it->second] = -1;
       cl.subscriptions.erase(it);
+      notify_subscriptions_changed();
     }
   }
 
@@ -536,6 +548,12 @@ std::size_t Server::subscriptions() const {
   std::size_t n = 0;
   for (const auto& ch : impl_->channels) n += static_cast<std::size_t>(ch->subscribers.load());
   return n;
+}
+
+std::size_t Server::wait_subscriptions_change(std::size_t seen, std::chrono::steady_clock::time_point deadline) const {
+  std::unique_lock<std::mutex> lock(impl_->subscriptions_mutex);
+  impl_->subscriptions_changed.wait_until(lock, deadline, [&] { return subscriptions() != seen; });
+  return subscriptions();
 }
 
 std::string Server::summary() const {

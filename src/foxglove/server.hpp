@@ -7,6 +7,7 @@
 // simulation or a change of what it computes.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -97,6 +98,10 @@ class Server {
   std::size_t connected() const;
   /// Subscriptions held now, over every client.
   std::size_t subscriptions() const;
+  /// Waits until subscriptions() is not `seen` or `deadline` passed, whichever comes first, and
+  /// returns subscriptions() then. Woken by the server thread as a client subscribes, unsubscribes
+  /// or leaves (no polling).
+  std::size_t wait_subscriptions_change(std::size_t seen, std::chrono::steady_clock::time_point deadline) const;
   /// One line for the node's summary: clients, messages sent and dropped, bad requests.
   std::string summary() const;
 

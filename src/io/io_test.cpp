@@ -819,7 +819,9 @@ TEST(TrajectoryWriterTest, NumbersRoundTripExactly) {
                        k % 2 == 1,
                        {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3},
                        k % 3 == 1,
-                       a(11) / 3.0};
+                       a(11) / 3.0,
+                       {},   // output_names: none
+                       {}};  // outputs
       const double t = static_cast<double>(k) * 1e7 / 1e9;
       const bool watchdog = k % 3 == 0;
       w.write(t, x, cmd, c, watchdog);
@@ -911,7 +913,10 @@ TEST(SeriesRecorderTest, HoldsWhatReadSeriesReadsFromTheWrittenCsvBitForBit) {
                                                      Eigen::Vector4d(a(7), a(8), 0.0, 0.0),
                                                      false,
                                                      {k % 4 == 0, k % 4 == 1, k % 5 == 2, k % 7 == 3},
-                                                     k % 3 == 1};
+                                                     k % 3 == 1,
+                                                     std::numeric_limits<double>::quiet_NaN(),  // no R_d
+                                                     {},                                        // output_names
+                                                     {}};                                       // outputs
       const double t = static_cast<double>(k) * 1e7 / 1e9;
       const Eigen::Vector4d command(a(2), a(3), 0.0, -a(4));
       w.write(t, x, command, c, k % 5 == 1);

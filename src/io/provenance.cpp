@@ -10,6 +10,7 @@
 #include <sstream>
 #include <variant>
 
+#include "controllers/registry.hpp"
 #include "io/output_folder.hpp"
 
 #ifndef QUADCOSIM_VERSION
@@ -41,10 +42,10 @@ std::string file_controller_type(const std::string& path) {
   try {
     const YAML::Node root = YAML::LoadFile(path);
     const YAML::Node c = root["controller"];
-    if (!c || !c.IsMap()) return "paper";
+    if (!c || !c.IsMap()) return std::string(controllers::kDefaultControllerType);
     if (c["python"]) return "python";
     if (c["fmu"]) return "fmu";
-    return c["type"] ? c["type"].as<std::string>() : "paper";
+    return c["type"] ? c["type"].as<std::string>() : std::string(controllers::kDefaultControllerType);
   } catch (const std::exception&) {
     return "";
   }

@@ -363,7 +363,8 @@ control::ControllerConfig read_controller(YamlSection& s, const model::VehiclePa
   for (const char* key : {"inputs", "outputs", "parameters"}) {
     if (s.has(key)) s.fail(key, "belongs to an FMU controller; expected fmu: beside it");
   }
-  const std::string type = s.choice("type", "paper", controllers::controller_type_list());
+  const std::string type =
+      s.choice("type", std::string(controllers::kDefaultControllerType), controllers::controller_type_list());
   control::ControllerConfig c;
   try {
     c = controllers::make_config(type, vehicle);
@@ -702,7 +703,7 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
   const std::string was_type = was_python                          ? "python"
                                : was_fmu                           ? "fmu"
                                : c["type"] && c["type"].IsScalar() ? c["type"].Scalar()
-                                                                   : "paper";
+                                                                   : std::string(controllers::kDefaultControllerType);
   const bool same = choice.kind == ControllerChoice::Kind::kType ? !was_python && !was_fmu && was_type == choice.target
                     : choice.kind == ControllerChoice::Kind::kPython
                         ? was_python && (choice.target.empty() || (c["python"] && c["python"].IsScalar() &&
@@ -813,7 +814,7 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   if (auto c = root.section("controller")) {
     sc.controller = read_controller(*c, believed, std::filesystem::path(path).parent_path(), &sc.controller_fmu);
   } else {
-    sc.controller = controllers::make_config("paper", believed);
+    sc.controller = controllers::make_config(controllers::kDefaultControllerType, believed);
   }
   read_schedule(root, sc, duration_s);
   read_realism(root, sc);

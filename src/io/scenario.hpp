@@ -134,7 +134,8 @@ struct Scenario {
   model::VehicleParams vehicle;
   /// The controller, its parameters and the node's setpoints (the paper's controller by default), and
   /// the `trajectory:` to track (controller.trajectory; none for kind steps, the default).
-  control::ControllerConfig controller = controllers::make_config("paper", model::VehicleParams{});
+  control::ControllerConfig controller =
+      controllers::make_config(controllers::kDefaultControllerType, model::VehicleParams{});
   /// The `trajectory:` section's description, from which controller.trajectory was made (what an
   /// exported controller FMU carries); nothing without a trajectory.
   std::optional<trajectory::TrajectorySpec> trajectory_spec;

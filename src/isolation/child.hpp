@@ -9,8 +9,9 @@
 //
 // The child dies with its parent (PR_SET_PDEATHSIG, SIGKILL) and ignores SIGINT: a Ctrl-C is the
 // parent's to handle. "Parent" is the thread that forked: a host must keep the thread that first steps
-// an isolated controller alive for the whole run (sim::Swarm keeps its threads through the run). Values travel as their
-// bytes (both ends are the same program): results are bit for bit those of the same calls in-process.
+// an isolated controller alive for the whole run (sim::Swarm keeps its threads through the run).
+// Values travel as their bytes (both ends are the same program): results are bit for bit those of
+// the same calls in-process.
 #pragma once
 
 #include <sys/types.h>

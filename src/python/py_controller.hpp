@@ -71,6 +71,8 @@ class PyController final : public control::Controller {
   ~PyController() override;
 
   std::string_view type() const override { return "python"; }
+  /// A step holds the interpreter's lock and can block: hosts give it a thread (docs/python.md).
+  bool wants_own_thread() const override { return true; }
   /// A copy.deepcopy of the object, with the same parameter values and step count.
   std::unique_ptr<control::Controller> clone() const override;
   /// The declared parameters, then step_timeout_s.

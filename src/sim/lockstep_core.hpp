@@ -50,9 +50,9 @@
 #include <utility>
 #include <vector>
 
-#include "analysis/log_histogram.hpp"
 #include "sim/clock.hpp"
 #include "sim/steppable_plant.hpp"
+#include "util/log_histogram.hpp"
 
 namespace quadcosim::sim {
 
@@ -88,7 +88,7 @@ class LockstepCore {
   /// `plants` and `host` must outlive the loop.
   LockstepCore(std::vector<Plant*> plants, const LockstepOptions& options, Hooks hooks, Host& host)
       : plants_(std::move(plants)), slots_(plants_.size()), o_(options), hooks_(std::move(hooks)), host_(host) {
-    if constexpr (!kSynchronous) round_trips_ns_ = std::make_unique<analysis::LogHistogram>();
+    if constexpr (!kSynchronous) round_trips_ns_ = std::make_unique<util::LogHistogram>();
   }
   LockstepCore(const LockstepCore&) = delete;
   LockstepCore& operator=(const LockstepCore&) = delete;
@@ -148,8 +148,8 @@ class LockstepCore {
   /// synchronous.
   /// Lockstep round trips [ns] (outputs published -> every command back), one per control period; in
   /// fixed memory however long the run. Empty for a synchronous loop.
-  const analysis::LogHistogram& round_trips_ns() const {
-    static const analysis::LogHistogram kNone;
+  const util::LogHistogram& round_trips_ns() const {
+    static const util::LogHistogram kNone;
     return round_trips_ns_ ? *round_trips_ns_ : kNone;
   }
   /// False while holding after a timeout.
@@ -278,7 +278,7 @@ class LockstepCore {
   bool waiting_ = true;                          ///< answers awaited (off while holding)
   std::size_t answered_ = 0;                     ///< plants [0, answered_) have answered k_
   std::int64_t asked_ns_ = 0, last_ask_ns_ = 0;  ///< k_ first / last published [wall ns]
-  std::unique_ptr<analysis::LogHistogram> round_trips_ns_;  ///< asynchronous loops only (30 kB)
+  std::unique_ptr<util::LogHistogram> round_trips_ns_;  ///< asynchronous loops only (30 kB)
 };
 
 }  // namespace quadcosim::sim

@@ -394,7 +394,9 @@ void set_key(YAML::Node root, const std::string& path, double value,
   if (parts.size() > 1 && parts[0] == "controller" && !controllers::find_controller_type(parts[1]) &&
       !control::node_parameters().find(join(parts, 1, parts.size()))) {
     const YAML::Node c = static_cast<const YAML::Node&>(root)["controller"];
-    const std::string type = c && c.IsMap() && c["type"] && c["type"].IsScalar() ? c["type"].Scalar() : "paper";
+    const std::string type = c && c.IsMap() && c["type"] && c["type"].IsScalar()
+                                 ? c["type"].Scalar()
+                                 : std::string(controllers::kDefaultControllerType);
     if (c && c.IsMap() && !c["python"] && !c["fmu"] && c[type] && c[type].IsMap()) {
       parts.insert(parts.begin() + 1, type);
     }

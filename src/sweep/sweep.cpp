@@ -134,7 +134,10 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
   s["vehicle"] = vehicle;
   j["sweep"] = s;
   // What flew, as every run folder records it (io/provenance.hpp).
-  j["provenance"] = io::describe_run(flown, {.python_target = io::python_target_of(plan.root)});
+  // The run context's defaults (in-process, lockstep, no override) are how a sweep flies.
+  io::RunContext context;
+  context.python_target = io::python_target_of(plan.root);
+  j["provenance"] = io::describe_run(flown, context);
   return j;
 }
 

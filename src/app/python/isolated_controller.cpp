@@ -144,6 +144,8 @@ class IsolatedPythonController final : public control::Controller {
   }
 
   std::string_view type() const override { return "python"; }
+  /// Its steps wait on the child process (a Python step that can block): hosts give it a thread.
+  bool wants_own_thread() const override { return true; }
 
   std::unique_ptr<control::Controller> clone() const override {
     const std::lock_guard lock(mirror_mutex_);

@@ -22,6 +22,7 @@
 
 #include "control/controller.hpp"
 #include "control/controller_config.hpp"
+#include "controllers/registry.hpp"
 #include "fmi/model_description.hpp"
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
@@ -68,7 +69,7 @@ struct FmuConfig {
 
   /// Controller FMU: the registry type (controllers/registry.hpp) and the values of its parameters
   /// that differ from the type's defaults for `vehicle` (any subset, applied all at once).
-  std::string controller_type = "paper";
+  std::string controller_type{controllers::kDefaultControllerType};
   std::vector<control::Setting> controller_parameters;
   /// Controller FMU: the reference inputs' start values (and the mode: attitude or position).
   control::Setpoint setpoint;

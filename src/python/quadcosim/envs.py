@@ -131,7 +131,7 @@ TRACKING_SCENARIO: Dict[str, Any] = {
     "description": "TrackingEnv: circle r = 1 m, period 10 s at 1 m",
     "simulation": {"plant_rate_hz": 100, "controller_rate_hz": 50, "duration_s": 20},
     "initial": {"position_m": [1.0, 0.0, 1.0], "hover": True},
-    "controller": {"type": "paper", "mode": "position"},
+    "controller": {"mode": "position"},
     "trajectory": {"kind": "circle", "centre_m": [0, 0], "altitude_m": 1, "radius_m": 1, "period_s": 10,
                    "ramp_s": 2, "yaw_mode": "fixed"},
 }

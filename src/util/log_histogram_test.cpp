@@ -1,6 +1,6 @@
 // LogHistogram against the exact percentiles of the same samples (analysis::percentile_lower on the
 // sorted vector): every bucket edge, random durations over nine decades, and the fixed memory.
-#include "analysis/log_histogram.hpp"
+#include "util/log_histogram.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,10 @@
 
 #include "analysis/percentile.hpp"
 
-namespace quadcosim::analysis {
+namespace quadcosim::util {
 namespace {
+
+using analysis::percentile_lower;
 
 TEST(LogHistogram, BucketsCoverEveryValueInOrderWithinOneSixtyFourth) {
   // Each value falls in the bucket whose lower edge is the largest edge not above it.
@@ -21,7 +23,9 @@ TEST(LogHistogram, BucketsCoverEveryValueInOrderWithinOneSixtyFourth) {
     const std::size_t i = LogHistogram::index(u);
     ASSERT_LT(i, LogHistogram::kBuckets) << u;
     EXPECT_LE(LogHistogram::lower_edge(i), u) << u;
-    if (i + 1 < LogHistogram::kBuckets) EXPECT_GT(LogHistogram::lower_edge(i + 1), u) << u;
+    if (i + 1 < LogHistogram::kBuckets) {
+      EXPECT_GT(LogHistogram::lower_edge(i + 1), u) << u;
+    }
     EXPECT_LE(static_cast<double>(u - LogHistogram::lower_edge(i)), static_cast<double>(u) / 64.0) << u;
   }
   for (std::size_t i = 1; i < LogHistogram::kBuckets; ++i) {
@@ -67,4 +71,4 @@ TEST(LogHistogram, SmallValuesAreExactAndNegativesCountAsZero) {
 }
 
 }  // namespace
-}  // namespace quadcosim::analysis
+}  // namespace quadcosim::util

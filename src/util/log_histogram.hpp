@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <limits>
 
-namespace quadcosim::analysis {
+namespace quadcosim::util {
 
 class LogHistogram {
  public:
@@ -69,4 +69,4 @@ class LogHistogram {
   std::uint64_t max_ = 0;
 };
 
-}  // namespace quadcosim::analysis
+}  // namespace quadcosim::util
