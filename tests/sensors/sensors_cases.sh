@@ -202,40 +202,33 @@ PY
     ;;
 
   bad_keys)
-    check() {  # check YAML_LINE EXPECTED_TEXT
-      sed "s|^  gnss:|$1\n  gnss:|" "$scenario" > "$tmp/bad.yaml"
+    refused() {  # refused WHAT EXPECTED_TEXT COMMAND...: exit 2 naming it, nothing written
+      local what="$1" expected="$2" rc
+      shift 2
       set +e
-      "$bin" run "$tmp/bad.yaml" --out "$tmp/bad_out" --no-plots > "$tmp/bad.log" 2>&1
+      "$@" > "$tmp/refused.log" 2>&1
       rc=$?
       set -e
-      rm -rf "$tmp/bad_out"
-      [ "$rc" -eq 2 ] || fail "exit $rc for $1, expected 2"
-      grep -qF "$2" "$tmp/bad.log" || fail "for $1: no '$2' in: $(cat "$tmp/bad.log")"
-      echo "ok: $1 -> $(grep -m1 error "$tmp/bad.log")"
+      [ "$rc" -eq 2 ] && grep -qF "$expected" "$tmp/refused.log" ||
+        fail "$what: exit $rc, expected 2 and '$expected' in: $(cat "$tmp/refused.log")"
+      echo "ok: $what -> $(grep -m1 error "$tmp/refused.log")"
     }
-    check "  magnetometer2: {}" "sensors.magnetometer2"
-    sed "s|    rate_hz: 10$|    rate_hz: 30|" "$scenario" > "$tmp/bad_rate.yaml"
-    set +e
-    "$bin" run "$tmp/bad_rate.yaml" --out "$tmp/bad_rate" --no-plots > "$tmp/bad_rate.log" 2>&1
-    rc=$?
-    set -e
-    [ "$rc" -eq 2 ] && grep -q "sensors.gnss.rate_hz: got 30" "$tmp/bad_rate.log" ||
-      fail "a GNSS rate that lands off the control ticks: exit $rc, $(cat "$tmp/bad_rate.log")"
-    sed "s|    latitude_deg: 47.397742|    latitude_deg: 97|" "$scenario" > "$tmp/bad_site.yaml"
-    set +e
-    "$bin" run "$tmp/bad_site.yaml" --out "$tmp/bad_site" --no-plots > "$tmp/bad_site.log" 2>&1
-    rc=$?
-    set -e
-    [ "$rc" -eq 2 ] && grep -q "environment.site.latitude_deg: got '97'" "$tmp/bad_site.log" ||
-      fail "a latitude of 97 deg: exit $rc, $(cat "$tmp/bad_site.log")"
-    set +e
-    "$bin" fmu export plant --scenario "$scenario" --out "$tmp/plant.fmu" > "$tmp/fmu.log" 2>&1
-    rc=$?
-    set -e
-    [ "$rc" -eq 2 ] && grep -q "sensors.magnetometer: the plant FMU outputs Pose, Velocity and Imu only" "$tmp/fmu.log" ||
-      fail "a plant FMU of a scenario with a magnetometer: exit $rc, $(cat "$tmp/fmu.log")"
+    edit() {  # edit SED_EXPRESSION NAME: the scenario changed by one sed expression, as $tmp/NAME.yaml
+      sed "$1" "$scenario" > "$tmp/$2.yaml"
+    }
+    edit "s|^  gnss:|  magnetometer2: {}\n  gnss:|" unknown
+    refused "an unknown sensor" "sensors.magnetometer2: unknown key; did you mean 'magnetometer'?" \
+      "$bin" run "$tmp/unknown.yaml" --out "$tmp/o1" --no-plots
+    edit "s|    rate_hz: 10$|    rate_hz: 30|" rate
+    refused "a GNSS rate off the control ticks" "sensors.gnss.rate_hz: got 30" \
+      "$bin" run "$tmp/rate.yaml" --out "$tmp/o2" --no-plots
+    edit "s|    latitude_deg: 47.397742|    latitude_deg: 97|" site
+    refused "a latitude of 97 deg" "environment.site.latitude_deg: got '97'" \
+      "$bin" run "$tmp/site.yaml" --out "$tmp/o3" --no-plots
+    refused "a plant FMU that would drop the sensors" \
+      "sensors.magnetometer: the plant FMU outputs Pose, Velocity and Imu only" \
+      "$bin" fmu export plant --scenario "$scenario" --out "$tmp/plant.fmu"
     [ ! -e "$tmp/plant.fmu" ] || fail "an FMU was written without its sensors"
-    echo "ok: wrong sensor keys and values are named; a plant FMU that would drop the sensors is refused"
     ;;
 
   *) fail "unknown case $case_name" ;;
