@@ -495,7 +495,10 @@ def step_title(step):
     meta = CHANNELS[step["channel"]]
     unit = meta["unit"]
     initial, target = step["initial"], step["target"]
-    title = f"{meta['name']} step {_fmt_num(initial)} → {_fmt_num(target)} {unit}"
+    # A measured start within 0.1 % of the step of zero (sensor noise before a position step) reads as
+    # ≈0: its digits are in the figures, not worth the title's space.
+    near_zero = initial != 0 and abs(initial) < 1e-3 * abs(target - initial)
+    title = f"{meta['name']} step {'≈0' if near_zero else _fmt_num(initial)} → {_fmt_num(target)} {unit}"
     d = step.get("step")
     if step["channel"] in ("roll", "pitch", "yaw") and d is not None and abs(d - (target - initial)) > 1e-9:
         sign = "+" if d >= 0 else "−"

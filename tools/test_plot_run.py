@@ -361,6 +361,11 @@ class UnwrapAndSaturationTest(unittest.TestCase):
                          "Yaw step 0 → 1 rad")
         self.assertEqual(self.pr.step_title({"channel": "z", "initial": 0.0, "target": 10.0, "step": None}),
                          "Altitude step 0 → 10 m")
+        # A noisy start below 0.1 % of the step is shown as about zero; one above it with its digits.
+        self.assertEqual(self.pr.step_title({"channel": "x", "initial": -0.0008464, "target": 2.0, "step": None}),
+                         "X position step ≈0 → 2 m")
+        self.assertEqual(self.pr.step_title({"channel": "x", "initial": -0.05, "target": 2.0, "step": None}),
+                         "X position step −0.05 → 2 m")
 
     def test_steps_without_metrics_are_the_commanded_setpoints(self):
         # yaw_des 3.0 -> -3.0 at t = 1 s: detect_steps on the unwrapped data gives the commanded values.
