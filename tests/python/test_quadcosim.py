@@ -378,6 +378,45 @@ def test_setpoints_and_sensors():
         sim.set_setpoint(mode="sideways")
 
 
+def test_the_extra_sensors_in_sensors():
+    """scenarios/realism/all_sensors.yaml: the magnetometer, barometer and GNSS reach sim.sensors in SI
+    units, each agreeing with the true state through formulas written here (field elements, metres per
+    degree on a sphere, the ISA's altitude-to-pressure law inverted by the module), within its noise."""
+    sim = quadcosim.Simulation("scenarios/realism/all_sensors.yaml")
+    for _ in range(50):
+        sim.step()
+    s = sim.sensors
+    assert not s["gnss"]["fix"] and math.isnan(s["gnss"]["latitude_deg"])  # fix_after_s 1.0, 0.1 s latency
+    for _ in range(50):
+        sim.step()
+    s, x = sim.sensors, sim.state
+    # Magnetometer: R^T B_W + hard iron, B_W from F = 48 uT, I = 63.5 deg, D = 3 deg (ENU).
+    F, I, D = 48e-6, math.radians(63.5), math.radians(3.0)
+    B = np.array([F * math.cos(I) * math.sin(D), F * math.cos(I) * math.cos(D), -F * math.sin(I)])
+    w, qx, qy, qz = x["q"]
+    R = np.array([[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - w * qz), 2 * (qx * qz + w * qy)],
+                  [2 * (qx * qy + w * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - w * qx)],
+                  [2 * (qx * qz - w * qy), 2 * (qy * qz + w * qx), 1 - 2 * (qx * qx + qy * qy)]])
+    expected = R.T @ B + np.array([2.0e-6, -1.5e-6, 0.8e-6])
+    assert np.abs(s["magnetometer"]["field"] - expected).max() < 2.5e-6, (s["magnetometer"], expected)
+    # Barometer: the pressure altitude of 488 m + z, off by its bias (turn-on sigma 20 Pa ~ 1.7 m).
+    assert abs(s["barometer"]["altitude"] - (488.0 + x["p"][2])) < 10.0, s["barometer"]
+    assert 90000 < s["barometer"]["pressure"] < 100000
+    # GNSS: 0.1 s old, sigma 0.8 m horizontal, 1.5 m vertical; a degree of latitude is ~111.2 km.
+    g = s["gnss"]
+    assert g["fix"] and g["t"] == pytest.approx(1.9)
+    metres_per_deg = math.pi / 180 * 6371000.0
+    assert abs((g["latitude_deg"] - 47.397742) * metres_per_deg - x["p"][1]) < 5.0, g
+    east = (g["longitude_deg"] - 8.545594) * metres_per_deg * math.cos(math.radians(47.397742))
+    assert abs(east - x["p"][0]) < 5.0, (east, x["p"])
+    assert abs(g["altitude_m"] - (488.0 + x["p"][2])) < 8.0, g
+    assert np.abs(g["v"] - x["v"]).max() < 0.5
+    # The paper's scenarios have none of them.
+    paper = quadcosim.Simulation(ALTITUDE_STEP)
+    paper.step()
+    assert sorted(paper.sensors) == ["imu", "pose", "velocity"]
+
+
 def test_help_teaches_the_api():
     text = quadcosim.Simulation.__doc__ + "".join(
         getattr(quadcosim.Simulation, n).__doc__ or "" for n in ["step", "set_setpoint", "reset", "state", "sensors"])
