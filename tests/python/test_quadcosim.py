@@ -182,21 +182,25 @@ def test_run_refuses_a_folder_holding_other_outputs(tmp_path):
     quadcosim.run(ALTITUDE_STEP, out=tmp_path / "r", force=True)
 
 
-def test_ctrl_c_ends_a_run_keeping_what_ran(tmp_path):
-    """An hour simulated (360,001 ticks, seconds of wall time): a SIGINT 0.2 s in ends it promptly with
-    KeyboardInterrupt, and trajectory.csv holds the ticks that ran, whole rows."""
+def interrupt_run(scenario, out):
+    """quadcosim.run(scenario, out=out) with a SIGINT 0.2 s in: it must end with KeyboardInterrupt."""
     import _thread
     import threading
-    import time
-    long = hover_scenario(duration_s=3600.0)
     timer = threading.Timer(0.2, _thread.interrupt_main)
-    start = time.perf_counter()
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            quadcosim.run(long, out=tmp_path / "long")
+            quadcosim.run(scenario, out=out)
     finally:
         timer.cancel()
+
+
+def test_ctrl_c_ends_a_run_keeping_what_ran(tmp_path):
+    """An hour simulated (360,001 ticks, seconds of wall time): a SIGINT 0.2 s in ends it promptly with
+    KeyboardInterrupt, and trajectory.csv holds the ticks that ran, whole rows."""
+    import time
+    start = time.perf_counter()
+    interrupt_run(hover_scenario(duration_s=3600.0), tmp_path / "long")
     lines = (tmp_path / "long" / "trajectory.csv").read_text().splitlines()
     assert 2 < len(lines) < 360_002
     assert all(len(line.split(",")) == len(lines[0].split(",")) for line in lines)
@@ -252,16 +256,8 @@ def test_a_swarm_judged_none_and_bad_sizes(tmp_path):
 def test_ctrl_c_ends_a_swarm_keeping_what_ran(tmp_path):
     """4 vehicles for an hour: a SIGINT 0.2 s in ends it with KeyboardInterrupt after the block being
     flown; the recorded vehicle's trajectory.csv holds whole rows, and no summary claims an end."""
-    import _thread
-    import threading
     long = dict(hover_scenario(duration_s=3600.0), swarm={"vehicles": 4, "record_vehicles": [1]})
-    timer = threading.Timer(0.2, _thread.interrupt_main)
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            quadcosim.run(long, out=tmp_path / "long")
-    finally:
-        timer.cancel()
+    interrupt_run(long, tmp_path / "long")
     lines = (tmp_path / "long" / "uav0001" / "trajectory.csv").read_text().splitlines()
     assert 2 < len(lines) < 360_002
     assert all(len(line.split(",")) == len(lines[0].split(",")) for line in lines)
