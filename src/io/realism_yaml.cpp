@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "model/wind.hpp"
 
@@ -25,46 +26,38 @@ Eigen::Vector3d vec3(YamlSection& s, const std::string& key, const Eigen::Vector
   return {v[0], v[1], v[2]};
 }
 
-// rate_hz -> a whole divisor of the plant tick that is also a whole divisor of the controller
-// period (lockstep needs a complete Pose/Velocity/Imu sample at every control tick); latency_ticks.
-sim::SensorTiming read_timing(YamlSection& s, const sim::SimulationConfig& cfg) {
-  sim::SensorTiming t;
-  const double plant_hz = 1e9 / static_cast<double>(cfg.plant.clock.period_ns);
-  const double rate = s.number("rate_hz", plant_hz, 1e-6, plant_hz);
-  const double div = plant_hz / rate;
-  if (std::abs(div - std::round(div)) > 1e-9 || cfg.controller_divider % static_cast<int>(std::round(div)) != 0) {
-    s.fail("rate_hz", fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
-                                  "also divides the controller period ({} plant ticks), e.g. {:g} or {:g}",
-                                  rate, plant_hz, cfg.controller_divider, plant_hz, plant_hz / cfg.controller_divider));
-  }
-  t.divider = static_cast<int>(std::round(div));
-  t.latency_ticks = static_cast<int>(s.integer("latency_ticks", 0, 0, 1000));
-  return t;
-}
-
-// The extra sensors' rate_hz: the plant rate divided by a whole number n that divides the controller
-// period or is a whole multiple of it (a sample lands on a control tick; GNSS at 5-10 Hz is slower than
-// the controller). Default `default_hz`, or the plant rate when it is above it.
-sim::SensorTiming read_extra_timing(YamlSection& s, const sim::SimulationConfig& cfg, double default_hz) {
+// rate_hz -> its divider n of the plant rate (default `default_hz`, or the plant rate when that is
+// lower), and latency_ticks. n must divide the controller period: lockstep needs a complete
+// Pose/Velocity/Imu sample at every control tick. With `slower_ok` (the magnetometer, barometer and
+// GNSS, which are not part of that sample) n may also be a whole multiple of it, so a sample still
+// lands on a control tick (GNSS at 5-10 Hz is slower than the controller).
+sim::SensorTiming read_timing(YamlSection& s, const sim::SimulationConfig& cfg,
+                              double default_hz = std::numeric_limits<double>::infinity(), bool slower_ok = false) {
   sim::SensorTiming t;
   const double plant_hz = 1e9 / static_cast<double>(cfg.plant.clock.period_ns);
   const double rate = s.number("rate_hz", std::min(default_hz, plant_hz), 1e-6, plant_hz);
   const double div = plant_hz / rate;
   const long n = std::lround(div);
   const long c = cfg.controller_divider;
-  if (std::abs(div - static_cast<double>(n)) > 1e-9 || n < 1 || (c % n != 0 && n % c != 0)) {
-    s.fail("rate_hz",
-           fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
-                       "divides the controller period ({} plant ticks) or is a multiple of it, e.g. "
-                       "{:g} or {:g}",
-                       rate, plant_hz, c, plant_hz / static_cast<double>(c), plant_hz / static_cast<double>(5 * c)));
+  const bool fits = c % n == 0 || (slower_ok && n % c == 0);
+  if (std::abs(div - static_cast<double>(n)) > 1e-9 || !fits) {
+    if (slower_ok) {
+      s.fail("rate_hz",
+             fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
+                         "divides the controller period ({} plant ticks) or is a multiple of it, e.g. "
+                         "{:g} or {:g}",
+                         rate, plant_hz, c, plant_hz / static_cast<double>(c), plant_hz / static_cast<double>(5 * c)));
+    }
+    s.fail("rate_hz", fmt::format("got {:g}, expected the plant rate ({:g} Hz) divided by a whole number that "
+                                  "also divides the controller period ({} plant ticks), e.g. {:g} or {:g}",
+                                  rate, plant_hz, c, plant_hz, plant_hz / static_cast<double>(c)));
   }
   t.divider = static_cast<int>(n);
   t.latency_ticks = static_cast<int>(s.integer("latency_ticks", 0, 0, 1000));
   return t;
 }
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 
 // environment.site: where the world origin is on the Earth (GNSS, barometer).
 sensors::Geodetic read_site(YamlSection& g) {
@@ -80,7 +73,7 @@ void read_extra_sensors(YamlSection& s, const sim::SimulationConfig& cfg, const 
                         sensors::SensorSet& set) {
   if (auto m = s.section("magnetometer")) {
     sensors::MagnetometerConfig c;
-    c.timing = read_extra_timing(*m, cfg, 100.0);
+    c.timing = read_timing(*m, cfg, 100.0, /*slower_ok=*/true);
     c.field_T = m->number("field_uT", c.field_T * 1e6, 1.0, 100.0) * 1e-6;
     c.inclination_rad = m->number("inclination_deg", c.inclination_rad / kDeg, -90.0, 90.0) * kDeg;
     c.declination_rad = m->number("declination_deg", c.declination_rad / kDeg, -180.0, 180.0) * kDeg;
@@ -91,7 +84,7 @@ void read_extra_sensors(YamlSection& s, const sim::SimulationConfig& cfg, const 
   }
   if (auto b = s.section("barometer")) {
     sensors::BarometerConfig c;
-    c.timing = read_extra_timing(*b, cfg, 50.0);
+    c.timing = read_timing(*b, cfg, 50.0, /*slower_ok=*/true);
     c.site_altitude_m = site.height_m;
     c.sea_level_pressure_Pa = b->number("sea_level_pressure_Pa", c.sea_level_pressure_Pa, 80000.0, 110000.0);
     c.noise_sigma_Pa = b->number("noise_sigma_Pa", 0.0, 0.0, 1000.0);
@@ -102,7 +95,7 @@ void read_extra_sensors(YamlSection& s, const sim::SimulationConfig& cfg, const 
   }
   if (auto g = s.section("gnss")) {
     sensors::GnssConfig c;
-    c.timing = read_extra_timing(*g, cfg, 10.0);
+    c.timing = read_timing(*g, cfg, 10.0, /*slower_ok=*/true);
     c.site = site;
     c.horizontal_sigma_m = g->number("horizontal_sigma_m", 0.0, 0.0, 1000.0);
     c.vertical_sigma_m = g->number("vertical_sigma_m", 0.0, 0.0, 1000.0);
