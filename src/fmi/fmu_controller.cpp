@@ -110,7 +110,8 @@ struct FmuController::Shared {
   std::vector<control::ParameterSpec> specs;
   std::vector<const Variable*> parameter_vars;
   std::vector<double> defaults;
-  bool isolated = true;  ///< FmuMapping::isolated
+  bool isolated = true;         ///< FmuMapping::isolated
+  double step_timeout_s = 0.0;  ///< FmuMapping::step_timeout_s
 };
 
 std::span<const Signal> controller_inputs() { return kInputs; }
@@ -121,6 +122,7 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
   auto sh = std::make_shared<Shared>();
   sh->fmu = std::move(fmu);
   sh->isolated = mapping.isolated;
+  sh->step_timeout_s = mapping.step_timeout_s;
   sh->description = describe_fmu(*sh->fmu);
   const ModelDescription& md = sh->fmu->description();
   const std::string name = fmu_name(*sh->fmu);
@@ -212,7 +214,7 @@ void FmuController::instantiate() {
   log_ = log;
   const std::string name = fmt::format("{}_{}", shared_->fmu->description().model_identifier, instances_made++);
   LogSink sink = [log](const std::string& c, const std::string& s, const std::string& m) { log->add(c, s, m); };
-  instance_ = shared_->isolated ? instantiate_isolated(shared_->fmu, name, std::move(sink))
+  instance_ = shared_->isolated ? instantiate_isolated(shared_->fmu, name, std::move(sink), shared_->step_timeout_s)
                                 : shared_->fmu->instantiate(name, std::move(sink));
   initialised_ = false;
   steps_ = 0;

@@ -31,6 +31,11 @@ struct FmuMapping {
   /// exits and hangs end the run with a message instead of taking it down. false (the scenario's
   /// `in_process: true`): the FMU runs in quadcosim's process, which costs no round trip per step.
   bool isolated = true;
+  /// How long an isolated instance's call may take once initialised (doStep and the gets and sets
+  /// around it) before its process is killed and the call throws FmuError naming the limit; 0: no
+  /// limit (Ctrl-C and SIGTERM still end a hung call). The scenario's `step_timeout_s` (default 10 s,
+  /// as the lockstep `--timeout`). Instantiation and initialisation are not limited.
+  double step_timeout_s = 10.0;
 };
 
 /// A mapping that does not fit the FMU. key(): the scenario key under the `plant:`/`controller:`

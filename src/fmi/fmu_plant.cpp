@@ -240,8 +240,9 @@ std::unique_ptr<sim::ExternalDynamics> FmuPlant::make(const model::VehicleParams
   }
   const int n = (*made_)++;
   const std::string instance_name = fmt::format("{}_{}", md.model_identifier, n);
-  std::unique_ptr<Instance> instance =
-      mapping_.isolated ? instantiate_isolated(fmu_, instance_name) : fmu_->instantiate(instance_name);
+  std::unique_ptr<Instance> instance = mapping_.isolated
+                                           ? instantiate_isolated(fmu_, instance_name, {}, mapping_.step_timeout_s)
+                                           : fmu_->instantiate(instance_name);
   ++*alive_;
   std::shared_ptr<std::atomic<int>> alive = alive_;
   struct Undo {  // the count goes down again if anything below throws

@@ -153,10 +153,12 @@ void serve(int fd, const std::shared_ptr<Fmu>& fmu, const std::string& name) {
 
 class IsolatedInstance final : public Instance {
  public:
-  IsolatedInstance(const std::shared_ptr<Fmu>& fmu, const std::string& name, LogSink log)
+  IsolatedInstance(const std::shared_ptr<Fmu>& fmu, const std::string& name, LogSink log, double call_timeout_s)
       : Instance(fmu),
         name_(name),
         log_(std::move(log)),
+        call_timeout_ns_(call_timeout_s > 0.0 ? static_cast<std::int64_t>(call_timeout_s * 1e9) : 0),
+        call_timeout_s_(call_timeout_s),
         prefix_(fmu->description().version == FmiVersion::k2 ? "fmi2" : "fmi3") {
     child_ = std::make_unique<Child>(fmt::format("FMU '{}'", fmu->description().model_name),
                                      [&](int fd) { serve(fd, fmu, name); });
@@ -188,6 +190,7 @@ class IsolatedInstance final : public Instance {
   }
   void exit_initialization() override {
     call([&] { return prefix_ + "ExitInitializationMode"; }, [](Writer& w) { w.put(Op::kExitInitialization); });
+    limited_ = call_timeout_ns_ > 0;  // from here on a call that takes too long is given up on
   }
   void do_step(double t_s, double h_s) override {
     call([&] { return fmt::format("{}DoStep(t = {:g}, h = {:g})", prefix_, t_s, h_s); },
@@ -277,11 +280,18 @@ class IsolatedInstance final : public Instance {
       fill(w);
       if (!child_->send(w.bytes)) return child_ended(call_text());
     }
+    const std::int64_t deadline = limited_ ? Child::now_ns() + call_timeout_ns_ : 0;
     for (;;) {
-      switch (child_->next(answer_)) {
+      switch (child_->next(answer_, deadline)) {
         case Child::Wait::kMessage: break;
-        case Child::Wait::kEnded:
-        case Child::Wait::kTimedOut: return child_ended(call_text());
+        case Child::Wait::kEnded: return child_ended(call_text());
+        case Child::Wait::kTimedOut:
+          child_->kill(fmt::format("killed after step_timeout_s = {:g} s", call_timeout_s_));
+          throw FmuError(fmt::format(
+              "{} of {}: did not return within step_timeout_s = {:g} s; the FMU's process was killed{} "
+              "(an FMU whose steps take longer needs a larger `step_timeout_s:` in its plant:/controller: section)",
+              call_text(), who(), call_timeout_s_,
+              last_logged_.empty() ? "; the FMU logged nothing" : "; it logged last: " + last_logged_));
         case Child::Wait::kStopped:
           child_->kill("killed on a stop request");
           throw InstanceInterrupted(
@@ -311,6 +321,9 @@ class IsolatedInstance final : public Instance {
 
   std::string name_;
   LogSink log_;
+  std::int64_t call_timeout_ns_ = 0;
+  double call_timeout_s_ = 0.0;
+  bool limited_ = false;  ///< past initialisation with a call timeout
   std::string prefix_;
   std::unique_ptr<Child> child_;
   std::string last_logged_;
@@ -320,8 +333,8 @@ class IsolatedInstance final : public Instance {
 }  // namespace
 
 std::unique_ptr<Instance> instantiate_isolated(const std::shared_ptr<Fmu>& fmu, const std::string& instance_name,
-                                               LogSink log) {
-  return std::make_unique<IsolatedInstance>(fmu, instance_name, std::move(log));
+                                               LogSink log, double call_timeout_s) {
+  return std::make_unique<IsolatedInstance>(fmu, instance_name, std::move(log), call_timeout_s);
 }
 
 }  // namespace quadcosim::fmi

@@ -6,7 +6,9 @@
 // ("killed by signal 11 (Segmentation fault)", "exited with status 0"), and every later call is
 // refused. A call that does not return cannot be waited out for ever: while it waits, the master
 // polls the stop check (isolation::set_stop_check: Ctrl-C, SIGTERM) every 50 ms and, once asked to
-// stop, kills the child and throws InstanceInterrupted.
+// stop, kills the child and throws InstanceInterrupted. With a call timeout, a call after
+// initialisation that takes longer is given up on too: the child is killed and the call throws
+// FmuError naming the call, the limit and the scenario key (`step_timeout_s`).
 //
 // The child dies with its parent (PR_SET_PDEATHSIG, SIGKILL) and ignores SIGINT: a Ctrl-C is the
 // parent's to handle. What the FMU logs is sent to the parent and reaches the instance's LogSink in
@@ -30,8 +32,9 @@ class InstanceInterrupted : public FmuError {
 
 /// Starts a child process that instantiates `fmu` (fmu->instantiate(instance_name, ...)) and returns
 /// the instance that forwards every call to it. Throws FmuError when the child cannot be started or
-/// the instantiation fails (its message, as in-process), or ends the child.
+/// the instantiation fails (its message, as in-process), or ends the child. `call_timeout_s` > 0
+/// limits each call after exit_initialization (FmuMapping::step_timeout_s); 0: no limit.
 std::unique_ptr<Instance> instantiate_isolated(const std::shared_ptr<Fmu>& fmu, const std::string& instance_name,
-                                               LogSink log = {});
+                                               LogSink log = {}, double call_timeout_s = 0.0);
 
 }  // namespace quadcosim::fmi

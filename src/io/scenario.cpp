@@ -138,6 +138,10 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
     if (depth == 1 && place == ParameterPlace::kTop && (controller_section_key(key) || type_section_key(key))) {
       continue;  // read by the caller
     }
+    if (depth == 1 && place == ParameterPlace::kTop && (key == "in_process" || key == "step_timeout_s") &&
+        s.node()["fmu"]) {
+      continue;  // an FMU controller's process options: read_fmu_spec's
+    }
     const YAML::Node n = s.raw(key);
     const std::string name = prefix.empty() ? key : prefix + "." + key;
     if (n.IsMap()) {
@@ -259,6 +263,14 @@ FmuSpec read_fmu_spec(YamlSection& s, const std::filesystem::path& folder) {
   spec.path = full.lexically_normal().string();
   // Each FMU instance runs in a child process unless asked otherwise (docs/reliability.md).
   spec.mapping.isolated = !s.boolean("in_process", false);
+  // An isolated call that takes longer is given up on (fmi/isolated_instance.hpp); an FMU in
+  // quadcosim's own process cannot be stopped inside a call, so a limit there would be a promise not kept.
+  if (s.has("step_timeout_s") && !spec.mapping.isolated) {
+    s.fail("step_timeout_s",
+           "applies to an FMU in its own process; with in_process: true a call cannot be stopped (remove one of "
+           "the two keys)");
+  }
+  spec.mapping.step_timeout_s = s.number("step_timeout_s", spec.mapping.step_timeout_s, 0.0, 1e6);
   for (const char* side : {"inputs", "outputs"}) {
     auto m = s.section(side);
     if (!m) continue;

@@ -104,6 +104,24 @@ case "$case_name" in
     plant_fmu 30
     hang_and_signal 2 TERM
     check_outputs 2 ;;
+  fmu_hang_timeout)  # no signal: the plant FMU hangs in doStep at t = 1 s, its step_timeout_s ends it
+    plant_fmu 30 ", step_timeout_s: 0.5"
+    t0="$(date +%s.%N)"
+    FAULTY_FMU_FAULT=hang FAULTY_FMU_AT=1 run_expect 6 "faulty_plant" "tick 100 \(t = 1 s\)" "fmi2DoStep\(t = 1" \
+      "did not return within step_timeout_s = 0.5 s"
+    took="$(python3 -c "print(round($(date +%s.%N) - $t0, 2))")"
+    python3 -c "import sys; sys.exit(0 if $took < 10 else 1)" || fail "the run took $took s, the limit is 0.5 s"
+    check_outputs 1
+    [ -z "$(pgrep -P $$ -f faulty || true)" ] || fail "an FMU process outlived the run"
+    # The limit is refused where it cannot be kept: a call in quadcosim's own process cannot be stopped.
+    plant_fmu 30 ", step_timeout_s: 0.5, in_process: true"
+    run_expect 2 "step_timeout_s: applies to an FMU in its own process" ;;
+  fmu_controller_hang_timeout)  # the controller FMU hangs at its step at t = 2 s: exit 5 after 0.3 s
+    scenario 5 ""
+    sed -i 's/^controller:$/controller:\n  fmu: faulty_controller.fmu\n  step_timeout_s: 0.3/' "$tmp/s.yaml"
+    FAULTY_FMU_FAULT=hang FAULTY_FMU_AT=2 run_expect 5 "faulty_controller" "control step [0-9]+ \(t = 2 s\)" \
+      "did not return within step_timeout_s = 0.3 s"
+    [ -z "$(ls -A "$TMPDIR")" ] || fail "left in the temporary directory: $(ls -A "$TMPDIR")" ;;
   fmu_dds_segv)  # over DDS the plant process survives its FMU's crash and exits 6; run passes 6 on
     plant_fmu
     RUN_FLAGS="--transport dds" FAULTY_FMU_FAULT=segv FAULTY_FMU_AT=2 run_expect 6 "faulty_plant" \
