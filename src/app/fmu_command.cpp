@@ -107,18 +107,6 @@ fmi::FmuConfig config_from(const FmuOptions& o, std::vector<std::string>& notes)
   c.initial = io::initial_state(sc);
   c.realism = sim.plant.realism;
   c.realism_namespace = sim.ns;
-  // The plant FMU's outputs are Pose, Velocity and Imu: a magnetometer, barometer or GNSS configured
-  // in the scenario would be dropped without a word.
-  if (c.kind == fmi::FmuKind::kPlant && c.realism.extra_sensors.any()) {
-    const auto& e = c.realism.extra_sensors;
-    throw io::ConfigError(o.scenario + ": sensors." +
-                          (e.magnetometer ? "magnetometer"
-                           : e.barometer  ? "barometer"
-                                          : "gnss") +
-                          ": the plant FMU outputs Pose, Velocity and Imu only; export from a scenario without the "
-                          "magnetometer, barometer and GNSS (docs/sensors.md)");
-  }
-
   // Schedule entries due at t = 0 act before the first control step: they are part of the start.
   control::ControllerConfig cc = sc.controller;
   std::size_t later = 0;

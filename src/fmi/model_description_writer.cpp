@@ -15,6 +15,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <string>
@@ -29,19 +30,22 @@ namespace {
 
 // ---- Units ----------------------------------------------------------------------------------------
 
-/// Exponents of the SI base units FMI's BaseUnit names (kg, m, s, A, K, mol, cd, rad); factor 1,
-/// offset 0 for every unit quadcosim writes.
+/// Exponents of the SI base units FMI's BaseUnit names (kg, m, s, A, K, mol, cd, rad) and the factor
+/// to them (1 but for "deg"); offset 0 for every unit quadcosim writes.
 struct BaseUnit {
   std::array<int, 8> exponent{};
+  double factor = 1.0;
   static constexpr std::array<const char*, 8> kNames = {"kg", "m", "s", "A", "K", "mol", "cd", "rad"};
 
   BaseUnit& operator*=(const BaseUnit& o) {
     for (std::size_t i = 0; i < exponent.size(); ++i) exponent[i] += o.exponent[i];
+    factor *= o.factor;
     return *this;
   }
   BaseUnit power(int n) const {
     BaseUnit r = *this;
     for (int& e : r.exponent) e *= n;
+    r.factor = std::pow(factor, n);
     return r;
   }
 };
@@ -68,6 +72,13 @@ const std::map<std::string_view, BaseUnit>& symbols() {
       {"J", base({{kg, 1}, {m, 2}, {s, -2}})},
       {"W", base({{kg, 1}, {m, 2}, {s, -3}})},
       {"Pa", base({{kg, 1}, {m, -1}, {s, -2}})},
+      {"T", base({{kg, 1}, {s, -2}, {A, -1}})},
+      {"deg",
+       [] {
+         BaseUnit u = base({{rad, 1}});
+         u.factor = std::numbers::pi / 180.0;
+         return u;
+       }()},
       {"Hz", base({{s, -1}})},
   };
   return table;
@@ -462,6 +473,11 @@ std::string write_model_description(const ModelDescription& md) {
       const BaseUnit& u = checked.base_units.at(name);
       for (std::size_t i = 0; i < u.exponent.size(); ++i) {
         if (u.exponent[i] != 0) w.attribute(BaseUnit::kNames[i], std::string_view(std::to_string(u.exponent[i])));
+      }
+      if (u.factor != 1.0) {
+        char buf[32];
+        const auto r = std::to_chars(buf, buf + sizeof buf, u.factor);  // shortest round trip
+        w.attribute("factor", std::string_view(buf, static_cast<std::size_t>(r.ptr - buf)));
       }
       w.end();
       w.end();

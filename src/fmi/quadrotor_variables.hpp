@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <string_view>
 
 namespace quadcosim::fmi::names {
@@ -34,6 +35,15 @@ inline constexpr std::array<std::string_view, 3> kSpecificForce = {"f_B[1]", "f_
 inline constexpr std::array<std::string_view, 3> kEuler = {"euler[1]", "euler[2]", "euler[3]"};
 /// Rotor speeds reached (after the motors' lag) [rad/s].
 inline constexpr std::array<std::string_view, 4> kRotorSpeed = {"omega[1]", "omega[2]", "omega[3]", "omega[4]"};
+
+/// The plant FMU's outputs of its extra sensors (sensors/registry.hpp), when the scenario it was
+/// exported from configures them: "<sensor>.<column>", a vector's components 1-based
+/// ("magnetometer.field[1]", "barometer.pressure", "gnss.v[3]"). `i` counts from 0.
+inline std::string sensor_variable(std::string_view sensor, std::string_view column, int width, int i) {
+  std::string name = std::string(sensor) + "." + std::string(column);
+  if (width > 1) name += "[" + std::to_string(i + 1) + "]";
+  return name;
+}
 
 // Plant FMU parameters.
 /// The initial state: this prefix + an output's name ("initial.p_W[3]", "initial.q_WB[1]",

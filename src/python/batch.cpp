@@ -22,6 +22,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -40,6 +41,7 @@
 #include "control/care.hpp"
 #include "io/scenario.hpp"
 #include "model/vehicle_params.hpp"
+#include "sensors/suite.hpp"
 #include "sim/controller_core.hpp"
 #include "sim/parameter_schedule.hpp"
 #include "sim/plant_node.hpp"
@@ -142,6 +144,16 @@ class Batch {
     imu_q_.assign(4 * n_, kNaN);
     imu_w_.assign(3 * n_, kNaN);
     imu_a_.assign(3 * n_, kNaN);
+    // The extra sensors' rows (vehicle keys change only the vehicle: every vehicle carries the same set).
+    std::size_t kind = 0;
+    sensors::for_each_kind([&]<class Kind>() {
+      if (Kind::config(c.plant.realism.extra_sensors)) {
+        sensor_rows_[kind].emplace(SensorRows{std::string(Kind::kName), sensors::sample_width<Kind>(),
+                                              std::vector<double>(n_, kNaN),
+                                              std::vector<double>(n_ * sensors::sample_width<Kind>(), kNaN)});
+      }
+      ++kind;
+    });
     std::vector<std::size_t> all(n_);
     for (std::size_t i = 0; i < n_; ++i) all[i] = i;
     reset_vehicles(all, seeds, vehicle_keys);
@@ -436,8 +448,45 @@ class Batch {
         {"imu.a", {&Batch::imu_a_, 3}},
     };
     const auto it = arrays.find(name);
-    if (it == arrays.end()) throw py::key_error(name);
-    return to_array(this->*(it->second.first), n_, it->second.second);
+    if (it != arrays.end()) return to_array(this->*(it->second.first), n_, it->second.second);
+    // "<sensor>.t" and "<sensor>.<column>" of the extra sensors the scenario configures.
+    std::optional<py::array_t<double>> found;
+    std::size_t kind = 0;
+    sensors::for_each_kind([&]<class Kind>() {
+      const std::optional<SensorRows>& rows = sensor_rows_[kind++];
+      if (!rows || found) return;
+      if (name == rows->name + ".t") {
+        found = to_array(rows->t, n_, 0);
+        return;
+      }
+      int offset = 0;
+      for (const auto& c : Kind::kColumns) {
+        if (name == rows->name + "." + std::string(c.name)) {
+          std::vector<double> column(n_ * static_cast<std::size_t>(c.width));
+          for (std::size_t i = 0; i < n_; ++i) {
+            for (int a = 0; a < c.width; ++a) column[i * c.width + a] = rows->values[i * rows->width + offset + a];
+          }
+          found = to_array(column, n_, c.width == 1 ? 0 : static_cast<std::size_t>(c.width));
+          return;
+        }
+        offset += c.width;
+      }
+    });
+    if (!found) throw py::key_error(name);
+    return *found;
+  }
+
+  /// The extra sensors the scenario configures and their columns ({"barometer": ["pressure", "altitude"]}).
+  py::dict sensor_columns() {
+    py::dict d;
+    std::size_t kind = 0;
+    sensors::for_each_kind([&]<class Kind>() {
+      if (!sensor_rows_[kind++]) return;
+      py::list names;
+      for (const auto& c : Kind::kColumns) names.append(std::string(c.name));
+      d[py::str(std::string(Kind::kName))] = names;
+    });
+    return d;
   }
 
   py::array_t<std::int64_t> ticks() {
@@ -486,14 +535,17 @@ class Batch {
       sim::RealismConfig realism = s.simulation.plant.realism;
       realism.seed = seed;
       // The noise streams named as PlantNode names them: by the vehicle's namespace (/drone/Pose -> /drone).
-      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s),
-                             topics.pose.substr(0, topics.pose.rfind('/')));
+      const std::string vehicle = topics.pose.substr(0, topics.pose.rfind('/'));
+      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s), vehicle);
+      // The extra sensors, as the plant node's channels sample them (sim/sensor_channels.hpp).
+      extra = sensors::Suite(realism.extra_sensors, seed, vehicle, s.simulation.plant.clock.period_ns);
       if (with_controller) {
         controller.emplace(s.controller, topics);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
       }
     }
     sim::PlantCore plant;
+    sensors::Suite extra;                            ///< the magnetometer, barometer, GNSS configured
     std::optional<sim::ControllerCore> controller;   ///< none: plant_only
     std::optional<sim::ParameterSchedule> schedule;  ///< the scenario's, when it has one
   };
@@ -618,6 +670,11 @@ class Batch {
       set4(imu_q_, i, kNaN, kNaN, kNaN, kNaN);
       set3(imu_w_, i, kNaN, kNaN, kNaN);
       set3(imu_a_, i, kNaN, kNaN, kNaN);
+      for (std::optional<SensorRows>& rows : sensor_rows_) {
+        if (!rows) continue;
+        rows->t[i] = kNaN;
+        std::fill_n(&rows->values[i * static_cast<std::size_t>(rows->width)], rows->width, kNaN);
+      }
       fill_state(i);
     }
     // Scenarios no vehicle flies any more are dropped (domain randomisation loads a new one per reset).
@@ -650,7 +707,13 @@ class Batch {
       v.sim->override_command(model::Vector4(c[0], c[1], c[2], c[3]));
     }
     const int ticks = v.scenario->simulation.controller_divider * periods;
-    for (int k = 0; k < ticks; ++k) v.sim->tick(v.next_tick++);
+    const sensors::Suite* extra = v.sim->plant().extra_sensors();
+    const sim::TickClock& clock = v.scenario->simulation.plant.clock;
+    for (int j = 0; j < ticks; ++j) {
+      const sim::Tick k = v.next_tick++;
+      v.sim->tick(k);
+      if (extra) write_sensors(i, *extra, k, stamp_s(msg::Time::from_ns(clock.ns(k))));
+    }
     if (bypass) v.sim->override_command(std::nullopt);
     fill_state(i);
   }
@@ -715,6 +778,7 @@ class Batch {
         set3(imu_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
         set3(imu_a_, i, y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z());
       }
+      if (!L.extra.empty() && L.extra.step(k, y)) write_sensors(i, L.extra, k, stamp);
       // On control ticks the controller's step or the command given (Simulation's after_outputs), taken
       // in as PlantNode::on_command takes it (every command answers its own tick).
       if (k % divider == 0) {
@@ -738,6 +802,21 @@ class Batch {
       L.plant.integrate(o.clock, k, o.substeps);
     }
     fill_state(i);
+  }
+
+  /// Row i of each extra sensor that published at tick k (stamp: that tick's time [s]).
+  void write_sensors(std::size_t i, const sensors::Suite& suite, sim::Tick k, double stamp) {
+    std::size_t kind = 0;
+    sensors::for_each_kind([&]<class Kind>() {
+      std::optional<SensorRows>& rows = sensor_rows_[kind++];
+      if (!rows || !suite.due<Kind>(k)) return;
+      rows->t[i] = stamp;
+      double* out = &rows->values[i * static_cast<std::size_t>(rows->width)];
+      for (const auto& c : Kind::kColumns) {
+        c.write(suite.slot<Kind>()->sample, out);
+        out += c.width;
+      }
+    });
   }
 
   void write_pose(std::size_t i, double t, const msg::Vector3& p, const msg::Quaternion& q) {
@@ -798,6 +877,13 @@ class Batch {
   // sensor messages (NaN before the first), and each vehicle's time.
   std::vector<double> p_, v_, q_, w_, omega_, command_, omega_cmd_, t_;
   std::vector<double> pose_t_, pose_p_, pose_q_, velocity_t_, velocity_v_, velocity_w_, imu_t_, imu_q_, imu_w_, imu_a_;
+  /// One configured extra sensor's rows: its stamps t (N) and its columns packed (N, width).
+  struct SensorRows {
+    std::string name;
+    int width = 0;
+    std::vector<double> t, values;
+  };
+  std::array<std::optional<SensorRows>, std::tuple_size_v<sensors::Kinds>> sensor_rows_;  ///< by kind
   WorkerPool pool_;
   std::mutex mutex_;  ///< one thread steps, resets or reads at a time (stepping runs without the GIL)
 };
@@ -849,6 +935,7 @@ void bind_batch(py::module_& m) {
       .def("tracks_trajectory", &Batch::tracks_trajectory)
       .def("vehicle_params", &Batch::vehicle_params)
       .def("get", &Batch::get, py::arg("name"))
+      .def("sensor_columns", &Batch::sensor_columns)
       .def("ticks", &Batch::ticks)
       .def("seeds", &Batch::seeds)
       .def("dt", &Batch::dt)

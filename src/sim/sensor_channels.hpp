@@ -1,10 +1,9 @@
-// The plant's extra sensors on the bus: each sensor the scenario configures (sensors::SensorSet,
-// registered in sim/sensor_wire.hpp) is a channel that samples its model at its rate and latency and
-// publishes the sample as its ROS message(s).
+// The plant's extra sensors on the bus: the vehicle's sensor suite (sensors/suite.hpp: each sensor the
+// scenario configures, sampled at its rate and latency) and, for each sensor, its wire form
+// (sim/sensor_wire.hpp) that publishes the sample as its ROS message(s).
 //
-// Determinism: a tick's samples are drawn once; publishing the same tick again (a lockstep repeat)
-// publishes the same samples. Each sensor draws from its own stream, model::stream_seed(seed, vehicle,
-// sensor name), so adding one never changes the numbers of another or of the paper's sensors.
+// Determinism: a tick's samples are drawn once (the suite's rule); publishing the same tick again (a
+// lockstep repeat) publishes the same samples.
 #pragma once
 
 #include <memory>
@@ -12,7 +11,7 @@
 #include <vector>
 
 #include "model/quadrotor.hpp"
-#include "sensors/sensor_set.hpp"
+#include "sensors/suite.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
 #include "sim/transport.hpp"
@@ -34,16 +33,15 @@ class SensorChannels {
   /// same samples.
   void publish(Tick k, const model::Outputs& y, const msg::Time& stamp);
 
-  /// One configured sensor on the bus (sensor_channels.cpp).
+  /// The samples (the newest of each sensor and its tick), as published.
+  const sensors::Suite& suite() const { return suite_; }
+
+  /// One configured sensor's wire form (sensor_channels.cpp).
   class Channel;
 
  private:
-  const model::Outputs& truth_at(Tick k) const;
-
-  TickClock clock_;
+  sensors::Suite suite_;
   std::vector<std::unique_ptr<Channel>> channels_;
-  std::vector<model::Outputs> history_;  ///< ring buffer of true outputs, max latency + 1 deep
-  Tick last_tick_ = -1;
 };
 
 }  // namespace quadcosim::sim

@@ -1,6 +1,7 @@
-// The registry of the plant's extra sensors: for each sensor of sensors::SensorSet, its model's
-// construction, its topics and messages, and how a sample fills them. Everything else (the channels
-// that sample and publish, the MCAP recorder, topic listings) is derived from this file.
+// The wire side of the plant's extra sensors: for each kind of sensors/registry.hpp, its topics and
+// messages and how a sample fills them. The channels that publish (sim/sensor_channels.hpp), the MCAP
+// recorder and topic listings are derived from this file; sampling is the sensor suite's
+// (sensors/suite.hpp), which knows no messages.
 //
 // Topic names follow the paper's (/drone/Pose, /drone/Imu): the message type's name under the vehicle's
 // namespace. Header stamps are the publication tick (as for Pose, Velocity, Imu); frames: body data in
@@ -10,9 +11,11 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <tuple>
+#include <type_traits>
 #include <utility>
 
-#include "sensors/sensor_set.hpp"
+#include "sensors/registry.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
 #include "sim/transport.hpp"
@@ -24,9 +27,7 @@ namespace sensor_wire {
 inline msg::Vector3 vector3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 struct Magnetometer {
-  using Model = sensors::Magnetometer;
-  static constexpr const char* kName = "magnetometer";  ///< also its random stream's name
-  static Model make(const sensors::MagnetometerConfig& c, model::Rng rng, const TickClock&) { return Model(c, rng); }
+  using Kind = sensors::MagnetometerKind;
   /// Calls f.template operator()<Message>(topic) for each of its topics.
   template <class F>
   static void topics(const std::string& ns, F&& f) {
@@ -48,11 +49,7 @@ struct Magnetometer {
 };
 
 struct Barometer {
-  using Model = sensors::Barometer;
-  static constexpr const char* kName = "barometer";
-  static Model make(const sensors::BarometerConfig& c, model::Rng rng, const TickClock& clock) {
-    return Model(c, clock.period_s() * c.timing.divider, rng);  // the drift steps once per sample
-  }
+  using Kind = sensors::BarometerKind;
   template <class F>
   static void topics(const std::string& ns, F&& f) {
     f.template operator()<msg::FluidPressure>(ns + "/FluidPressure");
@@ -72,9 +69,7 @@ struct Barometer {
 };
 
 struct Gnss {
-  using Model = sensors::Gnss;
-  static constexpr const char* kName = "gnss";
-  static Model make(const sensors::GnssConfig& c, model::Rng rng, const TickClock&) { return Model(c, rng); }
+  using Kind = sensors::GnssKind;
   template <class F>
   static void topics(const std::string& ns, F&& f) {
     f.template operator()<msg::NavSatFix>(ns + "/NavSatFix");
@@ -116,13 +111,25 @@ struct Gnss {
 
 }  // namespace sensor_wire
 
-/// The registry: calls f.template operator()<Wire>(config) for each sensor `set` configures, in a fixed
-/// order. One line per sensor.
+/// The wire form of each kind, in the registry's order.
+using Wires = std::tuple<sensor_wire::Magnetometer, sensor_wire::Barometer, sensor_wire::Gnss>;
+static_assert(std::tuple_size_v<Wires> == std::tuple_size_v<sensors::Kinds>,
+              "sim::Wires lists a wire form per sensors::Kinds entry");
+
+/// Calls f.template operator()<Wire>(config) for each sensor `set` configures, in the registry's order.
 template <class F>
 void for_each_sensor(const sensors::SensorSet& set, F&& f) {
-  if (set.magnetometer) f.template operator()<sensor_wire::Magnetometer>(*set.magnetometer);
-  if (set.barometer) f.template operator()<sensor_wire::Barometer>(*set.barometer);
-  if (set.gnss) f.template operator()<sensor_wire::Gnss>(*set.gnss);
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (
+        [&] {
+          using Wire = std::tuple_element_t<I, Wires>;
+          static_assert(std::is_same_v<typename Wire::Kind, std::tuple_element_t<I, sensors::Kinds>>,
+                        "sim::Wires lists the wire forms in the order of sensors::Kinds");
+          if (const auto& c = Wire::Kind::config(set)) f.template operator()<Wire>(*c);
+        }(),
+        ...);
+  }
+  (std::make_index_sequence<std::tuple_size_v<Wires>>{});
 }
 
 /// Calls f.template operator()<Message>(topic) for each topic the sensors of `set` publish under `ns`.

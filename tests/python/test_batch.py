@@ -39,22 +39,34 @@ def noisy_hover(vehicle=None):
     return d
 
 
+EXTRA_SENSORS = ("magnetometer", "barometer", "gnss")
+
+
 def snapshot_single(sim):
     s = sim.sensors
-    return {**{k: sim.state[k] for k in STATE}, "command": sim.command, "t": np.array(sim.t),
+    snap = {**{k: sim.state[k] for k in STATE}, "command": sim.command, "t": np.array(sim.t),
             "imu.a": s["imu"]["a"], "imu.w": s["imu"]["w"], "pose.p": s["pose"]["p"], "velocity.v": s["velocity"]["v"]}
+    for sensor in EXTRA_SENSORS:  # the extra sensors a scenario configures (a GNSS fix as 1.0 / 0.0 in a Batch)
+        for k, v in s.get(sensor, {}).items():
+            snap[f"{sensor}.{k}"] = np.asarray(v, dtype=float)
+    return snap
 
 
 def snapshot_row(batch, i):
     s = batch.sensors
-    return {**{k: batch.state[k][i] for k in STATE}, "command": batch.command[i], "t": np.array(batch.t[i]),
+    snap = {**{k: batch.state[k][i] for k in STATE}, "command": batch.command[i], "t": np.array(batch.t[i]),
             "imu.a": s["imu"]["a"][i], "imu.w": s["imu"]["w"][i], "pose.p": s["pose"]["p"][i],
             "velocity.v": s["velocity"]["v"][i]}
+    for sensor in EXTRA_SENSORS:
+        for k, v in s.get(sensor, {}).items():
+            snap[f"{sensor}.{k}"] = v[i]
+    return snap
 
 
 def assert_same(a, b, what):
+    assert sorted(a) == sorted(b), f"{what}: {sorted(a)} != {sorted(b)}"
     for k in a:
-        assert np.array_equal(a[k], b[k]), f"{what}: {k}: {a[k]} != {b[k]}"
+        assert np.array_equal(a[k], b[k], equal_nan=True), f"{what}: {k}: {a[k]} != {b[k]}"
 
 
 # --- a batch flies exactly what single simulations fly --------------------------------------------------
@@ -428,11 +440,27 @@ def _faulty_hover():
     return d
 
 
+def _sensors_hover():
+    """The noisy hover with a magnetometer, a barometer and a GNSS receiver (the GNSS slow, late and
+    without a fix for its first 0.5 s), and message faults on the Imu: whole Simulations."""
+    d = noisy_hover()
+    d["environment"] = {"site": {"latitude_deg": 47.397742, "longitude_deg": 8.545594, "altitude_m": 488}}
+    d["sensors"].update({
+        "magnetometer": {"rate_hz": 50, "noise_sigma_uT": 0.3, "hard_iron_uT": [1.0, -2.0, 0.5]},
+        "barometer": {"rate_hz": 25, "noise_sigma_Pa": 1.2, "drift_Pa_sqrt_s": 0.1, "bias_initial_Pa": 20},
+        "gnss": {"rate_hz": 10, "latency_ticks": 5, "horizontal_sigma_m": 0.8, "vertical_sigma_m": 1.5,
+                 "velocity_sigma_m_s": 0.05, "fix_after_s": 0.5}})
+    d["message_faults"] = {"topics": {"Imu": {"delay_ticks": 1}}}
+    return d
+
+
 PATHS = {  # scenario, and whether a Batch flies it without a bus (else whole Simulations)
     "schedule": ("scenarios/swarm/grid_takeoff.yaml", True),  # position mode, z_des set by its schedule
     "trajectory": ("scenarios/tracking/figure8_se3.yaml", True),  # the SE(3) controller on a figure 8
     "realism": (_realism_hover(), True),  # noise, rates, latency, wind and gusts, drag, motor lag, a delay
     "faults": (_faulty_hover(), False),  # injected message faults act on the bus
+    "sensors": ("scenarios/realism/all_sensors.yaml", True),  # magnetometer, barometer, GNSS too
+    "sensors_faults": (_sensors_hover(), False),  # the same on whole Simulations
 }
 
 
@@ -483,6 +511,10 @@ def test_every_kind_of_vehicle_equals_its_single_simulation(case, tmp_path):
                 assert_same(snapshot_single(sim), snapshot_row(batch, i), f"{case}: vehicle {i} step {k}")
     # The vehicles flew, and differently (else equality would prove little).
     assert np.all(batch.p[:, 2] > 0.5), batch.p
+    if case.startswith("sensors"):  # the extra sensors were compared, with a GNSS fix by now
+        row = snapshot_row(batch, 1)
+        assert np.all(np.isfinite(row["gnss.latitude_deg"])) and row["gnss.fix"] == 1.0, row
+        assert {"magnetometer.field", "barometer.altitude", "gnss.v"} <= set(row)
     assert not np.array_equal(batch.p[0], batch.p[2])
 
 

@@ -5,7 +5,8 @@
 # trajectory.csv through the ISA, WGS-84 and field formulas written again here, within the configured
 # noise), dds_identical (the DDS plant publishes the same samples, bit for bit), off_by_default (the
 # paper's scenarios publish none of them, and turning them on changes no other number), bad_keys (a
-# wrong key or value is named).
+# wrong key or value is named), fmu_outputs (the plant FMU declares each sensor's numbers with their
+# SI units; their values are checked against the plant node in FmuPlantNode's unit test).
 bin="$1"; src="$2"
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 py=/usr/bin/python3
@@ -225,10 +226,33 @@ PY
     edit "s|    latitude_deg: 47.397742|    latitude_deg: 97|" site
     refused "a latitude of 97 deg" "environment.site.latitude_deg: got '97'" \
       "$bin" run "$tmp/site.yaml" --out "$tmp/o3" --no-plots
-    refused "a plant FMU that would drop the sensors" \
-      "sensors.magnetometer: the plant FMU outputs Pose, Velocity and Imu only" \
-      "$bin" fmu export plant --scenario "$scenario" --out "$tmp/plant.fmu"
-    [ ! -e "$tmp/plant.fmu" ] || fail "an FMU was written without its sensors"
+    ;;
+
+  fmu_outputs)  # the plant FMU of all_sensors.yaml declares each sensor's numbers, in SI units
+    "$bin" fmu export plant --scenario "$scenario" --out "$tmp/plant.fmu" > "$tmp/export.log" 2>&1 ||
+      fail "fmu export plant failed: $(cat "$tmp/export.log")"
+    "$py" - "$tmp/plant.fmu" <<'PY' || fail "the plant FMU's description lacks the sensors"
+import math, sys, zipfile
+import xml.etree.ElementTree as ET
+root = ET.fromstring(zipfile.ZipFile(sys.argv[1]).read("modelDescription.xml"))
+units = {u.get("name"): u.find("BaseUnit").attrib for u in root.iter("Unit")}
+variables = {v.get("name"): v for v in root.iter("ScalarVariable")}
+want = {"magnetometer.field[1]": "T", "magnetometer.field[3]": "T", "barometer.pressure": "Pa",
+        "barometer.altitude": "m", "gnss.fix": "1", "gnss.latitude_deg": "deg", "gnss.longitude_deg": "deg",
+        "gnss.altitude_m": "m", "gnss.v[3]": "m/s"}
+for name, unit in want.items():
+    v = variables.get(name)
+    assert v is not None, f"no variable {name}"
+    assert v.get("causality") == "output" and v.get("variability") == "discrete", (name, v.attrib)
+    assert v.find("Real").get("unit") == unit, (name, v.find("Real").attrib)
+# The units as SI base units: tesla = kg s^-2 A^-1; a degree = pi/180 rad; a pascal = kg m^-1 s^-2.
+assert units["T"] == {"kg": "1", "s": "-2", "A": "-1"}, units["T"]
+assert units["Pa"] == {"kg": "1", "m": "-1", "s": "-2"}, units["Pa"]
+assert units["deg"]["rad"] == "1" and abs(float(units["deg"]["factor"]) - math.pi / 180) < 1e-18, units["deg"]
+outputs = [u.get("index") for u in root.find("ModelStructure").find("Outputs")]
+assert len(outputs) == len(set(outputs)) and len(outputs) >= 30, len(outputs)
+print(f"ok: {len(want)} sensor outputs checked, {len(outputs)} outputs in all")
+PY
     ;;
 
   *) fail "unknown case $case_name" ;;

@@ -7,10 +7,12 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <type_traits>
 
 #include "controllers/registry.hpp"
 #include "fmi/quadrotor_variables.hpp"
 #include "model/attitude.hpp"
+#include "sensors/registry.hpp"
 
 namespace quadcosim::fmi {
 
@@ -33,6 +35,23 @@ json vec(const Eigen::Ref<const Eigen::VectorXd>& v) {
 }
 
 json timing_json(const sim::SensorTiming& t) { return {{"divider", t.divider}, {"latency_ticks", t.latency_ticks}}; }
+
+/// The extra sensors' configurations (sensors/registry.hpp), each as its fields by name.
+json extra_sensors_json(const sensors::SensorSet& set) {
+  json j = json::object();
+  sensors::for_each_configured(set, [&]<class Kind>(const typename Kind::Config& c) {
+    json fields = json::object();
+    Kind::config_fields(c, [&](const char* name, const auto& v) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(v)>, Eigen::Vector3d>) {
+        fields[name] = vec(v);
+      } else {
+        fields[name] = v;
+      }
+    });
+    j[std::string(Kind::kName)] = fields;
+  });
+  return j;
+}
 
 json realism_json(const sim::RealismConfig& r) {
   json faults = json::array();
@@ -63,7 +82,8 @@ json realism_json(const sim::RealismConfig& r) {
               {"w20_m_s", r.wind.gusts.w20_m_s},
               {"altitude_m", r.wind.gusts.altitude_m},
               {"airspeed_m_s", r.wind.gusts.airspeed_m_s}}}}},
-          {"faults", faults}};
+          {"faults", faults},
+          {"extra_sensors", extra_sensors_json(r.extra_sensors)}};
 }
 
 json vehicle_json(const model::VehicleParams& v) {
@@ -456,6 +476,28 @@ FmuConfig config_from_json(std::string_view text, const std::string& source) {
     if (rf.rotor < 0 || rf.rotor > 3) f.at("rotor").fail("", "must be 0..3");
     m.faults.push_back(rf);
   }
+  if (re.has("extra_sensors")) {  // absent from the configurations of FMUs exported before there were any
+    const Reader extra = re.at("extra_sensors");
+    sensors::for_each_kind([&]<class Kind>() {
+      if (!extra.has(std::string(Kind::kName))) return;
+      const Reader fields = extra.at(std::string(Kind::kName));
+      typename Kind::Config config;
+      Kind::config_fields(config, [&](const char* name, auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+          v = fields.at(name).template vector<3>();
+        } else if constexpr (std::is_same_v<T, int>) {
+          v = fields.at(name).template integer<int>();
+        } else {
+          v = fields.at(name).number();
+        }
+      });
+      if (config.timing.divider < 1 || config.timing.latency_ticks < 0) {
+        fields.fail("", "has a sensor divider below 1 or a negative latency");
+      }
+      Kind::config(m.extra_sensors) = config;
+    });
+  }
   c.realism_namespace = r.at("realism_namespace").text();
 
   const Reader ctl = r.at("controller");
@@ -592,6 +634,15 @@ void plant_variables(const FmuConfig& c, Builder& b) {
   b.outputs(names::kRates, cont, "rad/s", "body angular velocity");
   b.outputs(names::kSpecificForce, cont, "m/s2", "specific force, body frame (what an accelerometer reads)");
   b.outputs(names::kRotorSpeed, cont, "rad/s", "rotor speeds reached (after the motors' lag)");
+  // The extra sensors the scenario configures: each column of the newest sample, held between samples.
+  sensors::for_each_configured(c.realism.extra_sensors, [&]<class Kind>(const typename Kind::Config&) {
+    for (const auto& col : Kind::kColumns) {
+      for (int i = 0; i < col.width; ++i) {
+        b.output(names::sensor_variable(Kind::kName, col.name, col.width, i), Variability::kDiscrete, col.unit,
+                 std::string(Kind::kName) + ": " + std::string(col.description) + " (the newest sample)");
+      }
+    }
+  });
 
   const Variability fixed = Variability::kFixed;
   for (const auto& p : model::vehicle_parameters()) {

@@ -1,10 +1,15 @@
 // The plant FMU against sim::PlantNode itself, the plant of every quadcosim run: with drag, wind,
 // gusts, a rotor fault and sensor noise, rates and latencies, the FMU's outputs after each 0.02 s
-// step are the node's published sensor messages of that tick, bit for bit.
+// step are the node's published sensor messages of that tick, bit for bit; with a magnetometer, a
+// barometer and a GNSS receiver, their outputs are the node's MagneticField, FluidPressure, NavSatFix
+// and NavSatVelocity messages of that tick.
+#include <cmath>
 #include <cstring>
+#include <numbers>
 
 #include "fmi/export/fmu_test_support.hpp"
 #include "fmi/quadrotor_variables.hpp"
+#include "sensors/barometer.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
 
@@ -56,6 +61,16 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
   transport.subscribe<msg::PoseStamped>(topics.pose, [&](const msg::PoseStamped& m) { pose = m; });
   transport.subscribe<msg::TwistStamped>(topics.velocity, [&](const msg::TwistStamped& m) { twist = m; });
   transport.subscribe<msg::Imu>(topics.imu, [&](const msg::Imu& m) { imu = m; });
+  msg::MagneticField mag;
+  msg::FluidPressure baro;
+  msg::NavSatFix fix;
+  msg::TwistStamped gnss_v;
+  const std::string& ns = c.realism_namespace;
+  transport.subscribe<msg::MagneticField>(ns + "/MagneticField", [&](const msg::MagneticField& m) { mag = m; });
+  transport.subscribe<msg::FluidPressure>(ns + "/FluidPressure", [&](const msg::FluidPressure& m) { baro = m; });
+  transport.subscribe<msg::NavSatFix>(ns + "/NavSatFix", [&](const msg::NavSatFix& m) { fix = m; });
+  transport.subscribe<msg::TwistStamped>(ns + "/NavSatVelocity", [&](const msg::TwistStamped& m) { gnss_v = m; });
+  const bool extra = c.realism.extra_sensors.any();
   auto commands = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
 
   Resources resources(c);
@@ -78,6 +93,13 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
   for (auto n : names::kAttitude) outputs.push_back(vr_of(c, n));
   for (auto n : names::kRotorSpeed) outputs.push_back(vr_of(c, n));
   for (auto n : names::kOmegaCmd) cmd_vrs.push_back(vr_of(c, n));
+  if (extra) {
+    for (const char* n : {"magnetometer.field[1]", "magnetometer.field[2]", "magnetometer.field[3]",
+                          "barometer.pressure", "barometer.altitude", "gnss.fix", "gnss.latitude_deg",
+                          "gnss.longitude_deg", "gnss.altitude_m", "gnss.v[1]", "gnss.v[2]", "gnss.v[3]"}) {
+      outputs.push_back(vr_of(c, n));
+    }
+  }
 
   const double hover = c.vehicle.hover_omega_rad_s();
   for (sim::Tick k = 0; k <= 300; ++k) {
@@ -86,27 +108,43 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
       std::vector<double> got(outputs.size());
       ASSERT_EQ(QC_FMI(fmi2GetReal)(fmu, outputs.data(), outputs.size(), got.data()), fmi2OK) << log.last();
       const auto& s = node.state().omega_rad_s;
-      const std::vector<double> want = {pose.position.x,
-                                        pose.position.y,
-                                        pose.position.z,
-                                        twist.linear.x,
-                                        twist.linear.y,
-                                        twist.linear.z,
-                                        imu.angular_velocity.x,
-                                        imu.angular_velocity.y,
-                                        imu.angular_velocity.z,
-                                        imu.linear_acceleration.x,
-                                        imu.linear_acceleration.y,
-                                        imu.linear_acceleration.z,
-                                        imu.orientation.w,
-                                        imu.orientation.x,
-                                        imu.orientation.y,
-                                        imu.orientation.z,
-                                        s[0],
-                                        s[1],
-                                        s[2],
-                                        s[3]};
+      std::vector<double> want = {pose.position.x,
+                                  pose.position.y,
+                                  pose.position.z,
+                                  twist.linear.x,
+                                  twist.linear.y,
+                                  twist.linear.z,
+                                  imu.angular_velocity.x,
+                                  imu.angular_velocity.y,
+                                  imu.angular_velocity.z,
+                                  imu.linear_acceleration.x,
+                                  imu.linear_acceleration.y,
+                                  imu.linear_acceleration.z,
+                                  imu.orientation.w,
+                                  imu.orientation.x,
+                                  imu.orientation.y,
+                                  imu.orientation.z,
+                                  s[0],
+                                  s[1],
+                                  s[2],
+                                  s[3]};
+      if (extra) {  // the messages' fields, in the messages' units (degrees), the altitude by the ISA
+        const double p0 = c.realism.extra_sensors.barometer->sea_level_pressure_Pa;
+        for (const double x : {mag.magnetic_field.x, mag.magnetic_field.y, mag.magnetic_field.z, baro.fluid_pressure,
+                               sensors::isa_pressure_altitude(baro.fluid_pressure, p0),
+                               fix.status.status >= msg::NavSatStatus::kStatusFix ? 1.0 : 0.0, fix.latitude,
+                               fix.longitude, fix.altitude, gnss_v.linear.x, gnss_v.linear.y, gnss_v.linear.z}) {
+          want.push_back(x);
+        }
+        if (k == 60) {
+          EXPECT_TRUE(std::isnan(got[want.size() - 5])) << "no GNSS fix before fix_after_s";
+        }
+        if (k == 300) {
+          EXPECT_EQ(got[want.size() - 7], 1.0) << "a GNSS fix by the end";
+        }
+      }
       for (std::size_t i = 0; i < want.size(); ++i) {
+        if (std::isnan(got[i]) && std::isnan(want[i])) continue;  // a GNSS without a fix
         ASSERT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0)
             << "output " << i << " at tick " << k << ": " << got[i] << " vs " << want[i];
       }
@@ -192,6 +230,31 @@ TEST(FmuPlantNode, WindGustsFaultsAndDragGiveThePlantNodesNumbers) {
 TEST(FmuPlantNode, WithSensorNoiseTheOutputsAreThePublishedSamples) {
   FmuConfig c = config_for(FmuKind::kPlant);
   c.realism = rough_air();
+  compare_with_plant_node(c, /*sensor_noise=*/true);
+}
+
+TEST(FmuPlantNode, TheMagnetometerBarometerAndGnssOutputsAreThePublishedSamples) {
+  // Each at a rate of its own (the barometer's off the FMU's 0.02 s steps: its samples inside a step
+  // are drawn too), the GNSS 50 ms late and without a fix for its first 0.8 s.
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.realism = rough_air();
+  auto& e = c.realism.extra_sensors;
+  e.magnetometer.emplace();
+  e.magnetometer->noise_sigma_T = 0.3e-6;
+  e.magnetometer->hard_iron_T = {1e-6, -2e-6, 0.5e-6};
+  e.barometer.emplace();
+  e.barometer->timing = {3, 0};
+  e.barometer->site_altitude_m = 488.0;
+  e.barometer->noise_sigma_Pa = 1.2;
+  e.barometer->drift_Pa_sqrt_s = 0.1;
+  e.barometer->bias_initial_Pa = 20.0;
+  e.gnss.emplace();
+  e.gnss->timing = {10, 5};
+  e.gnss->site = {47.397742 * std::numbers::pi / 180.0, 8.545594 * std::numbers::pi / 180.0, 535.0};
+  e.gnss->horizontal_sigma_m = 0.8;
+  e.gnss->vertical_sigma_m = 1.5;
+  e.gnss->velocity_sigma_m_s = 0.05;
+  e.gnss->fix_after_s = 0.8;
   compare_with_plant_node(c, /*sensor_noise=*/true);
 }
 

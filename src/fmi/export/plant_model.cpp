@@ -10,12 +10,20 @@
 // every tick (as the plant node publishes them): p_W from the pose, v_W from the velocity's linear
 // part, q_WB, w_B and f_B from the IMU (the samples the controller node uses), each held between its
 // sensor's ticks; euler is computed from that q_WB and omega stays the true rotor speeds.
+//
+// The extra sensors the scenario configured (magnetometer, barometer, GNSS: sensors/registry.hpp) are
+// the vehicle's sensor suite (sensors/suite.hpp), stepped on every tick as the plant node steps it;
+// their outputs ("barometer.pressure", "gnss.v[1]", ...) hold the newest sample. They do not depend on
+// realism.sensor_noise (they are sensors, not the state).
+#include <array>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "fmi/export/slave.hpp"
 #include "fmi/quadrotor_variables.hpp"
 #include "model/attitude.hpp"
+#include "sensors/suite.hpp"
 #include "sim/realism.hpp"
 
 namespace quadcosim::fmi::exported {
@@ -49,6 +57,13 @@ class PlantModel final : public Model {
         vehicle_.push_back({&p, find_vr(md, std::string(names::kVehiclePrefix) + std::string(p.name))});
       }
     }
+    sensors::for_each_configured(c.realism.extra_sensors, [&]<class Kind>(const typename Kind::Config&) {
+      std::vector<ValueReference>& vrs = extra_vrs_[sensors::kind_index<Kind>()];
+      for (const auto& col : Kind::kColumns) {
+        for (int i = 0; i < col.width; ++i)
+          vrs.push_back(find_vr(md, names::sensor_variable(Kind::kName, col.name, col.width, i)));
+      }
+    });
   }
 
   std::unique_ptr<Model> clone() const override { return std::make_unique<PlantModel>(*this); }
@@ -107,6 +122,8 @@ class PlantModel final : public Model {
       realism_.emplace(realism, vehicle, config_.realism_namespace, clock_);
     }
     sensor_noise_ = sensor_noise_ && realism_;
+    // Named, seeded and timed as the plant node's sensor channels (sim/sensor_channels.hpp).
+    extra_ = sensors::Suite(config_.realism.extra_sensors, realism.seed, config_.realism_namespace, clock_.period_ns);
     write_outputs(k, v);
     return {};
   }
@@ -117,7 +134,7 @@ class PlantModel final : public Model {
     for (sim::Tick i = k; i < k + n; ++i) {
       quad_->step(state_, clock_.seconds(i), rotor_input_, dt, config_.substeps, environment(i));
       // The sensors sample every tick (their rates and latencies count ticks), also inside a step.
-      if (sensor_noise_ && i + 1 < k + n) measure(i + 1);
+      if ((sensor_noise_ || !extra_.empty()) && i + 1 < k + n) measure(i + 1);
     }
     write_outputs(k + n, v);
     if (!state_.p_W.allFinite() || !state_.v_W.allFinite() || !state_.q_WB.coeffs().allFinite() ||
@@ -154,7 +171,24 @@ class PlantModel final : public Model {
   model::Outputs measure(sim::Tick k) {
     const model::Outputs y = quad_->outputs(clock_.seconds(k), state_, rotor_input_, environment(k));
     if (sensor_noise_) realism_->measure(k, y, pose_, twist_, imu_);
+    extra_.step(k, y);
     return y;
+  }
+
+  /// The extra sensors' outputs: the newest sample of each, column by column.
+  void write_extra_outputs(Values& v) const {
+    sensors::for_each_kind([&]<class Kind>() {
+      const sensors::Slot<Kind>* slot = extra_.slot<Kind>();
+      if (!slot) return;
+      const std::vector<ValueReference>& vrs = extra_vrs_[sensors::kind_index<Kind>()];
+      std::array<double, sensors::sample_width<Kind>()> values{};
+      double* out = values.data();
+      for (const auto& col : Kind::kColumns) {
+        col.write(slot->sample, out);
+        out += col.width;
+      }
+      for (std::size_t i = 0; i < vrs.size(); ++i) v.number[vrs[i]] = values[i];
+    });
   }
 
   void write_outputs(sim::Tick k, Values& v) {
@@ -174,6 +208,7 @@ class PlantModel final : public Model {
     put(v, w_, y.w_B);
     put(v, f_, y.specific_force_B);
     put(v, omega_, state_.omega_rad_s);
+    write_extra_outputs(v);
   }
 
   FmuConfig config_;
@@ -189,6 +224,8 @@ class PlantModel final : public Model {
   std::array<ValueReference, 4> init_omega_;
   ValueReference wind_, faults_, noise_, seed_;
   std::vector<std::pair<const model::VehicleParameter*, ValueReference>> vehicle_;
+  std::array<std::vector<ValueReference>, std::tuple_size_v<sensors::Kinds>> extra_vrs_;  ///< by kind, per number
+  sensors::Suite extra_;  ///< the extra sensors (empty: none configured)
 
   std::optional<model::Quadrotor> quad_;
   model::State state_;

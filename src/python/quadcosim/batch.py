@@ -287,12 +287,20 @@ class Batch:
         """The latest sensor messages each plant published (what its controller sees, after noise,
         latency and injected faults), as Simulation.sensors with one row per vehicle: pose: t (n,),
         p (n, 3), q (n, 4); velocity: t, v (world), w (body); imu: t, q, w, a (n, 3). NaN before a
-        vehicle's first step."""
-        return {
+        vehicle's first step.
+
+        With the scenario's extra sensors (docs/sensors.md), as the plant published them, with the
+        names of Simulation.sensors: magnetometer: t, field (n, 3) body [T]; barometer: t,
+        pressure [Pa], altitude [m] (its ISA pressure altitude); gnss: t, fix (1.0 with a fix, 0.0
+        without), latitude_deg, longitude_deg, altitude_m (NaN without a fix), v (n, 3) ENU [m/s]."""
+        d = {
             "pose": {k: self._b.get("pose." + k) for k in ("t", "p", "q")},
             "velocity": {k: self._b.get("velocity." + k) for k in ("t", "v", "w")},
             "imu": {k: self._b.get("imu." + k) for k in ("t", "q", "w", "a")},
         }
+        for sensor, columns in self._b.sensor_columns().items():
+            d[sensor] = {k: self._b.get(sensor + "." + k) for k in ["t"] + list(columns)}
+        return d
 
     @property
     def setpoints(self) -> Dict[str, Any]:

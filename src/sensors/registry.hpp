@@ -1,0 +1,176 @@
+// The registry of the sensors a vehicle can carry beyond the paper's Pose, Velocity and Imu: one
+// entry ("kind") per sensor, naming its configuration in SensorSet, its model and sample, how the
+// model is made and measures, and the sample's fields as named columns of numbers. Everything that
+// handles the sensors generically is derived from this list: the vehicle's sensor suite
+// (sensors/suite.hpp), Batch's arrays, the plant FMU's output variables; the wire side (topics,
+// messages) is the plant's (sim/sensor_wire.hpp).
+//
+// To add a sensor (docs/sensors.md, "Add a sensor"): its model (sensors/<name>.{hpp,cpp}), its line in
+// SensorSet, its kind here (and in Kinds), its scenario keys (io/realism_yaml.cpp) and its wire form
+// (sim/sensor_wire.hpp).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <string_view>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+
+#include "model/quadrotor.hpp"
+#include "model/random.hpp"
+#include "sensors/sensor_set.hpp"
+
+namespace quadcosim::sensors {
+
+/// The configuration's numbers by name, for what stores a configuration outside a scenario (the
+/// plant FMU's resources): Kind::config_fields(config, f) calls f(name, member) for every member, an
+/// int, a double or an Eigen::Vector3d (const or not, as `config` is). The timing comes first.
+template <class C, class F>
+void timing_fields(C& timing, F&& f) {
+  f("divider", timing.divider);
+  f("latency_ticks", timing.latency_ticks);
+}
+
+/// One named field of a sample: `width` numbers in `unit`, written by `write(sample, out)`.
+template <class Sample>
+struct Column {
+  std::string_view name;  ///< "field": with the sensor's name, "magnetometer.field"
+  int width = 1;          ///< numbers per sample (3 for a vector)
+  std::string_view unit;  ///< SI unit as FMI writes it ("T", "Pa", "m", "deg", "m/s", "1")
+  std::string_view description;
+  void (*write)(const Sample&, double* out) = nullptr;
+};
+
+struct MagnetometerKind {
+  using Config = MagnetometerConfig;
+  using Model = Magnetometer;
+  using Sample = MagnetometerSample;
+  static constexpr std::string_view kName = "magnetometer";  ///< also its random stream's name
+  static const std::optional<Config>& config(const SensorSet& s) { return s.magnetometer; }
+  static std::optional<Config>& config(SensorSet& s) { return s.magnetometer; }
+  static Model make(const Config& c, model::Rng rng, double /*plant_period_s*/) { return Model(c, rng); }
+  static Sample measure(Model& m, const model::Outputs& truth, double /*truth_t_s*/) { return m.measure(truth); }
+  template <class C, class F>
+  static void config_fields(C& c, F&& f) {
+    timing_fields(c.timing, f);
+    f("field_T", c.field_T);
+    f("inclination_rad", c.inclination_rad);
+    f("declination_rad", c.declination_rad);
+    f("noise_sigma_T", c.noise_sigma_T);
+    f("hard_iron_T", c.hard_iron_T);
+  }
+  static constexpr std::array<Column<Sample>, 1> kColumns{{
+      {"field", 3, "T", "the measured magnetic field in the body frame",
+       [](const Sample& s, double* o) {
+         for (int a = 0; a < 3; ++a) o[a] = s.field_B_T[a];
+       }},
+  }};
+};
+
+struct BarometerKind {
+  using Config = BarometerConfig;
+  using Model = Barometer;
+  using Sample = BarometerSample;
+  static constexpr std::string_view kName = "barometer";
+  static const std::optional<Config>& config(const SensorSet& s) { return s.barometer; }
+  static std::optional<Config>& config(SensorSet& s) { return s.barometer; }
+  /// The drift steps once per sample: the model is told the sample period.
+  static Model make(const Config& c, model::Rng rng, double plant_period_s) {
+    return Model(c, plant_period_s * c.timing.divider, rng);
+  }
+  static Sample measure(Model& m, const model::Outputs& truth, double /*truth_t_s*/) { return m.measure(truth); }
+  template <class C, class F>
+  static void config_fields(C& c, F&& f) {
+    timing_fields(c.timing, f);
+    f("site_altitude_m", c.site_altitude_m);
+    f("sea_level_pressure_Pa", c.sea_level_pressure_Pa);
+    f("noise_sigma_Pa", c.noise_sigma_Pa);
+    f("drift_Pa_sqrt_s", c.drift_Pa_sqrt_s);
+    f("bias_initial_Pa", c.bias_initial_Pa);
+  }
+  static constexpr std::array<Column<Sample>, 2> kColumns{{
+      {"pressure", 1, "Pa", "the static pressure reading", [](const Sample& s, double* o) { o[0] = s.pressure_Pa; }},
+      {"altitude", 1, "m", "the reading's ISA pressure altitude above mean sea level",
+       [](const Sample& s, double* o) { o[0] = s.altitude_m; }},
+  }};
+};
+
+struct GnssKind {
+  using Config = GnssConfig;
+  using Model = Gnss;
+  using Sample = GnssSample;
+  static constexpr std::string_view kName = "gnss";
+  static const std::optional<Config>& config(const SensorSet& s) { return s.gnss; }
+  static std::optional<Config>& config(SensorSet& s) { return s.gnss; }
+  static Model make(const Config& c, model::Rng rng, double /*plant_period_s*/) { return Model(c, rng); }
+  static Sample measure(Model& m, const model::Outputs& truth, double truth_t_s) { return m.measure(truth, truth_t_s); }
+  template <class C, class F>
+  static void config_fields(C& c, F&& f) {
+    timing_fields(c.timing, f);
+    f("site_latitude_rad", c.site.latitude_rad);
+    f("site_longitude_rad", c.site.longitude_rad);
+    f("site_height_m", c.site.height_m);
+    f("horizontal_sigma_m", c.horizontal_sigma_m);
+    f("vertical_sigma_m", c.vertical_sigma_m);
+    f("velocity_sigma_m_s", c.velocity_sigma_m_s);
+    f("fix_after_s", c.fix_after_s);
+  }
+  static constexpr double kDeg = 180.0 / std::numbers::pi;
+  static constexpr std::array<Column<Sample>, 5> kColumns{{
+      {"fix", 1, "1", "1 with a fix, 0 without (then the rest is NaN)",
+       [](const Sample& s, double* o) { o[0] = s.fix ? 1.0 : 0.0; }},
+      {"latitude_deg", 1, "deg", "WGS-84 geodetic latitude",
+       [](const Sample& s, double* o) { o[0] = s.position.latitude_rad * kDeg; }},
+      {"longitude_deg", 1, "deg", "WGS-84 longitude",
+       [](const Sample& s, double* o) { o[0] = s.position.longitude_rad * kDeg; }},
+      {"altitude_m", 1, "m", "height above the WGS-84 ellipsoid",
+       [](const Sample& s, double* o) { o[0] = s.position.height_m; }},
+      {"v", 3, "m/s", "velocity in the world frame (ENU)",
+       [](const Sample& s, double* o) {
+         for (int a = 0; a < 3; ++a) o[a] = s.velocity_W[a];
+       }},
+  }};
+};
+
+/// Every kind, in a fixed order (the order of samples, arrays and variables).
+using Kinds = std::tuple<MagnetometerKind, BarometerKind, GnssKind>;
+
+/// Calls f.template operator()<Kind>() for every kind of the registry, in order.
+template <class F>
+void for_each_kind(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (f.template operator()<std::tuple_element_t<I, Kinds>>(), ...);
+  }(std::make_index_sequence<std::tuple_size_v<Kinds>>{});
+}
+
+/// Kind's place in Kinds.
+template <class Kind, std::size_t I = 0>
+constexpr std::size_t kind_index() {
+  if constexpr (std::is_same_v<Kind, std::tuple_element_t<I, Kinds>>) {
+    return I;
+  } else {
+    return kind_index<Kind, I + 1>();
+  }
+}
+
+/// Calls f.template operator()<Kind>(config) for every kind `set` configures, in order.
+template <class F>
+void for_each_configured(const SensorSet& set, F&& f) {
+  for_each_kind([&]<class Kind>() {
+    if (const auto& c = Kind::config(set)) f.template operator()<Kind>(*c);
+  });
+}
+
+/// Numbers per sample of Kind (the sum of its columns' widths).
+template <class Kind>
+constexpr int sample_width() {
+  int n = 0;
+  for (const auto& c : Kind::kColumns) n += c.width;
+  return n;
+}
+
+}  // namespace quadcosim::sensors
