@@ -40,8 +40,9 @@ inline constexpr std::array<std::string_view, 4> kRotorSpeed = {"omega[1]", "ome
 /// exported from configures them: "<sensor>.<column>", a vector's components 1-based
 /// ("magnetometer.field[1]", "barometer.pressure", "gnss.v[3]"). `i` counts from 0.
 inline std::string sensor_variable(std::string_view sensor, std::string_view column, int width, int i) {
-  std::string name = std::string(sensor) + "." + std::string(column);
-  if (width > 1) name += "[" + std::to_string(i + 1) + "]";
+  std::string name(sensor);
+  name.append(".").append(column);
+  if (width > 1) name.append("[").append(std::to_string(i + 1)).append("]");
   return name;
 }
 

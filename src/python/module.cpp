@@ -34,8 +34,7 @@
 #include "io/trajectory_csv.hpp"
 #include "io/yaml_reader.hpp"
 #include "python/py_controller.hpp"
-#include "sensors/barometer.hpp"
-#include "sim/sensor_wire.hpp"
+#include "sensors/suite.hpp"
 #include "sim/simulation.hpp"
 
 namespace py = pybind11;
@@ -574,25 +573,30 @@ class PySimulation {
                    py::arg("w") = array({m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z}),
                    py::arg("a") = array({m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z}));
     }
-    // The extra sensors the scenario configures (docs/sensors.md), in SI units.
-    if (magnetic_field_) {
-      const auto& f = magnetic_field_->magnetic_field;
-      d["magnetometer"] =
-          py::dict(py::arg("t") = stamp_s(magnetic_field_->header), py::arg("field") = array({f.x, f.y, f.z}));
-    }
-    if (fluid_pressure_) {
-      const double p0 = scenario_.simulation.plant.realism.extra_sensors.barometer->sea_level_pressure_Pa;
-      d["barometer"] = py::dict(
-          py::arg("t") = stamp_s(fluid_pressure_->header), py::arg("pressure") = fluid_pressure_->fluid_pressure,
-          py::arg("altitude") = sensors::isa_pressure_altitude(fluid_pressure_->fluid_pressure, p0));
-    }
-    if (nav_sat_fix_ && nav_sat_velocity_) {
-      const auto& f = *nav_sat_fix_;
-      const auto& v = nav_sat_velocity_->linear;
-      d["gnss"] =
-          py::dict(py::arg("t") = stamp_s(f.header), py::arg("fix") = f.status.status >= msg::NavSatStatus::kStatusFix,
-                   py::arg("latitude_deg") = f.latitude, py::arg("longitude_deg") = f.longitude,
-                   py::arg("altitude_m") = f.altitude, py::arg("v") = array({v.x, v.y, v.z}));
+    // The extra sensors the scenario configures (docs/sensors.md): the newest sample of each, as the
+    // plant published it (sensors/suite.hpp), column by column in SI units.
+    if (const sensors::Suite* suite = sim_->plant().extra_sensors()) {
+      const sim::TickClock& clock = scenario_.simulation.plant.clock;
+      sensors::for_each_kind([&]<class Kind>() {
+        const sensors::Slot<Kind>* slot = suite->slot<Kind>();
+        if (!slot || slot->tick < 0) return;
+        py::dict one;
+        one["t"] = stamp_s(msg::Header{msg::Time::from_ns(clock.ns(slot->tick)), ""});
+        for (const auto& c : Kind::kColumns) {
+          std::array<double, sensors::sample_width<Kind>()> v{};
+          c.write(slot->sample, v.data());
+          if (c.width > 1) {
+            py::array_t<double> a(c.width);
+            std::copy(v.begin(), v.begin() + c.width, a.mutable_data());
+            one[py::str(std::string(c.name))] = a;
+          } else if (c.boolean) {
+            one[py::str(std::string(c.name))] = py::bool_(v[0] != 0.0);
+          } else {
+            one[py::str(std::string(c.name))] = v[0];
+          }
+        }
+        d[py::str(std::string(Kind::kName))] = one;
+      });
     }
     return d;
   }
@@ -643,10 +647,6 @@ class PySimulation {
     pose_.reset();
     velocity_.reset();
     imu_.reset();
-    magnetic_field_.reset();
-    fluid_pressure_.reset();
-    nav_sat_fix_.reset();
-    nav_sat_velocity_.reset();
     sim_.reset();
     try {
       sim_ = std::make_unique<sim::Simulation>(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller,
@@ -659,11 +659,6 @@ class PySimulation {
     t.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) { pose_ = m; });
     t.subscribe<msg::TwistStamped>(topics.velocity, [this](const msg::TwistStamped& m) { velocity_ = m; });
     t.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) { imu_ = m; });
-    // The extra sensors through the registry: the newest message of each topic.
-    sim::for_each_sensor_topic(sc.simulation.plant.realism.extra_sensors, sc.simulation.ns,
-                               [&]<class T>(const std::string& topic) {
-                                 t.subscribe<T>(topic, [this, topic](const T& m) { keep(topic, m); });
-                               });
     next_tick_ = 0;
   }
 
@@ -674,19 +669,6 @@ class PySimulation {
   std::optional<msg::PoseStamped> pose_;
   std::optional<msg::TwistStamped> velocity_;
   std::optional<msg::Imu> imu_;
-  std::optional<msg::MagneticField> magnetic_field_;
-  std::optional<msg::FluidPressure> fluid_pressure_;
-  std::optional<msg::NavSatFix> nav_sat_fix_;
-  std::optional<msg::TwistStamped> nav_sat_velocity_;  ///< the GNSS velocity (ENU), on its own topic
-  template <class T>
-  void keep(const std::string& topic, const T& m) {
-    if constexpr (std::is_same_v<T, msg::MagneticField>) magnetic_field_ = m;
-    if constexpr (std::is_same_v<T, msg::FluidPressure>) fluid_pressure_ = m;
-    if constexpr (std::is_same_v<T, msg::NavSatFix>) nav_sat_fix_ = m;
-    if constexpr (std::is_same_v<T, msg::TwistStamped>) {
-      if (topic.ends_with("/NavSatVelocity")) nav_sat_velocity_ = m;
-    }
-  }
   std::mutex mutex_;                         ///< one thread steps or reads at a time (stepping runs without the GIL)
   std::atomic<std::thread::id> stepping_{};  ///< the thread inside step(), if any
 };
@@ -849,7 +831,8 @@ omega (4) rotor speeds [rad/s].)")
 any noise, latency and injected faults), a dict of dicts with their stamp t [s]:
 pose: p (3) [m], q (4, w x y z); velocity: v (3) world [m/s], w (3) body [rad/s];
 imu: q (4), w (3) [rad/s], a (3) specific force in body [m/s^2]. Empty before the first step.
-With the scenario's extra sensors (docs/sensors.md): magnetometer: field (3) body [T];
+With the scenario's extra sensors (docs/sensors.md), the newest sample of each as the plant drew it
+(before any injected message fault), with its stamp t: magnetometer: field (3) body [T];
 barometer: pressure [Pa], altitude [m] (its ISA pressure altitude); gnss: fix (bool),
 latitude_deg, longitude_deg, altitude_m (NaN without a fix), v (3) world ENU [m/s].)")
       .def_property_readonly("setpoint", &PySimulation::setpoint,

@@ -43,6 +43,7 @@ struct Column {
   std::string_view unit;  ///< SI unit as FMI writes it ("T", "Pa", "m", "deg", "m/s", "1")
   std::string_view description;
   void (*write)(const Sample&, double* out) = nullptr;
+  bool boolean = false;  ///< a flag written as 1 or 0 (Python shows a bool where it shows one sample)
 };
 
 struct MagnetometerKind {
@@ -122,7 +123,7 @@ struct GnssKind {
   static constexpr double kDeg = 180.0 / std::numbers::pi;
   static constexpr std::array<Column<Sample>, 5> kColumns{{
       {"fix", 1, "1", "1 with a fix, 0 without (then the rest is NaN)",
-       [](const Sample& s, double* o) { o[0] = s.fix ? 1.0 : 0.0; }},
+       [](const Sample& s, double* o) { o[0] = s.fix ? 1.0 : 0.0; }, true},
       {"latitude_deg", 1, "deg", "WGS-84 geodetic latitude",
        [](const Sample& s, double* o) { o[0] = s.position.latitude_rad * kDeg; }},
       {"longitude_deg", 1, "deg", "WGS-84 longitude",
@@ -142,9 +143,8 @@ using Kinds = std::tuple<MagnetometerKind, BarometerKind, GnssKind>;
 /// Calls f.template operator()<Kind>() for every kind of the registry, in order.
 template <class F>
 void for_each_kind(F&& f) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) {
-    (f.template operator()<std::tuple_element_t<I, Kinds>>(), ...);
-  }(std::make_index_sequence<std::tuple_size_v<Kinds>>{});
+  [&]<std::size_t... I>(std::index_sequence<I...>) { (f.template operator()<std::tuple_element_t<I, Kinds>>(), ...); }
+  (std::make_index_sequence<std::tuple_size_v<Kinds>>{});
 }
 
 /// Kind's place in Kinds.

@@ -6,8 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "sim/inprocess_transport.hpp"
-#include "sim/plant_node.hpp"
+#include "sim/plant_rig_test_support.hpp"
 
 namespace quadcosim::sim {
 namespace {
@@ -19,30 +18,13 @@ struct Captured {
 };
 
 // A plant on an in-process bus whose sensor messages are collected.
-struct Rig {
-  InProcessTransport bus;
+struct Rig : test::PlantRig {
   Captured got;
-  PlantNode plant;
-  Rig(const RealismConfig& r, const model::State& x0, model::VehicleParams v = {})
-      : plant(bus, Topics::for_namespace("/drone"), v, options(r), x0) {
+  Rig(const RealismConfig& r, const model::State& x0, model::VehicleParams v = {}) : PlantRig(r, x0, v) {
     const Topics t = Topics::for_namespace("/drone");
     bus.subscribe<msg::PoseStamped>(t.pose, [this](const msg::PoseStamped& m) { got.pose.push_back(m); });
     bus.subscribe<msg::TwistStamped>(t.velocity, [this](const msg::TwistStamped& m) { got.twist.push_back(m); });
     bus.subscribe<msg::Imu>(t.imu, [this](const msg::Imu& m) { got.imu.push_back(m); });
-  }
-  static PlantOptions options(const RealismConfig& r) {
-    PlantOptions o;
-    o.watchdog_ticks = 0;  // the rig sends no commands; the watchdog has its own tests
-    o.realism = r;
-    return o;
-  }
-  void run(Tick ticks, bool repeat_each = false) {
-    for (Tick k = 0; k < ticks; ++k) {
-      plant.publish_outputs(k);
-      if (repeat_each) plant.publish_outputs(k);
-      plant.latch_command(k);
-      plant.integrate(k);
-    }
   }
 };
 

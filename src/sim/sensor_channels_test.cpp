@@ -6,21 +6,17 @@
 #include <vector>
 
 #include "sensors/barometer.hpp"
-#include "sim/inprocess_transport.hpp"
-#include "sim/plant_node.hpp"
+#include "sim/plant_rig_test_support.hpp"
 
 namespace quadcosim::sim {
 namespace {
 
-struct Rig {
-  InProcessTransport bus;
+struct Rig : test::PlantRig {
   std::vector<msg::MagneticField> mag;
   std::vector<msg::FluidPressure> baro;
   std::vector<msg::NavSatFix> fix;
   std::vector<msg::TwistStamped> vel;
-  PlantNode plant;
-  explicit Rig(const RealismConfig& r)
-      : plant(bus, Topics::for_namespace("/drone"), model::VehicleParams{}, options(r), climbing()) {
+  explicit Rig(const RealismConfig& r) : PlantRig(r, climbing()) {
     bus.subscribe<msg::MagneticField>("/drone/MagneticField", [this](const auto& m) { mag.push_back(m); });
     bus.subscribe<msg::FluidPressure>("/drone/FluidPressure", [this](const auto& m) { baro.push_back(m); });
     bus.subscribe<msg::NavSatFix>("/drone/NavSatFix", [this](const auto& m) { fix.push_back(m); });
@@ -31,20 +27,6 @@ struct Rig {
     model::State x = model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 5}, 0.0, true);
     x.v_W = {0, 0, 1};
     return x;
-  }
-  static PlantOptions options(const RealismConfig& r) {
-    PlantOptions o;
-    o.watchdog_ticks = 0;  // the rig sends no commands
-    o.realism = r;
-    return o;
-  }
-  void run(Tick ticks, bool repeat_each = false) {
-    for (Tick k = 0; k < ticks; ++k) {
-      plant.publish_outputs(k);
-      if (repeat_each) plant.publish_outputs(k);
-      plant.latch_command(k);
-      plant.integrate(k);
-    }
   }
 };
 
