@@ -61,13 +61,22 @@ class PlantProcess {
         [this](sim::SenderId s) { return pairing_.accepts(topics_.motor_commands, s) || take_over(s); });
     plant_.on_early_command([this](sim::Tick k) {
       if (!ambiguous_.empty()) return;
+      // The /clock of the tick before went out unheld when that tick is no control tick: a timer on ROS
+      // time faster than the control rate fires on it, and its command can come while this one is held.
+      const bool faster_timer = divider_ > 1;
       ambiguous_ = fmt::format(
-          "the controller sent a command before tick {}'s /clock (t = {:g} s) went out: it does not step from a "
-          "timer on ROS time (it publishes from a subscription callback, or from a wall-clock timer), so with "
-          "--sync clock its command answers no tick and the run stopped rather than fly a trajectory that differs "
-          "from run to run. A controller that answers each control tick's samples runs with --sync samples; one "
-          "that answers every sample needs simulation.controller_rate_hz equal to that sample rate (docs/ros2.md)",
-          k, clock_.seconds(k));
+          "the controller sent a command before tick {}'s /clock (t = {:g} s) went out: it does not publish only "
+          "from a timer on ROS time at the control rate ({:g} Hz); it publishes from a subscription callback, from "
+          "a wall-clock timer{}. With --sync clock such a command answers no tick, so the run stopped rather than "
+          "fly a trajectory that differs from run to run. {}A controller that answers each control tick's samples "
+          "runs with --sync samples; one that answers every sample needs simulation.controller_rate_hz equal to "
+          "that sample rate (docs/ros2.md)",
+          k, clock_.seconds(k), 1.0 / clock_.seconds(divider_),
+          faster_timer ? fmt::format(", or from a timer faster than the control rate (firing on the /clock of tick "
+                                     "{}, which is no control tick)",
+                                     k - 1)
+                       : std::string(),
+          faster_timer ? "A faster timer needs simulation.controller_rate_hz set to its rate. " : "");
       request_stop();  // wakes the lockstep's wait for the answer that will not come
     });
     transport_.subscribe_with_sender<msg::ControllerStatus>(topics_.controller_status,
@@ -364,7 +373,8 @@ class PlantProcess {
         replies, "get_parameters reply from " + node, [this, replies](const void* reply, sim::SenderId from) {
           if (clock_held_ >= 0 && dds::ParameterClient::is_reply_to(reply, barrier_request_) &&
               barrier_->from_peer(replies, from)) {
-            plant_.publish_clock(std::exchange(clock_held_, -1));
+            clock_released_ = std::exchange(clock_held_, -1);
+            plant_.publish_clock(clock_released_);
           }
         });
     plant_.set_clock_after_sensors(true);
@@ -399,6 +409,11 @@ class PlantProcess {
     // samples were queued. A control tick's /clock waits for that reply.
     const auto request = barrier_->send_get({});
     if (k < divider_ || k % divider_ != 0) return true;
+    // The tick published again (its answer is slow: the lockstep's retry) after its /clock went out: the
+    // controller may have stepped already and its command be on its way, so the /clock goes out again
+    // at once. Held again, that command would arrive while the /clock is held, and be taken for one
+    // that answers no tick.
+    if (k == clock_released_) return true;
     barrier_request_ = request;
     clock_held_ = k;
     return false;  // the reply's delivery publishes tick k's /clock
@@ -677,6 +692,7 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> barrier_;  ///< --sync clock: the controller node's parameter client
   dds::ParameterClient::Header barrier_request_;   ///< the last barrier request sent
   sim::Tick clock_held_ = -1;                      ///< the tick whose /clock awaits the barrier reply
+  sim::Tick clock_released_ = -1;                  ///< the last tick whose held /clock went out
   std::uint64_t answers_at_last_control_ = 0;      ///< the plant's command receipts at the last control tick
   std::string ambiguous_;  ///< why the controller's answers cannot be matched to ticks ("": they can)
   std::int64_t loop_start_ns_ = 0;

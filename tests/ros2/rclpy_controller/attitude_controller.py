@@ -6,9 +6,17 @@ timer on the node's clock (ROS time with use_sim_time:=true) and control law, co
 order, so both fly the same trajectory to the last bit. Run:
 
     attitude_controller.py --ros-args -p use_sim_time:=true [-p log_file:=steps.log]
+
+Other node shapes, for the tests of how lockstep treats them (tests/ros2/ros2_cases.sh):
+    -p shape:=pose_callback    step from the Pose subscription callback instead of a timer
+    -p rate_hz:=100.0          a timer at another rate
+    -p executor_threads:=2     spin in a MultiThreadedExecutor with that many threads (default 1:
+                               rclpy.spin, a SingleThreadedExecutor)
+    -p slow_step_ms:=80        every 25th step waits that long (wall clock) before it publishes
 """
 import math
 import sys
+import time
 
 import rclpy
 import rclpy.executors
@@ -38,6 +46,12 @@ class AttitudeControllerNode(Node):
         self.kd_att = self.declare_parameter("kd_att", 12.0).value
         rate_hz = self.declare_parameter("rate_hz", 50.0).value
         log_file = self.declare_parameter("log_file", "").value
+        shape = self.declare_parameter("shape", "timer").value
+        self.executor_threads = self.declare_parameter("executor_threads", 1).value
+        self.slow_step_s = self.declare_parameter("slow_step_ms", 0).value * 1e-3
+        self.steps = 0
+        if shape not in ("timer", "pose_callback"):
+            raise ValueError("shape must be timer or pose_callback, not %r" % shape)
         self.add_on_set_parameters_callback(self.on_set)
         self.log = open(log_file, "w") if log_file else None
         self.pose, self.vel, self.imu = PoseStamped(), TwistStamped(), Imu()
@@ -45,7 +59,9 @@ class AttitudeControllerNode(Node):
         self.create_subscription(TwistStamped, "/drone/Velocity", self.on_vel, 10)
         self.create_subscription(Imu, "/drone/Imu", self.on_imu, 10)
         self.pub = self.create_publisher(Float64MultiArray, "/drone/motor_commands", 10)
-        self.create_timer(round(1e9 / rate_hz) * 1e-9, self.step)
+        self.step_on_pose = shape == "pose_callback"
+        if not self.step_on_pose:
+            self.create_timer(round(1e9 / rate_hz) * 1e-9, self.step)
 
     def on_set(self, params):
         for p in params:
@@ -55,6 +71,8 @@ class AttitudeControllerNode(Node):
 
     def on_pose(self, m):
         self.pose = m
+        if self.step_on_pose:
+            self.step()
 
     def on_vel(self, m):
         self.vel = m
@@ -80,6 +98,9 @@ class AttitudeControllerNode(Node):
         sq = (a - c + d, a - b - d, a + c + d, a + b - d)
         cmd = Float64MultiArray()
         cmd.data = [min(math.sqrt(max(s, 0.0)), OMEGA_MAX) for s in sq]
+        self.steps += 1
+        if self.slow_step_s > 0 and self.steps % 25 == 0:
+            time.sleep(self.slow_step_s)
         self.pub.publish(cmd)
         if self.log:
             self.log.write("%d %d %d %d %s\n" % (now_ns, to_ns(self.pose.header.stamp), to_ns(self.vel.header.stamp),
@@ -90,8 +111,11 @@ class AttitudeControllerNode(Node):
 def main():
     rclpy.init(args=sys.argv)
     node = AttitudeControllerNode()
+    executor = None  # rclpy's global SingleThreadedExecutor
+    if node.executor_threads > 1:
+        executor = rclpy.executors.MultiThreadedExecutor(num_threads=node.executor_threads)
     try:
-        rclpy.spin(node)
+        rclpy.spin(node, executor=executor)
     except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
         pass
     except rclpy_implementation.RCLError:

@@ -12,12 +12,16 @@
 // Parameters: z_des [m], kp_z, kd_z, kp_att, kd_att, rate_hz, log_file: when set, one line per step
 // "now_ns pose_ns velocity_ns imu_ns w1 w2 w3 w4", so a test can check which samples each step used.
 // Flag --no-clock-thread (before --ros-args): NodeOptions::use_clock_thread(false).
+// Other node shapes, for the tests of how lockstep treats them (tests/ros2/ros2_cases.sh): parameter
+// shape "timer" (default) or "pose_callback" (step from the Pose subscription callback, no timer);
+// executor_threads N > 1: spin in a MultiThreadedExecutor with N threads instead of rclcpp::spin.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "geometry_msgs/msg/pose_stamped.hpp"
@@ -46,6 +50,12 @@ class AttitudeControllerNode : public rclcpp::Node {
     kd_att_ = declare_parameter("kd_att", 12.0);
     const double rate_hz = declare_parameter("rate_hz", 50.0);
     const std::string log_file = declare_parameter("log_file", std::string());
+    const std::string shape = declare_parameter("shape", std::string("timer"));
+    executor_threads_ = declare_parameter("executor_threads", 1);
+    if (shape != "timer" && shape != "pose_callback") {
+      throw std::invalid_argument("shape must be timer or pose_callback, not '" + shape + "'");
+    }
+    const bool step_on_pose = shape == "pose_callback";
     param_cb_ = add_on_set_parameters_callback([this](const std::vector<rclcpp::Parameter>& ps) {
       for (const auto& p : ps) {
         if (p.get_name() == "z_des") z_des_ = p.as_double();
@@ -60,15 +70,19 @@ class AttitudeControllerNode : public rclcpp::Node {
 
     const auto qos = rclcpp::QoS(10);
     pose_sub_ = create_subscription<geometry_msgs::msg::PoseStamped>(
-        "/drone/Pose", qos, [this](const geometry_msgs::msg::PoseStamped& m) { pose_ = m; });
+        "/drone/Pose", qos, [this, step_on_pose](const geometry_msgs::msg::PoseStamped& m) {
+          pose_ = m;
+          if (step_on_pose) step();
+        });
     vel_sub_ = create_subscription<geometry_msgs::msg::TwistStamped>(
         "/drone/Velocity", qos, [this](const geometry_msgs::msg::TwistStamped& m) { vel_ = m; });
     imu_sub_ = create_subscription<sensor_msgs::msg::Imu>("/drone/Imu", qos,
                                                           [this](const sensor_msgs::msg::Imu& m) { imu_ = m; });
     cmd_pub_ = create_publisher<std_msgs::msg::Float64MultiArray>("/drone/motor_commands", qos);
     const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(std::llround(1e9 / rate_hz)));
-    timer_ = create_timer(period, [this] { step(); });
+    if (!step_on_pose) timer_ = create_timer(period, [this] { step(); });
   }
+  std::int64_t executor_threads() const { return executor_threads_; }
   ~AttitudeControllerNode() override {
     if (log_ != nullptr) std::fclose(log_);
   }
@@ -102,6 +116,7 @@ class AttitudeControllerNode : public rclcpp::Node {
   }
 
   double z_des_, kp_z_, kd_z_, kp_att_, kd_att_;
+  std::int64_t executor_threads_ = 1;
   std::FILE* log_ = nullptr;
   geometry_msgs::msg::PoseStamped pose_;
   geometry_msgs::msg::TwistStamped vel_;
@@ -126,7 +141,14 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--no-clock-thread") == 0) clock_thread = false;
   }
   auto node = std::make_shared<AttitudeControllerNode>(rclcpp::NodeOptions().use_clock_thread(clock_thread));
-  rclcpp::spin(node);
+  if (node->executor_threads() > 1) {
+    rclcpp::executors::MultiThreadedExecutor executor(rclcpp::ExecutorOptions(),
+                                                      static_cast<std::size_t>(node->executor_threads()));
+    executor.add_node(node);
+    executor.spin();
+  } else {
+    rclcpp::spin(node);
+  }
   rclcpp::shutdown();
   return 0;
 }
