@@ -538,14 +538,19 @@ class Batch {
       const std::string vehicle = topics.pose.substr(0, topics.pose.rfind('/'));
       plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s), vehicle);
       // The extra sensors, as the plant node's channels sample them (sim/sensor_channels.hpp).
-      extra = sensors::Suite(realism.extra_sensors, seed, vehicle, s.simulation.plant.clock.period_ns);
+      if (realism.extra_sensors.any()) {
+        extra =
+            std::make_unique<sensors::Suite>(realism.extra_sensors, seed, vehicle, s.simulation.plant.clock.period_ns);
+      }
       if (with_controller) {
         controller.emplace(s.controller, topics);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
       }
     }
     sim::PlantCore plant;
-    sensors::Suite extra;                            ///< the magnetometer, barometer, GNSS configured
+    /// The magnetometer, barometer, GNSS configured; null for none (kept out of line: a vehicle's
+    /// object stays the few cache lines a step of many vehicles touches).
+    std::unique_ptr<sensors::Suite> extra;
     std::optional<sim::ControllerCore> controller;   ///< none: plant_only
     std::optional<sim::ParameterSchedule> schedule;  ///< the scenario's, when it has one
   };
@@ -778,7 +783,7 @@ class Batch {
         set3(imu_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
         set3(imu_a_, i, y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z());
       }
-      if (!L.extra.empty() && L.extra.step(k, y)) write_sensors(i, L.extra, k, stamp);
+      if (L.extra && L.extra->step(k, y)) write_sensors(i, *L.extra, k, stamp);
       // On control ticks the controller's step or the command given (Simulation's after_outputs), taken
       // in as PlantNode::on_command takes it (every command answers its own tick).
       if (k % divider == 0) {
