@@ -38,23 +38,28 @@ class Writer {
  public:
   template <class T>
   Writer& put(const T& v) {
-    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
-    return *this;
+    return append(&v, sizeof(T));
   }
   template <class T>
   Writer& span(std::span<const T> v) {
     put(static_cast<std::uint64_t>(v.size()));
-    const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
-    bytes.insert(bytes.end(), p, p + v.size_bytes());
-    return *this;
+    return append(v.data(), v.size_bytes());
   }
   Writer& text(std::string_view s) {
     put(static_cast<std::uint64_t>(s.size()));
-    bytes.insert(bytes.end(), s.begin(), s.end());
-    return *this;
+    return append(s.data(), s.size());
   }
   std::vector<std::uint8_t> bytes;
+
+ private:
+  /// n bytes from `from` at the end (resize and copy: GCC 12 warns, -Wstringop-overflow, on the
+  /// inlined vector::insert of a few bytes).
+  Writer& append(const void* from, std::size_t n) {
+    const std::size_t at = bytes.size();
+    bytes.resize(at + n);
+    if (n > 0) std::memcpy(bytes.data() + at, from, n);
+    return *this;
+  }
 };
 
 /// Reads what a Writer wrote, in the same order. A message shorter than what is read from it throws

@@ -94,8 +94,9 @@ std::vector<VehicleParameter> make_table() {
 #undef QC_CHOICE
 
 std::string signs_text(const std::array<int, 4>& s) {
-  return "[" + std::to_string(s[0]) + ", " + std::to_string(s[1]) + ", " + std::to_string(s[2]) + ", " +
-         std::to_string(s[3]) + "]";
+  std::string text = "[";  // appended piece by piece: GCC 12 warns (-Wrestrict) on "[" + std::string
+  for (std::size_t i = 0; i < s.size(); ++i) text.append(i ? ", " : "").append(std::to_string(s[i]));
+  return text.append("]");
 }
 
 }  // namespace
