@@ -145,14 +145,12 @@ class Batch {
     imu_w_.assign(3 * n_, kNaN);
     imu_a_.assign(3 * n_, kNaN);
     // The extra sensors' rows (vehicle keys change only the vehicle: every vehicle carries the same set).
-    std::size_t kind = 0;
     sensors::for_each_kind([&]<class Kind>() {
       if (Kind::config(c.plant.realism.extra_sensors)) {
-        sensor_rows_[kind].emplace(SensorRows{std::string(Kind::kName), sensors::sample_width<Kind>(),
-                                              std::vector<double>(n_, kNaN),
-                                              std::vector<double>(n_ * sensors::sample_width<Kind>(), kNaN)});
+        sensor_rows_[sensors::kind_index<Kind>()].emplace(
+            SensorRows{std::string(Kind::kName), sensors::sample_width<Kind>(), std::vector<double>(n_, kNaN),
+                       std::vector<double>(n_ * sensors::sample_width<Kind>(), kNaN)});
       }
-      ++kind;
     });
     std::vector<std::size_t> all(n_);
     for (std::size_t i = 0; i < n_; ++i) all[i] = i;
@@ -451,9 +449,8 @@ class Batch {
     if (it != arrays.end()) return to_array(this->*(it->second.first), n_, it->second.second);
     // "<sensor>.t" and "<sensor>.<column>" of the extra sensors the scenario configures.
     std::optional<py::array_t<double>> found;
-    std::size_t kind = 0;
     sensors::for_each_kind([&]<class Kind>() {
-      const std::optional<SensorRows>& rows = sensor_rows_[kind++];
+      const std::optional<SensorRows>& rows = sensor_rows_[sensors::kind_index<Kind>()];
       if (!rows || found) return;
       if (name == rows->name + ".t") {
         found = to_array(rows->t, n_, 0);
@@ -479,9 +476,8 @@ class Batch {
   /// The extra sensors the scenario configures and their columns ({"barometer": ["pressure", "altitude"]}).
   py::dict sensor_columns() {
     py::dict d;
-    std::size_t kind = 0;
     sensors::for_each_kind([&]<class Kind>() {
-      if (!sensor_rows_[kind++]) return;
+      if (!sensor_rows_[sensors::kind_index<Kind>()]) return;
       py::list names;
       for (const auto& c : Kind::kColumns) names.append(std::string(c.name));
       d[py::str(std::string(Kind::kName))] = names;
@@ -811,16 +807,11 @@ class Batch {
 
   /// Row i of each extra sensor that published at tick k (stamp: that tick's time [s]).
   void write_sensors(std::size_t i, const sensors::Suite& suite, sim::Tick k, double stamp) {
-    std::size_t kind = 0;
     sensors::for_each_kind([&]<class Kind>() {
-      std::optional<SensorRows>& rows = sensor_rows_[kind++];
+      std::optional<SensorRows>& rows = sensor_rows_[sensors::kind_index<Kind>()];
       if (!rows || !suite.due<Kind>(k)) return;
       rows->t[i] = stamp;
-      double* out = &rows->values[i * static_cast<std::size_t>(rows->width)];
-      for (const auto& c : Kind::kColumns) {
-        c.write(suite.slot<Kind>()->sample, out);
-        out += c.width;
-      }
+      sensors::write_sample<Kind>(suite.slot<Kind>()->sample, &rows->values[i * static_cast<std::size_t>(rows->width)]);
     });
   }
 

@@ -147,6 +147,15 @@ void for_each_kind(F&& f) {
   (std::make_index_sequence<std::tuple_size_v<Kinds>>{});
 }
 
+/// A sample's columns, in order, packed into out[0 .. sample_width<Kind>()).
+template <class Kind>
+void write_sample(const typename Kind::Sample& sample, double* out) {
+  for (const auto& c : Kind::kColumns) {
+    c.write(sample, out);
+    out += c.width;
+  }
+}
+
 /// Kind's place in Kinds.
 template <class Kind, std::size_t I = 0>
 constexpr std::size_t kind_index() {

@@ -182,11 +182,7 @@ class PlantModel final : public Model {
       if (!slot) return;
       const std::vector<ValueReference>& vrs = extra_vrs_[sensors::kind_index<Kind>()];
       std::array<double, sensors::sample_width<Kind>()> values{};
-      double* out = values.data();
-      for (const auto& col : Kind::kColumns) {
-        col.write(slot->sample, out);
-        out += col.width;
-      }
+      sensors::write_sample<Kind>(slot->sample, values.data());
       for (std::size_t i = 0; i < vrs.size(); ++i) v.number[vrs[i]] = values[i];
     });
   }
