@@ -160,7 +160,8 @@ int controller_command(const ControllerCommandOptions& o) {
     pairing.pair_by_token(pair_token);
     from_plant = [&pairing](const std::string& topic, sim::SenderId s) { return pairing.accepts(topic, s); };
   }
-  sim::ControllerNode node(transport, topics, sc.controller, std::move(from_plant));
+  sim::ControllerNode node(transport, topics, sc.controller, std::move(from_plant),
+                           sc.simulation.plant.realism.extra_sensors);
   // A controller that asks for it (one written in Python, docs/python.md) runs on a thread of its own:
   // one that blocks holds up neither the DDS threads (discovery, parameter services) nor a stop.
   const bool on_thread = sc.controller.wants_own_thread();

@@ -31,6 +31,7 @@
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/plant_node.hpp"
+#include "sim/sensor_wire.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::app {
@@ -163,12 +164,20 @@ class PlantProcess {
     return found;
   }
 
-  /// Which of Pose, Velocity and Imu `peer` subscribes (readers matched by ours).
+  /// The topics of every sensor the plant publishes: Pose, Velocity, Imu, then the extra sensors'.
+  std::vector<std::string> sensor_topics() const {
+    std::vector<std::string> all{topics_.pose, topics_.velocity, topics_.imu};
+    sim::for_each_sensor_topic(sc_.simulation.plant.realism.extra_sensors, topics_.ns,
+                               [&]<class>(const std::string& topic) { all.push_back(topic); });
+    return all;
+  }
+
+  /// Which of the sensor topics `peer` subscribes (readers matched by ours).
   std::vector<std::string> sensors_subscribed_by(const Guid& peer) const {
     std::vector<std::string> out;
-    for (const std::string* t : {&topics_.pose, &topics_.velocity, &topics_.imu}) {
-      const auto parts = transport_.matched_reader_participants(*t);
-      if (std::find(parts.begin(), parts.end(), peer) != parts.end()) out.push_back(*t);
+    for (const std::string& t : sensor_topics()) {
+      const auto parts = transport_.matched_reader_participants(t);
+      if (std::find(parts.begin(), parts.end(), peer) != parts.end()) out.push_back(t);
     }
     return out;
   }
@@ -188,6 +197,7 @@ class PlantProcess {
     std::vector<std::string> sensors;
     std::int64_t settled_at = 0;
     bool ambiguous = false;
+    const std::size_t all_sensors = sensor_topics().size();
     const bool found = transport_.spin_until(
         [&] {
           if (stop_requested()) return true;
@@ -211,7 +221,7 @@ class PlantProcess {
           // The run's own controller (a token) publishes its status, which tick 0's answer includes:
           // matched too, or tick 0 would be taken without it.
           if (!pair_token_.empty() && !controller_writes_status()) return false;
-          return sensors.size() == 3 || (!sensors.empty() && steady_ns() >= settled_at);
+          return sensors.size() == all_sensors || (!sensors.empty() && steady_ns() >= settled_at);
         },
         timeout_ns());
     if (ambiguous) return false;
@@ -235,7 +245,8 @@ class PlantProcess {
     peer_ = peer;
     if (pair_token_.empty()) pairing_.pair_by_participant(*peer);
     if (scheduler_) scheduler_->only_from(*peer);  // the schedule goes to the controller's node, not a namesake
-    if (sensors.size() < 3) {
+    subscribed_ = sensors;
+    if (sensors.size() < all_sensors) {
       std::string list;
       for (const std::string& t : sensors) list += (list.empty() ? "" : ", ") + t;
       std::cerr << fmt::format("plant: the controller subscribes {} only; the other sensor samples go to no one\n",
@@ -394,9 +405,10 @@ class PlantProcess {
       // thread, where tick 0 is published; deliveries go on meanwhile). Later ticks rely on in-order
       // delivery (docs/simulink.md).
       samples_acknowledged_ = host_.unlocked([this] {
-        return transport_.wait_for_acks(topics_.pose, timeout_ns()) &&
-               transport_.wait_for_acks(topics_.velocity, timeout_ns()) &&
-               transport_.wait_for_acks(topics_.imu, timeout_ns());
+        for (const std::string& t : subscribed_) {
+          if (!transport_.wait_for_acks(t, timeout_ns())) return false;
+        }
+        return true;
       });
       if (!samples_acknowledged_) {
         std::cerr << fmt::format("plant: warning: tick 0's samples not acknowledged within {} s\n", o_.timeout_s);
@@ -688,7 +700,8 @@ class PlantProcess {
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool watchdog_logged_ = false;
-  bool samples_acknowledged_ = false;              ///< /clock last: tick 0's samples reached the peer
+  std::vector<std::string> subscribed_;  ///< the sensor topics the controller subscribes (wait_for_controller)
+  bool samples_acknowledged_ = false;    ///< /clock last: tick 0's samples reached the peer
   std::unique_ptr<dds::ParameterClient> barrier_;  ///< --sync clock: the controller node's parameter client
   dds::ParameterClient::Header barrier_request_;   ///< the last barrier request sent
   sim::Tick clock_held_ = -1;                      ///< the tick whose /clock awaits the barrier reply

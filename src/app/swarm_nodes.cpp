@@ -213,7 +213,9 @@ class ControllerShard {
       auto c = std::make_unique<Vehicle>();
       const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
       if (sensor_qos) use_sensor_qos(transport_, topics);
-      c->node = std::make_unique<sim::ControllerNode>(transport_, topics, v.controller);
+      c->node =
+          std::make_unique<sim::ControllerNode>(transport_, topics, v.controller, sim::ControllerNode::SampleFilter{},
+                                                v.simulation.plant.realism.extra_sensors);
       driven.push_back({c->node.get(), std::move(v.schedule)});
       vehicles_.push_back(std::move(c));
     }

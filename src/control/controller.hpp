@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "control/parameters.hpp"
+#include "sensors/readings.hpp"
 
 namespace quadcosim::model {
 class Quadrotor;
@@ -47,6 +48,11 @@ struct Observation {
   std::int64_t pose_stamp_ns = -1, velocity_stamp_ns = -1, imu_stamp_ns = -1;
   /// Age of the oldest of the inputs above [s]; +inf when any input never arrived.
   double age_s = std::numeric_limits<double>::infinity();
+  /// The extra sensors the vehicle carries (magnetometer, barometer, GNSS: the scenario's `sensors:`),
+  /// each its newest sample and stamp: `sensors.get<sensors::GnssKind>()`, null for one not carried.
+  /// They are not part of age_s or the stale-data safety: each has its own rate (a 10 Hz GNSS), and a
+  /// controller that uses one judges its stamp (docs/sensors.md, "In the controller").
+  sensors::Readings sensors;
 };
 
 /// What the vehicle is asked to do at this step: a flat-output setpoint (position and its first three

@@ -46,6 +46,7 @@
 #include "sim/parameter_schedule.hpp"
 #include "sim/plant_node.hpp"
 #include "sim/realism.hpp"
+#include "sim/sensor_wire.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
 #include "sim/topics.hpp"
@@ -539,7 +540,7 @@ class Batch {
             std::make_unique<sensors::Suite>(realism.extra_sensors, seed, vehicle, s.simulation.plant.clock.period_ns);
       }
       if (with_controller) {
-        controller.emplace(s.controller, topics);
+        controller.emplace(s.controller, topics, realism.extra_sensors);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
       }
     }
@@ -779,7 +780,16 @@ class Batch {
         set3(imu_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
         set3(imu_a_, i, y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z());
       }
-      if (L.extra && L.extra->step(k, y)) write_sensors(i, *L.extra, k, stamp);
+      if (L.extra && L.extra->step(k, y)) {
+        write_sensors(i, *L.extra, k, stamp);
+        // Taken in by the controller as the node takes them from the channels' messages.
+        if (controller) {
+          sensors::for_each_configured(o.realism.extra_sensors, [&]<class Kind>(const typename Kind::Config& c) {
+            if (L.extra->due<Kind>(k))
+              controller->take<Kind>(sim::as_read<Kind>(L.extra->slot<Kind>()->sample, c), time);
+          });
+        }
+      }
       // On control ticks the controller's step or the command given (Simulation's after_outputs), taken
       // in as PlantNode::on_command takes it (every command answers its own tick).
       if (k % divider == 0) {

@@ -120,6 +120,8 @@ struct GnssKind {
     f("velocity_sigma_m_s", c.velocity_sigma_m_s);
     f("fix_after_s", c.fix_after_s);
   }
+  /// Without a fix only the fix flag is a number; the rest is NaN by definition.
+  static bool has_numbers(const Sample& s) { return s.fix; }
   static constexpr double kDeg = 180.0 / std::numbers::pi;
   static constexpr std::array<Column<Sample>, 5> kColumns{{
       {"fix", 1, "1", "1 with a fix, 0 without (then the rest is NaN)",
@@ -153,6 +155,17 @@ void write_sample(const typename Kind::Sample& sample, double* out) {
   for (const auto& c : Kind::kColumns) {
     c.write(sample, out);
     out += c.width;
+  }
+}
+
+/// Whether every column of `sample` holds a number (finite), as a controller may expect; false for a
+/// sample whose kind says its numbers are undefined (Kind::has_numbers: a GNSS sample without a fix).
+template <class Kind>
+bool has_numbers(const typename Kind::Sample& sample) {
+  if constexpr (requires { Kind::has_numbers(sample); }) {
+    return Kind::has_numbers(sample);
+  } else {
+    return true;
   }
 }
 

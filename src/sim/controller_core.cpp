@@ -9,7 +9,8 @@
 
 namespace quadcosim::sim {
 
-ControllerCore::ControllerCore(const control::ControllerConfig& config, const Topics& topics)
+ControllerCore::ControllerCore(const control::ControllerConfig& config, const Topics& topics,
+                               const sensors::SensorSet& carried)
     : controller_(config.controller ? config.controller->clone() : nullptr),
       settings_(config.node),
       trajectory_(config.trajectory),
@@ -23,6 +24,20 @@ ControllerCore::ControllerCore(const control::ControllerConfig& config, const To
   if (!controller_)
     throw std::invalid_argument("ControllerNode: the config has no controller (controllers::make_config)");
   output_.outputs.assign(controller_->output_names().size(), 0.0);
+  sensors::for_each_configured(carried, [&]<class Kind>(const typename Kind::Config& c) {
+    Extra& e = extras_[sensors::kind_index<Kind>()];
+    e.divider = c.timing.divider;
+    e.name = std::string(Kind::kName);
+    observation_.sensors.carry<Kind>();
+  });
+}
+
+bool ControllerCore::sensors_complete(std::int64_t stamp_ns, std::int64_t plant_period_ns) const {
+  const std::int64_t tick = stamp_ns / plant_period_ns;
+  for (const Extra& e : extras_) {
+    if (e.divider > 0 && tick % e.divider == 0 && e.stamp_ns != stamp_ns) return false;
+  }
+  return true;
 }
 
 bool ControllerCore::accept_refused(const SensorCheck& check, const std::string& topic, int& backwards) {

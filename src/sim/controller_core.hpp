@@ -24,6 +24,7 @@
 
 #include "control/controller.hpp"
 #include "control/controller_config.hpp"
+#include "sensors/registry.hpp"
 #include "sim/messages.hpp"
 #include "sim/topics.hpp"
 #include "sim/validation.hpp"
@@ -33,8 +34,9 @@ namespace quadcosim::sim {
 class ControllerCore {
  public:
   /// Flies a clone of config.controller (which must be set: std::invalid_argument otherwise). The
-  /// topics name the sensor topics in the log of refused samples.
-  ControllerCore(const control::ControllerConfig& config, const Topics& topics);
+  /// topics name the sensor topics in the log of refused samples. `carried`: the extra sensors the
+  /// vehicle carries (the scenario's `sensors:`), whose samples the observation holds (take()).
+  ControllerCore(const control::ControllerConfig& config, const Topics& topics, const sensors::SensorSet& carried = {});
 
   /// Sensor samples: true when taken; a sample that fails its check is counted, logged (1st of each
   /// reason, then every 100th) and dropped, the observation keeping its last valid values and ages.
@@ -70,6 +72,23 @@ class ControllerCore {
     imu_ref_ns_ = reference_time(imu_stamp_ns_, received);
     return true;
   }
+
+  /// An extra sensor's sample (Kind carried), as read from its message(s) (sim/sensor_wire.hpp),
+  /// stamped `stamp`: checked as the others (sim::check_sample), then the observation's reading.
+  template <class Kind>
+  bool take(const typename Kind::Sample& sample, const msg::Time& stamp) {
+    Extra& e = extras_[sensors::kind_index<Kind>()];
+    const std::int64_t received = receipt_now();
+    const SensorCheck check = check_sample<Kind>(sample, stamp, e.stamp_ns, ahead_limit(e.ref_ns, received));
+    if (!accept(check, e.name, e.backwards)) return false;
+    e.stamp_ns = stamp.to_ns();
+    e.ref_ns = reference_time(e.stamp_ns, received);
+    observation_.sensors.set<Kind>(sample, e.stamp_ns);
+    return true;
+  }
+  /// Whether every carried extra sensor that publishes at plant tick stamp_ns / plant_period_ns (its
+  /// divider) has its sample of that stamp: with Pose, Velocity and Imu of it, the tick is complete.
+  bool sensors_complete(std::int64_t stamp_ns, std::int64_t plant_period_ns) const;
 
   /// A step at now_ns [ns, the node's clock] begins: the observation completed (Euler angles, age,
   /// stamps) and the reference evaluated at the step's simulated time.
@@ -170,6 +189,15 @@ class ControllerCore {
   std::array<LogThrottle, kSensorFaultCount> fault_log_;  ///< per SensorFault: counts and log pacing
   std::function<void(const std::string&)> log_;
   std::string pose_topic_, velocity_topic_, imu_topic_;  ///< for the log of refused samples
+  /// Per kind of sensors::Kinds: the extra sensor's newest accepted stamp and its reference time (as
+  /// for Pose), the backwards count, its divider (0: not carried) and its name for the log.
+  struct Extra {
+    std::int64_t stamp_ns = kNever, ref_ns = kNever;
+    int backwards = 0;
+    int divider = 0;
+    std::string name;
+  };
+  std::array<Extra, std::tuple_size_v<sensors::Kinds>> extras_;
 };
 
 }  // namespace quadcosim::sim

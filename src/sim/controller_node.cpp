@@ -9,12 +9,13 @@
 
 #include "model/angle.hpp"
 #include "sim/controller_thread.hpp"
+#include "sim/sensor_wire.hpp"
 
 namespace quadcosim::sim {
 
 ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config,
-                               SampleFilter accepts)
-    : core_(config, topics), accepts_(std::move(accepts)) {
+                               SampleFilter accepts, const sensors::SensorSet& carried)
+    : core_(config, topics, carried), accepts_(std::move(accepts)) {
   const control::Controller& controller = core_.controller();
   status_.controller = controller.type();
   status_.output_names.assign(controller.output_names().begin(), controller.output_names().end());
@@ -23,6 +24,7 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
   command_pub_ = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
   command_msg_.data.resize(4);
   command_msg_.dim = {{"", 4, 4}};
+  subscribe_sensors(transport, topics.ns, carried);
   if (accepts_) {  // over a network: each sample's writer is checked first
     transport.subscribe_with_sender<msg::PoseStamped>(topics.pose,
                                                       [this, t = topics.pose](const msg::PoseStamped& m, SenderId s) {
@@ -48,6 +50,46 @@ ControllerNode::ControllerNode(Transport& transport, const Topics& topics, const
   });
   transport.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) {
     if (core_.take_imu(m) && on_sample_) on_sample_();
+  });
+}
+
+template <class Message, class Take>
+void ControllerNode::subscribe_sample(Transport& transport, const std::string& topic, Take take) {
+  if (accepts_) {
+    transport.subscribe_with_sender<Message>(topic, [this, topic, take](const Message& m, SenderId s) {
+      if (from_plant(topic, s) && take(m) && on_sample_) on_sample_();
+    });
+  } else {
+    transport.subscribe<Message>(topic, [this, take](const Message& m) {
+      if (take(m) && on_sample_) on_sample_();
+    });
+  }
+}
+
+void ControllerNode::subscribe_sensors(Transport& transport, const std::string& ns, const sensors::SensorSet& carried) {
+  for_each_sensor(carried, [&]<class Wire>(const auto& config) {
+    using Kind = typename Wire::Kind;
+    // The messages of one sample (the GNSS: fix and velocity) are read into one sample; it is taken
+    // when every one of them has come with the same stamp (again when one is repeated).
+    struct Inbox {
+      typename Kind::Sample sample{};
+      msg::Time stamp;
+      unsigned seen = 0;
+    };
+    constexpr unsigned kAll = (1u << Wire::kTopics.size()) - 1;
+    auto inbox = std::make_shared<Inbox>();
+    for_each_message<Wire>(ns, [&]<std::size_t I, class Message>(const std::string& topic) {
+      subscribe_sample<Message>(transport, topic, [this, inbox, config](const Message& m) {
+        Inbox& in = *inbox;
+        if (m.header.stamp.sec != in.stamp.sec || m.header.stamp.nanosec != in.stamp.nanosec || in.seen == 0) {
+          in.stamp = m.header.stamp;
+          in.seen = 0;
+        }
+        Wire::read(m, in.sample, config);
+        in.seen |= 1u << I;
+        return in.seen == kAll && core_.template take<Kind>(in.sample, in.stamp);
+      });
+    });
   });
 }
 

@@ -64,9 +64,11 @@ class ControllerNode {
   using SampleFilter = std::function<bool(const std::string& topic, SenderId sender)>;
 
   /// Flies a clone of config.controller (which must be set). Without `accepts` every sample is the
-  /// plant's (in-process: every message is the process's own).
+  /// plant's (in-process: every message is the process's own). `carried`: the extra sensors the
+  /// vehicle carries (the scenario's `sensors:`); the node subscribes their topics and the observation
+  /// holds their samples (control::Observation::sensors).
   ControllerNode(Transport& transport, const Topics& topics, const control::ControllerConfig& config,
-                 SampleFilter accepts = {});
+                 SampleFilter accepts = {}, const sensors::SensorSet& carried = {});
   ~ControllerNode();
 
   /// From now on the controller runs on a thread of its own (sim/controller_thread.hpp): every call
@@ -127,8 +129,8 @@ class ControllerNode {
   /// What the node decides with (a scheduled parameter change is set here).
   ControllerCore& core() { return core_; }
 
-  /// Called after each Pose, Velocity or Imu message taken in, where the transport delivers it: a
-  /// lockstep host steps from here (LockstepStepper) instead of polling after every wait.
+  /// Called after each Pose, Velocity or Imu message (or a whole extra sensor sample) taken in, where the transport
+  /// delivers it: a lockstep host steps from here (LockstepStepper) instead of polling after every wait.
   void on_sample(std::function<void()> f) { on_sample_ = std::move(f); }
 
   /// Where refused sensor messages are reported (rate-limited per reason). Default: stderr.
@@ -169,6 +171,12 @@ class ControllerNode {
   LogThrottle foreign_log_;  ///< foreign sensor samples: counted, logged 1st and every 100th
   /// A sample on `topic` from `sender` is the plant's; counts and logs it when not.
   bool from_plant(const std::string& topic, SenderId sender);
+  /// Subscribes `topic`; each message, when from the plant, goes to take(m), and a true return to on_sample.
+  template <class Message, class Take>
+  void subscribe_sample(Transport& transport, const std::string& topic, Take take);
+  /// Subscribes the extra sensors' topics (sim/sensor_wire.hpp), a sample taken when all its messages of
+  /// one stamp have come.
+  void subscribe_sensors(Transport& transport, const std::string& ns, const sensors::SensorSet& carried);
 };
 
 }  // namespace quadcosim::sim

@@ -6,6 +6,7 @@ LockstepStepper::LockstepStepper(ControllerNode& node, std::vector<ScheduledPara
                                  int controller_divider)
     : node_(node),
       schedule_(std::move(schedule), clock),
+      plant_period_ns_(clock.period_ns),
       control_period_ns_(clock.period_ns * controller_divider),
       dt_s_(static_cast<double>(control_period_ns_) / 1e9) {
   node_.on_sample([this] { react(); });
@@ -15,7 +16,7 @@ LockstepStepper::~LockstepStepper() { node_.on_sample(nullptr); }
 
 void LockstepStepper::react() {
   const std::int64_t s = node_.synchronized_stamp_ns();
-  if (s < 0 || s % control_period_ns_ != 0) return;
+  if (s < 0 || s % control_period_ns_ != 0 || !node_.core().sensors_complete(s, plant_period_ns_)) return;
   if (s > node_.last_step_ns()) {
     schedule_.apply(node_, s);
     node_.step(s, dt_s_);

@@ -1,6 +1,6 @@
 // A controller node in lockstep over DDS: it steps once per complete sensor sample (Pose, Velocity
-// and Imu of one plant tick) that falls on a control tick, on the sample's own time, after applying
-// the parameter schedule due by then; a complete sample of a tick it has answered already (the
+// and Imu of one plant tick, and the extra sensors due at that tick) that falls on a control tick, on the sample's own
+// time, after applying the parameter schedule due by then; a complete sample of a tick it has answered already (the
 // plant published it again) is answered again with the same command and status. Hooked to the
 // node's on_sample, so it reacts where the transport delivers, also on a DDS receive thread.
 #pragma once
@@ -30,6 +30,7 @@ class LockstepStepper {
  private:
   ControllerNode& node_;
   ParameterSchedule schedule_;
+  std::int64_t plant_period_ns_;
   std::int64_t control_period_ns_;
   double dt_s_;
 };

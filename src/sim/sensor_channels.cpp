@@ -18,18 +18,30 @@ namespace {
 template <class Wire>
 class ChannelOf final : public SensorChannels::Channel {
  public:
-  ChannelOf(Transport& t, const std::string& ns, const std::string& world_frame) : wire_(t, ns, world_frame) {}
+  ChannelOf(Transport& t, const std::string& ns, const std::string& world_frame) {
+    Wire::init(messages_, world_frame);
+    for_each_message<Wire>(ns, [&]<std::size_t I, class Message>(const std::string& topic) {
+      std::get<I>(publishers_) = t.advertise<Message>(topic);
+    });
+  }
   void publish(const sensors::Suite& suite, Tick k, const msg::Time& stamp) override {
     if (!suite.due<typename Wire::Kind>(k)) return;
     if (k != filled_) {
       filled_ = k;
-      wire_.fill(suite.slot<typename Wire::Kind>()->sample, stamp);
+      Wire::fill(suite.slot<typename Wire::Kind>()->sample, stamp, messages_);
     }
-    wire_.publish();
+    [&]<std::size_t... I>(std::index_sequence<I...>) {
+      (std::get<I>(publishers_).publish(std::get<I>(messages_)), ...);
+    }
+    (std::make_index_sequence<std::tuple_size_v<typename Wire::Messages>>{});
   }
 
  private:
-  Wire wire_;
+  template <class... M>
+  static std::tuple<Publisher<M>...> publishers_of(std::tuple<M...>*);
+
+  typename Wire::Messages messages_;
+  decltype(publishers_of(static_cast<typename Wire::Messages*>(nullptr))) publishers_;
   Tick filled_ = -1;
 };
 

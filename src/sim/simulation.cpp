@@ -22,7 +22,7 @@ Simulation::Simulation(const SimulationConfig& config, const model::VehicleParam
                        const control::ControllerConfig& controller, std::vector<ScheduledParameter> schedule)
     : config_(config),
       plant_(transport_, Topics::for_namespace(config.ns), vehicle, config.plant, initial),
-      controller_(transport_, Topics::for_namespace(config.ns), controller),
+      controller_(transport_, Topics::for_namespace(config.ns), controller, {}, config.plant.realism.extra_sensors),
       schedule_(std::move(schedule), config.plant.clock),
       loop_({&plant_}, lockstep_options(config), Hooks{this}, host_) {
   transport_.set_faults(config.faults);

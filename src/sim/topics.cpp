@@ -18,7 +18,8 @@ Topics Topics::for_namespace(const std::string& ns) {
           "/tf",
           "/tf_static",
           base + "/robot_description",
-          base + "/scene"};
+          base + "/scene",
+          base};
 }
 
 std::string validate_namespace(const std::string& ns) {

@@ -18,6 +18,9 @@ struct Topics {
   std::string tf_static;          ///< plant ->, tf2_msgs/TFMessage: base_link -> rotors, once (global)
   std::string robot_description;  ///< plant ->, std_msgs/String: the vehicle's URDF, once
   std::string scene;              ///< recorded only, foxglove_msgs/SceneUpdate: the vehicle drawn
+  /// The namespace the vehicle's topics are under ("/drone"; "" for "/"): the extra sensors' topics
+  /// are formed under it (sim/sensor_wire.hpp).
+  std::string ns;
 
   /// Topics under `ns` ("/drone" gives "/drone/Pose", ...). `ns` must start with '/'.
   static Topics for_namespace(const std::string& ns = "/drone");

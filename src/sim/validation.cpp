@@ -169,6 +169,12 @@ SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns, std::int64_
   return c;
 }
 
+SensorCheck check_stamp(const msg::Time& stamp, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns) {
+  SensorCheck c;
+  (void)stamp_ok(c, stamp, last_stamp_ns, ahead_limit_ns);
+  return c;
+}
+
 const char* to_string(SensorFault f) {
   switch (f) {
     case SensorFault::kNone: return "accepted";
@@ -191,6 +197,7 @@ const char* to_string(SensorField f) {
     case SensorField::kAngular: return "angular";
     case SensorField::kAngularVelocity: return "angular_velocity";
     case SensorField::kLinearAcceleration: return "linear_acceleration";
+    case SensorField::kSample: return "sample";
   }
   return "?";
 }
@@ -200,6 +207,10 @@ std::string SensorCheck::reason() const {
   switch (fault) {
     case SensorFault::kNone: return "";
     case SensorFault::kNonFinite:
+      if (field == SensorField::kSample) {
+        return fmt::format("{} {} {}: expected finite values", sensor, column,
+                           width == 1 ? fmt::format("{:g}", value[0]) : shown(value, false));
+      }
       return fmt::format("{} {}: expected finite values", to_string(field), shown(value, quaternion));
     case SensorFault::kBadQuaternion:
       return fmt::format("orientation {} has norm {:g}: expected a unit quaternion (within {:g})", shown(value, true),

@@ -7,11 +7,14 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "model/mixer.hpp"
+#include "sensors/registry.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::sim {
@@ -90,6 +93,7 @@ enum class SensorField : std::uint8_t {
   kAngular,             ///< Velocity angular
   kAngularVelocity,     ///< Imu angular_velocity
   kLinearAcceleration,  ///< Imu linear_acceleration
+  kSample,              ///< a column of an extra sensor's sample (SensorCheck::sensor, ::column)
 };
 const char* to_string(SensorField f);
 
@@ -110,6 +114,9 @@ struct SensorCheck {
   msg::Time stamp;                  ///< the stamp as sent (kBadStamp, kStampBackwards)
   std::int64_t newest_ns = 0;       ///< the newest accepted stamp it is older than, or too far ahead of [ns]
   std::int64_t ahead_limit_ns = 0;  ///< kStampAhead: how far ahead of newest_ns was allowed [ns]
+  /// kSample: the sensor's and the column's names ("gnss", "v": sensors/registry.hpp), values in value[0..2].
+  std::string_view sensor, column;
+  int width = 0;  ///< kSample: the column's numbers (1 or 3)
 
   bool ok() const { return fault == SensorFault::kNone; }
   /// The field and value at fault and what was expected, e.g. "position (nan, 2, 3): expected finite
@@ -130,6 +137,39 @@ SensorCheck check_pose(const msg::PoseStamped& m, std::int64_t last_stamp_ns,
 SensorCheck check_velocity(const msg::TwistStamped& m, std::int64_t last_stamp_ns,
                            std::int64_t ahead_limit_ns = kStampAheadLimitNs);
 SensorCheck check_imu(const msg::Imu& m, std::int64_t last_stamp_ns, std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+
+/// A stamp after the newest accepted on its topic, `last_stamp_ns`: its form, then its age, as above.
+SensorCheck check_stamp(const msg::Time& stamp, std::int64_t last_stamp_ns,
+                        std::int64_t ahead_limit_ns = kStampAheadLimitNs);
+
+/// A sample of an extra sensor (sensors/registry.hpp) as read from its message(s): each column finite
+/// (only the flag of a GNSS sample without a fix: the rest is NaN then), in column order, then its
+/// stamp as check_stamp. The field is kSample, naming the sensor and column. Allocates nothing.
+template <class Kind>
+SensorCheck check_sample(const typename Kind::Sample& sample, const msg::Time& stamp, std::int64_t last_stamp_ns,
+                         std::int64_t ahead_limit_ns = kStampAheadLimitNs) {
+  double v[sensors::sample_width<Kind>()];
+  sensors::write_sample<Kind>(sample, v);
+  const bool numbers = sensors::has_numbers<Kind>(sample);
+  const double* at = v;
+  for (const auto& c : Kind::kColumns) {
+    if (numbers || c.boolean) {
+      for (int i = 0; i < c.width; ++i) {
+        if (std::isfinite(at[i])) continue;
+        SensorCheck refused;
+        refused.fault = SensorFault::kNonFinite;
+        refused.field = SensorField::kSample;
+        refused.sensor = Kind::kName;
+        refused.column = c.name;
+        refused.width = c.width;
+        for (int j = 0; j < c.width && j < 3; ++j) refused.value[j] = at[j];
+        return refused;
+      }
+    }
+    at += c.width;
+  }
+  return check_stamp(stamp, last_stamp_ns, ahead_limit_ns);
+}
 
 /// A sender whose clock restarted (a plant process started again under a running controller) sends
 /// only well-formed samples older than the newest accepted. After this many such samples in a row
