@@ -534,20 +534,12 @@ class Batch {
       // The noise streams named as PlantNode names them: by the vehicle's namespace (/drone/Pose -> /drone).
       const std::string vehicle = topics.pose.substr(0, topics.pose.rfind('/'));
       plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s), vehicle);
-      // The extra sensors, as the plant node's channels sample them (sim/sensor_channels.hpp).
-      if (realism.extra_sensors.any()) {
-        extra =
-            std::make_unique<sensors::Suite>(realism.extra_sensors, seed, vehicle, s.simulation.plant.clock.period_ns);
-      }
       if (with_controller) {
         controller.emplace(s.controller, topics, realism.extra_sensors);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
       }
     }
     sim::PlantCore plant;
-    /// The magnetometer, barometer, GNSS configured; null for none (kept out of line: a vehicle's
-    /// object stays the few cache lines a step of many vehicles touches).
-    std::unique_ptr<sensors::Suite> extra;
     std::optional<sim::ControllerCore> controller;   ///< none: plant_only
     std::optional<sim::ParameterSchedule> schedule;  ///< the scenario's, when it has one
   };
@@ -780,13 +772,13 @@ class Batch {
         set3(imu_w_, i, y.w_B.x(), y.w_B.y(), y.w_B.z());
         set3(imu_a_, i, y.specific_force_B.x(), y.specific_force_B.y(), y.specific_force_B.z());
       }
-      if (L.extra && L.extra->step(k, y)) {
-        write_sensors(i, *L.extra, k, stamp);
+      if (L.plant.sense_extra(k, y)) {
+        const sensors::Suite& extra = *L.plant.extra_sensors();
+        write_sensors(i, extra, k, stamp);
         // Taken in by the controller as the node takes them from the channels' messages.
         if (controller) {
           sensors::for_each_configured(o.realism.extra_sensors, [&]<class Kind>(const typename Kind::Config& c) {
-            if (L.extra->due<Kind>(k))
-              controller->take<Kind>(sim::as_read<Kind>(L.extra->slot<Kind>()->sample, c), time);
+            if (extra.due<Kind>(k)) controller->take<Kind>(sim::as_read<Kind>(extra.slot<Kind>()->sample, c), time);
           });
         }
       }

@@ -3,8 +3,8 @@
 //
 // To add a sensor (docs/architecture.md, "Add a sensor"): its model (sensors/<name>.{hpp,cpp}: a config
 // from datasheet parameters, truth -> an SI sample, its own random stream), a line here, its scenario
-// keys (io/realism_yaml.cpp) and its line in the plant's registry (sim/sensor_channels.cpp: topic,
-// message and the sample's wire form).
+// keys (io/realism_yaml.cpp), its kind (sensors/registry.hpp) and its wire form (sim/sensor_wire.hpp:
+// topics, messages, fill and read).
 #pragma once
 
 #include <optional>

@@ -1,7 +1,8 @@
 // A vehicle's extra sensors stepping with its plant, with no bus: each sensor the scenario configures
 // (sensors/registry.hpp) samples its model on the plant ticks k with k % divider == 0, measuring the
-// truth of tick max(k - latency, 0). Every host steps the same suite: the plant node, which puts the
-// samples on the wire (sim/sensor_channels.hpp), Batch's vehicles and the plant FMU.
+// truth of tick max(k - latency, 0). Every host steps the same suite: the plant's core (sim::PlantCore,
+// which the plant node steps and puts on the wire through sim/sensor_channels.hpp, and Batch's lean
+// vehicles step directly) and the plant FMU.
 //
 // Determinism: a tick's samples are drawn once; stepping the same tick again (a lockstep repeat)
 // leaves them as they are. Each sensor draws from its own stream, model::stream_seed(seed, vehicle,

@@ -1,5 +1,6 @@
 // The native plant's tick without a bus: the 6-DOF model's state, the outputs of a tick and the
-// sensor messages made of them (with the sensor realism: noise, rates, latency), the command queue (a
+// sensor messages made of them (with the sensor realism: noise, rates, latency), the vehicle's extra
+// sensors (magnetometer, barometer, GNSS: its sensors::Suite, SI samples), the command queue (a
 // command takes effect command_delay_ticks after the tick it arrived in), the zero-order hold of the
 // newest due command, the command's age for the watchdog, and the integration to the next tick (wind,
 // rotor faults and drag acting inside the model).
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "model/quadrotor.hpp"
+#include "sensors/suite.hpp"
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
 #include "sim/realism.hpp"
@@ -46,12 +48,16 @@ class PlantCore {
  public:
   PlantCore() = default;
   /// The realism (noise streams named by `ns`, the vehicle's namespace "/drone") is made when
-  /// `realism` is active or the vehicle has aerodynamic drag; the paper's plant otherwise.
+  /// `realism` is active or the vehicle has aerodynamic drag; the paper's plant otherwise. The extra
+  /// sensors are realism.extra_sensors (none: no suite), seeded by realism.seed.
   PlantCore(const model::VehicleParams& vehicle, const RealismConfig& realism, const TickClock& clock,
             const model::State& initial, const std::string& ns)
       : model_(vehicle), state_(initial), latched_(initial.omega_rad_s), rotor_input_(model_->rotor_input(latched_)) {
     if (realism.active() || vehicle.aero.active()) {
       realism_ = std::make_unique<PlantRealism>(realism, vehicle, ns, clock);
+    }
+    if (realism.extra_sensors.any()) {
+      extra_ = std::make_unique<sensors::Suite>(realism.extra_sensors, realism.seed, ns, clock.period_ns);
     }
     pending_.reserve(4);  // now, beside the rest of the plant, not at the first command
   }
@@ -75,6 +81,12 @@ class PlantCore {
     return realism_->measure(k, y, pose, twist, imu);
   }
   bool has_realism() const { return static_cast<bool>(realism_); }
+
+  /// The extra sensors of tick k's outputs `y` (in tick order; a tick again draws nothing new): whether
+  /// any has a sample due at k. False without extra sensors.
+  bool sense_extra(Tick k, const model::Outputs& y) { return extra_ && extra_->step(k, y); }
+  /// The extra sensors' newest samples; null when the vehicle carries none.
+  const sensors::Suite* extra_sensors() const { return extra_.get(); }
 
   /// A valid command (speeds within [0, omega_max]) received during tick k takes effect at tick
   /// k + delay_ticks.
@@ -142,6 +154,9 @@ class PlantCore {
   std::size_t pending_head_ = 0;
   /// Present when the realism or the vehicle's drag asks for it; null keeps the paper's plant.
   std::unique_ptr<PlantRealism> realism_;
+  /// The magnetometer, barometer, GNSS configured; null for none (held out of line: a batch's plant
+  /// stays the few cache lines a step of many vehicles touches).
+  std::unique_ptr<sensors::Suite> extra_;
 };
 
 }  // namespace quadcosim::sim

@@ -53,9 +53,8 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   twist_.header.frame_id = options.frame_id;
   imu_.header.frame_id = "base_link";
   if (options.realism.extra_sensors.any()) {
-    extra_sensors_ = std::make_unique<SensorChannels>(options.realism.extra_sensors, options.realism.seed,
-                                                      topics.pose.substr(0, topics.pose.rfind('/')), options.clock,
-                                                      transport, options.frame_id);
+    extra_sensors_ =
+        std::make_unique<SensorChannels>(options.realism.extra_sensors, topics.ns, transport, options.frame_id);
   }
   if (options.publish_tf) {
     // tf2 names frames without a leading '/', the vehicle's namespace as their prefix (/drone ->
@@ -186,7 +185,7 @@ void PlantNode::publish_outputs(Tick k) {
     velocity_pub_.publish(twist_);
     imu_pub_.publish(imu_);
   }
-  if (extra_sensors_) extra_sensors_->publish(k, y, stamp);
+  if (core_.sense_extra(k, y)) extra_sensors_->publish(*core_.extra_sensors(), k, stamp);
   if (tf_pub_) {  // the true pose, whatever the sensors made of it
     msg::TransformStamped& t = tf_.transforms.front();
     t.header.stamp = stamp;

@@ -157,7 +157,7 @@ class PlantNode final : public SteppablePlant {
   const PlantOptions& options() const { return options_; }
   Tick current_tick() const { return current_tick_; }
   /// The extra sensors' newest samples (sensors/suite.hpp); null when the scenario configures none.
-  const sensors::Suite* extra_sensors() const { return extra_sensors_ ? &extra_sensors_->suite() : nullptr; }
+  const sensors::Suite* extra_sensors() const { return core_.extra_sensors(); }
 
  private:
   void on_command(const msg::Float64MultiArray& m, SenderId sender);

@@ -47,9 +47,8 @@ class ChannelOf final : public SensorChannels::Channel {
 
 }  // namespace
 
-SensorChannels::SensorChannels(const sensors::SensorSet& set, std::uint64_t seed, const std::string& ns,
-                               const TickClock& clock, Transport& transport, const std::string& world_frame)
-    : suite_(set, seed, ns, clock.period_ns) {
+SensorChannels::SensorChannels(const sensors::SensorSet& set, const std::string& ns, Transport& transport,
+                               const std::string& world_frame) {
   for_each_sensor(set, [&]<class Wire>(const auto&) {
     channels_.push_back(std::make_unique<ChannelOf<Wire>>(transport, ns, world_frame));
   });
@@ -57,9 +56,8 @@ SensorChannels::SensorChannels(const sensors::SensorSet& set, std::uint64_t seed
 
 SensorChannels::~SensorChannels() = default;
 
-void SensorChannels::publish(Tick k, const model::Outputs& y, const msg::Time& stamp) {
-  if (!suite_.step(k, y)) return;
-  for (const auto& c : channels_) c->publish(suite_, k, stamp);
+void SensorChannels::publish(const sensors::Suite& suite, Tick k, const msg::Time& stamp) {
+  for (const auto& c : channels_) c->publish(suite, k, stamp);
 }
 
 }  // namespace quadcosim::sim
