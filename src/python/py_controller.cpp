@@ -858,6 +858,7 @@ py::dict vehicle_dict(const model::VehicleParams& vehicle) {
 
 py::object observation_class() { return globals().observation_class; }
 py::object reference_class() { return globals().reference_class; }
+py::object sensor_reading_class() { return globals().sensor_reading_class; }
 
 py::object step_timeout_type() {
   py::gil_scoped_acquire gil;

@@ -146,9 +146,11 @@ void install_python_controller_factory();
 /// mixer_inverse (4 rows of 4: rotor speeds squared = mixer_inverse U, as the C++ controllers allocate).
 pybind11::dict vehicle_dict(const model::VehicleParams& vehicle);
 
-/// The classes of a step's `obs` and `ref` (quadcosim.Observation, quadcosim.Reference). Take the GIL.
+/// The classes of a step's `obs` and `ref` (quadcosim.Observation, quadcosim.Reference) and of
+/// obs.magnetometer, obs.barometer, obs.gnss (quadcosim.SensorReading). Take the GIL.
 pybind11::object observation_class();
 pybind11::object reference_class();
+pybind11::object sensor_reading_class();
 
 /// The Python exception type raised inside a step that overran step_timeout_s: quadcosim.StepTimeout, a
 /// BaseException (so that `except Exception:` in the controller does not swallow it). Takes the GIL.

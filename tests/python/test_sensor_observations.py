@@ -172,6 +172,7 @@ def test_obs_sensor_readings_at_a_slower_controller():
     with pytest.raises(ValueError):
         first[3][0] = 1.0
     assert isinstance(seen[99]["barometer"]["altitude"], float)
+    assert isinstance(first[2], quadcosim.SensorReading)
     assert "SensorReading(" in repr(first[2]) and "latitude_deg=" in repr(first[2])
 
 
