@@ -11,10 +11,14 @@
 #include <limits>
 #include <mutex>
 #include <stdexcept>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "control/controller_config.hpp"
 #include "fmi/isolated_instance.hpp"
 #include "fmi/quadrotor_variables.hpp"
+#include "sensors/readings.hpp"
 #include "sim/controller_node.hpp"
 
 namespace quadcosim::fmi {
@@ -54,6 +58,47 @@ const std::array<Signal, kCount> kInputs = {
     Signal{"ref.pitch", kRefPitch, "rad", false},
 };
 const std::array<Signal, 1> kOutputs = {Signal{"omega_cmd", names::kOmegaCmd, "rad/s", true}};
+
+constexpr std::size_t kSensorKinds = std::tuple_size_v<sensors::Kinds>;
+
+/// The extra sensors' inputs (sensors/registry.hpp): one optional signal per column of each kind,
+/// "<sensor>.<column>" with the plant FMU's output names (names::sensor_variable) and units, in the
+/// registry's order.
+struct SensorSignals {
+  std::deque<std::string> strings;                    ///< owns the names
+  std::deque<std::vector<std::string_view>> names;    ///< each signal's component names
+  std::vector<Signal> signals;                        ///< kind by kind, column by column
+  std::array<std::size_t, kSensorKinds + 1> first{};  ///< kind i's signals: [first[i], first[i + 1])
+};
+
+const SensorSignals& sensor_signals() {
+  static const SensorSignals* all = [] {
+    auto* s = new SensorSignals;
+    sensors::for_each_kind([&]<class Kind>() {
+      s->first[sensors::kind_index<Kind>()] = s->signals.size();
+      for (const auto& col : Kind::kColumns) {
+        const std::string& name = s->strings.emplace_back(std::string(Kind::kName) + "." + std::string(col.name));
+        auto& components = s->names.emplace_back();
+        for (int i = 0; i < col.width; ++i) {
+          components.emplace_back(s->strings.emplace_back(names::sensor_variable(Kind::kName, col.name, col.width, i)));
+        }
+        s->signals.push_back(Signal{name, components, col.unit, false});
+      }
+    });
+    s->first[kSensorKinds] = s->signals.size();
+    return s;
+  }();
+  return *all;
+}
+
+/// Every input signal a scenario may name under `inputs:`: the observation, the reference, the extra
+/// sensors' columns.
+std::vector<Signal> all_inputs() {
+  std::vector<Signal> all(kInputs.begin(), kInputs.end());
+  const auto& extra = sensor_signals().signals;
+  all.insert(all.end(), extra.begin(), extra.end());
+  return all;
+}
 
 const std::vector<std::string>* given(const std::map<std::string, std::vector<std::string>, std::less<>>& m,
                                       std::string_view name) {
@@ -100,6 +145,9 @@ struct FmuController::Shared {
   std::shared_ptr<Fmu> fmu;
   std::string description;
   std::array<int, kCount> in_at{};  ///< offset of each input signal in in_vrs, -1 when absent
+  std::vector<int> sensor_at;       ///< likewise for each of sensor_signals(), in its order
+  /// Per kind of the registry, the first FMU variable among its inputs (empty: the FMU has none).
+  std::array<std::string, kSensorKinds> sensor_input;
   std::vector<ValueReference> in_vrs;
   std::vector<ValueReference> out_vrs;  ///< omega_cmd[1..4], then the figures
   std::vector<std::string> out_names;   ///< the FMU variable of each out_vrs entry
@@ -126,7 +174,7 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
   sh->description = describe_fmu(*sh->fmu);
   const ModelDescription& md = sh->fmu->description();
   const std::string name = fmu_name(*sh->fmu);
-  check_signal_keys(mapping.inputs, kInputs, "inputs");
+  check_signal_keys(mapping.inputs, all_inputs(), "inputs");
   check_signal_keys(mapping.outputs, kOutputs, "outputs");
   bool observes = false;
   for (std::size_t i = 0; i < kInputs.size(); ++i) {
@@ -134,6 +182,18 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
     sh->in_at[i] = r.empty() ? -1 : static_cast<int>(sh->in_vrs.size());
     sh->in_vrs.insert(sh->in_vrs.end(), r.begin(), r.end());
     if (i < kRefP && !r.empty()) observes = true;
+  }
+  const SensorSignals& extra = sensor_signals();
+  for (std::size_t k = 0; k < kSensorKinds; ++k) {
+    for (std::size_t i = extra.first[k]; i < extra.first[k + 1]; ++i) {
+      const Signal& sig = extra.signals[i];
+      const std::vector<std::string>* names = given(mapping.inputs, sig.name);
+      const SignalRefs r = resolve_signal(md, name, sig, Side::kInput, names);
+      sh->sensor_at.push_back(r.empty() ? -1 : static_cast<int>(sh->in_vrs.size()));
+      sh->in_vrs.insert(sh->in_vrs.end(), r.begin(), r.end());
+      if (!r.empty() && sh->sensor_input[k].empty())
+        sh->sensor_input[k] = names ? names->front() : std::string(sig.names[0]);
+    }
   }
   if (!observes) {
     throw MappingError("inputs", fmt::format("{} has none of the sensor inputs p_W, v_W, q_WB, w_B, f_B by their "
@@ -319,6 +379,7 @@ void FmuController::step(const control::Observation& o, const control::Reference
   put(kRefYawRateIn, {r.yaw_rate_rad_s});
   put(kRefRollIn, {r.roll_rad});
   put(kRefPitchIn, {r.pitch_rad});
+  put_sensors(o.sensors);
   try {
     if (!initialised_) initialise();
     instance_->set_real(shared_->in_vrs, in_);
@@ -338,6 +399,45 @@ void FmuController::step(const control::Observation& o, const control::Reference
   ++steps_;
   for (std::size_t i = 0; i < shared_->figure_names.size() && i < out.outputs.size(); ++i) out.outputs[i] = out_[4 + i];
   control::rotor_speeds_output(model_, r, Eigen::Vector4d(out_[0], out_[1], out_[2], out_[3]), shared_->reported, out);
+}
+
+void FmuController::put_sensors(const sensors::Readings& readings) {
+  const SensorSignals& extra = sensor_signals();
+  sensors::for_each_kind([&]<class Kind>() {
+    constexpr std::size_t k = sensors::kind_index<Kind>();
+    if (shared_->sensor_input[k].empty()) return;
+    // The reading's columns packed; NaN (a flag 0) for a sensor not carried or before its first sample.
+    std::array<double, sensors::sample_width<Kind>()> values;
+    const sensors::Reading<Kind>* reading = readings.get<Kind>();
+    const bool sampled = reading && reading->stamp_ns >= 0;
+    if (sampled) {
+      sensors::write_sample<Kind>(reading->sample, values.data());
+    } else {
+      values.fill(std::numeric_limits<double>::quiet_NaN());
+    }
+    const double* v = values.data();
+    std::size_t i = extra.first[k];
+    for (const auto& col : Kind::kColumns) {
+      if (const int at = shared_->sensor_at[i++]; at >= 0) {
+        for (int c = 0; c < col.width; ++c)
+          in_[static_cast<std::size_t>(at + c)] = col.boolean && !sampled ? 0.0 : v[c];
+      }
+      v += col.width;
+    }
+  });
+}
+
+std::string FmuController::check_sensors(const sensors::SensorSet& carried) const {
+  std::string error;
+  sensors::for_each_kind([&]<class Kind>() {
+    const std::string& input = shared_->sensor_input[sensors::kind_index<Kind>()];
+    if (!error.empty() || input.empty() || Kind::config(carried)) return;
+    error = fmt::format(
+        "{} has the input '{}', but the vehicle carries no {}: turn it on with the scenario key "
+        "sensors.{} (docs/sensors.md)",
+        fmu_name(*shared_->fmu), input, Kind::kName, Kind::kName);
+  });
+  return error;
 }
 
 const std::shared_ptr<Fmu>& FmuController::fmu() const { return shared_->fmu; }

@@ -9,7 +9,12 @@
 //   inputs  p_W [m], v_W [m/s], q_WB [1] (w x y z), w_B [rad/s], f_B [m/s2] (the observation; at
 //           least one of them), ref.p_W [m], ref.v_W [m/s], ref.a_W [m/s2], ref.j_W [m/s3],
 //           ref.yaw [rad], ref.yaw_rate [rad/s], ref.roll [rad], ref.pitch [rad] (the reference);
-//           each optional: one the FMU lacks is not set;
+//           each optional: one the FMU lacks is not set; and the extra sensors' columns by the plant
+//           FMU's output names (magnetometer.field[1..3] [T], barometer.pressure [Pa],
+//           barometer.altitude [m], gnss.fix [1] (1 or 0), gnss.latitude_deg, gnss.longitude_deg
+//           [deg], gnss.altitude_m [m], gnss.v[1..3] [m/s]; names::sensor_variable), set from
+//           observation.sensors: the newest sample, NaN (a flag 0) before the first; an FMU with an
+//           input of a sensor the vehicle does not carry is refused at load (check_sensors);
 //   outputs omega_cmd [rad/s] x4, required.
 // The status's U is the wrench of omega_cmd on the controller's vehicle (eq. (4)); the tracked
 // attitude (roll_des, pitch_des, yaw_des) is the reference's; attitude_error is NaN; saturation flags
@@ -30,6 +35,8 @@
 #include "fmi/fmu.hpp"
 #include "fmi/fmu_mapping.hpp"
 #include "model/quadrotor.hpp"
+#include "sensors/readings.hpp"
+#include "sensors/sensor_set.hpp"
 
 namespace quadcosim::fmi {
 
@@ -56,6 +63,10 @@ class FmuController final : public control::Controller {
   void step(const control::Observation& observation, const control::Reference& reference, double dt_s,
             control::ControllerOutput& out) override;
 
+  /// Empty when the vehicle with `carried` carries every extra sensor the FMU has inputs of; else
+  /// why not, naming the FMU's input and the scenario key that turns the sensor on.
+  std::string check_sensors(const sensors::SensorSet& carried) const;
+
   const std::shared_ptr<Fmu>& fmu() const;
   std::string describe() const;
 
@@ -68,6 +79,8 @@ class FmuController final : public control::Controller {
   FmuController(std::shared_ptr<const Shared> shared, std::vector<double> values, const model::Quadrotor& model);
   void instantiate();
   void initialise();
+  /// Sets in_'s extra-sensor inputs from the observation's readings.
+  void put_sensors(const sensors::Readings& readings);
 
   std::shared_ptr<const Shared> shared_;
   std::vector<double> values_;  ///< each declared parameter's current value

@@ -394,8 +394,8 @@ class AltitudeInstance final : public Instance {
 
 class ControllerFmu final : public Fmu {
  public:
-  explicit ControllerFmu(Journal& j) : j_(j) {
-    description_ = altitude_controller_description();
+  explicit ControllerFmu(Journal& j, ModelDescription md = altitude_controller_description()) : j_(j) {
+    description_ = std::move(md);
     path_ = "/nowhere/altitude.fmu";
   }
   std::unique_ptr<Instance> instantiate(const std::string& name, LogSink) override {
@@ -528,6 +528,115 @@ TEST(FmuControllerAsController, MappingRefusals) {
   FmuMapping p;
   p.parameters = {{"controller.gain", "5000"}};
   refused(p, "parameters.controller.gain", "[-10, 1000]");
+}
+
+/// The altitude controller with inputs named like the plant FMU's extra-sensor outputs: the
+/// magnetometer's field, the barometer's altitude (not its pressure) and every GNSS column.
+ModelDescription sensing_controller_description() {
+  ModelDescription md = altitude_controller_description();
+  ValueReference vr = 100;
+  auto input = [&](const std::string& name, const std::string& unit) {
+    md.variables.push_back(var(name, vr++, Causality::kInput, unit));
+  };
+  for (int i = 1; i <= 3; ++i) input("magnetometer.field[" + std::to_string(i) + "]", "T");
+  input("barometer.altitude", "m");
+  input("gnss.fix", "1");
+  input("gnss.latitude_deg", "deg");
+  input("gnss.longitude_deg", "deg");
+  input("gnss.altitude_m", "m");
+  for (int i = 1; i <= 3; ++i) input("gnss.v[" + std::to_string(i) + "]", "m/s");
+  return md;
+}
+
+TEST(FmuControllerAsController, ExtraSensorInputsAreTheObservationsReadings) {
+  Journal j;
+  auto fmu = std::make_shared<ControllerFmu>(j, sensing_controller_description());
+  FmuController c(fmu, in_memory(), model::VehicleParams{});
+  control::Observation o;
+  o.sensors.carry<sensors::MagnetometerKind>();
+  o.sensors.carry<sensors::BarometerKind>();
+  o.sensors.carry<sensors::GnssKind>();
+  control::ControllerOutput out;
+  out.outputs.resize(1);
+  // Before the first sample: NaN, the fix flag 0.
+  c.step(o, {}, 0.02, out);
+  for (const char* n :
+       {"magnetometer.field[1]", "magnetometer.field[3]", "barometer.altitude", "gnss.latitude_deg", "gnss.v[2]"}) {
+    EXPECT_TRUE(std::isnan(j.set.at(n))) << n;
+  }
+  EXPECT_EQ(j.set.at("gnss.fix"), 0.0);
+
+  sensors::MagnetometerSample mag;
+  mag.field_B_T = {2.1e-5, -3.5e-6, -4.3e-5};
+  o.sensors.set<sensors::MagnetometerKind>(mag, 20'000'000);
+  sensors::BarometerSample baro;
+  baro.pressure_Pa = 95000.0;
+  baro.altitude_m = 540.25;
+  o.sensors.set<sensors::BarometerKind>(baro, 20'000'000);
+  sensors::GnssSample gnss;
+  gnss.fix = true;
+  gnss.position.latitude_rad = 0.8272;
+  gnss.position.longitude_rad = 0.1491;
+  gnss.position.height_m = 536.5;
+  gnss.velocity_W = {0.25, -0.5, 0.125};
+  o.sensors.set<sensors::GnssKind>(gnss, 0);
+  c.step(o, {}, 0.02, out);
+  EXPECT_EQ(j.set.at("magnetometer.field[1]"), 2.1e-5);
+  EXPECT_EQ(j.set.at("magnetometer.field[2]"), -3.5e-6);
+  EXPECT_EQ(j.set.at("magnetometer.field[3]"), -4.3e-5);
+  EXPECT_EQ(j.set.at("barometer.altitude"), 540.25);
+  EXPECT_EQ(j.set.count("barometer.pressure"), 0u);  // the FMU has no such input
+  EXPECT_EQ(j.set.at("gnss.fix"), 1.0);
+  EXPECT_NEAR(j.set.at("gnss.latitude_deg"), 47.395068813221705, 1e-12);  // 0.8272 rad
+  EXPECT_NEAR(j.set.at("gnss.longitude_deg"), 8.542800725400575, 1e-12);  // 0.1491 rad
+  EXPECT_EQ(j.set.at("gnss.altitude_m"), 536.5);
+  EXPECT_EQ(j.set.at("gnss.v[1]"), 0.25);
+  EXPECT_EQ(j.set.at("gnss.v[2]"), -0.5);
+  EXPECT_EQ(j.set.at("gnss.v[3]"), 0.125);
+
+  // What the vehicle must carry: every sensor the FMU has an input of.
+  sensors::SensorSet set;
+  set.magnetometer.emplace();
+  set.barometer.emplace();
+  EXPECT_NE(c.check_sensors(set).find("altitude.fmu has the input 'gnss.fix', but the vehicle carries no gnss: turn "
+                                      "it on with the scenario key sensors.gnss"),
+            std::string::npos)
+      << c.check_sensors(set);
+  set.gnss.emplace();
+  EXPECT_EQ(c.check_sensors(set), "");
+  // The altitude controller without them needs none.
+  FmuController plain(std::make_shared<ControllerFmu>(j), in_memory(), model::VehicleParams{});
+  EXPECT_EQ(plain.check_sensors(sensors::SensorSet{}), "");
+}
+
+TEST(FmuControllerAsController, ExtraSensorInputsMayBeRenamedAndAreChecked) {
+  Journal j;
+  ModelDescription md = altitude_controller_description();
+  md.variables.push_back(var("baro_alt", 200, Causality::kInput, "m"));
+  md.variables.push_back(var("baro_p", 201, Causality::kInput, "m"));
+  auto fmu = std::make_shared<ControllerFmu>(j, md);
+  FmuMapping m;
+  m.inputs["barometer.altitude"] = {"baro_alt"};
+  FmuController c(fmu, in_memory(m), model::VehicleParams{});
+  control::Observation o;
+  o.sensors.carry<sensors::BarometerKind>();
+  sensors::BarometerSample baro;
+  baro.altitude_m = 512.0;
+  o.sensors.set<sensors::BarometerKind>(baro, 0);
+  control::ControllerOutput out;
+  out.outputs.resize(1);
+  c.step(o, {}, 0.02, out);
+  EXPECT_EQ(j.set.at("baro_alt"), 512.0);
+  EXPECT_NE(c.check_sensors({}).find("'baro_alt'"), std::string::npos);
+  FmuMapping unit;
+  unit.inputs["barometer.pressure"] = {"baro_p"};
+  try {
+    FmuController bad(fmu, in_memory(unit), model::VehicleParams{});
+    ADD_FAILURE() << "a pressure input in metres was taken";
+  } catch (const MappingError& e) {
+    EXPECT_EQ(e.key(), "inputs.barometer.pressure");
+    EXPECT_NE(std::string(e.what()).find("unit 'm', expected 'Pa'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

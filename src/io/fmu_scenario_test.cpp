@@ -28,6 +28,7 @@ class FmuScenario : public ::testing::Test {
     dir_ = pattern;
     fs::create_directories(dir_ / "fmus");
     fs::copy_file(kFmuDir / "point_mass.fmu", dir_ / "fmus" / "point_mass.fmu");
+    fs::copy_file(kFmuDir / "sensor_echo.fmu", dir_ / "fmus" / "sensor_echo.fmu");
   }
   void TearDown() override {
     std::error_code ec;
@@ -127,6 +128,35 @@ TEST_F(FmuScenario, BadKeysAreRefusedNamingTheKey) {
   EXPECT_NE(typed.find("controller.type: got 'se3' beside fmu"), std::string::npos) << typed;
   const std::string stray = refusal("controller: {type: paper, outputs: {}}");
   EXPECT_NE(stray.find("controller.outputs: belongs to an FMU controller"), std::string::npos) << stray;
+}
+
+TEST_F(FmuScenario, AControllerFmuWithSensorInputsNeedsTheSensorsOn) {
+  // tests/fmi/sensor_echo: inputs of the magnetometer, the barometer and the GNSS.
+  const std::string controller = "controller: {fmu: fmus/sensor_echo.fmu}\n";
+  const std::string none = refusal(controller);
+  EXPECT_NE(none.find("controller.fmu: sensor_echo.fmu has the input 'magnetometer.field[1]', but the vehicle carries "
+                      "no magnetometer: turn it on with the scenario key sensors.magnetometer"),
+            std::string::npos)
+      << none;
+  const std::string two = refusal(controller + "sensors: {magnetometer: {}, barometer: {}}\n");
+  EXPECT_NE(two.find("controller.fmu: sensor_echo.fmu has the input 'gnss.fix', but the vehicle carries no gnss: turn "
+                     "it on with the scenario key sensors.gnss"),
+            std::string::npos)
+      << two;
+  const std::string all = controller + "sensors: {magnetometer: {}, barometer: {}, gnss: {}}\n";
+  EXPECT_EQ(refusal(all), "");
+  // The command line's --fmu is checked against the scenario's sensors too.
+  Scenario sc = load_scenario(write(std::string(kVertical)));
+  try {
+    use_controller_fmu(sc, FmuSpec{(dir_ / "fmus/sensor_echo.fmu").string(), {}}, "--fmu");
+    ADD_FAILURE() << "a controller FMU with sensor inputs was taken for a vehicle without the sensors";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("--fmu: fmu: sensor_echo.fmu has the input 'magnetometer.field[1]'"),
+              std::string::npos)
+        << e.what();
+  }
+  Scenario on = load_scenario(write(all));
+  use_controller_fmu(on, FmuSpec{(dir_ / "fmus/sensor_echo.fmu").string(), {}}, "--fmu");
 }
 
 TEST_F(FmuScenario, TheCommandLinesFmuReplacesThePlant) {

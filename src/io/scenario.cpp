@@ -314,6 +314,14 @@ std::shared_ptr<const control::Controller> make_controller_fmu(YamlSection& s, c
   });
 }
 
+// Why an FMU controller's inputs of extra sensors (magnetometer.field[1], gnss.fix, ...) do not fit the
+// sensors the scenario's vehicle carries, or empty.
+std::string controller_sensors_error(const Scenario& sc) {
+  if (!sc.controller.controller) return {};
+  const fmi::FmuController* fmu = fmi::fmu_controller(*sc.controller.controller);
+  return fmu ? fmu->check_sensors(sc.simulation.plant.realism.extra_sensors) : std::string();
+}
+
 std::mutex python_factory_mutex;
 PythonControllerFactory python_factory;
 
@@ -830,6 +838,7 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   }
   read_schedule(root, sc, duration_s);
   read_realism(root, sc);
+  if (std::string err = controller_sensors_error(sc); !err.empty()) root.fail("controller.fmu", err);
   if (auto p = root.section("plant")) {
     sc.plant_fmu = read_fmu_spec(*p, std::filesystem::path(path).parent_path());
     p->reject_unknown_keys();
@@ -898,6 +907,7 @@ void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& so
   c.trajectory_offset_W = sc.controller.trajectory_offset_W;
   c.controller = make_controller_fmu(s, spec, c.vehicle);
   sc.controller = std::move(c);
+  if (std::string err = controller_sensors_error(sc); !err.empty()) s.fail("fmu", err);
   sc.controller_fmu = spec;
 }
 

@@ -699,6 +699,7 @@ PYBIND11_MODULE(_quadcosim, m) {
   m.attr("StepTimeout") = step_timeout_type();
   m.attr("Observation") = observation_class();
   m.attr("Reference") = reference_class();
+  m.attr("SensorReading") = sensor_reading_class();
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -16,11 +17,14 @@
 #include <limits>
 #include <mutex>
 #include <thread>
+#include <tuple>
+#include <vector>
 
 #include "control/controller_config.hpp"
 #include "io/did_you_mean.hpp"
 #include "io/scenario.hpp"
 #include "model/mixer.hpp"
+#include "sensors/readings.hpp"
 
 namespace py = pybind11;
 
@@ -102,7 +106,7 @@ bool is_real_number(const py::handle& v) {
 // they may be needed until the interpreter finalises).
 
 struct Globals {
-  py::object observation_class, reference_class, step_timeout;
+  py::object observation_class, reference_class, sensor_reading_class, step_timeout;
   py::object deepcopy, signature;
   // Interned attribute names.
   PyObject *p, *v, *q, *w, *f, *a, *j, *roll, *pitch, *yaw, *yaw_rate, *age, *t, *mode;
@@ -117,12 +121,35 @@ class Observation:
     p, v: position [m] and velocity [m/s] in the world frame (numpy float64, 3); q: attitude body -> world
     (w, x, y, z); w: body rates [rad/s]; f: specific force (accelerometer) [m/s^2] in the body frame;
     roll, pitch, yaw: Z-Y-X angles of q [rad]; age: age of the oldest input [s]; t: the step's time [s].
+
+    The extra sensors (docs/sensors.md): magnetometer, barometer, gnss, each a SensorReading with the
+    newest sample the controller node took in, or None when the vehicle does not carry that sensor
+    (the scenario's sensors: section). age covers p, v, q, w, f only; each reading has its own stamp t.
     """
 
     __module__ = "quadcosim"
 
     def __repr__(self):
         return "Observation(" + ", ".join(f"{k}={v!r}" for k, v in self.__dict__.items()) + ")"
+
+
+class SensorReading:
+    """The newest sample of one extra sensor a Python controller observes (obs.magnetometer,
+    obs.barometer, obs.gnss; docs/sensors.md), reused from step to step like the Observation.
+
+    One attribute per column of the sample, in SI units: a vector a numpy float64 array (3, read-only,
+    rewritten in place), a number a float, a flag a bool. magnetometer: field (3) [T], body frame;
+    barometer: pressure [Pa], altitude [m] (ISA pressure altitude above mean sea level); gnss: fix (bool),
+    latitude_deg, longitude_deg [deg], altitude_m [m] (above the WGS-84 ellipsoid), v (3) [m/s], world
+    frame (ENU); without a fix the GNSS numbers are NaN. t: the sample's stamp [s] (the simulated time of
+    the tick that published it; with the sensor's latency_ticks it measures the truth that many ticks
+    earlier), None before the first sample (then every number is NaN and a flag False).
+    """
+
+    __module__ = "quadcosim"
+
+    def __repr__(self):
+        return "SensorReading(" + ", ".join(f"{k}={v!r}" for k, v in self.__dict__.items()) + ")"
 
 
 class Reference:
@@ -158,6 +185,7 @@ Globals& globals() {
     py::exec(kClassesSource, scope);
     n->observation_class = scope["Observation"];
     n->reference_class = scope["Reference"];
+    n->sensor_reading_class = scope["SensorReading"];
     n->step_timeout = scope["StepTimeout"];
     n->deepcopy = py::module_::import("copy").attr("deepcopy");
     n->signature = py::module_::import("inspect").attr("signature");
@@ -314,6 +342,42 @@ struct PyController::Shared {
   bool has_reset = false, has_set_parameters = false;
 };
 
+namespace {
+constexpr std::size_t kSensorKinds = std::tuple_size_v<sensors::Kinds>;
+
+/// obs.<sensor> of one extra sensor the vehicle carries: a SensorReading whose attributes are the
+/// columns of the registry's kind (sensors/registry.hpp), made once with the Call.
+struct SensorView {
+  py::object object, dict;       ///< the SensorReading and its __dict__; null when the kind is not carried
+  std::vector<py::object> keys;  ///< each column's attribute name (a vector's: its array is in place)
+  int at = 0;                    ///< where the sample's packed columns are in SensorViews::buffer
+};
+
+/// The step's extra sensors: which kinds the views were made for, each kind's view, the memory of
+/// their columns (every carried kind's sample packed, sensors::write_sample).
+struct SensorViews {
+  unsigned carried = ~0u;
+  std::array<SensorView, kSensorKinds> views;
+  py::array_t<double> buffer;
+  double* data = nullptr;
+};
+
+/// Which kinds `readings` carries, one bit per kind (sensors::kind_index).
+unsigned carried_kinds(const sensors::Readings& readings) {
+  unsigned bits = 0;
+  sensors::for_each_kind([&]<class Kind>() {
+    if (readings.carries<Kind>()) bits |= 1u << sensors::kind_index<Kind>();
+  });
+  return bits;
+}
+
+/// A stamp [ns] in seconds as a message header's sec + nanosec * 1e-9 (the same double as
+/// Simulation.sensors' t).
+double stamp_seconds(std::int64_t ns) {
+  return static_cast<double>(ns / 1'000'000'000) + static_cast<double>(ns % 1'000'000'000) * 1e-9;
+}
+}  // namespace
+
 /// The objects of the step call, made at the first step.
 struct PyController::Call {
   py::object step;      ///< the bound method
@@ -324,6 +388,7 @@ struct PyController::Call {
   py::object dt;
   double dt_value = std::numeric_limits<double>::quiet_NaN();
   int mode = -1;
+  SensorViews sensors;  ///< obs.magnetometer, obs.barometer, obs.gnss
 };
 
 namespace {
@@ -347,6 +412,22 @@ void set_item(const py::object& dict, PyObject* key, PyObject* value_new_ref) {
 }
 
 void set_float(const py::object& dict, PyObject* key, double value) { set_item(dict, key, PyFloat_FromDouble(value)); }
+
+void set_borrowed(const py::object& dict, PyObject* key, PyObject* value) { PyDict_SetItem(dict.ptr(), key, value); }
+
+/// A read-only numpy view of n doubles of `buffer` from `at`: C++ writes the memory, the controller reads it.
+py::object read_only_view(const py::array_t<double>& buffer, int at, int n) {
+  py::object a = buffer[py::slice(at, at + n, 1)];
+  a.attr("flags").attr("writeable") = false;
+  return a;
+}
+
+/// (Re)makes obs.magnetometer, obs.barometer, obs.gnss for the kinds `readings` carries (None for the
+/// others): every number NaN, every flag False and t None until the first sample.
+void prepare_sensors(SensorViews& v, const py::object& obs_dict, const sensors::Readings& readings);
+
+/// Writes each carried kind's reading into its view.
+void write_sensors(SensorViews& v, const sensors::Readings& readings);
 }  // namespace
 
 PyController::PyController(std::shared_ptr<const Shared> shared, py::object object, std::vector<double> values,
@@ -482,11 +563,7 @@ void PyController::prepare_call() {
   c->buffer = py::array_t<double>(kBufferSize);
   c->data = c->buffer.mutable_data();
   std::fill(c->data, c->data + kBufferSize, 0.0);
-  const auto view = [&](int at, int n) {
-    py::object a = c->buffer[py::slice(at, at + n, 1)];
-    a.attr("flags").attr("writeable") = false;  // C++ writes the memory; the controller reads it
-    return a;
-  };
+  const auto view = [&](int at, int n) { return read_only_view(c->buffer, at, n); };
   const auto put = [](const py::object& dict, PyObject* key, py::object value) {
     PyDict_SetItem(dict.ptr(), key, value.ptr());
   };
@@ -505,6 +582,77 @@ void PyController::prepare_call() {
   call_ = std::move(c);
 }
 
+namespace {
+
+void prepare_sensors(SensorViews& v, const py::object& obs_dict, const sensors::Readings& readings) {
+  const Globals& g = globals();
+  int width = 0;
+  sensors::for_each_kind([&]<class Kind>() {
+    if (readings.carries<Kind>()) width += sensors::sample_width<Kind>();
+  });
+  v.buffer = py::array_t<double>(std::max(width, 1));
+  v.data = v.buffer.mutable_data();
+  std::fill(v.data, v.data + std::max(width, 1), std::numeric_limits<double>::quiet_NaN());
+  int at = 0;
+  sensors::for_each_kind([&]<class Kind>() {
+    SensorView& s = v.views[sensors::kind_index<Kind>()];
+    s = SensorView{};
+    const py::str name(std::string(Kind::kName));
+    if (!readings.carries<Kind>()) {
+      obs_dict[name] = py::none();
+      return;
+    }
+    s.object = g.sensor_reading_class();
+    s.dict = s.object.attr("__dict__");
+    s.at = at;
+    for (const auto& col : Kind::kColumns) {
+      const py::str key(std::string(col.name));
+      if (col.width > 1) {
+        s.dict[key] = read_only_view(v.buffer, at, col.width);
+      } else {
+        s.dict[key] = col.boolean ? py::object(py::bool_(false)) : py::object(py::float_(v.data[at]));
+      }
+      s.keys.push_back(key);
+      at += col.width;
+    }
+    set_borrowed(s.dict, g.t, Py_None);
+    obs_dict[name] = s.object;
+  });
+  v.carried = carried_kinds(readings);
+}
+
+void write_sensors(SensorViews& v, const sensors::Readings& readings) {
+  const Globals& g = globals();
+  sensors::for_each_kind([&]<class Kind>() {
+    const sensors::Reading<Kind>* reading = readings.get<Kind>();
+    if (!reading) return;
+    const SensorView& s = v.views[sensors::kind_index<Kind>()];
+    double* d = v.data + s.at;
+    const bool sampled = reading->stamp_ns >= 0;
+    if (sampled) {
+      sensors::write_sample<Kind>(reading->sample, d);
+    } else {
+      std::fill(d, d + sensors::sample_width<Kind>(), std::numeric_limits<double>::quiet_NaN());
+    }
+    for (std::size_t i = 0; i < Kind::kColumns.size(); ++i) {
+      const auto& col = Kind::kColumns[i];
+      if (col.width == 1 && col.boolean) {
+        set_borrowed(s.dict, s.keys[i].ptr(), sampled && d[0] != 0.0 ? Py_True : Py_False);
+      } else if (col.width == 1) {
+        set_float(s.dict, s.keys[i].ptr(), d[0]);
+      }
+      d += col.width;
+    }
+    if (sampled) {
+      set_float(s.dict, g.t, stamp_seconds(reading->stamp_ns));
+    } else {
+      set_borrowed(s.dict, g.t, Py_None);
+    }
+  });
+}
+
+}  // namespace
+
 void PyController::fail_step(const std::string& what, double t, py::object cause) {
   // A failed step counts too: a node that flies on (--on-controller-error safety) names each failure
   // by its own step and time, and the next call is the next step.
@@ -520,6 +668,8 @@ void PyController::step(const control::Observation& o, const control::Reference&
   if (!call_) prepare_call();
   Call& c = *call_;
   const Globals& g = globals();
+  if (carried_kinds(o.sensors) != c.sensors.carried) prepare_sensors(c.sensors, c.obs_dict, o.sensors);
+  write_sensors(c.sensors, o.sensors);
   double* d = c.data;
   const auto copy3 = [](double* to, const Eigen::Vector3d& v) {
     to[0] = v.x();
@@ -708,6 +858,7 @@ py::dict vehicle_dict(const model::VehicleParams& vehicle) {
 
 py::object observation_class() { return globals().observation_class; }
 py::object reference_class() { return globals().reference_class; }
+py::object sensor_reading_class() { return globals().sensor_reading_class; }
 
 py::object step_timeout_type() {
   py::gil_scoped_acquire gil;

@@ -13,7 +13,10 @@
 // and after each accepted change. `obs` and `ref` are two objects reused from step to step whose
 // arrays C++ rewrites in place: obs.p, v (3), q (w, x, y, z), w, f (3), obs.roll, pitch, yaw, age, t;
 // ref.mode ("attitude"/"position"), p, v, a, j (3), ref.yaw, yaw_rate, roll, pitch. t = n dt at the
-// n-th step since the start or the last reset.
+// n-th step since the start or the last reset. obs.magnetometer, obs.barometer, obs.gnss: the extra
+// sensors' newest samples (control::Observation::sensors), one SensorReading per carried kind with an
+// attribute per column of its registry entry (sensors/registry.hpp) and its stamp t [s] (None before
+// the first sample); None for a kind the vehicle does not carry.
 //
 // The status fields are filled as for an FMU controller: U is the wrench of omega on the controller's
 // vehicle (eq. (4)), the tracked attitude is the reference's, attitude_error NaN, no saturation flags.
@@ -143,9 +146,11 @@ void install_python_controller_factory();
 /// mixer_inverse (4 rows of 4: rotor speeds squared = mixer_inverse U, as the C++ controllers allocate).
 pybind11::dict vehicle_dict(const model::VehicleParams& vehicle);
 
-/// The classes of a step's `obs` and `ref` (quadcosim.Observation, quadcosim.Reference). Take the GIL.
+/// The classes of a step's `obs` and `ref` (quadcosim.Observation, quadcosim.Reference) and of
+/// obs.magnetometer, obs.barometer, obs.gnss (quadcosim.SensorReading). Take the GIL.
 pybind11::object observation_class();
 pybind11::object reference_class();
+pybind11::object sensor_reading_class();
 
 /// The Python exception type raised inside a step that overran step_timeout_s: quadcosim.StepTimeout, a
 /// BaseException (so that `except Exception:` in the controller does not swallow it). Takes the GIL.

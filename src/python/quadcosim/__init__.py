@@ -22,13 +22,14 @@ from typing import Any, Dict, Optional, Union
 
 import numpy  # noqa: F401  (the arrays the module returns; fail here, clearly, without it)
 
-from ._quadcosim import ConfigError, ControllerError, Observation, Reference, Scenario, Simulation, StepTimeout
+from ._quadcosim import (ConfigError, ControllerError, Observation, Reference, Scenario, SensorReading, Simulation,
+                         StepTimeout)
 from . import _quadcosim
 from .batch import Batch  # noqa: E402  (N vehicles stepped together; docs/python.md)
 from . import envs  # noqa: E402  (Gymnasium-style environments: HoverEnv, TrackingEnv, VectorHoverEnv, ...)
 
-__all__ = ["ConfigError", "Controller", "ControllerError", "Observation", "Reference", "StepTimeout", "Scenario", "SwarmResult",
-           "Simulation", "RunResult", "load_scenario", "run"]
+__all__ = ["ConfigError", "Controller", "ControllerError", "Observation", "Reference", "SensorReading", "StepTimeout",
+           "Scenario", "SwarmResult", "Simulation", "RunResult", "load_scenario", "run"]
 
 ScenarioLike = Union[Scenario, dict, str, "os.PathLike[str]"]
 
