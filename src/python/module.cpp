@@ -189,9 +189,11 @@ PyScenario with_python_controller(const PyScenario& s, const py::object& control
                                   std::optional<double> step_timeout_s) {
   PyScenario r = s;
   r.root = s.from_file ? YAML::LoadFile(s.source) : YAML::Clone(s.root);
-  io::set_controller_type(r.root, "python");
-  r.controller_override = "python";
   const std::string target = controller_target(controller);
+  // As the CLI's --controller python:MODULE:CLASS: another class than the file's own Python class
+  // does not inherit that class's parameters (a registered type's flat gains do pass to it).
+  io::set_controller_type(r.root, "python:" + target);
+  r.controller_override = "python";
   if (r.root["controller"].IsMap()) {
     r.root["controller"]["python"] = target;
     if (step_timeout_s)
