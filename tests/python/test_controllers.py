@@ -738,3 +738,27 @@ def test_a_run_records_the_python_class_and_its_module_hash(tmp_path):
     assert yaml.safe_load((tmp_path / "run" / "metadata.yaml").read_text())["quadcosim_provenance"] == r.provenance
     assert yaml.safe_load((tmp_path / "run" / "scenario.yaml").read_text())["controller"]["python"] == \
         f"{__name__}:AltitudePD"
+
+
+def test_another_class_does_not_inherit_the_scenarios_python_class_parameters(tmp_path):
+    # A scenario flown by its own Python class with that class's gain; flown from Python by another
+    # class (which declares no such gain), the gain goes with the file's class, as with the CLI's
+    # --controller python:MODULE:CLASS. Before, the other class was handed 'k_own' and refused.
+    (tmp_path / "own_controllers.py").write_text(textwrap.dedent("""
+        class Own:
+            parameters = {"k_own": dict(default=1.0, min=0.0, max=10.0, unit="1", description="a gain")}
+            def step(self, obs, ref, dt):
+                return [0.0] * 4
+    """))
+    scenario = tmp_path / "own.yaml"
+    scenario.write_text(textwrap.dedent("""
+        simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 0.1}
+        controller: {python: "own_controllers:Own", k_own: 2.0}
+    """))
+
+    class Other:
+        def step(self, obs, ref, dt):
+            return [100.0] * 4
+
+    result = quadcosim.run(str(scenario), controller=Other)
+    assert result.trajectory["cmd1"][-1] == 100.0
