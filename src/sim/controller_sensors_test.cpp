@@ -25,13 +25,6 @@ using sensors::MagnetometerKind;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-/// Hovering thrust at 5 m, climbing at 1 m/s, level, yaw 0: z = 5 + t exactly.
-model::State climbing() {
-  model::State x = model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 5}, 0.0, true);
-  x.v_W = {0, 0, 1};
-  return x;
-}
-
 /// Every extra sensor, noiseless: the magnetometer at 100 Hz with a hard iron, the barometer at
 /// 50 Hz, the GNSS at 10 Hz, 100 ms old, without a fix for its first 0.25 s.
 RealismConfig noiseless_sensors() {
@@ -59,7 +52,7 @@ struct Rig : test::PlantRig {
   control::ControllerConfig cfg = controllers::make_config("paper", model::VehicleParams{});
   ControllerNode node;
   explicit Rig(const RealismConfig& r, const sensors::SensorSet& carried)
-      : PlantRig(r, climbing()), node(bus, Topics::for_namespace("/drone"), cfg, {}, carried) {}
+      : PlantRig(r, PlantRig::climbing()), node(bus, Topics::for_namespace("/drone"), cfg, {}, carried) {}
 };
 
 TEST(ControllerSensorsTest, TheObservationHoldsEachCarriedSensorsNewestSample) {

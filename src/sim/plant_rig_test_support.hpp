@@ -21,6 +21,13 @@ struct PlantRig {
     o.realism = r;
     return o;
   }
+  /// Hovering thrust at 5 m, climbing at 1 m/s, level, yaw 0: z = 5 + t exactly while the hover speeds
+  /// hold (thrust balances gravity, no drag).
+  static model::State climbing() {
+    model::State x = model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 5}, 0.0, true);
+    x.v_W = {0, 0, 1};
+    return x;
+  }
   /// Ticks 0 .. ticks - 1; with repeat_each every tick's outputs are published twice (a lockstep repeat).
   void run(Tick ticks, bool repeat_each = false) {
     for (Tick k = 0; k < ticks; ++k) {

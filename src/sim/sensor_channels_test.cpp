@@ -16,17 +16,11 @@ struct Rig : test::PlantRig {
   std::vector<msg::FluidPressure> baro;
   std::vector<msg::NavSatFix> fix;
   std::vector<msg::TwistStamped> vel;
-  explicit Rig(const RealismConfig& r) : PlantRig(r, climbing()) {
+  explicit Rig(const RealismConfig& r) : PlantRig(r, PlantRig::climbing()) {
     bus.subscribe<msg::MagneticField>("/drone/MagneticField", [this](const auto& m) { mag.push_back(m); });
     bus.subscribe<msg::FluidPressure>("/drone/FluidPressure", [this](const auto& m) { baro.push_back(m); });
     bus.subscribe<msg::NavSatFix>("/drone/NavSatFix", [this](const auto& m) { fix.push_back(m); });
     bus.subscribe<msg::TwistStamped>("/drone/NavSatVelocity", [this](const auto& m) { vel.push_back(m); });
-  }
-  /// Hovering thrust at 5 m, climbing at 1 m/s: z = 5 + t exactly (thrust balances gravity, no drag).
-  static model::State climbing() {
-    model::State x = model::Quadrotor(model::VehicleParams{}).initial_state({0, 0, 5}, 0.0, true);
-    x.v_W = {0, 0, 1};
-    return x;
   }
 };
 
