@@ -49,11 +49,13 @@ class PlantCore {
   PlantCore() = default;
   /// The realism (noise streams named by `ns`, the vehicle's namespace "/drone") is made when
   /// `realism` is active or the vehicle has aerodynamic drag; the paper's plant otherwise. The extra
-  /// sensors are realism.extra_sensors (none: no suite), seeded by realism.seed.
+  /// sensors are realism.extra_sensors (none: no suite), seeded by realism.seed. `environment`: make
+  /// the realism even when nothing of `realism` is active (a host that switches parts of a configured
+  /// realism off, the plant FMU, keeps the model's path through an Environment, whatever it holds).
   PlantCore(const model::VehicleParams& vehicle, const RealismConfig& realism, const TickClock& clock,
-            const model::State& initial, const std::string& ns)
+            const model::State& initial, const std::string& ns, bool environment = false)
       : model_(vehicle), state_(initial), latched_(initial.omega_rad_s), rotor_input_(model_->rotor_input(latched_)) {
-    if (realism.active() || vehicle.aero.active()) {
+    if (environment || realism.active() || vehicle.aero.active()) {
       realism_ = std::make_unique<PlantRealism>(realism, vehicle, ns, clock);
     }
     if (realism.extra_sensors.any()) {
@@ -61,6 +63,23 @@ class PlantCore {
     }
     pending_.reserve(4);  // now, beside the rest of the plant, not at the first command
   }
+  /// A copy steps on from the same state, the same draws to come (the plant FMU's saved states).
+  PlantCore(const PlantCore& o)
+      : model_(o.model_),
+        state_(o.state_),
+        latched_(o.latched_),
+        rotor_input_(o.rotor_input_),
+        last_valid_tick_(o.last_valid_tick_),
+        pending_(o.pending_),
+        pending_head_(o.pending_head_),
+        realism_(o.realism_ ? std::make_unique<PlantRealism>(*o.realism_) : nullptr),
+        extra_(o.extra_ ? std::make_unique<sensors::Suite>(*o.extra_) : nullptr) {}
+  PlantCore& operator=(const PlantCore& o) {
+    if (this != &o) *this = PlantCore(o);
+    return *this;
+  }
+  PlantCore(PlantCore&&) = default;
+  PlantCore& operator=(PlantCore&&) = default;
 
   /// The outputs of the state at tick k (at t_k on `clock`).
   model::Outputs outputs(const TickClock& clock, Tick k) {

@@ -1,8 +1,8 @@
-// The plant FMU: sim::PlantNode's integration without the node. Time is the integer tick of the
-// communication point; each tick is model::Quadrotor::step(state, clock.seconds(k), rotor_input,
-// period, substeps, env(k)) and the outputs at tick k are model::Quadrotor::outputs(clock.seconds(k),
-// state, rotor_input, env(k)) with the command that acted over the tick before, as PlantNode publishes
-// them, so that a run with this FMU as its plant gives the native plant's numbers bit for bit.
+// The plant FMU: the plant node's core (sim::PlantCore: the model's state, the realism, the extra
+// sensors) without the node. Time is the integer tick of the communication point; each tick is
+// PlantCore::integrate and the outputs at tick k are PlantCore::outputs with the command that acted
+// over the tick before, as PlantNode publishes them, so that a run with this FMU as its plant gives
+// the native plant's numbers bit for bit.
 //
 // The command (omega_cmd) is read at the start of each doStep and held over it (zero-order hold);
 // the model clamps it to [omega_min, omega_max]. Before the first step the command acting is
@@ -24,6 +24,7 @@
 #include "fmi/quadrotor_variables.hpp"
 #include "model/attitude.hpp"
 #include "sensors/suite.hpp"
+#include "sim/plant_core.hpp"
 #include "sim/realism.hpp"
 
 namespace quadcosim::fmi::exported {
@@ -112,33 +113,25 @@ class PlantModel final : public Model {
     }
     realism.seed = static_cast<std::uint64_t>(v.number[seed_]);
 
-    quad_.emplace(vehicle);
-    state_ = x;
-    rotor_input_ = quad_->rotor_input(x.omega_rad_s);  // PlantNode latches the initial speeds first
-    // Present whenever the plant node would have one (the configured realism, not what the switches
-    // left of it): the model then takes the same path through an Environment, whatever it holds.
-    realism_.reset();
-    if (config_.realism.active() || vehicle.aero.active()) {
-      realism_.emplace(realism, vehicle, config_.realism_namespace, clock_);
-    }
-    sensor_noise_ = sensor_noise_ && realism_;
-    // Named, seeded and timed as the plant node's sensor channels (sim/sensor_channels.hpp).
-    extra_ = sensors::Suite(config_.realism.extra_sensors, realism.seed, config_.realism_namespace, clock_.period_ns);
+    // The realism is present whenever the plant node would have one (the configured realism, not what
+    // the switches left of it): the model then takes the same path through an Environment, whatever it
+    // holds. The extra sensors are named, seeded and timed as the plant node's.
+    core_ = sim::PlantCore(vehicle, realism, clock_, x, config_.realism_namespace, config_.realism.active());
+    sensor_noise_ = sensor_noise_ && core_.has_realism();
     write_outputs(k, v);
     return {};
   }
 
   std::string step(sim::Tick k, std::int64_t n, Values& v) override {
-    rotor_input_ = quad_->rotor_input(vector<4>(v, omega_cmd_));
-    const double dt = clock_.period_s();
+    core_.set_latched(vector<4>(v, omega_cmd_));
     for (sim::Tick i = k; i < k + n; ++i) {
-      quad_->step(state_, clock_.seconds(i), rotor_input_, dt, config_.substeps, environment(i));
+      core_.integrate(clock_, i, config_.substeps);
       // The sensors sample every tick (their rates and latencies count ticks), also inside a step.
-      if ((sensor_noise_ || !extra_.empty()) && i + 1 < k + n) measure(i + 1);
+      if ((sensor_noise_ || core_.extra_sensors()) && i + 1 < k + n) measure(i + 1);
     }
     write_outputs(k + n, v);
-    if (!state_.p_W.allFinite() || !state_.v_W.allFinite() || !state_.q_WB.coeffs().allFinite() ||
-        !state_.w_B.allFinite()) {
+    const model::State& x = core_.state();
+    if (!x.p_W.allFinite() || !x.v_W.allFinite() || !x.q_WB.coeffs().allFinite() || !x.w_B.allFinite()) {
       return "the plant's state is no longer finite at t = " + std::to_string(clock_.seconds(k + n)) + " s";
     }
     return {};
@@ -165,20 +158,20 @@ class PlantModel final : public Model {
     for (std::size_t i = 0; i < N; ++i) v.number[vrs[i]] = x[static_cast<Eigen::Index>(i)];
   }
 
-  const model::Environment* environment(sim::Tick k) { return realism_ ? &realism_->environment(k) : nullptr; }
-
   /// The true outputs at tick k; with sensor noise, also the sensors' samples of tick k.
   model::Outputs measure(sim::Tick k) {
-    const model::Outputs y = quad_->outputs(clock_.seconds(k), state_, rotor_input_, environment(k));
-    if (sensor_noise_) realism_->measure(k, y, pose_, twist_, imu_);
-    extra_.step(k, y);
+    const model::Outputs y = core_.outputs(clock_, k);
+    if (sensor_noise_) core_.measure(k, y, pose_, twist_, imu_);
+    core_.sense_extra(k, y);
     return y;
   }
 
   /// The extra sensors' outputs: the newest sample of each, column by column.
   void write_extra_outputs(Values& v) const {
+    const sensors::Suite* extra = core_.extra_sensors();
+    if (!extra) return;
     sensors::for_each_kind([&]<class Kind>() {
-      const sensors::Slot<Kind>* slot = extra_.slot<Kind>();
+      const sensors::Slot<Kind>* slot = extra->slot<Kind>();
       if (!slot) return;
       const std::vector<ValueReference>& vrs = extra_vrs_[sensors::kind_index<Kind>()];
       std::array<double, sensors::sample_width<Kind>()> values{};
@@ -203,7 +196,7 @@ class PlantModel final : public Model {
     put(v, q_, Eigen::Vector4d(y.q_WB.w(), y.q_WB.x(), y.q_WB.y(), y.q_WB.z()));
     put(v, w_, y.w_B);
     put(v, f_, y.specific_force_B);
-    put(v, omega_, state_.omega_rad_s);
+    put(v, omega_, core_.state().omega_rad_s);
     write_extra_outputs(v);
   }
 
@@ -221,12 +214,8 @@ class PlantModel final : public Model {
   ValueReference wind_, faults_, noise_, seed_;
   std::vector<std::pair<const model::VehicleParameter*, ValueReference>> vehicle_;
   std::array<std::vector<ValueReference>, std::tuple_size_v<sensors::Kinds>> extra_vrs_;  ///< by kind, per number
-  sensors::Suite extra_;  ///< the extra sensors (empty: none configured)
 
-  std::optional<model::Quadrotor> quad_;
-  model::State state_;
-  model::RotorInput rotor_input_;
-  std::optional<sim::PlantRealism> realism_;
+  sim::PlantCore core_;  ///< the plant: made by initialize
   bool sensor_noise_ = false;
   msg::PoseStamped pose_;
   msg::TwistStamped twist_;
