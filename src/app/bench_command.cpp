@@ -26,13 +26,13 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
 #include "app/resources.hpp"
 #include "app/swarm.hpp"
 #include "baseline/baseline_setup.hpp"
+#include "hosts/child_process.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
 
@@ -73,12 +73,12 @@ double baseline_rtf(const io::Scenario& sc, double sim_s) {
 
 /// In-process swarm of n vehicles for sim_s [x real time].
 double swarm_inproc_rtf(const io::Scenario& sc, int n, double sim_s) {
-  io::SwarmSpec spec = swarm_spec(sc, n, 2);
+  io::SwarmSpec spec = hosts::swarm_spec(sc, n, 2);
   sim::SimulationConfig cfg = sc.simulation;
   cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
   sim::Swarm swarm(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
   const auto t0 = std::chrono::steady_clock::now();
-  swarm.run(spec.threads, kSwarmBlockTicks);
+  swarm.run(spec.threads, hosts::kSwarmBlockTicks);
   return sim_s / seconds_since(t0);
 }
 
@@ -99,7 +99,7 @@ struct NodeRun {
 };
 NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s, int vehicles, bool realtime,
                   int rt_priority = 0, bool pinned = false) {
-  const std::string self = self_executable();
+  const std::string self = hosts::self_executable();
   const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
   fs::remove(ps);
   fs::remove(cs);
@@ -125,8 +125,8 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
   }
   NodeRun out;
   {
-    ChildProcess controller(c, (tmp / "controller.log").string());
-    ChildProcess plant(p, (tmp / "plant.log").string());
+    hosts::ChildProcess controller(c, (tmp / "controller.log").string());
+    hosts::ChildProcess plant(p, (tmp / "plant.log").string());
     const auto rc = plant.wait(600.0);
     controller.stop();
     if (!rc || *rc != 0) {

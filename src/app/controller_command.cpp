@@ -12,13 +12,13 @@
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
 #include "app/python_host.hpp"
-#include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/node_announcer.hpp"
 #include "dds/parameter_service.hpp"
 #include "dds/peer_pairing.hpp"
 #include "drivers/controller_drivers.hpp"
+#include "hosts/signals.hpp"
 #include "io/scenario.hpp"
 #include "isolation/child.hpp"
 #include "sim/controller_node.hpp"
@@ -107,10 +107,10 @@ void run_until_stopped(Loop&& loop) {
   try {
     loop();
   } catch (const sim::ControllerFailure& e) {
-    if (!stop_signalled()) throw;
+    if (!hosts::stop_signalled()) throw;
     std::cerr << "controller: stop requested while the controller was stepping (" << e.what() << ")\n";
   } catch (const isolation::Interrupted& e) {
-    if (!stop_signalled()) throw;
+    if (!hosts::stop_signalled()) throw;
     std::cerr << "controller: " << e.what() << '\n';
   }
 }
@@ -171,7 +171,7 @@ int controller_command(const ControllerCommandOptions& o) {
     threading.wait_ns = wall_period_ns * 3 / 4;
     threading.on_error = o.on_controller_error == "safety" ? sim::ControllerThreading::OnError::kSafety
                                                            : sim::ControllerThreading::OnError::kStop;
-    threading.on_failure = [](const std::string&) { request_stop(); };
+    threading.on_failure = [](const std::string&) { hosts::request_stop(); };
     threading.thread_host = python_thread_host();
     node.run_controller_on_thread(std::move(threading));
   }
@@ -227,7 +227,7 @@ int controller_command(const ControllerCommandOptions& o) {
     run_until_stopped([&] { driver.run(); });
     if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
   }
-  if (std::optional<std::string> failure = node.controller_failure(); failure && !stop_signalled()) {
+  if (std::optional<std::string> failure = node.controller_failure(); failure && !hosts::stop_signalled()) {
     throw sim::ControllerFailure(*failure);
   }
   if (on_thread && (node.controller_failures() > 0 || node.late_steps() > 0)) {

@@ -7,8 +7,8 @@
 #include <chrono>
 #include <iostream>
 
-#include "app/signals.hpp"
 #include "foxglove/topic_tap.hpp"
+#include "hosts/signals.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {
@@ -111,7 +111,7 @@ void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& wh
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.wait_s));
   std::size_t seen = server.subscriptions();
-  while (seen == 0 && !stop_requested() && Clock::now() < deadline) {
+  while (seen == 0 && !hosts::stop_requested() && Clock::now() < deadline) {
     seen = server.wait_subscriptions_change(seen, std::min(deadline, Clock::now() + kStopCheck));
   }
   if (seen == 0) {
@@ -124,7 +124,7 @@ void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& wh
   const auto quiet = std::chrono::milliseconds(200);
   const auto last = Clock::now() + std::chrono::seconds(2);
   auto changed = Clock::now();
-  while (!stop_requested()) {
+  while (!hosts::stop_requested()) {
     const auto quiet_until = std::min(changed + quiet, last);
     const std::size_t n = server.wait_subscriptions_change(seen, std::min(quiet_until, Clock::now() + kStopCheck));
     const auto now = Clock::now();
@@ -137,12 +137,13 @@ void wait_for_foxglove_client(const FoxgloveCliOptions& o, const std::string& wh
 }
 
 void finish_foxglove(const FoxgloveCliOptions& o, const std::string& who, foxglove::Server& server) {
-  if (o.linger_s > 0.0 && !stop_requested()) {
+  if (o.linger_s > 0.0 && !hosts::stop_requested()) {
     std::cerr << fmt::format("{}: foxglove: run ended; serving its last state for {:g} s (Ctrl-C ends)\n", who,
                              o.linger_s)
               << std::flush;
-    wait_for_stop(std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                         std::chrono::duration<double>(o.linger_s)));
+    hosts::wait_for_stop(
+        std::chrono::steady_clock::now() +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o.linger_s)));
   }
   server.stop();
   std::cerr << fmt::format("{}: foxglove: {}\n", who, server.summary());

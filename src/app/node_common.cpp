@@ -19,14 +19,14 @@
 
 #include "analysis/percentile.hpp"
 #include "app/commands.hpp"
-#include "app/signals.hpp"
+#include "hosts/signals.hpp"
 
 namespace quadcosim::app {
 
 std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
                                                const std::string& scenario, const std::string& vehicle,
                                                const std::string& ns, const std::string& controller_type) {
-  install_stop_handlers();
+  hosts::install_stop_handlers();
   if (std::string err = use_cpus(cpus); !err.empty()) {
     std::cerr << "error: " << who << ": --cpus: " << err << '\n';
     return std::nullopt;
@@ -125,7 +125,7 @@ std::string lockstep_timeout_message(const dds::DdsTransport& transport, const s
       topics.motor_commands, k, clock.seconds(k), timeout_s, transport.matched_writers(topics.motor_commands), policy);
 }
 
-bool DdsDriverHost::stop_requested() { return app::stop_requested(); }
+bool DdsDriverHost::stop_requested() { return hosts::stop_requested(); }
 
 void DdsDriverHost::deliver_on_arrival(bool on) {
   if (!on) {

@@ -18,7 +18,6 @@
 #include "app/foxglove_cli.hpp"
 #include "app/node_common.hpp"
 #include "app/parameter_binding.hpp"
-#include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/graph.hpp"
@@ -27,6 +26,7 @@
 #include "dds/peer_pairing.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
 #include "drivers/realtime_plant_driver.hpp"
+#include "hosts/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
@@ -78,7 +78,7 @@ class PlantProcess {
                                      k - 1)
                        : std::string(),
           faster_timer ? "A faster timer needs simulation.controller_rate_hz set to its rate. " : "");
-      request_stop();  // wakes the lockstep's wait for the answer that will not come
+      hosts::request_stop();  // wakes the lockstep's wait for the answer that will not come
     });
     transport_.subscribe_with_sender<msg::ControllerStatus>(topics_.controller_status,
                                                             [this](const msg::ControllerStatus& m, sim::SenderId s) {
@@ -113,7 +113,7 @@ class PlantProcess {
   /// Runs every tick; returns the process's exit code.
   int run() {
     if ((o_.lockstep || o_.realtime.wait_for_controller) && !wait_for_controller()) return kExitNoController;
-    if (o_.lockstep && !stop_requested()) {
+    if (o_.lockstep && !hosts::stop_requested()) {
       if (const int rc = choose_sync(); rc != kExitOk) return rc;
     }
     loop_start_ns_ = steady_ns();
@@ -122,7 +122,7 @@ class PlantProcess {
     if (rc == kExitOk) report();
     if (foxglove_) finish_foxglove(o_.foxglove, "plant", *foxglove_);
     if (rc != kExitOk) return rc;
-    return stop_requested() ? kExitInterrupted : kExitOk;
+    return hosts::stop_requested() ? kExitInterrupted : kExitOk;
   }
 
  private:
@@ -200,7 +200,7 @@ class PlantProcess {
     const std::size_t all_sensors = sensor_topics().size();
     const bool found = transport_.spin_until(
         [&] {
-          if (stop_requested()) return true;
+          if (hosts::stop_requested()) return true;
           const std::vector<Guid> candidates = controller_candidates();
           if (candidates.size() > 1 && pair_token_.empty()) {
             ambiguous = true;
@@ -290,7 +290,7 @@ class PlantProcess {
         for (const dds::Endpoint& e : endpoints) {
           if (!e.writer && e.dds_topic == request) found = e.participant;
         }
-        return found.has_value() || stop_requested();
+        return found.has_value() || hosts::stop_requested();
       });
       return 0;
     });
@@ -371,8 +371,8 @@ class PlantProcess {
     }
     // The timer's /clock subscription must be there too, or its first /clock is lost.
     const int own = own_readers();
-    if (!transport_.spin_until([&] { return stop_requested() || transport_.matched_readers(topics_.clock) > own; },
-                               timeout_ns())) {
+    if (!transport_.spin_until(
+            [&] { return hosts::stop_requested() || transport_.matched_readers(topics_.clock) > own; }, timeout_ns())) {
       std::cerr << fmt::format("plant: {} does not subscribe {} within {} s\n", node, topics_.clock, o_.timeout_s);
       return kExitNoController;
     }
@@ -513,7 +513,7 @@ class PlantProcess {
     }
     if (r == drivers::LockstepResult::kRefused) return kExitRefused;
     if (r == drivers::LockstepResult::kTimedOut) return kExitNoController;
-    return r == drivers::LockstepResult::kDone && !stop_requested() ? check_answer_count() : kExitOk;
+    return r == drivers::LockstepResult::kDone && !hosts::stop_requested() ? check_answer_count() : kExitOk;
   }
 
   /// Lockstep matches an unlabelled command to the tick being awaited when it is delivered. A
@@ -577,7 +577,7 @@ class PlantProcess {
         "(docs/ros2.md, \"Lockstep with your own ROS 2 controller\")",
         answers, clock_.seconds(k), 1.0 / clock_.seconds(divider_),
         barrier_ ? "from a timer faster than that rate" : "answering every Pose, Velocity or Imu sample");
-    request_stop();
+    hosts::request_stop();
   }
 
   void after_latch(sim::Tick k) {

@@ -8,8 +8,8 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/signals.hpp"
 #include "dds/dds_transport.hpp"
+#include "hosts/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "sim/topics.hpp"
 
@@ -28,7 +28,7 @@ CLI::App* add_record_subcommand(CLI::App& app, RecordOptions& rec) {
 }
 
 int record_command(const RecordOptions& o) {
-  install_stop_handlers();
+  hosts::install_stop_handlers();
   if (std::string err = sim::validate_namespace(o.ns); !err.empty()) {
     std::cerr << "error: --namespace: " << err << '\n';
     return exit_code::kBadInput;
@@ -52,7 +52,7 @@ int record_command(const RecordOptions& o) {
   std::cerr << fmt::format("record: domain {}, writing {} (Ctrl-C to stop)\n", transport.participant().domain_id(),
                            o.out);
   const auto start = std::chrono::steady_clock::now();
-  while (!stop_requested()) {
+  while (!hosts::stop_requested()) {
     if (o.duration_s >= 0 &&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration_s) {
       break;

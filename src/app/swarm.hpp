@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
-#include "app/swarm_inprocess.hpp"
+#include "hosts/swarm_inprocess.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {

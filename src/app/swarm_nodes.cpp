@@ -15,12 +15,12 @@
 
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
-#include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/node_announcer.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
+#include "hosts/signals.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/plant_node.hpp"
@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 namespace {
 
 io::SwarmSpec node_spec(const io::Scenario& sc, int vehicles, const std::string& ns_prefix) {
-  io::SwarmSpec spec = swarm_spec(sc, vehicles, 0);
+  io::SwarmSpec spec = hosts::swarm_spec(sc, vehicles, 0);
   if (!ns_prefix.empty()) {
     if (std::string err = sim::validate_namespace(ns_prefix + "0"); !err.empty()) {
       throw io::ConfigError("--ns-prefix: got '" + ns_prefix + "': " + err);
@@ -116,7 +116,7 @@ class PlantShard {
             }
             ++ready;
           }
-          return stop_requested() || ready == vehicles_.size();
+          return hosts::stop_requested() || ready == vehicles_.size();
         },
         timeout_ns);
     if (!found) {
@@ -171,9 +171,9 @@ class PlantShard {
     return r == drivers::LockstepResult::kStopped ? exit_code::kInterrupted : exit_code::kOk;
   }
 
-  SwarmFinal final_of(int i) const {
+  hosts::SwarmFinal final_of(int i) const {
     const auto& p = *vehicles_[static_cast<std::size_t>(i - first_)]->plant;
-    SwarmFinal f;
+    hosts::SwarmFinal f;
     f.p_W = p.state().p_W;
     f.rejected = p.stats().commands_rejected;
     return f;
@@ -283,14 +283,14 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
                 {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
   }
   if (!o.swarm.out.empty()) {
-    std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
+    std::vector<hosts::SwarmFinal> rows(static_cast<std::size_t>(n));
     std::vector<std::string> namespaces(static_cast<std::size_t>(n));
     const model::State initial = io::initial_state(sc);
     for (int t = 0; t < threads; ++t) {
       for (int i = n * t / threads; i < n * (t + 1) / threads; ++i) {
         const sim::SwarmVehicle v =
             sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
-        SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
+        hosts::SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
         // The reference of the last control step: the trajectory's then, or the vehicle's initial
         // setpoint with its whole schedule applied.
         control::NodeSettings node = v.controller.node;
@@ -308,7 +308,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
       }
     }
-    write_swarm_summary(
+    hosts::write_swarm_summary(
         o.swarm.out, sc, spec, namespaces, rows,
         {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}},
         std::cout);

@@ -19,7 +19,7 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/node_common.hpp"
-#include "app/signals.hpp"
+#include "hosts/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
@@ -429,7 +429,7 @@ int sweep_command(const SweepOptions& o) {
   }
   // Ctrl-C or SIGTERM: no new run starts, those under way finish, and the summary of the finished ones
   // is written. Meanwhile the manifest lists what is written, at most a second late.
-  install_stop_handlers();
+  hosts::install_stop_handlers();
   auto last_record = std::chrono::steady_clock::now();
   int passed_before = 0;
   for (const auto& r : per_run) passed_before += r.at("passed").get<bool>() ? 1 : 0;
@@ -439,7 +439,7 @@ int sweep_command(const SweepOptions& o) {
                      passed_before, o.progress_every_s);
   }
   sweep::RunControl control;
-  control.stop = [] { return stop_requested(); };
+  control.stop = [] { return hosts::stop_requested(); };
   control.finished = [&](const sweep::RunResult& r) {
     if (progress) progress->finished(r.passed);
     const auto now = std::chrono::steady_clock::now();
@@ -481,7 +481,7 @@ int sweep_command(const SweepOptions& o) {
         "sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
         "join the shards with `quadcosim sweep merge OUT DIR...`\n",
         plan.nominal.name, o.shard, per_run.size(), plan.runs, passed, (out / "shard.json").string());
-    return stop_requested() ? exit_code::kInterrupted : exit_code::kOk;
+    return hosts::stop_requested() ? exit_code::kInterrupted : exit_code::kOk;
   }
   if (interrupted) {
     const nlohmann::json summary = sweep::partial_summary_json(header, std::move(per_run));
@@ -495,7 +495,7 @@ int sweep_command(const SweepOptions& o) {
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
-  if (stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
+  if (hosts::stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
   if (o.plots && !(run_tool("plot_sweep.py", {o.out_dir}) && make_index(o.out_dir))) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }

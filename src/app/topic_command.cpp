@@ -11,11 +11,11 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/signals.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/graph.hpp"
 #include "dds/steady_clock.hpp"
 #include "dds/topic_tools.hpp"
+#include "hosts/signals.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::app {
@@ -129,7 +129,7 @@ int topic_echo(const TopicOptions& o) {
     std::cout << yaml << "---\n" << std::flush;
     ++printed;
   });
-  while (!stop_requested() && (o.count <= 0 || printed < o.count)) transport.spin_once(100 * kMs);
+  while (!hosts::stop_requested() && (o.count <= 0 || printed < o.count)) transport.spin_once(100 * kMs);
   return exit_code::kOk;
 }
 
@@ -157,7 +157,7 @@ int topic_hz(const TopicOptions& o) {
       reported = window.messages();
     }
   };
-  while (!stop_requested()) {
+  while (!hosts::stop_requested()) {
     const std::int64_t now = steady_ns();
     if (now >= end) break;
     if (next_report < 0 && window.messages() > 0) next_report = now + kSecond;
@@ -218,7 +218,7 @@ CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& o) {
 }
 
 int topic_command(TopicOptions o) {
-  install_stop_handlers();
+  hosts::install_stop_handlers();
   if (o.verb == "list") {
     if (o.wait_s < 0) o.wait_s = 1.0;
     return topic_list(o);
