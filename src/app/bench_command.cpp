@@ -28,11 +28,11 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
 #include "app/resources.hpp"
 #include "app/swarm.hpp"
 #include "baseline/baseline_setup.hpp"
 #include "hosts/child_process.hpp"
+#include "hosts/node_common.hpp"
 #include "sim/simulation.hpp"
 #include "sim/swarm.hpp"
 
@@ -112,7 +112,7 @@ NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s
       v->push_back(std::to_string(vehicles));
     }
   }
-  if (pinned) pin_apart(p, c);
+  if (pinned) hosts::pin_apart(p, c);
   if (realtime) {
     // The controller's --stats (its period jitter) is real time only.
     for (const std::string& a : {std::string("--realtime"), std::string("--stats"), cs}) c.push_back(a);
@@ -267,7 +267,7 @@ int bench_command(const BenchOptions& o) {
     }
   }
   // The DDS parts again with the plant and the controller each on its own CPU (--cpus).
-  const std::vector<int> pin = two_cpus();
+  const std::vector<int> pin = hosts::two_cpus();
   j["pinned_cpus"] = pin.empty() ? nlohmann::json(nullptr) : nlohmann::json(pin);
   if (want("dds")) {
     const double s = o.seconds > 0 ? o.seconds : (q ? 4.0 : 120.0);

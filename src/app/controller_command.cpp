@@ -9,8 +9,6 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/foxglove_cli.hpp"
-#include "app/node_common.hpp"
-#include "app/parameter_binding.hpp"
 #include "app/python_host.hpp"
 #include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
@@ -18,6 +16,8 @@
 #include "dds/parameter_service.hpp"
 #include "dds/peer_pairing.hpp"
 #include "drivers/controller_drivers.hpp"
+#include "hosts/node_common.hpp"
+#include "hosts/parameter_binding.hpp"
 #include "hosts/signals.hpp"
 #include "io/scenario.hpp"
 #include "isolation/child.hpp"
@@ -118,7 +118,7 @@ void run_until_stopped(Loop&& loop) {
 
 int controller_command(const ControllerCommandOptions& o) {
   std::optional<io::Scenario> started =
-      start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns, o.controller);
+      hosts::start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns, o.controller);
   if (!started) return exit_code::kBadInput;
   io::Scenario& sc = *started;
   if (!o.params.empty()) {
@@ -149,7 +149,7 @@ int controller_command(const ControllerCommandOptions& o) {
   const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);
 
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
-  if (o.sensor_qos) use_sensor_qos(transport, topics);
+  if (o.sensor_qos) hosts::use_sensor_qos(transport, topics);
   // Paired with the plant by the run's token (run --transport dds): the node's writers carry it, and
   // it takes sensor samples from the plant's writers only (dds/peer_pairing.hpp).
   const std::string pair_token = dds::pair_token_from_environment();
@@ -177,10 +177,10 @@ int controller_command(const ControllerCommandOptions& o) {
   }
   const dds::NodeName ros_name = dds::parse_node_name(o.one_vehicle.node_name);
   // The ROS 2 parameter services, answered in the transport's waits (both drivers below).
-  dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
+  dds::ParameterServer parameters(transport, ros_name, hosts::controller_parameter_callbacks(node));
   if (!o.apply_schedule) sc.schedule.clear();
   // After the node's own readers, so a plant that counts this process's readers finds the node's first.
-  std::unique_ptr<foxglove::Server> fox = start_foxglove(o.foxglove, "controller", transport, topics, sc);
+  std::unique_ptr<foxglove::Server> fox = hosts::start_foxglove(o.foxglove, "controller", transport, topics, sc);
   dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
   announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
   std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s, controller {}\n",
@@ -194,17 +194,17 @@ int controller_command(const ControllerCommandOptions& o) {
     // Steps where the samples are delivered: on Cyclone's receive thread with delivery on
     // arrival, so answering a tick wakes no other thread; the host's waits serve the parameter
     // services.
-    DdsDriverHost host(transport);
+    hosts::DdsDriverHost host(transport);
     drivers::LockstepControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,
                                              host);
     run_until_stopped([&] { driver.run(); });
   } else {
     // Real time: a 50 Hz (or configured) timer; data age is measured on the receiving clock.
-    node.use_receipt_clock(steady_ns);
-    if (std::string err = use_realtime_priority(o.realtime.rt_priority); !err.empty()) {
+    node.use_receipt_clock(hosts::steady_ns);
+    if (std::string err = hosts::use_realtime_priority(o.realtime.rt_priority); !err.empty()) {
       std::cerr << "controller: warning: " << err << "; running with normal scheduling\n";
     }
-    PeriodJitter jitter(wall_period_ns);
+    hosts::PeriodJitter jitter(wall_period_ns);
     drivers::RealtimeControllerHooks h;
     h.on_wake = [&](std::int64_t now) { jitter.add(now); };
     h.on_first_sample = [](std::size_t, std::int64_t stamp_ns) {
@@ -221,11 +221,11 @@ int controller_command(const ControllerCommandOptions& o) {
                                                      : "the controller answers again: normal control",
                                node.observation().age_s, node.settings().stale_limit_s, static_cast<double>(now) / 1e9);
     };
-    DdsDriverHost host(transport, /*precise_deadlines=*/true);
+    hosts::DdsDriverHost host(transport, /*precise_deadlines=*/true);
     drivers::RealtimeControllerDriver driver({{&node, std::move(sc.schedule)}}, clock, sc.simulation.controller_divider,
                                              o.realtime.rate_factor, std::move(h), host);
     run_until_stopped([&] { driver.run(); });
-    if (!o.realtime.stats.empty()) write_stats(o.realtime.stats, jitter.figures());
+    if (!o.realtime.stats.empty()) hosts::write_stats(o.realtime.stats, jitter.figures());
   }
   if (std::optional<std::string> failure = node.controller_failure(); failure && !hosts::stop_signalled()) {
     throw sim::ControllerFailure(*failure);
@@ -240,7 +240,7 @@ int controller_command(const ControllerCommandOptions& o) {
                              node.foreign_samples());
   }
   std::cerr << "controller: stopped\n";
-  if (fox) finish_foxglove(o.foxglove, "controller", *fox);
+  if (fox) hosts::finish_foxglove(o.foxglove, "controller", *fox);
   return exit_code::kOk;
 }
 

@@ -16,8 +16,6 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/foxglove_cli.hpp"
-#include "app/node_common.hpp"
-#include "app/parameter_binding.hpp"
 #include "app/swarm.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/graph.hpp"
@@ -26,6 +24,8 @@
 #include "dds/peer_pairing.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
 #include "drivers/realtime_plant_driver.hpp"
+#include "hosts/node_common.hpp"
+#include "hosts/parameter_binding.hpp"
 #include "hosts/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/scenario.hpp"
@@ -93,7 +93,7 @@ class PlantProcess {
       if (sc_.simulation.plant.publish_tf) mcap_->record_vehicle(sc_.vehicle, sc_.simulation.ns, clock_.ns(0));
       mcap_->record_sensors(transport_, sc_.simulation.ns, sc_.simulation.plant.realism.extra_sensors);
     }
-    foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_, sc_);
+    foxglove_ = hosts::start_foxglove(o_.foxglove, "plant", transport_, topics_, sc_);
     if (!o_.one_vehicle.schedule_node.empty()) {
       scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
                                                           dds::parse_node_name(o_.one_vehicle.schedule_node));
@@ -102,7 +102,7 @@ class PlantProcess {
     if (o_.lockstep) plant_.before_clock([this](sim::Tick k) { return before_clock(k); });
     // Real time: the watchdog measures how long ago a command arrived on the wall clock, so a
     // controller that dies is noticed within its limit however the ticks are paced.
-    if (!o_.lockstep) plant_.use_receipt_clock(steady_ns);
+    if (!o_.lockstep) plant_.use_receipt_clock(hosts::steady_ns);
     announcer_.announce();  // `ros2 node list` shows /quadrotor_plant
     std::cerr << fmt::format(
         "plant: domain {}, namespace {}, {} mode, {} ticks of {} s{}\n", transport_.participant().domain_id(),
@@ -116,18 +116,18 @@ class PlantProcess {
     if (o_.lockstep && !hosts::stop_requested()) {
       if (const int rc = choose_sync(); rc != kExitOk) return rc;
     }
-    loop_start_ns_ = steady_ns();
+    loop_start_ns_ = hosts::steady_ns();
     const int rc = o_.lockstep ? run_lockstep() : run_realtime();
     finish(rc);
     if (rc == kExitOk) report();
-    if (foxglove_) finish_foxglove(o_.foxglove, "plant", *foxglove_);
+    if (foxglove_) hosts::finish_foxglove(o_.foxglove, "plant", *foxglove_);
     if (rc != kExitOk) return rc;
     return hosts::stop_requested() ? kExitInterrupted : kExitOk;
   }
 
  private:
   sim::PlantNode make_plant() {
-    if (o_.sensor_qos) use_sensor_qos(transport_, topics_);
+    if (o_.sensor_qos) hosts::use_sensor_qos(transport_, topics_);
     if (!pair_token_.empty()) {
       transport_.set_user_data_keys(std::string(dds::kPairTokenKey) + "=" + pair_token_ + ";");
       pairing_.pair_by_token(pair_token_);
@@ -216,12 +216,12 @@ class PlantProcess {
           if (candidates.empty()) return false;
           peer = candidates.front();
           const std::vector<std::string> now = sensors_subscribed_by(*peer);
-          if (now.size() != sensors.size()) settled_at = steady_ns() + kSettleNs;
+          if (now.size() != sensors.size()) settled_at = hosts::steady_ns() + kSettleNs;
           sensors = now;
           // The run's own controller (a token) publishes its status, which tick 0's answer includes:
           // matched too, or tick 0 would be taken without it.
           if (!pair_token_.empty() && !controller_writes_status()) return false;
-          return sensors.size() == all_sensors || (!sensors.empty() && steady_ns() >= settled_at);
+          return sensors.size() == all_sensors || (!sensors.empty() && hosts::steady_ns() >= settled_at);
         },
         timeout_ns());
     if (ambiguous) return false;
@@ -437,7 +437,7 @@ class PlantProcess {
     for (; scheduler_ && next_event_ != sc_.schedule.end() && next_event_->tick <= k; ++next_event_) {
       // The reply comes through Cyclone's receive thread: let deliveries on arrival through meanwhile.
       const auto r = host_.unlocked([&] {
-        return scheduler_->set({{next_event_->name, to_ros(next_event_->value)}}, timeout_ns());
+        return scheduler_->set({{next_event_->name, hosts::to_ros(next_event_->value)}}, timeout_ns());
       });
       if (r.size() != 1 || !r[0].successful) {
         std::cerr << fmt::format("plant: scheduled {} at t = {} s refused by {}: {}\n", next_event_->name,
@@ -488,7 +488,8 @@ class PlantProcess {
       check_one_answer_per_period(k);
     };
     h.on_timeout = [this](std::size_t, sim::Tick k) {
-      std::cerr << lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s, o_.lockstep_only.on_timeout);
+      std::cerr << hosts::lockstep_timeout_message(transport_, topics_, clock_, k, o_.timeout_s,
+                                                   o_.lockstep_only.on_timeout);
       if (!barrier_) return;
       const double period_s = clock_.seconds(divider_);
       std::cerr << (clock_held_ == k
@@ -523,8 +524,8 @@ class PlantProcess {
   /// last tick ran and what is still arriving came in (a 20 ms lull, at most 200 ms), more commands
   /// than control periods (one may answer the final samples) stop the run's success.
   int check_answer_count() {
-    const std::int64_t until = steady_ns() + 200'000'000;
-    while (transport_.spin_once(20'000'000) > 0 && steady_ns() < until) {
+    const std::int64_t until = hosts::steady_ns() + 200'000'000;
+    while (transport_.spin_once(20'000'000) > 0 && hosts::steady_ns() < until) {
     }
     const std::uint64_t periods = lockstep_->round_trips_ns().count();
     const std::uint64_t answers = plant_.command_receipt().received;
@@ -594,7 +595,7 @@ class PlantProcess {
   void log_watchdog(sim::Tick k) {
     if (plant_.watchdog_active() == watchdog_logged_) return;
     watchdog_logged_ = plant_.watchdog_active();
-    const double mono_s = static_cast<double>(steady_ns()) / 1e9;
+    const double mono_s = static_cast<double>(hosts::steady_ns()) / 1e9;
     if (watchdog_logged_) {
       std::cerr << fmt::format(
           "plant: watchdog: no valid motor command for {:.3f} s (limit {:g} s) at t = {:g} s "
@@ -623,8 +624,8 @@ class PlantProcess {
       // answered the last tick may have ended the run before Cyclone put the same sample into the
       // recorder's own reader, so wait for a 20 ms lull (at most 200 ms), or the recording could
       // miss the last command or status under load.
-      const std::int64_t lull_ns = o_.lockstep ? 20'000'000 : 0, until = steady_ns() + 200'000'000;
-      while (transport_.spin_once(lull_ns) > 0 && steady_ns() < until) {
+      const std::int64_t lull_ns = o_.lockstep ? 20'000'000 : 0, until = hosts::steady_ns() + 200'000'000;
+      while (transport_.spin_once(lull_ns) > 0 && hosts::steady_ns() < until) {
       }
       mcap_->close();
       const std::filesystem::path p(o_.one_vehicle.mcap);
@@ -648,7 +649,7 @@ class PlantProcess {
       stats["roundtrip_us_max"] = pct(1.0);
     }
     const auto& st = plant_.stats();
-    const double wall_s = static_cast<double>(steady_ns() - loop_start_ns_) / 1e9;
+    const double wall_s = static_cast<double>(hosts::steady_ns() - loop_start_ns_) / 1e9;
     // The simulated time reached, not the time asked for: a run stopped early (Ctrl-C) integrated
     // only the ticks it completed.
     const sim::Tick asked = sc_.simulation.duration_ticks;
@@ -672,7 +673,7 @@ class PlantProcess {
     stats["simulated_s"] = sim_s;
     stats["wall_s"] = wall_s;
     stats["real_time_factor"] = sim_s / wall_s;
-    if (!o_.stats.empty()) write_stats(o_.stats, stats);
+    if (!o_.stats.empty()) hosts::write_stats(o_.stats, stats);
   }
 
   std::int64_t timeout_ns() const { return static_cast<std::int64_t>(o_.timeout_s * 1e9); }
@@ -710,7 +711,7 @@ class PlantProcess {
   std::string ambiguous_;  ///< why the controller's answers cannot be matched to ticks ("": they can)
   std::int64_t loop_start_ns_ = 0;
   // Last: the drivers and their host (with delivery on arrival) go first.
-  DdsDriverHost host_{transport_};
+  hosts::DdsDriverHost host_{transport_};
   std::optional<drivers::LockstepPlantDriver> lockstep_;
   std::optional<drivers::RealtimePlantDriver> realtime_;
 };
@@ -812,7 +813,7 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
 }
 
 int plant_command(const PlantCommandOptions& o) {
-  std::optional<io::Scenario> started = start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns);
+  std::optional<io::Scenario> started = hosts::start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns);
   if (!started) return exit_code::kBadInput;
   io::Scenario& sc = *started;
   if (!o.fmu.empty()) io::use_plant_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu");

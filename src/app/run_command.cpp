@@ -16,12 +16,12 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/foxglove_cli.hpp"
-#include "app/node_common.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/peer_pairing.hpp"
 #include "hosts/child_process.hpp"
 #include "hosts/inprocess_run.hpp"
+#include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
@@ -106,7 +106,7 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     for (std::string a : {"--realtime", "--wait-for-controller", "--rate-factor"}) plant_args.push_back(a);
     plant_args.push_back(fmt::format("{}", opt.rate_factor));
   }
-  if (opt.pin) pin_apart(plant_args, controller_args);
+  if (opt.pin) hosts::pin_apart(plant_args, controller_args);
   for (const std::string& a : io::limit_arguments(io::limits())) {  // the child processes read the same files
     plant_args.push_back(a);
     controller_args.push_back(a);
@@ -251,8 +251,8 @@ int run_command(const RunOptions& opt) {
       std::unique_ptr<foxglove::Server> fox;
       std::chrono::steady_clock::time_point paced_from;
       const auto attach = [&](sim::Transport& transport, const sim::Topics& topics) {
-        fox = start_foxglove(opt.foxglove, "run", transport, topics, sc);
-        if (fox) wait_for_foxglove_client(opt.foxglove, "run", *fox);
+        fox = hosts::start_foxglove(opt.foxglove, "run", transport, topics, sc);
+        if (fox) hosts::wait_for_foxglove_client(opt.foxglove, "run", *fox);
         paced_from = std::chrono::steady_clock::now();
       };
       const auto on_tick = [&](double t_s) {
@@ -266,7 +266,7 @@ int run_command(const RunOptions& opt) {
       const bool completed = hosts::fly_inprocess(
           sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); },
           opt.foxglove.listen.empty() ? nullptr : std::function(attach));
-      if (fox) finish_foxglove(opt.foxglove, "run", *fox);
+      if (fox) hosts::finish_foxglove(opt.foxglove, "run", *fox);
       io::add_provenance_to_bag_metadata(out, provenance);
       if (!completed) {
         // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.

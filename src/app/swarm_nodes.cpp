@@ -14,12 +14,12 @@
 #include <thread>
 
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/node_announcer.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
+#include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
@@ -77,7 +77,7 @@ class PlantShard {
           sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto node = std::make_unique<Vehicle>();
       node->topics = sim::Topics::for_namespace(v.simulation.ns);
-      if (sensor_qos) use_sensor_qos(transport_, node->topics);
+      if (sensor_qos) hosts::use_sensor_qos(transport_, node->topics);
       sim::PlantOptions po = v.simulation.plant;
       po.drop_stale_commands = true;
       po.publish_clock = i == 0;  // one /clock for the whole swarm
@@ -153,16 +153,16 @@ class PlantShard {
           v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status) : io::ControlColumns::none());
     };
     h.on_timeout = [&](std::size_t i, sim::Tick k) {
-      std::cerr << lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
+      std::cerr << hosts::lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
     };
     h.on_resume = [](sim::Tick k) {
       std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
     };
     drivers::LockstepPlantDriver driver(std::move(plants), lo, std::move(h), host_);
     host_.on_delivery([&driver] { return driver.on_delivery(); });
-    start_ns_ = steady_ns();
+    start_ns_ = hosts::steady_ns();
     const drivers::LockstepResult r = driver.run();
-    end_ns_ = steady_ns();
+    end_ns_ = hosts::steady_ns();
     host_.on_delivery(nullptr);
     for (auto& v : vehicles_) {
       if (v->csv) v->csv->close();
@@ -195,7 +195,7 @@ class PlantShard {
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
   std::int64_t start_ns_ = 0, end_ns_ = 0;
-  DdsDriverHost host_{transport_};
+  hosts::DdsDriverHost host_{transport_};
 };
 
 // One thread's share of the controllers (drivers::LockstepControllerDriver): each steps where its
@@ -212,7 +212,7 @@ class ControllerShard {
       sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto c = std::make_unique<Vehicle>();
       const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
-      if (sensor_qos) use_sensor_qos(transport_, topics);
+      if (sensor_qos) hosts::use_sensor_qos(transport_, topics);
       c->node =
           std::make_unique<sim::ControllerNode>(transport_, topics, v.controller, sim::ControllerNode::SampleFilter{},
                                                 v.simulation.plant.realism.extra_sensors);
@@ -242,7 +242,7 @@ class ControllerShard {
     std::unique_ptr<sim::ControllerNode> node;
   };
   dds::DdsTransport transport_;
-  DdsDriverHost host_{transport_};
+  hosts::DdsDriverHost host_{transport_};
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::unique_ptr<drivers::LockstepControllerDriver> driver_;  ///< after the nodes: unhooks first
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
@@ -279,8 +279,8 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   std::cerr << fmt::format("plant: done; {} vehicles, {:g} s simulated in {:.3f} s ({:.2f}x real time)\n", n, sim_s,
                            wall_s, sim_s / wall_s);
   if (!o.stats.empty()) {
-    write_stats(o.stats,
-                {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
+    hosts::write_stats(
+        o.stats, {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
   }
   if (!o.swarm.out.empty()) {
     std::vector<hosts::SwarmFinal> rows(static_cast<std::size_t>(n));

@@ -12,9 +12,9 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
 #include "app/swarm.hpp"
 #include "hosts/child_process.hpp"
+#include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
@@ -43,7 +43,7 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
       controller_args.push_back("--controller");
       controller_args.push_back(opt.controller);
     }
-    if (opt.pin) pin_apart(plant_args, controller_args);
+    if (opt.pin) hosts::pin_apart(plant_args, controller_args);
     if (const int rc = hosts::run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;
   } else if (!hosts::fly_swarm_inprocess(sc, spec, out, std::cout, [](double) { return hosts::stop_requested(); })) {
     std::cerr << "\nrun: interrupted; the recorded vehicles' trajectory.csv hold what ran\n";

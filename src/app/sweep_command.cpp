@@ -18,7 +18,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
+#include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
