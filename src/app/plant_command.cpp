@@ -11,9 +11,9 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/foxglove_cli.hpp"
-#include "app/swarm.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/plant_process.hpp"
+#include "hosts/swarm_nodes.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {
@@ -134,7 +134,7 @@ int plant_command(const PlantCommandOptions& o) {
   if (o.duration_s >= 0.0) {
     sc.simulation.duration_ticks = static_cast<sim::Tick>(o.duration_s / sc.simulation.plant.clock.period_s() + 0.5);
   }
-  if (o.swarm.vehicles > 0) return swarm_plant_command(o, std::move(sc));
+  if (o.swarm.vehicles > 0) return hosts::run_plant_swarm(o, std::move(sc));
   return hosts::run_plant_process(o, std::move(sc));
 }
 

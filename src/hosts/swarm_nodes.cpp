@@ -1,8 +1,10 @@
-// `quadcosim plant --vehicles N` and `quadcosim controller --vehicles N`: N vehicles' nodes in one
-// process over DDS, each vehicle under its own namespace (<prefix>0000, ...), lockstep only. The
-// vehicles are split over `threads` threads; each thread has its own DDS participant and runs its
-// vehicles' PlantNodes (or ControllerNodes) exactly as the single-vehicle processes do, so every
-// vehicle's numbers equal those of the in-process swarm.
+// The swarm processes (`quadcosim plant --vehicles N`, `quadcosim controller --vehicles N`): N
+// vehicles' nodes in one process over DDS, each vehicle under its own namespace (<prefix>0000, ...),
+// lockstep only. The vehicles are split over `threads` threads; each thread has its own DDS
+// participant and runs its vehicles' PlantNodes (or ControllerNodes) exactly as the single-vehicle
+// processes do, so every vehicle's numbers equal those of the in-process swarm.
+#include "hosts/swarm_nodes.hpp"
+
 #include <fmt/format.h>
 
 #include <atomic>
@@ -13,26 +15,26 @@
 #include <mutex>
 #include <thread>
 
-#include "app/exit_codes.hpp"
-#include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/node_announcer.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
+#include "hosts/exit_code.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
+#include "hosts/swarm_inprocess.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/plant_node.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 namespace fs = std::filesystem;
 
 namespace {
 
 io::SwarmSpec node_spec(const io::Scenario& sc, int vehicles, const std::string& ns_prefix) {
-  io::SwarmSpec spec = hosts::swarm_spec(sc, vehicles, 0);
+  io::SwarmSpec spec = swarm_spec(sc, vehicles, 0);
   if (!ns_prefix.empty()) {
     if (std::string err = sim::validate_namespace(ns_prefix + "0"); !err.empty()) {
       throw io::ConfigError("--ns-prefix: got '" + ns_prefix + "': " + err);
@@ -77,7 +79,7 @@ class PlantShard {
           sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto node = std::make_unique<Vehicle>();
       node->topics = sim::Topics::for_namespace(v.simulation.ns);
-      if (sensor_qos) hosts::use_sensor_qos(transport_, node->topics);
+      if (sensor_qos) use_sensor_qos(transport_, node->topics);
       sim::PlantOptions po = v.simulation.plant;
       po.drop_stale_commands = true;
       po.publish_clock = i == 0;  // one /clock for the whole swarm
@@ -116,7 +118,7 @@ class PlantShard {
             }
             ++ready;
           }
-          return hosts::stop_requested() || ready == vehicles_.size();
+          return stop_requested() || ready == vehicles_.size();
         },
         timeout_ns);
     if (!found) {
@@ -153,16 +155,16 @@ class PlantShard {
           v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status) : io::ControlColumns::none());
     };
     h.on_timeout = [&](std::size_t i, sim::Tick k) {
-      std::cerr << hosts::lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
+      std::cerr << lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
     };
     h.on_resume = [](sim::Tick k) {
       std::cerr << fmt::format("plant: commands are back at tick {}; lockstep resumes\n", k);
     };
     drivers::LockstepPlantDriver driver(std::move(plants), lo, std::move(h), host_);
     host_.on_delivery([&driver] { return driver.on_delivery(); });
-    start_ns_ = hosts::steady_ns();
+    start_ns_ = steady_ns();
     const drivers::LockstepResult r = driver.run();
-    end_ns_ = hosts::steady_ns();
+    end_ns_ = steady_ns();
     host_.on_delivery(nullptr);
     for (auto& v : vehicles_) {
       if (v->csv) v->csv->close();
@@ -171,9 +173,9 @@ class PlantShard {
     return r == drivers::LockstepResult::kStopped ? exit_code::kInterrupted : exit_code::kOk;
   }
 
-  hosts::SwarmFinal final_of(int i) const {
+  SwarmFinal final_of(int i) const {
     const auto& p = *vehicles_[static_cast<std::size_t>(i - first_)]->plant;
-    hosts::SwarmFinal f;
+    SwarmFinal f;
     f.p_W = p.state().p_W;
     f.rejected = p.stats().commands_rejected;
     return f;
@@ -195,7 +197,7 @@ class PlantShard {
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
   std::int64_t start_ns_ = 0, end_ns_ = 0;
-  hosts::DdsDriverHost host_{transport_};
+  DdsDriverHost host_{transport_};
 };
 
 // One thread's share of the controllers (drivers::LockstepControllerDriver): each steps where its
@@ -212,7 +214,7 @@ class ControllerShard {
       sim::SwarmVehicle v = sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
       auto c = std::make_unique<Vehicle>();
       const sim::Topics topics = sim::Topics::for_namespace(v.simulation.ns);
-      if (sensor_qos) hosts::use_sensor_qos(transport_, topics);
+      if (sensor_qos) use_sensor_qos(transport_, topics);
       c->node =
           std::make_unique<sim::ControllerNode>(transport_, topics, v.controller, sim::ControllerNode::SampleFilter{},
                                                 v.simulation.plant.realism.extra_sensors);
@@ -242,7 +244,7 @@ class ControllerShard {
     std::unique_ptr<sim::ControllerNode> node;
   };
   dds::DdsTransport transport_;
-  hosts::DdsDriverHost host_{transport_};
+  DdsDriverHost host_{transport_};
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::unique_ptr<drivers::LockstepControllerDriver> driver_;  ///< after the nodes: unhooks first
   std::unique_ptr<dds::NodeAnnouncer> announcer_;
@@ -250,7 +252,7 @@ class ControllerShard {
 
 }  // namespace
 
-int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
+int run_plant_swarm(const PlantProcessOptions& o, io::Scenario sc) {
   const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
   const int threads = std::clamp(o.swarm.threads, 1, n);
@@ -279,18 +281,18 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   std::cerr << fmt::format("plant: done; {} vehicles, {:g} s simulated in {:.3f} s ({:.2f}x real time)\n", n, sim_s,
                            wall_s, sim_s / wall_s);
   if (!o.stats.empty()) {
-    hosts::write_stats(
-        o.stats, {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
+    write_stats(o.stats,
+                {{"vehicles", n}, {"simulated_s", sim_s}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}});
   }
   if (!o.swarm.out.empty()) {
-    std::vector<hosts::SwarmFinal> rows(static_cast<std::size_t>(n));
+    std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
     std::vector<std::string> namespaces(static_cast<std::size_t>(n));
     const model::State initial = io::initial_state(sc);
     for (int t = 0; t < threads; ++t) {
       for (int i = n * t / threads; i < n * (t + 1) / threads; ++i) {
         const sim::SwarmVehicle v =
             sim::swarm_vehicle(sc.simulation, initial, sc.controller, sc.schedule, spec.layout, i);
-        hosts::SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
+        SwarmFinal f = shards[static_cast<std::size_t>(t)]->final_of(i);
         // The reference of the last control step: the trajectory's then, or the vehicle's initial
         // setpoint with its whole schedule applied.
         control::NodeSettings node = v.controller.node;
@@ -308,7 +310,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
         namespaces[static_cast<std::size_t>(i)] = v.simulation.ns;
       }
     }
-    hosts::write_swarm_summary(
+    write_swarm_summary(
         o.swarm.out, sc, spec, namespaces, rows,
         {{"transport", "dds"}, {"threads", threads}, {"wall_s", wall_s}, {"real_time_factor", sim_s / wall_s}},
         std::cout);
@@ -316,7 +318,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   return exit_code::kOk;
 }
 
-int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc) {
+int run_controller_swarm(const ControllerProcessOptions& o, io::Scenario sc) {
   const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
   const int threads = std::clamp(o.swarm.threads, 1, n);
@@ -335,4 +337,4 @@ int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc)
   return rc;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts
