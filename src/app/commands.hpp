@@ -11,6 +11,8 @@
 
 #include "controllers/registry.hpp"
 #include "hosts/node_options.hpp"
+#include "hosts/recorder_process.hpp"
+#include "hosts/topic_process.hpp"
 
 namespace CLI {
 class App;
@@ -122,30 +124,14 @@ int param_command(const ParamOptions& options);
 /// "" when `text` is a valid ROS node name (NAME or /NAMESPACE/NAME), else why not (a CLI check).
 std::string check_node_name(const std::string& text);
 
-/// `quadcosim topic list|echo|hz` (topic_command.cpp). Negative wait_s: the verb's default.
-struct TopicOptions {
-  std::string verb;         ///< "list", "echo" or "hz" (set by the subcommand parsed)
-  bool show_types = false;  ///< list -t
-  bool include_hidden = false;
-  double wait_s = -1.0;  ///< list: discovery time (1 s); echo/hz: how long to look for the topic (5 s)
-  std::string topic;
-  int count = 0;              ///< echo: stop after this many messages (0: until Ctrl-C)
-  std::string qos;            ///< "default" (reliable) or "sensor" (best effort); "": the verb's default
-  int window = 10000;         ///< hz: intervals the statistics cover
-  double duration_s = 0.0;    ///< hz: stop after this long (0: until Ctrl-C)
-  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
-};
+/// `quadcosim topic list|echo|hz`: the topic tools' options (hosts/topic_process.hpp).
+using TopicOptions = hosts::TopicToolOptions;
 /// Adds the `topic` subcommand with list/echo/hz under `app`, parsing into `options`.
 CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& options);
 int topic_command(TopicOptions options);
 
-struct RecordOptions {
-  std::string out;                  ///< MCAP file (metadata.yaml is written beside it)
-  std::string ns = "/drone";        ///< the vehicle's namespace
-  std::vector<std::string> topics;  ///< subset of the vehicle's topics (default: all)
-  double duration_s = -1.0;         ///< stop after this wall time [s] (default: Ctrl-C)
-  std::string enclave = "/";        ///< DDS Security enclave (rcl --enclave)
-};
+/// `quadcosim record`: the recorder process's options (hosts/recorder_process.hpp).
+using RecordOptions = hosts::RecorderOptions;
 int record_command(const RecordOptions& options);
 CLI::App* add_record_subcommand(CLI::App& app, RecordOptions& options);
 
