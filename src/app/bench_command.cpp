@@ -26,15 +26,12 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
 #include "app/resources.hpp"
-#include "app/swarm.hpp"
 #include "baseline/baseline_setup.hpp"
-#include "sim/simulation.hpp"
-#include "sim/swarm.hpp"
+#include "hosts/bench_runs.hpp"
+#include "hosts/node_common.hpp"
 
 namespace quadcosim::app {
 
@@ -48,16 +45,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 void note(const std::string& s) { std::cerr << "bench: " << s << std::endl; }
 
-/// One vehicle in-process (any controller) for sim_s simulated seconds, recording off; best of `reps` [x real time].
-double inproc_rtf(const io::Scenario& sc, double sim_s) {
-  sim::SimulationConfig cfg = sc.simulation;
-  cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
-  sim::Simulation s(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
-  const auto t0 = std::chrono::steady_clock::now();
-  for (sim::Tick k = 0; k <= cfg.duration_ticks; ++k) s.tick(k);
-  return sim_s / seconds_since(t0);
-}
-
 double baseline_rtf(const io::Scenario& sc, double sim_s) {
   const double dt = sc.simulation.plant.clock.period_s();
   const long ticks = static_cast<long>(sim_s / dt + 0.5);
@@ -69,74 +56,6 @@ double baseline_rtf(const io::Scenario& sc, double sim_s) {
   const double rtf = sim_s / seconds_since(t0);
   if (!std::isfinite(loop.state().x[2])) note("baseline loop diverged");
   return rtf;
-}
-
-/// In-process swarm of n vehicles for sim_s [x real time].
-double swarm_inproc_rtf(const io::Scenario& sc, int n, double sim_s) {
-  io::SwarmSpec spec = swarm_spec(sc, n, 2);
-  sim::SimulationConfig cfg = sc.simulation;
-  cfg.duration_ticks = static_cast<sim::Tick>(sim_s / cfg.plant.clock.period_s() + 0.5);
-  sim::Swarm swarm(cfg, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
-  const auto t0 = std::chrono::steady_clock::now();
-  swarm.run(spec.threads, kSwarmBlockTicks);
-  return sim_s / seconds_since(t0);
-}
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream f(p);
-  if (!f) return nullptr;
-  try {
-    return nlohmann::json::parse(f);
-  } catch (const std::exception&) {
-    return nullptr;
-  }
-}
-
-/// Plant and controller processes over DDS (lockstep, or real time); the plant's --stats (and the
-/// controller's, in real time) as JSON; null on failure.
-struct NodeRun {
-  nlohmann::json plant, controller;
-};
-NodeRun run_nodes(const fs::path& tmp, const std::string& scenario, double sim_s, int vehicles, bool realtime,
-                  int rt_priority = 0, bool pinned = false) {
-  const std::string self = self_executable();
-  const std::string ps = (tmp / "plant.json").string(), cs = (tmp / "controller.json").string();
-  fs::remove(ps);
-  fs::remove(cs);
-  std::vector<std::string> c = {self, "controller", "--scenario", scenario};
-  std::vector<std::string> p = {self,      "plant", "--scenario", scenario, "--duration", fmt::format("{}", sim_s),
-                                "--stats", ps,      "--timeout",  "60"};
-  if (vehicles > 0) {
-    for (auto* v : {&c, &p}) {
-      v->push_back("--vehicles");
-      v->push_back(std::to_string(vehicles));
-    }
-  }
-  if (pinned) pin_apart(p, c);
-  if (realtime) {
-    // The controller's --stats (its period jitter) is real time only.
-    for (const std::string& a : {std::string("--realtime"), std::string("--stats"), cs}) c.push_back(a);
-    if (rt_priority > 0) {
-      c.push_back("--rt-priority");
-      c.push_back(std::to_string(rt_priority));
-    }
-    p.push_back("--realtime");
-    p.push_back("--wait-for-controller");
-  }
-  NodeRun out;
-  {
-    ChildProcess controller(c, (tmp / "controller.log").string());
-    ChildProcess plant(p, (tmp / "plant.log").string());
-    const auto rc = plant.wait(600.0);
-    controller.stop();
-    if (!rc || *rc != 0) {
-      note(fmt::format("plant exited with {} (log: {})", rc ? *rc : -1, (tmp / "plant.log").string()));
-      return out;
-    }
-  }
-  out.plant = read_json(ps);
-  out.controller = read_json(cs);
-  return out;
 }
 
 /// Largest n with rate(n) >= 1: doubling from `start` (up to `cap`), then `bisections` halvings of
@@ -256,18 +175,18 @@ int bench_command(const BenchOptions& o) {
       }
       double r = 0.0, b = 0.0;
       for (int rep = 0; rep < (q ? 1 : 9); ++rep) {
-        r = std::max(r, inproc_rtf(paper, s));
+        r = std::max(r, hosts::inproc_rtf(paper, s));
         if (baseline) b = std::max(b, baseline_rtf(paper, s));
       }
       j["inproc_rtf"] = r;
       j["baseline_rtf"] = baseline ? nlohmann::json(b) : nlohmann::json(nullptr);
       j["inproc_vs_baseline"] = baseline ? nlohmann::json(r / b) : nlohmann::json(nullptr);
     } else {
-      j["inproc_rtf"] = inproc_rtf(paper, s);  // one run of exactly --seconds (for callgrind)
+      j["inproc_rtf"] = hosts::inproc_rtf(paper, s);  // one run of exactly --seconds (for callgrind)
     }
   }
   // The DDS parts again with the plant and the controller each on its own CPU (--cpus).
-  const std::vector<int> pin = two_cpus();
+  const std::vector<int> pin = hosts::two_cpus();
   j["pinned_cpus"] = pin.empty() ? nlohmann::json(nullptr) : nlohmann::json(pin);
   if (want("dds")) {
     const double s = o.seconds > 0 ? o.seconds : (q ? 4.0 : 120.0);
@@ -276,7 +195,7 @@ int bench_command(const BenchOptions& o) {
       const std::string suffix = pinned ? "_pinned" : "";
       note(fmt::format("DDS lockstep, one vehicle, {} s simulated{}", s,
                        pinned ? fmt::format(", plant on CPU {}, controller on CPU {}", pin[0], pin[1]) : ""));
-      const NodeRun r = run_nodes(tmp, o.scenario, s, 0, false, 0, pinned);
+      const hosts::NodeRun r = hosts::run_nodes(tmp, o.scenario, s, 0, false, 0, pinned);
       j["dds_lockstep_rtf" + suffix] = r.plant.is_object() ? r.plant.value("real_time_factor", 0.0) : 0.0;
       j["dds_cmd_roundtrip_us_p50" + suffix] = r.plant.is_object() ? r.plant.value("roundtrip_us_p50", 0.0) : 0.0;
       j["dds_cmd_roundtrip_us_p99" + suffix] = r.plant.is_object() ? r.plant.value("roundtrip_us_p99", 0.0) : 0.0;
@@ -293,7 +212,7 @@ int bench_command(const BenchOptions& o) {
     auto measure = [&](int priority, const std::string& suffix) {
       note(fmt::format("real time, one vehicle, {} s{}", s,
                        priority > 0 ? fmt::format(", SCHED_FIFO {}", priority) : ""));
-      const NodeRun r = run_nodes(tmp, o.scenario, s, 0, true, priority);
+      const hosts::NodeRun r = hosts::run_nodes(tmp, o.scenario, s, 0, true, priority);
       for (const char* k : {"p50", "p99", "max"}) {
         const std::string key = std::string("period_jitter_us_") + k;
         j["realtime_" + key + suffix] = r.controller.is_object() ? r.controller.value(key, 0.0) : 0.0;
@@ -313,8 +232,8 @@ int bench_command(const BenchOptions& o) {
   if (want("swarm_inproc")) {
     const double s = q ? 0.5 : 2.0;
     note(fmt::format("in-process swarm, {} s simulated per trial", s));
-    j["swarm_inproc_vehicles_at_rt"] = largest_at_real_time(q ? 256 : 4096, q ? 1024 : 1 << 20, q ? 0 : 5,
-                                                            [&](int n) { return swarm_inproc_rtf(swarm, n, s); });
+    j["swarm_inproc_vehicles_at_rt"] = largest_at_real_time(
+        q ? 256 : 4096, q ? 1024 : 1 << 20, q ? 0 : 5, [&](int n) { return hosts::swarm_inproc_rtf(swarm, n, s); });
     j["swarm_inproc_trial_s"] = s;
   }
   if (want("swarm_dds")) {
@@ -324,7 +243,7 @@ int bench_command(const BenchOptions& o) {
       note(fmt::format("DDS swarm, {} s simulated per trial{}", s, pinned ? ", plant and controller pinned" : ""));
       j[pinned ? "swarm_dds_vehicles_at_rt_pinned" : "swarm_dds_vehicles_at_rt"] =
           largest_at_real_time(q ? 4 : 32, q ? 8 : 8192, q ? 0 : 4, [&](int n) {
-            const NodeRun r = run_nodes(tmp, o.swarm_scenario, s, n, false, 0, pinned);
+            const hosts::NodeRun r = hosts::run_nodes(tmp, o.swarm_scenario, s, n, false, 0, pinned);
             return r.plant.is_object() ? r.plant.value("real_time_factor", 0.0) : 0.0;
           });
     }

@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "controllers/registry.hpp"
+#include "hosts/node_options.hpp"
+#include "hosts/recorder_process.hpp"
+#include "hosts/topic_process.hpp"
 
 namespace CLI {
 class App;
@@ -21,17 +24,8 @@ class OutputFolder;
 
 namespace quadcosim::app {
 
-/// `--foxglove [ADDR:]PORT` and its companions (run, plant, controller): serve the node's topics live
-/// over the Foxglove WebSocket protocol (app/foxglove_cli.hpp, docs/foxglove.md).
-struct FoxgloveCliOptions {
-  std::string listen;            ///< "PORT" (on 127.0.0.1) or "ADDR:PORT"; "" for no server
-  double linger_s = 0.0;         ///< keep serving the last state this long after the run [s]
-  double wait_s = 0.0;           ///< in-process run: wait this long for a client to subscribe first [s]
-  double pace = 0.0;             ///< in-process run: run at this many times real time (0: unpaced)
-  std::size_t queue_kib = 1024;  ///< per-client queue above which messages are dropped [KiB]
-  /// --foxglove-allow-origin: browser Origins admitted besides the local ones ("*": any)
-  std::vector<std::string> allow_origins;
-};
+/// `--foxglove [ADDR:]PORT` and its companions (run, plant, controller): hosts/node_options.hpp.
+using FoxgloveCliOptions = hosts::FoxgloveOptions;
 
 struct RunOptions {
   std::string scenario;
@@ -99,103 +93,15 @@ int summary_command(const SummaryOptions& options);
 CLI::App* add_summary_subcommand(CLI::App& app, SummaryOptions& options);
 
 /// --vehicles N: how `plant` and `controller` host a swarm (lockstep only).
-struct NodeSwarmOptions {
-  int vehicles = 0;       ///< > 0: host this many vehicles (namespaces <ns-prefix>0000, ...)
-  std::string ns_prefix;  ///< overrides the scenario's swarm.namespace_prefix
-  int threads = 2;        ///< threads (one DDS participant each)
-};
+using NodeSwarmOptions = hosts::NodeSwarmOptions;
 
-/// `quadcosim plant`: what every mode takes, then what one mode alone takes (its own struct).
-struct PlantCommandOptions {
-  /// Lockstep only (one vehicle or --vehicles N).
-  struct Lockstep {
-    std::string on_timeout = "abort";  ///< "abort" (exit 4) or "hold" (last commands, go on unpaced)
-    /// How the controller steps (one vehicle): "samples" (on each control tick's samples, answering
-    /// tick 0), "clock" (from a timer on ROS time: samples, a parameter round trip to its node, then
-    /// /clock; first answer one period in), "auto" (clock when the node has use_sim_time true).
-    std::string sync = "auto";
-    std::string controller_node;  ///< the node --sync talks to ("" = found from the command publisher)
-  };
-  /// Real time only (--realtime).
-  struct Realtime {
-    double rate_factor = 1.0;          ///< run k times faster than the wall clock
-    bool wait_for_controller = false;  ///< start the clock only once a controller is matched
-  };
-  /// One vehicle only (lockstep or real time).
-  struct OneVehicle {
-    std::string record;  ///< trajectory CSV to write ("" for none)
-    std::string mcap;    ///< MCAP file to record the topics into, metadata.yaml beside it ("" for none)
-    /// Apply the scenario's schedule through this node's ROS 2 parameter services, each change
-    /// before the tick it is due at ("" = the plant leaves the schedule to the controller).
-    std::string schedule_node;
-  };
-  /// --vehicles N (lockstep).
-  struct Swarm : NodeSwarmOptions {
-    std::string out;  ///< directory for summary.json, vehicles.csv, recorded vehicles
-  };
-
-  // Every mode.
-  std::string scenario;         ///< vehicle, rates, duration, initial state ("" for defaults)
-  std::string vehicle;          ///< vehicle file, replaces the scenario's vehicle when set
-  std::string fmu;              ///< --fmu: a co-simulation FMU flown as the plant (default variable names)
-  std::string ns;               ///< overrides the scenario's namespace when set
-  bool sensor_qos = false;      ///< publish Pose/Velocity/Imu with the ROS sensor-data QoS (best effort)
-  std::string cpus;             ///< run on these CPUs only ("0", "0-1"; "" for any)
-  bool lockstep = true;         ///< false: real time
-  double duration_s = -1.0;     ///< overrides the scenario's duration when >= 0
-  double timeout_s = 10.0;      ///< how long to wait for a controller (and, in lockstep, for one command)
-  double watchdog_s = -1.0;     ///< overrides simulation.watchdog_s when >= 0 (0: off)
-  std::string watchdog_policy;  ///< overrides simulation.watchdog_policy when set: "hold" or "stop"
-  std::string stats;            ///< write run figures (real-time factor, round trip) as JSON here ("" none)
-  std::string enclave = "/";    ///< DDS Security enclave (rcl --enclave)
-  /// Publish /clock after each tick's Pose, Velocity and Imu (a peer stepping on /clock).
-  bool clock_after_sensors = false;
-
-  FoxgloveCliOptions foxglove;  ///< one vehicle
-
-  Lockstep lockstep_only;
-  Realtime realtime;
-  OneVehicle one_vehicle;
-  Swarm swarm;
-};
+/// `quadcosim plant`: the plant process's options (hosts/node_options.hpp).
+using PlantCommandOptions = hosts::PlantProcessOptions;
 int plant_command(const PlantCommandOptions& options);
 CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& options);
 
-/// `quadcosim controller`: what every mode takes, then what one mode alone takes (its own struct).
-struct ControllerCommandOptions {
-  /// Real time only (--realtime).
-  struct Realtime {
-    double rate_factor = 1.0;  ///< the timer runs k times faster (to match a faster plant)
-    std::string stats;         ///< write the control period jitter as JSON here on exit
-    int rt_priority = 0;       ///< run the control loop under SCHED_FIFO at this priority (0 off)
-  };
-  /// One vehicle only.
-  struct OneVehicle {
-    std::string node_name = "attitude_controller";  ///< ROS node name (parameter services, node list)
-  };
-  /// --vehicles N (lockstep): this many vehicles' controllers.
-  using Swarm = NodeSwarmOptions;
-
-  // Every mode.
-  std::string scenario;    ///< controller parameters, rates, schedule ("" for defaults)
-  std::string controller;  ///< --controller: replaces the scenario's controller.type ("" keeps it)
-  std::string params;      ///< controller parameter file, applied over the scenario's
-  std::string vehicle;     ///< vehicle file (the controller's model of the vehicle)
-  std::string fmu;         ///< --fmu: a co-simulation FMU flown as the controller (default variable names)
-  std::string python;      ///< --python module:Class: a controller written in Python
-  std::string on_controller_error = "stop";  ///< a failed step: "stop" the node or send the "safety" command
-  std::string ns;
-  bool sensor_qos = false;  ///< subscribe Pose/Velocity/Imu with the sensor-data QoS (best effort)
-  std::string cpus;         ///< run on these CPUs only ("1", "0-1"; "" for any)
-  bool lockstep = true;
-  bool apply_schedule = true;   ///< apply the scenario's schedule itself (off when the plant does it)
-  std::string enclave = "/";    ///< DDS Security enclave (rcl --enclave)
-  FoxgloveCliOptions foxglove;  ///< one vehicle
-
-  Realtime realtime;
-  OneVehicle one_vehicle;
-  Swarm swarm;
-};
+/// `quadcosim controller`: the controller process's options (hosts/node_options.hpp).
+using ControllerCommandOptions = hosts::ControllerProcessOptions;
 int controller_command(const ControllerCommandOptions& options);
 CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& options);
 
@@ -218,30 +124,14 @@ int param_command(const ParamOptions& options);
 /// "" when `text` is a valid ROS node name (NAME or /NAMESPACE/NAME), else why not (a CLI check).
 std::string check_node_name(const std::string& text);
 
-/// `quadcosim topic list|echo|hz` (topic_command.cpp). Negative wait_s: the verb's default.
-struct TopicOptions {
-  std::string verb;         ///< "list", "echo" or "hz" (set by the subcommand parsed)
-  bool show_types = false;  ///< list -t
-  bool include_hidden = false;
-  double wait_s = -1.0;  ///< list: discovery time (1 s); echo/hz: how long to look for the topic (5 s)
-  std::string topic;
-  int count = 0;              ///< echo: stop after this many messages (0: until Ctrl-C)
-  std::string qos;            ///< "default" (reliable) or "sensor" (best effort); "": the verb's default
-  int window = 10000;         ///< hz: intervals the statistics cover
-  double duration_s = 0.0;    ///< hz: stop after this long (0: until Ctrl-C)
-  std::string enclave = "/";  ///< DDS Security enclave (rcl --enclave)
-};
+/// `quadcosim topic list|echo|hz`: the topic tools' options (hosts/topic_process.hpp).
+using TopicOptions = hosts::TopicToolOptions;
 /// Adds the `topic` subcommand with list/echo/hz under `app`, parsing into `options`.
 CLI::App* add_topic_subcommand(CLI::App& app, TopicOptions& options);
 int topic_command(TopicOptions options);
 
-struct RecordOptions {
-  std::string out;                  ///< MCAP file (metadata.yaml is written beside it)
-  std::string ns = "/drone";        ///< the vehicle's namespace
-  std::vector<std::string> topics;  ///< subset of the vehicle's topics (default: all)
-  double duration_s = -1.0;         ///< stop after this wall time [s] (default: Ctrl-C)
-  std::string enclave = "/";        ///< DDS Security enclave (rcl --enclave)
-};
+/// `quadcosim record`: the recorder process's options (hosts/recorder_process.hpp).
+using RecordOptions = hosts::RecorderOptions;
 int record_command(const RecordOptions& options);
 CLI::App* add_record_subcommand(CLI::App& app, RecordOptions& options);
 
@@ -257,6 +147,14 @@ struct SecurityOptions {
 };
 CLI::App* add_security_subcommand(CLI::App& app, SecurityOptions& options);
 int security_command(const SecurityOptions& options);
+
+/// Adds `--controller TYPE` (a registered controller type, checked) to `cmd`.
+void add_controller_type_option(CLI::App& cmd, std::string& type);
+
+/// `--judge spec|paper|none` (run, sweep): the criteria set a run is judged against (io::Judge); any
+/// other value is refused (exit 2) with the choices.
+void add_judge_option(CLI::App& cmd, std::string& judge);
+
 /// Adds `--enclave NAME` (validated as rcl validates enclave names) to a DDS command.
 void add_enclave_option(CLI::App* command, std::string& enclave);
 /// `--cpus LIST` (plant, controller): the CPUs the process runs on, checked as a CPU list.

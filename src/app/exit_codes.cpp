@@ -7,10 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/signals.hpp"
 #include "control/care.hpp"
 #include "dds/parameter_client.hpp"
 #include "fmi/model_description.hpp"
+#include "hosts/signals.hpp"
 #include "io/scenario.hpp"
 #include "security/keystore.hpp"
 #include "sim/controller_node.hpp"
@@ -92,10 +92,10 @@ int run_guarded(const std::string& command, const std::function<int()>& body) {
   } catch (const sim::ControllerFailure& e) {  // names the controller, the step and its time
     std::cerr << "error: " << command << ": " << e.what() << '\n';
     // A wait on an isolated controller given up on Ctrl-C or SIGTERM ends its step too.
-    return stop_signalled() ? exit_code::kInterrupted : exit_code::kControllerFailed;
+    return hosts::stop_signalled() ? exit_code::kInterrupted : exit_code::kControllerFailed;
   } catch (const fmi::FmuError& e) {  // names the FMU, the call, the tick and its time
     std::cerr << "error: " << command << ": " << e.what() << '\n';
-    return stop_requested() ? exit_code::kInterrupted : exit_code::kPlantFailed;
+    return hosts::stop_requested() ? exit_code::kInterrupted : exit_code::kPlantFailed;
   } catch (const dds::ParameterCallError& e) {
     std::cerr << "error: " << e.what() << '\n';
     return exit_code::kNoPeer;

@@ -8,25 +8,16 @@
 #include <string_view>
 #include <vector>
 
+#include "hosts/exit_code.hpp"
+
 namespace CLI {
 class App;
 }
 
 namespace quadcosim::app {
 
-/// The values a command returns (main() returns them as the process status).
-namespace exit_code {
-enum : int {
-  kOk = 0,                ///< done; every criterion passed
-  kFailed = 1,            ///< done, but the verdict is "no" (a criterion failed, a check found problems, ...)
-  kBadInput = 2,          ///< a file, flag or value was wrong (the message names it); nothing was run
-  kOutput = 3,            ///< an output could not be written, or a tool or system call failed
-  kNoPeer = 4,            ///< a DDS peer did not answer in time (lockstep timeout, no such node)
-  kControllerFailed = 5,  ///< the controller failed (raised, returned garbage, crashed, exited, hung)
-  kPlantFailed = 6,       ///< the plant's FMU failed (answered Error, crashed, exited, gave a NaN)
-  kInterrupted = 130      ///< SIGINT / SIGTERM (Ctrl-C) before the end; the outputs hold what ran
-};
-}
+/// The values a command returns (main() returns them as the process status): the hosts' (src/hosts/).
+namespace exit_code = hosts::exit_code;
 
 /// One row of the table: the code, what it means, and the commands that can return it with that
 /// meaning ("*": every command). A code may have one row per meaning.

@@ -24,7 +24,6 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
 #include "app/resources.hpp"
 #include "controllers/registry.hpp"
 #include "fmi/export/fmu_config.hpp"
@@ -32,6 +31,7 @@
 #include "fmi/quadrotor_variables.hpp"
 #include "fmi/unzip.hpp"
 #include "fmi/zip_writer.hpp"
+#include "hosts/node_common.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {

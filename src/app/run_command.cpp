@@ -13,16 +13,16 @@
 #include <optional>
 #include <thread>
 
-#include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/foxglove_cli.hpp"
-#include "app/inprocess_run.hpp"
-#include "app/node_common.hpp"
-#include "app/signals.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/peer_pairing.hpp"
+#include "hosts/child_process.hpp"
+#include "hosts/inprocess_run.hpp"
+#include "hosts/node_common.hpp"
+#include "hosts/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
@@ -67,8 +67,8 @@ class Progress {
 // Plant and controller as two child processes over DDS, lockstep; the plant records. Both are ended
 // on every path (ChildProcess), also on Ctrl-C.
 int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
-  install_stop_handlers();
-  const std::string self = self_executable();
+  hosts::install_stop_handlers();
+  const std::string self = hosts::self_executable();
   const std::string timeout = fmt::format("{}", opt.timeout_s);
   // The plant owns simulated time, so in lockstep it applies the schedule through the controller's
   // parameter services, each change before its tick; in real time the controller applies it itself.
@@ -106,7 +106,7 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     for (std::string a : {"--realtime", "--wait-for-controller", "--rate-factor"}) plant_args.push_back(a);
     plant_args.push_back(fmt::format("{}", opt.rate_factor));
   }
-  if (opt.pin) pin_apart(plant_args, controller_args);
+  if (opt.pin) hosts::pin_apart(plant_args, controller_args);
   for (const std::string& a : io::limit_arguments(io::limits())) {  // the child processes read the same files
     plant_args.push_back(a);
     controller_args.push_back(a);
@@ -119,7 +119,7 @@ int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
     if (opt.foxglove.linger_s > 0)
       plant_args.insert(plant_args.end(), {"--foxglove-linger", fmt::format("{}", opt.foxglove.linger_s)});
   }
-  return run_plant_and_controller(plant_args, controller_args);
+  return hosts::run_plant_and_controller(plant_args, controller_args);
 }
 
 // The run's provenance record (io/provenance.hpp): made once, written into metadata.yaml, metrics.json
@@ -135,7 +135,7 @@ nlohmann::json run_provenance(const RunOptions& opt, const io::Scenario& flown) 
 
 // "run: FAILED against spec: z overshoot_pct 30.2 outside [-, 25]; ...": the judged criteria that failed,
 // each named by its block and figure, so the exit code 1 comes with its reason on one line.
-std::string failed_criteria_line(const RunJudgement& j) {
+std::string failed_criteria_line(const hosts::RunJudgement& j) {
   std::vector<std::string> failed;
   const auto add = [&](const std::string& block, const std::vector<io::CriterionResult>& criteria) {
     for (const auto& c : criteria) {
@@ -244,15 +244,15 @@ int run_command(const RunOptions& opt) {
       io::add_provenance_to_bag_metadata(out, provenance);  // the plant wrote it: what ran, also when stopped
       if (rc != 0) return rc;
     } else {
-      install_stop_handlers();
+      hosts::install_stop_handlers();
       Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
       // --foxglove: served from the simulation's transport; --foxglove-pace holds each tick back
       // until its time on the wall clock (scaled), so a viewer sees the run as it would fly.
       std::unique_ptr<foxglove::Server> fox;
       std::chrono::steady_clock::time_point paced_from;
       const auto attach = [&](sim::Transport& transport, const sim::Topics& topics) {
-        fox = start_foxglove(opt.foxglove, "run", transport, topics, sc);
-        if (fox) wait_for_foxglove_client(opt.foxglove, "run", *fox);
+        fox = hosts::start_foxglove(opt.foxglove, "run", transport, topics, sc);
+        if (fox) hosts::wait_for_foxglove_client(opt.foxglove, "run", *fox);
         paced_from = std::chrono::steady_clock::now();
       };
       const auto on_tick = [&](double t_s) {
@@ -261,12 +261,12 @@ int run_command(const RunOptions& opt) {
           std::this_thread::sleep_until(paced_from + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                          std::chrono::duration<double>(t_s / opt.foxglove.pace)));
         }
-        return stop_requested();
+        return hosts::stop_requested();
       };
-      const bool completed = fly_inprocess(
+      const bool completed = hosts::fly_inprocess(
           sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); },
           opt.foxglove.listen.empty() ? nullptr : std::function(attach));
-      if (fox) finish_foxglove(opt.foxglove, "run", *fox);
+      if (fox) hosts::finish_foxglove(opt.foxglove, "run", *fox);
       io::add_provenance_to_bag_metadata(out, provenance);
       if (!completed) {
         // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.
@@ -276,7 +276,8 @@ int run_command(const RunOptions& opt) {
     }
 
     // Both transports are judged from what was recorded: the exact doubles of trajectory.csv.
-    const RunJudgement judged = judge_run(sc, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec), provenance);
+    const hosts::RunJudgement judged =
+        hosts::judge_run(sc, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec), provenance);
     std::cout << judged.table;  // says what was judged, and once when the scenario has none of that set
     if (judged.saturation) {
       if (const std::string w = io::saturation_warning(*judged.saturation); !w.empty()) {

@@ -1,4 +1,5 @@
-// Swarm runs: many vehicles in one `run`, in-process or over DDS (swarm_run.cpp, swarm_nodes.cpp).
+// Swarm runs: many vehicles in one `run`, in-process or over DDS (swarm_run.cpp; the hosts are
+// hosts/swarm_inprocess.hpp and hosts/swarm_nodes.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -9,7 +10,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
-#include "app/swarm_inprocess.hpp"
+#include "hosts/swarm_inprocess.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::app {
@@ -20,9 +21,5 @@ namespace quadcosim::app {
 /// record, also in each recorded vehicle's metrics.json) to summary.json.
 int run_swarm(const RunOptions& options, const io::Scenario& sc, const std::filesystem::path& out,
               io::OutputFolder& folder, const nlohmann::json& provenance);
-
-/// `plant --vehicles N` / `controller --vehicles N`: N vehicles in one process over DDS.
-int swarm_plant_command(const PlantCommandOptions& options, io::Scenario sc);
-int swarm_controller_command(const ControllerCommandOptions& options, io::Scenario sc);
 
 }  // namespace quadcosim::app

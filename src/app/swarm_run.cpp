@@ -10,12 +10,12 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "app/child_process.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
-#include "app/signals.hpp"
 #include "app/swarm.hpp"
+#include "hosts/child_process.hpp"
+#include "hosts/node_common.hpp"
+#include "hosts/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
 
@@ -25,14 +25,14 @@ namespace fs = std::filesystem;
 
 int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out, io::OutputFolder& folder,
               const nlohmann::json& provenance) {
-  const io::SwarmSpec spec = swarm_spec(sc, opt.vehicles, opt.threads);
+  const io::SwarmSpec spec = hosts::swarm_spec(sc, opt.vehicles, opt.threads);
   const int n = spec.layout.vehicles;
   const std::vector<std::string> dirs =
-      make_recorded_dirs(out, spec, io::effective_scenario_text(opt.scenario, opt.controller));
-  install_stop_handlers();
+      hosts::make_recorded_dirs(out, spec, io::effective_scenario_text(opt.scenario, opt.controller));
+  hosts::install_stop_handlers();
   if (opt.transport == "dds") {
     // The plant process records; the controller process answers.
-    const std::string self = self_executable();
+    const std::string self = hosts::self_executable();
     std::vector<std::string> plant_args = {
         self,          "plant",           "--scenario", opt.scenario,
         "--vehicles",  std::to_string(n), "--timeout",  fmt::format("{}", opt.timeout_s),
@@ -43,14 +43,14 @@ int run_swarm(const RunOptions& opt, const io::Scenario& sc, const fs::path& out
       controller_args.push_back("--controller");
       controller_args.push_back(opt.controller);
     }
-    if (opt.pin) pin_apart(plant_args, controller_args);
-    if (const int rc = run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;
-  } else if (!fly_swarm_inprocess(sc, spec, out, std::cout, [](double) { return stop_requested(); })) {
+    if (opt.pin) hosts::pin_apart(plant_args, controller_args);
+    if (const int rc = hosts::run_plant_and_controller(plant_args, controller_args); rc != 0) return rc;
+  } else if (!hosts::fly_swarm_inprocess(sc, spec, out, std::cout, [](double) { return hosts::stop_requested(); })) {
     std::cerr << "\nrun: interrupted; the recorded vehicles' trajectory.csv hold what ran\n";
     return exit_code::kInterrupted;
   }
-  const SwarmJudgement judged =
-      judge_swarm(sc, spec, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec), provenance);
+  const hosts::SwarmJudgement judged =
+      hosts::judge_swarm(sc, spec, out, io::parse_judge(opt.judge).value_or(io::Judge::kSpec), provenance);
   for (const std::string& w : judged.warnings) std::cerr << "run: " << w << '\n';
   std::cout << "wrote " << (out / "summary.json").string() << ", vehicles.csv"
             << (dirs.empty() ? "" : fmt::format(", {} recorded vehicle(s)", dirs.size())) << '\n';

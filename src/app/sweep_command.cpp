@@ -18,8 +18,9 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
-#include "app/signals.hpp"
+#include "app/sweep_progress.hpp"
+#include "hosts/node_common.hpp"
+#include "hosts/signals.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
@@ -106,74 +107,6 @@ bool parse_shard(const std::string& text, int& k, int& n) {
     return false;
   }
 }
-
-// Progress of the runs on stderr: on a terminal one line rewritten in place (at most 5 times a second),
-// else a line every `every_s` seconds (each run with 0); always the last count. Only stderr: what
-// the sweep writes does not depend on it. Called from run_many's `finished`, one call at a time.
-class Progress {
- public:
-  Progress(std::string name, int total, int done_before, int passed_before, double every_s)
-      : name_(std::move(name)),
-        total_(total),
-        done_(done_before),
-        passed_(passed_before),
-        done_before_(done_before),
-        tty_(isatty(STDERR_FILENO) == 1),
-        every_s_(tty_ ? 0.2 : every_s),
-        start_(std::chrono::steady_clock::now()),
-        last_(start_) {}
-
-  void finished(bool passed) {
-    ++done_;
-    passed_ += passed ? 1 : 0;
-    const auto now = std::chrono::steady_clock::now();
-    if (done_ < total_ && std::chrono::duration<double>(now - last_).count() < every_s_) return;
-    last_ = now;
-    print(now);
-  }
-
-  // The last count, and the end of the line on a terminal (before anything else is printed).
-  void end() {
-    if (done_ == printed_) {
-      if (tty_ && printed_ >= 0) std::cerr << '\n';
-      return;
-    }
-    print(std::chrono::steady_clock::now());
-    if (tty_) std::cerr << '\n';
-  }
-
- private:
-  void print(std::chrono::steady_clock::time_point now) {
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const int flown = done_ - done_before_;  // this command's runs: what the time left is estimated from
-    const std::string left = done_ >= total_ ? "done"
-                             : flown > 0 ? fmt::format("about {} left", duration(elapsed / flown * (total_ - done_)))
-                                         : "time left unknown";
-    const std::string line =
-        fmt::format("sweep {}: {}/{} runs done, {} passed ({:.1f} %), {} elapsed, {}", name_, done_, total_, passed_,
-                    done_ > 0 ? 100.0 * passed_ / done_ : 0.0, duration(elapsed), left);
-    if (tty_) {
-      std::cerr << "\r\033[K" << line << std::flush;  // the line rewritten in place
-    } else {
-      std::cerr << line << std::endl;
-    }
-    printed_ = done_;
-  }
-
-  static std::string duration(double s) {
-    if (s < 60.0) return fmt::format("{:.1f} s", s);
-    const auto whole = static_cast<long long>(std::llround(s));
-    if (whole < 3600) return fmt::format("{}:{:02d} min", whole / 60, whole % 60);
-    return fmt::format("{}:{:02d}:{:02d} h", whole / 3600, (whole / 60) % 60, whole % 60);
-  }
-
-  std::string name_;
-  int total_, done_, passed_, done_before_;
-  int printed_ = -1;  ///< the count last printed
-  bool tty_;
-  double every_s_;
-  std::chrono::steady_clock::time_point start_, last_;
-};
 
 // Makes PYTHONPATH what the sweep in `dir` recorded (origin.json) ahead of the current one, before
 // anything starts Python, so that a Python controller is imported from where the sweep imported it,
@@ -429,17 +362,17 @@ int sweep_command(const SweepOptions& o) {
   }
   // Ctrl-C or SIGTERM: no new run starts, those under way finish, and the summary of the finished ones
   // is written. Meanwhile the manifest lists what is written, at most a second late.
-  install_stop_handlers();
+  hosts::install_stop_handlers();
   auto last_record = std::chrono::steady_clock::now();
   int passed_before = 0;
   for (const auto& r : per_run) passed_before += r.at("passed").get<bool>() ? 1 : 0;
-  std::optional<Progress> progress;
+  std::optional<SweepProgress> progress;
   if (o.progress && !indices.empty()) {
     progress.emplace(plan.nominal.name, static_cast<int>(done.size() + indices.size()), static_cast<int>(done.size()),
                      passed_before, o.progress_every_s);
   }
   sweep::RunControl control;
-  control.stop = [] { return stop_requested(); };
+  control.stop = [] { return hosts::stop_requested(); };
   control.finished = [&](const sweep::RunResult& r) {
     if (progress) progress->finished(r.passed);
     const auto now = std::chrono::steady_clock::now();
@@ -481,7 +414,7 @@ int sweep_command(const SweepOptions& o) {
         "sweep {} shard {}: {} of {} runs ({} passed); wrote {} and runs/NNNN/metrics.json; "
         "join the shards with `quadcosim sweep merge OUT DIR...`\n",
         plan.nominal.name, o.shard, per_run.size(), plan.runs, passed, (out / "shard.json").string());
-    return stop_requested() ? exit_code::kInterrupted : exit_code::kOk;
+    return hosts::stop_requested() ? exit_code::kInterrupted : exit_code::kOk;
   }
   if (interrupted) {
     const nlohmann::json summary = sweep::partial_summary_json(header, std::move(per_run));
@@ -495,7 +428,7 @@ int sweep_command(const SweepOptions& o) {
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
   print_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
-  if (stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
+  if (hosts::stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
   if (o.plots && !(run_tool("plot_sweep.py", {o.out_dir}) && make_index(o.out_dir))) return exit_code::kOutput;
   return verdict(summary, o.min_pass_rate);
 }

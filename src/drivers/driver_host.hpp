@@ -1,6 +1,6 @@
 // What a driver (drivers/*.hpp) needs from the place it runs in, and nothing else: a monotonic wall
 // clock, a way to wait while the answers are delivered, and whether to stop. Over DDS the app builds
-// one on a DdsTransport and its ArrivalExecutor (app/node_common.hpp); in-process and in tests a
+// one on a DdsTransport and its ArrivalExecutor (hosts/node_common.hpp); in-process and in tests a
 // host delivers synchronously or from a queue. A host never decides anything about ticks.
 #pragma once
 

@@ -1,6 +1,6 @@
 // The Python module quadcosim (its compiled part, quadcosim._quadcosim; the package's __init__.py adds
 // load_scenario(), run() and RunResult on top). Scenarios are read and validated by io::load_scenario,
-// runs recorded and judged by the code `quadcosim run` uses (app/inprocess_run.hpp), so a run from
+// runs recorded and judged by the code `quadcosim run` uses (hosts/inprocess_run.hpp), so a run from
 // Python writes the same bytes as the CLI. The GIL is released around all C++ simulation work.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -23,10 +23,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "app/inprocess_run.hpp"
-#include "app/swarm_inprocess.hpp"
 #include "batch.hpp"
 #include "control/care.hpp"
+#include "hosts/inprocess_run.hpp"
+#include "hosts/swarm_inprocess.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
 #include "io/scenario.hpp"
@@ -348,14 +348,14 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
     throw py::value_error("judge: got '" + judge_name + "', expected 'spec', 'paper' or 'none'");
   }
   const bool swarm = vehicles > 0 || s.scenario.swarm.has_value();
-  const io::SwarmSpec spec = app::swarm_spec(s.scenario, vehicles, threads);
+  const io::SwarmSpec spec = hosts::swarm_spec(s.scenario, vehicles, threads);
   if (swarm) io::check_swarm_fits(spec.layout.vehicles);
   std::optional<TempDir> temp;
   std::optional<io::OutputFolder> folder;
   fs::path dir;
   std::ostringstream notes, info, warn;
-  app::RunJudgement judged;
-  app::SwarmJudgement swarm_judged;
+  hosts::RunJudgement judged;
+  hosts::SwarmJudgement swarm_judged;
   std::vector<std::pair<std::string, std::vector<double>>> columns;
   std::vector<std::string> recorded_dirs;
   std::vector<std::vector<std::pair<std::string, std::vector<double>>>> recorded_columns;
@@ -384,15 +384,15 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
       const nlohmann::json provenance = io::describe_run(
           s.scenario, {.controller_override = s.controller_override, .python_target = io::python_target_of(s.root)});
       if (swarm) {
-        recorded_dirs = app::make_recorded_dirs(dir, spec, flown);
-        interrupted = !app::fly_swarm_inprocess(s.scenario, spec, dir, info, [&](double) { return signalled(); });
-        if (!interrupted) swarm_judged = app::judge_swarm(s.scenario, spec, dir, *judge, provenance);
+        recorded_dirs = hosts::make_recorded_dirs(dir, spec, flown);
+        interrupted = !hosts::fly_swarm_inprocess(s.scenario, spec, dir, info, [&](double) { return signalled(); });
+        if (!interrupted) swarm_judged = hosts::judge_swarm(s.scenario, spec, dir, *judge, provenance);
       } else {
         sim::Tick ticks = 0;
         const auto on_tick = [&](double) { return ++ticks % 4096 == 0 && signalled(); };
-        interrupted = !app::fly_inprocess(s.scenario, dir, info, warn, on_tick);
+        interrupted = !hosts::fly_inprocess(s.scenario, dir, info, warn, on_tick);
         io::add_provenance_to_bag_metadata(dir, provenance);
-        if (!interrupted) judged = app::judge_run(s.scenario, dir, *judge, provenance);
+        if (!interrupted) judged = hosts::judge_run(s.scenario, dir, *judge, provenance);
       }
     } catch (const control::CareError& e) {
       throw io::ConfigError(s.source + ": controller design failed: " + e.what());

@@ -18,11 +18,11 @@
 #include <optional>
 #include <string>
 
-#include "app/parameter_binding.hpp"
 #include "closed_loop.hpp"
 #include "cyclone_bytes.hpp"
 #include "dds/parameter_service.hpp"
 #include "dds/parameter_wire.hpp"
+#include "hosts/parameter_binding.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
@@ -40,12 +40,12 @@ struct Setup {
 
   Setup() {
     dds::ParameterCallbacks cb;
-    cb.names = [] { return app::controller_parameter_callbacks(*g_node).names(); };
-    cb.get = [](const std::string& n) { return app::controller_parameter_callbacks(*g_node).get(n); };
+    cb.names = [] { return hosts::controller_parameter_callbacks(*g_node).names(); };
+    cb.get = [](const std::string& n) { return hosts::controller_parameter_callbacks(*g_node).get(n); };
     cb.set = [](const std::string& n, const dds::ParamValue& v) {
-      return app::controller_parameter_callbacks(*g_node).set(n, v);
+      return hosts::controller_parameter_callbacks(*g_node).set(n, v);
     };
-    cb.describe = [](const std::string& n) { return app::controller_parameter_callbacks(*g_node).describe(n); };
+    cb.describe = [](const std::string& n) { return hosts::controller_parameter_callbacks(*g_node).describe(n); };
     dds::ParameterServerOptions options;
     options.reply_wait_ns = 0;
     const dds::NodeName node{"/", "attitude_controller"};

@@ -28,7 +28,7 @@ bool g_running = false;
 /// threads that call controllers (a sweep's runs, a node's controller thread) can take it.
 void start_python() {
   std::call_once(g_started, [] {
-    // The CLI keeps its own SIGINT/SIGTERM handlers (app/signals.hpp): Python installs none.
+    // The CLI keeps its own SIGINT/SIGTERM handlers (hosts/signals.hpp): Python installs none.
     py::initialize_interpreter(/*init_signal_handlers=*/false);
     {
       // The package quadcosim where it was built, after PYTHONPATH: `import quadcosim` in a

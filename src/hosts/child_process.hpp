@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 class ChildProcess {
  public:
@@ -48,4 +48,4 @@ int run_plant_and_controller(const std::vector<std::string>& plant_argv,
 /// Path of the running executable (/proc/self/exe).
 std::string self_executable();
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -1,6 +1,6 @@
-#include "app/child_process.hpp"
+#include "hosts/child_process.hpp"
 
-#include "app/signals.hpp"
+#include "hosts/signals.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -17,7 +17,7 @@
 
 extern char** environ;
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::string& output_path) {
   // Everything the child needs is made before fork(): between fork and exec only async-signal-safe
@@ -158,4 +158,4 @@ int run_plant_and_controller(const std::vector<std::string>& plant_argv,
   return 0;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -6,7 +6,7 @@
 #include "dds/parameter_service.hpp"
 #include "sim/controller_node.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 /// A declared parameter's value as a ROS 2 ParameterValue: numbers DOUBLE, choices STRING.
 dds::ParamValue to_ros(const control::ParameterValue& value);
@@ -14,4 +14,4 @@ dds::ParamValue to_ros(const control::ParameterValue& value);
 /// Callbacks bound to `node` (which must outlive them).
 dds::ParameterCallbacks controller_parameter_callbacks(sim::ControllerNode& node);
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

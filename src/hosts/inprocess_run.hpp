@@ -16,7 +16,7 @@
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 /// Flies `scenario` in one process (sim::Simulation) and records it into `out`: trajectory.csv,
 /// run.mcap and metadata.yaml. Notes on the plant's watchdog go to `warn` as they happen; the run's
@@ -54,4 +54,4 @@ struct RunJudgement {
 RunJudgement judge_run(const io::Scenario& scenario, const std::filesystem::path& out,
                        io::Judge judge = io::Judge::kSpec, const nlohmann::json& provenance = nullptr);
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -17,7 +17,7 @@
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 /// In-process swarms advance each vehicle 100 ticks (1 s at 100 Hz) at a time (sim::Swarm::run).
 constexpr sim::Tick kSwarmBlockTicks = 100;
@@ -71,4 +71,4 @@ struct SwarmJudgement {
 SwarmJudgement judge_swarm(const io::Scenario& scenario, const io::SwarmSpec& spec, const std::filesystem::path& out,
                            io::Judge judge, const nlohmann::json& provenance);
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

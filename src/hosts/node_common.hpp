@@ -2,8 +2,6 @@
 // measure with, how they find their scenario, and the sensor-data QoS option.
 #pragma once
 
-#include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -20,7 +18,7 @@
 #include "io/scenario.hpp"
 #include "sim/topics.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 constexpr std::int64_t kMs = 1'000'000;  ///< [ns]
 
@@ -39,13 +37,6 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
                                                const std::string& scenario, const std::string& vehicle,
                                                const std::string& ns, const std::string& controller_type = "");
 
-/// Adds `--controller TYPE` (a registered controller type, checked) to `cmd`.
-void add_controller_type_option(CLI::App& cmd, std::string& type);
-
-/// `--judge spec|paper|none` (run, sweep): the criteria set a run is judged against (io::Judge); any
-/// other value is refused (exit 2) with the choices.
-void add_judge_option(CLI::App& cmd, std::string& judge);
-
 /// Real-time loops: lets the DDS transport deliver messages until 1 ms before `deadline_ns`
 /// (steady_ns), then spins on the clock until the deadline (5 % of a core for a 20 ms period), so
 /// the wake-up lands on the deadline instead of a scheduler wake-up later. The first call also asks
@@ -57,7 +48,7 @@ void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns);
 /// dds::ArrivalExecutor (its threading rule) that runs `on_delivery` after each delivery.
 class DdsDriverHost final : public drivers::DriverHost {
  public:
-  /// `precise_deadlines`: wait_until spins its last millisecond (app::wait_until), for the
+  /// `precise_deadlines`: wait_until spins its last millisecond (hosts::wait_until), for the
   /// real-time controller's timer.
   explicit DdsDriverHost(dds::DdsTransport& transport, bool precise_deadlines = false)
       : transport_(transport), precise_(precise_deadlines) {}
@@ -134,4 +125,4 @@ void write_stats(const std::string& path, const nlohmann::json& stats);
 /// ROS sensor-data QoS (KEEP_LAST 5, BEST_EFFORT) on the three sensor topics.
 void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics);
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -1,8 +1,8 @@
-#include "app/parameter_binding.hpp"
+#include "hosts/parameter_binding.hpp"
 
 #include "control/parameters.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 dds::ParamValue to_ros(const control::ParameterValue& v) {
   if (const auto* s = std::get_if<std::string>(&v)) return dds::ParamValue::of_string(*s);
@@ -73,4 +73,4 @@ dds::ParameterCallbacks controller_parameter_callbacks(sim::ControllerNode& node
   return cb;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -1,8 +1,6 @@
-#include "app/node_common.hpp"
+#include "hosts/node_common.hpp"
 
 #include <fmt/format.h>
-
-#include <CLI/CLI.hpp>
 
 #include <pthread.h>
 #include <sched.h>
@@ -18,15 +16,14 @@
 #include <iostream>
 
 #include "analysis/percentile.hpp"
-#include "app/commands.hpp"
-#include "app/signals.hpp"
+#include "hosts/signals.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
                                                const std::string& scenario, const std::string& vehicle,
                                                const std::string& ns, const std::string& controller_type) {
-  install_stop_handlers();
+  hosts::install_stop_handlers();
   if (std::string err = use_cpus(cpus); !err.empty()) {
     std::cerr << "error: " << who << ": --cpus: " << err << '\n';
     return std::nullopt;
@@ -50,33 +47,6 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
                           "(quadcosim run without --transport dds); over DDS use tc netem (docs/reliability.md)");
   }
   return sc;
-}
-
-void check_controller_choice(CLI::Option& option) {
-  option.check(CLI::Validator(
-      [](std::string& value) -> std::string {
-        try {
-          (void)io::parse_controller_choice(value);
-          return "";
-        } catch (const std::invalid_argument& e) {
-          return e.what();
-        }
-      },
-      "TYPE|python:MODULE:CLASS|fmu:PATH"));
-}
-
-void add_controller_type_option(CLI::App& cmd, std::string& type) {
-  check_controller_choice(
-      *cmd.add_option("--controller", type,
-                      "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
-                      "python:MODULE:CLASS or fmu:PATH; the scenario's setpoints, reference and criteria stay"));
-}
-
-void add_judge_option(CLI::App& cmd, std::string& judge) {
-  cmd.add_option("--judge", judge,
-                 "judge the run against: spec (the scenario's specification, default), paper (the paper "
-                 "controller's measured response bands), none (figures only, no verdict)")
-      ->check(CLI::IsMember(io::judge_names()));
 }
 
 void wait_until(dds::DdsTransport& transport, std::int64_t deadline_ns) {
@@ -110,7 +80,7 @@ void DdsDriverHost::wait(std::int64_t timeout_ns, const std::function<bool()>& w
 
 void DdsDriverHost::wait_until(std::int64_t deadline_ns) {
   if (precise_ && !arrival_) {
-    app::wait_until(transport_, deadline_ns);
+    hosts::wait_until(transport_, deadline_ns);
   } else {
     DriverHost::wait_until(deadline_ns);
   }
@@ -125,7 +95,7 @@ std::string lockstep_timeout_message(const dds::DdsTransport& transport, const s
       topics.motor_commands, k, clock.seconds(k), timeout_s, transport.matched_writers(topics.motor_commands), policy);
 }
 
-bool DdsDriverHost::stop_requested() { return app::stop_requested(); }
+bool DdsDriverHost::stop_requested() { return hosts::stop_requested(); }
 
 void DdsDriverHost::deliver_on_arrival(bool on) {
   if (!on) {
@@ -174,41 +144,6 @@ std::string parse_cpu_list(const std::string& text, std::vector<int>& cpus) {
   std::sort(cpus.begin(), cpus.end());
   cpus.erase(std::unique(cpus.begin(), cpus.end()), cpus.end());
   return {};
-}
-
-void add_cpus_option(CLI::App* command, std::string& cpus) {
-  command
-      ->add_option("--cpus", cpus,
-                   "run this process on these CPUs only, e.g. 0 or 0-1 (as taskset -c; on 2 cores, plant and "
-                   "controller each on its own CPU run lockstep faster)")
-      ->check(CLI::Validator(
-          [](const std::string& text) {
-            std::vector<int> cpus;
-            return parse_cpu_list(text, cpus);
-          },
-          "LIST"));
-}
-
-void add_node_host_options(CLI::App* command, std::string& ns, NodeSwarmOptions& swarm, bool& sensor_qos,
-                           const std::string& sensor_qos_help, std::string& cpus) {
-  const CLI::Validator ros_namespace(sim::validate_namespace, "NAMESPACE");
-  command->add_option("--namespace", ns, "topic namespace, e.g. /uav1 (one vehicle)")->check(ros_namespace);
-  command->add_option("--vehicles", swarm.vehicles, "host N vehicles, namespaces <prefix>0000.. (lockstep)")
-      ->check(CLI::Range(1, 1'000'000));
-  command->add_option("--ns-prefix", swarm.ns_prefix,
-                      "with --vehicles: namespace prefix (default: swarm.namespace_prefix, /uav)");
-  command->add_option("--threads", swarm.threads, "with --vehicles: threads, one DDS participant each")
-      ->check(CLI::Range(1, 64));
-  command->add_flag("--sensor-qos", sensor_qos, sensor_qos_help);
-  add_cpus_option(command, cpus);
-}
-
-void refuse_idle_flags(const CLI::App& command, std::initializer_list<FlagRule> rules) {
-  for (const FlagRule& r : rules) {
-    if (command.count(r.flag) > 0 && !r.acts) {
-      throw CLI::ValidationError(r.flag, std::string("does nothing with ") + r.mode);
-    }
-  }
 }
 
 std::string use_cpus(const std::string& list) {
@@ -282,4 +217,4 @@ void use_sensor_qos(dds::DdsTransport& transport, const sim::Topics& topics) {
   }
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

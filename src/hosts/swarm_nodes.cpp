@@ -1,8 +1,10 @@
-// `quadcosim plant --vehicles N` and `quadcosim controller --vehicles N`: N vehicles' nodes in one
-// process over DDS, each vehicle under its own namespace (<prefix>0000, ...), lockstep only. The
-// vehicles are split over `threads` threads; each thread has its own DDS participant and runs its
-// vehicles' PlantNodes (or ControllerNodes) exactly as the single-vehicle processes do, so every
-// vehicle's numbers equal those of the in-process swarm.
+// The swarm processes (`quadcosim plant --vehicles N`, `quadcosim controller --vehicles N`): N
+// vehicles' nodes in one process over DDS, each vehicle under its own namespace (<prefix>0000, ...),
+// lockstep only. The vehicles are split over `threads` threads; each thread has its own DDS
+// participant and runs its vehicles' PlantNodes (or ControllerNodes) exactly as the single-vehicle
+// processes do, so every vehicle's numbers equal those of the in-process swarm.
+#include "hosts/swarm_nodes.hpp"
+
 #include <fmt/format.h>
 
 #include <atomic>
@@ -13,19 +15,19 @@
 #include <mutex>
 #include <thread>
 
-#include "app/exit_codes.hpp"
-#include "app/node_common.hpp"
-#include "app/signals.hpp"
-#include "app/swarm.hpp"
 #include "control/care.hpp"
 #include "dds/node_announcer.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
+#include "hosts/exit_code.hpp"
+#include "hosts/node_common.hpp"
+#include "hosts/signals.hpp"
+#include "hosts/swarm_inprocess.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/plant_node.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 namespace fs = std::filesystem;
 
@@ -250,7 +252,7 @@ class ControllerShard {
 
 }  // namespace
 
-int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
+int run_plant_swarm(const PlantProcessOptions& o, io::Scenario sc) {
   const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
   const int threads = std::clamp(o.swarm.threads, 1, n);
@@ -316,7 +318,7 @@ int swarm_plant_command(const PlantCommandOptions& o, io::Scenario sc) {
   return exit_code::kOk;
 }
 
-int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc) {
+int run_controller_swarm(const ControllerProcessOptions& o, io::Scenario sc) {
   const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
   const int threads = std::clamp(o.swarm.threads, 1, n);
@@ -335,4 +337,4 @@ int swarm_controller_command(const ControllerCommandOptions& o, io::Scenario sc)
   return rc;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -1,4 +1,4 @@
-#include "app/swarm_inprocess.hpp"
+#include "hosts/swarm_inprocess.hpp"
 
 #include <fmt/format.h>
 
@@ -14,7 +14,7 @@
 #include "io/trajectory_csv.hpp"
 #include "sim/swarm.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 namespace fs = std::filesystem;
 
@@ -161,4 +161,4 @@ SwarmJudgement judge_swarm(const io::Scenario& sc, const io::SwarmSpec& spec, co
   return verdict;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

@@ -3,7 +3,7 @@
 
 #include <chrono>
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 /// Routes SIGINT and SIGTERM to stop_requested(), which is also what a wait on an FMU's process polls
 /// (fmi::set_stop_check): a step that hangs there is given up and its process killed.
@@ -24,4 +24,4 @@ void request_stop();
 /// request_stop() and, once install_stop_handlers() ran, by SIGINT/SIGTERM (no polling).
 bool wait_for_stop(std::chrono::steady_clock::time_point deadline);
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

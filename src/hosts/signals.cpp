@@ -1,4 +1,4 @@
-#include "app/signals.hpp"
+#include "hosts/signals.hpp"
 
 #include <semaphore.h>
 #include <unistd.h>
@@ -13,7 +13,7 @@
 
 #include "isolation/child.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 namespace {
 // The one piece of process-wide state a signal handler may touch, and the semaphore it posts
@@ -83,4 +83,4 @@ bool wait_for_stop(std::chrono::steady_clock::time_point deadline) {
   return g_stop_wait.wait_until(lock, deadline, [] { return stop_requested(); });
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts

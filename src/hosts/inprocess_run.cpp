@@ -1,16 +1,16 @@
-#include "app/inprocess_run.hpp"
+#include "hosts/inprocess_run.hpp"
 
 #include <fmt/format.h>
 
 #include <fstream>
 
-#include "app/signals.hpp"
+#include "hosts/signals.hpp"
 #include "io/mcap_recorder.hpp"
 #include "io/provenance.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 namespace fs = std::filesystem;
 
@@ -99,4 +99,4 @@ RunJudgement judge_run(const io::Scenario& sc, const fs::path& out, io::Judge ju
   return j;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts
