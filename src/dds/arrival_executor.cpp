@@ -53,15 +53,7 @@ void ArrivalExecutor::after_each(std::function<bool()> hook) {
 }
 
 void ArrivalExecutor::on_data(std::size_t subscription) {
-  std::unique_lock<std::recursive_mutex> g(mutex_, std::try_to_lock);
-  if (!g.owns_lock()) {  // the owner works, or another thread delivers: the owner's wait takes it
-    {
-      const std::lock_guard<std::mutex> n(noted_mutex_);
-      noted_.push_back(subscription);
-    }
-    dds_set_guardcondition(wake_, true);
-    return;
-  }
+  const std::lock_guard<std::recursive_mutex> g(mutex_);
   if (failure_) return;  // delivery stopped; wait() rethrows
   try {
     delivered_ += transport_.take(subscription);
@@ -91,27 +83,9 @@ int ArrivalExecutor::wait(std::int64_t timeout_ns) {
   const dds_return_t rc = transport_.wait_waitset(timeout_ns);
   mutex_.lock();
   dds_set_guardcondition(wake_, false);
-  take_noted();
   if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
   const int served = transport_.serve_wait(rc);  // extra work (no subscription is on the waitset)
   return std::exchange(delivered_, 0) + served;
-}
-
-void ArrivalExecutor::take_noted() {
-  std::vector<std::size_t> noted;
-  {
-    const std::lock_guard<std::mutex> n(noted_mutex_);
-    noted.swap(noted_);
-  }
-  for (const std::size_t i : noted) {
-    if (failure_) return;
-    try {
-      delivered_ += transport_.take(i);
-    } catch (...) {
-      failure_ = std::current_exception();
-    }
-    after_delivery();  // may set the guard: the next wait returns at once, harmlessly
-  }
 }
 
 bool ArrivalExecutor::wait_until(const std::function<bool()>& done, std::int64_t timeout_ns) {

@@ -13,12 +13,6 @@
 //     lock; when it returns true, the owner's wait returns. Without a hook, deliveries do not end
 //     waits (wait_until's condition is asked after each delivery too).
 //   - A delivery may publish (also to this transport's own readers: the lock is recursive).
-//   - A receive thread never blocks on the lock: Cyclone runs one listener of a reader at a time, so
-//     a receive thread waiting inside reader R's listener for the owner, while the owner's own write
-//     delivers to R locally (a recorder reading a topic the owner publishes and a stranger publishes
-//     too), would wait for each other for ever. A delivery that finds the lock taken leaves its
-//     samples in the reader, notes the subscription and wakes the owner, whose next wait() takes them
-//     (on the owner's thread, in the order noted).
 //   - An exception a delivery (or the hook) throws is kept, later deliveries are dropped, the
 //     owner's wait returns at once and rethrows it.
 //   - Extra work of the transport (parameter services) is served by wait() on the owner's thread,
@@ -34,7 +28,6 @@
 #include <functional>
 #include <mutex>
 #include <thread>
-#include <vector>
 
 #include "dds/dds_transport.hpp"
 
@@ -75,8 +68,6 @@ class ArrivalExecutor {
 
  private:
   void on_data(std::size_t subscription);
-  /// Takes what deliveries that found the lock taken left (under the lock, on the owner's thread).
-  void take_noted();
   void after_delivery();
   void check_owner(const char* what) const;
 
@@ -90,10 +81,6 @@ class ArrivalExecutor {
   std::exception_ptr failure_;
   std::function<bool()> after_;
   const std::function<bool()>* until_ = nullptr;  ///< wait_until's condition while it runs
-  // Subscriptions whose delivery found the lock taken, for the owner's next wait (under noted_mutex_,
-  // which is never held while Cyclone is called).
-  std::mutex noted_mutex_;
-  std::vector<std::size_t> noted_;
 };
 
 }  // namespace quadcosim::dds
