@@ -41,9 +41,10 @@ std::vector<std::string> PlantProcess::sensor_topics() const {
   return all;
 }
 
-std::vector<std::string> PlantProcess::sensors_subscribed_by(const Guid& peer) const {
+std::vector<std::string> PlantProcess::sensors_subscribed_by(const Guid& peer,
+                                                             const std::vector<std::string>& topics) const {
   std::vector<std::string> out;
-  for (const std::string& t : sensor_topics()) {
+  for (const std::string& t : topics) {
     const auto parts = transport_.matched_reader_participants(t);
     if (std::find(parts.begin(), parts.end(), peer) != parts.end()) out.push_back(t);
   }
@@ -60,7 +61,7 @@ bool PlantProcess::wait_for_controller() {
   std::vector<std::string> sensors;
   std::int64_t settled_at = 0;
   bool ambiguous = false;
-  const std::size_t all_sensors = sensor_topics().size();
+  const std::vector<std::string> sensor_topics_all = sensor_topics();
   const bool found = transport_.spin_until(
       [&] {
         if (stop_requested()) return true;
@@ -81,13 +82,13 @@ bool PlantProcess::wait_for_controller() {
         }
         if (candidates.empty()) return false;
         peer = candidates.front();
-        const std::vector<std::string> now = sensors_subscribed_by(*peer);
+        const std::vector<std::string> now = sensors_subscribed_by(*peer, sensor_topics_all);
         if (now.size() != sensors.size()) settled_at = steady_ns() + kSettleNs;
         sensors = now;
         // The run's own controller (a token) publishes its status, which tick 0's answer includes:
         // matched too, or tick 0 would be taken without it.
         if (!pair_token_.empty() && !controller_writes_status()) return false;
-        return sensors.size() == all_sensors || (!sensors.empty() && steady_ns() >= settled_at);
+        return sensors.size() == sensor_topics_all.size() || (!sensors.empty() && steady_ns() >= settled_at);
       },
       timeout_ns());
   if (ambiguous) return false;
@@ -112,7 +113,7 @@ bool PlantProcess::wait_for_controller() {
   if (pair_token_.empty()) pairing_.pair_by_participant(*peer);
   if (scheduler_) scheduler_->only_from(*peer);  // the schedule goes to the controller's node, not a namesake
   subscribed_ = sensors;
-  if (sensors.size() < all_sensors) {
+  if (sensors.size() < sensor_topics_all.size()) {
     std::string list;
     for (const std::string& t : sensors) list += (list.empty() ? "" : ", ") + t;
     std::cerr << fmt::format("plant: the controller subscribes {} only; the other sensor samples go to no one\n", list);

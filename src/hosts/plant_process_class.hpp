@@ -61,8 +61,8 @@ class PlantProcess {
   /// The topics of every sensor the plant publishes: Pose, Velocity, Imu, then the extra sensors'.
   std::vector<std::string> sensor_topics() const;
 
-  /// Which of the sensor topics `peer` subscribes (readers matched by ours).
-  std::vector<std::string> sensors_subscribed_by(const Guid& peer) const;
+  /// Which of `topics` (sensor_topics()) `peer` subscribes (readers matched by ours).
+  std::vector<std::string> sensors_subscribed_by(const Guid& peer, const std::vector<std::string>& topics) const;
 
   /// Finds the controller, pairs with its writers (dds/peer_pairing.hpp: only its commands are
   /// answers; every other writer's are counted as foreign and ignored) and waits until it subscribes

@@ -531,9 +531,8 @@ class Batch {
       const sim::Topics topics = sim::Topics::for_namespace(s.simulation.ns);
       sim::RealismConfig realism = s.simulation.plant.realism;
       realism.seed = seed;
-      // The noise streams named as PlantNode names them: by the vehicle's namespace (/drone/Pose -> /drone).
-      const std::string vehicle = topics.pose.substr(0, topics.pose.rfind('/'));
-      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s), vehicle);
+      // The noise streams named as PlantNode names them: by the vehicle's namespace.
+      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s), topics.ns);
       if (with_controller) {
         controller.emplace(s.controller, topics, realism.extra_sensors);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);

@@ -33,8 +33,8 @@ std::string external_plant_conflict(const RealismConfig& realism, const model::V
 PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::VehicleParams& vehicle,
                      const PlantOptions& options, const model::State& initial)
     : core_(vehicle, options.realism, options.clock, initial,
-            // The vehicle's namespace names its noise streams: /drone/Pose -> /drone.
-            topics.pose.substr(0, topics.pose.rfind('/'))),
+            // The vehicle's namespace names its noise streams.
+            topics.ns),
       options_(options) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
   if (options.external) {
@@ -59,7 +59,7 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   if (options.publish_tf) {
     // tf2 names frames without a leading '/', the vehicle's namespace as their prefix (/drone ->
     // drone/base_link), so many vehicles share one /tf.
-    const std::string ns = topics.pose.substr(0, topics.pose.rfind('/'));
+    const std::string& ns = topics.ns;
     tf_.transforms.resize(1);
     tf_.transforms[0].header.frame_id = options.frame_id;
     tf_.transforms[0].child_frame_id = tf_prefix(ns) + "base_link";
