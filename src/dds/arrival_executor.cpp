@@ -32,11 +32,15 @@ ArrivalExecutor::ArrivalExecutor(DdsTransport& transport) : transport_(transport
 }
 
 ArrivalExecutor::~ArrivalExecutor() {
-  mutex_.unlock();  // first: removing a listener waits for its delivery, which needs the lock
+  take_noted(false);  // held samples are data: delivered, not dropped (a failure now is not reported)
+  mutex_.unlock();    // then deliveries on arrival until the listeners go
   try {
     transport_.set_arrival_sink(nullptr);
   } catch (const std::exception&) {  // DdsError: the participant's deletion removes the listeners too
   }
+  mutex_.lock();  // what a delivery found the lock taken for meanwhile
+  take_noted(false);
+  mutex_.unlock();
   transport_.remove_extra_work(wake_work_);  // then wake_ goes, with the members
 }
 
@@ -53,17 +57,88 @@ void ArrivalExecutor::after_each(std::function<bool()> hook) {
 }
 
 void ArrivalExecutor::on_data(std::size_t subscription) {
-  const std::lock_guard<std::recursive_mutex> g(mutex_);
-  if (failure_) return;  // delivery stopped; wait() rethrows
+  const bool owner = std::this_thread::get_id() == owner_;
+  std::unique_lock<std::recursive_mutex> g(mutex_, std::defer_lock);
+  if (owner) {
+    g.lock();  // the owner's own local delivery: it holds the lock already (it is recursive)
+  } else if (!g.try_lock()) {
+    std::vector<DdsTransport::Held> taken;  // out of the reader: its history depth drops nothing
+    std::exception_ptr failed;
+    try {
+      transport_.hold(subscription, taken);
+    } catch (...) {
+      failed = std::current_exception();
+    }
+    {
+      const std::lock_guard<std::mutex> n(noted_mutex_);
+      noted_.insert(noted_.end(), taken.begin(), taken.end());
+      if (failed && !noted_failure_) noted_failure_ = failed;
+    }
+    dds_set_guardcondition(wake_, true);
+    return;
+  }
+  if (owner || depth_ > 0) {
+    take_noted_of(subscription);  // the reader's own order: what it held comes first
+  } else {
+    take_noted(false);  // a receive thread's outermost delivery: what was held before it is older
+  }
+  deliver(subscription);
+  if (!owner && depth_ == 0) take_noted(false);  // held while this one ran
+}
+
+bool ArrivalExecutor::deliver(std::size_t subscription) {
+  if (failure_) return true;  // delivery stopped; wait() rethrows
+  ++depth_;
   try {
     delivered_ += transport_.take(subscription);
   } catch (...) {
     failure_ = std::current_exception();
   }
-  after_delivery();
+  --depth_;
+  return after_delivery();
 }
 
-void ArrivalExecutor::after_delivery() {
+bool ArrivalExecutor::deliver(DdsTransport::Held& held) {
+  if (failure_) {  // delivery stopped: the memory goes back
+    transport_.drop_held(held);
+    return true;
+  }
+  ++depth_;
+  try {
+    delivered_ += transport_.deliver_held(held);
+  } catch (...) {
+    failure_ = std::current_exception();
+  }
+  --depth_;
+  return after_delivery();
+}
+
+bool ArrivalExecutor::next_noted(DdsTransport::Held& held, const std::size_t* only) {
+  const std::lock_guard<std::mutex> n(noted_mutex_);
+  if (noted_failure_ && !failure_) failure_ = std::exchange(noted_failure_, nullptr);
+  for (auto it = noted_.begin(); it != noted_.end(); ++it) {
+    if (only != nullptr && it->index != *only) continue;
+    held = *it;
+    noted_.erase(it);
+    return true;
+  }
+  return false;
+}
+
+bool ArrivalExecutor::take_noted(bool stop_at_wake) {
+  DdsTransport::Held held;
+  while (next_noted(held, nullptr)) {
+    if (deliver(held) && stop_at_wake) return true;
+  }
+  return false;
+}
+
+void ArrivalExecutor::take_noted_of(std::size_t subscription) {
+  DdsTransport::Held held;
+  while (next_noted(held, &subscription)) deliver(held);
+}
+
+bool ArrivalExecutor::after_delivery() {
   bool wake = static_cast<bool>(failure_);
   if (!wake) {
     try {
@@ -75,14 +150,19 @@ void ArrivalExecutor::after_delivery() {
     }
   }
   if (wake) dds_set_guardcondition(wake_, true);
+  return wake;
 }
 
 int ArrivalExecutor::wait(std::int64_t timeout_ns) {
   check_owner("wait");
+  // What came while the owner worked, before anything newer; a delivery of it that wakes the
+  // owner ends this wait at once (the rest stay noted for the next).
+  const bool woken = take_noted(true);
   mutex_.unlock();
-  const dds_return_t rc = transport_.wait_waitset(timeout_ns);
+  const dds_return_t rc = transport_.wait_waitset(woken ? 0 : timeout_ns);
   mutex_.lock();
   dds_set_guardcondition(wake_, false);
+  if (!woken) take_noted(true);
   if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
   const int served = transport_.serve_wait(rc);  // extra work (no subscription is on the waitset)
   return std::exchange(delivered_, 0) + served;

@@ -1,7 +1,8 @@
 // Delivery on arrival for one DdsTransport: each subscription's samples are delivered on the
-// Cyclone thread that received them (a DATA_AVAILABLE listener), so a node that reacts where it is
-// delivered (a lockstep controller stepping on a complete sample, a lockstep plant running its
-// next ticks once the answer is in) answers without waking another thread.
+// Cyclone thread that received them (a DATA_AVAILABLE listener) or, when they came while the owner
+// worked, at the owner's next wait, so a node that reacts where it is delivered (a lockstep controller stepping on a
+// complete sample, a lockstep plant running its next ticks once the answer is in) answers without waking another
+// thread.
 //
 // The threading rule, stated here once (callers need nothing else):
 //   - The thread that creates the executor owns it. It holds the executor's (recursive) lock from
@@ -13,6 +14,18 @@
 //     lock; when it returns true, the owner's wait returns. Without a hook, deliveries do not end
 //     waits (wait_until's condition is asked after each delivery too).
 //   - A delivery may publish (also to this transport's own readers: the lock is recursive).
+//   - A receive thread never blocks on the lock. Cyclone runs one listener of a reader at a time:
+//     a receive thread waiting inside reader R's listener for the owner, while the owner's own
+//     write delivers to R locally (R records a topic the owner publishes and someone else on the
+//     domain publishes too), would wait for each other for ever. A delivery that finds the lock
+//     taken takes its samples out of the reader (so the reader's history depth drops none), holds
+//     them and wakes the owner. Held samples are delivered in the order held, before anything
+//     newer: by the owner's wait() (first thing, and again after its wait) and by the next receive
+//     thread that gets the lock (before its own); a delivery on the owner's thread (its own local
+//     write) or inside a delivery first delivers only what its own reader held, so each reader
+//     keeps its order. So the order is the one blocking would give: what arrived while the owner
+//     worked comes after the owner's own messages of that work. Deliveries then run on the owner's
+//     thread too, still only while it waits or inside its own writes.
 //   - An exception a delivery (or the hook) throws is kept, later deliveries are dropped, the
 //     owner's wait returns at once and rethrows it.
 //   - Extra work of the transport (parameter services) is served by wait() on the owner's thread,
@@ -24,10 +37,12 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include "dds/dds_transport.hpp"
 
@@ -68,7 +83,17 @@ class ArrivalExecutor {
 
  private:
   void on_data(std::size_t subscription);
-  void after_delivery();
+  /// Delivers one subscription's samples (or held ones) and runs the hook; true when that wakes
+  /// the owner (or delivery has stopped).
+  bool deliver(std::size_t subscription);
+  bool deliver(DdsTransport::Held& held);
+  /// The oldest held batch (of subscription *only, when given) out of noted_.
+  bool next_noted(DdsTransport::Held& held, const std::size_t* only);
+  /// Delivers the held batches in order (under mutex_); with stop_at_wake, stops after the first
+  /// delivery that wakes the owner (the rest stay held) and returns true.
+  bool take_noted(bool stop_at_wake);
+  void take_noted_of(std::size_t subscription);
+  bool after_delivery();
   void check_owner(const char* what) const;
 
   DdsTransport& transport_;
@@ -81,6 +106,12 @@ class ArrivalExecutor {
   std::exception_ptr failure_;
   std::function<bool()> after_;
   const std::function<bool()>* until_ = nullptr;  ///< wait_until's condition while it runs
+  int depth_ = 0;  ///< deliveries in progress on the thread that holds the lock (nested: > 1)
+  // Samples whose delivery found the lock taken, taken out of their readers, oldest first (under
+  // noted_mutex_, which is never held while a delivery runs); what taking them threw.
+  std::mutex noted_mutex_;
+  std::deque<DdsTransport::Held> noted_;
+  std::exception_ptr noted_failure_;
 };
 
 }  // namespace quadcosim::dds

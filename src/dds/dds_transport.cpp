@@ -209,8 +209,23 @@ void DdsTransport::set_arrival_sink(std::function<void(std::size_t)> sink) {
   if (!on) arrival_sink_ = nullptr;
 }
 
+int DdsTransport::deliver_taken(Reader& r, void* const* samples, const dds_sample_info_t* infos, int n) {
+  int delivered = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!infos[i].valid_data) continue;
+    r.sender = infos[i].publication_handle;
+    if (r.ops != nullptr) {
+      r.ops->deliver(samples[i], r.deliver);
+    } else {
+      r.deliver(samples[i]);
+    }
+    ++delivered;
+  }
+  return delivered;
+}
+
 int DdsTransport::drain(Reader& r) {
-  constexpr int kBatch = 16;
+  constexpr int kBatch = Held::kBatch;
   int delivered = 0;
   for (;;) {
     void* samples[kBatch] = {nullptr};
@@ -219,16 +234,7 @@ int DdsTransport::drain(Reader& r) {
     if (n < 0) check(n, ("dds_take " + r.topic).c_str());
     if (n == 0) break;
     try {
-      for (int i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
-        r.sender = infos[i].publication_handle;
-        if (r.ops != nullptr) {
-          r.ops->deliver(samples[i], r.deliver);
-        } else {
-          r.deliver(samples[i]);
-        }
-        ++delivered;
-      }
+      delivered += deliver_taken(r, samples, infos, n);
     } catch (...) {
       dds_return_loan(r.reader, samples, n);  // the loan goes back whatever a delivery throws
       throw;
@@ -237,6 +243,39 @@ int DdsTransport::drain(Reader& r) {
     if (n < kBatch) break;
   }
   return delivered;
+}
+
+void DdsTransport::hold(std::size_t index, std::vector<Held>& into) {
+  // Cyclone lends its one buffer to the first take and allocates for the others (given back
+  // by dds_return_loan too), so any number may be held at once.
+  Reader& r = *readers_[index];
+  for (;;) {
+    Held h;
+    h.index = index;
+    const dds_return_t n = dds_take(r.reader, h.samples, h.infos, Held::kBatch, Held::kBatch);
+    if (n < 0) check(n, ("dds_take " + r.topic).c_str());
+    if (n == 0) break;
+    h.n = n;
+    into.push_back(h);
+    if (n < Held::kBatch) break;
+  }
+}
+
+int DdsTransport::deliver_held(Held& held) {
+  Reader& r = *readers_[held.index];
+  try {
+    const int delivered = deliver_taken(r, held.samples, held.infos, held.n);
+    drop_held(held);
+    return delivered;
+  } catch (...) {
+    drop_held(held);
+    throw;
+  }
+}
+
+void DdsTransport::drop_held(Held& held) {
+  if (held.n > 0) dds_return_loan(readers_[held.index]->reader, held.samples, held.n);
+  held.n = 0;
 }
 
 int DdsTransport::spin_once(std::int64_t timeout_ns) {

@@ -122,6 +122,22 @@ class DdsTransport final : public sim::Transport {
   void set_arrival_sink(std::function<void(std::size_t)> sink);
   /// Delivers what subscription `index` holds on the calling thread; returns how many.
   int take(std::size_t index) { return drain(*readers_[index]); }
+  /// Samples taken out of a subscription's reader, undelivered (their memory lent by Cyclone until
+  /// deliver_held or drop_held gives it back).
+  struct Held {
+    static constexpr int kBatch = 16;
+    std::size_t index = 0;
+    int n = 0;
+    void* samples[kBatch] = {nullptr};
+    dds_sample_info_t infos[kBatch];
+  };
+  /// Takes what subscription `index` holds into `into` (appended, in order) without delivering it:
+  /// out of the reader, so its history depth cannot drop what waits.
+  void hold(std::size_t index, std::vector<Held>& into);
+  /// Delivers held samples on the calling thread (then gives their memory back, whatever a delivery
+  /// throws); returns how many.
+  int deliver_held(Held& held);
+  void drop_held(Held& held);
   std::size_t subscription_count() const { return readers_.size(); }
   /// spin_once in two halves: the wait (its result kept for serve_wait), then the deliveries and
   /// the extra work.
@@ -150,6 +166,8 @@ class DdsTransport final : public sim::Transport {
   dds_entity_t topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops);
   QosProfile qos_for(const std::string& ros_topic) const;
   int drain(Reader& r);
+  /// Delivers n taken samples of `r` (the loan stays the caller's to return).
+  int deliver_taken(Reader& r, void* const* samples, const dds_sample_info_t* infos, int n);
 
   Participant participant_;
   dds_entity_t waitset_ = 0;
