@@ -726,7 +726,7 @@ class Batch {
     const sim::PlantOptions& o = s.simulation.plant;
     const int divider = s.simulation.controller_divider;
     const double control_dt_s = o.clock.period_s() * divider;  // as Simulation's
-    const double omega_max = L.plant.model().params().motor.omega_max_rad_s;
+    const std::int64_t watchdog_ns = o.watchdog_ticks > 0 ? o.clock.ns(o.watchdog_ticks) : 0;
     sim::ControllerCore* const controller = L.controller ? &*L.controller : nullptr;
     thread_local msg::Float64MultiArray command;  // the command message, as the controller node or Simulation sends it
     if (bypass) {
@@ -790,16 +790,10 @@ class Batch {
           const model::Vector4& omega = controller->output().omega_rad_s;
           for (int r = 0; r < 4; ++r) command.data[r] = omega[r];
         }
-        const sim::CommandCheck check = sim::check_command(command, omega_max);
-        if (check.verdict() != sim::CommandVerdict::kRejected)
-          L.plant.queue(k, o.command_delay_ticks, check.omega_rad_s);
+        L.plant.take_command(k, o.command_delay_ticks, command);
       }
       // The latch (PlantNode::latch_command): the newest due command, then the watchdog.
-      L.plant.latch_due(k);
-      if (o.watchdog_ticks > 0 && o.watchdog_policy == sim::WatchdogPolicy::kStop &&
-          L.plant.command_age_ns(o.clock, k) >= o.clock.ns(o.watchdog_ticks)) {
-        L.plant.latch_omega_min();
-      }
+      L.plant.latch(k, L.plant.command_age_ns(o.clock, k), watchdog_ns, o.watchdog_policy);
       // The integration to t_k+1 (PlantNode::integrate).
       L.plant.integrate(o.clock, k, o.substeps);
     }

@@ -1,14 +1,17 @@
 // The native plant's tick without a bus: the 6-DOF model's state, the outputs of a tick and the
 // sensor messages made of them (with the sensor realism: noise, rates, latency), the vehicle's extra
-// sensors (magnetometer, barometer, GNSS: its sensors::Suite, SI samples), the command queue (a
-// command takes effect command_delay_ticks after the tick it arrived in), the zero-order hold of the
-// newest due command, the command's age for the watchdog, and the integration to the next tick (wind,
-// rotor faults and drag acting inside the model).
+// sensors (magnetometer, barometer, GNSS: its sensors::Suite, SI samples), the command intake (a
+// command message checked, then queued to take effect command_delay_ticks after the tick it arrived
+// in), the zero-order hold of the newest due command and the watchdog's decision on the command's
+// age, and the integration to the next tick (wind, rotor faults and drag acting inside the model).
 //
-// sim::PlantNode wraps one in the bus (topics, the command checks and statistics, lockstep labels, a
-// receipt clock, the watchdog's policy, external dynamics); quadcosim.Batch steps one per vehicle
-// directly (src/python/batch.cpp), so both run the same calls in the same order. The options are the
-// caller's (a node keeps its own copy; a batch's vehicles share their scenario's).
+// A tick is these phases, in the order sim::SteppablePlant states (steppable_plant.hpp): outputs and
+// sense (+ sense_extra), the commands that arrive (take_command), latch, integrate. sim::PlantNode
+// puts them on a bus (topics, who may command, lockstep labels, statistics and logs, a receipt clock
+// in real time, external dynamics); quadcosim.Batch calls them per vehicle directly
+// (src/python/batch.cpp); the plant FMU (src/fmi/export/plant_model.cpp) takes its rotor speeds as an
+// FMI input acting over the step (set_latched: no queue, no watchdog). The options are the caller's
+// (a node keeps its own copy; a batch's vehicles share their scenario's).
 #pragma once
 
 #include <algorithm>
@@ -22,8 +25,16 @@
 #include "sim/clock.hpp"
 #include "sim/messages.hpp"
 #include "sim/realism.hpp"
+#include "sim/validation.hpp"
 
 namespace quadcosim::sim {
+
+/// What the plant does with its motors when no valid command has arrived for the watchdog limit.
+enum class WatchdogPolicy {
+  kHold,  ///< keep the last valid command
+  kStop,  ///< all motors to the vehicle's omega_min_rad_s (0 by default: the motors stop)
+};
+inline std::string to_string(WatchdogPolicy p) { return p == WatchdogPolicy::kHold ? "hold" : "stop"; }
 
 /// The sensor messages of the plant's outputs `y` at `stamp` as the plant publishes them: every field
 /// a tick changes (the frame ids are set once). With sensor realism, PlantRealism::measure then
@@ -107,6 +118,14 @@ class PlantCore {
   /// The extra sensors' newest samples; null when the vehicle carries none.
   const sensors::Suite* extra_sensors() const { return extra_.get(); }
 
+  /// A command message received during tick k: checked (sim::check_command against the vehicle's
+  /// omega_max: a rejected one changes nothing, an out-of-range one is clamped), then queued to take
+  /// effect at tick k + delay_ticks. Returns the check, for the caller's statistics.
+  CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
+    const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s);
+    if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s);
+    return check;
+  }
   /// A valid command (speeds within [0, omega_max]) received during tick k takes effect at tick
   /// k + delay_ticks.
   void queue(Tick k, Tick delay_ticks, const model::Vector4& omega_rad_s) {
@@ -132,6 +151,16 @@ class PlantCore {
   void set_latched(const model::Vector4& omega_rad_s) {
     latched_ = omega_rad_s;
     rotor_input_ = model_->rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
+  }
+  /// The command acting over [t_k, t_k+1): the newest due by tick k (latch_due), then the watchdog:
+  /// when limit_ns > 0 and the command's age `age_ns` (command_age_ns in simulated time; a host in
+  /// real time measures it on its receipt clock) has reached it, the command is stale and kStop
+  /// latches every motor at omega_min. Returns whether it is stale.
+  bool latch(Tick k, std::int64_t age_ns, std::int64_t limit_ns, WatchdogPolicy policy) {
+    latch_due(k);
+    const bool stale = limit_ns > 0 && age_ns >= limit_ns;
+    if (stale && policy == WatchdogPolicy::kStop) latch_omega_min();
+    return stale;
   }
   /// Latches every motor at the vehicle's omega_min_rad_s (the watchdog's stop policy).
   void latch_omega_min() { set_latched(model::Vector4::Constant(model_->params().motor.omega_min_rad_s)); }

@@ -14,8 +14,6 @@ msg::Vector3 to_msg(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 }  // namespace
 
-std::string to_string(WatchdogPolicy p) { return p == WatchdogPolicy::kHold ? "hold" : "stop"; }
-
 std::string external_plant_conflict(const RealismConfig& realism, const model::VehicleParams& vehicle) {
   if (realism.wind.active()) return "environment";
   if (!realism.faults.empty()) return "faults";
@@ -91,20 +89,20 @@ void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
     return;
   }
   ++stats_.commands_received;
-  // Checked first, so that what a command says about its tick counts only once it is known to be a
-  // command at all.
-  const CommandCheck check = check_command(m, core_.model().params().motor.omega_max_rad_s);
   // Lockstep repeats, whatever their content: an answer to an earlier tick, or a second copy of the
   // accepted answer to this one (the controller sends its last command again when the plant repeats
   // a tick). Dropped and counted apart, so the other counters are those of a run without repeats.
   // The label is read only in lockstep, where commands cross a network and may come twice or late;
-  // delivered in-process, every command answers the tick it arrives in.
+  // delivered in-process, every command answers the tick it arrives in. What a label says counts
+  // for later commands only once the command is accepted (below).
   const std::int64_t stamp = options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1;
   if (stamp >= 0 && (stamp < options_.clock.ns(current_tick_) || stamp == last_label_accepted_ns_)) {
     ++stats_.commands_stale;
     return;
   }
   last_command_stamp_ns_ = stamp;  // the controller's answer to its tick, whatever its verdict
+  // Checked, and queued unless rejected (PlantCore::take_command).
+  const CommandCheck check = core_.take_command(current_tick_, options_.command_delay_ticks, m);
   if (check.verdict() == CommandVerdict::kRejected) {
     stats_.last_problem = check.reason();
     ++stats_.commands_rejected;
@@ -126,12 +124,7 @@ void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
            " clamped so far (logged: 1st, then every 100th)");
     }
   }
-  accept_command(check.omega_rad_s);
-}
-
-void PlantNode::accept_command(const model::Vector4& omega_rad_s) {
   if (receipt_clock_) last_valid_receipt_ns_ = receipt_clock_();
-  core_.queue(current_tick_, options_.command_delay_ticks, omega_rad_s);
 }
 
 void PlantNode::publish_status(Tick k) {
@@ -172,19 +165,12 @@ void PlantNode::publish_outputs(Tick k) {
   publish_status(k);
 
   // The messages are kept between ticks (their frame ids are set once); every field that changes
-  // is written here or by the realism below (PlantCore::sense, spelt out: no sample is skipped
-  // without realism).
-  write_sensor_messages(y, stamp, pose_, twist_, imu_);
-  if (core_.has_realism()) {  // what the sensors make of it: noise, rates, latency (same sample on a repeat)
-    const PlantRealism::Due due = core_.measure(k, y, pose_, twist_, imu_);
-    if (due.pose) pose_pub_.publish(pose_);
-    if (due.velocity) velocity_pub_.publish(twist_);
-    if (due.imu) imu_pub_.publish(imu_);
-  } else {
-    pose_pub_.publish(pose_);
-    velocity_pub_.publish(twist_);
-    imu_pub_.publish(imu_);
-  }
+  // is written by sense, with what the sensors make of it (noise, rates, latency; the same sample on
+  // a repeated tick).
+  const PlantRealism::Due due = core_.sense(k, y, stamp, pose_, twist_, imu_);
+  if (due.pose) pose_pub_.publish(pose_);
+  if (due.velocity) velocity_pub_.publish(twist_);
+  if (due.imu) imu_pub_.publish(imu_);
   if (core_.sense_extra(k, y)) extra_sensors_->publish(*core_.extra_sensors(), k, stamp);
   if (tf_pub_) {  // the true pose, whatever the sensors made of it
     msg::TransformStamped& t = tf_.transforms.front();
@@ -214,8 +200,10 @@ model::Outputs PlantNode::external_outputs(Tick k) {
 }
 
 void PlantNode::latch_command(Tick k) {
-  core_.latch_due(k);
-  if (options_.watchdog_ticks <= 0) return;
+  if (options_.watchdog_ticks <= 0) {
+    core_.latch_due(k);
+    return;
+  }
   if (receipt_clock_) {
     const std::int64_t now = receipt_clock_();
     if (last_valid_receipt_ns_ < 0) last_valid_receipt_ns_ = now;  // the limit runs from the first tick
@@ -223,14 +211,11 @@ void PlantNode::latch_command(Tick k) {
   } else {
     command_age_ns_ = core_.command_age_ns(options_.clock, k);
   }
-  const bool expired = command_age_ns_ >= options_.clock.ns(options_.watchdog_ticks);
+  const bool expired =
+      core_.latch(k, command_age_ns_, options_.clock.ns(options_.watchdog_ticks), options_.watchdog_policy);
   if (expired && !watchdog_active_) ++stats_.watchdog_trips;
   watchdog_active_ = expired;
-  if (!expired) return;
-  ++stats_.watchdog_ticks;
-  if (options_.watchdog_policy == WatchdogPolicy::kStop) {
-    core_.latch_omega_min();
-  }
+  if (expired) ++stats_.watchdog_ticks;
 }
 
 void PlantNode::integrate(Tick k) {

@@ -22,13 +22,6 @@
 
 namespace quadcosim::sim {
 
-/// What the plant does with its motors when no valid command has arrived for the watchdog limit.
-enum class WatchdogPolicy {
-  kHold,  ///< keep the last valid command
-  kStop,  ///< all motors to the vehicle's omega_min_rad_s (0 by default: the motors stop)
-};
-std::string to_string(WatchdogPolicy p);
-
 struct PlantOptions {
   TickClock clock;
   int substeps = 1;             ///< RK4 steps per plant tick
@@ -161,8 +154,6 @@ class PlantNode final : public SteppablePlant {
 
  private:
   void on_command(const msg::Float64MultiArray& m, SenderId sender);
-  /// A valid command (speeds within [0, omega_max]) takes effect after the configured delay.
-  void accept_command(const model::Vector4& omega_rad_s);
   void publish_status(Tick k);
   /// The external dynamics' outputs at tick k; the core's state becomes the state they report.
   model::Outputs external_outputs(Tick k);
