@@ -231,6 +231,50 @@ TEST(ScenarioTest, EmptyMappingGivesTheDefaults) {
   EXPECT_EQ(load_scenario(dir.write("unnamed.yaml", "description: x\n")).name, "unnamed");
 }
 
+// The extra sensors' keys in their units (uT, deg, Pa, m), in SI in the configuration; what is not
+// given keeps the model's default exactly; environment.site reaches the barometer and the GNSS.
+TEST(ScenarioTest, ExtraSensorKeysAreReadInTheirUnits) {
+  TempDir dir;
+  const Scenario sc = load_scenario(dir.write("sensors.yaml",
+                                              "environment:\n"
+                                              "  site: {latitude_deg: 47.5, longitude_deg: 8.25, altitude_m: 420}\n"
+                                              "sensors:\n"
+                                              "  magnetometer: {rate_hz: 50, field_uT: 48, declination_deg: 2.5,\n"
+                                              "                 hard_iron_uT: [2, -1.5, 0.8]}\n"
+                                              "  barometer: {noise_sigma_Pa: 3, latency_ticks: 2}\n"
+                                              "  gnss: {rate_hz: 5, vertical_sigma_m: 1.5}\n"));
+  const sensors::SensorSet& s = sc.simulation.plant.realism.extra_sensors;
+  ASSERT_TRUE(s.magnetometer && s.barometer && s.gnss);
+  const sensors::MagnetometerConfig defaults_m;
+  EXPECT_EQ(s.magnetometer->timing.divider, 2);  // 100 Hz plant / 50 Hz
+  EXPECT_DOUBLE_EQ(s.magnetometer->field_T, 48e-6);
+  EXPECT_DOUBLE_EQ(s.magnetometer->declination_rad, 2.5 * 3.14159265358979323846 / 180.0);
+  EXPECT_EQ(s.magnetometer->inclination_rad, defaults_m.inclination_rad);  // not given: the default
+  EXPECT_EQ(s.magnetometer->noise_sigma_T, 0.0);
+  EXPECT_DOUBLE_EQ(s.magnetometer->hard_iron_T.x(), 2e-6);
+  EXPECT_DOUBLE_EQ(s.magnetometer->hard_iron_T.y(), -1.5e-6);
+  EXPECT_DOUBLE_EQ(s.magnetometer->hard_iron_T.z(), 0.8e-6);
+  EXPECT_EQ(s.barometer->timing.divider, 2);  // its default 50 Hz
+  EXPECT_EQ(s.barometer->timing.latency_ticks, 2);
+  EXPECT_EQ(s.barometer->noise_sigma_Pa, 3.0);
+  EXPECT_EQ(s.barometer->sea_level_pressure_Pa, sensors::BarometerConfig{}.sea_level_pressure_Pa);
+  EXPECT_EQ(s.barometer->site_altitude_m, 420.0);
+  EXPECT_EQ(s.gnss->timing.divider, 20);  // 100 Hz / 5 Hz
+  EXPECT_EQ(s.gnss->vertical_sigma_m, 1.5);
+  EXPECT_EQ(s.gnss->horizontal_sigma_m, 0.0);
+  EXPECT_DOUBLE_EQ(s.gnss->site.latitude_rad, 47.5 * 3.14159265358979323846 / 180.0);
+  EXPECT_DOUBLE_EQ(s.gnss->site.longitude_rad, 8.25 * 3.14159265358979323846 / 180.0);
+  EXPECT_EQ(s.gnss->site.height_m, 420.0);
+  // A key out of its range is named with its range, in the key's unit.
+  try {
+    load_scenario(dir.write("bad.yaml", "sensors:\n  magnetometer: {field_uT: 500}\n"));
+    FAIL() << "accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("sensors.magnetometer.field_uT"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("100"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ScenarioTest, ScheduleTimesBecomeTicks) {
   TempDir dir;
   const std::string path =

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "model/wind.hpp"
+#include "sensors/registry.hpp"
 
 namespace quadcosim::io {
 
@@ -69,41 +70,28 @@ sensors::Geodetic read_site(YamlSection& g) {
   return site;
 }
 
+// Every sensor of the registry the scenario configures (sensors.<name>), read from its kind's
+// scenario keys (sensors/registry.hpp).
 void read_extra_sensors(YamlSection& s, const sim::SimulationConfig& cfg, const sensors::Geodetic& site,
                         sensors::SensorSet& set) {
-  if (auto m = s.section("magnetometer")) {
-    sensors::MagnetometerConfig c;
-    c.timing = read_timing(*m, cfg, 100.0, /*slower_ok=*/true);
-    c.field_T = m->number("field_uT", c.field_T * 1e6, 1.0, 100.0) * 1e-6;
-    c.inclination_rad = m->number("inclination_deg", c.inclination_rad / kDeg, -90.0, 90.0) * kDeg;
-    c.declination_rad = m->number("declination_deg", c.declination_rad / kDeg, -180.0, 180.0) * kDeg;
-    c.noise_sigma_T = m->number("noise_sigma_uT", 0.0, 0.0, 100.0) * 1e-6;
-    c.hard_iron_T = vec3(*m, "hard_iron_uT", Eigen::Vector3d::Zero(), -1000.0, 1000.0) * 1e-6;
-    m->reject_unknown_keys();
-    set.magnetometer = c;
-  }
-  if (auto b = s.section("barometer")) {
-    sensors::BarometerConfig c;
-    c.timing = read_timing(*b, cfg, 50.0, /*slower_ok=*/true);
-    c.site_altitude_m = site.height_m;
-    c.sea_level_pressure_Pa = b->number("sea_level_pressure_Pa", c.sea_level_pressure_Pa, 80000.0, 110000.0);
-    c.noise_sigma_Pa = b->number("noise_sigma_Pa", 0.0, 0.0, 1000.0);
-    c.drift_Pa_sqrt_s = b->number("drift_Pa_sqrt_s", 0.0, 0.0, 100.0);
-    c.bias_initial_Pa = b->number("bias_initial_Pa", 0.0, 0.0, 1000.0);
-    b->reject_unknown_keys();
-    set.barometer = c;
-  }
-  if (auto g = s.section("gnss")) {
-    sensors::GnssConfig c;
-    c.timing = read_timing(*g, cfg, 10.0, /*slower_ok=*/true);
-    c.site = site;
-    c.horizontal_sigma_m = g->number("horizontal_sigma_m", 0.0, 0.0, 1000.0);
-    c.vertical_sigma_m = g->number("vertical_sigma_m", 0.0, 0.0, 1000.0);
-    c.velocity_sigma_m_s = g->number("velocity_sigma_m_s", 0.0, 0.0, 100.0);
-    c.fix_after_s = g->number("fix_after_s", 0.0, 0.0, 1e6);
-    g->reject_unknown_keys();
-    set.gnss = c;
-  }
+  sensors::for_each_kind([&]<class Kind>() {
+    auto section = s.section(std::string(Kind::kName));
+    if (!section) return;
+    typename Kind::Config c;
+    c.timing = read_timing(*section, cfg, Kind::kDefaultRateHz, /*slower_ok=*/true);
+    for (const auto& key : Kind::kScenarioKeys) {
+      const std::string name(key.name);
+      if (!section->has(name)) continue;  // the default, exactly
+      if (key.number != nullptr) {
+        c.*key.number = section->number(name, 0.0, key.min, key.max) * key.to_si;
+      } else {
+        c.*key.vector = vec3(*section, name, Eigen::Vector3d::Zero(), key.min, key.max) * key.to_si;
+      }
+    }
+    if constexpr (requires { Kind::at_site(c, site); }) Kind::at_site(c, site);
+    section->reject_unknown_keys();
+    Kind::config(set) = c;
+  });
 }
 
 }  // namespace

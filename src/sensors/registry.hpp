@@ -6,8 +6,8 @@
 // messages) is the plant's (sim/sensor_wire.hpp).
 //
 // To add a sensor (docs/sensors.md, "Add a sensor"): its model (sensors/<name>.{hpp,cpp}), its line in
-// SensorSet, its kind here (and in Kinds), its scenario keys (io/realism_yaml.cpp) and its wire form
-// (sim/sensor_wire.hpp).
+// SensorSet, its kind here (and in Kinds: with its scenario keys, columns and configuration fields)
+// and its wire form (sim/sensor_wire.hpp).
 #pragma once
 
 #include <array>
@@ -34,6 +34,22 @@ void timing_fields(C& timing, F&& f) {
   f("divider", timing.divider);
   f("latency_ticks", timing.latency_ticks);
 }
+
+/// One scenario key of a sensor's configuration (sensors.<name>.<key>, docs/sensors.md): a number,
+/// or a list of three for a vector member, in the key's own unit (uT, deg, ...), within [min, max]
+/// in that unit; `to_si` turns it into the configuration's SI member. An absent key leaves the
+/// member at its default. Besides these, every sensor reads rate_hz and latency_ticks (its timing),
+/// and Kind::at_site(config, site) copies what it needs of environment.site.
+template <class Config>
+struct ScenarioKey {
+  std::string_view name;
+  double min = 0.0, max = 0.0;
+  double to_si = 1.0;
+  double Config::*number = nullptr;           ///< the member a number key sets, or
+  Eigen::Vector3d Config::*vector = nullptr;  ///< the member a three-number key sets
+};
+
+inline constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 /// One named field of a sample: `width` numbers in `unit`, written by `write(sample, out)`.
 template <class Sample>
@@ -64,6 +80,14 @@ struct MagnetometerKind {
     f("noise_sigma_T", c.noise_sigma_T);
     f("hard_iron_T", c.hard_iron_T);
   }
+  static constexpr double kDefaultRateHz = 100.0;
+  static constexpr std::array<ScenarioKey<Config>, 5> kScenarioKeys{{
+      {"field_uT", 1.0, 100.0, 1e-6, &Config::field_T},
+      {"inclination_deg", -90.0, 90.0, kDegToRad, &Config::inclination_rad},
+      {"declination_deg", -180.0, 180.0, kDegToRad, &Config::declination_rad},
+      {"noise_sigma_uT", 0.0, 100.0, 1e-6, &Config::noise_sigma_T},
+      {"hard_iron_uT", -1000.0, 1000.0, 1e-6, nullptr, &Config::hard_iron_T},
+  }};
   static constexpr std::array<Column<Sample>, 1> kColumns{{
       {"field", 3, "T", "the measured magnetic field in the body frame",
        [](const Sample& s, double* o) {
@@ -93,6 +117,15 @@ struct BarometerKind {
     f("drift_Pa_sqrt_s", c.drift_Pa_sqrt_s);
     f("bias_initial_Pa", c.bias_initial_Pa);
   }
+  static constexpr double kDefaultRateHz = 50.0;
+  static constexpr std::array<ScenarioKey<Config>, 4> kScenarioKeys{{
+      {"sea_level_pressure_Pa", 80000.0, 110000.0, 1.0, &Config::sea_level_pressure_Pa},
+      {"noise_sigma_Pa", 0.0, 1000.0, 1.0, &Config::noise_sigma_Pa},
+      {"drift_Pa_sqrt_s", 0.0, 100.0, 1.0, &Config::drift_Pa_sqrt_s},
+      {"bias_initial_Pa", 0.0, 1000.0, 1.0, &Config::bias_initial_Pa},
+  }};
+  /// The world origin's altitude: the pressure there follows from it.
+  static void at_site(Config& c, const Geodetic& site) { c.site_altitude_m = site.height_m; }
   static constexpr std::array<Column<Sample>, 2> kColumns{{
       {"pressure", 1, "Pa", "the static pressure reading", [](const Sample& s, double* o) { o[0] = s.pressure_Pa; }},
       {"altitude", 1, "m", "the reading's ISA pressure altitude above mean sea level",
@@ -120,6 +153,15 @@ struct GnssKind {
     f("velocity_sigma_m_s", c.velocity_sigma_m_s);
     f("fix_after_s", c.fix_after_s);
   }
+  static constexpr double kDefaultRateHz = 10.0;
+  static constexpr std::array<ScenarioKey<Config>, 4> kScenarioKeys{{
+      {"horizontal_sigma_m", 0.0, 1000.0, 1.0, &Config::horizontal_sigma_m},
+      {"vertical_sigma_m", 0.0, 1000.0, 1.0, &Config::vertical_sigma_m},
+      {"velocity_sigma_m_s", 0.0, 100.0, 1.0, &Config::velocity_sigma_m_s},
+      {"fix_after_s", 0.0, 1e6, 1.0, &Config::fix_after_s},
+  }};
+  /// The world origin is where the receiver's positions are measured from.
+  static void at_site(Config& c, const Geodetic& site) { c.site = site; }
   /// Without a fix only the fix flag is a number; the rest is NaN by definition.
   static bool has_numbers(const Sample& s) { return s.fix; }
   static constexpr double kDeg = 180.0 / std::numbers::pi;
