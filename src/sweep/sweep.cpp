@@ -230,6 +230,7 @@ RunResult run_one(const Plan& plan, int index, const fs::path& run_dir, Keep kee
 std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs, const fs::path& runs_dir,
                                 Keep keep, const RunControl& control) {
   std::vector<RunResult> results(indices.size());
+  std::vector<char> cut(indices.size(), 0);  // runs the stop cut short: not finished
   std::atomic<std::size_t> next{0};
   std::mutex finished_mutex;  // one `finished` call at a time
   auto worker = [&] {
@@ -240,8 +241,19 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
       const std::size_t i = next.fetch_add(1);
       if (i >= indices.size()) return;
       const int index = indices[i];
-      results[i] =
-          run_into(plan, index, runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index), keep, series);
+      const fs::path run_dir = runs_dir.empty() ? fs::path() : runs_dir / fmt::format("{:04d}", index);
+      results[i] = run_into(plan, index, run_dir, keep, series);
+      // A run that failed once the stop was asked for failed of it (a controller in a process of its
+      // own is killed on Ctrl-C): it did not finish, so --resume flies it again. What it wrote goes.
+      if (!results[i].error.empty() && control.stop && control.stop()) {
+        cut[i] = 1;
+        if (!run_dir.empty()) {
+          std::error_code ec;
+          for (const char* f : {"trajectory.csv", "metrics.json"}) fs::remove(run_dir / f, ec);
+          fs::remove(run_dir, ec);  // only when empty
+        }
+        continue;
+      }
       if (control.finished) {
         const std::lock_guard lock(finished_mutex);
         control.finished(results[i]);
@@ -252,8 +264,13 @@ std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indice
   const int threads = std::max(1, std::min<int>(jobs, static_cast<int>(indices.size())));
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
-  results.resize(std::min(next.load(), indices.size()));
-  return results;
+  const std::size_t started = std::min(next.load(), indices.size());
+  std::vector<RunResult> finished;
+  finished.reserve(started);
+  for (std::size_t i = 0; i < started; ++i) {
+    if (!cut[i]) finished.push_back(std::move(results[i]));
+  }
+  return finished;
 }
 
 void write_json(const fs::path& path, const nlohmann::json& j) { io::write_file_atomically(path, j.dump(2) + "\n"); }

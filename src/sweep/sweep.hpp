@@ -57,7 +57,9 @@ struct RunControl {
 
 /// Runs `indices` on `jobs` threads, each into runs_dir/NNNN (no files when runs_dir is empty);
 /// results in the order of `indices`, whatever the scheduling. When `control.stop` stopped it, the
-/// results are those of the runs started, a leading part of `indices` (fewer than asked).
+/// results are those of the runs finished (fewer than asked): the runs started (a leading part of
+/// `indices`) but those that failed once the stop was asked (the stop cut them short: a controller
+/// in a process of its own is killed on Ctrl-C), whose files are removed, so a resume flies them.
 std::vector<RunResult> run_many(const Plan& plan, const std::vector<int>& indices, int jobs,
                                 const std::filesystem::path& runs_dir, Keep keep = Keep::kNone,
                                 const RunControl& control = {});

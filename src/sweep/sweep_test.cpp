@@ -497,6 +497,36 @@ TEST(RunMany, StoppedItReturnsTheRunsStartedALeadingPartAndAResumeGivesTheSameSu
   EXPECT_THROW(partial_summary_json(header, {out_of_range}), std::invalid_argument);
 }
 
+// A run that fails once the stop was asked for failed of the stop (Ctrl-C kills a controller that
+// flies in a process of its own): it is not a finished run, and its files are gone, so a resume flies
+// it again. A run that fails before the stop, or finishes after it, is a result as any other.
+TEST(RunMany, ARunThatFailsOnceStoppedIsNotFinished) {
+  // initial.yaw_rad is refused outside [-10, 10], when the run is flown: normal(0, 1000) draws run 0
+  // (seed 5) outside it.
+  const Plan p = make_plan(scenario_file().string(), {"initial.yaw_rad=normal(0,1000)"}, 5, 4, Sampler::kRandom);
+  ASSERT_GT(std::abs(sample(p, 0).values[0].second), 10.0);
+  const std::vector<int> all = shard_indices(p.runs, 1, 1);
+  const fs::path dir = fs::temp_directory_path() / ("quadcosim_sweep_cut_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  int asked = 0;
+  RunControl control;
+  control.stop = [&] { return ++asked > 1; };  // not before the first run, asked from then on
+  EXPECT_TRUE(run_many(p, all, 1, dir, Keep::kAll, control).empty());
+  EXPECT_FALSE(fs::exists(dir / "0000"));
+  // Not stopped: the same failure is the run's result.
+  const auto failed = run_many(p, {0}, 1, dir, Keep::kAll);
+  ASSERT_EQ(failed.size(), 1u);
+  EXPECT_THAT(failed[0].error, HasSubstr("initial.yaw_rad"));
+  // A run that succeeds while the stop is asked is finished.
+  const Plan good = make_plan(scenario_file().string(), {"mass=5%"}, 5, 4, Sampler::kRandom);
+  asked = 0;
+  const auto kept = run_many(good, all, 1, dir, Keep::kNone, control);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_TRUE(kept[0].error.empty()) << kept[0].error;
+  EXPECT_TRUE(fs::exists(dir / "0000" / "metrics.json"));
+  fs::remove_all(dir);
+}
+
 // A metrics.json written by hand: the bound named is the one the value is outside, a figure without
 // a value names none (its note says why), passed criteria are left out, a channel's second step is
 // "<channel>#2" as in summary.json, and fields the criteria layer adds are carried over.
