@@ -14,6 +14,8 @@ export ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
 py=/usr/bin/python3
 hover="$src/tests/faults/hover.yaml"
+# shellcheck source=../lib/same_recording.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/same_recording.sh"
 tmp="$(mktemp -d)"
 pids=()
 namespaces=()
@@ -114,7 +116,7 @@ netns_identical() {
   set -e
   [ "$rc" -eq 0 ] || fail "plant across namespaces exited with $rc"
   cmp "$tmp/in/trajectory.csv" "$tmp/ns/trajectory.csv" || fail "trajectory differs from the in-process run"
-  cmp "$tmp/in/run.mcap" "$tmp/ns/run.mcap" || fail "MCAP recording differs from the in-process run"
+  same_recording "$tmp/in/run.mcap" "$tmp/ns/run.mcap" || fail "MCAP recording differs from the in-process run"
   [ "$(wc -l < "$tmp/ns/trajectory.csv")" -eq 1502 ] || fail "trajectory has the wrong length"
   # One command per control tick (0, 0.02, ..., 15 s); repeats answering a tick asked for again are
   # counted as stale.

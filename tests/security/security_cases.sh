@@ -5,6 +5,8 @@
 bin="$1"; src="$2"
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 scenario="$src/scenarios/paper/altitude_step.yaml"
+# shellcheck source=../lib/same_recording.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/same_recording.sh"
 ks="$tmp/keystore"
 
 # Secured settings for one command: secure ENCLAVE COMMAND...
@@ -42,7 +44,7 @@ case "$case_name" in
     done
     cmp "$tmp/in/trajectory.csv" "$tmp/sec/trajectory.csv" || fail "trajectories differ"
     /usr/bin/python3 "$(dirname "${BASH_SOURCE[0]}")/../lib/same_metrics.py" "$tmp/in/metrics.json" "$tmp/sec/metrics.json" || fail "metrics differ"
-    cmp "$tmp/in/run.mcap" "$tmp/sec/run.mcap" || fail "MCAP recordings differ"
+    same_recording "$tmp/in/run.mcap" "$tmp/sec/run.mcap" || fail "MCAP recordings differ"
     [ "$(wc -l < "$tmp/sec/trajectory.csv")" -gt 500 ] || fail "trajectory too short"
     # A second run uses the keystore as it is (nothing re-created).
     "$bin" run "$scenario" --out "$tmp/sec2" --no-plots --transport dds --keystore "$ks" > "$tmp/sec2.log" 2>&1 \
