@@ -59,6 +59,46 @@ std::shared_ptr<const control::Controller> read_sitl_controller(YamlSection& c, 
     if (!a.IsScalar()) s.fail("args", "expected command-line arguments (text)");
     spec.args.push_back(a.Scalar());
   }
+  spec.echo_statustext = s.boolean("echo_statustext", false);
+  const std::vector<YAML::Node> items = s.sequence("mission");
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const std::string key = "mission[" + std::to_string(i) + "]";
+    if (!items[i].IsMap()) s.fail(key, "got " + YamlSection::describe(items[i]) + ", expected a mapping");
+    YamlSection m(items[i], s.file(), s.key_path(key));
+    sitl::MissionItem item;
+    item.at_s = m.number("at_s", 0.0, 0.0, 1e9);
+    int kinds = 0;
+    if (m.has("mode")) {
+      ++kinds;
+      item.kind = sitl::MissionItem::Kind::kMode;
+      item.mode = m.text("mode", "");
+      if (sitl::copter_mode_number(item.mode) < 0) {
+        m.fail("mode", "got '" + item.mode +
+                           "', expected stabilize, acro, alt_hold, auto, guided, loiter, rtl, circle, land, poshold "
+                           "or brake");
+      }
+    }
+    if (m.has("arm")) {
+      ++kinds;
+      item.kind = m.boolean("arm", true) ? sitl::MissionItem::Kind::kArm : sitl::MissionItem::Kind::kDisarm;
+    }
+    if (m.has("takeoff_m")) {
+      ++kinds;
+      item.kind = sitl::MissionItem::Kind::kTakeoff;
+      item.takeoff_m = m.number("takeoff_m", 0.0, 0.1, 1e4);
+    }
+    if (m.has("goto_m")) {
+      ++kinds;
+      item.kind = sitl::MissionItem::Kind::kGoto;
+      const std::vector<double> p = m.numbers("goto_m", {}, 3);
+      item.p_W = {p[0], p[1], p[2]};
+    }
+    if (kinds != 1) {
+      s.fail(key, "expected exactly one of mode, arm, takeoff_m, goto_m (a position [x, y, z] in the world, ENU)");
+    }
+    m.reject_unknown_keys();
+    spec.mission.push_back(item);
+  }
   s.reject_unknown_keys();
   try {
     return std::make_shared<sitl::SitlController>(spec, vehicle);

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include "sitl/firmware_process.hpp"
 #include "sitl/frames.hpp"
 #include "sitl/json_codec.hpp"
+#include "sitl/mavlink.hpp"
 
 namespace quadcosim::sitl {
 
@@ -65,7 +67,32 @@ struct SitlController::Link {
   sockaddr_in peer{};
   std::uint32_t pending = 0;  ///< frame count of the packet the next reply answers
   bool have_pending = false;
-  std::vector<std::uint8_t> mavlink_in;  ///< bytes the firmware sent on its MAVLink link
+  mavlink::Parser parser;  ///< the firmware's MAVLink stream
+  std::uint8_t seq = 0;
+  std::uint8_t target_system = 1;  ///< the firmware's system id (from its heartbeat)
+  mavlink::Heartbeat heartbeat;    ///< its newest
+  bool have_heartbeat = false;
+  // The mission: the item in progress, when it was last sent (simulated time), the answers to it.
+  std::size_t item = 0;
+  double item_sent_s = -1.0;
+  std::optional<std::uint8_t> item_result;
+  std::uint16_t item_command = 0;
+  long long decisions = 0;
+  std::ofstream statustext;
+
+  void send(std::uint32_t msgid, const std::vector<std::uint8_t>& payload) {
+    if (tcp < 0) return;
+    const std::vector<std::uint8_t> frame = mavlink::encode(seq++, 255, 190, msgid, payload);
+    std::size_t at = 0;
+    while (at < frame.size()) {
+      const ssize_t n = ::send(tcp, frame.data() + at, frame.size() - at, MSG_NOSIGNAL);
+      if (n <= 0) {
+        if (errno == EAGAIN || errno == EINTR) continue;
+        return;
+      }
+      at += static_cast<std::size_t>(n);
+    }
+  }
 
   ~Link() {
     process.reset();  // ends the firmware first
@@ -89,10 +116,20 @@ struct SitlController::Link {
     for (;;) {
       const ssize_t n = ::recv(tcp, buf.data(), buf.size(), MSG_DONTWAIT);
       if (n <= 0) break;
-      if (mavlink_in.size() < (1u << 20)) mavlink_in.insert(mavlink_in.end(), buf.begin(), buf.begin() + n);
+      parser.feed(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
     }
   }
 };
+
+int copter_mode_number(const std::string& name) {
+  static const std::pair<const char*, int> kModes[] = {
+      {"stabilize", 0}, {"acro", 1},   {"alt_hold", 2}, {"auto", 3},     {"guided", 4}, {"loiter", 5},
+      {"rtl", 6},       {"circle", 7}, {"land", 9},     {"poshold", 16}, {"brake", 17}};
+  for (const auto& [n, v] : kModes) {
+    if (name == n) return v;
+  }
+  return -1;
+}
 
 SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicle)
     : spec_(std::move(spec)),
@@ -108,6 +145,13 @@ SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicl
   }
   for (const std::string& p : spec_.params) {
     if (!fs::is_regular_file(p)) throw std::invalid_argument("params: no such file '" + p + "'");
+  }
+  for (const MissionItem& m : spec_.mission) {
+    if (m.kind == MissionItem::Kind::kMode && copter_mode_number(m.mode) < 0) {
+      throw std::invalid_argument("mission: mode '" + m.mode +
+                                  "' is not one of stabilize, acro, alt_hold, auto, guided, loiter, rtl, circle, "
+                                  "land, poshold, brake");
+    }
   }
   if (!(spec_.timeout_s > 0) || !(spec_.start_timeout_s > 0)) {
     throw std::invalid_argument("timeout_s and start_timeout_s must be positive");
@@ -221,6 +265,82 @@ void SitlController::start() {
   }
 }
 
+void SitlController::service_mavlink() {
+  Link& l = *link_;
+  l.service_tcp();
+  while (auto f = l.parser.next()) {
+    if (f->msgid == mavlink::kHeartbeat) {
+      const mavlink::Heartbeat h = mavlink::read_heartbeat(*f);
+      if (h.type == 6) continue;  // another GCS's
+      l.heartbeat = h;
+      l.have_heartbeat = true;
+      l.target_system = f->sysid;
+    } else if (f->msgid == mavlink::kCommandAck) {
+      const mavlink::CommandAck a = mavlink::read_command_ack(*f);
+      if (a.command == l.item_command && l.item_sent_s >= 0) l.item_result = a.result;
+    } else if (f->msgid == mavlink::kStatustext) {
+      const auto [severity, text] = mavlink::read_statustext(*f);
+      if (!l.statustext.is_open()) l.statustext.open(fs::path(l.work_dir) / "statustext.log");
+      l.statustext << fmt::format("{:.3f} {} {}\n", t_s_, severity, text) << std::flush;
+      if (spec_.echo_statustext) std::fprintf(stderr, "sitl: t = %.3f s: %s\n", t_s_, text.c_str());
+    }
+  }
+  // Decisions once the firmware has spoken on its link (its first HEARTBEAT), and then at whole
+  // multiples of 0.25 s of simulated time only (step counts, not wall time).
+  if (!l.have_heartbeat || l.tcp < 0) return;
+  const long long decision = static_cast<long long>(std::floor(t_s_ / 0.25 + 1e-9));
+  if (decision < l.decisions) return;
+  l.decisions = decision + 1;
+  if (decision % 4 == 0) l.send(mavlink::kHeartbeat, mavlink::heartbeat(6, 8, 0, 0, 4));  // a GCS, at 1 Hz
+  while (l.item < spec_.mission.size()) {
+    const MissionItem& m = spec_.mission[l.item];
+    if (l.item_sent_s >= 0) {
+      if (l.item_result && *l.item_result == 0) {  // accepted: the next one
+        ++l.item;
+        l.item_sent_s = -1.0;
+        l.item_result.reset();
+        continue;
+      }
+      if (t_s_ - l.item_sent_s < 1.0 - 1e-9) return;  // its answer may still come
+    }
+    if (t_s_ + 1e-9 < m.at_s) return;
+    const std::uint8_t ts = l.target_system;
+    l.item_result.reset();
+    l.item_sent_s = t_s_;
+    switch (m.kind) {
+      case MissionItem::Kind::kMode:
+        l.item_command = mavlink::kCmdDoSetMode;
+        l.send(mavlink::kCommandLong,
+               mavlink::command_long(ts, 1, l.item_command, 0,
+                                     {1.0f, static_cast<float>(copter_mode_number(m.mode)), 0, 0, 0, 0, 0}));
+        break;
+      case MissionItem::Kind::kArm:
+      case MissionItem::Kind::kDisarm:
+        l.item_command = mavlink::kCmdComponentArmDisarm;
+        l.send(mavlink::kCommandLong,
+               mavlink::command_long(ts, 1, l.item_command, 0,
+                                     {m.kind == MissionItem::Kind::kArm ? 1.0f : 0.0f, 0, 0, 0, 0, 0, 0}));
+        break;
+      case MissionItem::Kind::kTakeoff:
+        l.item_command = mavlink::kCmdNavTakeoff;
+        l.send(mavlink::kCommandLong,
+               mavlink::command_long(ts, 1, l.item_command, 0, {0, 0, 0, 0, 0, 0, static_cast<float>(m.takeoff_m)}));
+        break;
+      case MissionItem::Kind::kGoto: {
+        const Eigen::Vector3d p = enu_to_ned(m.p_W);
+        l.send(mavlink::kSetPositionTargetLocalNed,
+               mavlink::set_position_target_local_ned(static_cast<std::uint32_t>(t_s_ * 1000.0), ts, 1,
+                                                      static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                                      static_cast<float>(p.z()), false, 0.0f));
+        l.item_command = 0;
+        l.item_result = 0;  // no answer to a position target: done when sent
+        break;
+      }
+    }
+    return;
+  }
+}
+
 void SitlController::step(const control::Observation& obs, const control::Reference& reference, double dt_s,
                           control::ControllerOutput& out) {
   if (!link_) start();
@@ -228,8 +348,10 @@ void SitlController::step(const control::Observation& obs, const control::Refere
   const bool first = !l.have_pending;
   const double limit_s = first ? spec_.start_timeout_s : spec_.timeout_s;
 
-  // The state at t_n answers the pending packet.
+  // The state at t_n answers the pending packet. Commands go out first: the firmware waits for the
+  // answer, so they are in its link's buffer before it runs the frame (the same frame on every run).
   if (l.have_pending) {
+    service_mavlink();
     FdmState s;
     s.timestamp_s = t_s_;
     s.gyro_FRD = flu_to_frd(obs.w_B);
@@ -318,6 +440,9 @@ void SitlController::step(const control::Observation& obs, const control::Refere
     for (int c = 0; c < 4; ++c) out.outputs[1 + c] = c < static_cast<int>(packet.pwm_us.size()) ? packet.pwm_us[c] : 0;
     out.outputs[5] = static_cast<double>(counts_.repeated);
     out.outputs[6] = static_cast<double>(counts_.skipped);
+    out.outputs[7] = l.have_heartbeat && l.heartbeat.armed() ? 1.0 : 0.0;
+    out.outputs[8] = l.have_heartbeat ? static_cast<double>(l.heartbeat.custom_mode) : -1.0;
+    out.outputs[9] = static_cast<double>(l.item);
     control::rotor_speeds_output(model_, reference, omega, reported_, out);
     break;
   }

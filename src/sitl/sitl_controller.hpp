@@ -24,6 +24,22 @@
 
 namespace quadcosim::sitl {
 
+/// One command of a mission flown over the firmware's MAVLink link (docs/sitl.md), sent once the
+/// simulated time reaches at_s and the previous one was accepted (COMMAND_ACK result 0); a refused or
+/// unanswered command is sent again every second. The mission is looked at every 0.25 s of simulated
+/// time only, so that when an answer arrives within that period never changes the flight.
+struct MissionItem {
+  enum class Kind { kMode, kArm, kDisarm, kTakeoff, kGoto };
+  double at_s = 0.0;
+  Kind kind = Kind::kMode;
+  std::string mode;                               ///< kMode: stabilize, alt_hold, guided, loiter, rtl, land, ...
+  double takeoff_m = 0.0;                         ///< kTakeoff: height above home [m]
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< kGoto: position in quadcosim's world (ENU) [m]
+};
+
+/// ArduCopter's custom mode number for a mode name (lower case), or -1.
+int copter_mode_number(const std::string& name);
+
 /// What a scenario's `controller: {sitl: {...}}` says (docs/scenarios.md).
 struct SitlSpec {
   std::string firmware = "ardupilot";  ///< the flight stack (only ArduPilot's JSON protocol so far)
@@ -36,10 +52,14 @@ struct SitlSpec {
   double pwm_min_us = 1000.0;                        ///< zero rotor speed at and below [us]
   double pwm_max_us = 2000.0;                        ///< omega_max at and above [us]
   std::vector<std::string> args;                     ///< more command-line arguments for the firmware
+  std::vector<MissionItem> mission;  ///< commands over MAVLink (none: the firmware flies as its params say)
+  bool echo_statustext = false;      ///< print the firmware's STATUSTEXT messages on stderr as they come
 };
 
 /// The figures a SITL controller records (out.<name> in trajectory.csv).
-inline constexpr const char* kSitlOutputs[] = {"frame", "pwm1", "pwm2", "pwm3", "pwm4", "repeated", "skipped"};
+/// armed and mode are the firmware's last HEARTBEAT's; mission is the index of the mission item in progress.
+inline constexpr const char* kSitlOutputs[] = {"frame",    "pwm1",    "pwm2",  "pwm3", "pwm4",
+                                               "repeated", "skipped", "armed", "mode", "mission"};
 
 class SitlController final : public control::Controller {
  public:
@@ -81,6 +101,8 @@ class SitlController final : public control::Controller {
  private:
   struct Link;
   void start();
+  /// Reads the firmware's MAVLink messages; at decision times, advances the mission.
+  void service_mavlink();
   [[noreturn]] void fail(const std::string& what) const;
 
   SitlSpec spec_;

@@ -4,6 +4,12 @@
 //   FAKE_MODE 0: every motor at FAKE_PWM [us] (open loop: the height follows a closed form)
 //   FAKE_MODE 1: hold FAKE_ALT [m] above home, level (PD on height and tilt, hover feed-forward from
 //                FAKE_MASS [kg], FAKE_KT [N/(rad/s)^2], FAKE_WMAX [rad/s], FAKE_ARM [m])
+//   FAKE_MODE 2: as 1, but commanded over MAVLink on its SERIAL0 link, as a GCS commands ArduCopter:
+//                HEARTBEAT at 1 Hz (armed flag, custom mode); COMMAND_LONG DO_SET_MODE (4 guided,
+//                9 land), COMPONENT_ARM_DISARM (refused, result 1, before FAKE_READY_S [s] and outside
+//                guided), NAV_TAKEOFF (param7 [m]) each answered by COMMAND_ACK;
+//                SET_POSITION_TARGET_LOCAL_NED sets the height (-z); land descends to the ground and
+//                disarms there. Disarmed, every motor is at MOT_PWM_MIN (stopped).
 // and its faults from its own options (quadcosim passes a scenario's sitl.args):
 //   --fake-bad-magic-at N   frame N goes out with a wrong magic
 //   --fake-die-at N         exit(3) instead of sending frame N
@@ -32,6 +38,7 @@
 #include <vector>
 
 #include "sitl/json_codec.hpp"
+#include "sitl/mavlink.hpp"
 
 using quadcosim::sitl::FdmState;
 
@@ -82,7 +89,8 @@ int main(int argc, char** argv) {
   const auto p = read_params(defaults);
   const int mode = static_cast<int>(get(p, "FAKE_MODE", 1));
   const double pwm_const = get(p, "FAKE_PWM", 1400);
-  const double alt = get(p, "FAKE_ALT", 2.0);
+  double alt = get(p, "FAKE_ALT", 2.0);
+  const double ready_s = get(p, "FAKE_READY_S", 2.0);
   const double mass = get(p, "FAKE_MASS", 1.96), kt = get(p, "FAKE_KT", 2.06e-7);
   const double wmax = get(p, "FAKE_WMAX", 12000), arm = get(p, "FAKE_ARM", 0.59), g = 9.81;
   const double pwm_min = get(p, "MOT_PWM_MIN", 1000), pwm_max = get(p, "MOT_PWM_MAX", 2000);
@@ -99,6 +107,23 @@ int main(int argc, char** argv) {
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     if (::connect(tcp, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) std::perror("fake firmware: connect");
   }
+  namespace mav = quadcosim::sitl::mavlink;
+  mav::Parser parser;
+  std::uint8_t seq = 0;
+  bool armed = mode != 2;
+  std::uint32_t custom_mode = 0;
+  long last_heartbeat = -1;
+  const auto send = [&](std::uint32_t id, const std::vector<std::uint8_t>& payload) {
+    if (tcp < 0) return;
+    const auto f = mav::encode(seq++, 1, 1, id, payload);
+    if (::send(tcp, f.data(), f.size(), MSG_NOSIGNAL) < 0) std::perror("fake firmware: send");
+  };
+  const auto ack = [&](std::uint16_t command, std::uint8_t result) {
+    std::vector<std::uint8_t> payload = {static_cast<std::uint8_t>(command & 0xff),
+                                         static_cast<std::uint8_t>(command >> 8), result};
+    send(mav::kCommandAck, payload);
+    std::printf("fake firmware: command %u -> %u\n", command, result);
+  };
   const int udp = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in to{};
   to.sin_family = AF_INET;
@@ -156,6 +181,55 @@ int main(int argc, char** argv) {
     if (mode == 0) {
       for (double& w : pwm) w = pwm_const;
       continue;
+    }
+    if (mode == 2) {
+      // Its GCS link, once a frame: heartbeats, commands.
+      if (static_cast<long>(s.timestamp_s) > last_heartbeat) {
+        last_heartbeat = static_cast<long>(s.timestamp_s);
+        send(mav::kHeartbeat,
+             mav::heartbeat(2, 3, static_cast<std::uint8_t>(armed ? 0x80 | 0x01 : 0x01), custom_mode, armed ? 4 : 3));
+      }
+      std::uint8_t in[4096];
+      for (ssize_t n; tcp >= 0 && (n = ::recv(tcp, in, sizeof(in), MSG_DONTWAIT)) > 0;) {
+        parser.feed(std::span<const std::uint8_t>(in, static_cast<std::size_t>(n)));
+      }
+      while (auto f = parser.next()) {
+        if (f->msgid == mav::kCommandLong) {
+          std::vector<std::uint8_t> pl = f->payload;
+          pl.resize(33, 0);
+          float param[7];
+          std::memcpy(param, pl.data(), sizeof(param));
+          const std::uint16_t command = static_cast<std::uint16_t>(pl[28] | (pl[29] << 8));
+          if (command == mav::kCmdDoSetMode) {
+            custom_mode = static_cast<std::uint32_t>(param[1]);
+            if (custom_mode == 9) alt = -1.0;  // land: down to the ground
+            ack(command, 0);
+          } else if (command == mav::kCmdComponentArmDisarm) {
+            const bool ok = param[0] == 0.0f || (custom_mode == 4 && s.timestamp_s >= ready_s);
+            if (ok) armed = param[0] != 0.0f;
+            ack(command, ok ? 0 : 1);
+          } else if (command == mav::kCmdNavTakeoff) {
+            const bool ok = armed && custom_mode == 4;
+            if (ok) alt = param[6];
+            ack(command, ok ? 0 : 4);
+          } else {
+            ack(command, 3);
+          }
+        } else if (f->msgid == mav::kSetPositionTargetLocalNed) {
+          std::vector<std::uint8_t> pl = f->payload;
+          pl.resize(53, 0);
+          float z = 0;
+          std::memcpy(&z, pl.data() + 12, sizeof(z));
+          alt = -z;
+          std::printf("fake firmware: target height %.2f m\n", alt);
+        }
+      }
+      if (armed && custom_mode == 9 && -s.p_NED.z() < 0.02 && std::abs(s.v_NED.z()) < 0.05) armed = false;
+      if (!armed) {
+        for (double& w : pwm) w = pwm_min;
+        integral = 0.0;
+        continue;
+      }
     }
     // Hold FAKE_ALT: height and climb rate from NED, attitude from the quaternion (FRD).
     const double h = -s.p_NED.z(), climb = -s.v_NED.z();

@@ -170,6 +170,31 @@ YAML
     [ "$rc" -eq 2 ] && grep -q "controller.sitl.timeout" "$tmp/unknown.log" || fail "unknown key: exit $rc $(cat "$tmp/unknown.log")"
     cat "$tmp/nobin.log" "$tmp/notexec.log" "$tmp/noparm.log" "$tmp/unknown.log" | grep -i "error\|sitl" | head -4
     ;;
+  mission)
+    # A mission over MAVLink: the arm command is refused until the firmware is ready (2 s) and sent again
+    # each second, so it is accepted at the 2.25 s decision; then take off to 3 m, a 5 m target at 8 s,
+    # land at 14 s (disarmed on the ground). Twice: the same bytes.
+    scenario fake_mission m1
+    scenario fake_mission m2
+    run m1 0
+    run m2 0
+    cmp "$tmp/m1/trajectory.csv" "$tmp/m2/trajectory.csv" || fail "two mission runs differ"
+    "$py" - "$tmp/m1/trajectory.csv" <<'PY' || fail "mission"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+at = lambda t: rows[round(t * 400)]
+armed = [float(r["t"]) for r in rows if r["out.armed"] == "1"]
+assert armed and 2.25 <= armed[0] <= 3.25, armed[:1]
+assert all(float(r["z"]) == 0.0 for r in rows if float(r["t"]) < 2.25)
+assert abs(float(at(7.5)["z"]) - 3) < 0.3, at(7.5)["z"]
+assert abs(float(at(13.5)["z"]) - 5) < 0.3, at(13.5)["z"]
+last = rows[-1]
+assert float(last["z"]) == 0.0 and last["out.armed"] == "0" and last["out.mode"] == "9", last
+assert float(last["out.mission"]) == 5
+print(f"mission: armed at {armed[0]:.4f} s, z(7.5 s) = {float(at(7.5)['z']):.3f} m, "
+      f"z(13.5 s) = {float(at(13.5)['z']):.3f} m, landed and disarmed; two runs identical")
+PY
+    ;;
   controller_flag)
     # --controller sitl:ardupilot:BINARY flies a scenario written for another controller with the
     # firmware; the file's sitl section (params, timeouts) is kept when it has one. The open-loop
