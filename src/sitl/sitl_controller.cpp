@@ -295,7 +295,13 @@ void SitlController::service_mavlink() {
   while (l.item < spec_.mission.size()) {
     const MissionItem& m = spec_.mission[l.item];
     if (l.item_sent_s >= 0) {
-      if (l.item_result && *l.item_result == 0) {  // accepted: the next one
+      // Accepted, and for a mode or arming, shown so by the firmware's heartbeat: the next one.
+      const bool shown = m.kind == MissionItem::Kind::kMode
+                             ? l.heartbeat.custom_mode == static_cast<std::uint32_t>(copter_mode_number(m.mode))
+                         : m.kind == MissionItem::Kind::kArm    ? l.heartbeat.armed()
+                         : m.kind == MissionItem::Kind::kDisarm ? !l.heartbeat.armed()
+                                                                : true;
+      if (l.item_result && *l.item_result == 0 && shown) {
         ++l.item;
         l.item_sent_s = -1.0;
         l.item_result.reset();

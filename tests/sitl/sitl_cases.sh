@@ -211,5 +211,38 @@ PY
     [ "$rc" -eq 2 ] && grep -q "expected sitl:ardupilot" "$tmp/px4.log" || fail "sitl:px4: exit $rc $(cat "$tmp/px4.log")"
     echo "controller flag: sitl:ardupilot:BINARY flew the open-loop file, z(2 s) as expected"
     ;;
+  real_mission)
+    # ArduCopter's SITL build (QUADCOSIM_ARDUPILOT_SITL) flies scenarios/sitl/takeoff_waypoint_land.yaml
+    # twice: the same trajectory.csv bytes; it arms once its EKF is ready, holds 10 m, reaches the
+    # waypoint (10, 5, 10), lands and disarms; one frame per tick, none repeated or skipped.
+    if [ -z "${QUADCOSIM_ARDUPILOT_SITL:-}" ] || [ ! -x "$QUADCOSIM_ARDUPILOT_SITL" ]; then
+      echo "SKIPPED: QUADCOSIM_ARDUPILOT_SITL does not name ArduCopter's SITL executable (docs/sitl.md)"
+      exit 77
+    fi
+    for n in r1 r2; do
+      rc=0; "$bin" run "$src/scenarios/sitl/takeoff_waypoint_land.yaml" --out "$tmp/$n" --judge none \
+        > "$tmp/$n.log" 2>&1 || rc=$?
+      [ "$rc" -eq 0 ] || fail "$n exited $rc"
+    done
+    cmp "$tmp/r1/trajectory.csv" "$tmp/r2/trajectory.csv" || fail "two runs of the same firmware differ"
+    "$py" - "$tmp/r1/trajectory.csv" <<'PY' || fail "mission"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+rate = 800
+at = lambda t: rows[round(t * rate)]
+armed = [float(r["t"]) for r in rows if r["out.armed"] == "1"]
+assert armed, "never armed"
+hold = [float(r["z"]) for r in rows if 52 <= float(r["t"]) <= 60]
+assert min(hold) > 9.5 and max(hold) < 10.5, (min(hold), max(hold))
+wp = [math.hypot(float(r["x"]) - 10, float(r["y"]) - 5) for r in rows if 70 <= float(r["t"]) <= 80]
+assert max(wp) < 0.3, max(wp)
+last = rows[-1]
+assert float(last["z"]) < 0.05 and last["out.armed"] == "0", (last["z"], last["out.armed"])
+assert float(last["out.frame"]) - float(rows[0]["out.frame"]) == len(rows) - 1
+assert float(last["out.repeated"]) == 0 and float(last["out.skipped"]) == 0
+print(f"real mission: armed at {armed[0]:.2f} s, 10 m held within [{min(hold):.3f}, {max(hold):.3f}] m, "
+      f"waypoint within {max(wp):.3f} m, landed and disarmed at {armed[-1]:.2f} s; two runs identical")
+PY
+    ;;
   *) echo "unknown case $case_name"; exit 2 ;;
 esac
