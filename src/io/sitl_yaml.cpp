@@ -11,7 +11,8 @@ namespace {
 
 std::string resolved(const std::string& given, const std::filesystem::path& folder) {
   const std::filesystem::path p(given);
-  return (p.is_absolute() ? p : folder / p).lexically_normal().string();
+  // Absolute: the firmware runs in a folder of its own.
+  return std::filesystem::absolute(p.is_absolute() ? p : folder / p).lexically_normal().string();
 }
 
 }  // namespace

@@ -380,6 +380,15 @@ void SitlController::step(const control::Observation& obs, const control::Refere
     if (auto end = l.process->ended()) {
       fail(fmt::format("step {} (t = {:.4f} s): the firmware {}", steps_, t_s_, *end));
     }
+    if (first) {
+      // A firmware that panics while starting (ArduPilot's SITL then spins instead of exiting) says so
+      // in its log: fail at once with its words rather than after start_timeout_s.
+      const std::string tail = l.process->log_tail(4);
+      if (const std::size_t at = tail.find("PANIC"); at != std::string::npos) {
+        fail(
+            fmt::format("step 0: the firmware panicked while starting: {}", tail.substr(at, tail.find('\n', at) - at)));
+      }
+    }
     const double left = deadline - wall_s();
     if (left <= 0) {
       fail(fmt::format("step {} (t = {:.4f} s): no servo packet for {:g} s (frame {}{})", steps_, t_s_, limit_s,

@@ -16,6 +16,8 @@
 //   --fake-hang-at N        stop answering (sleep) at frame N
 //   --fake-repeat-every N   every Nth frame is sent twice (as the firmware does when it waits long)
 //   --fake-first-copies N   the first frame is sent N times before the first answer
+//   --fake-panic            print a PANIC line and hang before any frame (as ArduPilot's SITL does on a
+//                           bad --defaults path)
 //   --fake-pid-file PATH    writes its process id there (for the tests: is it gone afterwards?)
 // Motor outputs follow ArduPilot's quad plus frame: channel 1 right, 2 left, 3 front, 4 back.
 #include <arpa/inet.h>
@@ -84,6 +86,11 @@ int main(int argc, char** argv) {
     if (a == "--fake-hang-at") hang_at = std::atol(next);
     if (a == "--fake-repeat-every") repeat_every = std::atol(next);
     if (a == "--fake-first-copies") first_copies = std::atol(next);
+    if (a == "--fake-panic") {
+      std::printf("PANIC: Failed to load defaults from %s\n", defaults.c_str());
+      std::fflush(stdout);
+      for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
     if (a == "--fake-pid-file") std::ofstream(next) << ::getpid() << "\n";
   }
   const auto p = read_params(defaults);

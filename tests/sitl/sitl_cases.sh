@@ -143,6 +143,20 @@ PY
     gone "$tmp/hang.pid"
     echo "firmware hangs: ended after $took s, firmware killed"
     ;;
+  firmware_panics)
+    # A PANIC line in the firmware's log while it starts ends the run at once (start_timeout_s is 30 s),
+    # quoting it; and a scenario given by a relative path passes absolute parameter paths.
+    scenario fake_open_loop panic --fake-panic
+    start=$SECONDS
+    run panic 5
+    [ $((SECONDS - start)) -le 10 ] || fail "took $((SECONDS - start)) s"
+    grep -q "step 0: the firmware panicked while starting: PANIC: Failed to load defaults" "$tmp/panic.log" ||
+      fail "message: $(cat "$tmp/panic.log")"
+    grep -q "fake_open_loop.parm" "$tmp/panic.log" || fail "the parameter file is not named"
+    (cd "$src" && "$bin" run tests/sitl/fake_open_loop.yaml --controller "sitl:ardupilot:$fake" --out "$tmp/rel" \
+      --judge none > "$tmp/rel.log" 2>&1) || fail "relative scenario path: $(tail -3 "$tmp/rel.log")"
+    grep -q "PANIC" "$tmp/panic.log" | head -1
+    ;;
   bad_spec)
     # A missing binary, one that is not executable, a params file that does not exist, an unknown key.
     cat > "$tmp/nobin.yaml" <<YAML
