@@ -18,6 +18,7 @@
 //   --fake-first-copies N   the first frame is sent N times before the first answer
 //   --fake-panic            print a PANIC line and hang before any frame (as ArduPilot's SITL does on a
 //                           bad --defaults path)
+//   --fake-record PATH      writes each state it receives: t, gyro FRD, accel FRD (one line a frame)
 //   --fake-pid-file PATH    writes its process id there (for the tests: is it gone afterwards?)
 // Motor outputs follow ArduPilot's quad plus frame: channel 1 right, 2 left, 3 front, 4 back.
 #include <arpa/inet.h>
@@ -70,6 +71,7 @@ double get(const std::map<std::string, double>& p, const char* name, double fall
 
 int main(int argc, char** argv) {
   int sim_port = 9002, mavlink_port = 0;
+  std::ofstream record;
   std::string defaults;
   long bad_magic_at = -1, die_at = -1, hang_at = -1, repeat_every = 0, first_copies = 1;
   for (int i = 1; i < argc; ++i) {
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
     if (a == "--fake-hang-at") hang_at = std::atol(next);
     if (a == "--fake-repeat-every") repeat_every = std::atol(next);
     if (a == "--fake-first-copies") first_copies = std::atol(next);
+    if (a == "--fake-record") record.open(next);
     if (a == "--fake-panic") {
       std::printf("PANIC: Failed to load defaults from %s\n", defaults.c_str());
       std::fflush(stdout);
@@ -182,6 +185,11 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       std::printf("fake firmware: %s\n", e.what());
       return 5;
+    }
+    if (record.is_open()) {
+      record.precision(17);
+      record << s.timestamp_s << ' ' << s.gyro_FRD.x() << ' ' << s.gyro_FRD.y() << ' ' << s.gyro_FRD.z() << ' '
+             << s.accel_FRD.x() << ' ' << s.accel_FRD.y() << ' ' << s.accel_FRD.z() << std::endl;  // it is killed
     }
     const double dt = s.timestamp_s - last_t;
     last_t = s.timestamp_s;

@@ -143,6 +143,30 @@ PY
     gone "$tmp/hang.pid"
     echo "firmware hangs: ended after $took s, firmware killed"
     ;;
+  imu_noise)
+    # The IMU the firmware is sent is the one realism makes: gyro white noise of density
+    # 0.001 rad/s/sqrt(Hz) at 400 Hz is sigma = 0.001 sqrt(400) = 0.02 rad/s per axis on a vehicle
+    # whose true rates stay 0 (open loop, level); the accelerometer (no noise) reads the specific
+    # force 4 k_t 4800^2 / m = 9.686204 m/s^2 along -z FRD.
+    scenario fake_open_loop noisy --fake-record "$tmp/received.txt"
+    printf 'sensors:\n  imu:\n    rate_hz: 400\n    gyro_noise_density_rad_s_sqrt_hz: 0.001\n' >> "$tmp/noisy.yaml"
+    run noisy 0
+    "$py" - "$tmp/received.txt" "$tmp/noisy/trajectory.csv" <<'PY' || fail "imu noise"
+import csv, math, sys
+rec = [list(map(float, l.split())) for l in open(sys.argv[1])]
+truth = list(csv.DictReader(open(sys.argv[2])))
+assert max(abs(float(r[k])) for r in truth for k in ("p", "q", "r")) == 0.0
+assert len(rec) >= 800, len(rec)
+for axis in (1, 2, 3):
+    v = [r[axis] for r in rec]
+    m = sum(v) / len(v)
+    sd = math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1))
+    assert 0.018 < sd < 0.022 and abs(m) < 0.003, (axis, m, sd)
+f = 4 * 2.06e-7 * 4800.0 ** 2 / 1.96
+assert all(abs(r[6] + f) < 1e-9 and r[4] == 0 and r[5] == 0 for r in rec), rec[:2]
+print(f"imu noise: the firmware received gyro sigma {sd:.4f} rad/s (expected 0.02), accel z {rec[-1][6]:.6f} (expected {-f:.6f})")
+PY
+    ;;
   firmware_panics)
     # A PANIC line in the firmware's log while it starts ends the run at once (start_timeout_s is 30 s),
     # quoting it; and a scenario given by a relative path passes absolute parameter paths.
