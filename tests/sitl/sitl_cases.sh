@@ -5,7 +5,7 @@
 # never a hang, with the firmware process gone afterwards.
 # Usage: sitl_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID FAKE_FIRMWARE
 set -euo pipefail
-bin="$1"; src="$2"; case_name="$3"; fake="$5"
+bin="$1"; src="$2"; case_name="$3"; domain="$4"; fake="$5"
 here="$src/tests/sitl"
 py=/usr/bin/python3
 tmp="$(mktemp -d)"
@@ -142,6 +142,19 @@ PY
     grep -q "no servo packet for 2 s (frame 200: it went silent)" "$tmp/hang.log" || fail "message: $(cat "$tmp/hang.log")"
     gone "$tmp/hang.pid"
     echo "firmware hangs: ended after $took s, firmware killed"
+    ;;
+  dds)
+    # The firmware as the controller of `run --transport dds` (the controller process starts it): the
+    # same trajectory.csv bytes as in-process.
+    export ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+    unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
+    scenario fake_hover inproc
+    cp "$tmp/inproc.yaml" "$tmp/overdds.yaml"
+    run inproc 0
+    rc=0; "$bin" run "$tmp/overdds.yaml" --out "$tmp/overdds" --transport dds --judge none > "$tmp/overdds.log" 2>&1 || rc=$?
+    [ "$rc" -eq 0 ] || fail "over DDS: exit $rc"
+    cmp "$tmp/inproc/trajectory.csv" "$tmp/overdds/trajectory.csv" || fail "over DDS the trajectory differs"
+    echo "dds: the test firmware over DDS, trajectory.csv identical to in-process"
     ;;
   imu_noise)
     # The IMU the firmware is sent is the one realism makes: gyro white noise of density
