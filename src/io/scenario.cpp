@@ -755,25 +755,14 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
   const bool was_python = c["python"] || (c["type"] && c["type"].IsScalar() && c["type"].Scalar() == "python");
   const bool was_fmu = static_cast<bool>(c["fmu"]);
   const bool was_sitl = c["sitl"] || (c["type"] && c["type"].IsScalar() && c["type"].Scalar() == "sitl");
-  if (choice.kind == ControllerChoice::Kind::kSitl) {
-    // The firmware flies what the file says of it (params, timeouts), with the binary named, if one is.
-    if (!was_sitl) {
-      for (const char* key : {"python", "fmu", "inputs", "outputs", "parameters", "in_process", "step_timeout_s"}) {
-        c.remove(key);
-      }
-    }
-    c["type"] = "sitl";
-    if (!c["sitl"] || !c["sitl"].IsMap()) c["sitl"] = YAML::Node(YAML::NodeType::Map);
-    c["sitl"]["firmware"] = choice.firmware;
-    if (!choice.target.empty()) c["sitl"]["binary"] = choice.target;
-    return;
-  }
   const std::string was_type = was_python                          ? "python"
                                : was_fmu                           ? "fmu"
                                : c["type"] && c["type"].IsScalar() ? c["type"].Scalar()
                                                                    : std::string(controllers::kDefaultControllerType);
+  // A SITL firmware flies what the file says of it (its sitl: section: parameters, mission) when it has one.
   const bool same =
-      choice.kind == ControllerChoice::Kind::kType ? !was_python && !was_fmu && !was_sitl && was_type == choice.target
+      choice.kind == ControllerChoice::Kind::kType   ? !was_python && !was_fmu && !was_sitl && was_type == choice.target
+      : choice.kind == ControllerChoice::Kind::kSitl ? was_sitl
       : choice.kind == ControllerChoice::Kind::kPython
           ? was_python && (choice.target.empty() ||
                            (c["python"] && c["python"].IsScalar() && c["python"].Scalar() == choice.target))
@@ -816,7 +805,12 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       c.remove("type");
       c["fmu"] = choice.target;
       break;
-    case ControllerChoice::Kind::kSitl: break;  // handled above
+    case ControllerChoice::Kind::kSitl:
+      c["type"] = "sitl";
+      if (!c["sitl"] || !c["sitl"].IsMap()) c["sitl"] = YAML::Node(YAML::NodeType::Map);
+      c["sitl"]["firmware"] = choice.firmware;
+      if (!choice.target.empty()) c["sitl"]["binary"] = choice.target;
+      break;
   }
 }
 

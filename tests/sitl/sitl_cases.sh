@@ -260,6 +260,13 @@ PY
     [ "$(tail -1 "$tmp/flag/trajectory.csv" | cut -d, -f4)" = "9.75240816326531" ] || fail "not the open-loop flight"
     rc=0; "$bin" run "$tmp/paper.yaml" --controller "sitl:px4" --out "$tmp/x" > "$tmp/px4.log" 2>&1 || rc=$?
     [ "$rc" -eq 2 ] && grep -q "expected sitl:ardupilot" "$tmp/px4.log" || fail "sitl:px4: exit $rc $(cat "$tmp/px4.log")"
+    # A file whose gains sit directly under controller: (the paper controller's, the older form): they
+    # move into its paper: section, checked and unused, and the firmware flies.
+    sed -e "s/duration_s: .*/duration_s: 1/" "$src/tests/faults/hover_gusts.yaml" > "$tmp/flat.yaml"
+    rc=0; "$bin" run "$tmp/flat.yaml" --controller "sitl:ardupilot:$fake" --out "$tmp/flat" --judge none --no-plots \
+      > "$tmp/flat.log" 2>&1 || rc=$?
+    [ "$rc" -eq 0 ] || fail "flat gains: exit $rc $(grep error "$tmp/flat.log")"
+    grep -q "^  paper:" "$tmp/flat/scenario.yaml" || fail "the flat gains did not move to paper:"
     echo "controller flag: sitl:ardupilot:BINARY flew the open-loop file, z(2 s) as expected"
     ;;
   real_mission)
