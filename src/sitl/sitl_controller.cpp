@@ -18,6 +18,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "isolation/child.hpp"
 #include "sitl/firmware_process.hpp"
 #include "sitl/frames.hpp"
 #include "sitl/json_codec.hpp"
@@ -388,6 +389,10 @@ void SitlController::step(const control::Observation& obs, const control::Refere
         fail(
             fmt::format("step 0: the firmware panicked while starting: {}", tail.substr(at, tail.find('\n', at) - at)));
       }
+    }
+    if (isolation::stop_requested()) {
+      fail(fmt::format("step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM) while waiting for the firmware", steps_,
+                       t_s_));
     }
     const double left = deadline - wall_s();
     if (left <= 0) {

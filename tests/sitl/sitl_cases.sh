@@ -194,6 +194,25 @@ PY
       --judge none > "$tmp/rel.log" 2>&1) || fail "relative scenario path: $(tail -3 "$tmp/rel.log")"
     grep -q "PANIC" "$tmp/panic.log" | head -1
     ;;
+  interrupted)
+    # Ctrl-C (SIGINT to quadcosim) while the firmware hangs: exit 130 within 2 s, not after timeout_s
+    # (set to 30 s here), the firmware gone.
+    scenario fake_open_loop intr --fake-hang-at 100 --fake-pid-file "$tmp/intr.pid"
+    sed -i "s/timeout_s: 2/timeout_s: 30/" "$tmp/intr.yaml"
+    "$bin" run "$tmp/intr.yaml" --out "$tmp/intr" --judge none --no-plots > "$tmp/intr.log" 2>&1 &
+    q=$!
+    echo "$q" > "$tmp/q.pid"
+    for _ in $(seq 100); do grep -q "hanging at frame 100" /tmp/quadcosim-sitl-*/firmware.log 2>/dev/null && break; sleep 0.1; done
+    sleep 0.3
+    start=$("$py" -c 'import time; print(time.monotonic())')
+    kill -INT "$q"
+    rc=0; wait "$q" || rc=$?
+    took=$("$py" -c "import time; print(f'{time.monotonic() - $start:.2f}')")
+    [ "$rc" -eq 130 ] || fail "exit $rc $(cat "$tmp/intr.log")"
+    "$py" -c "import sys; sys.exit(0 if $took < 2.0 else 1)" || fail "took $took s"
+    gone "$tmp/intr.pid"
+    echo "interrupted: exit 130 after $took s, firmware gone"
+    ;;
   bad_spec)
     # A missing binary, one that is not executable, a params file that does not exist, an unknown key.
     cat > "$tmp/nobin.yaml" <<YAML
