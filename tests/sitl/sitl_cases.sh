@@ -198,11 +198,11 @@ PY
     # Ctrl-C (SIGINT to quadcosim) while the firmware hangs: exit 130 within 2 s, not after timeout_s
     # (set to 30 s here), the firmware gone.
     scenario fake_open_loop intr --fake-hang-at 100 --fake-pid-file "$tmp/intr.pid"
-    sed -i "s/timeout_s: 2/timeout_s: 30/" "$tmp/intr.yaml"
+    sed -i "s|timeout_s: 2|timeout_s: 30\n    work_dir: $tmp/fw|" "$tmp/intr.yaml"
     "$bin" run "$tmp/intr.yaml" --out "$tmp/intr" --judge none --no-plots > "$tmp/intr.log" 2>&1 &
     q=$!
     echo "$q" > "$tmp/q.pid"
-    for _ in $(seq 100); do grep -q "hanging at frame 100" /tmp/quadcosim-sitl-*/firmware.log 2>/dev/null && break; sleep 0.1; done
+    for _ in $(seq 100); do grep -q "hanging at frame 100" "$tmp/fw/firmware.log" 2>/dev/null && break; sleep 0.1; done
     sleep 0.3
     start=$("$py" -c 'import time; print(time.monotonic())')
     kill -INT "$q"
