@@ -390,9 +390,10 @@ void SitlController::step(const control::Observation& obs, const control::Refere
             fmt::format("step 0: the firmware panicked while starting: {}", tail.substr(at, tail.find('\n', at) - at)));
       }
     }
-    if (isolation::stop_requested()) {
-      fail(fmt::format("step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM) while waiting for the firmware", steps_,
-                       t_s_));
+    if (isolation::stop_requested()) {  // the firmware's folder goes as after a run that succeeded
+      throw control::ControllerFailure(
+          fmt::format("controller sitl ({} {}): step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM)",
+                      spec_.firmware, spec_.binary, steps_, t_s_));
     }
     const double left = deadline - wall_s();
     if (left <= 0) {
