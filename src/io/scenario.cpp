@@ -18,6 +18,7 @@
 #include "io/did_you_mean.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/scenario_limits.hpp"
+#include "io/sitl_yaml.hpp"
 #include "io/trajectory_yaml.hpp"
 #include "io/yaml_reader.hpp"
 #include "sim/topics.hpp"
@@ -118,7 +119,8 @@ constexpr int kMaxParameterDepth = 3;
 
 // The keys of a `controller:` section that are not parameters: read by read_controller.
 bool controller_section_key(const std::string& key) {
-  return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters" || key == "python";
+  return key == "type" || key == "fmu" || key == "inputs" || key == "outputs" || key == "parameters" ||
+         key == "python" || key == "sitl";
 }
 
 // A key of a `controller:` section (or of a schedule's `set:`) named after a registered controller
@@ -336,6 +338,19 @@ PythonControllerFactory python_controller_factory() {
 // and the class's declared parameters.
 control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle,
                                           const std::filesystem::path& folder, std::optional<FmuSpec>* fmu_spec) {
+  if (s.has("sitl") || (s.has("type") && s.text("type", "") == "sitl")) {
+    if (s.has("type") && s.text("type", "") != "sitl") {
+      s.fail("type", "got '" + s.text("type", "") + "' beside sitl; the firmware is the controller (type: sitl)");
+    }
+    for (const char* key : {"python", "fmu", "inputs", "outputs", "parameters"}) {
+      if (s.has(key)) s.fail(key, "beside sitl; a SITL firmware is the controller (docs/sitl.md)");
+    }
+    control::ControllerConfig c;
+    c.vehicle = vehicle;
+    c.controller = read_sitl_controller(s, vehicle, folder);
+    read_parameters(s, c, nullptr);
+    return c;
+  }
   if (s.has("python") || (s.has("type") && s.text("type", "") == "python")) {
     if (s.has("type") && s.text("type", "") != "python") {
       s.fail("type",
@@ -695,6 +710,23 @@ ControllerChoice parse_controller_choice(const std::string& text) {
       throw std::invalid_argument("got '" + text + "': no such file '" + c.target + "'");
     }
     c.target = std::filesystem::absolute(c.target).lexically_normal().string();
+  } else if (text == "sitl" || text.rfind("sitl:", 0) == 0) {
+    c.kind = ControllerChoice::Kind::kSitl;
+    const std::string rest = text.size() > 5 ? text.substr(5) : "ardupilot";
+    const std::size_t colon = rest.find(':');
+    c.firmware = rest.substr(0, colon);
+    if (c.firmware != "ardupilot") {
+      throw std::invalid_argument("got '" + text +
+                                  "', expected sitl:ardupilot or sitl:ardupilot:BINARY (docs/sitl.md)");
+    }
+    if (colon != std::string::npos) {
+      c.target = rest.substr(colon + 1);
+      std::error_code ec;
+      if (c.target.empty() || !std::filesystem::exists(c.target, ec)) {
+        throw std::invalid_argument("got '" + text + "': no such file '" + c.target + "'");
+      }
+      c.target = std::filesystem::absolute(c.target).lexically_normal().string();
+    }
   } else if (text == "python") {
     c.kind = ControllerChoice::Kind::kPython;  // the class is named by the caller (controller.python)
   } else {
@@ -703,7 +735,9 @@ ControllerChoice parse_controller_choice(const std::string& text) {
       for (const auto& t : controllers::controller_types()) types.emplace_back(t.name);
       throw std::invalid_argument(
           "got '" + text + "', expected a controller type (" + controllers::controller_type_names() +
-          "), python:MODULE:CLASS (a class written in Python) or fmu:PATH (an FMU)" + did_you_mean(text, types));
+          "), python:MODULE:CLASS (a class written in Python), fmu:PATH (an FMU) or sitl:ardupilot[:BINARY] (a "
+          "firmware's SITL build)" +
+          did_you_mean(text, types));
     }
     c.target = text;
   }
@@ -720,15 +754,19 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
   // What the file flies: a Python class, an FMU, or a registered type (paper by default).
   const bool was_python = c["python"] || (c["type"] && c["type"].IsScalar() && c["type"].Scalar() == "python");
   const bool was_fmu = static_cast<bool>(c["fmu"]);
+  const bool was_sitl = c["sitl"] || (c["type"] && c["type"].IsScalar() && c["type"].Scalar() == "sitl");
   const std::string was_type = was_python                          ? "python"
                                : was_fmu                           ? "fmu"
                                : c["type"] && c["type"].IsScalar() ? c["type"].Scalar()
                                                                    : std::string(controllers::kDefaultControllerType);
-  const bool same = choice.kind == ControllerChoice::Kind::kType ? !was_python && !was_fmu && was_type == choice.target
-                    : choice.kind == ControllerChoice::Kind::kPython
-                        ? was_python && (choice.target.empty() || (c["python"] && c["python"].IsScalar() &&
-                                                                   c["python"].Scalar() == choice.target))
-                        : was_fmu && c["fmu"].IsScalar() && c["fmu"].Scalar() == choice.target;
+  // A SITL firmware flies what the file says of it (its sitl: section: parameters, mission) when it has one.
+  const bool same =
+      choice.kind == ControllerChoice::Kind::kType   ? !was_python && !was_fmu && !was_sitl && was_type == choice.target
+      : choice.kind == ControllerChoice::Kind::kSitl ? was_sitl
+      : choice.kind == ControllerChoice::Kind::kPython
+          ? was_python && (choice.target.empty() ||
+                           (c["python"] && c["python"].IsScalar() && c["python"].Scalar() == choice.target))
+          : was_fmu && c["fmu"].IsScalar() && c["fmu"].Scalar() == choice.target;
   if (!same) {
     // The gains written directly under controller: are the file's controller's. A registered type's
     // move into its own section (kept, checked, unused); a Python class's or an FMU's go with it.
@@ -741,7 +779,7 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       if (control::node_parameters().find(key)) continue;
       moved.push_back(key);
     }
-    const bool keep = !was_python && !was_fmu && controllers::find_controller_type(was_type);
+    const bool keep = !was_python && !was_fmu && !was_sitl && controllers::find_controller_type(was_type);
     // A Python class takes the flat gains as its own (its declared parameters, the way a scenario
     // dict passes them with quadcosim.run(..., controller=Class)); they stay where they are.
     if (choice.kind == ControllerChoice::Kind::kPython && keep) moved.clear();
@@ -754,7 +792,7 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
     }
     // The other kinds' own keys go; a Python controller's time limit stays for the Python class
     // that replaces it (the scenario's step_timeout_s applies to whichever class flies).
-    for (const char* key : {"python", "fmu", "inputs", "outputs", "parameters", "in_process"}) c.remove(key);
+    for (const char* key : {"python", "fmu", "sitl", "inputs", "outputs", "parameters", "in_process"}) c.remove(key);
     if (choice.kind != ControllerChoice::Kind::kPython) c.remove("step_timeout_s");
   }
   switch (choice.kind) {
@@ -766,6 +804,12 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
     case ControllerChoice::Kind::kFmu:
       c.remove("type");
       c["fmu"] = choice.target;
+      break;
+    case ControllerChoice::Kind::kSitl:
+      c["type"] = "sitl";
+      if (!c["sitl"] || !c["sitl"].IsMap()) c["sitl"] = YAML::Node(YAML::NodeType::Map);
+      c["sitl"]["firmware"] = choice.firmware;
+      if (!choice.target.empty()) c["sitl"]["binary"] = choice.target;
       break;
   }
 }

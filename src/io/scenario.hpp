@@ -192,8 +192,11 @@ Scenario load_scenario(const std::string& path, const std::string& controller);
 /// ("python:MODULE:CLASS"), or a co-simulation FMU ("fmu:PATH", made absolute from the current
 /// directory). Throws std::invalid_argument saying what was expected.
 struct ControllerChoice {
-  enum class Kind { kType, kPython, kFmu } kind = Kind::kType;
-  std::string target;  ///< the type's name, MODULE:CLASS ("" for a bare "python") or the FMU's absolute path
+  enum class Kind { kType, kPython, kFmu, kSitl } kind = Kind::kType;
+  /// the type's name, MODULE:CLASS ("" for a bare "python"), the FMU's absolute path, or for
+  /// "sitl:FIRMWARE[:BINARY]" the binary's absolute path ("": the scenario's or the environment's)
+  std::string target;
+  std::string firmware;  ///< "sitl:FIRMWARE[:BINARY]": the firmware (ardupilot)
 };
 ControllerChoice parse_controller_choice(const std::string& text);
 

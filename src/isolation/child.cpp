@@ -67,6 +67,8 @@ std::string describe_end(int status) {
 
 void set_stop_check(bool (*stop_requested)()) { g_stop_check.store(stop_requested); }
 
+bool stop_requested() { return stop_asked(); }
+
 std::int64_t Child::now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();

@@ -113,6 +113,9 @@ std::string describe_end(int wait_status);
 /// What every wait on a child asks, every 50 ms, whether to give up (e.g. a SIGINT flag). One per
 /// process (signals are per process); null (the default) waits until the answer or the child's end.
 void set_stop_check(bool (*stop_requested)());
+/// What the stop check says now (false without one): for other waits on foreign processes (a SITL
+/// firmware) to give up on Ctrl-C as these do.
+bool stop_requested();
 
 class Child {
  public:

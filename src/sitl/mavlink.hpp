@@ -1,0 +1,90 @@
+// The few MAVLink 2 messages quadcosim sends to and reads from a firmware's GCS link (docs/sitl.md):
+// HEARTBEAT, COMMAND_LONG, COMMAND_ACK, SET_POSITION_TARGET_LOCAL_NED and STATUSTEXT, framed as
+// MAVLink 2 (STX 0xFD, no signing) from the message definitions (common.xml): fields on the wire by
+// size, largest first, extensions after; trailing zero bytes of the payload left out; the checksum
+// CRC-16/MCRF4XX over the frame after STX, then over the message's CRC_EXTRA.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace quadcosim::sitl::mavlink {
+
+inline constexpr std::uint8_t kStx = 0xFD;
+
+/// Message ids and their CRC_EXTRA.
+enum MessageId : std::uint32_t {
+  kHeartbeat = 0,
+  kCommandLong = 76,
+  kCommandAck = 77,
+  kSetPositionTargetLocalNed = 84,
+  kStatustext = 253,
+};
+/// The CRC_EXTRA of a message id this file knows, or nothing.
+std::optional<std::uint8_t> crc_extra(std::uint32_t msgid);
+
+/// CRC-16/MCRF4XX (init 0xFFFF, the X.25 accumulate step) of `bytes`, continuing from `crc`.
+std::uint16_t crc16(std::span<const std::uint8_t> bytes, std::uint16_t crc = 0xFFFF);
+
+/// One frame's contents.
+struct Frame {
+  std::uint8_t seq = 0;
+  std::uint8_t sysid = 0;
+  std::uint8_t compid = 0;
+  std::uint32_t msgid = 0;
+  std::vector<std::uint8_t> payload;  ///< as sent (trailing zeros may be missing: read as zeros)
+};
+
+/// A whole MAVLink 2 frame for `payload` (its trailing zero bytes left out, at least one byte kept).
+std::vector<std::uint8_t> encode(std::uint8_t seq, std::uint8_t sysid, std::uint8_t compid, std::uint32_t msgid,
+                                 std::span<const std::uint8_t> payload);
+
+/// Reads frames out of a byte stream: skips bytes until STX, waits for a whole frame, checks its CRC
+/// (frames of unknown ids and of MAVLink 1 are skipped; a bad CRC is counted).
+class Parser {
+ public:
+  void feed(std::span<const std::uint8_t> bytes);
+  /// The next whole, checked frame of a known id, or nothing yet.
+  std::optional<Frame> next();
+  long long bad_crc() const { return bad_crc_; }
+
+ private:
+  std::vector<std::uint8_t> buf_;
+  long long bad_crc_ = 0;
+};
+
+// Payloads (wire order), and what is read back.
+std::vector<std::uint8_t> heartbeat(std::uint8_t type, std::uint8_t autopilot, std::uint8_t base_mode,
+                                    std::uint32_t custom_mode, std::uint8_t system_status);
+std::vector<std::uint8_t> command_long(std::uint8_t target_system, std::uint8_t target_component, std::uint16_t command,
+                                       std::uint8_t confirmation, const std::array<float, 7>& params);
+/// Position target in MAV_FRAME_LOCAL_NED (1) with only x, y, z (and yaw when `use_yaw`) used.
+std::vector<std::uint8_t> set_position_target_local_ned(std::uint32_t time_boot_ms, std::uint8_t target_system,
+                                                        std::uint8_t target_component, float x, float y, float z,
+                                                        bool use_yaw, float yaw);
+
+struct Heartbeat {
+  std::uint8_t type = 0, autopilot = 0, base_mode = 0, system_status = 0;
+  std::uint32_t custom_mode = 0;
+  bool armed() const { return (base_mode & 0x80) != 0; }  ///< MAV_MODE_FLAG_SAFETY_ARMED
+};
+Heartbeat read_heartbeat(const Frame& f);
+struct CommandAck {
+  std::uint16_t command = 0;
+  std::uint8_t result = 0;  ///< MAV_RESULT: 0 accepted, 1 temporarily rejected, 2 denied, 3 unsupported, 4 failed
+};
+CommandAck read_command_ack(const Frame& f);
+/// STATUSTEXT's severity and text (up to 50 characters).
+std::pair<std::uint8_t, std::string> read_statustext(const Frame& f);
+
+// MAV_CMD numbers used.
+inline constexpr std::uint16_t kCmdNavLand = 21;
+inline constexpr std::uint16_t kCmdNavTakeoff = 22;
+inline constexpr std::uint16_t kCmdDoSetMode = 176;
+inline constexpr std::uint16_t kCmdComponentArmDisarm = 400;
+
+}  // namespace quadcosim::sitl::mavlink

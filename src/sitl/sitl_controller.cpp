@@ -1,0 +1,477 @@
+#include "sitl/sitl_controller.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "isolation/child.hpp"
+#include "sitl/firmware_process.hpp"
+#include "sitl/frames.hpp"
+#include "sitl/json_codec.hpp"
+#include "sitl/mavlink.hpp"
+
+namespace quadcosim::sitl {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string>& output_list() {
+  static const std::vector<std::string> names(std::begin(kSitlOutputs), std::end(kSitlOutputs));
+  return names;
+}
+
+// A socket on 127.0.0.1 at a port the system chooses; its port number.
+int bound_socket(int type, int& port) {
+  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw std::runtime_error(std::string("socket: ") + std::strerror(errno));
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  socklen_t len = sizeof(a);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0 ||
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+    const int e = errno;
+    ::close(fd);
+    throw std::runtime_error(std::string("bind on 127.0.0.1: ") + std::strerror(e));
+  }
+  port = ntohs(a.sin_port);
+  return fd;
+}
+
+double wall_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+}  // namespace
+
+struct SitlController::Link {
+  std::string work_dir;
+  bool temporary = false;
+  int udp = -1, listener = -1, tcp = -1;
+  int json_port = 0, mavlink_port = 0, rc_port = 0;
+  std::unique_ptr<FirmwareProcess> process;
+  bool have_peer = false;
+  sockaddr_in peer{};
+  std::uint32_t pending = 0;  ///< frame count of the packet the next reply answers
+  bool have_pending = false;
+  mavlink::Parser parser;  ///< the firmware's MAVLink stream
+  std::uint8_t seq = 0;
+  std::uint8_t target_system = 1;  ///< the firmware's system id (from its heartbeat)
+  mavlink::Heartbeat heartbeat;    ///< its newest
+  bool have_heartbeat = false;
+  // The mission: the item in progress, when it was last sent (simulated time), the answers to it.
+  std::size_t item = 0;
+  double item_sent_s = -1.0;
+  std::optional<std::uint8_t> item_result;
+  std::uint16_t item_command = 0;
+  long long decisions = 0;
+  std::ofstream statustext;
+
+  void send(std::uint32_t msgid, const std::vector<std::uint8_t>& payload) {
+    if (tcp < 0) return;
+    const std::vector<std::uint8_t> frame = mavlink::encode(seq++, 255, 190, msgid, payload);
+    std::size_t at = 0;
+    while (at < frame.size()) {
+      const ssize_t n = ::send(tcp, frame.data() + at, frame.size() - at, MSG_NOSIGNAL);
+      if (n <= 0) {
+        if (errno == EAGAIN || errno == EINTR) continue;
+        return;
+      }
+      at += static_cast<std::size_t>(n);
+    }
+  }
+
+  ~Link() {
+    process.reset();  // ends the firmware first
+    for (int fd : {udp, listener, tcp}) {
+      if (fd >= 0) ::close(fd);
+    }
+    if (temporary && !work_dir.empty()) {
+      std::error_code ec;
+      fs::remove_all(work_dir, ec);
+    }
+  }
+
+  // Accepts the firmware's MAVLink connection and drains what it sent (kept for the MAVLink layer).
+  void service_tcp() {
+    if (tcp < 0 && listener >= 0) {
+      const int fd = ::accept4(listener, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+      if (fd >= 0) tcp = fd;
+    }
+    if (tcp < 0) return;
+    std::array<std::uint8_t, 4096> buf{};
+    for (;;) {
+      const ssize_t n = ::recv(tcp, buf.data(), buf.size(), MSG_DONTWAIT);
+      if (n <= 0) break;
+      parser.feed(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
+    }
+  }
+};
+
+int copter_mode_number(const std::string& name) {
+  static const std::pair<const char*, int> kModes[] = {
+      {"stabilize", 0}, {"acro", 1},   {"alt_hold", 2}, {"auto", 3},     {"guided", 4}, {"loiter", 5},
+      {"rtl", 6},       {"circle", 7}, {"land", 9},     {"poshold", 16}, {"brake", 17}};
+  for (const auto& [n, v] : kModes) {
+    if (name == n) return v;
+  }
+  return -1;
+}
+
+SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicle)
+    : spec_(std::move(spec)),
+      model_(vehicle),
+      map_(motor_map_for(vehicle, spec_.pwm_min_us, spec_.pwm_max_us)),
+      reported_(control::ReportedOutputs::find(output_list())) {
+  if (spec_.firmware != "ardupilot") {
+    throw std::invalid_argument("firmware '" + spec_.firmware + "': only ardupilot is supported");
+  }
+  if (spec_.binary.empty()) throw std::invalid_argument("binary: missing; expected the SITL executable's path");
+  if (::access(spec_.binary.c_str(), X_OK) != 0 || fs::is_directory(spec_.binary)) {
+    throw std::invalid_argument("binary '" + spec_.binary + "' is not an executable file");
+  }
+  for (const std::string& p : spec_.params) {
+    if (!fs::is_regular_file(p)) throw std::invalid_argument("params: no such file '" + p + "'");
+  }
+  for (const MissionItem& m : spec_.mission) {
+    if (m.kind == MissionItem::Kind::kMode && copter_mode_number(m.mode) < 0) {
+      throw std::invalid_argument("mission: mode '" + m.mode +
+                                  "' is not one of stabilize, acro, alt_hold, auto, guided, loiter, rtl, circle, "
+                                  "land, poshold, brake");
+    }
+  }
+  if (!(spec_.timeout_s > 0) || !(spec_.start_timeout_s > 0)) {
+    throw std::invalid_argument("timeout_s and start_timeout_s must be positive");
+  }
+}
+
+SitlController::~SitlController() = default;
+
+std::unique_ptr<control::Controller> SitlController::clone() const {
+  return std::make_unique<SitlController>(spec_, model_.params());
+}
+
+std::string SitlController::set_parameters(std::span<const control::Setting> settings) {
+  if (settings.empty()) return {};
+  return settings.front().name +
+         ": no such parameter (a SITL controller's parameters are the firmware's own: "
+         "its params files)";
+}
+
+std::span<const std::string> SitlController::output_names() const { return output_list(); }
+
+void SitlController::reset() {
+  link_.reset();
+  counts_ = {};
+  steps_ = 0;
+  t_s_ = 0.0;
+}
+
+std::string SitlController::generated_params() const {
+  return fmt::format(
+      "# written by quadcosim for this vehicle (docs/sitl.md); the files after it may override the rest\n"
+      "FRAME_CLASS 1\nFRAME_TYPE {}\nMOT_PWM_MIN {:g}\nMOT_PWM_MAX {:g}\n",
+      map_.frame_type, map_.pwm_min_us, map_.pwm_max_us);
+}
+
+std::vector<std::string> SitlController::command_line(int json_port, int mavlink_port, int rc_port,
+                                                      const std::string& generated) const {
+  std::string defaults = generated;
+  for (const std::string& p : spec_.params) defaults += "," + p;
+  std::vector<std::string> argv = {spec_.binary,
+                                   "--model",
+                                   "JSON:127.0.0.1",
+                                   "--sim-port-out",
+                                   std::to_string(json_port),
+                                   "--serial0",
+                                   "tcpclient:127.0.0.1:" + std::to_string(mavlink_port),
+                                   "--rc-in-port",
+                                   std::to_string(rc_port),
+                                   "--home",
+                                   spec_.home,
+                                   "--defaults",
+                                   defaults,
+                                   "-w"};
+  // The other serial ports would listen on fixed TCP ports (5762, ...): two runs at once would clash.
+  for (const char* s : {"--serial1", "--serial2", "--serial5", "--serial6", "--serial7", "--serial8"}) {
+    argv.emplace_back(s);
+    argv.emplace_back("none:0");
+  }
+  argv.insert(argv.end(), spec_.args.begin(), spec_.args.end());
+  return argv;
+}
+
+void SitlController::fail(const std::string& what) const {
+  std::string msg = fmt::format("controller sitl ({} {}): {}", spec_.firmware, spec_.binary, what);
+  if (link_ && link_->process) {
+    msg += fmt::format("; its log {}:{}", link_->process->log_path(), link_->process->log_tail());
+    link_->temporary = false;  // keep the folder with the log
+  }
+  throw control::ControllerFailure(msg);
+}
+
+void SitlController::start() {
+  link_ = std::make_unique<Link>();
+  Link& l = *link_;
+  if (spec_.work_dir.empty()) {
+    std::string tmpl = (fs::temp_directory_path() / "quadcosim-sitl-XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) fail(std::string("cannot make a folder to run in: ") + std::strerror(errno));
+    l.work_dir = tmpl;
+    l.temporary = true;
+  } else {
+    std::error_code ec;
+    fs::create_directories(spec_.work_dir, ec);
+    l.work_dir = fs::absolute(spec_.work_dir).string();
+  }
+  try {
+    l.udp = bound_socket(SOCK_DGRAM, l.json_port);
+    l.listener = bound_socket(SOCK_STREAM, l.mavlink_port);
+    if (::listen(l.listener, 1) != 0) throw std::runtime_error(std::string("listen: ") + std::strerror(errno));
+    ::fcntl(l.listener, F_SETFL, O_NONBLOCK);
+    // A free UDP port for the firmware's RC input, released for it to bind.
+    const int rc = bound_socket(SOCK_DGRAM, l.rc_port);
+    ::close(rc);
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+  const std::string generated = (fs::path(l.work_dir) / "quadcosim-frame.parm").string();
+  {
+    std::ofstream f(generated);
+    f << generated_params();
+    if (!f) fail("cannot write " + generated);
+  }
+  const std::vector<std::string> argv = command_line(l.json_port, l.mavlink_port, l.rc_port, generated);
+  {
+    std::ofstream f(fs::path(l.work_dir) / "command_line.txt");
+    for (const std::string& a : argv) f << a << '\n';
+  }
+  try {
+    l.process = std::make_unique<FirmwareProcess>(argv, l.work_dir, (fs::path(l.work_dir) / "firmware.log").string());
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+}
+
+void SitlController::service_mavlink() {
+  Link& l = *link_;
+  l.service_tcp();
+  while (auto f = l.parser.next()) {
+    if (f->msgid == mavlink::kHeartbeat) {
+      const mavlink::Heartbeat h = mavlink::read_heartbeat(*f);
+      if (h.type == 6) continue;  // another GCS's
+      l.heartbeat = h;
+      l.have_heartbeat = true;
+      l.target_system = f->sysid;
+    } else if (f->msgid == mavlink::kCommandAck) {
+      const mavlink::CommandAck a = mavlink::read_command_ack(*f);
+      if (a.command == l.item_command && l.item_sent_s >= 0) l.item_result = a.result;
+    } else if (f->msgid == mavlink::kStatustext) {
+      const auto [severity, text] = mavlink::read_statustext(*f);
+      if (!l.statustext.is_open()) l.statustext.open(fs::path(l.work_dir) / "statustext.log");
+      l.statustext << fmt::format("{:.3f} {} {}\n", t_s_, severity, text) << std::flush;
+      if (spec_.echo_statustext) std::fprintf(stderr, "sitl: t = %.3f s: %s\n", t_s_, text.c_str());
+    }
+  }
+  // Decisions once the firmware has spoken on its link (its first HEARTBEAT), and then at whole
+  // multiples of 0.25 s of simulated time only (step counts, not wall time).
+  if (!l.have_heartbeat || l.tcp < 0) return;
+  const long long decision = static_cast<long long>(std::floor(t_s_ / 0.25 + 1e-9));
+  if (decision < l.decisions) return;
+  l.decisions = decision + 1;
+  if (decision % 4 == 0) l.send(mavlink::kHeartbeat, mavlink::heartbeat(6, 8, 0, 0, 4));  // a GCS, at 1 Hz
+  while (l.item < spec_.mission.size()) {
+    const MissionItem& m = spec_.mission[l.item];
+    if (l.item_sent_s >= 0) {
+      // Accepted, and for a mode or arming, shown so by the firmware's heartbeat: the next one.
+      const bool shown = m.kind == MissionItem::Kind::kMode
+                             ? l.heartbeat.custom_mode == static_cast<std::uint32_t>(copter_mode_number(m.mode))
+                         : m.kind == MissionItem::Kind::kArm    ? l.heartbeat.armed()
+                         : m.kind == MissionItem::Kind::kDisarm ? !l.heartbeat.armed()
+                                                                : true;
+      if (l.item_result && *l.item_result == 0 && shown) {
+        ++l.item;
+        l.item_sent_s = -1.0;
+        l.item_result.reset();
+        continue;
+      }
+      if (t_s_ - l.item_sent_s < 1.0 - 1e-9) return;  // its answer may still come
+    }
+    if (t_s_ + 1e-9 < m.at_s) return;
+    const std::uint8_t ts = l.target_system;
+    l.item_result.reset();
+    l.item_sent_s = t_s_;
+    switch (m.kind) {
+      case MissionItem::Kind::kMode:
+        l.item_command = mavlink::kCmdDoSetMode;
+        l.send(mavlink::kCommandLong,
+               mavlink::command_long(ts, 1, l.item_command, 0,
+                                     {1.0f, static_cast<float>(copter_mode_number(m.mode)), 0, 0, 0, 0, 0}));
+        break;
+      case MissionItem::Kind::kArm:
+      case MissionItem::Kind::kDisarm:
+        l.item_command = mavlink::kCmdComponentArmDisarm;
+        l.send(mavlink::kCommandLong,
+               mavlink::command_long(ts, 1, l.item_command, 0,
+                                     {m.kind == MissionItem::Kind::kArm ? 1.0f : 0.0f, 0, 0, 0, 0, 0, 0}));
+        break;
+      case MissionItem::Kind::kTakeoff:
+        l.item_command = mavlink::kCmdNavTakeoff;
+        l.send(mavlink::kCommandLong,
+               mavlink::command_long(ts, 1, l.item_command, 0, {0, 0, 0, 0, 0, 0, static_cast<float>(m.takeoff_m)}));
+        break;
+      case MissionItem::Kind::kGoto: {
+        const Eigen::Vector3d p = enu_to_ned(m.p_W);
+        l.send(mavlink::kSetPositionTargetLocalNed,
+               mavlink::set_position_target_local_ned(static_cast<std::uint32_t>(t_s_ * 1000.0), ts, 1,
+                                                      static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                                      static_cast<float>(p.z()), false, 0.0f));
+        l.item_command = 0;
+        l.item_result = 0;  // no answer to a position target: done when sent
+        break;
+      }
+    }
+    return;
+  }
+}
+
+void SitlController::step(const control::Observation& obs, const control::Reference& reference, double dt_s,
+                          control::ControllerOutput& out) {
+  if (!link_) start();
+  Link& l = *link_;
+  const bool first = !l.have_pending;
+  const double limit_s = first ? spec_.start_timeout_s : spec_.timeout_s;
+
+  // The state at t_n answers the pending packet. Commands go out first: the firmware waits for the
+  // answer, so they are in its link's buffer before it runs the frame (the same frame on every run).
+  if (l.have_pending) {
+    service_mavlink();
+    FdmState s;
+    s.timestamp_s = t_s_;
+    s.gyro_FRD = flu_to_frd(obs.w_B);
+    s.accel_FRD = flu_to_frd(obs.specific_force_B);
+    s.p_NED = enu_to_ned(obs.p_W);
+    s.v_NED = enu_to_ned(obs.v_W);
+    s.q_NED_FRD = attitude_ned_frd(obs.q_WB);
+    const std::string line = encode_fdm_json(s);
+    if (::sendto(l.udp, line.data(), line.size(), 0, reinterpret_cast<const sockaddr*>(&l.peer), sizeof(l.peer)) !=
+        static_cast<ssize_t>(line.size())) {
+      fail(fmt::format("step {} (t = {:.4f} s): cannot send the state: {}", steps_, t_s_, std::strerror(errno)));
+    }
+  }
+
+  // Its next servo packet: the rotor speeds over [t_n, t_n+1).
+  const double deadline = wall_s() + limit_s;
+  std::array<std::uint8_t, 512> buf{};
+  for (;;) {
+    l.service_tcp();
+    if (auto end = l.process->ended()) {
+      fail(fmt::format("step {} (t = {:.4f} s): the firmware {}", steps_, t_s_, *end));
+    }
+    if (first) {
+      // A firmware that panics while starting (ArduPilot's SITL then spins instead of exiting) says so
+      // in its log: fail at once with its words rather than after start_timeout_s.
+      const std::string tail = l.process->log_tail(4);
+      if (const std::size_t at = tail.find("PANIC"); at != std::string::npos) {
+        fail(
+            fmt::format("step 0: the firmware panicked while starting: {}", tail.substr(at, tail.find('\n', at) - at)));
+      }
+    }
+    if (isolation::stop_requested()) {  // the firmware's folder goes as after a run that succeeded
+      throw control::ControllerFailure(
+          fmt::format("controller sitl ({} {}): step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM)",
+                      spec_.firmware, spec_.binary, steps_, t_s_));
+    }
+    const double left = deadline - wall_s();
+    if (left <= 0) {
+      fail(fmt::format("step {} (t = {:.4f} s): no servo packet for {:g} s (frame {}{})", steps_, t_s_, limit_s,
+                       l.have_pending ? std::to_string(l.pending + 1) : std::string("0"),
+                       first ? ": it never spoke on its JSON port" : ": it went silent"));
+    }
+    pollfd p{l.udp, POLLIN, 0};
+    const int r = ::poll(&p, 1, static_cast<int>(std::min(left, 0.05) * 1000.0) + 1);
+    if (r <= 0) continue;
+    sockaddr_in from{};
+    socklen_t from_len = sizeof(from);
+    const ssize_t n =
+        ::recvfrom(l.udp, buf.data(), buf.size(), MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&from), &from_len);
+    if (n < 0) continue;
+    if (l.have_peer && (from.sin_port != l.peer.sin_port || from.sin_addr.s_addr != l.peer.sin_addr.s_addr)) {
+      ++counts_.foreign;
+      continue;
+    }
+    ServoPacket packet;
+    try {
+      packet = decode_servo_packet(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
+    } catch (const DecodeError& e) {
+      fail(fmt::format("step {} (t = {:.4f} s): {}", steps_, t_s_, e.what()));
+    }
+    if (!l.have_peer) {
+      l.peer = from;
+      l.have_peer = true;
+    }
+    if (first) {
+      // Its first frame, perhaps sent more than once while it waited: take the newest.
+      for (;;) {
+        pollfd q{l.udp, POLLIN, 0};
+        if (::poll(&q, 1, 0) <= 0) break;
+        const ssize_t m = ::recv(l.udp, buf.data(), buf.size(), MSG_DONTWAIT);
+        if (m <= 0) break;
+        try {
+          const ServoPacket again = decode_servo_packet(std::span<const std::uint8_t>(buf.data(), std::size_t(m)));
+          if (again.frame_count == packet.frame_count) {
+            ++counts_.repeated;
+          } else {
+            packet = again;
+          }
+        } catch (const DecodeError& e) {
+          fail(fmt::format("step {} (t = {:.4f} s): {}", steps_, t_s_, e.what()));
+        }
+      }
+    } else {
+      if (packet.frame_count == l.pending) {
+        ++counts_.repeated;  // sent again while it waited for our answer: answered already
+        continue;
+      }
+      if (packet.frame_count < l.pending) {
+        fail(fmt::format("step {} (t = {:.4f} s): frame count went back from {} to {}: the firmware restarted", steps_,
+                         t_s_, l.pending, packet.frame_count));
+      }
+      counts_.skipped += packet.frame_count - l.pending - 1;
+    }
+    l.pending = packet.frame_count;
+    l.have_pending = true;
+    ++counts_.frames;
+    const Eigen::Vector4d omega = map_.omega_from_pwm(packet.pwm_us);
+    out.outputs.resize(output_list().size());
+    out.outputs[0] = packet.frame_count;
+    for (int c = 0; c < 4; ++c) out.outputs[1 + c] = c < static_cast<int>(packet.pwm_us.size()) ? packet.pwm_us[c] : 0;
+    out.outputs[5] = static_cast<double>(counts_.repeated);
+    out.outputs[6] = static_cast<double>(counts_.skipped);
+    out.outputs[7] = l.have_heartbeat && l.heartbeat.armed() ? 1.0 : 0.0;
+    out.outputs[8] = l.have_heartbeat ? static_cast<double>(l.heartbeat.custom_mode) : -1.0;
+    out.outputs[9] = static_cast<double>(l.item);
+    control::rotor_speeds_output(model_, reference, omega, reported_, out);
+    break;
+  }
+  ++steps_;
+  // t_{n+1} as a product, not a running sum: the same times on every run.
+  t_s_ = static_cast<double>(steps_) * dt_s;
+}
+
+const SitlController* sitl_controller(const control::Controller& c) { return dynamic_cast<const SitlController*>(&c); }
+
+}  // namespace quadcosim::sitl

@@ -1,0 +1,121 @@
+// A flight stack's SITL build as a quadcosim controller (docs/sitl.md): each control step hands the
+// firmware the vehicle's state as its sensors observed it (realism's noisy IMU included) and returns
+// the rotor speeds its next servo packet commands, in lockstep over ArduPilot's JSON physics protocol.
+//
+// Step n (period dt): the state at t_n = n dt goes to the firmware as the answer to its pending servo
+// packet (frame c); the firmware runs its loop up to t_n and sends frame c + 1, whose PWM widths
+// (motor_map.hpp) are the rotor speeds over [t_n, t_n+1). A frame count seen again is dropped and
+// counted (never answered twice, never integrated twice); a frame count that jumps ahead is counted
+// as skipped; one that goes back means the firmware restarted, and fails the step. The firmware
+// process starts at the first step (ports chosen free then: its JSON port, a TCP port it connects to
+// as its SERIAL0 / MAVLink link, its RC input port), runs in a folder of its own, and ends with the
+// controller on every path (firmware_process.hpp). A firmware that exits, sends something that is not
+// a servo packet, or stays silent past timeout_s fails the step (control::ControllerFailure naming
+// the firmware, the step, its time and the end of the firmware's log).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "control/controller.hpp"
+#include "model/quadrotor.hpp"
+#include "sitl/motor_map.hpp"
+
+namespace quadcosim::sitl {
+
+/// One command of a mission flown over the firmware's MAVLink link (docs/sitl.md), sent once the
+/// simulated time reaches at_s and the previous one was accepted (COMMAND_ACK result 0); a refused or
+/// unanswered command is sent again every second. The mission is looked at every 0.25 s of simulated
+/// time only, so that when an answer arrives within that period never changes the flight.
+struct MissionItem {
+  enum class Kind { kMode, kArm, kDisarm, kTakeoff, kGoto };
+  double at_s = 0.0;
+  Kind kind = Kind::kMode;
+  std::string mode;                               ///< kMode: stabilize, alt_hold, guided, loiter, rtl, land, ...
+  double takeoff_m = 0.0;                         ///< kTakeoff: height above home [m]
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< kGoto: position in quadcosim's world (ENU) [m]
+};
+
+/// ArduCopter's custom mode number for a mode name (lower case), or -1.
+int copter_mode_number(const std::string& name);
+
+/// What a scenario's `controller: {sitl: {...}}` says (docs/scenarios.md).
+struct SitlSpec {
+  std::string firmware = "ardupilot";  ///< the flight stack (only ArduPilot's JSON protocol so far)
+  std::string binary;                  ///< the SITL executable (e.g. build/sitl/bin/arducopter)
+  std::vector<std::string> params;     ///< parameter files, applied in order as its defaults
+  std::string work_dir;                ///< where it runs (eeprom, logs); empty: a fresh temporary folder, removed after
+  std::string home = "-35.363261,149.165230,584,0";  ///< --home: latitude, longitude [deg], altitude [m], yaw
+  double start_timeout_s = 30.0;                     ///< [s] wall time for its first servo packet
+  double timeout_s = 5.0;                            ///< [s] wall time without a servo packet that ends the run
+  double pwm_min_us = 1000.0;                        ///< zero rotor speed at and below [us]
+  double pwm_max_us = 2000.0;                        ///< omega_max at and above [us]
+  std::vector<std::string> args;                     ///< more command-line arguments for the firmware
+  std::vector<MissionItem> mission;  ///< commands over MAVLink (none: the firmware flies as its params say)
+  bool echo_statustext = false;      ///< print the firmware's STATUSTEXT messages on stderr as they come
+};
+
+/// The figures a SITL controller records (out.<name> in trajectory.csv).
+/// armed and mode are the firmware's last HEARTBEAT's; mission is the index of the mission item in progress.
+inline constexpr const char* kSitlOutputs[] = {"frame",    "pwm1",    "pwm2",  "pwm3", "pwm4",
+                                               "repeated", "skipped", "armed", "mode", "mission"};
+
+class SitlController final : public control::Controller {
+ public:
+  /// Checks the spec (the binary exists and is executable, the parameter files exist, the vehicle's
+  /// spin signs fit an ArduPilot quad): std::invalid_argument naming what is wrong. Starts nothing.
+  SitlController(SitlSpec spec, const model::VehicleParams& vehicle);
+  ~SitlController() override;
+
+  std::string_view type() const override { return "sitl"; }
+  /// The step waits on another process's sockets (up to timeout_s).
+  bool wants_own_thread() const override { return true; }
+  /// A controller with the same spec whose firmware has not started.
+  std::unique_ptr<control::Controller> clone() const override;
+  std::span<const control::ParameterSpec> parameters() const override { return {}; }
+  std::optional<control::ParameterValue> get_parameter(std::string_view) const override { return std::nullopt; }
+  std::string set_parameters(std::span<const control::Setting> settings) override;
+  std::span<const std::string> output_names() const override;
+  /// Ends the firmware; the next step starts a fresh one (its eeprom wiped).
+  void reset() override;
+  void step(const control::Observation& observation, const control::Reference& reference, double dt_s,
+            control::ControllerOutput& out) override;
+
+  const SitlSpec& spec() const { return spec_; }
+  const MotorMap& motor_map() const { return map_; }
+  /// The command line the firmware gets (its ports as given), for docs and tests.
+  std::vector<std::string> command_line(int json_port, int mavlink_port, int rc_port,
+                                        const std::string& generated_params) const;
+  /// The parameter file quadcosim writes before the user's: the frame that matches the vehicle.
+  std::string generated_params() const;
+
+  struct Counts {
+    long long frames = 0;    ///< servo packets taken (one a step)
+    long long repeated = 0;  ///< packets dropped because their frame count was seen already
+    long long skipped = 0;   ///< frame counts that never came (a jump ahead)
+    long long foreign = 0;   ///< datagrams from another sender, dropped
+  };
+  const Counts& counts() const { return counts_; }
+
+ private:
+  struct Link;
+  void start();
+  /// Reads the firmware's MAVLink messages; at decision times, advances the mission.
+  void service_mavlink();
+  [[noreturn]] void fail(const std::string& what) const;
+
+  SitlSpec spec_;
+  model::Quadrotor model_;
+  MotorMap map_;
+  std::unique_ptr<Link> link_;
+  Counts counts_;
+  long long steps_ = 0;
+  double t_s_ = 0.0;
+  control::ReportedOutputs reported_;
+};
+
+/// The SITL controller a configuration flies, or nullptr.
+const SitlController* sitl_controller(const control::Controller& c);
+
+}  // namespace quadcosim::sitl
