@@ -35,6 +35,9 @@ std::optional<std::uint8_t> crc_extra(std::uint32_t msgid) {
     case kCommandLong: return 152;
     case kCommandAck: return 143;
     case kSetPositionTargetLocalNed: return 143;
+    case kHilActuatorControls: return 47;
+    case kHilSensor: return 108;
+    case kHilGps: return 124;
     case kStatustext: return 83;
     default: return std::nullopt;
   }
@@ -138,6 +141,30 @@ std::vector<std::uint8_t> set_position_target_local_ned(std::uint32_t time_boot_
   for (int i = 0; i < 6; ++i) p(0.0f);
   p(use_yaw ? yaw : 0.0f)(0.0f);
   return p(mask)(target_system)(target_component)(std::uint8_t{1}).b;
+}
+
+std::vector<std::uint8_t> hil_sensor(const HilSensor& m) {
+  Put p;
+  p(m.time_usec);
+  for (const auto* v : {&m.acc_m_s2, &m.gyro_rad_s, &m.mag_gauss}) {
+    for (float e : *v) p(e);
+  }
+  return p(m.abs_pressure_hpa)(m.diff_pressure_hpa)(m.pressure_alt_m)(m.temperature_c)(m.fields_updated)(m.id).b;
+}
+
+std::vector<std::uint8_t> hil_gps(const HilGps& m) {
+  return Put{}(m.time_usec)(m.lat)(m.lon)(m.alt)(m.eph)(m.epv)(m.vel)(m.vn)(m.ve)(m.vd)(m.cog)(m.fix_type)(
+             m.satellites_visible)(m.id)(m.yaw)
+      .b;
+}
+
+HilActuatorControls read_hil_actuator_controls(const Frame& f) {
+  HilActuatorControls m;
+  m.time_usec = get<std::uint64_t>(f.payload, 0);
+  m.flags = get<std::uint64_t>(f.payload, 8);
+  for (std::size_t i = 0; i < m.controls.size(); ++i) m.controls[i] = get<float>(f.payload, 16 + 4 * i);
+  m.mode = get<std::uint8_t>(f.payload, 80);
+  return m;
 }
 
 Heartbeat read_heartbeat(const Frame& f) {

@@ -1,5 +1,6 @@
 // The few MAVLink 2 messages quadcosim sends to and reads from a firmware's GCS link (docs/sitl.md):
-// HEARTBEAT, COMMAND_LONG, COMMAND_ACK, SET_POSITION_TARGET_LOCAL_NED and STATUSTEXT, framed as
+// HEARTBEAT, COMMAND_LONG, COMMAND_ACK, SET_POSITION_TARGET_LOCAL_NED and STATUSTEXT, and the
+// simulator link's HIL_SENSOR, HIL_GPS and HIL_ACTUATOR_CONTROLS (PX4's simulator interface), framed as
 // MAVLink 2 (STX 0xFD, no signing) from the message definitions (common.xml): fields on the wire by
 // size, largest first, extensions after; trailing zero bytes of the payload left out; the checksum
 // CRC-16/MCRF4XX over the frame after STX, then over the message's CRC_EXTRA.
@@ -22,6 +23,9 @@ enum MessageId : std::uint32_t {
   kCommandLong = 76,
   kCommandAck = 77,
   kSetPositionTargetLocalNed = 84,
+  kHilActuatorControls = 93,
+  kHilSensor = 107,
+  kHilGps = 113,
   kStatustext = 253,
 };
 /// The CRC_EXTRA of a message id this file knows, or nothing.
@@ -66,6 +70,37 @@ std::vector<std::uint8_t> command_long(std::uint8_t target_system, std::uint8_t 
 std::vector<std::uint8_t> set_position_target_local_ned(std::uint32_t time_boot_ms, std::uint8_t target_system,
                                                         std::uint8_t target_component, float x, float y, float z,
                                                         bool use_yaw, float yaw);
+
+/// HIL_SENSOR (107): what a simulator gives PX4's sensor drivers, body FRD. fields_updated: bits 0-2
+/// acceleration, 3-5 rates, 6-8 magnetic field, 9 absolute pressure, 10 differential pressure, 11
+/// pressure altitude, 12 temperature. `id` (an extension) names the sensor instance.
+struct HilSensor {
+  std::uint64_t time_usec = 0;
+  std::array<float, 3> acc_m_s2{}, gyro_rad_s{}, mag_gauss{};
+  float abs_pressure_hpa = 0, diff_pressure_hpa = 0, pressure_alt_m = 0, temperature_c = 0;
+  std::uint32_t fields_updated = 0;
+  std::uint8_t id = 0;
+};
+std::vector<std::uint8_t> hil_sensor(const HilSensor& m);
+/// HIL_GPS (113): a GNSS fix. lat, lon [degE7], alt [mm above MSL], eph, epv [cm], vel [cm/s],
+/// vn, ve, vd [cm/s, NED], cog [cdeg]; `id` and `yaw` [cdeg] are extensions.
+struct HilGps {
+  std::uint64_t time_usec = 0;
+  std::int32_t lat = 0, lon = 0, alt = 0;
+  std::uint16_t eph = 0, epv = 0, vel = 0;
+  std::int16_t vn = 0, ve = 0, vd = 0;
+  std::uint16_t cog = 0;
+  std::uint8_t fix_type = 0, satellites_visible = 0, id = 0;
+  std::uint16_t yaw = 0;
+};
+std::vector<std::uint8_t> hil_gps(const HilGps& m);
+/// HIL_ACTUATOR_CONTROLS (93): the firmware's outputs (motors 0..1, others -1..1), its mode and flags.
+struct HilActuatorControls {
+  std::uint64_t time_usec = 0, flags = 0;
+  std::array<float, 16> controls{};
+  std::uint8_t mode = 0;
+};
+HilActuatorControls read_hil_actuator_controls(const Frame& f);
 
 struct Heartbeat {
   std::uint8_t type = 0, autopilot = 0, base_mode = 0, system_status = 0;

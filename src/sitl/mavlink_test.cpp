@@ -2,6 +2,7 @@
 // ardupilotmega.xml) and CRC_EXTRA values recomputed from the message definitions.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,42 @@ TEST(Mavlink, CrcExtrasFollowTheDefinitions) {
                                                        {"uint8_t", "target_component"},
                                                        {"uint8_t", "coordinate_frame"}}));
   EXPECT_EQ(*crc_extra(kStatustext), extra_of("STATUSTEXT", {{"uint8_t", "severity"}, {"char", "text"}}, {0, 50}));
+  // PX4's simulator link (the published CRC_EXTRA values: 108, 124, 47).
+  EXPECT_EQ(*crc_extra(kHilSensor), extra_of("HIL_SENSOR", {{"uint64_t", "time_usec"},
+                                                            {"float", "xacc"},
+                                                            {"float", "yacc"},
+                                                            {"float", "zacc"},
+                                                            {"float", "xgyro"},
+                                                            {"float", "ygyro"},
+                                                            {"float", "zgyro"},
+                                                            {"float", "xmag"},
+                                                            {"float", "ymag"},
+                                                            {"float", "zmag"},
+                                                            {"float", "abs_pressure"},
+                                                            {"float", "diff_pressure"},
+                                                            {"float", "pressure_alt"},
+                                                            {"float", "temperature"},
+                                                            {"uint32_t", "fields_updated"}}));
+  EXPECT_EQ(*crc_extra(kHilSensor), 108);
+  EXPECT_EQ(*crc_extra(kHilGps), extra_of("HIL_GPS", {{"uint64_t", "time_usec"},
+                                                      {"int32_t", "lat"},
+                                                      {"int32_t", "lon"},
+                                                      {"int32_t", "alt"},
+                                                      {"uint16_t", "eph"},
+                                                      {"uint16_t", "epv"},
+                                                      {"uint16_t", "vel"},
+                                                      {"int16_t", "vn"},
+                                                      {"int16_t", "ve"},
+                                                      {"int16_t", "vd"},
+                                                      {"uint16_t", "cog"},
+                                                      {"uint8_t", "fix_type"},
+                                                      {"uint8_t", "satellites_visible"}}));
+  EXPECT_EQ(*crc_extra(kHilGps), 124);
+  EXPECT_EQ(*crc_extra(kHilActuatorControls),
+            extra_of("HIL_ACTUATOR_CONTROLS",
+                     {{"uint64_t", "time_usec"}, {"uint64_t", "flags"}, {"float", "controls"}, {"uint8_t", "mode"}},
+                     {0, 0, 16, 0}));
+  EXPECT_EQ(*crc_extra(kHilActuatorControls), 47);
   EXPECT_FALSE(crc_extra(12345).has_value());
 }
 
@@ -140,6 +177,86 @@ TEST(Mavlink, RefusesACorruptFrame) {
   p.feed(b);
   EXPECT_FALSE(p.next());
   EXPECT_EQ(p.bad_crc(), 1);
+}
+
+}  // namespace
+}  // namespace quadcosim::sitl::mavlink
+
+namespace quadcosim::sitl::mavlink {
+namespace {
+
+// The simulator link's payloads at the byte offsets of the wire order (8-byte fields, then 4, 2, 1,
+// extensions last), written and read against offsets counted by hand.
+TEST(Mavlink, HilMessagesLieWhereTheWireOrderPutsThem) {
+  HilSensor s;
+  s.time_usec = 4000;
+  s.acc_m_s2 = {0.5f, -0.25f, -9.75f};
+  s.mag_gauss = {0.21f, 0.0f, 0.43f};
+  s.abs_pressure_hpa = 1013.25f;
+  s.fields_updated = 0x1BFF;
+  s.id = 0;
+  const std::vector<std::uint8_t> p = hil_sensor(s);
+  ASSERT_EQ(p.size(), 65u);  // 8 + 13 floats + a uint32 + the extension's byte
+  auto f32 = [&](std::size_t at) {
+    float v;
+    std::memcpy(&v, &p[at], 4);
+    return v;
+  };
+  EXPECT_EQ(p[0], 0xA0);  // 4000 = 0x0FA0, little-endian
+  EXPECT_EQ(p[1], 0x0F);
+  EXPECT_EQ(f32(8), 0.5f);
+  EXPECT_EQ(f32(16), -9.75f);
+  EXPECT_EQ(f32(32), 0.21f);     // xmag after 3 accelerations and 3 rates
+  EXPECT_EQ(f32(44), 1013.25f);  // abs_pressure
+  EXPECT_EQ(p[60], 0xFF);        // fields_updated
+  EXPECT_EQ(p[61], 0x1B);
+
+  HilGps g;
+  g.lat = 473977420;  // 47.397742 deg
+  g.eph = 30;
+  g.vn = -150;
+  g.fix_type = 3;
+  g.satellites_visible = 10;
+  const std::vector<std::uint8_t> q = hil_gps(g);
+  ASSERT_EQ(q.size(), 39u);  // 8 + 3 x 4 + 7 x 2 + 2 + the extensions' 3
+  std::int32_t lat;
+  std::memcpy(&lat, &q[8], 4);
+  EXPECT_EQ(lat, 473977420);
+  EXPECT_EQ(q[20], 30);  // eph after time, lat, lon, alt
+  std::int16_t vn;
+  std::memcpy(&vn, &q[26], 2);
+  EXPECT_EQ(vn, -150);
+  EXPECT_EQ(q[34], 3);   // fix_type
+  EXPECT_EQ(q[35], 10);  // satellites_visible
+
+  // HIL_ACTUATOR_CONTROLS as PX4 writes it, its trailing zeros cut as MAVLink 2 sends it.
+  std::vector<std::uint8_t> a(81, 0);
+  const std::uint64_t t = 123456789, flags = 1;
+  std::memcpy(&a[0], &t, 8);
+  std::memcpy(&a[8], &flags, 8);
+  const float m1 = 0.5625f, m4 = 0.125f;
+  std::memcpy(&a[16], &m1, 4);
+  std::memcpy(&a[28], &m4, 4);
+  a[80] = 129;
+  Parser parser;
+  parser.feed(encode(7, 1, 1, kHilActuatorControls, a));
+  const auto frame = parser.next();
+  ASSERT_TRUE(frame.has_value());
+  const HilActuatorControls c = read_hil_actuator_controls(*frame);
+  EXPECT_EQ(c.time_usec, 123456789u);
+  EXPECT_EQ(c.flags, 1u);
+  EXPECT_EQ(c.controls[0], 0.5625f);
+  EXPECT_EQ(c.controls[3], 0.125f);
+  EXPECT_EQ(c.controls[1], 0.0f);
+  EXPECT_EQ(c.mode, 129);
+  // Cut after the controls (mode 0 and zero controls at the end): still read, the rest as zeros.
+  a[80] = 0;
+  parser.feed(encode(8, 1, 1, kHilActuatorControls, a));
+  const auto cut = parser.next();
+  ASSERT_TRUE(cut.has_value());
+  EXPECT_LT(cut->payload.size(), 81u);
+  EXPECT_EQ(read_hil_actuator_controls(*cut).controls[3], 0.125f);
+  EXPECT_EQ(read_hil_actuator_controls(*cut).mode, 0);
 }
 
 }  // namespace
