@@ -14,22 +14,11 @@
 #include <stdexcept>
 #include <thread>
 
+#include "isolation/child.hpp"
+
 extern char** environ;
 
 namespace quadcosim::sitl {
-
-namespace {
-
-std::string describe(int status) {
-  if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
-    return "was killed by signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
-  }
-  return "ended (wait status " + std::to_string(status) + ")";
-}
-
-}  // namespace
 
 FirmwareProcess::FirmwareProcess(const std::vector<std::string>& argv, const std::string& work_dir,
                                  const std::string& log_path)
@@ -68,7 +57,7 @@ std::optional<std::string> FirmwareProcess::ended() {
   if (end_ || pid_ <= 0) return end_;
   int status = 0;
   if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-    end_ = describe(status);
+    end_ = isolation::describe_end(status);
     ::kill(-pid_, SIGKILL);  // whatever it started goes with it
   }
   return end_;
@@ -85,7 +74,7 @@ void FirmwareProcess::stop(double grace_s) {
   ::kill(-pid_, SIGKILL);
   int status = 0;
   ::waitpid(pid_, &status, 0);
-  end_ = describe(status);
+  end_ = isolation::describe_end(status);
 }
 
 std::string FirmwareProcess::log_tail(int lines) const {

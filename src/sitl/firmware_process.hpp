@@ -23,8 +23,8 @@ class FirmwareProcess {
   FirmwareProcess& operator=(const FirmwareProcess&) = delete;
 
   pid_t pid() const { return pid_; }
-  /// How the process ended ("exited with status 1", "was killed by signal 6 (Aborted)"), or nothing
-  /// while it runs. Does not block.
+  /// How the process ended, as isolation::describe_end says it ("exited with status 1", "was killed
+  /// by signal 6 (Aborted): it crashed"), or nothing while it runs. Does not block.
   std::optional<std::string> ended();
   /// Ends the process group: SIGTERM, up to grace_s, then SIGKILL; reaps. Idempotent.
   void stop(double grace_s = 1.0);
