@@ -691,6 +691,17 @@ model::State initial_state(const Scenario& sc) {
 
 Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path, nullptr); }
 
+namespace {
+// `path` from --controller TEXT as an absolute path; std::invalid_argument when there is no such file.
+std::string existing_file(const std::string& text, const std::string& path) {
+  std::error_code ec;
+  if (path.empty() || !std::filesystem::exists(path, ec)) {
+    throw std::invalid_argument("got '" + text + "': no such file '" + path + "'");
+  }
+  return std::filesystem::absolute(path).lexically_normal().string();
+}
+}  // namespace
+
 ControllerChoice parse_controller_choice(const std::string& text) {
   ControllerChoice c;
   if (text.rfind("python:", 0) == 0) {
@@ -705,11 +716,7 @@ ControllerChoice parse_controller_choice(const std::string& text) {
     c.kind = ControllerChoice::Kind::kFmu;
     c.target = text.substr(4);
     if (c.target.empty()) throw std::invalid_argument("got '" + text + "', expected fmu:PATH of a co-simulation FMU");
-    std::error_code ec;
-    if (!std::filesystem::exists(c.target, ec)) {
-      throw std::invalid_argument("got '" + text + "': no such file '" + c.target + "'");
-    }
-    c.target = std::filesystem::absolute(c.target).lexically_normal().string();
+    c.target = existing_file(text, c.target);
   } else if (text == "sitl" || text.rfind("sitl:", 0) == 0) {
     c.kind = ControllerChoice::Kind::kSitl;
     const std::string rest = text.size() > 5 ? text.substr(5) : "ardupilot";
@@ -719,14 +726,7 @@ ControllerChoice parse_controller_choice(const std::string& text) {
       throw std::invalid_argument("got '" + text +
                                   "', expected sitl:ardupilot or sitl:ardupilot:BINARY (docs/sitl.md)");
     }
-    if (colon != std::string::npos) {
-      c.target = rest.substr(colon + 1);
-      std::error_code ec;
-      if (c.target.empty() || !std::filesystem::exists(c.target, ec)) {
-        throw std::invalid_argument("got '" + text + "': no such file '" + c.target + "'");
-      }
-      c.target = std::filesystem::absolute(c.target).lexically_normal().string();
-    }
+    if (colon != std::string::npos) c.target = existing_file(text, rest.substr(colon + 1));
   } else if (text == "python") {
     c.kind = ControllerChoice::Kind::kPython;  // the class is named by the caller (controller.python)
   } else {

@@ -472,6 +472,4 @@ void SitlController::step(const control::Observation& obs, const control::Refere
   t_s_ = static_cast<double>(steps_) * dt_s;
 }
 
-const SitlController* sitl_controller(const control::Controller& c) { return dynamic_cast<const SitlController*>(&c); }
-
 }  // namespace quadcosim::sitl

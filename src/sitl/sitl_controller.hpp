@@ -115,7 +115,4 @@ class SitlController final : public control::Controller {
   control::ReportedOutputs reported_;
 };
 
-/// The SITL controller a configuration flies, or nullptr.
-const SitlController* sitl_controller(const control::Controller& c);
-
 }  // namespace quadcosim::sitl
