@@ -86,11 +86,11 @@ void ArrivalExecutor::on_data(std::size_t subscription) {
   if (!owner && depth_ == 0) take_noted(false);  // held while this one ran
 }
 
-bool ArrivalExecutor::deliver(std::size_t subscription) {
-  if (failure_) return true;  // delivery stopped; wait() rethrows
+template <class Take>
+bool ArrivalExecutor::delivery(Take take) {
   ++depth_;
   try {
-    delivered_ += transport_.take(subscription);
+    delivered_ += take();
   } catch (...) {
     failure_ = std::current_exception();
   }
@@ -98,19 +98,17 @@ bool ArrivalExecutor::deliver(std::size_t subscription) {
   return after_delivery();
 }
 
+bool ArrivalExecutor::deliver(std::size_t subscription) {
+  if (failure_) return true;  // delivery stopped; wait() rethrows
+  return delivery([&] { return transport_.take(subscription); });
+}
+
 bool ArrivalExecutor::deliver(DdsTransport::Held& held) {
   if (failure_) {  // delivery stopped: the memory goes back
     transport_.drop_held(held);
     return true;
   }
-  ++depth_;
-  try {
-    delivered_ += transport_.deliver_held(held);
-  } catch (...) {
-    failure_ = std::current_exception();
-  }
-  --depth_;
-  return after_delivery();
+  return delivery([&] { return transport_.deliver_held(held); });
 }
 
 bool ArrivalExecutor::next_noted(DdsTransport::Held& held, const std::size_t* only) {

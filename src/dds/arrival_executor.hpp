@@ -87,6 +87,9 @@ class ArrivalExecutor {
   /// the owner (or delivery has stopped).
   bool deliver(std::size_t subscription);
   bool deliver(DdsTransport::Held& held);
+  /// Runs take() (it delivers; returns how many) as a delivery: counted, its failure kept, the hook run.
+  template <class Take>
+  bool delivery(Take take);
   /// The oldest held batch (of subscription *only, when given) out of noted_.
   bool next_noted(DdsTransport::Held& held, const std::size_t* only);
   /// Delivers the held batches in order (under mutex_); with stop_at_wake, stops after the first
