@@ -4,26 +4,20 @@
 # (a wrong packet, a firmware that exits or hangs, a bad section), each a clear message and exit 5 or 2,
 # never a hang, with the firmware process gone afterwards.
 # Usage: sitl_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID FAKE_FIRMWARE
-set -euo pipefail
-bin="$1"; src="$2"; case_name="$3"; domain="$4"; fake="$5"
+bin="$1"; src="$2"; fake="$5"
+# shellcheck source=../lib/process_case.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 here="$src/tests/sitl"
 py=/usr/bin/python3
-tmp="$(mktemp -d)"
-cleanup() {
-  local rc=$?
+# Before process_case.sh's cleanup: the firmware processes by their pid files, and the folders a failed
+# run keeps (its message names it, with the log), those made here.
+sitl_cleanup() {
+  local f d
   set +e
-  for f in "$tmp"/*.pid; do [ -f "$f" ] && kill -KILL "$(cat "$f")" 2>/dev/null; done
-  # A failed run keeps the firmware's folder (its message names it, with the log): remove those made here.
+  for f in "$tmp"/*.pid; do [ -f "$f" ] && { kill -KILL "$(cat "$f")" 2>/dev/null || true; }; done
   for d in $(grep -ho "/[^ ]*/quadcosim-sitl-[A-Za-z0-9]*" "$tmp"/*.log 2>/dev/null | sort -u); do rm -rf "$d"; done
-  rm -rf "$tmp"
-  exit "$rc"
 }
-trap cleanup EXIT
-fail() {
-  echo "FAIL [$case_name]: $*"
-  for f in "$tmp"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -25 "$f"; }; done
-  exit 1
-}
+trap 'sitl_cleanup; cleanup' EXIT
 # scenario BASE NAME [ARG...]: BASE's scenario flying the built test firmware with ARGs, as $tmp/NAME.yaml.
 scenario() {
   local base="$1" name="$2"; shift 2
@@ -146,8 +140,6 @@ PY
   dds)
     # The firmware as the controller of `run --transport dds` (the controller process starts it): the
     # same trajectory.csv bytes as in-process.
-    export ROS_DOMAIN_ID="$domain" ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-    unset ROS_LOCALHOST_ONLY ROS_STATIC_PEERS CYCLONEDDS_URI
     scenario fake_hover inproc
     cp "$tmp/inproc.yaml" "$tmp/overdds.yaml"
     run inproc 0
