@@ -52,6 +52,21 @@ PlantProcess::PlantProcess(const PlantProcessOptions& o, io::Scenario sc)
         faster_timer ? "A faster timer needs simulation.controller_rate_hz set to its rate. " : "");
     request_stop();  // wakes the lockstep's wait for the answer that will not come
   });
+  plant_.on_label_behind([this](std::int64_t label_ns, sim::Tick k) {
+    // A timer on ROS time fires once per control tick, after the reply that says the tick's samples
+    // were taken: a command labelled with older samples (the oldest it used, as a node that labels its
+    // commands does) is a step on samples its executor had not yet delivered to the node.
+    if (!barrier_ || !ambiguous_.empty()) return;
+    ambiguous_ = fmt::format(
+        "the controller stepped at tick {} (t = {:g} s) on samples of t = {:g} s (its command's label "
+        "rotors@{}): its executor ran the timer before a subscription callback that held the tick's samples "
+        "(a multi-threaded executor, or subscriptions in a callback group of another executor), so the run "
+        "stopped rather than fly a trajectory that differs from run to run. Serve the subscriptions, the "
+        "timer and the parameter services from one single-threaded executor (docs/ros2.md, \"Lockstep with "
+        "your own ROS 2 controller\")",
+        k, clock_.seconds(k), static_cast<double>(label_ns) * 1e-9, label_ns);
+    request_stop();
+  });
   transport_.subscribe_with_sender<msg::ControllerStatus>(topics_.controller_status,
                                                           [this](const msg::ControllerStatus& m, sim::SenderId s) {
                                                             if (!pairing_.accepts(topics_.controller_status, s))

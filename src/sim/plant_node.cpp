@@ -98,6 +98,7 @@ void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
   const std::int64_t stamp = options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1;
   if (stamp >= 0 && (stamp < options_.clock.ns(current_tick_) || stamp == last_label_accepted_ns_)) {
     ++stats_.commands_stale;
+    if (on_label_behind_ && stamp < options_.clock.ns(current_tick_)) on_label_behind_(stamp, current_tick_);
     return;
   }
   last_command_stamp_ns_ = stamp;  // the controller's answer to its tick, whatever its verdict

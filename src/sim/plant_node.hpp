@@ -113,6 +113,11 @@ class PlantNode final : public SteppablePlant {
   /// Told of each command of the controller's that arrives while a tick's /clock is held back
   /// (commands_early), with that tick: the lockstep host decides what it means.
   void on_early_command(std::function<void(Tick)> f) { on_early_command_ = std::move(f); }
+  /// Told of each command of the controller's labelled with a stamp older than the current tick k
+  /// (dropped and counted in commands_stale as a repeat), with that label and k: where the controller
+  /// cannot answer a tick twice (a timer on ROS time), it is no repeat but a step on older samples,
+  /// and the lockstep host decides what that means.
+  void on_label_behind(std::function<void(std::int64_t, Tick)> f) { on_label_behind_ = std::move(f); }
   /// Changes PlantOptions::clock_after_sensors before the first tick (a lockstep plant decides once it
   /// knows how its controller steps).
   void set_clock_after_sensors(bool after) { options_.clock_after_sensors = after; }
@@ -182,6 +187,7 @@ class PlantNode final : public SteppablePlant {
   Publisher<msg::Clock> clock_pub_;
   std::function<bool(Tick)> before_clock_;
   std::function<void(Tick)> on_early_command_;
+  std::function<void(std::int64_t, Tick)> on_label_behind_;
   Tick clock_held_ = -1;  ///< the tick whose /clock before_clock held back, until publish_clock
   Publisher<msg::PoseStamped> pose_pub_;
   Publisher<msg::TwistStamped> velocity_pub_;

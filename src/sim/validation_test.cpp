@@ -436,6 +436,33 @@ TEST(PlantValidationTest, LockstepRepeatsOfACommandAreNotCountedTwice) {
   EXPECT_EQ(rig.plant->command_receipt().label_ns, 20'000'000);
 }
 
+// A command labelled with a stamp behind the current tick is told to the host with that label and
+// the tick (a ROS-time timer that stepped on older samples); a copy of the tick's accepted answer is
+// no such command.
+TEST(PlantValidationTest, ALabelBehindTheTickIsToldWithTheTick) {
+  PlantOptions options;
+  options.drop_stale_commands = true;
+  Rig rig(options);
+  std::vector<std::pair<std::int64_t, Tick>> told;
+  rig.plant->on_label_behind([&](std::int64_t label_ns, Tick k) { told.emplace_back(label_ns, k); });
+  auto labelled = [](std::vector<double> w, std::int64_t stamp_ns) {
+    msg::Float64MultiArray m = command(std::move(w));
+    m.dim.push_back({msg::command_label(stamp_ns), 4, 4});
+    return m;
+  };
+  for (Tick k = 0; k < 4; ++k) rig.tick(k);
+  rig.plant->publish_outputs(4);                                // t = 0.04 s
+  rig.cmd.publish(labelled({100, 200, 300, 400}, 40'000'000));  // the tick's answer
+  rig.cmd.publish(labelled({100, 200, 300, 400}, 40'000'000));  // its copy: a repeat, not behind
+  EXPECT_TRUE(told.empty());
+  rig.cmd.publish(labelled({1, 2, 3, 4}, 30'000'000));  // on the samples of tick 3
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0], (std::pair<std::int64_t, Tick>{30'000'000, 4}));
+  EXPECT_EQ(rig.plant->stats().commands_stale, 2u);
+  rig.plant->latch_command(4);
+  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+}
+
 // A NaN command labelled with the current tick, then the valid answer with the same label: the valid
 // one is taken, not dropped as a copy of the NaN.
 TEST(PlantValidationTest, ANonFiniteCommandLabelledWithTheTickDoesNotMakeTheAnswerARepeat) {

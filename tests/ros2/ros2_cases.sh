@@ -5,7 +5,8 @@
 #
 #   ros2_cases.sh QUADCOSIM SOURCE_DIR CASE DOMAIN_ID WORK_DIR
 #   CASE: rclcpp_lockstep | rclcpp_no_clock_thread | rclpy_lockstep | cli | rclpy_pose_callback |
-#         rclpy_timer_100hz | rclpy_multithreaded | rclcpp_multithreaded | rclcpp_pose_callback
+#         rclpy_timer_100hz | rclpy_multithreaded | rclcpp_multithreaded | rclcpp_pose_callback |
+#         rclpy_slow_steps | rclcpp_labelled
 #
 # Needs a ROS 2 installation: one already sourced (ROS_DISTRO set, `ros2` on PATH), or the setup
 # file named by QUADCOSIM_ROS2_SETUP (e.g. /opt/ros/jazzy/setup.bash), with rclcpp, rclpy, ros2cli
@@ -23,9 +24,12 @@
 #    0.48, settled to 2 % by ~6 s);
 #  - nothing in the ROS 2 processes' output is a warning or an error (rclcpp's INFO line on SIGTERM
 #    is not);
-#  - node shapes (a Pose callback publishing, a 100 Hz timer, a 2-thread MultiThreadedExecutor, steps
-#    slower than the plant's repeat): every run refused with exit 4 and the message naming the shape,
-#    or every run flown as above with the same bytes; never exit 0 with a timing-dependent flight.
+#  - node shapes (a Pose callback publishing, a 100 Hz timer, steps slower than the plant's repeat):
+#    every run refused with exit 4 and the message naming the shape, or every run flown as above with
+#    the same bytes; never exit 0 with a timing-dependent flight;
+#  - a 2-thread MultiThreadedExecutor whose node labels its commands with the stamps it used: each run
+#    flown with the single-threaded node's bytes, or refused (exit 4) at the step the node's own log
+#    shows on older samples.
 set -euo pipefail
 QC="$1" SRC="$2" case_arg="$3" DOMAIN="$4" WORK="$5"
 
@@ -108,11 +112,16 @@ fly() {
   echo "$rc" > "$d/rc"
 }
 
-# lockstep_run N CONTROLLER...: fly, and check run N: exit 0, the ROS-time protocol, no warnings,
-# every step on its own tick's samples, z(15 s) = 10 m.
+# lockstep_run N CONTROLLER...: fly, and check run N (check_flown).
 lockstep_run() {
-  local n="$1" d="$tmp/run$1"
   fly "$@"
+  check_flown "$1"
+}
+
+# check_flown N: run N exited 0 on the ROS-time protocol, without warnings, every step on its own
+# tick's samples, z(15 s) = 10 m.
+check_flown() {
+  local n="$1" d="$tmp/run$1"
   local rc
   rc=$(cat "$d/rc")
   [ "$rc" = 0 ] || { cat "$d/plant.out"; fail "run $n: plant exited with $rc"; }
@@ -164,6 +173,42 @@ refused_runs() {
   grep -hoE "$pattern" "$tmp"/run*/plant.out | sort | uniq -c
 }
 
+# flown_or_refused RUNS REFERENCE CONTROLLER...: RUNS runs of a node that labels its commands with
+# the oldest stamp of the samples its step used, on an executor that may step it on older samples:
+# each run is either flown (check_flown, and REFERENCE's trajectory.csv bytes) or refused with exit 4
+# at the very step the node's own log shows on older samples, with that step's oldest stamp as the
+# label the plant names. Prints how many of each.
+flown_or_refused() {
+  local runs="$1" ref="$2" i rc flown=0 refused=0
+  shift 2
+  for ((i = 1; i <= runs; i++)); do
+    fly "$i" "$@"
+    rc=$(cat "$tmp/run$i/rc")
+    if [ "$rc" = 0 ]; then
+      check_flown "$i"
+      same_bytes "$i" "$i" "$ref"
+      flown=$((flown + 1))
+      continue
+    fi
+    [ "$rc" = 4 ] || { cat "$tmp/run$i/plant.out"; fail "run $i: plant exited with $rc, expected 0 or 4"; }
+    local msg tick label
+    msg=$(grep -oE "stepped at tick [0-9]+ \(t = [0-9.e+-]+ s\) on samples of t = [0-9.e+-]+ s \(its command's label rotors@[0-9]+\)" \
+      "$tmp/run$i/plant.out") || { cat "$tmp/run$i/plant.out"; fail "run $i: exit 4 without naming the step on older samples"; }
+    tick=$(sed -E 's/stepped at tick ([0-9]+).*/\1/' <<< "$msg")
+    label=$(sed -E 's/.*rotors@([0-9]+).*/\1/' <<< "$msg")
+    # The node's first step on older samples is the plant's tick (10 ms plant period), with that label.
+    awk -v run="$i" -v t_ns="$((tick * 10000000))" -v label="$label" '
+      $1 != $2 || $1 != $3 || $1 != $4 {
+        m = $2; if ($3 < m) m = $3; if ($4 < m) m = $4
+        if ($1 != t_ns || m != label) { printf "run %s: the node first stepped on older samples at %s ns (oldest %s), the plant named %s ns (%s)\n", run, $1, m, t_ns, label; exit 1 }
+        found = 1; exit 0 }
+      END { if (!found) { printf "run %s: the plant refused, but no step of the node used older samples\n", run; exit 1 } }' \
+      "$tmp/run$i/steps.log" || fail "run $i: the refusal does not name the node's own step on older samples"
+    refused=$((refused + 1))
+  done
+  echo "$flown runs flown (every step on its own samples, the same bytes), $refused refused at the step on older samples"
+}
+
 case "$case_arg" in
   rclcpp_lockstep)
     build_rclcpp_controller
@@ -209,26 +254,31 @@ case "$case_arg" in
     ;;
   rclpy_multithreaded)
     # A 50 Hz timer spun by a MultiThreadedExecutor with 2 threads (the default, mutually exclusive,
-    # callback group). Registered DISABLED in CMakeLists.txt: a reply can overtake a sensor callback
-    # here too (docs/ros2.md); measured once in 56 runs (the step at 8.14 s on the Pose of 8.13 s).
+    # callback group), its commands labelled with the oldest stamp its step used: a reply can overtake
+    # a sensor callback here too (docs/ros2.md; unlabelled, measured once in 56 runs, flown unseen).
+    # Each run flown with the single-threaded node's bytes or refused at the step on older samples.
     build_rclcpp_controller
-    for i in $(seq 1 20); do lockstep_run "$i" "$ROS_PY" "$CTL_PY" --ros-args -p executor_threads:=2; done
-    same_bytes 1 20
     lockstep_run 21 "$CTL_CPP"
-    same_bytes 1 21
-    echo "20 runs of an rclpy node on a 2-thread MultiThreadedExecutor: byte-identical, the single-threaded bytes"
+    flown_or_refused 20 "$tmp/run21/trajectory.csv" "$ROS_PY" "$CTL_PY" --ros-args -p executor_threads:=2 -p label:=true
+    echo "20 runs of a labelling rclpy node on a 2-thread MultiThreadedExecutor: each flown with the single-threaded bytes or refused at its step on older samples"
     ;;
   rclcpp_multithreaded)
-    # Registered DISABLED in CMakeLists.txt: rclcpp's MultiThreadedExecutor lets the get_parameters
-    # reply overtake a sensor callback, and the plant cannot see it (docs/ros2.md). Measured: 20 of 20
-    # runs exit 0, each with 2-10 of its 750 steps on the previous tick's Pose or Velocity, 20
-    # different trajectory.csv.
+    # rclcpp's MultiThreadedExecutor lets the get_parameters reply overtake a sensor callback (docs/ros2.md;
+    # unlabelled, measured: 20 of 20 runs exit 0, each with 2-10 of its 750 steps on the previous tick's
+    # Pose or Velocity). Labelled, each run is flown with the single-threaded bytes or refused at the
+    # node's first step on older samples.
     build_rclcpp_controller
-    for i in $(seq 1 20); do lockstep_run "$i" "$CTL_CPP" --ros-args -p executor_threads:=2; done
-    same_bytes 1 20
     lockstep_run 21 "$CTL_CPP"
-    same_bytes 1 21
-    echo "20 runs of an rclcpp node on a 2-thread MultiThreadedExecutor: byte-identical, the single-threaded bytes"
+    flown_or_refused 20 "$tmp/run21/trajectory.csv" "$CTL_CPP" --ros-args -p executor_threads:=2 -p label:=true
+    echo "20 runs of a labelling rclcpp node on a 2-thread MultiThreadedExecutor: each flown with the single-threaded bytes or refused at its step on older samples"
+    ;;
+  rclcpp_labelled)
+    # A labelling node on rclcpp::spin: labels change nothing of the flight (the unlabelled node's bytes).
+    build_rclcpp_controller
+    lockstep_run 4 "$CTL_CPP"
+    for i in 1 2 3; do lockstep_run "$i" "$CTL_CPP" --ros-args -p label:=true; done
+    same_bytes 1 4
+    echo "3 runs of a labelling rclcpp node: the unlabelled node's bytes"
     ;;
   rclpy_slow_steps)
     # A 50 Hz timer whose every 25th step takes 80 ms before it publishes, longer than the plant's

@@ -13,6 +13,8 @@ Other node shapes, for the tests of how lockstep treats them (tests/ros2/ros2_ca
     -p executor_threads:=2     spin in a MultiThreadedExecutor with that many threads (default 1:
                                rclpy.spin, a SingleThreadedExecutor)
     -p slow_step_ms:=80        every 25th step waits that long (wall clock) before it publishes
+    -p label:=true             label each command "rotors@<ns>" with the oldest header stamp of the
+                               three samples its step used (docs/ros2.md, "Labelled commands")
 """
 import math
 import sys
@@ -25,7 +27,7 @@ from geometry_msgs.msg import PoseStamped, TwistStamped
 from rclpy.node import Node
 from rcl_interfaces.msg import SetParametersResult
 from sensor_msgs.msg import Imu
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 
 MASS, GRAVITY = 1.96, 9.81
 IXX, IYY, IZZ = 0.0149, 0.0153, 0.0532
@@ -49,6 +51,7 @@ class AttitudeControllerNode(Node):
         shape = self.declare_parameter("shape", "timer").value
         self.executor_threads = self.declare_parameter("executor_threads", 1).value
         self.slow_step_s = self.declare_parameter("slow_step_ms", 0).value * 1e-3
+        self.label = self.declare_parameter("label", False).value
         self.steps = 0
         if shape not in ("timer", "pose_callback"):
             raise ValueError("shape must be timer or pose_callback, not %r" % shape)
@@ -98,6 +101,9 @@ class AttitudeControllerNode(Node):
         sq = (a - c + d, a - b - d, a + c + d, a + b - d)
         cmd = Float64MultiArray()
         cmd.data = [min(math.sqrt(max(s, 0.0)), OMEGA_MAX) for s in sq]
+        if self.label:
+            oldest = min(to_ns(self.pose.header.stamp), to_ns(self.vel.header.stamp), to_ns(self.imu.header.stamp))
+            cmd.layout.dim = [MultiArrayDimension(label="rotors@%d" % oldest, size=4, stride=4)]
         self.steps += 1
         if self.slow_step_s > 0 and self.steps % 25 == 0:
             time.sleep(self.slow_step_s)

@@ -15,6 +15,9 @@
 // Other node shapes, for the tests of how lockstep treats them (tests/ros2/ros2_cases.sh): parameter
 // shape "timer" (default) or "pose_callback" (step from the Pose subscription callback, no timer);
 // executor_threads N > 1: spin in a MultiThreadedExecutor with N threads instead of rclcpp::spin.
+// Parameter label (default false): label each command "rotors@<ns>" with the oldest header stamp of
+// the three samples its step used (one std_msgs/MultiArrayDimension), so the plant can tell a step
+// on older samples (docs/ros2.md, "Labelled commands").
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -52,6 +55,7 @@ class AttitudeControllerNode : public rclcpp::Node {
     const std::string log_file = declare_parameter("log_file", std::string());
     const std::string shape = declare_parameter("shape", std::string("timer"));
     executor_threads_ = declare_parameter("executor_threads", 1);
+    label_ = declare_parameter("label", false);
     if (shape != "timer" && shape != "pose_callback") {
       throw std::invalid_argument("shape must be timer or pose_callback, not '" + shape + "'");
     }
@@ -104,6 +108,14 @@ class AttitudeControllerNode : public rclcpp::Node {
     const double sq[4] = {a - c + d, a - b - d, a + c + d, a + b - d};
     std_msgs::msg::Float64MultiArray cmd;
     cmd.data.resize(4);
+    if (label_) {
+      const std::int64_t oldest =
+          std::min({to_ns(pose_.header.stamp), to_ns(vel_.header.stamp), to_ns(imu_.header.stamp)});
+      cmd.layout.dim.resize(1);
+      cmd.layout.dim[0].label = "rotors@" + std::to_string(oldest);
+      cmd.layout.dim[0].size = 4;
+      cmd.layout.dim[0].stride = 4;
+    }
     for (int i = 0; i < 4; ++i) cmd.data[i] = std::min(std::sqrt(std::max(sq[i], 0.0)), kOmegaMax);
     cmd_pub_->publish(cmd);
     if (log_ != nullptr) {
@@ -117,6 +129,7 @@ class AttitudeControllerNode : public rclcpp::Node {
 
   double z_des_, kp_z_, kd_z_, kp_att_, kd_att_;
   std::int64_t executor_threads_ = 1;
+  bool label_ = false;
   std::FILE* log_ = nullptr;
   geometry_msgs::msg::PoseStamped pose_;
   geometry_msgs::msg::TwistStamped vel_;
