@@ -19,8 +19,8 @@ namespace quadcosim::dds {
 /// "string<=256 name", "builtin_interfaces/msg/Time stamp", "rcl_interfaces/msg/IntegerRange[<=1] r").
 /// Constants and default values are left out: neither is part of the hash.
 struct MessageDescription {
-  const char* name;
-  const char* fields;
+  std::string name;
+  std::string fields;
 };
 
 /// One service as its .srv file declares it: "pkg/srv/Name" and the fields of its request and

@@ -35,12 +35,9 @@ std::vector<std::uint8_t> to_cdr(const msg::String& m);
 std::vector<std::uint8_t> to_cdr(const msg::SceneUpdate& m);
 
 /// The full `ros2msg` schema text of a ROS 2 message type named "pkg/msg/Type" (e.g.
-/// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType): the type's own .msg fields,
-/// then every type it depends on, depth first in field order, each once, as a line of 80 '=', a line
-/// "MSG: pkg/Type" and that type's fields (the ros1msg/ros2msg convention of the MCAP registry and
-/// rosbag2); a type's .msg constants come before its fields, one "TYPE NAME=VALUE" line each. Known: the message types
-/// of sim/messages.hpp, foxglove_msgs/msg/SceneUpdate (sim/scene_messages.hpp) and the types they contain. Throws
-/// std::invalid_argument naming `ros_type` for any other.
+/// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType), as msg::ros2msg_definition
+/// (sim/message_schema.hpp) derives it from the types' fields(). Throws std::invalid_argument naming
+/// `ros_type` for a type that is not one of them.
 const std::string& ros2msg_definition(std::string_view ros_type);
 
 /// The `offered_qos_profiles` channel metadata the MCAP ros2 profile requires, in rosbag2's YAML
