@@ -13,17 +13,6 @@ namespace quadcosim::dds {
 
 std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_topic; }
 
-QosProfile QosProfile::for_topic(const std::string& ros_topic) {
-  static const std::string kDescription = "/robot_description";
-  if (ros_topic == "/tf") return {100, true, false};
-  if (ros_topic == "/tf_static") return {1, true, true};
-  if (ros_topic.size() >= kDescription.size() &&
-      ros_topic.compare(ros_topic.size() - kDescription.size(), kDescription.size(), kDescription) == 0) {
-    return {1, true, true};
-  }
-  return ros_default();
-}
-
 DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
   waitset_ = check(dds_create_waitset(participant_.handle()), "dds_create_waitset");
 }

@@ -17,22 +17,13 @@
 
 #include "dds/participant.hpp"
 #include "dds/ros_types.hpp"
+#include "sim/topic_qos.hpp"
 #include "sim/transport.hpp"
 
 namespace quadcosim::dds {
 
-struct QosProfile {
-  int depth = 10;                ///< KEEP_LAST depth
-  bool reliable = true;          ///< RELIABLE (ROS default) or BEST_EFFORT (ROS sensor data)
-  bool transient_local = false;  ///< TRANSIENT_LOCAL (late joiners get the last `depth`) or VOLATILE
-  static QosProfile ros_default() { return {10, true, false}; }
-  static QosProfile sensor_data() { return {5, false, false}; }
-  /// What ROS 2 uses for `ros_topic` unless told otherwise: tf2's for /tf (reliable, volatile, depth
-  /// 100: tf2_ros::DynamicBroadcasterQoS and DynamicListenerQoS) and /tf_static (reliable, transient
-  /// local, depth 1: StaticBroadcasterQoS), robot_state_publisher's for any `.../robot_description`
-  /// (reliable, transient local, depth 1), the ROS default for every other topic.
-  static QosProfile for_topic(const std::string& ros_topic);
-};
+/// The topics' QoS table (sim/topic_qos.hpp).
+using QosProfile = sim::TopicQos;
 
 /// The USER_DATA key of a pairing token (dds/peer_pairing.hpp).
 inline constexpr const char* kPairTokenKey = "quadcosim_pair";

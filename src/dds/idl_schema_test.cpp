@@ -19,9 +19,9 @@ namespace quadcosim::dds {
 namespace {
 
 const std::map<std::string, std::string> kIdlPrimitive = {
-    {"double", "float64"}, {"float", "float32"},   {"boolean", "bool"},    {"octet", "byte"},   {"char", "char"},
-    {"int8", "int8"},      {"uint8", "uint8"},     {"int16", "int16"},     {"uint16", "uint16"}, {"int32", "int32"},
-    {"uint32", "uint32"},  {"int64", "int64"},     {"uint64", "uint64"},   {"string", "string"}};
+    {"double", "float64"}, {"float", "float32"}, {"boolean", "bool"},  {"octet", "byte"},    {"char", "char"},
+    {"int8", "int8"},      {"uint8", "uint8"},   {"int16", "int16"},   {"uint16", "uint16"}, {"int32", "int32"},
+    {"uint32", "uint32"},  {"int64", "int64"},   {"uint64", "uint64"}, {"string", "string"}};
 
 // An IDL type as a .msg type: primitives renamed, "pkg::msg::dds_::Type_" (or a bare "Type_" of the
 // same module) as "pkg/msg/Type".
@@ -70,10 +70,10 @@ TEST(IdlSchemaTest, TheWireLayoutIsTheMessagesFields) {
   const auto idl = idl_structs();
   // What quadcosim's nodes publish on DDS (docs/ros2.md), and every type those contain.
   std::vector<std::string> todo = {
-      "geometry_msgs/msg/PoseStamped",   "geometry_msgs/msg/TwistStamped",      "sensor_msgs/msg/Imu",
-      "sensor_msgs/msg/MagneticField",   "sensor_msgs/msg/FluidPressure",       "sensor_msgs/msg/NavSatFix",
-      "std_msgs/msg/Float64MultiArray",  "rosgraph_msgs/msg/Clock",             "quadcosim_msgs/msg/ControllerStatus",
-      "quadcosim_msgs/msg/PlantStatus",  "tf2_msgs/msg/TFMessage",              "std_msgs/msg/String"};
+      "geometry_msgs/msg/PoseStamped",  "geometry_msgs/msg/TwistStamped", "sensor_msgs/msg/Imu",
+      "sensor_msgs/msg/MagneticField",  "sensor_msgs/msg/FluidPressure",  "sensor_msgs/msg/NavSatFix",
+      "std_msgs/msg/Float64MultiArray", "rosgraph_msgs/msg/Clock",        "quadcosim_msgs/msg/ControllerStatus",
+      "quadcosim_msgs/msg/PlantStatus", "tf2_msgs/msg/TFMessage",         "std_msgs/msg/String"};
   std::set<std::string> done;
   while (!todo.empty()) {
     const std::string name = todo.back();

@@ -34,7 +34,7 @@ McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, c
   add<msg::ControllerStatus>(transport, topics.controller_status);
   add<msg::PlantStatus>(transport, topics.plant_status);
   add<msg::Float64MultiArray>(transport, topics.motor_commands);
-  add<msg::TFMessage>(transport, topics.tf, Qos{100, true, false});  // tf2's dynamic broadcaster QoS
+  add<msg::TFMessage>(transport, topics.tf);
 }
 
 bool McapRecorder::wanted(const std::string& topic) const {
@@ -42,10 +42,10 @@ bool McapRecorder::wanted(const std::string& topic) const {
 }
 
 void McapRecorder::record_vehicle(const model::VehicleParams& vehicle, const std::string& ns, std::int64_t t_ns) {
-  const Qos latched{1, true, true};  // robot_state_publisher's and tf2's static broadcaster's
   for (LatchedMessage& m : vehicle_description_messages(vehicle, ns, t_ns)) {
     if (!wanted(m.topic)) continue;
-    push(static_cast<std::uint16_t>(open_channel(m.topic, m.type, latched)), t_ns, std::move(m.cdr));
+    push(static_cast<std::uint16_t>(open_channel(m.topic, m.type, sim::TopicQos::for_topic(m.topic))), t_ns,
+         std::move(m.cdr));
   }
 }
 
@@ -56,11 +56,12 @@ McapRecorder::~McapRecorder() {
   }
 }
 
-std::size_t McapRecorder::open_channel(const std::string& topic, const std::string& type, Qos qos) {
+std::size_t McapRecorder::open_channel(const std::string& topic, const std::string& type, sim::TopicQos qos) {
   const std::uint16_t schema = writer_.add_schema(type, "ros2msg", ros2msg_definition(type));
   const std::uint16_t id = writer_.add_channel(
       topic, schema, "cdr",
-      {{"offered_qos_profiles", ros2_offered_qos_profiles(qos.depth, qos.reliable, qos.transient_local)}});
+      {{"offered_qos_profiles",
+        ros2_offered_qos_profiles(static_cast<std::uint32_t>(qos.depth), qos.reliable, qos.transient_local)}});
   ChannelInfo c;
   c.topic = topic;
   c.type = type;
@@ -71,9 +72,9 @@ std::size_t McapRecorder::open_channel(const std::string& topic, const std::stri
 }
 
 template <class T>
-void McapRecorder::add(sim::Transport& transport, const std::string& topic, Qos qos) {
+void McapRecorder::add(sim::Transport& transport, const std::string& topic) {
   if (!wanted(topic)) return;
-  const std::size_t index = open_channel(topic, std::string(T::kRosType), qos);
+  const std::size_t index = open_channel(topic, std::string(T::kRosType), sim::TopicQos::for_topic(topic));
   transport.subscribe_with_sender<T>(topic, [this, index](const T& m, sim::SenderId sender) {
     const std::int64_t t = message_time_ns(m, last_stamp_ns_);
     bool stamped = true;  // the message carries its own time (header, clock, or command label)
@@ -157,7 +158,8 @@ void McapRecorder::write_bag_metadata(const std::string& dir, const std::string&
       << "        type: " << c.type << "\n"
       << "        serialization_format: cdr\n"
       << "        offered_qos_profiles: \"";
-    for (char ch : ros2_offered_qos_profiles(c.qos.depth, c.qos.reliable, c.qos.transient_local)) {
+    for (char ch :
+         ros2_offered_qos_profiles(static_cast<std::uint32_t>(c.qos.depth), c.qos.reliable, c.qos.transient_local)) {
       y << (ch == '\n' ? std::string("\\n") : std::string(1, ch));
     }
     y << "\"\n"

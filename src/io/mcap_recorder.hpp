@@ -14,6 +14,7 @@
 #include "model/vehicle_params.hpp"
 #include "sensors/sensor_set.hpp"
 #include "sim/messages.hpp"
+#include "sim/topic_qos.hpp"
 #include "sim/topics.hpp"
 #include "sim/transport.hpp"
 
@@ -106,17 +107,10 @@ class McapRecorder {
     std::uint64_t arrival;
     std::vector<std::uint8_t> cdr;
   };
-  /// A channel's offered QoS (no member initialisers: clang refuses one of those in the default
-  /// argument of add() below, inside the class).
-  struct Qos {
-    std::uint32_t depth;
-    bool reliable;
-    bool transient_local;
-  };
   struct ChannelInfo {
     std::string topic, type;
     std::uint16_t id;
-    Qos qos{10, true, false};
+    sim::TopicQos qos;
     std::uint64_t count = 0;
     std::uint32_t sequence = 0;
     /// Newest stamp recorded per writer (a stranger's stamps say nothing about the run's own
@@ -127,9 +121,9 @@ class McapRecorder {
     std::map<std::pair<sim::SenderId, std::string>, std::int64_t> newest_by_frame;
   };
   /// The channel of `topic` with the schema of `type` ("pkg/msg/Type"); its index in channels_.
-  std::size_t open_channel(const std::string& topic, const std::string& type, Qos qos);
+  std::size_t open_channel(const std::string& topic, const std::string& type, sim::TopicQos qos);
   template <class T>
-  void add(sim::Transport& transport, const std::string& topic, Qos qos = {10, true, false});
+  void add(sim::Transport& transport, const std::string& topic);
   bool wanted(const std::string& topic) const;
   void push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr);
 

@@ -15,7 +15,7 @@ namespace quadcosim::msg {
 
 /// One field as a .msg file declares it.
 struct SchemaField {
-  std::string type;           ///< a primitive ("float64", "uint8[9]", "string[]") or "pkg/msg/Type" (+ "[]"/"[N]")
+  std::string type;  ///< a primitive ("float64", "uint8[9]", "string[]") or "pkg/msg/Type" (+ "[]"/"[N]")
   std::string name;
   std::string default_value;  ///< "" for none
 };
