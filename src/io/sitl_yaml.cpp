@@ -63,13 +63,14 @@ std::shared_ptr<const control::Controller> read_sitl_controller(YamlSection& c, 
                               "outputs as 0..1 (docs/sitl.md)"));
     }
   }
-  for (const char* key : {"etc_dir", "airframe", "instance", "settle_ms"}) {
+  for (const char* key : {"etc_dir", "airframe", "instance", "settle_ms", "cpu"}) {
     if (!px4 && s.has(key)) s.fail(key, "is PX4's (firmware: px4)");
   }
   if (s.has("etc_dir")) spec.etc_dir = resolved(s.text("etc_dir", ""), folder);
   spec.airframe = static_cast<int>(s.integer("airframe", spec.airframe, 1, 99999999));
   spec.instance = static_cast<int>(s.integer("instance", spec.instance, -1, 99));
   spec.settle_ms = s.number("settle_ms", spec.settle_ms, 0.0, 10000.0);
+  spec.cpu = static_cast<int>(s.integer("cpu", spec.cpu, -2, 1023));
   spec.home = s.text("home", spec.home);
   spec.start_timeout_s = s.number("start_timeout_s", spec.start_timeout_s, 0.1, 3600.0);
   spec.timeout_s = s.number("timeout_s", spec.timeout_s, 0.01, 3600.0);

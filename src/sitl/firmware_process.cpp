@@ -2,6 +2,7 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -25,7 +26,7 @@ extern char** environ;
 namespace quadcosim::sitl {
 
 FirmwareProcess::FirmwareProcess(const std::vector<std::string>& argv, const std::string& work_dir,
-                                 const std::string& log_path, const std::vector<std::string>& env)
+                                 const std::string& log_path, const std::vector<std::string>& env, int cpu)
     : log_path_(log_path) {
   if (argv.empty()) throw std::runtime_error("firmware: no program to start");
   // Everything the child needs is made before fork(): between fork and exec only async-signal-safe calls.
@@ -44,12 +45,16 @@ FirmwareProcess::FirmwareProcess(const std::vector<std::string>& argv, const std
   envp.push_back(nullptr);
   const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (log < 0) throw std::runtime_error("firmware: cannot write its log " + log_path + ": " + std::strerror(errno));
+  cpu_set_t one_cpu;
+  CPU_ZERO(&one_cpu);
+  if (cpu >= 0) CPU_SET(cpu, &one_cpu);
   const pid_t parent = ::getpid();
   pid_ = ::fork();
   if (pid_ == 0) {
     ::setpgid(0, 0);
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent) ::_exit(127);
+    if (cpu >= 0 && ::sched_setaffinity(0, sizeof(one_cpu), &one_cpu) != 0) ::_exit(125);
     ::signal(SIGINT, SIG_IGN);  // Ctrl-C is the parent's to handle: it ends the group
     if (::chdir(work_dir.c_str()) != 0) ::_exit(126);
     ::dup2(log, STDOUT_FILENO);

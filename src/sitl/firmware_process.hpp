@@ -17,10 +17,11 @@ namespace quadcosim::sitl {
 class FirmwareProcess {
  public:
   /// Starts argv (argv[0] the program) in `work_dir` with output to `log_path`, its environment this
-  /// process's with the NAME=VALUE entries of `env` added (replacing any of the same name). Throws
-  /// std::runtime_error naming the program when it cannot.
+  /// process's with the NAME=VALUE entries of `env` added (replacing any of the same name); with
+  /// `cpu` >= 0 it (and what it starts) runs on that CPU only. Throws std::runtime_error naming the
+  /// program when it cannot.
   FirmwareProcess(const std::vector<std::string>& argv, const std::string& work_dir, const std::string& log_path,
-                  const std::vector<std::string>& env = {});
+                  const std::vector<std::string>& env = {}, int cpu = -1);
   ~FirmwareProcess();
   FirmwareProcess(const FirmwareProcess&) = delete;
   FirmwareProcess& operator=(const FirmwareProcess&) = delete;

@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -35,6 +36,7 @@ struct SitlController::Px4Link {
   std::uint8_t target_system = 1;
   mavlink::Heartbeat heartbeat;
   bool have_heartbeat = false;
+  double shown_mode = -1.0;  ///< its HEARTBEAT's custom_mode at the last mission decision (out.mode)
   // The mission (as SitlController::Link's): item in progress, when sent, its answer.
   std::size_t item = 0;
   double item_sent_s = -1.0;
@@ -44,7 +46,15 @@ struct SitlController::Px4Link {
   long long heartbeats = 0;
   std::ofstream statustext;
 
+  long long unsettled = 0;  ///< steps sent before its threads slept (a note on stderr at the end)
+
   ~Px4Link() {
+    if (unsettled > 0) {
+      std::fprintf(stderr,
+                   "sitl: PX4 was sent %lld step(s) before all its threads had gone to sleep (settle_ms): "
+                   "this run may not repeat bit for bit (a busy machine; a larger settle_ms)\n",
+                   unsettled);
+    }
     process.reset();  // ends the firmware first
     for (int fd : {listener, sim, gcs}) {
       if (fd >= 0) ::close(fd);

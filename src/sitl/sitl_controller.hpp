@@ -58,17 +58,20 @@ struct SitlSpec {
   std::vector<MissionItem> mission;  ///< commands over MAVLink (none: the firmware flies as its params say)
   bool echo_statustext = false;      ///< print the firmware's STATUSTEXT messages on stderr as they come
   // PX4 only.
-  std::string etc_dir;      ///< its ROMFS folder (default: the binary's build folder's etc, ../etc from bin/px4)
-  int airframe = 10016;     ///< PX4_SYS_AUTOSTART
-  int instance = -1;        ///< -i: its ports are 4560 + i (simulator), 18570 + i (GCS), ...; -1: the first free
-  double settle_ms = 50.0;  ///< [ms] wall time to wait, before each step, for its threads to sleep (0: no wait)
-  sensors::Geodetic site;   ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
+  std::string etc_dir;       ///< its ROMFS folder (default: the binary's build folder's etc, ../etc from bin/px4)
+  int airframe = 10016;      ///< PX4_SYS_AUTOSTART
+  int instance = -1;         ///< -i: its ports are 4560 + i (simulator), 18570 + i (GCS), ...; -1: the first free
+  double settle_ms = 200.0;  ///< [ms] wall time to wait, before each step, for its threads to sleep (0: no wait)
+  /// The CPU it runs on (its real-time threads then take turns in priority order, the same on every
+  /// run); -1: any; -2 (default): the last CPU this process may use.
+  int cpu = -2;
+  sensors::Geodetic site;  ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
 };
 
-/// The figures a PX4 controller records (out.<name>): u1..u4 are its outputs 1..4 (0..1); unsettled
-/// counts the steps whose sensors went out before its threads had all gone to sleep (settle_ms).
-inline constexpr const char* kPx4Outputs[] = {"frame", "u1",        "u2",    "u3",   "u4",
-                                              "late",  "unsettled", "armed", "mode", "mission"};
+/// The figures a PX4 controller records (out.<name>): frame counts its answers, u1..u4 are its outputs
+/// 1..4 (0..1), armed its HIL_ACTUATOR_CONTROLS' flag, mode its HEARTBEAT's custom_mode as seen at the
+/// last 0.25 s decision (-1 before the first), mission the index of the mission item in progress.
+inline constexpr const char* kPx4Outputs[] = {"frame", "u1", "u2", "u3", "u4", "armed", "mode", "mission"};
 
 /// The figures a SITL controller records (out.<name> in trajectory.csv).
 /// armed and mode are the firmware's last HEARTBEAT's; mission is the index of the mission item in progress.

@@ -10,16 +10,18 @@
 // stopped. Before each step quadcosim also waits (up to settle_ms) for PX4's threads that are not
 // lockstep components (commander, navigator, the MAVLink links) to go to sleep: what they do for a
 // time is then done before the next time starts, whatever the machine's load. A step sent without
-// that (the wait ran out) is counted in out.unsettled.
+// that (the wait ran out) is counted, and a note at the end says the run may not repeat.
 //
 // The mission goes over PX4's GCS link (UDP 18570 + instance) as COMMAND_LONG / COMMAND_INT.
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <sched.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <chrono>
@@ -145,9 +147,20 @@ void SitlController::start_px4() {
     for (const std::string& e : env) f << e << '\n';
     for (const std::string& a : argv) f << a << '\n';
   }
+  int cpu = spec_.cpu;
+  if (cpu == -2) {
+    cpu_set_t allowed;
+    CPU_ZERO(&allowed);
+    cpu = -1;
+    if (::sched_getaffinity(0, sizeof(allowed), &allowed) == 0) {
+      for (int c = 0; c < CPU_SETSIZE; ++c) {
+        if (CPU_ISSET(c, &allowed)) cpu = c;
+      }
+    }
+  }
   try {
     l.process =
-        std::make_unique<FirmwareProcess>(argv, l.work_dir, (fs::path(l.work_dir) / "firmware.log").string(), env);
+        std::make_unique<FirmwareProcess>(argv, l.work_dir, (fs::path(l.work_dir) / "firmware.log").string(), env, cpu);
   } catch (const std::exception& e) {
     fail(e.what());
   }
@@ -187,11 +200,12 @@ void SitlController::service_px4_gcs() {
     ++l.heartbeats;
     send(mavlink::kHeartbeat, mavlink::heartbeat(6, 8, 0, 0, 4));
   }
-  // Mission decisions once PX4's GCS link has spoken, at whole multiples of 0.25 s of simulated time.
-  if (!l.have_heartbeat) return;
+  // Mission decisions at whole multiples of 0.25 s of simulated time, once PX4's GCS link has spoken.
   const long long decision = static_cast<long long>(std::floor(t_s_ / 0.25 + 1e-9));
   if (decision < l.decisions) return;
   l.decisions = decision + 1;
+  if (!l.have_heartbeat) return;
+  l.shown_mode = static_cast<double>(l.heartbeat.custom_mode);  // out.mode: as seen at the decisions
   while (l.item < spec_.mission.size()) {
     const MissionItem& m = spec_.mission[l.item];
     if (l.item_sent_s >= 0) {
@@ -307,7 +321,13 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
     }
   };
   service_px4_gcs();
-  if (l.answered && spec_.settle_ms > 0 && !wait_idle(0.0001, spec_.settle_ms / 1000.0)) ++counts_.unsettled;
+  // While its start-up script runs (commands that start, talk to PX4 and end), time waits for it (up to
+  // 2 s a step): the script's commands land at the same times on every run.
+  const double settle_s = l.group_settled ? spec_.settle_ms / 1000.0 : std::max(spec_.settle_ms / 1000.0, 2.0);
+  if (l.answered && spec_.settle_ms > 0 && !wait_idle(0.0001, settle_s) && l.group_settled) {
+    ++counts_.unsettled;  // counted once its start-up script is done (its commands run longer, harmlessly)
+    l.unsettled = counts_.unsettled;
+  }
 
   const std::uint64_t t_us = static_cast<std::uint64_t>(std::llround(static_cast<double>(steps_ + 1) * dt_s * 1e6));
   std::vector<std::uint8_t> bytes;
@@ -347,6 +367,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   const double limit_s = l.answered ? spec_.timeout_s : spec_.start_timeout_s;
   const double deadline = wall_s() + limit_s;
   std::array<std::uint8_t, 4096> buf{};
+  bool quiet = false;
   while (!answer) {
     check_alive();
     for (;;) {
@@ -380,10 +401,11 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
     if (l.sim_parser.bad_crc() > 0) {
       fail(fmt::format("step {} (t = {:.4f} s): a frame with a wrong checksum on the simulator link", steps_, t_s_));
     }
-    if (answer) break;
+    if (answer || quiet) break;
     if (!l.answered) {
-      // Starting: nothing more comes for this time once everything of its group sleeps.
-      if (wait_idle(0.005, 0.02)) break;
+      // Starting: nothing more comes for this time once everything of its group sleeps (read once more
+      // after that: the answer may have come while it went to sleep).
+      quiet = wait_idle(0.005, 0.02);
     } else {
       pollfd p{l.sim, POLLIN, 0};
       ::poll(&p, 1, 20);
@@ -406,11 +428,9 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   out.outputs.resize(std::size(kPx4Outputs));
   out.outputs[0] = static_cast<double>(counts_.frames);
   for (int c = 0; c < 4; ++c) out.outputs[1 + c] = controls[static_cast<std::size_t>(c)];
-  out.outputs[5] = static_cast<double>(counts_.late);
-  out.outputs[6] = static_cast<double>(counts_.unsettled);
-  out.outputs[7] = l.armed ? 1.0 : 0.0;
-  out.outputs[8] = l.have_heartbeat ? static_cast<double>(l.heartbeat.custom_mode) : -1.0;
-  out.outputs[9] = static_cast<double>(l.item);
+  out.outputs[5] = l.armed ? 1.0 : 0.0;
+  out.outputs[6] = l.shown_mode;
+  out.outputs[7] = static_cast<double>(l.item);
   control::rotor_speeds_output(model_, reference, omega, reported_, out);
   ++steps_;
   t_s_ = static_cast<double>(steps_) * dt_s;
