@@ -886,9 +886,11 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   }
   read_schedule(root, sc, duration_s);
   // PX4 flies on the magnetometer, barometer and GNSS: what the file lacks of them is added first.
-  add_px4_sensors(root, 1.0 / sc.simulation.plant.clock.period_s(), sc.simulation.controller_divider);
+  std::vector<std::string> added =
+      add_px4_sensors(root, 1.0 / sc.simulation.plant.clock.period_s(), sc.simulation.controller_divider);
   read_realism(root, sc);
-  sc.controller.controller = with_px4_site(sc.controller.controller, sc.simulation.plant.realism.extra_sensors);
+  sc.controller.controller =
+      with_px4_site(sc.controller.controller, sc.simulation.plant.realism.extra_sensors, std::move(added));
   if (std::string err = controller_sensors_error(sc); !err.empty()) root.fail("controller.fmu", err);
   if (auto p = root.section("plant")) {
     sc.plant_fmu = read_fmu_spec(*p, std::filesystem::path(path).parent_path());

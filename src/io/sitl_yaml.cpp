@@ -251,10 +251,11 @@ std::vector<std::string> add_px4_sensors(YamlSection& root, double plant_rate_hz
 }
 
 std::shared_ptr<const control::Controller> with_px4_site(std::shared_ptr<const control::Controller> controller,
-                                                         const sensors::SensorSet& sensors) {
+                                                         const sensors::SensorSet& sensors,
+                                                         std::vector<std::string> added) {
   const auto* s = dynamic_cast<const sitl::SitlController*>(controller.get());
   if (!s || !s->px4()) return controller;
-  return s->with_site(sensors.gnss ? sensors.gnss->site : sensors::Geodetic{});
+  return s->with_site(sensors.gnss ? sensors.gnss->site : sensors::Geodetic{}, std::move(added));
 }
 
 }  // namespace quadcosim::io

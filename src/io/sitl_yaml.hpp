@@ -35,8 +35,10 @@ std::shared_ptr<const control::Controller> read_sitl_controller(YamlSection& s, 
 std::vector<std::string> add_px4_sensors(YamlSection& root, double plant_rate_hz, int controller_divider);
 
 /// The PX4 controller of `controller` told its site (the GNSS's origin, for takeoff altitudes and goto
-/// positions), or `controller` unchanged when it is not PX4's.
+/// positions) and what add_px4_sensors added (it notes them on stderr when it starts), or `controller`
+/// unchanged when it is not PX4's.
 std::shared_ptr<const control::Controller> with_px4_site(std::shared_ptr<const control::Controller> controller,
-                                                         const sensors::SensorSet& sensors);
+                                                         const sensors::SensorSet& sensors,
+                                                         std::vector<std::string> added);
 
 }  // namespace quadcosim::io

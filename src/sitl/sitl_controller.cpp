@@ -183,9 +183,11 @@ std::unique_ptr<control::Controller> SitlController::clone() const {
   return std::make_unique<SitlController>(spec_, model_.params());
 }
 
-std::shared_ptr<SitlController> SitlController::with_site(const sensors::Geodetic& site) const {
+std::shared_ptr<SitlController> SitlController::with_site(const sensors::Geodetic& site,
+                                                          std::vector<std::string> added) const {
   SitlSpec spec = spec_;
   spec.site = site;
+  spec.added = std::move(added);
   return std::make_shared<SitlController>(spec, model_.params());
 }
 

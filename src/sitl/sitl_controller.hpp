@@ -66,6 +66,7 @@ struct SitlSpec {
   /// run); -1: any; -2 (default): the last CPU this process may use.
   int cpu = -2;
   sensors::Geodetic site;  ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
+  std::vector<std::string> added;  ///< what the scenario lacked and was added for PX4 (noted when it starts)
 };
 
 /// The figures a PX4 controller records (out.<name>): frame counts its answers, u1..u4 are its outputs
@@ -102,7 +103,7 @@ class SitlController final : public control::Controller {
   const SitlSpec& spec() const { return spec_; }
   bool px4() const { return spec_.firmware == "px4"; }
   /// The same controller with `site` as its world origin on the Earth (PX4's takeoff and goto).
-  std::shared_ptr<SitlController> with_site(const sensors::Geodetic& site) const;
+  std::shared_ptr<SitlController> with_site(const sensors::Geodetic& site, std::vector<std::string> added = {}) const;
   /// PX4's command line and environment (NAME=VALUE: PX4_SYS_AUTOSTART, PX4_PARAM_* of the vehicle's
   /// parameters and then the files'), for `instance` and `work_dir`.
   std::vector<std::string> px4_command_line(int instance, const std::string& work_dir) const;

@@ -26,6 +26,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -101,6 +102,12 @@ std::vector<std::string> SitlController::px4_environment() const {
 }
 
 void SitlController::start_px4() {
+  if (!spec_.added.empty()) {
+    std::string list;
+    for (const std::string& a : spec_.added) list += (list.empty() ? "" : ", ") + a;
+    std::fprintf(stderr, "sitl: the scenario lacks what PX4 flies on; added with their defaults (docs/sitl.md): %s\n",
+                 list.c_str());
+  }
   px4_ = std::make_unique<Px4Link>();
   Px4Link& l = *px4_;
   if (spec_.work_dir.empty()) {
@@ -373,6 +380,8 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
     for (;;) {
       const ssize_t n = ::recv(l.sim, buf.data(), buf.size(), MSG_DONTWAIT);
       if (n == 0) {
+        // A firmware that exits closes the link first: say how it ended when it does within a second.
+        for (int i = 0; i < 100 && !l.process->ended(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
         check_alive();
         fail(fmt::format("step {} (t = {:.4f} s): it closed the simulator link", steps_, t_s_));
       }
