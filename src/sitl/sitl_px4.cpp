@@ -304,8 +304,8 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
     }
   }
   // Its threads asleep: what they do for the last time is done before the next starts.
-  // Idle: asleep at every look over at least min_s (two looks at least); false after max_s.
-  auto wait_idle = [&](double min_s, double max_s) {
+  // Idle: asleep at every look over at least min_s (min_looks looks at least); false after max_s.
+  auto wait_idle = [&](double min_s, double max_s, int min_looks) {
     const double t0 = wall_s();
     double idle_since = -1.0;
     int looks = 0;
@@ -315,7 +315,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
       const double now = wall_s();
       if (idle) {
         if (idle_since < 0) idle_since = now;
-        if (++looks >= 2 && now - idle_since >= min_s) {
+        if (++looks >= min_looks && now - idle_since >= min_s) {
           if (l.answered && processes <= 1) l.group_settled = true;  // the start-up script is done
           return true;
         }
@@ -331,7 +331,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   // While its start-up script runs (commands that start, talk to PX4 and end), time waits for it (up to
   // 2 s a step): the script's commands land at the same times on every run.
   const double settle_s = l.group_settled ? spec_.settle_ms / 1000.0 : std::max(spec_.settle_ms / 1000.0, 2.0);
-  if (l.answered && spec_.settle_ms > 0 && !wait_idle(0.0001, settle_s) && l.group_settled) {
+  if (l.answered && spec_.settle_ms > 0 && !wait_idle(0.0001, settle_s, 2) && l.group_settled) {
     ++counts_.unsettled;  // counted once its start-up script is done (its commands run longer, harmlessly)
     l.unsettled = counts_.unsettled;
   }
@@ -414,7 +414,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
     if (!l.answered) {
       // Starting: nothing more comes for this time once everything of its group sleeps (read once more
       // after that: the answer may have come while it went to sleep).
-      quiet = wait_idle(0.005, 0.02);
+      quiet = wait_idle(0.02, 0.05, 2);
     } else {
       pollfd p{l.sim, POLLIN, 0};
       ::poll(&p, 1, 20);
