@@ -466,6 +466,17 @@ print(f"px4 mission: armed at {armed[0]} s, takeoff to 491 m AMSL, reposition at
       f"(closed form {hover:.1f}), landed; two runs identical")
 PY
     ;;
+  px4_dds)
+    # The test PX4's mission as the controller of `run --transport dds` (the controller process starts
+    # the test PX4; its magnetometer, barometer and GNSS samples cross DDS): the in-process bytes.
+    px4_scenario fake_px4_mission inproc
+    cp "$tmp/inproc.yaml" "$tmp/overdds.yaml"
+    run inproc 0
+    rc=0; "$bin" run "$tmp/overdds.yaml" --out "$tmp/overdds" --transport dds --judge none > "$tmp/overdds.log" 2>&1 || rc=$?
+    [ "$rc" -eq 0 ] || fail "over DDS: exit $rc $(tail -3 "$tmp/overdds.log")"
+    cmp "$tmp/inproc/trajectory.csv" "$tmp/overdds/trajectory.csv" || fail "over DDS the trajectory differs"
+    echo "px4 dds: the test PX4's mission over DDS, trajectory.csv identical to in-process"
+    ;;
   px4_failures)
     # Each a message naming the firmware, the step and its time, exit 5, the test PX4 gone.
     px4_scenario fake_px4_open_loop die --fake-die-at 100 --fake-pid-file "$tmp/die.pid"
