@@ -331,7 +331,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   // While its start-up script runs (commands that start, talk to PX4 and end), time waits for it (up to
   // 2 s a step): the script's commands land at the same times on every run.
   const double settle_s = l.group_settled ? spec_.settle_ms / 1000.0 : std::max(spec_.settle_ms / 1000.0, 2.0);
-  if (l.answered && spec_.settle_ms > 0 && !wait_idle(0.0001, settle_s, 2) && l.group_settled) {
+  if (l.answered && spec_.settle_ms > 0 && !wait_idle(0.0, settle_s, 2) && l.group_settled) {
     ++counts_.unsettled;  // counted once its start-up script is done (its commands run longer, harmlessly)
     l.unsettled = counts_.unsettled;
   }
