@@ -5,12 +5,14 @@
 // PX4's clock is quadcosim's plus one control period (it needs a first time above zero).
 //
 // Start-up: PX4's start-up script runs while its clock advances, and PX4 answers only once its
-// outputs run (about 0.26 s of its time). Until its first answer a step waits for an answer or for
+// outputs run (about 30 ms of its time here). Until its first answer a step waits for an answer or for
 // every process of its group to sleep (nothing more can come for this time), then flies the rotors
-// stopped. Before each step quadcosim also waits (up to settle_ms) for PX4's threads that are not
-// lockstep components (commander, navigator, the MAVLink links) to go to sleep: what they do for a
-// time is then done before the next time starts, whatever the machine's load. A step sent without
-// that (the wait ran out) is counted, and a note at the end says the run may not repeat.
+// stopped. Before each step quadcosim also waits (up to settle_ms; up to 2 s while the start-up
+// script's commands run) for PX4's threads that are not lockstep components (commander, navigator,
+// the MAVLink links, the script) to go to sleep: what they do for a time is then done before the
+// next time starts, whatever the machine's load. A step sent without that (the wait ran out) is
+// counted, and a note at the end says the run may not repeat. PX4 runs on one CPU (spec.cpu): its
+// real-time threads then take turns in priority order, the same on every run.
 //
 // The mission goes over PX4's GCS link (UDP 18570 + instance) as COMMAND_LONG / COMMAND_INT.
 #include <arpa/inet.h>
