@@ -29,7 +29,8 @@ void add_controller_type_option(CLI::App& cmd, std::string& type) {
   check_controller_choice(
       *cmd.add_option("--controller", type,
                       "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
-                      "python:MODULE:CLASS or fmu:PATH; the scenario's setpoints, reference and criteria stay"));
+                      "python:MODULE:CLASS, fmu:PATH or sitl:ardupilot|px4[:BINARY] (docs/sitl.md); the scenario's "
+                      "setpoints, reference and criteria stay"));
 }
 
 void add_judge_option(CLI::App& cmd, std::string& judge) {

@@ -722,9 +722,9 @@ ControllerChoice parse_controller_choice(const std::string& text) {
     const std::string rest = text.size() > 5 ? text.substr(5) : "ardupilot";
     const std::size_t colon = rest.find(':');
     c.firmware = rest.substr(0, colon);
-    if (c.firmware != "ardupilot") {
+    if (c.firmware != "ardupilot" && c.firmware != "px4") {
       throw std::invalid_argument("got '" + text +
-                                  "', expected sitl:ardupilot or sitl:ardupilot:BINARY (docs/sitl.md)");
+                                  "', expected sitl:ardupilot[:BINARY] or sitl:px4[:BINARY] (docs/sitl.md)");
     }
     if (colon != std::string::npos) c.target = existing_file(text, rest.substr(colon + 1));
   } else if (text == "python") {
@@ -735,8 +735,8 @@ ControllerChoice parse_controller_choice(const std::string& text) {
       for (const auto& t : controllers::controller_types()) types.emplace_back(t.name);
       throw std::invalid_argument(
           "got '" + text + "', expected a controller type (" + controllers::controller_type_names() +
-          "), python:MODULE:CLASS (a class written in Python), fmu:PATH (an FMU) or sitl:ardupilot[:BINARY] (a "
-          "firmware's SITL build)" +
+          "), python:MODULE:CLASS (a class written in Python), fmu:PATH (an FMU) or sitl:ardupilot|px4[:BINARY] "
+          "(a firmware's SITL build)" +
           did_you_mean(text, types));
     }
     c.target = text;
@@ -759,10 +759,14 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
                                : was_fmu                           ? "fmu"
                                : c["type"] && c["type"].IsScalar() ? c["type"].Scalar()
                                                                    : std::string(controllers::kDefaultControllerType);
-  // A SITL firmware flies what the file says of it (its sitl: section: parameters, mission) when it has one.
+  // A SITL firmware flies what the file says of it (its sitl: section: parameters, mission) when it has
+  // one for the same firmware.
   const bool same =
-      choice.kind == ControllerChoice::Kind::kType   ? !was_python && !was_fmu && !was_sitl && was_type == choice.target
-      : choice.kind == ControllerChoice::Kind::kSitl ? was_sitl
+      choice.kind == ControllerChoice::Kind::kType ? !was_python && !was_fmu && !was_sitl && was_type == choice.target
+      : choice.kind == ControllerChoice::Kind::kSitl
+          ? was_sitl && (c["sitl"] && c["sitl"].IsMap() && c["sitl"]["firmware"] && c["sitl"]["firmware"].IsScalar()
+                             ? c["sitl"]["firmware"].Scalar()
+                             : std::string("ardupilot")) == choice.firmware
       : choice.kind == ControllerChoice::Kind::kPython
           ? was_python && (choice.target.empty() ||
                            (c["python"] && c["python"].IsScalar() && c["python"].Scalar() == choice.target))
@@ -881,7 +885,12 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
     sc.controller = controllers::make_config(controllers::kDefaultControllerType, believed);
   }
   read_schedule(root, sc, duration_s);
+  // PX4 flies on the magnetometer, barometer and GNSS: what the file lacks of them is added first.
+  std::vector<std::string> added =
+      add_px4_sensors(root, 1.0 / sc.simulation.plant.clock.period_s(), sc.simulation.controller_divider);
   read_realism(root, sc);
+  sc.controller.controller =
+      with_px4_site(sc.controller.controller, sc.simulation.plant.realism.extra_sensors, std::move(added));
   if (std::string err = controller_sensors_error(sc); !err.empty()) root.fail("controller.fmu", err);
   if (auto p = root.section("plant")) {
     sc.plant_fmu = read_fmu_spec(*p, std::filesystem::path(path).parent_path());

@@ -1,17 +1,22 @@
 #include "sitl/firmware_process.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <fstream>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 
 #include "isolation/child.hpp"
@@ -21,28 +26,42 @@ extern char** environ;
 namespace quadcosim::sitl {
 
 FirmwareProcess::FirmwareProcess(const std::vector<std::string>& argv, const std::string& work_dir,
-                                 const std::string& log_path)
+                                 const std::string& log_path, const std::vector<std::string>& env, int cpu)
     : log_path_(log_path) {
   if (argv.empty()) throw std::runtime_error("firmware: no program to start");
   // Everything the child needs is made before fork(): between fork and exec only async-signal-safe calls.
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  std::vector<char*> envp;
+  auto name_of = [](std::string_view e) { return e.substr(0, e.find('=') + 1); };
+  for (char** e = environ; *e; ++e) {
+    const std::string_view name = name_of(*e);
+    if (std::none_of(env.begin(), env.end(), [&](const std::string& x) { return name_of(x) == name; })) {
+      envp.push_back(*e);
+    }
+  }
+  for (const std::string& e : env) envp.push_back(const_cast<char*>(e.c_str()));
+  envp.push_back(nullptr);
   const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (log < 0) throw std::runtime_error("firmware: cannot write its log " + log_path + ": " + std::strerror(errno));
+  cpu_set_t one_cpu;
+  CPU_ZERO(&one_cpu);
+  if (cpu >= 0) CPU_SET(cpu, &one_cpu);
   const pid_t parent = ::getpid();
   pid_ = ::fork();
   if (pid_ == 0) {
     ::setpgid(0, 0);
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent) ::_exit(127);
+    if (cpu >= 0 && ::sched_setaffinity(0, sizeof(one_cpu), &one_cpu) != 0) ::_exit(125);
     ::signal(SIGINT, SIG_IGN);  // Ctrl-C is the parent's to handle: it ends the group
     if (::chdir(work_dir.c_str()) != 0) ::_exit(126);
     ::dup2(log, STDOUT_FILENO);
     ::dup2(log, STDERR_FILENO);
     const int null_in = ::open("/dev/null", O_RDONLY);
     if (null_in >= 0) ::dup2(null_in, STDIN_FILENO);
-    ::execve(args[0], args.data(), environ);
+    ::execve(args[0], args.data(), envp.data());
     ::_exit(127);
   }
   const int fork_errno = errno;
@@ -51,7 +70,10 @@ FirmwareProcess::FirmwareProcess(const std::vector<std::string>& argv, const std
   ::setpgid(pid_, pid_);  // also from this side: no race with a kill of the group right after fork
 }
 
-FirmwareProcess::~FirmwareProcess() { stop(); }
+FirmwareProcess::~FirmwareProcess() {
+  stop();
+  for (const auto& [tid, fd] : thread_stat_fds_) ::close(fd);
+}
 
 std::optional<std::string> FirmwareProcess::ended() {
   if (end_ || pid_ <= 0) return end_;
@@ -75,6 +97,98 @@ void FirmwareProcess::stop(double grace_s) {
   int status = 0;
   ::waitpid(pid_, &status, 0);
   end_ = isolation::describe_end(status);
+}
+
+namespace {
+
+// The state letter and the process group of /proc/.../stat ("pid (comm) S ppid pgrp ..."); the name
+// may hold spaces and parentheses: read after the last ')'.
+bool read_stat(const std::string& path, char& state, long& pgrp) {
+  char buf[512];
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const ssize_t n = ::read(fd, buf, sizeof(buf) - 1);
+  ::close(fd);
+  if (n <= 0) return false;
+  buf[n] = '\0';
+  const char* close = std::strrchr(buf, ')');
+  if (!close) return false;
+  long ppid = 0;
+  return std::sscanf(close + 1, " %c %ld %ld", &state, &ppid, &pgrp) == 3;
+}
+
+// True when no thread of process `pid` runs (R) or waits on the disk (D).
+bool threads_idle(long pid) {
+  const std::string dir = "/proc/" + std::to_string(pid) + "/task";
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return true;  // gone
+  bool idle = true;
+  while (const dirent* e = ::readdir(d)) {
+    if (e->d_name[0] < '0' || e->d_name[0] > '9') continue;
+    char state = 0;
+    long pgrp = 0;
+    if (read_stat(dir + "/" + e->d_name + "/stat", state, pgrp) && (state == 'R' || state == 'D')) {
+      idle = false;
+      break;
+    }
+  }
+  ::closedir(d);
+  return idle;
+}
+
+}  // namespace
+
+bool FirmwareProcess::idle(bool whole_group, int* processes) const {
+  if (pid_ <= 0 || end_) return true;
+  if (!whole_group) {
+    // Its threads' stat files stay open and are read again from the start (one system call each); the
+    // list of threads is read again every call (new threads, gone ones).
+    if (processes) *processes = 1;
+    const std::string dir = "/proc/" + std::to_string(pid_) + "/task";
+    DIR* d = ::opendir(dir.c_str());
+    if (!d) return true;
+    std::map<long, int> now;
+    while (const dirent* e = ::readdir(d)) {
+      if (e->d_name[0] < '0' || e->d_name[0] > '9') continue;
+      const long tid = std::atol(e->d_name);
+      auto it = thread_stat_fds_.find(tid);
+      if (it != thread_stat_fds_.end()) {
+        now.emplace(tid, it->second);
+        thread_stat_fds_.erase(it);
+      } else {
+        const int fd = ::open((dir + "/" + e->d_name + "/stat").c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd >= 0) now.emplace(tid, fd);
+      }
+    }
+    ::closedir(d);
+    for (const auto& [tid, fd] : thread_stat_fds_) ::close(fd);
+    thread_stat_fds_ = std::move(now);
+    for (const auto& [tid, fd] : thread_stat_fds_) {
+      char buf[512];
+      const ssize_t n = ::pread(fd, buf, sizeof(buf) - 1, 0);
+      if (n <= 0) continue;
+      buf[n] = '\0';
+      const char* close = std::strrchr(buf, ')');
+      if (close && close[1] == ' ' && (close[2] == 'R' || close[2] == 'D')) return false;
+    }
+    return true;
+  }
+  DIR* d = ::opendir("/proc");
+  if (!d) return threads_idle(pid_);
+  bool idle = true;
+  int seen = 0;
+  while (const dirent* e = ::readdir(d)) {
+    if (e->d_name[0] < '0' || e->d_name[0] > '9') continue;
+    char state = 0;
+    long pgrp = 0;
+    if (!read_stat(std::string("/proc/") + e->d_name + "/stat", state, pgrp) || pgrp != pid_) continue;
+    ++seen;
+    if (state == 'Z') continue;
+    if (idle && !threads_idle(std::atol(e->d_name))) idle = false;
+  }
+  ::closedir(d);
+  if (processes) *processes = seen;
+  return idle;
 }
 
 std::string FirmwareProcess::log_tail(int lines) const {

@@ -7,6 +7,7 @@
 
 #include <sys/types.h>
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,9 +16,12 @@ namespace quadcosim::sitl {
 
 class FirmwareProcess {
  public:
-  /// Starts argv (argv[0] the program) in `work_dir` with output to `log_path`. Throws
-  /// std::runtime_error naming the program when it cannot.
-  FirmwareProcess(const std::vector<std::string>& argv, const std::string& work_dir, const std::string& log_path);
+  /// Starts argv (argv[0] the program) in `work_dir` with output to `log_path`, its environment this
+  /// process's with the NAME=VALUE entries of `env` added (replacing any of the same name); with
+  /// `cpu` >= 0 it (and what it starts) runs on that CPU only. Throws std::runtime_error naming the
+  /// program when it cannot.
+  FirmwareProcess(const std::vector<std::string>& argv, const std::string& work_dir, const std::string& log_path,
+                  const std::vector<std::string>& env = {}, int cpu = -1);
   ~FirmwareProcess();
   FirmwareProcess(const FirmwareProcess&) = delete;
   FirmwareProcess& operator=(const FirmwareProcess&) = delete;
@@ -28,6 +32,11 @@ class FirmwareProcess {
   std::optional<std::string> ended();
   /// Ends the process group: SIGTERM, up to grace_s, then SIGKILL; reaps. Idempotent.
   void stop(double grace_s = 1.0);
+  /// True when no thread of the firmware is running or waiting on the disk (every one asleep, waiting
+  /// for time, input or a lock), read from /proc: its own threads, or with `whole_group` those of every
+  /// process of its group (the shell of a start-up script and the commands it runs). The number of
+  /// processes seen in the group, when asked. A process that is gone counts as idle.
+  bool idle(bool whole_group, int* processes = nullptr) const;
   /// The last `lines` lines of the log (for error messages).
   std::string log_tail(int lines = 8) const;
   const std::string& log_path() const { return log_path_; }
@@ -35,6 +44,7 @@ class FirmwareProcess {
  private:
   pid_t pid_ = -1;
   std::optional<std::string> end_;
+  mutable std::map<long, int> thread_stat_fds_;  ///< its threads' /proc stat files, kept open (idle())
   std::string log_path_;
 };
 

@@ -32,6 +32,7 @@ T get(const std::vector<std::uint8_t>& p, std::size_t at) {
 std::optional<std::uint8_t> crc_extra(std::uint32_t msgid) {
   switch (msgid) {
     case kHeartbeat: return 50;
+    case kCommandInt: return 158;
     case kCommandLong: return 152;
     case kCommandAck: return 143;
     case kSetPositionTargetLocalNed: return 143;
@@ -129,6 +130,14 @@ std::vector<std::uint8_t> command_long(std::uint8_t target_system, std::uint8_t 
   Put p;
   for (float v : params) p(v);
   return p(command)(target_system)(target_component)(confirmation).b;
+}
+
+std::vector<std::uint8_t> command_int(std::uint8_t target_system, std::uint8_t target_component, std::uint16_t command,
+                                      std::uint8_t frame, const std::array<float, 4>& params, std::int32_t x,
+                                      std::int32_t y, float z) {
+  Put p;
+  for (float v : params) p(v);
+  return p(x)(y)(z)(command)(target_system)(target_component)(frame)(std::uint8_t{0})(std::uint8_t{0}).b;
 }
 
 std::vector<std::uint8_t> set_position_target_local_ned(std::uint32_t time_boot_ms, std::uint8_t target_system,

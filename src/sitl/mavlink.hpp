@@ -1,5 +1,5 @@
 // The few MAVLink 2 messages quadcosim sends to and reads from a firmware's GCS link (docs/sitl.md):
-// HEARTBEAT, COMMAND_LONG, COMMAND_ACK, SET_POSITION_TARGET_LOCAL_NED and STATUSTEXT, and the
+// HEARTBEAT, COMMAND_LONG, COMMAND_INT, COMMAND_ACK, SET_POSITION_TARGET_LOCAL_NED and STATUSTEXT, and the
 // simulator link's HIL_SENSOR, HIL_GPS and HIL_ACTUATOR_CONTROLS (PX4's simulator interface), framed as
 // MAVLink 2 (STX 0xFD, no signing) from the message definitions (common.xml): fields on the wire by
 // size, largest first, extensions after; trailing zero bytes of the payload left out; the checksum
@@ -20,6 +20,7 @@ inline constexpr std::uint8_t kStx = 0xFD;
 /// Message ids and their CRC_EXTRA.
 enum MessageId : std::uint32_t {
   kHeartbeat = 0,
+  kCommandInt = 75,
   kCommandLong = 76,
   kCommandAck = 77,
   kSetPositionTargetLocalNed = 84,
@@ -66,6 +67,11 @@ std::vector<std::uint8_t> heartbeat(std::uint8_t type, std::uint8_t autopilot, s
                                     std::uint32_t custom_mode, std::uint8_t system_status);
 std::vector<std::uint8_t> command_long(std::uint8_t target_system, std::uint8_t target_component, std::uint16_t command,
                                        std::uint8_t confirmation, const std::array<float, 7>& params);
+/// COMMAND_INT: params 1-4, x and y (a global position's latitude and longitude [degE7]), z (its
+/// altitude [m]) in `frame` (0: MAV_FRAME_GLOBAL, altitude above mean sea level).
+std::vector<std::uint8_t> command_int(std::uint8_t target_system, std::uint8_t target_component, std::uint16_t command,
+                                      std::uint8_t frame, const std::array<float, 4>& params, std::int32_t x,
+                                      std::int32_t y, float z);
 /// Position target in MAV_FRAME_LOCAL_NED (1) with only x, y, z (and yaw when `use_yaw`) used.
 std::vector<std::uint8_t> set_position_target_local_ned(std::uint32_t time_boot_ms, std::uint8_t target_system,
                                                         std::uint8_t target_component, float x, float y, float z,
@@ -120,6 +126,7 @@ std::pair<std::uint8_t, std::string> read_statustext(const Frame& f);
 inline constexpr std::uint16_t kCmdNavLand = 21;
 inline constexpr std::uint16_t kCmdNavTakeoff = 22;
 inline constexpr std::uint16_t kCmdDoSetMode = 176;
+inline constexpr std::uint16_t kCmdDoReposition = 192;
 inline constexpr std::uint16_t kCmdComponentArmDisarm = 400;
 
 }  // namespace quadcosim::sitl::mavlink

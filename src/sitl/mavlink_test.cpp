@@ -72,6 +72,20 @@ TEST(Mavlink, CrcExtrasFollowTheDefinitions) {
                                                                 {"uint8_t", "target_system"},
                                                                 {"uint8_t", "target_component"},
                                                                 {"uint8_t", "confirmation"}}));
+  EXPECT_EQ(*crc_extra(kCommandInt), extra_of("COMMAND_INT", {{"float", "param1"},
+                                                              {"float", "param2"},
+                                                              {"float", "param3"},
+                                                              {"float", "param4"},
+                                                              {"int32_t", "x"},
+                                                              {"int32_t", "y"},
+                                                              {"float", "z"},
+                                                              {"uint16_t", "command"},
+                                                              {"uint8_t", "target_system"},
+                                                              {"uint8_t", "target_component"},
+                                                              {"uint8_t", "frame"},
+                                                              {"uint8_t", "current"},
+                                                              {"uint8_t", "autocontinue"}}));
+  EXPECT_EQ(*crc_extra(kCommandInt), 158);
   EXPECT_EQ(*crc_extra(kCommandAck), extra_of("COMMAND_ACK", {{"uint16_t", "command"}, {"uint8_t", "result"}}));
   EXPECT_EQ(*crc_extra(kSetPositionTargetLocalNed),
             extra_of("SET_POSITION_TARGET_LOCAL_NED", {{"uint32_t", "time_boot_ms"},
@@ -257,6 +271,31 @@ TEST(Mavlink, HilMessagesLieWhereTheWireOrderPutsThem) {
   EXPECT_LT(cut->payload.size(), 81u);
   EXPECT_EQ(read_hil_actuator_controls(*cut).controls[3], 0.125f);
   EXPECT_EQ(read_hil_actuator_controls(*cut).mode, 0);
+}
+
+TEST(Mavlink, CommandIntPayloadAtItsOffsets) {
+  // DO_REPOSITION to 47.3977420 N, 8.5455940 E, 498 m: params at 0..15, x 16, y 20, z 24, command 28,
+  // targets 30 and 31, frame 32, current 33, autocontinue 34 (35 bytes, counted by hand).
+  const std::vector<std::uint8_t> p =
+      command_int(1, 1, kCmdDoReposition, 0, {-1.0f, 1.0f, 0.0f, 0.5f}, 473977420, 85455940, 498.0f);
+  ASSERT_EQ(p.size(), 35u);
+  float f;
+  std::memcpy(&f, &p[0], 4);
+  EXPECT_EQ(f, -1.0f);
+  std::memcpy(&f, &p[12], 4);
+  EXPECT_EQ(f, 0.5f);
+  std::int32_t x, y;
+  std::memcpy(&x, &p[16], 4);
+  std::memcpy(&y, &p[20], 4);
+  EXPECT_EQ(x, 473977420);
+  EXPECT_EQ(y, 85455940);
+  std::memcpy(&f, &p[24], 4);
+  EXPECT_EQ(f, 498.0f);
+  EXPECT_EQ(p[28], 192);
+  EXPECT_EQ(p[29], 0);
+  EXPECT_EQ(p[30], 1);
+  EXPECT_EQ(p[31], 1);
+  EXPECT_EQ(p[32], 0);
 }
 
 }  // namespace

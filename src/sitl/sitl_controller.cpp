@@ -23,6 +23,8 @@
 #include "sitl/frames.hpp"
 #include "sitl/json_codec.hpp"
 #include "sitl/mavlink.hpp"
+#include "sitl/px4.hpp"
+#include "sitl/px4_link.hpp"
 
 namespace quadcosim::sitl {
 
@@ -30,9 +32,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string>& output_list() {
+const std::vector<std::string>& output_list(bool px4 = false) {
   static const std::vector<std::string> names(std::begin(kSitlOutputs), std::end(kSitlOutputs));
-  return names;
+  static const std::vector<std::string> px4_names(std::begin(kPx4Outputs), std::end(kPx4Outputs));
+  return px4 ? px4_names : names;
 }
 
 // A socket on 127.0.0.1 at a port the system chooses; its port number.
@@ -136,9 +139,9 @@ SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicl
     : spec_(std::move(spec)),
       model_(vehicle),
       map_(motor_map_for(vehicle, spec_.pwm_min_us, spec_.pwm_max_us)),
-      reported_(control::ReportedOutputs::find(output_list())) {
-  if (spec_.firmware != "ardupilot") {
-    throw std::invalid_argument("firmware '" + spec_.firmware + "': only ardupilot is supported");
+      reported_(control::ReportedOutputs::find(output_list(spec_.firmware == "px4"))) {
+  if (spec_.firmware != "ardupilot" && spec_.firmware != "px4") {
+    throw std::invalid_argument("firmware '" + spec_.firmware + "': expected ardupilot or px4");
   }
   if (spec_.binary.empty()) throw std::invalid_argument("binary: missing; expected the SITL executable's path");
   if (::access(spec_.binary.c_str(), X_OK) != 0 || fs::is_directory(spec_.binary)) {
@@ -147,7 +150,22 @@ SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicl
   for (const std::string& p : spec_.params) {
     if (!fs::is_regular_file(p)) throw std::invalid_argument("params: no such file '" + p + "'");
   }
+  if (px4()) {
+    if (spec_.etc_dir.empty()) spec_.etc_dir = (fs::path(spec_.binary).parent_path().parent_path() / "etc").string();
+    if (!fs::is_directory(fs::path(spec_.etc_dir) / "init.d-posix")) {
+      throw std::invalid_argument("etc_dir '" + spec_.etc_dir +
+                                  "' is not PX4's ROMFS folder (no init.d-posix in it); expected the etc folder of "
+                                  "the px4_sitl build (build/px4_sitl_default/etc)");
+    }
+    for (const std::string& p : spec_.params) px4::read_param_file(p);  // throws naming the line
+  }
   for (const MissionItem& m : spec_.mission) {
+    if (px4()) {
+      if (m.kind == MissionItem::Kind::kMode && !px4::mode_numbers(m.mode)) {
+        throw std::invalid_argument("mission: mode '" + m.mode + "' is not one of PX4's " + px4::mode_names());
+      }
+      continue;
+    }
     if (m.kind == MissionItem::Kind::kMode && copter_mode_number(m.mode) < 0) {
       throw std::invalid_argument("mission: mode '" + m.mode +
                                   "' is not one of stabilize, acro, alt_hold, auto, guided, loiter, rtl, circle, "
@@ -159,10 +177,18 @@ SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicl
   }
 }
 
-SitlController::~SitlController() = default;
+SitlController::~SitlController() = default;  // Px4Link: sitl/px4_link.hpp
 
 std::unique_ptr<control::Controller> SitlController::clone() const {
   return std::make_unique<SitlController>(spec_, model_.params());
+}
+
+std::shared_ptr<SitlController> SitlController::with_site(const sensors::Geodetic& site,
+                                                          std::vector<std::string> added) const {
+  SitlSpec spec = spec_;
+  spec.site = site;
+  spec.added = std::move(added);
+  return std::make_shared<SitlController>(spec, model_.params());
 }
 
 std::string SitlController::set_parameters(std::span<const control::Setting> settings) {
@@ -172,10 +198,11 @@ std::string SitlController::set_parameters(std::span<const control::Setting> set
          "its params files)";
 }
 
-std::span<const std::string> SitlController::output_names() const { return output_list(); }
+std::span<const std::string> SitlController::output_names() const { return output_list(px4()); }
 
 void SitlController::reset() {
   link_.reset();
+  px4_.reset();
   counts_ = {};
   steps_ = 0;
   t_s_ = 0.0;
@@ -220,6 +247,10 @@ void SitlController::fail(const std::string& what) const {
   if (link_ && link_->process) {
     msg += fmt::format("; its log {}:{}", link_->process->log_path(), link_->process->log_tail());
     link_->temporary = false;  // keep the folder with the log
+  }
+  if (px4_ && px4_->process) {
+    msg += fmt::format("; its log {}:{}", px4_->process->log_path(), px4_->process->log_tail());
+    px4_->temporary = false;
   }
   throw control::ControllerFailure(msg);
 }
@@ -350,6 +381,10 @@ void SitlController::service_mavlink() {
 
 void SitlController::step(const control::Observation& obs, const control::Reference& reference, double dt_s,
                           control::ControllerOutput& out) {
+  if (px4()) {
+    step_px4(obs, reference, dt_s, out);
+    return;
+  }
   if (!link_) start();
   Link& l = *link_;
   const bool first = !l.have_pending;

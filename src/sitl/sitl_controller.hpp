@@ -1,6 +1,8 @@
 // A flight stack's SITL build as a quadcosim controller (docs/sitl.md): each control step hands the
 // firmware the vehicle's state as its sensors observed it (realism's noisy IMU included) and returns
-// the rotor speeds its next servo packet commands, in lockstep over ArduPilot's JSON physics protocol.
+// the rotor speeds its next servo packet commands, in lockstep over ArduPilot's JSON physics protocol;
+// or, for PX4 (firmware px4, sitl_px4.cpp), hands it HIL_SENSOR / HIL_GPS messages made of the IMU,
+// magnetometer, barometer and GNSS samples and flies its HIL_ACTUATOR_CONTROLS answer (px4.hpp).
 //
 // Step n (period dt): the state at t_n = n dt goes to the firmware as the answer to its pending servo
 // packet (frame c); the firmware runs its loop up to t_n and sends frame c + 1, whose PWM widths
@@ -20,6 +22,7 @@
 
 #include "control/controller.hpp"
 #include "model/quadrotor.hpp"
+#include "sensors/geodesy.hpp"
 #include "sitl/motor_map.hpp"
 
 namespace quadcosim::sitl {
@@ -32,7 +35,7 @@ struct MissionItem {
   enum class Kind { kMode, kArm, kDisarm, kTakeoff, kGoto };
   double at_s = 0.0;
   Kind kind = Kind::kMode;
-  std::string mode;                               ///< kMode: stabilize, alt_hold, guided, loiter, rtl, land, ...
+  std::string mode;  ///< kMode: ArduCopter's stabilize, alt_hold, guided, ...; PX4's posctl, takeoff, loiter, land, ...
   double takeoff_m = 0.0;                         ///< kTakeoff: height above home [m]
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< kGoto: position in quadcosim's world (ENU) [m]
 };
@@ -42,9 +45,9 @@ int copter_mode_number(const std::string& name);
 
 /// What a scenario's `controller: {sitl: {...}}` says (docs/scenarios.md).
 struct SitlSpec {
-  std::string firmware = "ardupilot";  ///< the flight stack (only ArduPilot's JSON protocol so far)
-  std::string binary;                  ///< the SITL executable (e.g. build/sitl/bin/arducopter)
-  std::vector<std::string> params;     ///< parameter files, applied in order as its defaults
+  std::string firmware = "ardupilot";  ///< the flight stack: ardupilot (JSON protocol) or px4 (simulator_mavlink)
+  std::string binary;                  ///< the SITL executable (build/sitl/bin/arducopter, build/px4_sitl_*/bin/px4)
+  std::vector<std::string> params;     ///< parameter files (NAME VALUE lines), applied in order
   std::string work_dir;                ///< where it runs (eeprom, logs); empty: a fresh temporary folder, removed after
   std::string home = "-35.363261,149.165230,584,0";  ///< --home: latitude, longitude [deg], altitude [m], yaw
   double start_timeout_s = 30.0;                     ///< [s] wall time for its first servo packet
@@ -54,7 +57,22 @@ struct SitlSpec {
   std::vector<std::string> args;                     ///< more command-line arguments for the firmware
   std::vector<MissionItem> mission;  ///< commands over MAVLink (none: the firmware flies as its params say)
   bool echo_statustext = false;      ///< print the firmware's STATUSTEXT messages on stderr as they come
+  // PX4 only.
+  std::string etc_dir;       ///< its ROMFS folder (default: the binary's build folder's etc, ../etc from bin/px4)
+  int airframe = 10016;      ///< PX4_SYS_AUTOSTART
+  int instance = -1;         ///< -i: its ports are 4560 + i (simulator), 18570 + i (GCS), ...; -1: the first free
+  double settle_ms = 200.0;  ///< [ms] wall time to wait, before each step, for its threads to sleep (0: no wait)
+  /// The CPU it runs on (its real-time threads then take turns in priority order, the same on every
+  /// run); -1: any; -2 (default): the last CPU this process may use.
+  int cpu = -2;
+  sensors::Geodetic site;  ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
+  std::vector<std::string> added;  ///< what the scenario lacked and was added for PX4 (noted when it starts)
 };
+
+/// The figures a PX4 controller records (out.<name>): frame counts its answers, u1..u4 are its outputs
+/// 1..4 (0..1), armed its HIL_ACTUATOR_CONTROLS' flag, mode its HEARTBEAT's custom_mode as seen at the
+/// last 0.25 s decision (-1 before the first), mission the index of the mission item in progress.
+inline constexpr const char* kPx4Outputs[] = {"frame", "u1", "u2", "u3", "u4", "armed", "mode", "mission"};
 
 /// The figures a SITL controller records (out.<name> in trajectory.csv).
 /// armed and mode are the firmware's last HEARTBEAT's; mission is the index of the mission item in progress.
@@ -83,6 +101,13 @@ class SitlController final : public control::Controller {
             control::ControllerOutput& out) override;
 
   const SitlSpec& spec() const { return spec_; }
+  bool px4() const { return spec_.firmware == "px4"; }
+  /// The same controller with `site` as its world origin on the Earth (PX4's takeoff and goto).
+  std::shared_ptr<SitlController> with_site(const sensors::Geodetic& site, std::vector<std::string> added = {}) const;
+  /// PX4's command line and environment (NAME=VALUE: PX4_SYS_AUTOSTART, PX4_PARAM_* of the vehicle's
+  /// parameters and then the files'), for `instance` and `work_dir`.
+  std::vector<std::string> px4_command_line(int instance, const std::string& work_dir) const;
+  std::vector<std::string> px4_environment() const;
   const MotorMap& motor_map() const { return map_; }
   /// The command line the firmware gets (its ports as given), for docs and tests.
   std::vector<std::string> command_line(int json_port, int mavlink_port, int rc_port,
@@ -91,16 +116,23 @@ class SitlController final : public control::Controller {
   std::string generated_params() const;
 
   struct Counts {
-    long long frames = 0;    ///< servo packets taken (one a step)
-    long long repeated = 0;  ///< packets dropped because their frame count was seen already
-    long long skipped = 0;   ///< frame counts that never came (a jump ahead)
-    long long foreign = 0;   ///< datagrams from another sender, dropped
+    long long frames = 0;     ///< servo packets taken (one a step)
+    long long repeated = 0;   ///< packets dropped because their frame count was seen already
+    long long skipped = 0;    ///< frame counts that never came (a jump ahead)
+    long long foreign = 0;    ///< datagrams from another sender, dropped
+    long long late = 0;       ///< PX4: answers to an earlier step (while it started), dropped
+    long long unsettled = 0;  ///< PX4: steps sent before its threads had all gone to sleep
   };
   const Counts& counts() const { return counts_; }
 
  private:
   struct Link;
+  struct Px4Link;
   void start();
+  void start_px4();
+  void step_px4(const control::Observation& observation, const control::Reference& reference, double dt_s,
+                control::ControllerOutput& out);
+  void service_px4_gcs();
   /// Reads the firmware's MAVLink messages; at decision times, advances the mission.
   void service_mavlink();
   [[noreturn]] void fail(const std::string& what) const;
@@ -109,6 +141,7 @@ class SitlController final : public control::Controller {
   model::Quadrotor model_;
   MotorMap map_;
   std::unique_ptr<Link> link_;
+  std::unique_ptr<Px4Link> px4_;
   Counts counts_;
   long long steps_ = 0;
   double t_s_ = 0.0;

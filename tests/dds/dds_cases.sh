@@ -36,8 +36,10 @@ PY
 identical_all() {
   local files=("trajectory.csv" "metrics.json" "run.mcap" "vehicles.csv") n=0
   for s in "$src"/scenarios/*/*.yaml; do
-    # scenarios/sitl fly ArduPilot's SITL build: only where QUADCOSIM_ARDUPILOT_SITL names it (docs/sitl.md).
-    [[ "$s" == */scenarios/sitl/* && -z "${QUADCOSIM_ARDUPILOT_SITL:-}" ]] && continue
+    # scenarios/sitl fly ArduPilot's SITL build, px4_* PX4's: only where QUADCOSIM_ARDUPILOT_SITL /
+    # QUADCOSIM_PX4_SITL names it (docs/sitl.md).
+    [[ "$s" == */scenarios/sitl/px4_* && -z "${QUADCOSIM_PX4_SITL:-}" ]] && continue
+    [[ "$s" == */scenarios/sitl/* && "$s" != */scenarios/sitl/px4_* && -z "${QUADCOSIM_ARDUPILOT_SITL:-}" ]] && continue
     local name; name="$(basename "$s" .yaml)"
     s="${s#"$src/"}"  # run from the source folder: metrics.json names the scenario as given
     cd "$src"

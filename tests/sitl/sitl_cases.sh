@@ -5,6 +5,7 @@
 # never a hang, with the firmware process gone afterwards.
 # Usage: sitl_cases.sh BINARY SOURCE_DIR CASE DOMAIN_ID FAKE_FIRMWARE
 bin="$1"; src="$2"; fake="$5"
+fake_px4="$(dirname "$fake")/fake_px4"  # built beside it (tests/sitl/fake_px4.cpp)
 # shellcheck source=../lib/process_case.sh
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/process_case.sh" "$3" "$4"
 here="$src/tests/sitl"
@@ -31,6 +32,16 @@ run() {
   local name="$1" want="$2" rc=0
   "$bin" run "$tmp/$name.yaml" --out "$tmp/$name" --judge none > "$tmp/$name.log" 2>&1 || rc=$?
   [ "$rc" -eq "$want" ] || fail "$name exited $rc, expected $want"
+}
+# px4_scenario BASE NAME [ARG...]: BASE's scenario flying the built test PX4 with ARGs, as $tmp/NAME.yaml
+# (its etc folder: one with an init.d-posix folder, as PX4's ROMFS has).
+px4_scenario() {
+  local base="$1" name="$2"; shift 2
+  local args=""
+  for a in "$@"; do args="$args\"$a\", "; done
+  mkdir -p "$tmp/etc/init.d-posix"
+  sed -e "s|binary: fake_px4.*|binary: $fake_px4|" -e "s|etc_dir: ETC.*|etc_dir: $tmp/etc|" -e "s|params: |params: $here/|" \
+      -e "s|    timeout_s: 2|    timeout_s: 2\n    args: [${args%, }]|" "$here/$base.yaml" > "$tmp/$name.yaml"
 }
 gone() {  # the firmware whose pid file is $1 no longer runs
   local pid; pid="$(cat "$1")"
@@ -269,8 +280,9 @@ PY
     grep -q "type: sitl" "$tmp/flag/scenario.yaml" && grep -q "binary: $fake" "$tmp/flag/scenario.yaml" ||
       fail "scenario.yaml does not say what flew: $(cat "$tmp/flag/scenario.yaml")"
     [ "$(tail -1 "$tmp/flag/trajectory.csv" | cut -d, -f4)" = "9.75240816326531" ] || fail "not the open-loop flight"
-    rc=0; "$bin" run "$tmp/paper.yaml" --controller "sitl:px4" --out "$tmp/x" > "$tmp/px4.log" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] && grep -q "expected sitl:ardupilot" "$tmp/px4.log" || fail "sitl:px4: exit $rc $(cat "$tmp/px4.log")"
+    rc=0; "$bin" run "$tmp/paper.yaml" --controller "sitl:betaflight" --out "$tmp/x" > "$tmp/bf.log" 2>&1 || rc=$?
+    [ "$rc" -eq 2 ] && grep -q "expected sitl:ardupilot\[:BINARY\] or sitl:px4" "$tmp/bf.log" ||
+      fail "sitl:betaflight: exit $rc $(cat "$tmp/bf.log")"
     # A file whose gains sit directly under controller: (the paper controller's, the older form): they
     # move into its paper: section, checked and unused, and the firmware flies.
     sed -e "s/duration_s: .*/duration_s: 1/" "$src/tests/faults/hover_gusts.yaml" > "$tmp/flat.yaml"
@@ -310,6 +322,243 @@ assert float(last["z"]) < 0.05 and last["out.armed"] == "0", (last["z"], last["o
 assert float(last["out.frame"]) - float(rows[0]["out.frame"]) == len(rows) - 1
 assert float(last["out.repeated"]) == 0 and float(last["out.skipped"]) == 0
 print(f"real mission: armed at {armed[0]:.2f} s, 10 m held within [{min(hold):.3f}, {max(hold):.3f}] m, "
+      f"waypoint within {max(wp):.3f} m, landed and disarmed at {armed[-1]:.2f} s; two runs identical")
+PY
+    ;;
+  px4_open_loop)
+    # The test PX4 holds every output at 0.4 (4800 rad/s) from 10 m: z(t) = 10 + a t^2 / 2 at every
+    # tick, answered from the first HIL_SENSOR, one answer a step; the sensors the file lacks added.
+    px4_scenario fake_px4_open_loop ol --fake-pid-file "$tmp/ol.pid"
+    run ol 0
+    gone "$tmp/ol.pid"
+    grep -q "added with their defaults (docs/sitl.md): environment.site, sensors.imu, sensors.magnetometer, sensors.barometer, sensors.gnss" \
+      "$tmp/ol.log" || fail "the added sensors are not noted: $(cat "$tmp/ol.log")"
+    "$py" - "$tmp/ol/trajectory.csv" <<'PY' || fail "open-loop height"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+kt, m, g = 2.06e-7, 1.96, 9.81
+w = 0.4000000059604645 * 12000  # the float 0.4 PX4's message carries, times omega_max
+a = 4 * kt * w * w / m - g
+assert len(rows) == 501, len(rows)
+worst = max(abs(float(r["z"]) - (10 + 0.5 * a * float(r["t"]) ** 2)) for r in rows)
+assert worst < 1e-9, f"height differs from the closed form by {worst} m"
+for k, r in enumerate(rows[:-1]):
+    assert float(r["out.frame"]) == k + 1, (k, r["out.frame"])
+    assert all(float(r[f"w{i}"]) == w for i in range(1, 5)) or k == 0, (k, [r[f"w{i}"] for i in range(1, 5)])
+    assert r["out.u1"] == "0.4000000059604645" and r["out.armed"] == "1", r
+assert all(float(r["x"]) == 3 and float(r["y"]) == 4 for r in rows)
+print(f"px4 open loop: z(2 s) = {float(rows[-1]['z']):.9f} m, closed form {10 + 2 * a:.9f} m, worst {worst:.1e} m")
+PY
+    ;;
+  px4_sensors)
+    # What reaches the test PX4, in PX4's units, against formulas written here: the open-loop flight
+    # above at (3, 4) east/north of PX4's home with nearly noiseless sensors. HIL_SENSOR every step at
+    # time (n + 1) 4 ms; the specific force -4 k_t w^2 / m on FRD z; the magnetometer's field in gauss
+    # in the body FRD frame (nose east) at 50 Hz; the standard atmosphere's pressure in hPa at
+    # 488 m + z at 50 Hz; HIL_GPS at 10 Hz with latitude and longitude in degE7 from the radii of
+    # curvature of the WGS-84 ellipsoid, altitude in mm, vertical speed in cm/s.
+    px4_scenario fake_px4_open_loop se --fake-record "$tmp/received.txt"
+    cat >> "$tmp/se.yaml" <<'YAML'
+environment:
+  site: {latitude_deg: 47.397742, longitude_deg: 8.545594, altitude_m: 488}
+sensors:
+  imu: {gyro_noise_density_rad_s_sqrt_hz: 1.0e-7, accel_noise_density_m_s2_sqrt_hz: 1.0e-7}
+  magnetometer: {rate_hz: 50, field_uT: 48.24, inclination_deg: 63.16, declination_deg: 3.41, noise_sigma_uT: 1.0e-6}
+  barometer: {rate_hz: 50, noise_sigma_Pa: 1.0e-6}
+  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6}
+YAML
+    run se 0
+    "$py" - "$tmp/received.txt" <<'PY' || fail "sensors"
+import math, sys
+S = [l.split() for l in open(sys.argv[1]) if l.startswith("S ")]
+G = [l.split() for l in open(sys.argv[1]) if l.startswith("G ")]
+kt, m, g0 = 2.06e-7, 1.96, 9.81
+w = 0.4000000059604645 * 12000
+acc = 4 * kt * w * w / m - g0
+z = lambda t: 10 + 0.5 * acc * t * t
+assert len(S) == 501, len(S)
+F, I, D = 48.24, math.radians(63.16), math.radians(3.41)
+north, east, down = F * math.cos(I) * math.cos(D), F * math.cos(I) * math.sin(D), F * math.sin(I)
+mag_frd = (east / 100, -north / 100, down / 100)  # nose east: x = east, y (right) = south, z = down; 100 uT = 1 G
+def isa_hpa(h):  # ISO 2533 troposphere, constants as published
+    T0, L, g, M, R = 288.15, 0.0065, 9.80665, 0.0289644, 8.31432
+    return 1013.25 * (1 - L * h / T0) ** (g * M / (R * L))
+worst = {"acc": 0, "mag": 0, "p": 0}
+for n, s in enumerate(S):
+    t_us, fields = int(s[1]), int(s[14])
+    assert t_us == (n + 1) * 4000, (n, t_us)
+    assert fields & 0x3F == 0x3F, fields
+    assert abs(float(s[4]) + 4 * kt * w * w / m) < 1e-4 or n == 0, s
+    worst["acc"] = max(worst["acc"], abs(float(s[4]) + 4 * kt * w * w / m)) if n else 0
+    has_mag, has_baro = fields & 0x1C0 == 0x1C0, fields & 0x1A00 == 0x1A00
+    assert has_mag == (n % 5 == 0) and has_baro == (n % 5 == 0), (n, hex(fields))
+    if has_mag:
+        d = max(abs(float(s[8 + i]) - mag_frd[i]) for i in range(3))
+        worst["mag"] = max(worst["mag"], d)
+        assert d < 2e-7, (n, s[8:11], mag_frd)
+    if has_baro:
+        t = 0.004 * n
+        p = isa_hpa(488 + z(t))
+        worst["p"] = max(worst["p"], abs(float(s[11]) - p))
+        assert abs(float(s[11]) - p) < 2e-4, (n, s[11], p)
+        assert abs(float(s[12]) - (488 + z(t))) < 0.01 and abs(float(s[13]) - (15 - 0.0065 * (488 + z(t)))) < 1e-3, s
+a, f = 6378137.0, 1 / 298.257223563
+e2 = f * (2 - f)
+lat0, lon0 = math.radians(47.397742), math.radians(8.545594)
+assert len(G) == 21, len(G)  # 0, 0.1, ..., 2.0 s
+for k, gps in enumerate(G):
+    t = 0.1 * k
+    h = 488 + z(t)
+    Mr = a * (1 - e2) / (1 - e2 * math.sin(lat0) ** 2) ** 1.5  # meridian radius of curvature
+    Nr = a / math.sqrt(1 - e2 * math.sin(lat0) ** 2)            # prime vertical
+    lat = math.degrees(lat0 + 4 / (Mr + h)) * 1e7
+    lon = math.degrees(lon0 + 3 / ((Nr + h) * math.cos(lat0))) * 1e7
+    assert abs(int(gps[2]) - lat) <= 1 and abs(int(gps[3]) - lon) <= 1, (k, gps[2:4], lat, lon)
+    assert abs(int(gps[4]) - h * 1000) <= 2, (k, gps[4], h)
+    assert int(gps[1]) == 1767225600 * 10**6 + round(t * 1e6), gps[1]
+    assert abs(int(gps[10]) - (-acc * t * 100)) <= 1, (k, gps[10], -acc * t * 100)  # vd [cm/s], down
+    assert gps[5] == "1" and gps[6] == "1" and gps[12] == "3" and gps[13] == "10", gps
+print(f"px4 sensors: 501 HIL_SENSOR, 21 HIL_GPS; worst accel {worst['acc']:.1e} m/s^2, field {worst['mag']:.1e} G, "
+      f"pressure {worst['p']:.1e} hPa; lat/lon within 1e-7 deg, alt within 2 mm")
+PY
+    ;;
+  px4_mission)
+    # A mission over the GCS link: take off (param7 = 488 + 3 m above mean sea level), arm (refused
+    # at 1.25 s, the test PX4 ready at 2 s, accepted at the 2.25 s decision), a reposition as COMMAND_INT to the degE7 of (2, 1)
+    # east/north at 493 m, land; the test PX4 hovers at the closed-form speed sqrt(m g / 4 k_t) through
+    # the MPC_THR_HOVER quadcosim passes it. Twice: the same bytes.
+    px4_scenario fake_px4_mission m1 --fake-record "$tmp/m1.txt"
+    px4_scenario fake_px4_mission m2
+    run m1 0
+    run m2 0
+    cmp "$tmp/m1/trajectory.csv" "$tmp/m2/trajectory.csv" || fail "two mission runs differ"
+    "$py" - "$tmp/m1/trajectory.csv" "$tmp/m1.txt" <<'PY' || fail "mission"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+C = [l.split() for l in open(sys.argv[2]) if l.startswith("C ")]
+at = lambda t: rows[round(t * 250)]
+assert all(r["out.frame"] == "0" for r in rows[:10]) and rows[10]["out.frame"] == "1", [r["out.frame"] for r in rows[:12]]
+armed = [float(r["t"]) for r in rows if r["out.armed"] == "1"]
+assert armed and 2.25 <= armed[0] < 2.26, armed[:1]  # refused at 1.25 s, accepted at 2.25 s
+takeoff = [c for c in C if c[1] == "22"]
+assert float(takeoff[0][4]) == 491.0, takeoff
+rep = [c for c in C if c[1] == "192"]
+assert len(rep) == 1, rep
+a, f = 6378137.0, 1 / 298.257223563
+e2 = f * (2 - f)
+lat0, lon0, h = math.radians(47.397742), math.radians(8.545594), 493.0
+Mr = a * (1 - e2) / (1 - e2 * math.sin(lat0) ** 2) ** 1.5
+Nr = a / math.sqrt(1 - e2 * math.sin(lat0) ** 2)
+lat = math.degrees(lat0 + 1 / (Mr + h)) * 1e7
+lon = math.degrees(lon0 + 2 / ((Nr + h) * math.cos(lat0))) * 1e7
+assert abs(int(rep[0][2]) - lat) <= 1 and abs(int(rep[0][3]) - lon) <= 1 and float(rep[0][4]) == 493.0, (rep, lat, lon)
+assert abs(float(at(7.5)["z"]) - 3) < 0.1, at(7.5)["z"]
+assert abs(float(at(13.5)["z"]) - 5) < 0.1, at(13.5)["z"]
+hold = [r for r in rows if 12 <= float(r["t"]) < 14]
+mean_w = sum(float(r["w1"]) for r in hold) / len(hold)
+hover = math.sqrt(1.96 * 9.81 / (4 * 2.06e-7))
+assert abs(mean_w / hover - 1) < 0.002, (mean_w, hover)
+last = rows[-1]
+assert float(last["z"]) == 0.0 and last["out.armed"] == "0", (last["z"], last["out.armed"])
+assert last["out.mode"] == str(4 << 16 | 6 << 24) and last["out.mission"] == "4", (last["out.mode"], last["out.mission"])
+print(f"px4 mission: armed at {armed[0]} s, takeoff to 491 m AMSL, reposition at degE7 ({rep[0][2]}, {rep[0][3]}), "
+      f"z(7.5) = {float(at(7.5)['z']):.3f}, z(13.5) = {float(at(13.5)['z']):.3f} m, hover {mean_w:.1f} rad/s "
+      f"(closed form {hover:.1f}), landed; two runs identical")
+PY
+    ;;
+  px4_dds)
+    # The test PX4's mission as the controller of `run --transport dds` (the controller process starts
+    # the test PX4; its magnetometer, barometer and GNSS samples cross DDS): the in-process bytes.
+    px4_scenario fake_px4_mission inproc
+    cp "$tmp/inproc.yaml" "$tmp/overdds.yaml"
+    run inproc 0
+    rc=0; "$bin" run "$tmp/overdds.yaml" --out "$tmp/overdds" --transport dds --judge none > "$tmp/overdds.log" 2>&1 || rc=$?
+    [ "$rc" -eq 0 ] || fail "over DDS: exit $rc $(tail -3 "$tmp/overdds.log")"
+    cmp "$tmp/inproc/trajectory.csv" "$tmp/overdds/trajectory.csv" || fail "over DDS the trajectory differs"
+    echo "px4 dds: the test PX4's mission over DDS, trajectory.csv identical to in-process"
+    ;;
+  px4_failures)
+    # Each a message naming the firmware, the step and its time, exit 5, the test PX4 gone.
+    px4_scenario fake_px4_open_loop die --fake-die-at 100 --fake-pid-file "$tmp/die.pid"
+    run die 5
+    grep -q "controller sitl (px4 .*fake_px4): step 99 (t = 0.3960 s): the firmware exited with status 3" "$tmp/die.log" ||
+      fail "dies: $(cat "$tmp/die.log")"
+    grep -q "fake px4: instance" "$tmp/die.log" || fail "the firmware's log is not quoted"
+    gone "$tmp/die.pid"
+    [ "$(($(wc -l < "$tmp/die/trajectory.csv") - 1))" -eq 99 ] || fail "expected the 99 ticks before"
+    px4_scenario fake_px4_open_loop hang --fake-hang-at 200 --fake-pid-file "$tmp/hang.pid"
+    start=$SECONDS
+    run hang 5
+    [ $((SECONDS - start)) -le 15 ] || fail "hang took $((SECONDS - start)) s"
+    grep -q "step 199 (t = 0.7960 s): no HIL_ACTUATOR_CONTROLS for 2 s (it went silent)" "$tmp/hang.log" ||
+      fail "hangs: $(cat "$tmp/hang.log")"
+    gone "$tmp/hang.pid"
+    px4_scenario fake_px4_open_loop crc --fake-bad-crc-at 50 --fake-pid-file "$tmp/crc.pid"
+    run crc 5
+    grep -q "step 49 (t = 0.1960 s): a frame with a wrong checksum on the simulator link" "$tmp/crc.log" ||
+      fail "bad crc: $(cat "$tmp/crc.log")"
+    gone "$tmp/crc.pid"
+    px4_scenario fake_px4_open_loop nls --fake-no-lockstep
+    run nls 5
+    grep -q "step 0 (t = 0.0000 s): HIL_ACTUATOR_CONTROLS without the lockstep flag" "$tmp/nls.log" ||
+      fail "no lockstep: $(cat "$tmp/nls.log")"
+    grep -h "controller sitl (px4" "$tmp/die.log" "$tmp/hang.log" "$tmp/crc.log" "$tmp/nls.log" | cut -c1-160
+    ;;
+  px4_spec)
+    # What a PX4 scenario must say, each refused with exit 2 naming the key.
+    mkdir -p "$tmp/etc/init.d-posix"
+    check() {  # check NAME PATTERN YAML: exit 2 and the pattern in the message
+      printf '%s\n' "$3" > "$tmp/$1.yaml"
+      local rc=0; env -u QUADCOSIM_PX4_SITL "$bin" run "$tmp/$1.yaml" --out "$tmp/x" > "$tmp/$1.log" 2>&1 || rc=$?
+      [ "$rc" -eq 2 ] && grep -q "$2" "$tmp/$1.log" || fail "$1: exit $rc $(cat "$tmp/$1.log")"
+      grep -o "error.*" "$tmp/$1.log" | head -1 | cut -c1-180
+    }
+    ok="binary: $fake_px4, etc_dir: $tmp/etc"
+    check nobin "controller.sitl.binary: missing.*QUADCOSIM_PX4_SITL" "controller: {sitl: {firmware: px4}}"
+    check etc "controller.sitl.etc_dir: .*not PX4's ROMFS folder" "controller: {sitl: {firmware: px4, binary: $fake_px4, etc_dir: $tmp}}"
+    check home "controller.sitl.home: is ArduPilot's" "controller: {sitl: {firmware: px4, $ok, home: '1,2,3,4'}}"
+    check cpu "controller.sitl.cpu: is PX4's" "controller: {sitl: {binary: $fake, cpu: 0}}"
+    check mode "mode: got 'guided', expected one of PX4's manual, altctl" "controller: {sitl: {firmware: px4, $ok, mission: [{mode: guided}]}}"
+    check elsewhere "sensors: has no magnetometer.*World Magnetic Model" \
+      "$(printf 'environment: {site: {latitude_deg: 10, longitude_deg: 20}}\ncontroller: {sitl: {firmware: px4, %s}}' "$ok")"
+    check quiet "sensors.magnetometer.noise_sigma_uT: missing: PX4 takes a sensor whose readings repeat" \
+      "$(printf 'sensors: {magnetometer: {field_uT: 48}}\ncontroller: {sitl: {firmware: px4, %s}}' "$ok")"
+    printf 'BAD LINE HERE\n' > "$tmp/bad.parm"
+    check parm "controller.sitl.params: .*bad.parm:1: expected NAME VALUE" "controller: {sitl: {firmware: px4, $ok, params: $tmp/bad.parm}}"
+    # --controller sitl:px4:BINARY flies a file written for another controller (its sensors added).
+    sed -e "/^controller:/,/^analysis:/{/^analysis:/!d}" "$here/fake_px4_open_loop.yaml" > "$tmp/paper.yaml"
+    sed -i "s|^analysis:|controller:\n  sitl:\n    firmware: px4\n    etc_dir: $tmp/etc\n    params: $here/fake_px4_open_loop.parm\nanalysis:|" "$tmp/paper.yaml"
+    rc=0; "$bin" run "$tmp/paper.yaml" --controller "sitl:px4:$fake_px4" --out "$tmp/flag" --judge none --no-plots \
+      > "$tmp/flag.log" 2>&1 || rc=$?
+    [ "$rc" -eq 0 ] || fail "--controller sitl:px4: exit $rc $(cat "$tmp/flag.log")"
+    grep -q "firmware: px4" "$tmp/flag/scenario.yaml" || fail "scenario.yaml: $(cat "$tmp/flag/scenario.yaml")"
+    echo "px4 spec: 8 refusals named; --controller sitl:px4:BINARY flew"
+    ;;
+  real_px4)
+    # PX4's SITL build (QUADCOSIM_PX4_SITL) flies scenarios/sitl/px4_takeoff_waypoint_land.yaml twice:
+    # the same trajectory.csv bytes; it holds 10 m, reaches the waypoint (10, 5, 10), lands and disarms.
+    if [ -z "${QUADCOSIM_PX4_SITL:-}" ] || [ ! -x "$QUADCOSIM_PX4_SITL" ]; then
+      echo "SKIPPED: QUADCOSIM_PX4_SITL does not name PX4's SITL executable (build/px4_sitl_default/bin/px4, docs/sitl.md)"
+      exit 77
+    fi
+    for n in r1 r2; do
+      rc=0; "$bin" run "$src/scenarios/sitl/px4_takeoff_waypoint_land.yaml" --out "$tmp/$n" --judge none \
+        > "$tmp/$n.log" 2>&1 || rc=$?
+      [ "$rc" -eq 0 ] || fail "$n exited $rc: $(tail -5 "$tmp/$n.log")"
+    done
+    cmp "$tmp/r1/trajectory.csv" "$tmp/r2/trajectory.csv" || fail "two runs of the same firmware differ"
+    "$py" - "$tmp/r1/trajectory.csv" <<'PY' || fail "mission"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+armed = [float(r["t"]) for r in rows if r["out.armed"] == "1"]
+assert armed, "never armed"
+hold = [float(r["z"]) for r in rows if 25 <= float(r["t"]) <= 40]
+assert min(hold) > 9.5 and max(hold) < 10.5, (min(hold), max(hold))
+wp = [math.hypot(float(r["x"]) - 10, float(r["y"]) - 5) for r in rows if 52 <= float(r["t"]) <= 65]
+assert max(wp) < 0.5, max(wp)
+last = rows[-1]
+assert float(last["z"]) < 0.05 and last["out.armed"] == "0", (last["z"], last["out.armed"])
+print(f"real px4: armed at {armed[0]:.2f} s, 10 m held within [{min(hold):.3f}, {max(hold):.3f}] m, "
       f"waypoint within {max(wp):.3f} m, landed and disarmed at {armed[-1]:.2f} s; two runs identical")
 PY
     ;;
