@@ -12,8 +12,8 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/python_host.hpp"
-#include "io/did_you_mean.hpp"
 #include "io/scenario_limits.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace {
 
@@ -49,7 +49,8 @@ std::string unknown_option(const CLI::App& app) {
     // Compared without their dashes: "--outt" is one letter from "--out", not one in six.
     std::vector<std::string> bare;
     for (const std::string& k : known) bare.push_back(k.substr(k.find_first_not_of('-')));
-    const std::string near = quadcosim::io::nearest_name(given.substr(dashes == std::string::npos ? 0 : dashes), bare);
+    const std::string near =
+        quadcosim::util::nearest_name(given.substr(dashes == std::string::npos ? 0 : dashes), bare);
     std::string hint;
     for (std::size_t i = 0; i < bare.size() && !near.empty(); ++i) {
       if (bare[i] == near) {

@@ -15,13 +15,13 @@
 #include "fmi/fmu_controller.hpp"
 #include "fmi/fmu_plant.hpp"
 #include "io/criteria_yaml.hpp"
-#include "io/did_you_mean.hpp"
 #include "io/realism_yaml.hpp"
 #include "io/scenario_limits.hpp"
 #include "io/sitl_yaml.hpp"
 #include "io/trajectory_yaml.hpp"
 #include "io/yaml_reader.hpp"
 #include "sim/topics.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace quadcosim::io {
 
@@ -166,7 +166,7 @@ void collect_parameters(YamlSection& s, const std::string& prefix, control::Cont
       for (const control::ParameterSpec* p : control::all_parameters(c)) known.emplace_back(p->name);
       s.fail(key, "unknown parameter '" + name + "' of the node or of controller type '" + std::string(c.type()) +
                       "' (see `quadcosim params --controller " + std::string(c.type()) + "`)" +
-                      did_you_mean(name, known));
+                      util::did_you_mean(name, known));
     }
     const control::ParameterValue value = parameter_value(s, key, *spec, n);
     if (node) {
@@ -480,7 +480,7 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
         std::vector<std::string> known;
         for (const auto& [name, topic] : by_name) known.push_back(name);
         per->fail(key, "unknown topic; expected motor_commands, Pose, Velocity, Imu, clock or controller_status" +
-                           did_you_mean(key, known));
+                           util::did_you_mean(key, known));
       }
       auto one = per->section(key);
       if (!one) per->fail(key, "expected a mapping with drop_probability and/or delay_ticks");
@@ -737,7 +737,7 @@ ControllerChoice parse_controller_choice(const std::string& text) {
           "got '" + text + "', expected a controller type (" + controllers::controller_type_names() +
           "), python:MODULE:CLASS (a class written in Python), fmu:PATH (an FMU) or sitl:ardupilot[:BINARY] (a "
           "firmware's SITL build)" +
-          did_you_mean(text, types));
+          util::did_you_mean(text, types));
     }
     c.target = text;
   }

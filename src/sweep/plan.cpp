@@ -10,8 +10,8 @@
 #include "control/controller_config.hpp"
 #include "control/parameters.hpp"
 #include "controllers/registry.hpp"
-#include "io/did_you_mean.hpp"
 #include "model/random.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace quadcosim::sweep {
 
@@ -211,7 +211,7 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
     throw PlanError("--vary " + v.spec + ": unknown parameter '" + v.name + "' (expected an alias (" + known_aliases() +
                     "), a vehicle field such as mass_kg or motor.tau_up_s, or a scenario key by its YAML path such as "
                     "controller.altitude.kp or initial.position_m[2]; see docs/sweeps.md)" +
-                    io::did_you_mean(v.name, known));
+                    util::did_you_mean(v.name, known));
   }
   Key k;
   k.path = v.name;
@@ -232,7 +232,7 @@ std::vector<Key> resolve(const Vary& v, const io::Scenario& nominal, const YAML:
       std::vector<std::string> known;
       for (const control::ParameterSpec* p : control::all_parameters(nominal.controller)) known.emplace_back(p->name);
       throw PlanError("--vary " + v.spec + ": unknown controller parameter '" + name + "' (see `quadcosim params`)" +
-                      io::did_you_mean(name, known));
+                      util::did_you_mean(name, known));
     }
     if (spec->is_choice()) {
       throw PlanError("--vary " + v.spec + ": controller parameter '" + name + "' is a choice, not a number");
