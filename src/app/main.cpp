@@ -11,8 +11,8 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/python_host.hpp"
 #include "io/scenario_limits.hpp"
+#include "python/embedded/python_host.hpp"
 #include "util/did_you_mean.hpp"
 
 namespace {
@@ -157,11 +157,11 @@ int main(int argc, char** argv) {
   }
   // A scenario's `controller: {python: ...}` resolves through the embedded Python (started on first
   // use only).
-  install_python_controllers();
+  quadcosim::embedded_python::install_python_controllers();
   for (const Subcommand& c : commands) {
     if (*c.cli) {
       const int code = run_guarded(c.cli->get_name(), c.run);
-      python_at_exit();
+      quadcosim::embedded_python::python_at_exit();
       return code;
     }
   }
