@@ -175,9 +175,6 @@ struct FlagRule {
 /// for the first rule whose flag was given to `command` and does not act. Call it from the command's
 /// parse_complete_callback, once every flag is parsed and before anything runs.
 void refuse_idle_flags(const CLI::App& command, std::initializer_list<FlagRule> rules);
-/// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
-/// existing ones are used as they are. 0, or 2 after printing why not.
-int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);
 /// `quadcosim sweep` (sweep_command.cpp, on the sweep library src/sweep/, docs/sweeps.md): runs of a
 /// scenario with varied keys and seeded noise; `sweep rerun DIR I --out RUN` flies run I again with
 /// the outputs of `run`; `sweep merge OUT DIR...` joins shards. Exit 0 when at least min_pass_rate of
