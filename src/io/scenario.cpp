@@ -330,38 +330,6 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
 
 }  // namespace
 
-const char* to_string(CriteriaSet set) { return set == CriteriaSet::kSpec ? "spec" : "paper"; }
-
-const char* to_string(Judge judge) {
-  switch (judge) {
-    case Judge::kSpec: return "spec";
-    case Judge::kPaper: return "paper";
-    case Judge::kNone: return "none";
-  }
-  return "?";
-}
-
-const std::vector<std::string>& judge_names() {
-  static const std::vector<std::string> names = {"spec", "paper", "none"};
-  return names;
-}
-
-std::optional<Judge> parse_judge(const std::string& name) {
-  for (Judge j : {Judge::kSpec, Judge::kPaper, Judge::kNone}) {
-    if (name == to_string(j)) return j;
-  }
-  return std::nullopt;
-}
-
-bool has_criteria(const Scenario& sc, CriteriaSet set) {
-  const auto any = [&](const std::vector<Criterion>& criteria) {
-    return std::any_of(criteria.begin(), criteria.end(), [&](const Criterion& c) { return c.set == set; });
-  };
-  return std::any_of(sc.steps.begin(), sc.steps.end(), [&](const StepSpec& s) { return any(s.criteria); }) ||
-         (sc.hold && any(sc.hold->criteria)) || (sc.limits && any(sc.limits->criteria)) ||
-         (sc.tracking && any(sc.tracking->criteria));
-}
-
 const std::vector<std::string>& hold_figure_names() {
   static const std::vector<std::string> names = {"max_horizontal_error_m", "rms_horizontal_error_m",
                                                  "max_vertical_error_m"};
