@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "controllers/registry.hpp"
+#include "hosts/bench.hpp"
 #include "hosts/node_options.hpp"
 #include "hosts/recorder_process.hpp"
 #include "hosts/topic_process.hpp"
@@ -175,9 +176,6 @@ struct FlagRule {
 /// for the first rule whose flag was given to `command` and does not act. Call it from the command's
 /// parse_complete_callback, once every flag is parsed and before anything runs.
 void refuse_idle_flags(const CLI::App& command, std::initializer_list<FlagRule> rules);
-/// For `run --keystore`: creates the keystore (for ROS_DOMAIN_ID) and each enclave that is missing;
-/// existing ones are used as they are. 0, or 2 after printing why not.
-int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves);
 /// `quadcosim sweep` (sweep_command.cpp, on the sweep library src/sweep/, docs/sweeps.md): runs of a
 /// scenario with varied keys and seeded noise; `sweep rerun DIR I --out RUN` flies run I again with
 /// the outputs of `run`; `sweep merge OUT DIR...` joins shards. Exit 0 when at least min_pass_rate of
@@ -265,15 +263,7 @@ struct CompareOptions {
 CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& options);
 int compare_command(const CompareOptions& options);
 
-struct BenchOptions {
-  bool json = false;           ///< one JSON object on stdout (else the same, indented)
-  bool quick = false;          ///< short runs and small searches (a smoke test, not figures)
-  std::string only;            ///< one part: inproc, dds, realtime, swarm_inproc, swarm_dds ("" all)
-  double seconds = 0.0;        ///< > 0: simulated seconds of the inproc / dds part (e.g. for callgrind)
-  std::string scenario;        ///< single-vehicle scenario (default: scenarios/paper/altitude_step.yaml)
-  std::string swarm_scenario;  ///< swarm scenario (default: scenarios/swarm/grid_takeoff.yaml)
-  int rt_priority = 50;        ///< realtime part: also measure with the controller under SCHED_FIFO (0: not)
-};
+using BenchOptions = hosts::BenchOptions;
 /// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
 int bench_command(const BenchOptions& options);
 CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& options);

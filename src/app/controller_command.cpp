@@ -10,10 +10,10 @@
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
 #include "app/foxglove_cli.hpp"
-#include "app/python_host.hpp"
 #include "hosts/controller_process.hpp"
 #include "hosts/swarm_nodes.hpp"
 #include "io/scenario.hpp"
+#include "python/embedded/python_host.hpp"
 
 namespace quadcosim::app {
 
@@ -105,7 +105,8 @@ int controller_command(const ControllerCommandOptions& o) {
     // Replaces the controller only: the node's setpoints, safety and trajectory stay the scenario's.
     const std::filesystem::path folder =
         o.scenario.empty() ? std::filesystem::path() : std::filesystem::path(o.scenario).parent_path();
-    sc.controller.controller = make_python_controller(o.python, folder, sc.controller.vehicle, "--python");
+    sc.controller.controller =
+        embedded_python::make_python_controller(o.python, folder, sc.controller.vehicle, "--python");
     sc.controller_fmu.reset();
   }
   if (o.swarm.vehicles > 0) {
@@ -114,7 +115,7 @@ int controller_command(const ControllerCommandOptions& o) {
     }
     return hosts::run_controller_swarm(o, std::move(sc));
   }
-  return hosts::run_controller_process(o, std::move(sc), python_thread_host());
+  return hosts::run_controller_process(o, std::move(sc), embedded_python::python_thread_host());
 }
 
 }  // namespace quadcosim::app

@@ -11,9 +11,9 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/python_host.hpp"
-#include "io/did_you_mean.hpp"
 #include "io/scenario_limits.hpp"
+#include "python/embedded/python_host.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace {
 
@@ -49,7 +49,8 @@ std::string unknown_option(const CLI::App& app) {
     // Compared without their dashes: "--outt" is one letter from "--out", not one in six.
     std::vector<std::string> bare;
     for (const std::string& k : known) bare.push_back(k.substr(k.find_first_not_of('-')));
-    const std::string near = quadcosim::io::nearest_name(given.substr(dashes == std::string::npos ? 0 : dashes), bare);
+    const std::string near =
+        quadcosim::util::nearest_name(given.substr(dashes == std::string::npos ? 0 : dashes), bare);
     std::string hint;
     for (std::size_t i = 0; i < bare.size() && !near.empty(); ++i) {
       if (bare[i] == near) {
@@ -156,11 +157,11 @@ int main(int argc, char** argv) {
   }
   // A scenario's `controller: {python: ...}` resolves through the embedded Python (started on first
   // use only).
-  install_python_controllers();
+  quadcosim::embedded_python::install_python_controllers();
   for (const Subcommand& c : commands) {
     if (*c.cli) {
       const int code = run_guarded(c.cli->get_name(), c.run);
-      python_at_exit();
+      quadcosim::embedded_python::python_at_exit();
       return code;
     }
   }

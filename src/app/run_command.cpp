@@ -1,4 +1,6 @@
-// `quadcosim run SCENARIO --out DIR`
+// `quadcosim run SCENARIO --out DIR`: the flags, the output folder, the provenance and the verdict
+// line; flying is hosts/inprocess_run.hpp's (in process), hosts/dds_run.hpp's (over DDS) and
+// swarm_run.cpp's (swarms).
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
@@ -18,8 +20,7 @@
 #include "app/foxglove_cli.hpp"
 #include "app/swarm.hpp"
 #include "control/care.hpp"
-#include "dds/peer_pairing.hpp"
-#include "hosts/child_process.hpp"
+#include "hosts/dds_run.hpp"
 #include "hosts/inprocess_run.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
@@ -63,64 +64,6 @@ class Progress {
   std::chrono::steady_clock::time_point start_, last_;
   bool shown_ = false;
 };
-
-// Plant and controller as two child processes over DDS, lockstep; the plant records. Both are ended
-// on every path (ChildProcess), also on Ctrl-C.
-int run_over_dds(const RunOptions& opt, const std::string& csv_path) {
-  hosts::install_stop_handlers();
-  const std::string self = hosts::self_executable();
-  const std::string timeout = fmt::format("{}", opt.timeout_s);
-  // The plant owns simulated time, so in lockstep it applies the schedule through the controller's
-  // parameter services, each change before its tick; in real time the controller applies it itself.
-  std::vector<std::string> controller_args = {self, "controller", "--scenario", opt.scenario};
-  if (!opt.controller.empty()) {
-    controller_args.push_back("--controller");
-    controller_args.push_back(opt.controller);
-  }
-  const std::string mcap_path = (std::filesystem::path(csv_path).parent_path() / "run.mcap").string();
-  // A fresh pairing token for this run's two children: each takes the other's writers only
-  // (dds/peer_pairing.hpp), so a stranger's message or a controller left from another run bends nothing.
-  setenv(dds::kPairTokenEnv, dds::new_pair_token().c_str(), 1);
-  std::vector<std::string> plant_args = {self,     "plant",  "--scenario", opt.scenario, "--record",
-                                         csv_path, "--mcap", mcap_path,    "--timeout",  timeout};
-  if (!opt.realtime) {
-    controller_args.push_back("--no-schedule");
-    for (std::string a : {"--schedule-via", "/attitude_controller"}) plant_args.push_back(a);
-  }
-  if (!opt.keystore.empty()) {
-    // Secured: each node in its own enclave of the keystore, strategy Enforce (the children inherit
-    // the environment; an enclave override would put both in one enclave, so it is dropped).
-    const std::string keystore = fs::absolute(opt.keystore).string();
-    const std::string plant_enclave = "/quadcosim/plant", controller_enclave = "/quadcosim/controller";
-    if (int rc = prepare_keystore_for_run(keystore, {plant_enclave, controller_enclave}); rc != 0) return rc;
-    setenv("ROS_SECURITY_ENABLE", "true", 1);
-    setenv("ROS_SECURITY_STRATEGY", "Enforce", 1);
-    setenv("ROS_SECURITY_KEYSTORE", keystore.c_str(), 1);
-    unsetenv("ROS_SECURITY_ENCLAVE_OVERRIDE");
-    controller_args.insert(controller_args.end(), {"--enclave", controller_enclave});
-    plant_args.insert(plant_args.end(), {"--enclave", plant_enclave});
-  }
-  if (opt.realtime) {
-    for (std::string a : {"--realtime", "--rate-factor"}) controller_args.push_back(a);
-    controller_args.push_back(fmt::format("{}", opt.rate_factor));
-    for (std::string a : {"--realtime", "--wait-for-controller", "--rate-factor"}) plant_args.push_back(a);
-    plant_args.push_back(fmt::format("{}", opt.rate_factor));
-  }
-  if (opt.pin) hosts::pin_apart(plant_args, controller_args);
-  for (const std::string& a : io::limit_arguments(io::limits())) {  // the child processes read the same files
-    plant_args.push_back(a);
-    controller_args.push_back(a);
-  }
-  if (!opt.foxglove.listen.empty()) {  // the plant serves: it has every topic, and the simulated time
-    plant_args.insert(plant_args.end(), {"--foxglove", opt.foxglove.listen, "--foxglove-queue-kib",
-                                         fmt::format("{}", opt.foxglove.queue_kib)});
-    for (const std::string& origin : opt.foxglove.allow_origins)
-      plant_args.insert(plant_args.end(), {"--foxglove-allow-origin", origin});
-    if (opt.foxglove.linger_s > 0)
-      plant_args.insert(plant_args.end(), {"--foxglove-linger", fmt::format("{}", opt.foxglove.linger_s)});
-  }
-  return hosts::run_plant_and_controller(plant_args, controller_args);
-}
 
 // The run's provenance record (io/provenance.hpp): made once, written into metadata.yaml, metrics.json
 // and (through them) the report and plots.
@@ -240,7 +183,15 @@ int run_command(const RunOptions& opt) {
     if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder, provenance);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {
-      const int rc = run_over_dds(opt, csv_path);
+      const int rc = hosts::run_over_dds({.scenario = opt.scenario,
+                                          .controller = opt.controller,
+                                          .realtime = opt.realtime,
+                                          .rate_factor = opt.rate_factor,
+                                          .timeout_s = opt.timeout_s,
+                                          .pin = opt.pin,
+                                          .keystore = opt.keystore,
+                                          .foxglove = opt.foxglove},
+                                         csv_path);
       io::add_provenance_to_bag_metadata(out, provenance);  // the plant wrote it: what ran, also when stopped
       if (rc != 0) return rc;
     } else {

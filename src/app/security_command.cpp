@@ -106,26 +106,4 @@ int security_command(const SecurityOptions& o) {
   return exit_code::kBadInput;
 }
 
-int prepare_keystore_for_run(const std::string& keystore, const std::vector<std::string>& enclaves) {
-  try {
-    if (!security::is_keystore(keystore)) {
-      const std::uint32_t domain = dds::read_ros_environment().domain_id;
-      security::create_keystore(keystore, domain);
-      std::cerr << fmt::format("run: created keystore {} for domain {}\n", keystore, domain);
-    }
-    for (const auto& name : enclaves) {
-      std::error_code ec;
-      if (fs::exists(security::enclave_dir(keystore, name) / "cert.pem", ec)) continue;  // kept as it is
-      security::EnclavePolicy policy;
-      policy.domain_id = dds::read_ros_environment().domain_id;
-      security::create_enclave(keystore, name, policy);
-      std::cerr << fmt::format("run: created enclave {} in {}\n", name, keystore);
-    }
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "error: run --keystore " << keystore << ": " << e.what() << '\n';
-    return exit_code::kBadInput;
-  }
-}
-
 }  // namespace quadcosim::app

@@ -1,6 +1,7 @@
 // `quadcosim sweep SCENARIO --runs N --seed S --vary KEY=DIST ... --out DIR` and its `rerun` and
-// `merge` subcommands: flags and console text only; drawing, running and summarising the runs is the
-// sweep library's (src/sweep/, docs/sweeps.md).
+// `merge` subcommands: flags, the sweep folder's files and console text; flying the runs and saying
+// the summary is hosts/sweep_runs.hpp's, drawing, running and summarising one run the sweep library's
+// (src/sweep/, docs/sweeps.md).
 #include <fmt/format.h>
 
 #include <unistd.h>
@@ -18,9 +19,9 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "app/sweep_progress.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
+#include "hosts/sweep_runs.hpp"
 #include "io/output_folder.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
@@ -31,58 +32,6 @@ namespace quadcosim::app {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Console summary: pass count, then per figure the runs that have it and the missing ones, and the
-// statistics of those that have it.
-void print_summary(const nlohmann::json& j, std::ostream& os) {
-  const int runs = j["runs"].get<int>();
-  const int passed = j["passed"].get<int>();
-  if (j.contains("partial")) {
-    const int finished = j["partial"]["finished"].get<int>();
-    os << fmt::format("sweep {}: interrupted: {} of {} runs finished; {} of them passed ({:.1f} %), seed {}\n",
-                      j["scenario"].get<std::string>(), finished, runs, passed,
-                      finished > 0 ? 100.0 * passed / finished : 0.0, j["seed"].get<std::uint64_t>());
-  } else if (j.value("judge", std::string("spec")) == "none") {
-    os << fmt::format("sweep {}: {} runs, figures only (--judge none: no verdict), seed {}\n",
-                      j["scenario"].get<std::string>(), runs, j["seed"].get<std::uint64_t>());
-  } else {
-    os << fmt::format("sweep {}: {} of {} runs passed ({:.1f} %) against {}, seed {}\n",
-                      j["scenario"].get<std::string>(), passed, runs, 100.0 * passed / runs,
-                      j.value("judge", std::string("spec")), j["seed"].get<std::uint64_t>());
-  }
-  int failed_runs = 0;
-  for (const auto& r : j["per_run"]) failed_runs += r.contains("error") ? 1 : 0;
-  if (failed_runs > 0)
-    os << fmt::format("  {} runs could not be flown (their error is in summary.json)\n", failed_runs);
-  os << fmt::format("  {:<36} {:>6} {:>7}  {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "figure", "count", "missing",
-                    "mean", "std", "min", "p50", "p95", "max");
-  for (const auto& [name, d] : j["figures"].items()) {
-    const auto count = d["count"].get<int>(), missing = d["missing"].get<int>();
-    if (count == 0) {
-      os << fmt::format("  {:<36} {:>6} {:>7}  (no run has this figure)\n", name, count, missing);
-      continue;
-    }
-    os << fmt::format("  {:<36} {:>6} {:>7}  {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g}\n", name,
-                      count, missing, d["mean"].get<double>(), d["std"].get<double>(), d["min"].get<double>(),
-                      d["p50"].get<double>(), d["p95"].get<double>(), d["max"].get<double>());
-  }
-}
-
-// A run whose controller failed makes the sweep exit as `run` would (5): the controller needs fixing
-// before its pass rate means anything. Otherwise 0 or 1 by the pass rate.
-int verdict(const nlohmann::json& j, double min_pass_rate) {
-  int controller_failures = 0;
-  for (const nlohmann::json& run : j.value("per_run", nlohmann::json::array())) {
-    if (run.value("error_cause", "") == "controller") ++controller_failures;
-  }
-  if (controller_failures > 0) {
-    std::cerr << fmt::format("sweep: the controller failed in {} run{} (their errors are above and in summary.json)\n",
-                             controller_failures, controller_failures == 1 ? "" : "s");
-    return exit_code::kControllerFailed;
-  }
-  return j["passed"].get<int>() >= sweep::passes_needed(min_pass_rate, j["runs"].get<int>()) ? exit_code::kOk
-                                                                                             : exit_code::kFailed;
-}
 
 std::string read_file(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -209,10 +158,10 @@ int merge_command(const SweepOptions& o) {
   if (fs::is_regular_file(fs::path(o.shard_dirs.front()) / sweep::kOriginFile))
     copy_output(fs::path(o.shard_dirs.front()) / sweep::kOriginFile, out / sweep::kOriginFile);
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
-  print_summary(summary, std::cout);
+  hosts::print_sweep_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " from " << o.shard_dirs.size() << " shards\n";
   if (o.plots && !(run_tool("plot_sweep.py", {o.out_dir}) && make_index(o.out_dir))) return exit_code::kOutput;
-  return verdict(summary, o.min_pass_rate);
+  return hosts::sweep_verdict(summary, o.min_pass_rate, std::cerr);
 }
 
 }  // namespace
@@ -335,8 +284,8 @@ int sweep_command(const SweepOptions& o) {
                                out.string());
       if (!o.shard.empty()) return exit_code::kOk;
       const nlohmann::json summary = nlohmann::json::parse(read_file(out / "summary.json"));
-      print_summary(summary, std::cout);
-      return verdict(summary, o.min_pass_rate);
+      hosts::print_sweep_summary(summary, std::cout);
+      return hosts::sweep_verdict(summary, o.min_pass_rate, std::cerr);
     }
   } else {
     // --force removes the runs the previous sweep's manifest lists; runs/ files no manifest lists
@@ -346,59 +295,20 @@ int sweep_command(const SweepOptions& o) {
     sweep::write_json(out / sweep::kOriginFile,
                       sweep::origin_json(sweep::origin_of(o.scenario, fs::current_path(), std::getenv("PYTHONPATH"))));
   }
-  fs::create_directories(out / "runs");
   const sweep::Keep keep = o.keep == "all"       ? sweep::Keep::kAll
                            : o.keep == "failing" ? sweep::Keep::kFailing
                                                  : sweep::Keep::kNone;
-  std::set<int> done;
-  for (const auto& r : per_run) done.insert(r.at("index").get<int>());
-  std::vector<int> indices;
-  for (const int i : sweep::shard_indices(plan.runs, shard, shards)) {
-    if (done.count(i) == 0) indices.push_back(i);
-  }
-  if (o.resume) {
-    std::cout << fmt::format("sweep {}: resuming in {}: {} runs finished, {} to run\n", plan.nominal.name, out.string(),
-                             done.size(), indices.size());
-  }
-  // Ctrl-C or SIGTERM: no new run starts, those under way finish, and the summary of the finished ones
-  // is written. Meanwhile the manifest lists what is written, at most a second late.
-  hosts::install_stop_handlers();
-  auto last_record = std::chrono::steady_clock::now();
-  int passed_before = 0;
-  for (const auto& r : per_run) passed_before += r.at("passed").get<bool>() ? 1 : 0;
-  std::optional<SweepProgress> progress;
-  if (o.progress && !indices.empty()) {
-    progress.emplace(plan.nominal.name, static_cast<int>(done.size() + indices.size()), static_cast<int>(done.size()),
-                     passed_before, o.progress_every_s);
-  }
-  sweep::RunControl control;
-  control.stop = [] { return hosts::stop_requested(); };
-  control.finished = [&](const sweep::RunResult& r) {
-    if (progress) progress->finished(r.passed);
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_record < std::chrono::seconds(1)) return;
-    last_record = now;
-    try {
-      folder->record("outputs");
-    } catch (const std::exception&) {
-      // A full disk, say: the manifest stays the last one written; the run's own write reports it.
-    }
-  };
-  const auto results = sweep::run_many(plan, indices, o.jobs, out / "runs", keep, control);
-  if (progress) progress->end();
-  for (const auto& r : results) {
-    if (!r.error.empty()) {
-      std::cerr << fmt::format("sweep: run {} (seed {}) failed: {}\n", r.sample.index, r.sample.seed, r.error);
-    }
-    per_run.push_back(sweep::per_run_json(plan, r));
-  }
-  std::sort(per_run.begin(), per_run.end(), [](const auto& a, const auto& b) {
-    return a.at("index").template get<int>() < b.at("index").template get<int>();
-  });
-  const bool interrupted = results.size() < indices.size();
+  const hosts::SweepRunsDone runs = hosts::fly_sweep_runs(plan, shard, shards, out,
+                                                          {.jobs = o.jobs,
+                                                           .keep = keep,
+                                                           .resume = o.resume,
+                                                           .progress = o.progress,
+                                                           .progress_every_s = o.progress_every_s},
+                                                          *folder, per_run, std::cout, std::cerr);
+  const bool interrupted = runs.interrupted;
   const std::string resume_hint = "finish it with the same command and --resume instead of --force";
   if (!o.shard.empty()) {
-    const std::size_t expected = done.size() + indices.size();
+    const std::size_t expected = runs.expected;
     int passed = 0;
     for (const auto& r : per_run) passed += r.at("passed").get<bool>() ? 1 : 0;
     nlohmann::json j = {{"header", header}, {"shard", o.shard}, {"per_run", per_run}};
@@ -419,18 +329,18 @@ int sweep_command(const SweepOptions& o) {
   if (interrupted) {
     const nlohmann::json summary = sweep::partial_summary_json(header, std::move(per_run));
     sweep::write_json(out / "summary.json", summary);
-    print_summary(summary, std::cout);
+    hosts::print_sweep_summary(summary, std::cout);
     std::cout << fmt::format("wrote {} (partial) and runs/NNNN/metrics.json; {}\n", (out / "summary.json").string(),
                              resume_hint);
     return exit_code::kInterrupted;
   }
   const nlohmann::json summary = sweep::summary_json(header, std::move(per_run));
   sweep::write_json(out / "summary.json", summary);  // a write failure: exit 3 naming the file (run_guarded)
-  print_summary(summary, std::cout);
+  hosts::print_sweep_summary(summary, std::cout);
   std::cout << "wrote " << (out / "summary.json").string() << " and runs/NNNN/metrics.json\n";
   if (hosts::stop_requested()) return exit_code::kInterrupted;  // every run finished; no plots
   if (o.plots && !(run_tool("plot_sweep.py", {o.out_dir}) && make_index(o.out_dir))) return exit_code::kOutput;
-  return verdict(summary, o.min_pass_rate);
+  return hosts::sweep_verdict(summary, o.min_pass_rate, std::cerr);
 }
 
 }  // namespace quadcosim::app

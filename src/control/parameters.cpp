@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "io/did_you_mean.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace quadcosim::control {
 
@@ -20,7 +20,7 @@ std::string unknown_parameter(std::string_view name) { return "unknown parameter
 std::string unknown_parameter(std::string_view name, std::span<const ParameterSpec> known) {
   std::vector<std::string> names;
   for (const ParameterSpec& s : known) names.emplace_back(s.name);
-  return unknown_parameter(name) + io::did_you_mean(name, names);
+  return unknown_parameter(name) + util::did_you_mean(name, names);
 }
 
 std::string check_value(const ParameterSpec& spec, const ParameterValue& value) {

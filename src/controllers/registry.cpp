@@ -2,7 +2,7 @@
 
 #include <array>
 
-#include "io/did_you_mean.hpp"
+#include "util/did_you_mean.hpp"
 
 #include "controllers/example_pd/example_pd_controller.hpp"
 #include "controllers/paper/paper_controller.hpp"
@@ -55,7 +55,7 @@ control::ControllerConfig make_config(std::string_view type, const model::Vehicl
     std::vector<std::string> known;
     for (const auto& k : kTypes) known.emplace_back(k.name);
     throw std::invalid_argument("unknown controller type '" + std::string(type) +
-                                "' (known: " + controller_type_names() + ")" + io::did_you_mean(type, known));
+                                "' (known: " + controller_type_names() + ")" + util::did_you_mean(type, known));
   }
   control::ControllerConfig c;
   c.vehicle = vehicle;

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "io/did_you_mean.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace quadcosim::fmi {
 
@@ -99,7 +99,7 @@ void check_signal_keys(const std::map<std::string, std::vector<std::string>, std
     }
     if (!known) {
       throw MappingError(section + "." + name,
-                         "unknown signal; expected one of " + expected + io::did_you_mean(name, signal_names));
+                         "unknown signal; expected one of " + expected + util::did_you_mean(name, signal_names));
     }
   }
 }

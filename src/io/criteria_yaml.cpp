@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "io/did_you_mean.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace quadcosim::io {
 
@@ -29,7 +29,7 @@ std::optional<std::vector<Criterion>> read_criteria_sets(YamlSection& block, con
     if (!out) out.emplace();
     for (const std::string& fig : bands->keys()) {
       if (std::find(known.begin(), known.end(), fig) == known.end()) {
-        bands->fail(fig, "unknown " + what + " (expected " + or_list(known) + ")" + did_you_mean(fig, known));
+        bands->fail(fig, "unknown " + what + " (expected " + or_list(known) + ")" + util::did_you_mean(fig, known));
       }
       const auto [min, max] = bands->bounds(fig);
       out->push_back(Criterion{fig, min, max, set});

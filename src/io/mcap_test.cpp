@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "dds/entity.hpp"
 #include "dds/participant.hpp"
 #include "dds/ros_types.hpp"
 #include "io/mcap_test_messages.hpp"
@@ -45,15 +46,15 @@ std::vector<std::uint8_t> cyclone_cdr(const dds::Participant& p, const T& m) {
   const dds::TypeOps* ops = dds::type_ops(typeid(T));
   EXPECT_NE(ops, nullptr);
   const std::string name = "rt/mcap_test/cdr" + std::to_string(++topic_count);
-  const dds_entity_t topic =
-      dds::check(dds_create_topic(p.handle(), ops->descriptor, name.c_str(), nullptr, nullptr), "dds_create_topic");
-  dds_qos_t* qos = dds::ros_qos(10, true);
-  const dds_entity_t reader = dds::check(dds_create_reader(p.handle(), topic, qos, nullptr), "dds_create_reader");
-  const dds_entity_t writer = dds::check(dds_create_writer(p.handle(), topic, qos, nullptr), "dds_create_writer");
-  dds_delete_qos(qos);
+  // Owned (dds/entity.hpp): deleted on every way out, a failed check's exception included.
+  const dds::Entity topic(
+      dds::check(dds_create_topic(p.handle(), ops->descriptor, name.c_str(), nullptr, nullptr), "dds_create_topic"));
+  const dds::Qos qos(dds::ros_qos(10, true));
+  const dds::Entity reader(dds::check(dds_create_reader(p.handle(), topic, qos.get(), nullptr), "dds_create_reader"));
+  const dds::Entity writer(dds::check(dds_create_writer(p.handle(), topic, qos.get(), nullptr), "dds_create_writer"));
   dds::check(ops->write(writer, &m), "dds_write");
 
-  const dds_entity_t ws = dds::check(dds_create_waitset(p.handle()), "dds_create_waitset");
+  const dds::Entity ws(dds::check(dds_create_waitset(p.handle()), "dds_create_waitset"));
   const dds_entity_t cond = dds::check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
   dds::check(dds_waitset_attach(ws, cond, 0), "dds_waitset_attach");
   EXPECT_GT(dds_waitset_wait(ws, nullptr, 0, DDS_SECS(5)), 0) << "no sample arrived on " << name;
@@ -66,10 +67,6 @@ std::vector<std::uint8_t> cyclone_cdr(const dds::Participant& p, const T& m) {
     ddsi_serdata_to_ser(sd, 0, bytes.size(), bytes.data());
     ddsi_serdata_unref(sd);
   }
-  dds_delete(ws);
-  dds_delete(writer);
-  dds_delete(reader);
-  dds_delete(topic);
   return bytes;
 }
 

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <sstream>
 
-#include "io/did_you_mean.hpp"
 #include "io/scenario_limits.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace quadcosim::io {
 
@@ -163,7 +163,7 @@ std::string YamlSection::choice(const std::string& key, const std::string& fallb
     for (const auto& c : choices) {
       if (n.Scalar() == c) return c;
     }
-    fail(key, "got " + shown(n) + ", " + expected + did_you_mean(n.Scalar(), choices));
+    fail(key, "got " + shown(n) + ", " + expected + util::did_you_mean(n.Scalar(), choices));
   }
   fail(key, "got " + shown(n) + ", " + expected);
 }
@@ -224,7 +224,7 @@ void YamlSection::reject_unknown_keys() const {
     if (used_.count(key)) continue;
     std::vector<std::string> known(used_.begin(), used_.end());
     known.insert(known.end(), asked_.begin(), asked_.end());
-    fail(key, "unknown key" + did_you_mean(key, known));
+    fail(key, "unknown key" + util::did_you_mean(key, known));
   }
 }
 

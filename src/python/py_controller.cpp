@@ -21,10 +21,10 @@
 #include <vector>
 
 #include "control/controller_config.hpp"
-#include "io/did_you_mean.hpp"
 #include "io/scenario.hpp"
 #include "model/mixer.hpp"
 #include "sensors/readings.hpp"
+#include "util/did_you_mean.hpp"
 
 namespace py = pybind11;
 
@@ -969,7 +969,7 @@ std::shared_ptr<PyController> make_python_controller(py::object given, const mod
           } else {
             throw std::invalid_argument(
                 fmt::format("{}: unknown key '{}'; expected default, unit, min, max, description{}", where, field,
-                            io::did_you_mean(field, {"default", "unit", "min", "max", "description"})));
+                            util::did_you_mean(field, {"default", "unit", "min", "max", "description"})));
           }
         }
         if (!s.contains("default")) {

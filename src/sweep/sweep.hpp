@@ -88,6 +88,14 @@ RunResult rerun(const Plan& plan, int index, const std::filesystem::path& dir);
 /// factors, vehicle: designed vs flown}.
 nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, const RunResult& r);
 
+/// A run's figures by their name in summary.json: "<channel>.<figure>" for steps ("roll.overshoot_pct";
+/// a second step of the same channel "roll#2.overshoot_pct"), "hold.<figure>", "saturation.<figure>"
+/// (every run has them), "tracking.<figure>"; null when the run could not be flown or lacks the figure.
+std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunResult& r, const io::Scenario& sc);
+
+/// A sample's varied values as a JSON object, by key.
+nlohmann::json values_json(const Sample& s);
+
 /// What identifies a sweep: scenario, scenario_file, seed, runs, sampler, runs_per_point, vary.
 /// Shards of one sweep have equal headers.
 nlohmann::json header_json(const Plan& plan);

@@ -17,7 +17,7 @@
 #include "control/controller.hpp"
 #include "python/py_controller.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::embedded_python {
 
 /// `prototype` flown in a child process. Takes the GIL to fork (the caller must not hold it).
 std::unique_ptr<control::Controller> isolate_python_controller(std::shared_ptr<const python::PyController> prototype);
@@ -25,4 +25,4 @@ std::unique_ptr<control::Controller> isolate_python_controller(std::shared_ptr<c
 /// True unless QUADCOSIM_PYTHON_IN_PROCESS is set to 1.
 bool python_controllers_isolated();
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::embedded_python

@@ -1,9 +1,9 @@
-// The CLI built without Python (app/python_host.hpp): --python says so; a scenario's
+// The CLI built without Python (python/embedded/python_host.hpp): --python says so; a scenario's
 // `controller: {python: ...}` gets io's own error (no hook installed).
-#include "app/python_host.hpp"
 #include "io/scenario.hpp"
+#include "python/embedded/python_host.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::embedded_python {
 
 bool built_with_python() { return false; }
 
@@ -23,4 +23,4 @@ std::function<void(const std::function<void()>&)> python_thread_host() { return 
 
 void python_at_exit() {}
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::embedded_python

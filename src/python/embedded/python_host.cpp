@@ -1,4 +1,4 @@
-// The CLI's embedded Python (app/python_host.hpp), built when Python and pybind11 are found.
+// The CLI's embedded Python (python/embedded/python_host.hpp), built when Python and pybind11 are found.
 #include <pybind11/embed.h>
 #include <pybind11/numpy.h>
 
@@ -8,16 +8,16 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/python/isolated_controller.hpp"
-#include "app/python_host.hpp"
 #include "io/provenance.hpp"
 #include "io/scenario.hpp"
+#include "python/embedded/isolated_controller.hpp"
+#include "python/embedded/python_host.hpp"
 #include "python/py_controller.hpp"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
 
-namespace quadcosim::app {
+namespace quadcosim::embedded_python {
 
 namespace {
 
@@ -47,7 +47,7 @@ void start_python() {
 }
 
 /// The controller `target` names, flown in a process of its own unless QUADCOSIM_PYTHON_IN_PROCESS=1
-/// (app/python/isolated_controller.hpp).
+/// (python/embedded/isolated_controller.hpp).
 std::shared_ptr<const control::Controller> load(const std::string& target, const fs::path& folder,
                                                 const model::VehicleParams& vehicle) {
   start_python();
@@ -108,4 +108,4 @@ void python_at_exit() {
   }
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::embedded_python

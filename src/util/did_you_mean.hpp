@@ -1,7 +1,7 @@
 // The nearest known name to a misspelt one, for "unknown key" errors ("simulaton: unknown key; did
-// you mean 'simulation'?"). Header-only so that the libraries below io (control, controllers, fmi)
-// use it without linking io; Debian packages no small C++ edit-distance library, and the few lines
-// here are all it takes.
+// you mean 'simulation'?"). Header-only and below every layer, so that control, controllers, fmi
+// and io use it without linking each other; Debian packages no small C++ edit-distance library, and
+// the few lines here are all it takes.
 #pragma once
 
 #include <algorithm>
@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-namespace quadcosim::io {
+namespace quadcosim::util {
 
 /// Edits (insert, delete, replace, swap of two neighbours) turning `a` into `b`, letters compared
 /// without case: a swap counts one, as typing `q_angel` for `q_angle` is one slip.
@@ -65,4 +65,4 @@ inline std::string did_you_mean(std::string_view given, const std::vector<std::s
   return near.empty() ? std::string() : "; did you mean '" + near + "'?";
 }
 
-}  // namespace quadcosim::io
+}  // namespace quadcosim::util

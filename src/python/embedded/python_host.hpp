@@ -11,7 +11,7 @@
 #include "control/controller.hpp"
 #include "model/vehicle_params.hpp"
 
-namespace quadcosim::app {
+namespace quadcosim::embedded_python {
 
 /// True when this quadcosim was built with Python.
 bool built_with_python();
@@ -44,4 +44,4 @@ std::function<void(const std::function<void()>&)> python_thread_host();
 /// meet a finalized interpreter.
 void python_at_exit();
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::embedded_python

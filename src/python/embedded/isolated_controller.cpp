@@ -1,5 +1,5 @@
-// app/python/isolated_controller.hpp: a Python controller served by a child process.
-#include "app/python/isolated_controller.hpp"
+// python/embedded/isolated_controller.hpp: a Python controller served by a child process.
+#include "python/embedded/isolated_controller.hpp"
 
 #include <fmt/format.h>
 #include <pybind11/pybind11.h>
@@ -18,7 +18,7 @@
 
 namespace py = pybind11;
 
-namespace quadcosim::app {
+namespace quadcosim::embedded_python {
 
 namespace {
 
@@ -321,4 +321,4 @@ bool python_controllers_isolated() {
   return v == nullptr || std::strcmp(v, "1") != 0;
 }
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::embedded_python

@@ -1,4 +1,4 @@
-// `quadcosim sweep`'s progress line on stderr (sweep_command.cpp).
+// `quadcosim sweep`'s progress line on stderr (hosts/sweep_runs.cpp).
 #pragma once
 
 #include <fmt/format.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <utility>
 
-namespace quadcosim::app {
+namespace quadcosim::hosts {
 
 /// Progress of the runs on stderr: on a terminal one line rewritten in place (at most 5 times a second),
 /// else a line every `every_s` seconds (each run with 0); always the last count. Only stderr: what
@@ -80,4 +80,4 @@ class SweepProgress {
   std::chrono::steady_clock::time_point start_, last_;
 };
 
-}  // namespace quadcosim::app
+}  // namespace quadcosim::hosts
