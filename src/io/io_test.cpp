@@ -1494,6 +1494,39 @@ TEST(SaturationTest, TimesAreTicksTimesThePeriod) {
       "");
 }
 
+// Motors off on the ground (a disarmed flight stack before take-off and after landing) is no
+// saturation: rows with every command at omega_min, z = 0 and vz = 0 are not counted; the same
+// commands in the air (z > 0) or while the vehicle moves are.
+TEST(SaturationTest, MotorsOffOnTheGroundAreNoSaturation) {
+  Scenario sc;
+  Series s;
+  // 100 Hz, 401 rows: on the ground with the motors off (rows 0..99), flying (100..299: every rotor at
+  // omega_max on rows 150..159), falling with the motors off (300..349, z > 0), resting with the
+  // motors off again (350..400).
+  for (int k = 0; k <= 400; ++k) {
+    const bool off = k < 100 || k >= 300;
+    const bool max = k >= 150 && k < 160;
+    const double w = off ? 0.0 : max ? sc.vehicle.motor.omega_max_rad_s : 5000.0;
+    s.t_s.push_back(k / 100.0);
+    for (int r = 1; r <= 4; ++r) {
+      s.append("sat" + std::to_string(r), off || max ? 1.0 : 0.0);
+      s.append("cmd" + std::to_string(r), w);
+    }
+    s.append("tilt_sat", 0.0);
+    s.append("z", k < 100 || k >= 350 ? 0.0 : 1.0);
+    s.append("vz", k < 100 || k >= 350 ? 0.0 : -0.5);
+    s.append("U1", 0.0);
+    s.append("safety", 0.0);
+    s.append("watchdog", 0.0);
+  }
+  const auto r = evaluate_saturation(sc, s);
+  ASSERT_TRUE(r.has_value());
+  // Rows 150..159 (0.10 s) and 300..349 (0.50 s): 0.60 s; the 100 + 51 resting rows are not counted.
+  EXPECT_NEAR(r->saturated_s(), 0.60, 1e-9);
+  for (int k = 1; k <= 4; ++k) EXPECT_NEAR(r->rotor_saturated_s(k), 0.60, 1e-9);
+  EXPECT_NEAR(r->figures.at("command_at_limit_s"), 0.60, 1e-9);
+}
+
 TEST(SaturationTest, LimitsAreCriteria) {
   TempDir dir;
   Scenario sc = load_scenario(dir.write("limits.yaml", R"(simulation: {duration_s: 3}
@@ -1531,11 +1564,13 @@ TEST(SaturationTest, ColumnsRoundTripThroughTrajectoryCsv) {
   const std::string path = dir.file("trajectory.csv");
   {
     TrajectoryWriter w(path);
+    model::State airborne;  // in the air: motors at omega_min on the ground would be motors off
+    airborne.p_W.z() = 1.0;
     for (int k = 0; k < 20; ++k) {
       ControlColumns c = ControlColumns::none();
       c.rotor_saturated = {false, k < 5, false, k >= 15};
       c.tilt_saturated = k == 7;
-      w.write(k / 100.0, model::State{}, Eigen::Vector4d::Zero(), c);
+      w.write(k / 100.0, airborne, Eigen::Vector4d::Zero(), c);
     }
     w.close();
   }

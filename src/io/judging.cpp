@@ -152,11 +152,25 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
   const bool measured =
       command[0] && command[1] && command[2] && command[3] && safety != v.end() && watchdog != v.end() && u1 != v.end();
   const model::MotorParams& motor = sc.vehicle.motor;
+  // A vehicle at rest on the ground (z = 0 and vz = 0: the ground contact holds it) with every rotor
+  // commanded to omega_min has its motors off (a flight stack disarmed before take-off or after
+  // landing, a controller waiting to start): no controller pushes against a limit there, so those
+  // rows count as no saturation.
+  const auto z = v.find("z"), vz = v.find("vz");
+  const bool rests_known = command[0] && command[1] && command[2] && command[3] && z != v.end() && vz != v.end();
+  const auto motors_off_on_ground = [&](std::size_t i) {
+    if (!rests_known || z->second[i] > 0.0 || vz->second[i] != 0.0) return false;
+    for (int k = 0; k < 4; ++k) {
+      if ((*command[k])[i] > motor.omega_min_rad_s) return false;
+    }
+    return true;
+  };
   double at_limit = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double dt = period(i);
+    const bool off = motors_off_on_ground(i);
     bool some = false;
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < 4 && !off; ++k) {
       if (v.at("sat" + std::to_string(k + 1))[i] != 0.0) {
         rotor[k] += dt;
         some = true;
@@ -166,7 +180,7 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
     if (v.at("tilt_sat")[i] != 0.0) tilt += dt;
     // The controller's commands only: not before its first step (no U1 yet), nor the stale-data safety
     // command or the plant watchdog's (they stop the rotors on purpose).
-    if (measured && std::isfinite(u1->second[i]) && safety->second[i] == 0.0 && watchdog->second[i] == 0.0) {
+    if (measured && !off && std::isfinite(u1->second[i]) && safety->second[i] == 0.0 && watchdog->second[i] == 0.0) {
       for (int k = 0; k < 4; ++k) {
         const double w = (*command[k])[i];
         if (w >= motor.omega_max_rad_s || w <= motor.omega_min_rad_s) {

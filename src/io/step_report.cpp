@@ -26,7 +26,7 @@ const std::vector<std::string>& series_columns() {
   static const std::vector<std::string> names = {"x",     "y",     "z",        "roll",      "pitch",   "yaw",  "x_des",
                                                  "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "sat1", "sat2",
                                                  "sat3",  "sat4",  "tilt_sat", "U1",        "att_err", "cmd1", "cmd2",
-                                                 "cmd3",  "cmd4",  "safety",   "watchdog"};
+                                                 "cmd3",  "cmd4",  "safety",   "watchdog",  "vz"};
   return names;
 }
 

@@ -172,8 +172,9 @@ void SeriesRecorder::add(double t_s, const model::State& x, const Eigen::Vector4
                         command[2],
                         command[3],
                         c.safety ? 1.0 : 0.0,
-                        watchdog ? 1.0 : 0.0};
-  static_assert(std::size(row) == 25);
+                        watchdog ? 1.0 : 0.0,
+                        x.v_W.z()};
+  static_assert(std::size(row) == 26);
   assert(columns_.size() == std::size(row));
   series_.t_s.push_back(t_s);
   for (std::size_t i = 0; i < columns_.size(); ++i) columns_[i]->push_back(row[i]);
