@@ -183,6 +183,42 @@ assert all(abs(r[6] + f) < 1e-9 and r[4] == 0 and r[5] == 0 for r in rec), rec[:
 print(f"imu noise: the firmware received gyro sigma {sd:.4f} rad/s (expected 0.02), accel z {rec[-1][6]:.6f} (expected {-f:.6f})")
 PY
     ;;
+  faults)
+    # A rotor fault reaches the ArduPilot-side test firmware in the IMU it is sent, as numbers it did
+    # not make: rotor 1 (the nose of the '+' layout, clockwise) at 75 % from 1 s under its open-loop
+    # law (every motor at 1400 us: 4800 rad/s). The accelerometer reads -4 k_t w^2 / m on FRD z
+    # before and -3.75 k_t w^2 / m from the fault's tick on; the gyro 0 before and, from rest after it,
+    # tau / I (t - 1 s): about FRD y -l dF / I_yy (nose down), about z (k_m / k_t) dF / I_zz (less of a
+    # clockwise rotor's reaction), none about x (the Euler coupling adds 0.43 (t - 1)^3 rad/s there).
+    scenario fake_open_loop fa --fake-record "$tmp/received.txt"
+    printf 'faults:\n  - {at_s: 1, rotor: 1, efficiency: 0.75}\n' >> "$tmp/fa.yaml"
+    run fa 0
+    "$py" - "$tmp/received.txt" <<'PY' || fail "a rotor fault reaching the test firmware"
+import sys
+rec = [list(map(float, l.split())) for l in open(sys.argv[1])]
+kt, m, l, km_over_kt = 2.06e-7, 1.96, 0.59, 0.5e-3  # Table 1
+I = (0.0149, 0.0153, 0.0532)
+F = kt * 4800.0 ** 2
+dF = 0.25 * F
+tau_frd = (0.0, -l * dF, km_over_kt * dF)  # FLU (0, l dF, -k dF) -> FRD (x, -y, -z)
+assert len(rec) >= 800, len(rec)
+seen = 0
+for r in rec:
+    t, gyro, az = r[0], r[1:4], r[6]
+    if t < 1 - 1e-9:
+        assert abs(az + 4 * F / m) < 1e-9 and max(abs(g) for g in gyro) == 0, r
+    else:
+        assert abs(az + 3.75 * F / m) < 1e-9, (t, az, -3.75 * F / m)
+        if t < 1.1:
+            for i in range(3):
+                want = tau_frd[i] / I[i] * (t - 1)
+                assert abs(gyro[i] - want) < 2e-3 * abs(want) + 5e-4, (t, i, gyro[i], want)
+            seen += 1
+assert seen >= 40, seen
+print(f"faults: the firmware's accel z {-4 * F / m:.6f} -> {-3.75 * F / m:.6f} m/s^2 at 1 s, gyro y "
+      f"{tau_frd[1] / I[1]:.3f} rad/s^2 and z {tau_frd[2] / I[2]:.5f} rad/s^2 times (t - 1 s) ({seen} frames)")
+PY
+    ;;
   firmware_panics)
     # A PANIC line in the firmware's log while it starts ends the run at once (start_timeout_s is 30 s),
     # quoting it; and a scenario given by a relative path passes absolute parameter paths.
