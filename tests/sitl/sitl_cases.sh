@@ -183,6 +183,42 @@ assert all(abs(r[6] + f) < 1e-9 and r[4] == 0 and r[5] == 0 for r in rec), rec[:
 print(f"imu noise: the firmware received gyro sigma {sd:.4f} rad/s (expected 0.02), accel z {rec[-1][6]:.6f} (expected {-f:.6f})")
 PY
     ;;
+  faults)
+    # A rotor fault reaches the ArduPilot-side test firmware in the IMU it is sent, as numbers it did
+    # not make: rotor 1 (the nose of the '+' layout, clockwise) at 75 % from 1 s under its open-loop
+    # law (every motor at 1400 us: 4800 rad/s). The accelerometer reads -4 k_t w^2 / m on FRD z
+    # before and -3.75 k_t w^2 / m from the fault's tick on; the gyro 0 before and, from rest after it,
+    # tau / I (t - 1 s): about FRD y -l dF / I_yy (nose down), about z (k_m / k_t) dF / I_zz (less of a
+    # clockwise rotor's reaction), none about x (the Euler coupling adds 0.43 (t - 1)^3 rad/s there).
+    scenario fake_open_loop fa --fake-record "$tmp/received.txt"
+    printf 'faults:\n  - {at_s: 1, rotor: 1, efficiency: 0.75}\n' >> "$tmp/fa.yaml"
+    run fa 0
+    "$py" - "$tmp/received.txt" <<'PY' || fail "a rotor fault reaching the test firmware"
+import sys
+rec = [list(map(float, l.split())) for l in open(sys.argv[1])]
+kt, m, l, km_over_kt = 2.06e-7, 1.96, 0.59, 0.5e-3  # Table 1
+I = (0.0149, 0.0153, 0.0532)
+F = kt * 4800.0 ** 2
+dF = 0.25 * F
+tau_frd = (0.0, -l * dF, km_over_kt * dF)  # FLU (0, l dF, -k dF) -> FRD (x, -y, -z)
+assert len(rec) >= 800, len(rec)
+seen = 0
+for r in rec:
+    t, gyro, az = r[0], r[1:4], r[6]
+    if t < 1 - 1e-9:
+        assert abs(az + 4 * F / m) < 1e-9 and max(abs(g) for g in gyro) == 0, r
+    else:
+        assert abs(az + 3.75 * F / m) < 1e-9, (t, az, -3.75 * F / m)
+        if t < 1.1:
+            for i in range(3):
+                want = tau_frd[i] / I[i] * (t - 1)
+                assert abs(gyro[i] - want) < 2e-3 * abs(want) + 5e-4, (t, i, gyro[i], want)
+            seen += 1
+assert seen >= 40, seen
+print(f"faults: the firmware's accel z {-4 * F / m:.6f} -> {-3.75 * F / m:.6f} m/s^2 at 1 s, gyro y "
+      f"{tau_frd[1] / I[1]:.3f} rad/s^2 and z {tau_frd[2] / I[2]:.5f} rad/s^2 times (t - 1 s) ({seen} frames)")
+PY
+    ;;
   firmware_panics)
     # A PANIC line in the firmware's log while it starts ends the run at once (start_timeout_s is 30 s),
     # quoting it; and a scenario given by a relative path passes absolute parameter paths.
@@ -503,6 +539,68 @@ PY
     grep -q "step 0 (t = 0.0000 s): HIL_ACTUATOR_CONTROLS without the lockstep flag" "$tmp/nls.log" ||
       fail "no lockstep: $(cat "$tmp/nls.log")"
     grep -h "controller sitl (px4" "$tmp/die.log" "$tmp/hang.log" "$tmp/crc.log" "$tmp/nls.log" | cut -c1-160
+    ;;
+  px4_faults)
+    # Faults and realism of the scenario reach the test PX4, in numbers it did not make: rotor 1 (the
+    # nose of the '+' layout, clockwise) at 75 % efficiency from 1 s under the open-loop law (every output 0.4, 4800
+    # rad/s) and a GNSS without a fix before 0.5 s. The accelerometer reads -4 k_t w^2 / m on FRD z
+    # before the fault and -(3 + 0.75) k_t w^2 / m from the fault's tick on (the body-frame specific
+    # force does not depend on the tilt; no drag); the gyro reads 0 before it and, after it, the rates
+    # the lost quarter of rotor 1's thrust and torque drive from rest: tau / I (t - 1 s), none about FRD x,
+    # about y l dF / I_yy (nose down: negative) and about z (k_m / k_t) dF / I_zz (less of a clockwise
+    # rotor's reaction: positive); HIL_GPS says no fix (fix_type 1, no satellites) at 0, 0.1, ..., 0.4 s and a 3D fix
+    # with 10 satellites from 0.5 s on, every 0.1 s.
+    px4_scenario fake_px4_open_loop fa --fake-record "$tmp/faults.txt"
+    cat >> "$tmp/fa.yaml" <<'YAML'
+environment:
+  site: {latitude_deg: 47.397742, longitude_deg: 8.545594, altitude_m: 488}
+sensors:
+  imu: {gyro_noise_density_rad_s_sqrt_hz: 1.0e-7, accel_noise_density_m_s2_sqrt_hz: 1.0e-7}
+  magnetometer: {rate_hz: 50, field_uT: 48.24, inclination_deg: 63.16, declination_deg: 3.41, noise_sigma_uT: 1.0e-6}
+  barometer: {rate_hz: 50, noise_sigma_Pa: 1.0e-6}
+  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6, fix_after_s: 0.5}
+faults:
+  - {at_s: 1, rotor: 1, efficiency: 0.75}
+YAML
+    run fa 0
+    "$py" - "$tmp/faults.txt" <<'PY' || fail "faults reaching the test PX4"
+import math, sys
+S = [l.split() for l in open(sys.argv[1]) if l.startswith("S ")]
+G = [l.split() for l in open(sys.argv[1]) if l.startswith("G ")]
+kt, m, l, km_over_kt = 2.06e-7, 1.96, 0.59, 0.5e-3  # Table 1: k_t, mass, arm, k_m / k_t
+Ixx, Iyy, Izz = 0.0149, 0.0153, 0.0532
+w = 0.4000000059604645 * 12000
+F = kt * w * w                       # one rotor's thrust at 4800 rad/s
+dF = 0.25 * F                        # what rotor 1 lost
+tau_frd = (0.0, -l * dF, km_over_kt * dF)  # '+': rotor 1 at (l, 0) in FLU; FLU (0, l dF, -k dF) -> FRD (x, -y, -z)
+I = (Ixx, Iyy, Izz)
+assert len(S) == 501, len(S)
+n_fault = None
+worst = [0.0, 0.0]
+for n, s in enumerate(S[1:], 1):
+    t = 0.004 * n                    # the state's time (HIL_SENSOR n is stamped (n + 1) 4 ms)
+    az, gyro = float(s[4]), [float(v) for v in s[5:8]]
+    if t < 1 - 1e-9:
+        assert abs(az + 4 * F / m) < 1e-4, (n, az, -4 * F / m)
+        assert max(abs(g) for g in gyro) < 1e-4, (n, gyro)
+    else:
+        assert abs(az + 3.75 * F / m) < 1e-4, (n, az, -3.75 * F / m)
+        if t < 1.1:                  # from rest: rate = tau / I (t - 1); the Euler coupling (I_yy - I_zz) q r / I_xx
+                                     # adds 0.43 (t - 1)^3 rad/s about x, under 5e-4 by 1.1 s
+            for i in range(3):
+                want = tau_frd[i] / I[i] * (t - 1)
+                worst[0] = max(worst[0], abs(gyro[i] - want))
+                assert abs(gyro[i] - want) < 2e-3 * abs(want) + 5e-4, (n, i, gyro[i], want)
+    if t > 1 - 1e-9 and n_fault is None:
+        n_fault = n
+assert len(G) == 21, len(G)
+nofix = [k for k, gps in enumerate(G) if gps[12] == "1" and gps[13] == "0"]
+fix = [k for k, gps in enumerate(G) if gps[12] == "3" and gps[13] == "10"]
+assert nofix == list(range(5)) and fix == list(range(5, 21)), (nofix, fix)
+print(f"px4 faults: az {-4 * F / m:.6f} -> {-3.75 * F / m:.6f} m/s^2 at t = 1 s (HIL_SENSOR {n_fault}); "
+      f"rates at 1.1 s {[round(float(v), 5) for v in S[275][5:8]]} rad/s, worst {worst[0]:.1e} from tau/I t; "
+      f"HIL_GPS without a fix 0..0.4 s (5), with one 0.5..2 s (16)")
+PY
     ;;
   px4_spec)
     # What a PX4 scenario must say, each refused with exit 2 naming the key.
