@@ -81,9 +81,10 @@ REQUIRED_COLUMNS = (
     "x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",
 )
 
-# Read when present (saturation flags, the attitude error Psi; docs/outputs.md); older trajectories lack them.
+# Read when present (saturation flags, the attitude error Psi, the commands at the plant; docs/outputs.md);
+# older trajectories lack them.
 SATURATION_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
-OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err",)
+OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err", "cmd1", "cmd2", "cmd3", "cmd4")
 # The controller's own figures: trajectory.csv's columns out.<name>, read when present.
 OUTPUT_PREFIX = "out."
 # At most this many panels in outputs.png; the names beyond are listed in its title.
@@ -279,12 +280,20 @@ def shade_saturation(ax, traj, lo=None, hi=None):
     if not all(traj.has(c) for c in SATURATION_COLUMNS):
         return handles
     t = traj["t"]
+    # Resting on the ground (z = 0, vz = 0) with every command at 0 is motors off (a flight stack
+    # disarmed before take-off or after landing), not saturation: the limits figures skip those rows.
+    off = np.zeros(len(t), dtype=bool)
+    if all(traj.has(c) for c in ("z", "vz", "cmd1", "cmd2", "cmd3", "cmd4")):
+        off = (traj["z"] <= 0.0) & (traj["vz"] == 0.0)
+        for k in range(1, 5):
+            off &= traj[f"cmd{k}"] <= 0.0
     any_rotor = np.zeros(len(t), dtype=bool)
     rotors = []
     for k in range(1, 5):
-        if np.any(traj[f"sat{k}"] != 0):
+        sat = (traj[f"sat{k}"] != 0) & ~off
+        if np.any(sat):
             rotors.append(str(k))
-        any_rotor |= traj[f"sat{k}"] != 0
+        any_rotor |= sat
     for flags, color, label in ((any_rotor, COLOR_SATURATED, f"rotor{'s' if len(rotors) > 1 else ''} "
                                  f"{', '.join(rotors)} saturated"),
                                 (traj["tilt_sat"] != 0, COLOR_TILT_LIMIT, "tilt limit acting")):

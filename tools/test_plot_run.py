@@ -416,6 +416,30 @@ class UnwrapAndSaturationTest(unittest.TestCase):
         self.assertEqual(len(handles), 1)
         self.assertIn("rotors 2, 4 saturated", handles[0].get_label())
 
+    def test_motors_off_on_the_ground_are_not_shaded(self):
+        # Rows 0..49 rest on the ground with every command 0 (a disarmed flight stack): not shaded; rows
+        # 100..119 have the same commands in the air (z > 0): shaded, as the limits figures count them.
+        import matplotlib.pyplot as plt
+        t = np.arange(201) / 100.0
+        resting = t < 0.5
+        falling = (t >= 1.0) & (t < 1.2)
+        off = resting | falling
+        cols = {"t": t, "z": np.where(resting, 0.0, 1.0), "vz": np.where(resting, 0.0, -0.5),
+                "tilt_sat": np.zeros(201)}
+        for k in range(1, 5):
+            cols[f"sat{k}"] = off.astype(float)
+            cols[f"cmd{k}"] = np.where(off, 0.0, 5000.0)
+        names = list(cols)
+        traj = self.pr.Trajectory("mem", names, np.column_stack([cols[n] for n in names]))
+        fig, ax = plt.subplots()
+        handles = self.pr.shade_saturation(ax, traj)
+        spans = sorted((p.get_xy()[0][0], p.get_xy()[2][0]) for p in ax.patches)
+        plt.close(fig)
+        self.assertEqual(len(spans), 1)
+        self.assertAlmostEqual(spans[0][0], 1.0)
+        self.assertAlmostEqual(spans[0][1], 1.2)
+        self.assertIn("(0.20 s shown)", handles[0].get_label())
+
 
 class StepOnTraceTest(unittest.TestCase):
     """The target, band and setpoint of a step figure lie on the trace as drawn (an angle unwrapped
