@@ -38,10 +38,7 @@ struct SitlController::Px4Link {
   bool have_heartbeat = false;
   double shown_mode = -1.0;  ///< its HEARTBEAT's custom_mode at the last mission decision (out.mode)
   // The mission (as SitlController::Link's): item in progress, when sent, its answer.
-  std::size_t item = 0;
-  double item_sent_s = -1.0;
-  std::optional<std::uint8_t> item_result;
-  std::uint16_t item_command = 0;
+  MissionProgress mission;
   long long decisions = 0;
   long long heartbeats = 0;
   std::ofstream statustext;

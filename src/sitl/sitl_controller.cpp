@@ -77,10 +77,7 @@ struct SitlController::Link {
   mavlink::Heartbeat heartbeat;    ///< its newest
   bool have_heartbeat = false;
   // The mission: the item in progress, when it was last sent (simulated time), the answers to it.
-  std::size_t item = 0;
-  double item_sent_s = -1.0;
-  std::optional<std::uint8_t> item_result;
-  std::uint16_t item_command = 0;
+  MissionProgress mission;
   long long decisions = 0;
   std::ofstream statustext;
 
@@ -309,7 +306,7 @@ void SitlController::service_mavlink() {
       l.target_system = f->sysid;
     } else if (f->msgid == mavlink::kCommandAck) {
       const mavlink::CommandAck a = mavlink::read_command_ack(*f);
-      if (a.command == l.item_command && l.item_sent_s >= 0) l.item_result = a.result;
+      l.mission.on_ack(a.command, a.result);
     } else if (f->msgid == mavlink::kStatustext) {
       const auto [severity, text] = mavlink::read_statustext(*f);
       if (!l.statustext.is_open()) l.statustext.open(fs::path(l.work_dir) / "statustext.log");
@@ -324,45 +321,35 @@ void SitlController::service_mavlink() {
   if (decision < l.decisions) return;
   l.decisions = decision + 1;
   if (decision % 4 == 0) l.send(mavlink::kHeartbeat, mavlink::heartbeat(6, 8, 0, 0, 4));  // a GCS, at 1 Hz
-  while (l.item < spec_.mission.size()) {
-    const MissionItem& m = spec_.mission[l.item];
-    if (l.item_sent_s >= 0) {
-      // Accepted, and for a mode or arming, shown so by the firmware's heartbeat: the next one.
-      const bool shown = m.kind == MissionItem::Kind::kMode
-                             ? l.heartbeat.custom_mode == static_cast<std::uint32_t>(copter_mode_number(m.mode))
-                         : m.kind == MissionItem::Kind::kArm    ? l.heartbeat.armed()
-                         : m.kind == MissionItem::Kind::kDisarm ? !l.heartbeat.armed()
-                                                                : true;
-      if (l.item_result && *l.item_result == 0 && shown) {
-        ++l.item;
-        l.item_sent_s = -1.0;
-        l.item_result.reset();
-        continue;
-      }
-      if (t_s_ - l.item_sent_s < 1.0 - 1e-9) return;  // its answer may still come
-    }
-    if (t_s_ + 1e-9 < m.at_s) return;
+  // Accepted, and for a mode or arming, shown so by the firmware's heartbeat: the next one.
+  const MissionItem* due = l.mission.due(t_s_, spec_.mission, [&](const MissionItem& m) {
+    return m.kind == MissionItem::Kind::kMode
+               ? l.heartbeat.custom_mode == static_cast<std::uint32_t>(copter_mode_number(m.mode))
+           : m.kind == MissionItem::Kind::kArm    ? l.heartbeat.armed()
+           : m.kind == MissionItem::Kind::kDisarm ? !l.heartbeat.armed()
+                                                  : true;
+  });
+  if (due != nullptr) {
+    const MissionItem& m = *due;
     const std::uint8_t ts = l.target_system;
-    l.item_result.reset();
-    l.item_sent_s = t_s_;
     switch (m.kind) {
       case MissionItem::Kind::kMode:
-        l.item_command = mavlink::kCmdDoSetMode;
+        l.mission.command = mavlink::kCmdDoSetMode;
         l.send(mavlink::kCommandLong,
-               mavlink::command_long(ts, 1, l.item_command, 0,
+               mavlink::command_long(ts, 1, l.mission.command, 0,
                                      {1.0f, static_cast<float>(copter_mode_number(m.mode)), 0, 0, 0, 0, 0}));
         break;
       case MissionItem::Kind::kArm:
       case MissionItem::Kind::kDisarm:
-        l.item_command = mavlink::kCmdComponentArmDisarm;
+        l.mission.command = mavlink::kCmdComponentArmDisarm;
         l.send(mavlink::kCommandLong,
-               mavlink::command_long(ts, 1, l.item_command, 0,
+               mavlink::command_long(ts, 1, l.mission.command, 0,
                                      {m.kind == MissionItem::Kind::kArm ? 1.0f : 0.0f, 0, 0, 0, 0, 0, 0}));
         break;
       case MissionItem::Kind::kTakeoff:
-        l.item_command = mavlink::kCmdNavTakeoff;
+        l.mission.command = mavlink::kCmdNavTakeoff;
         l.send(mavlink::kCommandLong,
-               mavlink::command_long(ts, 1, l.item_command, 0, {0, 0, 0, 0, 0, 0, static_cast<float>(m.takeoff_m)}));
+               mavlink::command_long(ts, 1, l.mission.command, 0, {0, 0, 0, 0, 0, 0, static_cast<float>(m.takeoff_m)}));
         break;
       case MissionItem::Kind::kGoto: {
         const Eigen::Vector3d p = enu_to_ned(m.p_W);
@@ -370,12 +357,11 @@ void SitlController::service_mavlink() {
                mavlink::set_position_target_local_ned(static_cast<std::uint32_t>(t_s_ * 1000.0), ts, 1,
                                                       static_cast<float>(p.x()), static_cast<float>(p.y()),
                                                       static_cast<float>(p.z()), false, 0.0f));
-        l.item_command = 0;
-        l.item_result = 0;  // no answer to a position target: done when sent
+        l.mission.command = 0;
+        l.mission.result = 0;  // no answer to a position target: done when sent
         break;
       }
     }
-    return;
   }
 }
 
@@ -498,7 +484,7 @@ void SitlController::step(const control::Observation& obs, const control::Refere
     out.outputs[6] = static_cast<double>(counts_.skipped);
     out.outputs[7] = l.have_heartbeat && l.heartbeat.armed() ? 1.0 : 0.0;
     out.outputs[8] = l.have_heartbeat ? static_cast<double>(l.heartbeat.custom_mode) : -1.0;
-    out.outputs[9] = static_cast<double>(l.item);
+    out.outputs[9] = static_cast<double>(l.mission.item);
     control::rotor_speeds_output(model_, reference, omega, reported_, out);
     break;
   }

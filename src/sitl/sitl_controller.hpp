@@ -17,6 +17,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,43 @@ struct MissionItem {
   std::string mode;  ///< kMode: ArduCopter's stabilize, alt_hold, guided, ...; PX4's posctl, takeoff, loiter, land, ...
   double takeoff_m = 0.0;                         ///< kTakeoff: height above home [m]
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< kGoto: position in quadcosim's world (ENU) [m]
+};
+
+/// Where a mission stands (the same rules for every firmware): the item being asked, when it was sent,
+/// the MAVLink command whose COMMAND_ACK answers it, and that answer.
+struct MissionProgress {
+  std::size_t item = 0;  ///< the next item not yet done
+  double sent_s = -1.0;  ///< when it was last sent [s, simulated]; -1: not yet
+  std::uint16_t command = 0;
+  std::optional<std::uint8_t> result;
+
+  /// A COMMAND_ACK: the answer to the item asked when it names its command.
+  void on_ack(std::uint16_t acked, std::uint8_t r) {
+    if (acked == command && sent_s >= 0) result = r;
+  }
+  /// At a decision at t_s: the item to send now (marked sent, its answer cleared), or null. An item sent
+  /// is done once accepted (result 0) and `shown(item)` (the firmware's state says so: a mode, arming);
+  /// unanswered or refused, it is sent again a second after; the next waits for its at_s.
+  template <class Shown>
+  const MissionItem* due(double t_s, const std::vector<MissionItem>& mission, Shown&& shown) {
+    while (item < mission.size()) {
+      const MissionItem& m = mission[item];
+      if (sent_s >= 0) {
+        if (result && *result == 0 && shown(m)) {
+          ++item;
+          sent_s = -1.0;
+          result.reset();
+          continue;
+        }
+        if (t_s - sent_s < 1.0 - 1e-9) return nullptr;  // its answer may still come
+      }
+      if (t_s + 1e-9 < m.at_s) return nullptr;
+      result.reset();
+      sent_s = t_s;
+      return &m;
+    }
+    return nullptr;
+  }
 };
 
 /// ArduCopter's custom mode number for a mode name (lower case), or -1.

@@ -192,7 +192,7 @@ void SitlController::service_px4_gcs() {
       l.target_system = f->sysid;
     } else if (f->msgid == mavlink::kCommandAck) {
       const mavlink::CommandAck a = mavlink::read_command_ack(*f);
-      if (a.command == l.item_command && l.item_sent_s >= 0) l.item_result = a.result;
+      l.mission.on_ack(a.command, a.result);
     } else if (f->msgid == mavlink::kStatustext) {
       const auto [severity, text] = mavlink::read_statustext(*f);
       if (!l.statustext.is_open()) l.statustext.open(fs::path(l.work_dir) / "statustext.log");
@@ -215,46 +215,34 @@ void SitlController::service_px4_gcs() {
   l.decisions = decision + 1;
   if (!l.have_heartbeat) return;
   l.shown_mode = static_cast<double>(l.heartbeat.custom_mode);  // out.mode: as seen at the decisions
-  while (l.item < spec_.mission.size()) {
-    const MissionItem& m = spec_.mission[l.item];
-    if (l.item_sent_s >= 0) {
-      // Accepted (PX4 accepts a mode only once it switched), and an arming shown in its outputs' mode.
-      const bool shown = m.kind == MissionItem::Kind::kArm      ? l.armed
-                         : m.kind == MissionItem::Kind::kDisarm ? !l.armed
-                                                                : true;
-      if (l.item_result && *l.item_result == 0 && shown) {
-        ++l.item;
-        l.item_sent_s = -1.0;
-        l.item_result.reset();
-        continue;
-      }
-      if (t_s_ - l.item_sent_s < 1.0 - 1e-9) return;  // its answer may still come
-    }
-    if (t_s_ + 1e-9 < m.at_s) return;
+  // Accepted (PX4 accepts a mode only once it switched), and an arming shown in its outputs' mode.
+  const MissionItem* due = l.mission.due(t_s_, spec_.mission, [&](const MissionItem& m) {
+    return m.kind == MissionItem::Kind::kArm ? l.armed : m.kind == MissionItem::Kind::kDisarm ? !l.armed : true;
+  });
+  if (due != nullptr) {
+    const MissionItem& m = *due;
     const std::uint8_t ts = l.target_system;
-    l.item_result.reset();
-    l.item_sent_s = t_s_;
     switch (m.kind) {
       case MissionItem::Kind::kMode: {
         const px4::ModeNumbers n = *px4::mode_numbers(m.mode);
-        l.item_command = mavlink::kCmdDoSetMode;
+        l.mission.command = mavlink::kCmdDoSetMode;
         send(mavlink::kCommandLong,
-             mavlink::command_long(ts, 1, l.item_command, 0,
+             mavlink::command_long(ts, 1, l.mission.command, 0,
                                    {1.0f, static_cast<float>(n.main), static_cast<float>(n.sub), 0, 0, 0, 0}));
         break;
       }
       case MissionItem::Kind::kArm:
       case MissionItem::Kind::kDisarm:
-        l.item_command = mavlink::kCmdComponentArmDisarm;
+        l.mission.command = mavlink::kCmdComponentArmDisarm;
         send(mavlink::kCommandLong,
-             mavlink::command_long(ts, 1, l.item_command, 0,
+             mavlink::command_long(ts, 1, l.mission.command, 0,
                                    {m.kind == MissionItem::Kind::kArm ? 1.0f : 0.0f, 0, 0, 0, 0, 0, 0}));
         break;
       case MissionItem::Kind::kTakeoff:
         // param7: the altitude above mean sea level; the site's altitude is home's (the GNSS's origin).
-        l.item_command = mavlink::kCmdNavTakeoff;
+        l.mission.command = mavlink::kCmdNavTakeoff;
         send(mavlink::kCommandLong,
-             mavlink::command_long(ts, 1, l.item_command, 0,
+             mavlink::command_long(ts, 1, l.mission.command, 0,
                                    {0, 0, 0, kNaN, kNaN, kNaN, static_cast<float>(spec_.site.height_m + m.takeoff_m)}));
         break;
       case MissionItem::Kind::kGoto: {
@@ -264,14 +252,13 @@ void SitlController::service_px4_gcs() {
         const auto e7 = [](double rad) {
           return static_cast<std::int32_t>(std::llround(rad * 180.0 / std::numbers::pi * 1e7));
         };
-        l.item_command = mavlink::kCmdDoReposition;
+        l.mission.command = mavlink::kCmdDoReposition;
         send(mavlink::kCommandInt,
-             mavlink::command_int(ts, 1, l.item_command, 0, {-1.0f, 1.0f, 0.0f, kNaN}, e7(g.latitude_rad),
+             mavlink::command_int(ts, 1, l.mission.command, 0, {-1.0f, 1.0f, 0.0f, kNaN}, e7(g.latitude_rad),
                                   e7(g.longitude_rad), static_cast<float>(spec_.site.height_m + m.p_W.z())));
         break;
       }
     }
-    return;
   }
 }
 
@@ -441,7 +428,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   for (int c = 0; c < 4; ++c) out.outputs[1 + c] = controls[static_cast<std::size_t>(c)];
   out.outputs[5] = l.armed ? 1.0 : 0.0;
   out.outputs[6] = l.shown_mode;
-  out.outputs[7] = static_cast<double>(l.item);
+  out.outputs[7] = static_cast<double>(l.mission.item);
   control::rotor_speeds_output(model_, reference, omega, reported_, out);
   ++steps_;
   t_s_ = static_cast<double>(steps_) * dt_s;
