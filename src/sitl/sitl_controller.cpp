@@ -252,19 +252,22 @@ void SitlController::fail(const std::string& what) const {
   throw control::ControllerFailure(msg);
 }
 
-void SitlController::start() {
-  link_ = std::make_unique<Link>();
-  Link& l = *link_;
+std::string SitlController::make_work_dir(bool& temporary) const {
   if (spec_.work_dir.empty()) {
     std::string tmpl = (fs::temp_directory_path() / "quadcosim-sitl-XXXXXX").string();
     if (!::mkdtemp(tmpl.data())) fail(std::string("cannot make a folder to run in: ") + std::strerror(errno));
-    l.work_dir = tmpl;
-    l.temporary = true;
-  } else {
-    std::error_code ec;
-    fs::create_directories(spec_.work_dir, ec);
-    l.work_dir = fs::absolute(spec_.work_dir).string();
+    temporary = true;
+    return tmpl;
   }
+  std::error_code ec;
+  fs::create_directories(spec_.work_dir, ec);
+  return fs::absolute(spec_.work_dir).string();
+}
+
+void SitlController::start() {
+  link_ = std::make_unique<Link>();
+  Link& l = *link_;
+  l.work_dir = make_work_dir(l.temporary);
   try {
     l.udp = bound_socket(SOCK_DGRAM, l.json_port);
     l.listener = bound_socket(SOCK_STREAM, l.mavlink_port);

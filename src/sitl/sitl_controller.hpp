@@ -168,6 +168,9 @@ class SitlController final : public control::Controller {
   struct Px4Link;
   void start();
   void start_px4();
+  /// The folder the firmware runs in: spec_.work_dir (made when missing), or a fresh temporary one
+  /// (`temporary` set: removed after a run that succeeded).
+  std::string make_work_dir(bool& temporary) const;
   void step_px4(const control::Observation& observation, const control::Reference& reference, double dt_s,
                 control::ControllerOutput& out);
   void service_px4_gcs();

@@ -112,16 +112,7 @@ void SitlController::start_px4() {
   }
   px4_ = std::make_unique<Px4Link>();
   Px4Link& l = *px4_;
-  if (spec_.work_dir.empty()) {
-    std::string tmpl = (fs::temp_directory_path() / "quadcosim-sitl-XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) fail(std::string("cannot make a folder to run in: ") + std::strerror(errno));
-    l.work_dir = tmpl;
-    l.temporary = true;
-  } else {
-    std::error_code ec;
-    fs::create_directories(spec_.work_dir, ec);
-    l.work_dir = fs::absolute(spec_.work_dir).string();
-  }
+  l.work_dir = make_work_dir(l.temporary);
   // An instance whose ports are all free: the simulator port (kept, listening, for the whole run, so
   // no other run takes it) and the UDP ports PX4's MAVLink links bind.
   const int first = spec_.instance >= 0 ? spec_.instance : 0;
