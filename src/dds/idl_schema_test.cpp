@@ -58,7 +58,7 @@ std::map<std::string, std::vector<std::string>> idl_structs() {
         const bool sequence = (*f)[2].matched;
         std::string type = msg_type(sequence ? (*f)[2].str() : (*f)[1].str(), package);
         if (sequence) type += "[]";
-        if ((*f)[4].matched) type += "[" + (*f)[5].str() + "]";
+        if ((*f)[4].matched) type.append("[").append((*f)[5].str()).append("]");
         fields.push_back(type + " " + (*f)[3].str());
       }
     }
