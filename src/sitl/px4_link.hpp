@@ -5,6 +5,8 @@
 #include <netinet/in.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +19,29 @@
 #include "sitl/sitl_controller.hpp"
 
 namespace quadcosim::sitl {
+
+/// A frame from the firmware's GCS link, taken into a link (ArduPilot's or PX4's: each has heartbeat,
+/// have_heartbeat, target_system, mission, statustext and work_dir): its heartbeat (another GCS's
+/// ignored), the COMMAND_ACK of the mission's item, a STATUSTEXT into statustext.log (and on stderr
+/// with `echo`) at simulated time t_s.
+template <class Link>
+void take_gcs_frame(Link& l, const mavlink::Frame& f, double t_s, bool echo) {
+  if (f.msgid == mavlink::kHeartbeat) {
+    const mavlink::Heartbeat h = mavlink::read_heartbeat(f);
+    if (h.type == 6) return;  // another GCS's
+    l.heartbeat = h;
+    l.have_heartbeat = true;
+    l.target_system = f.sysid;
+  } else if (f.msgid == mavlink::kCommandAck) {
+    const mavlink::CommandAck a = mavlink::read_command_ack(f);
+    l.mission.on_ack(a.command, a.result);
+  } else if (f.msgid == mavlink::kStatustext) {
+    const auto [severity, text] = mavlink::read_statustext(f);
+    if (!l.statustext.is_open()) l.statustext.open(std::filesystem::path(l.work_dir) / "statustext.log");
+    l.statustext << fmt::format("{:.3f} {} {}\n", t_s, severity, text) << std::flush;
+    if (echo) std::fprintf(stderr, "sitl: t = %.3f s: %s\n", t_s, text.c_str());
+  }
+}
 
 struct SitlController::Px4Link {
   std::string work_dir;

@@ -301,21 +301,7 @@ void SitlController::service_mavlink() {
   Link& l = *link_;
   l.service_tcp();
   while (auto f = l.parser.next()) {
-    if (f->msgid == mavlink::kHeartbeat) {
-      const mavlink::Heartbeat h = mavlink::read_heartbeat(*f);
-      if (h.type == 6) continue;  // another GCS's
-      l.heartbeat = h;
-      l.have_heartbeat = true;
-      l.target_system = f->sysid;
-    } else if (f->msgid == mavlink::kCommandAck) {
-      const mavlink::CommandAck a = mavlink::read_command_ack(*f);
-      l.mission.on_ack(a.command, a.result);
-    } else if (f->msgid == mavlink::kStatustext) {
-      const auto [severity, text] = mavlink::read_statustext(*f);
-      if (!l.statustext.is_open()) l.statustext.open(fs::path(l.work_dir) / "statustext.log");
-      l.statustext << fmt::format("{:.3f} {} {}\n", t_s_, severity, text) << std::flush;
-      if (spec_.echo_statustext) std::fprintf(stderr, "sitl: t = %.3f s: %s\n", t_s_, text.c_str());
-    }
+    take_gcs_frame(l, *f, t_s_, spec_.echo_statustext);
   }
   // Decisions once the firmware has spoken on its link (its first HEARTBEAT), and then at whole
   // multiples of 0.25 s of simulated time only (step counts, not wall time).

@@ -175,21 +175,7 @@ void SitlController::service_px4_gcs() {
     l.gcs_parser.feed(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
   }
   while (auto f = l.gcs_parser.next()) {
-    if (f->msgid == mavlink::kHeartbeat) {
-      const mavlink::Heartbeat h = mavlink::read_heartbeat(*f);
-      if (h.type == 6) continue;
-      l.heartbeat = h;
-      l.have_heartbeat = true;
-      l.target_system = f->sysid;
-    } else if (f->msgid == mavlink::kCommandAck) {
-      const mavlink::CommandAck a = mavlink::read_command_ack(*f);
-      l.mission.on_ack(a.command, a.result);
-    } else if (f->msgid == mavlink::kStatustext) {
-      const auto [severity, text] = mavlink::read_statustext(*f);
-      if (!l.statustext.is_open()) l.statustext.open(fs::path(l.work_dir) / "statustext.log");
-      l.statustext << fmt::format("{:.3f} {} {}\n", t_s_, severity, text) << std::flush;
-      if (spec_.echo_statustext) std::fprintf(stderr, "sitl: t = %.3f s: %s\n", t_s_, text.c_str());
-    }
+    take_gcs_frame(l, *f, t_s_, spec_.echo_statustext);
   }
   auto send = [&](std::uint32_t msgid, const std::vector<std::uint8_t>& payload) {
     const std::vector<std::uint8_t> frame = mavlink::encode(l.gcs_seq++, 255, 190, msgid, payload);
