@@ -41,6 +41,7 @@
 #include "control/care.hpp"
 #include "io/scenario.hpp"
 #include "model/vehicle_params.hpp"
+#include "python/module_resolvers.hpp"
 #include "sensors/suite.hpp"
 #include "sim/controller_core.hpp"
 #include "sim/parameter_schedule.hpp"
@@ -583,8 +584,8 @@ class Batch {
   /// io::load_scenario on `root`, its errors prefixed by `who`.
   std::shared_ptr<const io::Scenario> load_checked(const YAML::Node& root, const std::string& who) const {
     try {
-      return std::make_shared<const io::Scenario>(
-          io::load_scenario(root, source_, nominal_controller_ && base_ ? &base_->vehicle : nullptr));
+      return std::make_shared<const io::Scenario>(io::load_scenario(
+          root, source_, module_resolvers(), nominal_controller_ && base_ ? &base_->vehicle : nullptr));
     } catch (const control::CareError& e) {
       throw io::ConfigError(who + source_ + ": controller design failed: " + e.what());
     } catch (const io::ConfigError& e) {
@@ -884,7 +885,7 @@ class Batch {
 /// ticks after a warm-up of `warmup_ticks`; the wall seconds of the timed part.
 double swarm_wall_s(const std::string& yaml, const std::string& source, int n, long long ticks, int threads,
                     long long block_ticks, long long warmup_ticks) {
-  const io::Scenario sc = io::load_scenario(YAML::Load(yaml), source);
+  const io::Scenario sc = io::load_scenario(YAML::Load(yaml), source, module_resolvers());
   py::gil_scoped_release release;
   sim::SwarmLayout layout = sc.swarm ? sc.swarm->layout : sim::SwarmLayout{};
   layout.vehicles = n;

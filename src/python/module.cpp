@@ -20,7 +20,6 @@
 #include <sstream>
 #include <string>
 #include <thread>
-#include <unordered_map>
 #include <vector>
 
 #include "batch.hpp"
@@ -33,6 +32,7 @@
 #include "io/scenario_limits.hpp"
 #include "io/trajectory_csv.hpp"
 #include "io/yaml_reader.hpp"
+#include "python/module_resolvers.hpp"
 #include "python/py_controller.hpp"
 #include "sensors/suite.hpp"
 #include "sim/simulation.hpp"
@@ -120,7 +120,7 @@ io::Scenario checked(const std::string& source, F load) {
 
 PyScenario load_file(const std::string& path, const std::string& controller) {
   PyScenario s;
-  s.scenario = checked(path, [&] { return io::load_scenario(path, controller); });
+  s.scenario = checked(path, [&] { return io::load_scenario(path, controller, module_resolvers()); });
   s.root = YAML::LoadFile(path);  // read already: cannot fail now
   if (!controller.empty()) io::set_controller_type(s.root, controller);
   s.source = path;
@@ -137,7 +137,7 @@ PyScenario load_dict(const py::dict& d, const std::string& controller) {
   s.controller_override = controller;
   {
     py::gil_scoped_release release;
-    s.scenario = checked(s.source, [&] { return io::load_scenario(s.root, s.source); });
+    s.scenario = checked(s.source, [&] { return io::load_scenario(s.root, s.source, module_resolvers()); });
   }
   return s;
 }
@@ -150,29 +150,26 @@ PyScenario with_controller(const PyScenario& s, const std::string& controller) {
   r.root = YAML::Clone(s.root);
   io::set_controller_type(r.root, controller);
   r.controller_override = controller;
-  r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
+  r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source, module_resolvers()); });
   return r;
 }
 
-/// Python controllers given as objects (quadcosim.run(..., controller=obj)) while a scenario naming them
-/// is loaded: the scenario's controller.python names the object's class ("module:Class") and the
-/// module's resolver of controller.python takes the object from here rather than importing it.
-thread_local std::unordered_map<std::string, py::object>* given_controllers = nullptr;
-
-/// The resolver of `controller: {python: ...}` the module installs: a given object, else an import.
-std::shared_ptr<const control::Controller> resolve_python_controller(const std::string& target,
-                                                                     const std::filesystem::path& folder,
-                                                                     const model::VehicleParams& vehicle) {
-  if (given_controllers) {
-    if (const auto it = given_controllers->find(target); it != given_controllers->end()) {
-      try {
-        return make_python_controller(it->second, vehicle);
-      } catch (const ControllerError& e) {
-        throw std::invalid_argument(e.what());
-      }
+/// The module's resolvers with a Python controller given as an object (quadcosim.run(..., controller=obj))
+/// for the scenario naming it: its controller.python, `target` (the object's class, "module:Class"), is
+/// made from the object rather than imported.
+io::ScenarioResolvers with_given_controller(const std::string& target, const py::object& controller) {
+  io::ScenarioResolvers r = module_resolvers();
+  r.python = [target, &controller, imported = r.python](
+                 const std::string& named, const std::filesystem::path& folder,
+                 const model::VehicleParams& vehicle) -> std::shared_ptr<const control::Controller> {
+    if (named != target) return imported(named, folder, vehicle);
+    try {
+      return make_python_controller(controller, vehicle);
+    } catch (const ControllerError& e) {
+      throw std::invalid_argument(e.what());
     }
-  }
-  return load_python_controller(target, folder, vehicle);
+  };
+  return r;
 }
 
 /// "module:Class" of a controller object or class (its class's).
@@ -199,15 +196,8 @@ PyScenario with_python_controller(const PyScenario& s, const py::object& control
     if (step_timeout_s)
       r.root["controller"]["step_timeout_s"] = py::repr(py::float_(*step_timeout_s)).cast<std::string>();
   }
-  std::unordered_map<std::string, py::object> given = {{target, controller}};
-  given_controllers = &given;
-  try {
-    r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
-  } catch (...) {
-    given_controllers = nullptr;
-    throw;
-  }
-  given_controllers = nullptr;
+  const io::ScenarioResolvers resolvers = with_given_controller(target, controller);
+  r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source, resolvers); });
   return r;
 }
 
@@ -224,7 +214,7 @@ PyScenario with_any_controller(const PyScenario& s, const py::object& controller
     PyScenario r = s;
     r.root = s.from_file ? YAML::LoadFile(s.source) : YAML::Clone(s.root);
     r.root["controller"]["step_timeout_s"] = py::repr(py::float_(*step_timeout_s)).cast<std::string>();
-    r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source); });
+    r.scenario = checked(r.source, [&] { return io::load_scenario(r.root, r.source, module_resolvers()); });
     return r;
   }
   if (py::isinstance<py::str>(controller)) {
@@ -381,8 +371,10 @@ py::dict run(const PyScenario& s, const std::optional<std::string>& out, bool fo
         py::gil_scoped_acquire acquire;
         return PyErr_CheckSignals() != 0;  // the exception stays set for the caller
       };
-      const nlohmann::json provenance = io::describe_run(
-          s.scenario, {.controller_override = s.controller_override, .python_target = io::python_target_of(s.root)});
+      const nlohmann::json provenance =
+          io::describe_run(s.scenario, {.controller_override = s.controller_override,
+                                        .python_target = io::python_target_of(s.root),
+                                        .python_module = module_resolvers().python_module});
       if (swarm) {
         recorded_dirs = hosts::make_recorded_dirs(dir, spec, flown);
         interrupted = !hosts::fly_swarm_inprocess(s.scenario, spec, dir, info, [&](double) { return signalled(); });
@@ -716,8 +708,6 @@ PYBIND11_MODULE(_quadcosim, m) {
       PyErr_SetObject(controller_error->ptr(), error.ptr());
     }
   });
-  io::set_python_controller_factory(&resolve_python_controller);
-  io::set_python_module_locator(&loaded_module_file);
 
   py::class_<PyScenario>(m, "Scenario", R"(A validated scenario (see docs/scenarios.md for every key).
 

@@ -1103,12 +1103,4 @@ std::string loaded_module_file(const std::string& target) {
   return py::isinstance<py::str>(file) ? file.cast<std::string>() : "";
 }
 
-void install_python_controller_factory() {
-  io::set_python_controller_factory(
-      [](const std::string& target, const std::filesystem::path& folder,
-         const model::VehicleParams& vehicle) -> std::shared_ptr<const control::Controller> {
-        return load_python_controller(target, folder, vehicle);
-      });
-}
-
 }  // namespace quadcosim::python
