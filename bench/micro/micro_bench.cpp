@@ -10,6 +10,7 @@
 #include "control/allocation.hpp"
 #include "control/care.hpp"
 #include "controllers/paper/paper_controller.hpp"
+#include "hosts/scenario_resolvers.hpp"
 #include "io/scenario.hpp"
 #include "model/quadrotor.hpp"
 #include "sim/simulation.hpp"
@@ -100,7 +101,8 @@ BENCHMARK(BM_BaselineTick);
 // off): /clock, Pose, Velocity, Imu published, the 50 Hz controller on even ticks, the command
 // latched, RK4.
 void BM_SimulationTick(benchmark::State& st) {
-  const qc::io::Scenario sc = qc::io::load_scenario(QUADCOSIM_SOURCE_DIR "/scenarios/paper/altitude_step.yaml");
+  const qc::io::Scenario sc = qc::io::load_scenario(QUADCOSIM_SOURCE_DIR "/scenarios/paper/altitude_step.yaml",
+                                                    qc::hosts::scenario_resolvers());
   constexpr qc::sim::Tick kTicks = 100'000;
   auto cfg = sc.simulation;
   cfg.duration_ticks = kTicks;

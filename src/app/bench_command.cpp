@@ -65,8 +65,8 @@ CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& bench) {
   return bench_cmd;
 }
 
-int bench_command(const BenchOptions& o) {
-  nlohmann::json j = hosts::run_bench(o);
+int bench_command(const BenchOptions& o, const io::ScenarioResolvers& resolvers) {
+  nlohmann::json j = hosts::run_bench(o, resolvers);
   j["machine"] = machine();
   if (o.json) {
     std::cout << j.dump() << std::endl;

@@ -14,6 +14,7 @@
 #include "hosts/node_options.hpp"
 #include "hosts/recorder_process.hpp"
 #include "hosts/topic_process.hpp"
+#include "io/scenario_resolvers.hpp"
 
 namespace CLI {
 class App;
@@ -49,7 +50,7 @@ struct RunOptions {
   /// (the paper controller's measured bands) or none (figures only; exit 0 whatever they are).
   std::string judge = "spec";
 };
-int run_command(const RunOptions& options);
+int run_command(const RunOptions& options, const io::ScenarioResolvers& resolvers);
 CLI::App* add_run_subcommand(CLI::App& app, RunOptions& options);
 
 struct OpenloopOptions {
@@ -68,7 +69,7 @@ struct LqrOptions {
   std::string params;   ///< controller parameter file, "" for defaults
   std::string vehicle;  ///< vehicle file, "" for the paper's vehicle
 };
-int lqr_command(const LqrOptions& options);
+int lqr_command(const LqrOptions& options, const io::ScenarioResolvers& resolvers);
 CLI::App* add_lqr_subcommand(CLI::App& app, LqrOptions& options);
 
 struct ParamsOptions {
@@ -79,7 +80,7 @@ struct ParamsOptions {
 };
 /// Lists the controller's (or with `vehicle`, the vehicle's) parameters: name, unit, range, default,
 /// meaning.
-int params_command(const ParamsOptions& options);
+int params_command(const ParamsOptions& options, const io::ScenarioResolvers& resolvers);
 CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& options);
 
 /// Checks a --controller value as io::parse_controller_choice reads it (a registered type,
@@ -98,12 +99,12 @@ using NodeSwarmOptions = hosts::NodeSwarmOptions;
 
 /// `quadcosim plant`: the plant process's options (hosts/node_options.hpp).
 using PlantCommandOptions = hosts::PlantProcessOptions;
-int plant_command(const PlantCommandOptions& options);
+int plant_command(const PlantCommandOptions& options, const io::ScenarioResolvers& resolvers);
 CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& options);
 
 /// `quadcosim controller`: the controller process's options (hosts/node_options.hpp).
 using ControllerCommandOptions = hosts::ControllerProcessOptions;
-int controller_command(const ControllerCommandOptions& options);
+int controller_command(const ControllerCommandOptions& options, const io::ScenarioResolvers& resolvers);
 CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& options);
 
 /// `quadcosim param get|set|list|describe NODE [NAME [VALUE]]` (param_command.cpp): the ROS 2
@@ -204,7 +205,7 @@ struct SweepOptions {
   std::string judge = "spec";           ///< --judge: spec, paper or none (as `run`'s)
 };
 CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& options);
-int sweep_command(const SweepOptions& options);
+int sweep_command(const SweepOptions& options, const io::ScenarioResolvers& resolvers);
 
 /// `quadcosim margins [SCENARIO]` (margins_command.cpp, docs/margins.md): gain, phase and delay margins
 /// of each loop about hover: analytic for the paper controller, measured in simulation for any
@@ -225,7 +226,7 @@ struct MarginsOptions {
   double min_frequency = 0.1;  ///< measured: lowest grid frequency [rad/s]
 };
 CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& options);
-int margins_command(const MarginsOptions& options);
+int margins_command(const MarginsOptions& options, const io::ScenarioResolvers& resolvers);
 
 /// `quadcosim fmu export|info` (fmu_command.cpp): quadcosim's plant or controller as an FMI co-simulation
 /// FMU, and what any FMU declares. Exit 0 on success, 2 on bad input (a flag, the scenario, a file
@@ -240,7 +241,7 @@ struct FmuOptions {
   std::string fmu;         ///< info: the .fmu to read
 };
 CLI::App* add_fmu_subcommand(CLI::App& app, FmuOptions& options);
-int fmu_command(const FmuOptions& options);
+int fmu_command(const FmuOptions& options, const io::ScenarioResolvers& resolvers);
 
 /// Runs tools/`script` with `args` under /usr/bin/python3 (QUADCOSIM_PYTHON, QUADCOSIM_TOOLS_DIR
 /// override); returns false (after printing why) when it fails.
@@ -265,7 +266,7 @@ int compare_command(const CompareOptions& options);
 
 using BenchOptions = hosts::BenchOptions;
 /// `quadcosim bench`: speed figures of this machine (bench_command.cpp, docs/performance.md).
-int bench_command(const BenchOptions& options);
+int bench_command(const BenchOptions& options, const io::ScenarioResolvers& resolvers);
 CLI::App* add_bench_subcommand(CLI::App& app, BenchOptions& options);
 
 /// The PNG plots and report.html of a run directory (tools/plot_run.py, tools/report.py). The files

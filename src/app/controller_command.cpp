@@ -89,18 +89,18 @@ CLI::App* add_controller_subcommand(CLI::App& app, ControllerCommandOptions& ctl
   return ctl_cmd;
 }
 
-int controller_command(const ControllerCommandOptions& o) {
+int controller_command(const ControllerCommandOptions& o, const io::ScenarioResolvers& resolvers) {
   std::optional<io::Scenario> started =
-      hosts::start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns, o.controller);
+      hosts::start_node_process("controller", o.cpus, o.scenario, o.vehicle, o.ns, resolvers, o.controller);
   if (!started) return exit_code::kBadInput;
   io::Scenario& sc = *started;
   if (!o.params.empty()) {
     // The file replaces the controller and the node's parameters; the scenario's trajectory stays.
     const auto trajectory = sc.controller.trajectory;
-    sc.controller = io::load_controller(o.params, sc.vehicle);
+    sc.controller = io::load_controller(o.params, sc.vehicle, resolvers);
     sc.controller.trajectory = trajectory;
   }
-  if (!o.fmu.empty()) io::use_controller_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu");
+  if (!o.fmu.empty()) io::use_controller_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu", resolvers);
   if (!o.python.empty()) {
     // Replaces the controller only: the node's setpoints, safety and trajectory stay the scenario's.
     const std::filesystem::path folder =
@@ -110,8 +110,13 @@ int controller_command(const ControllerCommandOptions& o) {
     sc.controller_fmu.reset();
   }
   if (o.swarm.vehicles > 0) {
-    if (sc.controller.type() == "python") {
-      throw io::ConfigError("controller: a Python controller flies one vehicle (no --vehicles)");
+    // The swarm's shards step their vehicles' controllers in turn on shared threads: a controller that
+    // asks for a thread of its own (Controller::wants_own_thread: one written in Python, a SITL
+    // firmware) cannot be one of them.
+    if (sc.controller.wants_own_thread()) {
+      throw io::ConfigError(
+          fmt::format("controller: a {} controller runs on a thread of its own and flies one vehicle (no --vehicles)",
+                      sc.controller.type()));
     }
     return hosts::run_controller_swarm(o, std::move(sc));
   }

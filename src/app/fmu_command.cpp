@@ -58,14 +58,14 @@ fs::path find_fmu_library() {
       file, looked));
 }
 
-int export_fmu(const FmuOptions& o) {
+int export_fmu(const FmuOptions& o, const io::ScenarioResolvers& resolvers) {
   const hosts::FmuExport r = hosts::export_fmu({.kind = o.kind,
                                                 .scenario = o.scenario,
                                                 .controller = o.controller,
                                                 .fmi = o.fmi,
                                                 .out = o.out,
                                                 .generation_tool = std::string("quadcosim ") + QUADCOSIM_VERSION},
-                                               find_fmu_library);
+                                               find_fmu_library, resolvers);
   const fmi::ModelDescription& md = r.description;
   int inputs = 0, outputs = 0, parameters = 0;
   for (const fmi::Variable& v : md.variables) {
@@ -182,6 +182,8 @@ CLI::App* add_fmu_subcommand(CLI::App& app, FmuOptions& o) {
   return fmu;
 }
 
-int fmu_command(const FmuOptions& o) { return o.verb == "export" ? export_fmu(o) : info(o); }
+int fmu_command(const FmuOptions& o, const io::ScenarioResolvers& resolvers) {
+  return o.verb == "export" ? export_fmu(o, resolvers) : info(o);
+}
 
 }  // namespace quadcosim::app

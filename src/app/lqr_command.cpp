@@ -43,12 +43,12 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
   return params_cmd;
 }
 
-int lqr_command(const LqrOptions& opt) {
+int lqr_command(const LqrOptions& opt, const io::ScenarioResolvers& resolvers) {
   model::VehicleParams vehicle;
   if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
   const control::ControllerConfig cfg = opt.params.empty()
                                             ? controllers::make_config(controllers::kDefaultControllerType, vehicle)
-                                            : io::load_controller(opt.params, vehicle);
+                                            : io::load_controller(opt.params, vehicle, resolvers);
   const controllers::PaperController* paper = controllers::paper_controller(cfg);
   if (!paper) {
     // Only the paper controller's attitude loops are LQR designs; other controllers have no A, B,
@@ -114,7 +114,7 @@ int vehicle_params_table(bool markdown) {
 
 }  // namespace
 
-int params_command(const ParamsOptions& options) {
+int params_command(const ParamsOptions& options, const io::ScenarioResolvers& resolvers) {
   if (options.vehicle) return vehicle_params_table(options.markdown);
   if (options.list) {
     std::cout << fmt::format("{:<10} {}\n", "type", "controller");
@@ -124,7 +124,7 @@ int params_command(const ParamsOptions& options) {
   }
   // A Python class or an FMU is loaded as a scenario naming it would load it: its declared parameters
   // and their defaults are known only then.
-  const control::ControllerConfig defaults = io::defaults_flown_by(options.controller).controller;
+  const control::ControllerConfig defaults = io::defaults_flown_by(options.controller, resolvers).controller;
   std::cout << fmt::format("{:<26} {:<10} {:<22} {:<12} {}\n", "name", "unit", "range", "default", "meaning");
   for (const control::ParameterSpec* spec : control::all_parameters(defaults)) {
     const control::ParameterSpec& p = *spec;

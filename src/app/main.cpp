@@ -11,6 +11,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "hosts/scenario_resolvers.hpp"
 #include "io/scenario_limits.hpp"
 #include "python/embedded/python_host.hpp"
 #include "util/did_you_mean.hpp"
@@ -88,17 +89,21 @@ int main(int argc, char** argv) {
   MarginsOptions margins;
   BenchOptions bench;
   FmuOptions fmu;
+  // What makes the FMUs and Python classes the scenarios name: the FMUs through a loader this process
+  // owns for its life, Python classes through the embedded interpreter (started on first use only).
+  const quadcosim::io::ScenarioResolvers resolvers = quadcosim::hosts::scenario_resolvers(
+      quadcosim::embedded_python::python_controller_factory(), quadcosim::embedded_python::python_module_file);
   struct Subcommand {
     CLI::App* cli;
     std::function<int()> run;
   };
   const std::vector<Subcommand> commands = {
-      {add_run_subcommand(app, run), [&] { return run_command(run); }},
-      {add_plant_subcommand(app, plant), [&] { return plant_command(plant); }},
-      {add_controller_subcommand(app, controller), [&] { return controller_command(controller); }},
+      {add_run_subcommand(app, run), [&] { return run_command(run, resolvers); }},
+      {add_plant_subcommand(app, plant), [&] { return plant_command(plant, resolvers); }},
+      {add_controller_subcommand(app, controller), [&] { return controller_command(controller, resolvers); }},
       {add_openloop_subcommand(app, openloop), [&] { return openloop_command(openloop); }},
-      {add_lqr_subcommand(app, lqr), [&] { return lqr_command(lqr); }},
-      {add_params_subcommand(app, params), [&] { return params_command(params); }},
+      {add_lqr_subcommand(app, lqr), [&] { return lqr_command(lqr, resolvers); }},
+      {add_params_subcommand(app, params), [&] { return params_command(params, resolvers); }},
       {add_summary_subcommand(app, summary), [&] { return summary_command(summary); }},
       {add_topic_subcommand(app, topic), [&] { return topic_command(topic); }},
       {add_param_subcommand(app, param), [&] { return param_command(param); }},
@@ -106,10 +111,10 @@ int main(int argc, char** argv) {
       {add_compare_subcommand(app, compare), [&] { return compare_command(compare); }},
       {add_record_subcommand(app, record), [&] { return record_command(record); }},
       {add_security_subcommand(app, security), [&] { return security_command(security); }},
-      {add_sweep_subcommand(app, sweep), [&] { return sweep_command(sweep); }},
-      {add_margins_subcommand(app, margins), [&] { return margins_command(margins); }},
-      {add_bench_subcommand(app, bench), [&] { return bench_command(bench); }},
-      {add_fmu_subcommand(app, fmu), [&] { return fmu_command(fmu); }},
+      {add_sweep_subcommand(app, sweep), [&] { return sweep_command(sweep, resolvers); }},
+      {add_margins_subcommand(app, margins), [&] { return margins_command(margins, resolvers); }},
+      {add_bench_subcommand(app, bench), [&] { return bench_command(bench, resolvers); }},
+      {add_fmu_subcommand(app, fmu), [&] { return fmu_command(fmu, resolvers); }},
   };
   add_exit_code_footers(app);
   // Limits on what files and flags may ask for (io/scenario_limits.hpp), on the commands that read
@@ -155,9 +160,6 @@ int main(int argc, char** argv) {
     }
     quadcosim::io::set_limits(limits);
   }
-  // A scenario's `controller: {python: ...}` resolves through the embedded Python (started on first
-  // use only).
-  quadcosim::embedded_python::install_python_controllers();
   for (const Subcommand& c : commands) {
     if (*c.cli) {
       const int code = run_guarded(c.cli->get_name(), c.run);

@@ -57,7 +57,7 @@ CLI::App* add_margins_subcommand(CLI::App& app, MarginsOptions& o) {
   return cmd;
 }
 
-int margins_command(const MarginsOptions& o) {
+int margins_command(const MarginsOptions& o, const io::ScenarioResolvers& resolvers) {
   if (!o.plots && o.out_dir.empty()) {
     std::cerr << "error: --no-plots needs --out (plots are only written into an output directory)\n";
     return exit_code::kBadInput;
@@ -68,7 +68,7 @@ int margins_command(const MarginsOptions& o) {
   }
   // A bad file (io::ConfigError), a failed LQR design (control::CareError) or a vehicle that cannot
   // hover: bad input (run_guarded).
-  const hosts::MarginsPlan plan = hosts::plan_margins(o.scenario, o.controller, o.measure);
+  const hosts::MarginsPlan plan = hosts::plan_margins(o.scenario, o.controller, o.measure, resolvers);
   if (!plan.measured && (o.amplitude != MarginsOptions{}.amplitude || o.frequencies != MarginsOptions{}.frequencies ||
                          o.min_frequency != MarginsOptions{}.min_frequency)) {
     std::cerr << "error: --amplitude, --frequencies and --min-frequency set the measurement; the paper controller's "

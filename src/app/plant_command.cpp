@@ -112,11 +112,12 @@ CLI::App* add_plant_subcommand(CLI::App& app, PlantCommandOptions& plant) {
   return plant_cmd;
 }
 
-int plant_command(const PlantCommandOptions& o) {
-  std::optional<io::Scenario> started = hosts::start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns);
+int plant_command(const PlantCommandOptions& o, const io::ScenarioResolvers& resolvers) {
+  std::optional<io::Scenario> started =
+      hosts::start_node_process("plant", o.cpus, o.scenario, o.vehicle, o.ns, resolvers);
   if (!started) return exit_code::kBadInput;
   io::Scenario& sc = *started;
-  if (!o.fmu.empty()) io::use_plant_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu");
+  if (!o.fmu.empty()) io::use_plant_fmu(sc, io::FmuSpec{o.fmu, {}}, "--fmu", resolvers);
   if (o.watchdog_s >= 0.0) {
     const double ticks = o.watchdog_s / sc.simulation.plant.clock.period_s();
     if (std::abs(ticks - std::round(ticks)) > 1e-6) {

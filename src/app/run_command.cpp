@@ -67,13 +67,15 @@ class Progress {
 
 // The run's provenance record (io/provenance.hpp): made once, written into metadata.yaml, metrics.json
 // and (through them) the report and plots.
-nlohmann::json run_provenance(const RunOptions& opt, const io::Scenario& flown) {
+nlohmann::json run_provenance(const RunOptions& opt, const io::Scenario& flown,
+                              const io::ScenarioResolvers& resolvers) {
   YAML::Node root = YAML::LoadFile(opt.scenario);  // read by load_scenario already
   if (!opt.controller.empty()) io::set_controller_type(root, opt.controller);
   return io::describe_run(flown, {.transport = opt.transport,
                                   .clock = opt.transport == "dds" && opt.realtime ? "realtime" : "lockstep",
                                   .controller_override = opt.controller,
-                                  .python_target = io::python_target_of(root)});
+                                  .python_target = io::python_target_of(root),
+                                  .python_module = resolvers.python_module});
 }
 
 // "run: FAILED against spec: z overshoot_pct 30.2 outside [-, 25]; ...": the judged criteria that failed,
@@ -151,8 +153,8 @@ CLI::App* add_run_subcommand(CLI::App& app, RunOptions& run) {
   return run_cmd;
 }
 
-int run_command(const RunOptions& opt) {
-  const io::Scenario sc = io::load_scenario(opt.scenario, opt.controller);
+int run_command(const RunOptions& opt, const io::ScenarioResolvers& resolvers) {
+  const io::Scenario sc = io::load_scenario(opt.scenario, opt.controller, resolvers);
 
   if (opt.transport == "dds" && sc.simulation.faults.active() && !(opt.vehicles > 0 || sc.swarm)) {
     std::cerr << "error: " << opt.scenario
@@ -179,7 +181,7 @@ int run_command(const RunOptions& opt) {
   try {  // the model's and the controller's checks of the scenario name no file: say which
     // The scenario as flown: the file, or with --controller applied.
     io::write_file_atomically(out / "scenario.yaml", io::effective_scenario_text(opt.scenario, opt.controller));
-    const nlohmann::json provenance = run_provenance(opt, sc);
+    const nlohmann::json provenance = run_provenance(opt, sc, resolvers);
     if (opt.vehicles > 0 || sc.swarm) return run_swarm(opt, sc, out, folder, provenance);
     const std::string csv_path = (out / "trajectory.csv").string();
     if (opt.transport == "dds") {

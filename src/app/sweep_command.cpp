@@ -81,11 +81,11 @@ std::string recorded_scenario_file(const fs::path& dir, const std::string& shard
 // index.html of a sweep folder (tools/sweep_index.py), after the plots it shows.
 bool make_index(const std::string& dir) { return run_tool("sweep_index.py", {dir}); }
 
-int rerun_command(const SweepOptions& o) {
+int rerun_command(const SweepOptions& o, const io::ScenarioResolvers& resolvers) {
   sweep::Plan plan;
   try {
     (void)use_origin(o.sweep_dir);
-    plan = sweep::plan_of(o.sweep_dir);
+    plan = sweep::plan_of(o.sweep_dir, resolvers);
   } catch (const std::runtime_error& e) {  // names the file: not a sweep folder, or not this one's
     std::cerr << "error: " << e.what() << '\n';
     return exit_code::kBadInput;
@@ -219,8 +219,8 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepOptions& o) {
   return c;
 }
 
-int sweep_command(const SweepOptions& o) {
-  if (o.mode == "rerun") return rerun_command(o);
+int sweep_command(const SweepOptions& o, const io::ScenarioResolvers& resolvers) {
+  if (o.mode == "rerun") return rerun_command(o, resolvers);
   if (o.mode == "merge") return merge_command(o);
   if (o.scenario.empty() || o.out_dir.empty()) {
     std::cerr << "error: sweep: give a SCENARIO and --out DIR (or `sweep rerun`, `sweep merge`; see --help)\n";
@@ -246,7 +246,7 @@ int sweep_command(const SweepOptions& o) {
     recorded_file = recorded_scenario_file(out, o.shard);
   }
   sweep::Plan plan = sweep::make_plan(o.scenario, o.vary, o.seed, grid && !o.runs_given ? 1 : o.runs,
-                                      o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom,
+                                      o.sampler == "lhs" ? sweep::Sampler::kLhs : sweep::Sampler::kRandom, resolvers,
                                       origin ? sweep::scenario_source_of(*origin) : std::string());
   if (!recorded_file.empty()) {
     plan.scenario_file = recorded_file;

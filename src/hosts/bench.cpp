@@ -95,9 +95,9 @@ nlohmann::json number_or_null(double v) {
 
 }  // namespace
 
-nlohmann::json run_bench(const BenchOptions& o) {
-  const io::Scenario paper = io::load_scenario(o.scenario);
-  const io::Scenario swarm = io::load_scenario(o.swarm_scenario);
+nlohmann::json run_bench(const BenchOptions& o, const io::ScenarioResolvers& resolvers) {
+  const io::Scenario paper = io::load_scenario(o.scenario, resolvers);
+  const io::Scenario swarm = io::load_scenario(o.swarm_scenario, resolvers);
   const bool q = o.quick;
   const auto all_start = std::chrono::steady_clock::now();
   auto want = [&](const char* part) { return o.only.empty() || o.only == part; };

@@ -17,6 +17,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "io/scenario_resolvers.hpp"
+
 namespace quadcosim::hosts {
 
 struct BenchOptions {
@@ -31,6 +33,6 @@ struct BenchOptions {
 
 /// Runs the parts `o` asks for and returns their figures (the keys above, and quick and bench_wall_s),
 /// saying on stderr what it measures as it goes. Throws io::ConfigError for a bad scenario.
-nlohmann::json run_bench(const BenchOptions& o);
+nlohmann::json run_bench(const BenchOptions& o, const io::ScenarioResolvers& resolvers);
 
 }  // namespace quadcosim::hosts

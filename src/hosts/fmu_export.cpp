@@ -31,7 +31,8 @@ std::string platform_folder(fmi::FmiVersion version) {
 }
 
 /// The FMU's configuration from the scenario (or the defaults: the paper's vehicle and controller).
-fmi::FmuConfig fmu_config_from(const FmuExportOptions& o, std::vector<std::string>& notes) {
+fmi::FmuConfig fmu_config_from(const FmuExportOptions& o, std::vector<std::string>& notes,
+                               const io::ScenarioResolvers& resolvers) {
   io::Scenario sc;
   if (!o.controller.empty() && io::parse_controller_choice(o.controller).kind != io::ControllerChoice::Kind::kType) {
     throw io::ConfigError("--controller " + o.controller + ": fmu export packs one of quadcosim's controller types (" +
@@ -39,7 +40,7 @@ fmi::FmuConfig fmu_config_from(const FmuExportOptions& o, std::vector<std::strin
                           "); a class written in Python or an FMU is not packed");
   }
   if (!o.scenario.empty()) {
-    sc = io::load_scenario(o.scenario, o.controller);
+    sc = io::load_scenario(o.scenario, o.controller, resolvers);
   } else if (!o.controller.empty()) {
     sc.controller = controllers::make_config(o.controller, sc.vehicle);
   }
@@ -98,12 +99,13 @@ fmi::FmuConfig fmu_config_from(const FmuExportOptions& o, std::vector<std::strin
   return c;
 }
 
-FmuExport export_fmu(const FmuExportOptions& o, const std::function<fs::path()>& find_library) {
+FmuExport export_fmu(const FmuExportOptions& o, const std::function<fs::path()>& find_library,
+                     const io::ScenarioResolvers& resolvers) {
   if (fs::path(o.out).extension() != ".fmu")
     throw std::invalid_argument(fmt::format("--out: '{}' must end in .fmu", o.out));
   FmuExport r;
   fmi::FmuConfig& config = r.config;
-  config = fmu_config_from(o, r.notes);
+  config = fmu_config_from(o, r.notes, resolvers);
   r.platform = platform_folder(config.fmi_version);
   if (r.platform.empty())
     throw std::invalid_argument(

@@ -12,6 +12,7 @@
 
 #include "fmi/export/fmu_config.hpp"
 #include "fmi/model_description.hpp"
+#include "io/scenario_resolvers.hpp"
 
 namespace quadcosim::hosts {
 
@@ -47,7 +48,8 @@ struct FmuExport {
 /// known to be packable; it throws to say the library is missing). Throws std::invalid_argument for
 /// bad input (the file name, the scenario, a setting an FMU cannot express) and fmi::FmuError when
 /// the archive cannot be written.
-FmuExport export_fmu(const FmuExportOptions& o, const std::function<std::filesystem::path()>& find_library);
+FmuExport export_fmu(const FmuExportOptions& o, const std::function<std::filesystem::path()>& find_library,
+                     const io::ScenarioResolvers& resolvers);
 
 /// What an FMU declares, and whether it has a binary for this machine.
 struct FmuInfo {

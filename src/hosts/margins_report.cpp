@@ -193,11 +193,12 @@ MeasuredReport measure_all(const MarginsSetup& s, const analysis::MeasurementOpt
 
 }  // namespace
 
-MarginsPlan plan_margins(const std::string& path, const std::string& controller_type, bool measure) {
+MarginsPlan plan_margins(const std::string& path, const std::string& controller_type, bool measure,
+                         const io::ScenarioResolvers& resolvers) {
   MarginsPlan p;
   MarginsSetup& s = p.setup;
   try {
-    s = margins_setup(path, controller_type);
+    s = margins_setup(path, controller_type, resolvers);
     const controllers::PaperController* paper = controllers::paper_controller(s.controller);
     p.analytic = paper != nullptr;
     p.measured = !p.analytic || measure;

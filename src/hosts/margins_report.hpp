@@ -31,7 +31,8 @@ struct MarginsPlan {
 /// replaces its controller.type); `measure` measures the paper controller's margins too. Throws
 /// io::ConfigError (bad file), control::CareError (a failed LQR design) and std::invalid_argument
 /// naming the scenario when the vehicle cannot be linearised about hover.
-MarginsPlan plan_margins(const std::string& path, const std::string& controller_type, bool measure);
+MarginsPlan plan_margins(const std::string& path, const std::string& controller_type, bool measure,
+                         const io::ScenarioResolvers& resolvers);
 
 struct MarginsReport {
   nlohmann::json doc;  ///< margins.json

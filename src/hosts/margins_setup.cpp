@@ -46,10 +46,11 @@ Eigen::Vector3d trim_position(const control::ControllerConfig& c, std::vector<st
 
 }  // namespace
 
-MarginsSetup margins_setup(const std::string& path, const std::string& controller_type) {
+MarginsSetup margins_setup(const std::string& path, const std::string& controller_type,
+                           const io::ScenarioResolvers& resolvers) {
   MarginsSetup s;
   if (path.empty()) {
-    s.controller = io::defaults_flown_by(controller_type).controller;
+    s.controller = io::defaults_flown_by(controller_type, resolvers).controller;
     s.source = fmt::format("defaults (the paper's vehicle, {} controller, plant 100 Hz, controller 50 Hz)",
                            s.controller.type());
     s.measured.vehicle = s.plant;
@@ -57,7 +58,7 @@ MarginsSetup margins_setup(const std::string& path, const std::string& controlle
     s.measured.trim_p_W = trim_position(s.controller, s.measured_notes);
     return s;
   }
-  const io::Scenario sc = io::load_scenario(path, controller_type);
+  const io::Scenario sc = io::load_scenario(path, controller_type, resolvers);
   s.source = path;
   s.plant = sc.vehicle;
   s.controller = sc.controller;

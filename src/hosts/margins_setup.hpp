@@ -9,6 +9,7 @@
 #include "analysis/hover_loops.hpp"
 #include "analysis/measured_margins.hpp"
 #include "control/controller_config.hpp"
+#include "io/scenario_resolvers.hpp"
 #include "model/vehicle_params.hpp"
 
 namespace quadcosim::hosts {
@@ -29,6 +30,7 @@ struct MarginsSetup {
 /// The controller of the scenario at `path` (the defaults when empty; `controller_type`, when not
 /// empty, replaces its controller.type) after its schedule, its plant and its timing. Throws
 /// io::ConfigError (bad file) or std::invalid_argument (a refused scheduled change).
-MarginsSetup margins_setup(const std::string& path, const std::string& controller_type);
+MarginsSetup margins_setup(const std::string& path, const std::string& controller_type,
+                           const io::ScenarioResolvers& resolvers);
 
 }  // namespace quadcosim::hosts

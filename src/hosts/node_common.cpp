@@ -22,7 +22,8 @@ namespace quadcosim::hosts {
 
 std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
                                                const std::string& scenario, const std::string& vehicle,
-                                               const std::string& ns, const std::string& controller_type) {
+                                               const std::string& ns, const io::ScenarioResolvers& resolvers,
+                                               const std::string& controller_type) {
   hosts::install_stop_handlers();
   if (std::string err = use_cpus(cpus); !err.empty()) {
     std::cerr << "error: " << who << ": --cpus: " << err << '\n';
@@ -30,8 +31,8 @@ std::optional<io::Scenario> start_node_process(const std::string& who, const std
   }
   // One write: run --pin starts both processes on one stderr, and grep reads whole lines.
   if (!cpus.empty()) std::cerr << fmt::format("{}: on CPU(s) {} only\n", who, cpus);
-  io::Scenario sc =
-      scenario.empty() ? io::defaults_flown_by(controller_type) : io::load_scenario(scenario, controller_type);
+  io::Scenario sc = scenario.empty() ? io::defaults_flown_by(controller_type, resolvers)
+                                     : io::load_scenario(scenario, controller_type, resolvers);
   if (!vehicle.empty()) {
     sc.vehicle = io::load_vehicle(vehicle);
     if (sc.controller_fmu) {

@@ -32,10 +32,12 @@ using dds::steady_ns;
 /// (exit 2); throws io::ConfigError for a bad file or when the scenario asks for injected faults,
 /// which only the in-process transport can inject (over DDS, faults come from the network: tc netem,
 /// docs/reliability.md).
-/// `controller_type`, when not empty, replaces the scenario's controller.type (--controller).
+/// `controller_type`, when not empty, replaces the scenario's controller.type (--controller); the
+/// scenario's FMUs and Python classes are made by `resolvers`.
 std::optional<io::Scenario> start_node_process(const std::string& who, const std::string& cpus,
                                                const std::string& scenario, const std::string& vehicle,
-                                               const std::string& ns, const std::string& controller_type = "");
+                                               const std::string& ns, const io::ScenarioResolvers& resolvers,
+                                               const std::string& controller_type = "");
 
 /// Real-time loops: lets the DDS transport deliver messages until 1 ms before `deadline_ns`
 /// (steady_ns), then spins on the clock until the deadline (5 % of a core for a 20 ms period), so

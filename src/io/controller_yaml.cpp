@@ -5,13 +5,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <map>
-#include <mutex>
 #include <string_view>
 
 #include "controllers/registry.hpp"
-#include "fmi/fmu_controller.hpp"
-#include "fmi/fmu_plant.hpp"
 #include "io/sitl_yaml.hpp"
 #include "util/did_you_mean.hpp"
 
@@ -150,21 +146,6 @@ void read_parameters(YamlSection& s, control::ControllerConfig& c,
 
 namespace {
 
-// One FMU's loaded description and binary per file, shared by every scenario that names it while any
-// of them lives (a sweep loads its scenario once per run).
-std::shared_ptr<fmi::Fmu> load_fmu(const std::string& path) {
-  static std::mutex mutex;
-  static std::map<std::string, std::pair<std::filesystem::file_time_type, std::weak_ptr<fmi::Fmu>>> cache;
-  std::error_code ec;
-  const auto mtime = std::filesystem::last_write_time(path, ec);
-  const std::lock_guard lock(mutex);
-  auto& entry = cache[path];
-  if (auto fmu = entry.second.lock(); fmu && !ec && entry.first == mtime) return fmu;
-  std::shared_ptr<fmi::Fmu> fmu = fmi::Fmu::load(path);
-  entry = {mtime, fmu};
-  return fmu;
-}
-
 // A list of FMU variable names under `key` of `s` (one per component of a signal).
 std::vector<std::string> variable_names(YamlSection& s, const std::string& key) {
   const YAML::Node n = s.raw(key);
@@ -237,43 +218,42 @@ auto checked_fmu(YamlSection& s, F make) -> decltype(make()) {
 
 }  // namespace
 
-std::shared_ptr<const sim::ExternalDynamicsFactory> make_plant_fmu(YamlSection& s, const FmuSpec& spec) {
-  return checked_fmu(s, [&] { return std::make_shared<const fmi::FmuPlant>(load_fmu(spec.path), spec.mapping); });
-}
-
-std::shared_ptr<const control::Controller> make_controller_fmu(YamlSection& s, const FmuSpec& spec,
-                                                               const model::VehicleParams& vehicle) {
-  return checked_fmu(s, [&]() -> std::shared_ptr<const control::Controller> {
-    return std::make_shared<fmi::FmuController>(load_fmu(spec.path), spec.mapping, vehicle);
-  });
-}
-
-// Why an FMU controller's inputs of extra sensors (magnetometer.field[1], gnss.fix, ...) do not fit the
-// sensors the scenario's vehicle carries, or empty.
-std::string controller_sensors_error(const Scenario& sc) {
-  if (!sc.controller.controller) return {};
-  const fmi::FmuController* fmu = fmi::fmu_controller(*sc.controller.controller);
-  return fmu ? fmu->check_sensors(sc.simulation.plant.realism.extra_sensors) : std::string();
-}
-
 namespace {
 
-std::mutex python_factory_mutex;
-PythonControllerFactory python_factory;
-
-PythonControllerFactory python_controller_factory() {
-  const std::lock_guard lock(python_factory_mutex);
-  return python_factory;
+const FmuResolver& fmu_resolver(YamlSection& s, const ScenarioResolvers& resolvers) {
+  if (!resolvers.fmu) s.fail("fmu", "this program cannot load FMUs here (it was given no FMU resolver)");
+  return *resolvers.fmu;
 }
 
 }  // namespace
 
+std::shared_ptr<const sim::ExternalDynamicsFactory> make_plant_fmu(YamlSection& s, const FmuSpec& spec,
+                                                                   const ScenarioResolvers& resolvers) {
+  const FmuResolver& fmus = fmu_resolver(s, resolvers);
+  return checked_fmu(s, [&] { return fmus.plant(spec); });
+}
+
+std::shared_ptr<const control::Controller> make_controller_fmu(YamlSection& s, const FmuSpec& spec,
+                                                               const model::VehicleParams& vehicle,
+                                                               const ScenarioResolvers& resolvers) {
+  const FmuResolver& fmus = fmu_resolver(s, resolvers);
+  return checked_fmu(s, [&] { return fmus.controller(spec, vehicle); });
+}
+
+// Why an FMU controller's inputs of extra sensors (magnetometer.field[1], gnss.fix, ...) do not fit the
+// sensors the scenario's vehicle carries, or empty.
+std::string controller_sensors_error(const Scenario& sc, const ScenarioResolvers& resolvers) {
+  if (!sc.controller.controller || !resolvers.fmu) return {};
+  return resolvers.fmu->sensors_error(*sc.controller.controller, sc.simulation.plant.realism.extra_sensors);
+}
+
 // A `controller:` section: `type` (default paper) and the parameters, for `vehicle`; or `fmu` (with
 // its inputs, outputs and parameters) and the node's and the FMU's parameters; or `python` (type
-// python: a class written in Python, resolved by the installed PythonControllerFactory) and the node's
+// python: a class written in Python, resolved by resolvers.python) and the node's
 // and the class's declared parameters.
 control::ControllerConfig read_controller(YamlSection& s, const model::VehicleParams& vehicle,
-                                          const std::filesystem::path& folder, std::optional<FmuSpec>* fmu_spec) {
+                                          const std::filesystem::path& folder, std::optional<FmuSpec>* fmu_spec,
+                                          const ScenarioResolvers& resolvers) {
   if (s.has("sitl") || (s.has("type") && s.text("type", "") == "sitl")) {
     if (s.has("type") && s.text("type", "") != "sitl") {
       s.fail("type", "got '" + s.text("type", "") + "' beside sitl; the firmware is the controller (type: sitl)");
@@ -300,7 +280,7 @@ control::ControllerConfig read_controller(YamlSection& s, const model::VehiclePa
     if (target.empty()) {
       s.fail("python", "missing; expected the controller's class as module:Class (e.g. my_controllers:AltitudePD)");
     }
-    const PythonControllerFactory factory = python_controller_factory();
+    const PythonControllerFactory& factory = resolvers.python;
     if (!factory) {
       s.fail("python",
              "this quadcosim was built without Python (or runs without an interpreter), so a controller written in "
@@ -326,7 +306,7 @@ control::ControllerConfig read_controller(YamlSection& s, const model::VehiclePa
     const FmuSpec spec = read_fmu_spec(s, folder);
     control::ControllerConfig c;
     c.vehicle = vehicle;
-    c.controller = make_controller_fmu(s, spec, vehicle);
+    c.controller = make_controller_fmu(s, spec, vehicle, resolvers);
     read_parameters(s, c, nullptr);
     if (fmu_spec) *fmu_spec = spec;
     return c;
@@ -472,11 +452,6 @@ void set_controller_type(YAML::Node root, const std::string& controller) {
       if (!choice.target.empty()) c["sitl"]["binary"] = choice.target;
       break;
   }
-}
-
-void set_python_controller_factory(PythonControllerFactory factory) {
-  const std::lock_guard lock(python_factory_mutex);
-  python_factory = std::move(factory);
 }
 
 }  // namespace quadcosim::io

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/external_dynamics.hpp"
@@ -97,7 +98,7 @@ class ExternalPlant : public ::testing::TestWithParam<const char*> {};
 TEST_P(ExternalPlant, NativeModelBehindTheSeamWritesTheSameTrajectoryCsv) {
   const fs::path dir = fs::temp_directory_path() / ("quadcosim_external_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  Scenario sc = load_scenario((kSourceDir / "scenarios" / GetParam()).string());
+  Scenario sc = load_scenario((kSourceDir / "scenarios" / GetParam()).string(), hosts::test_resolvers());
   const std::string native = trajectory_csv(sc, dir / "native.csv");
 
   auto factory = std::make_shared<NativeFactory>(sc.simulation.plant.substeps);
@@ -117,7 +118,7 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, ExternalPlant,
                                            "paper/yaw_step.yaml", "realism/roll_step_noisy_imu.yaml"));
 
 TEST(ExternalPlantSeam, OutputsForEveryPublicationAndOneStepPerTick) {
-  Scenario sc = load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string());
+  Scenario sc = load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string(), hosts::test_resolvers());
   auto factory = std::make_shared<NativeFactory>(1);
   sc.simulation.plant.external = factory;
   sim::InProcessTransport bus;
@@ -134,7 +135,8 @@ TEST(ExternalPlantSeam, OutputsForEveryPublicationAndOneStepPerTick) {
 }
 
 TEST(ExternalPlantSeam, NativeOnlyFeaturesAreRefusedByKey) {
-  const Scenario base = load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string());
+  const Scenario base =
+      load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string(), hosts::test_resolvers());
   auto expect_refused = [&](Scenario sc, const std::string& key) {
     sc.simulation.plant.external = std::make_shared<NativeFactory>(1);
     EXPECT_EQ(sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle), key);

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <string>
 
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "io/scenario.hpp"
 
 namespace quadcosim::io {
@@ -17,7 +18,7 @@ std::string write_yaml(const std::string& name, const std::string& text) {
 
 std::string error_of(const std::string& name, const std::string& text) {
   try {
-    load_scenario(write_yaml(name, text));
+    load_scenario(write_yaml(name, text), hosts::test_resolvers());
   } catch (const ConfigError& e) {
     return e.what();
   }
@@ -25,7 +26,7 @@ std::string error_of(const std::string& name, const std::string& text) {
 }
 
 TEST(ReliabilityKeysTest, DefaultsAreAHalfSecondStopWatchdogAndNoFaults) {
-  const Scenario sc = load_scenario(write_yaml("defaults", "simulation: {duration_s: 1}\n"));
+  const Scenario sc = load_scenario(write_yaml("defaults", "simulation: {duration_s: 1}\n"), hosts::test_resolvers());
   EXPECT_EQ(sc.simulation.plant.watchdog_ticks, 50);
   EXPECT_EQ(sc.simulation.plant.watchdog_policy, sim::WatchdogPolicy::kStop);
   EXPECT_FALSE(sc.simulation.faults.active());
@@ -44,7 +45,8 @@ message_faults:
   topics:
     motor_commands: {drop_probability: 0.2}
     controller_status: {delay_ticks: 3}
-)"));
+)"),
+                                    hosts::test_resolvers());
   EXPECT_EQ(sc.simulation.plant.watchdog_ticks, 50);  // 0.25 s at 200 Hz
   EXPECT_EQ(sc.simulation.plant.watchdog_policy, sim::WatchdogPolicy::kHold);
   const auto& t = sc.simulation.faults.topics;

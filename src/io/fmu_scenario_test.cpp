@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "io/scenario.hpp"
 #include "sim/simulation.hpp"
 
@@ -43,7 +44,7 @@ class FmuScenario : public ::testing::Test {
   /// The message load_scenario refuses `text` with ("" when it is not refused).
   std::string refusal(const std::string& text) {
     try {
-      load_scenario(write(text));
+      load_scenario(write(text), hosts::test_resolvers());
     } catch (const ConfigError& e) {
       return e.what();
     }
@@ -75,8 +76,8 @@ std::vector<model::State> fly(const Scenario& sc) {
 }
 
 TEST_F(FmuScenario, PointMassPlantFliesThePaperAltitudeChannelAsTheNativePlantDoes) {
-  const Scenario native = load_scenario(write(kVertical));
-  const Scenario fmu = load_scenario(write(std::string(kVertical) + kPointMassPlant));
+  const Scenario native = load_scenario(write(kVertical), hosts::test_resolvers());
+  const Scenario fmu = load_scenario(write(std::string(kVertical) + kPointMassPlant), hosts::test_resolvers());
   ASSERT_TRUE(fmu.simulation.plant.external);
   ASSERT_TRUE(fmu.plant_fmu);
   EXPECT_EQ(fmu.plant_fmu->path, (dir_ / "fmus/point_mass.fmu").lexically_normal().string());  // relative to the file
@@ -146,27 +147,27 @@ TEST_F(FmuScenario, AControllerFmuWithSensorInputsNeedsTheSensorsOn) {
   const std::string all = controller + "sensors: {magnetometer: {}, barometer: {}, gnss: {}}\n";
   EXPECT_EQ(refusal(all), "");
   // The command line's --fmu is checked against the scenario's sensors too.
-  Scenario sc = load_scenario(write(std::string(kVertical)));
+  Scenario sc = load_scenario(write(std::string(kVertical)), hosts::test_resolvers());
   try {
-    use_controller_fmu(sc, FmuSpec{(dir_ / "fmus/sensor_echo.fmu").string(), {}}, "--fmu");
+    use_controller_fmu(sc, FmuSpec{(dir_ / "fmus/sensor_echo.fmu").string(), {}}, "--fmu", hosts::test_resolvers());
     ADD_FAILURE() << "a controller FMU with sensor inputs was taken for a vehicle without the sensors";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("--fmu: fmu: sensor_echo.fmu has the input 'magnetometer.field[1]'"),
               std::string::npos)
         << e.what();
   }
-  Scenario on = load_scenario(write(all));
-  use_controller_fmu(on, FmuSpec{(dir_ / "fmus/sensor_echo.fmu").string(), {}}, "--fmu");
+  Scenario on = load_scenario(write(all), hosts::test_resolvers());
+  use_controller_fmu(on, FmuSpec{(dir_ / "fmus/sensor_echo.fmu").string(), {}}, "--fmu", hosts::test_resolvers());
 }
 
 TEST_F(FmuScenario, TheCommandLinesFmuReplacesThePlant) {
-  Scenario sc = load_scenario(write(std::string(kVertical)));
-  use_plant_fmu(sc, FmuSpec{(dir_ / "fmus/point_mass.fmu").string(), {}}, "--fmu");
+  Scenario sc = load_scenario(write(std::string(kVertical)), hosts::test_resolvers());
+  use_plant_fmu(sc, FmuSpec{(dir_ / "fmus/point_mass.fmu").string(), {}}, "--fmu", hosts::test_resolvers());
   ASSERT_TRUE(sc.simulation.plant.external);
   EXPECT_NE(sc.simulation.plant.external->describe().find("point_mass.fmu (model 'PointMass', FMI 2.0)"),
             std::string::npos);
   try {
-    use_plant_fmu(sc, FmuSpec{(dir_ / "nothing.fmu").string(), {}}, "--fmu");
+    use_plant_fmu(sc, FmuSpec{(dir_ / "nothing.fmu").string(), {}}, "--fmu", hosts::test_resolvers());
     ADD_FAILURE() << "a missing FMU was taken";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("--fmu: fmu: ", 0), 0u) << e.what();

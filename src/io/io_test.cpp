@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "controllers/paper/paper_controller.hpp"
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
 #include "io/trajectory_csv.hpp"
@@ -145,7 +146,7 @@ class PaperScenarioTest : public ::testing::TestWithParam<PaperScenario> {};
 TEST_P(PaperScenarioTest, LoadsWithTheDocumentedValues) {
   const PaperScenario& e = GetParam();
   const std::string path = (kSourceDir / "scenarios" / "paper" / e.file).string();
-  const Scenario sc = load_scenario(path);
+  const Scenario sc = load_scenario(path, hosts::test_resolvers());
 
   EXPECT_EQ(sc.path, path);
   EXPECT_EQ(sc.name, e.name);
@@ -207,7 +208,8 @@ INSTANTIATE_TEST_SUITE_P(Paper, PaperScenarioTest, ::testing::ValuesIn(paper_sce
                          [](const auto& info) { return info.param.name; });
 
 TEST(ScenarioTest, AltitudeStepReferenceFigures) {
-  const Scenario sc = load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string());
+  const Scenario sc =
+      load_scenario((kSourceDir / "scenarios/paper/altitude_step.yaml").string(), hosts::test_resolvers());
   ASSERT_EQ(sc.steps.size(), 1u);
   const std::map<std::string, double> expected = {
       {"overshoot_pct", 18.0}, {"peak_time_s", 2.5}, {"settling_time_2pct_s", 8.0}};
@@ -218,7 +220,7 @@ TEST(ScenarioTest, AltitudeStepReferenceFigures) {
 TEST(ScenarioTest, EmptyMappingGivesTheDefaults) {
   TempDir dir;
   const std::string path = dir.write("minimal.yaml", "name: minimal\n");
-  const Scenario sc = load_scenario(path);
+  const Scenario sc = load_scenario(path, hosts::test_resolvers());
   EXPECT_EQ(sc.name, "minimal");
   EXPECT_EQ(sc.simulation.plant.clock.period_ns, 10'000'000);
   EXPECT_EQ(sc.simulation.controller_divider, 2);
@@ -227,7 +229,7 @@ TEST(ScenarioTest, EmptyMappingGivesTheDefaults) {
   EXPECT_TRUE(sc.steps.empty());
 
   // Without a name, the file's stem.
-  EXPECT_EQ(load_scenario(dir.write("unnamed.yaml", "description: x\n")).name, "unnamed");
+  EXPECT_EQ(load_scenario(dir.write("unnamed.yaml", "description: x\n"), hosts::test_resolvers()).name, "unnamed");
 }
 
 // The extra sensors' keys in their units (uT, deg, Pa, m), in SI in the configuration; what is not
@@ -241,7 +243,8 @@ TEST(ScenarioTest, ExtraSensorKeysAreReadInTheirUnits) {
                                               "  magnetometer: {rate_hz: 50, field_uT: 48, declination_deg: 2.5,\n"
                                               "                 hard_iron_uT: [2, -1.5, 0.8]}\n"
                                               "  barometer: {noise_sigma_Pa: 3, latency_ticks: 2}\n"
-                                              "  gnss: {rate_hz: 5, vertical_sigma_m: 1.5}\n"));
+                                              "  gnss: {rate_hz: 5, vertical_sigma_m: 1.5}\n"),
+                                    hosts::test_resolvers());
   const sensors::SensorSet& s = sc.simulation.plant.realism.extra_sensors;
   ASSERT_TRUE(s.magnetometer && s.barometer && s.gnss);
   const sensors::MagnetometerConfig defaults_m;
@@ -266,7 +269,7 @@ TEST(ScenarioTest, ExtraSensorKeysAreReadInTheirUnits) {
   EXPECT_EQ(s.gnss->site.height_m, 420.0);
   // A key out of its range is named with its range, in the key's unit.
   try {
-    load_scenario(dir.write("bad.yaml", "sensors:\n  magnetometer: {field_uT: 500}\n"));
+    load_scenario(dir.write("bad.yaml", "sensors:\n  magnetometer: {field_uT: 500}\n"), hosts::test_resolvers());
     FAIL() << "accepted";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("sensors.magnetometer.field_uT"), std::string::npos) << e.what();
@@ -284,7 +287,7 @@ schedule:
   - at_s: 1.25
     set: {mode: position}
 )");
-  const Scenario sc = load_scenario(path);
+  const Scenario sc = load_scenario(path, hosts::test_resolvers());
   EXPECT_EQ(sc.simulation.plant.clock.period_ns, 5'000'000);
   EXPECT_EQ(sc.simulation.controller_divider, 4);
   EXPECT_EQ(sc.simulation.duration_ticks, 600);
@@ -316,7 +319,8 @@ schedule:
   - at_s: 1
     set:
       lqr: {pitch: {q_angle: 4}}
-)"));
+)"),
+                                        hosts::test_resolvers());
   const Scenario dotted = load_scenario(dir.write("dotted.yaml", R"(controller:
   mode: position
   altitude.kp: 5.5
@@ -328,7 +332,8 @@ schedule:
 schedule:
   - at_s: 1
     set: {lqr.pitch.q_angle: 4}
-)"));
+)"),
+                                        hosts::test_resolvers());
   const Scenario mixed = load_scenario(dir.write("mixed.yaml", R"(controller:
   mode: position
   altitude: {kp: 5.5}
@@ -338,7 +343,8 @@ schedule:
 schedule:
   - at_s: 1
     set: {lqr.pitch: {q_angle: 4}}
-)"));
+)"),
+                                       hosts::test_resolvers());
   for (const Scenario* sc : {&nested, &dotted, &mixed}) {
     SCOPED_TRACE(sc->path);
     const auto& p = paper_params(sc->controller);
@@ -373,11 +379,11 @@ schedule:
   - at_s: 1
     set: {z_des: 6, paper: {position.kd: 1.1}, se3: {k_v.x: 2.5}}
 )");
-  const Scenario paper = load_scenario(file);
+  const Scenario paper = load_scenario(file, hosts::test_resolvers());
   EXPECT_EQ(paper.controller.type(), "paper");
   EXPECT_EQ(paper_params(paper.controller).roll.q_angle, 2.0);
   EXPECT_EQ(paper_params(paper.controller).position.kp, 0.9);
-  const Scenario se3 = load_scenario(file, "se3");
+  const Scenario se3 = load_scenario(file, "se3", hosts::test_resolvers());
   EXPECT_EQ(se3.controller.type(), "se3");
   EXPECT_EQ(std::get<double>(*control::get_parameter(se3.controller, "k_x.x")), 7.5);
   for (const Scenario* sc : {&paper, &se3}) {
@@ -392,7 +398,7 @@ schedule:
   // A typo in the gains of a type that does not fly is still an error, named at its key.
   const std::string typo = dir.write("typo.yaml", "controller:\n  paper:\n    lqr: {roll: {q_angel: 2}}\n");
   try {
-    (void)load_scenario(typo, "se3");
+    (void)load_scenario(typo, "se3", hosts::test_resolvers());
     ADD_FAILURE() << "a misspelt paper gain was accepted while se3 flies";
   } catch (const ConfigError& e) {
     EXPECT_THAT(e.what(), HasSubstr("controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel'"));
@@ -400,7 +406,7 @@ schedule:
   // The node's parameters belong to what is flown, not to a type's gains.
   const std::string node = dir.write("node.yaml", "controller:\n  se3: {z_des: 3}\n");
   try {
-    (void)load_scenario(node);
+    (void)load_scenario(node, hosts::test_resolvers());
     ADD_FAILURE() << "z_des inside se3: was accepted";
   } catch (const ConfigError& e) {
     EXPECT_THAT(e.what(), HasSubstr("controller.se3.z_des: 'z_des' is the node's"));
@@ -417,8 +423,8 @@ TEST(ScenarioTest, AnotherTypeTakesTheFilesFlatGainsAsThePaperControllers) {
   lqr: {roll: {q_angle: 3.0}}
   position: {kp: 0.7}
 )");
-  EXPECT_EQ(paper_params(load_scenario(file).controller).roll.q_angle, 3.0);
-  const Scenario se3 = load_scenario(file, "se3");
+  EXPECT_EQ(paper_params(load_scenario(file, hosts::test_resolvers()).controller).roll.q_angle, 3.0);
+  const Scenario se3 = load_scenario(file, "se3", hosts::test_resolvers());
   EXPECT_EQ(se3.controller.type(), "se3");
   EXPECT_EQ(se3.controller.node.setpoint.p_des_W.z(), 2.0);
   YAML::Node root = YAML::LoadFile(file);
@@ -430,7 +436,7 @@ TEST(ScenarioTest, AnotherTypeTakesTheFilesFlatGainsAsThePaperControllers) {
   EXPECT_EQ(root["controller"]["z_des"].as<double>(), 2.0);
   // Back to paper: the moved gains apply again, from their section.
   set_controller_type(root, "paper");
-  EXPECT_EQ(paper_params(load_scenario(root, file).controller).roll.q_angle, 3.0);
+  EXPECT_EQ(paper_params(load_scenario(root, file, hosts::test_resolvers()).controller).roll.q_angle, 3.0);
 }
 
 TEST(ScenarioTest, ControllerChoicesAreParsedOrRefusedWithWhatWasExpected) {
@@ -453,7 +459,8 @@ TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {
   layout: x
   spin: [-1, 1, -1, 1]
   motor: {model: first_order, tau_up_s: 0.03}
-)"));
+)"),
+                                    hosts::test_resolvers());
   EXPECT_EQ(sc.vehicle.mass_kg, 2.5);
   EXPECT_EQ(sc.vehicle.layout, model::RotorLayout::kX);
   EXPECT_EQ(sc.vehicle.spin, (std::array<int, 4>{-1, 1, -1, 1}));
@@ -527,7 +534,7 @@ TEST_P(BadScenarioTest, ConfigErrorNamesFileKeyAndValue) {
   TempDir dir;
   const std::string path = dir.write(b.label + ".yaml", b.yaml);
   try {
-    load_scenario(path);
+    load_scenario(path, hosts::test_resolvers());
     FAIL() << "no error for\n" << b.yaml;
   } catch (const ConfigError& e) {
     const std::string msg = e.what();
@@ -713,7 +720,7 @@ TEST(ScenarioTest, MissingFileIsAConfigErrorNamingIt) {
   TempDir dir;
   const std::string path = dir.file("does_not_exist.yaml");
   try {
-    load_scenario(path);
+    load_scenario(path, hosts::test_resolvers());
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
@@ -725,7 +732,8 @@ TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
   const model::VehicleParams v = load_vehicle(dir.write("v.yaml", "mass_kg: 3\nIzz_kg_m2: 0.06\n"));
   EXPECT_EQ(v.mass_kg, 3.0);
   EXPECT_EQ(v.Izz_kg_m2, 0.06);
-  const control::ControllerConfig c = load_controller(dir.write("c.yaml", "lqr: {roll: {r: 20}}\nyaw_des: 0.5\n"), v);
+  const control::ControllerConfig c =
+      load_controller(dir.write("c.yaml", "lqr: {roll: {r: 20}}\nyaw_des: 0.5\n"), v, hosts::test_resolvers());
   EXPECT_EQ(paper_params(c).roll.r, 20.0);
   EXPECT_EQ(c.node.setpoint.yaw_des_rad, 0.5);
   EXPECT_EQ(c.vehicle.mass_kg, 3.0);
@@ -742,7 +750,7 @@ TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
   }
   const std::string bad_controller = dir.write("bad_c.yaml", "lqr:\n  roll: {r: -1}\n");
   try {
-    load_controller(bad_controller, v);
+    load_controller(bad_controller, v, hosts::test_resolvers());
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     const std::string msg = e.what();
@@ -1194,7 +1202,7 @@ TEST(JudgeTest, SpecPaperAndTheOldCriteriaKeyAreRead) {
                                      "  limits:\n"
                                      "    spec: {max_saturated_s: 0.5}\n"
                                      "    paper: {max_tilt_saturated_s: 0}\n");
-  const Scenario sc = load_scenario(path);
+  const Scenario sc = load_scenario(path, hosts::test_resolvers());
   ASSERT_EQ(sc.steps.size(), 2u);
   const auto& c = sc.steps[0].criteria;  // spec first, then paper, each in file order
   ASSERT_EQ(c.size(), 3u);
@@ -1532,7 +1540,8 @@ TEST(SaturationTest, LimitsAreCriteria) {
   Scenario sc = load_scenario(dir.write("limits.yaml", R"(simulation: {duration_s: 3}
 analysis:
   limits: {max_saturated_s: 1.5, max_rotor_saturated_s: 1.0, max_tilt_saturated_s: 0.2, max_rms_u1_deviation_n: 0.5}
-)"));
+)"),
+                              hosts::test_resolvers());
   ASSERT_TRUE(sc.limits.has_value());
   ASSERT_EQ(sc.limits->criteria.size(), 7u);
   const auto r = evaluate_saturation(sc, saturation_series());

@@ -84,14 +84,7 @@ void emit(YAML::Emitter& e, const nlohmann::json& j) {
   }
 }
 
-PythonModuleLocator& python_module_locator() {
-  static PythonModuleLocator locator;
-  return locator;
-}
-
 }  // namespace
-
-void set_python_module_locator(PythonModuleLocator locator) { python_module_locator() = std::move(locator); }
 
 std::string file_sha256(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -142,8 +135,7 @@ nlohmann::json describe_run(const Scenario& flown, const RunContext& context) {
   controller["parameters"] = parameter_values(*flown.controller.controller);
   std::string label = type;
   if (!context.python_target.empty()) {
-    const PythonModuleLocator& locate = python_module_locator();
-    const std::string file = locate ? locate(context.python_target) : "";
+    const std::string file = context.python_module ? context.python_module(context.python_target) : "";
     std::string module_file;
     if (!file.empty()) {
       std::error_code ec;

@@ -28,14 +28,10 @@ struct RunContext {
   std::string controller_override;
   /// A Python controller's "module:Class" (the effective scenario's controller.python), else "".
   std::string python_target;
+  /// What finds python_target's module file (the host's ScenarioResolvers::python_module); empty: the
+  /// record's module file and hash are null.
+  PythonModuleLocator python_module;
 };
-
-/// What finds the source file of a Python controller's module ("module:Class" -> the file the
-/// interpreter imported, "" when it cannot tell). Installed beside the resolver of `controller:
-/// {python: ...}` (set_python_controller_factory) by whatever hosts an interpreter; without one, a
-/// Python controller's provenance has a null module file and hash.
-using PythonModuleLocator = std::function<std::string(const std::string& target)>;
-void set_python_module_locator(PythonModuleLocator locator);
 
 /// The provenance record of a run flying `flown` (the effective scenario: the override already
 /// applied), as JSON (its schema in docs/outputs.md): controller (label, type, the file's type,

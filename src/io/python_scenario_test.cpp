@@ -1,6 +1,6 @@
-// `controller: {python: "module:Class"}` in a scenario: resolved through the hook io leaves to whatever
-// hosts a Python interpreter (io::set_python_controller_factory), refused by name without one. The
-// hook here is a C++ stand-in (it returns example_pd), so these tests need no Python.
+// `controller: {python: "module:Class"}` in a scenario: resolved through the factory the caller hands
+// io (ScenarioResolvers::python: whatever hosts a Python interpreter), refused by name without one.
+// The factory here is a C++ stand-in (it returns example_pd), so these tests need no Python.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -25,7 +25,6 @@ class PythonScenarioTest : public ::testing::Test {
     dir_ = pattern;
   }
   void TearDown() override {
-    set_python_controller_factory({});
     std::error_code ec;
     fs::remove_all(dir_, ec);
   }
@@ -37,7 +36,7 @@ class PythonScenarioTest : public ::testing::Test {
   /// The message of the ConfigError loading `text` throws ("" when it loads).
   std::string error_of(const std::string& text) const {
     try {
-      load_scenario(write(text));
+      load_scenario(write(text), resolvers_);
     } catch (const ConfigError& e) {
       return e.what();
     }
@@ -45,6 +44,7 @@ class PythonScenarioTest : public ::testing::Test {
   }
 
   fs::path dir_;
+  ScenarioResolvers resolvers_;  ///< no FMUs; the Python factory each test sets
 };
 
 TEST_F(PythonScenarioTest, WithoutAnInterpreterTheKeyIsRefusedByName) {
@@ -58,12 +58,12 @@ TEST_F(PythonScenarioTest, TheHookGetsTargetFolderAndVehicleAndTheSectionItsPara
   std::string target;
   fs::path folder;
   double mass = 0.0;
-  set_python_controller_factory([&](const std::string& t, const fs::path& f, const model::VehicleParams& v) {
+  resolvers_.python = [&](const std::string& t, const fs::path& f, const model::VehicleParams& v) {
     target = t;
     folder = f;
     mass = v.mass_kg;
     return controllers::make_config("example_pd", v).controller;
-  });
+  };
   const Scenario sc = load_scenario(write(R"(
 vehicle: {mass_kg: 2.5}
 controller:
@@ -73,7 +73,8 @@ controller:
   position.kp: 2.5
 schedule:
   - {at_s: 1, set: {position.kd: 0.5}}
-)"));
+)"),
+                                    resolvers_);
   EXPECT_EQ(target, "my_controllers:Outer.Inner");
   EXPECT_EQ(folder, dir_);
   EXPECT_EQ(mass, 2.5);
@@ -90,18 +91,18 @@ schedule:
 }
 
 TEST_F(PythonScenarioTest, TheHookRefusingIsAConfigErrorAtTheKey) {
-  set_python_controller_factory([](const std::string&, const fs::path&,
-                                   const model::VehicleParams&) -> std::shared_ptr<const control::Controller> {
+  resolvers_.python = [](const std::string&, const fs::path&,
+                         const model::VehicleParams&) -> std::shared_ptr<const control::Controller> {
     throw std::invalid_argument("cannot import m:C: ModuleNotFoundError: No module named 'm'");
-  });
+  };
   const std::string e = error_of("controller: {python: \"m:C\"}\n");
   EXPECT_NE(e.find("controller.python: got 'm:C': cannot import m:C: ModuleNotFoundError"), std::string::npos) << e;
 }
 
 TEST_F(PythonScenarioTest, WhatCannotStandBesideIt) {
-  set_python_controller_factory([](const std::string&, const fs::path&, const model::VehicleParams& v) {
+  resolvers_.python = [](const std::string&, const fs::path&, const model::VehicleParams& v) {
     return controllers::make_config("example_pd", v).controller;
-  });
+  };
   EXPECT_NE(error_of("controller: {type: paper, python: \"m:C\"}\n").find("controller.type: got 'paper' beside python"),
             std::string::npos);
   EXPECT_NE(error_of("controller: {fmu: x.fmu, python: \"m:C\"}\n").find("controller.fmu: beside python"),

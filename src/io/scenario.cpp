@@ -326,7 +326,8 @@ void read_swarm(YamlSection& s, SwarmSpec& spec) {
   s.reject_unknown_keys();
 }
 
-Scenario read_scenario(YamlSection root, const std::string& path, const model::VehicleParams* controller_vehicle);
+Scenario read_scenario(YamlSection root, const std::string& path, const ScenarioResolvers& resolvers,
+                       const model::VehicleParams* controller_vehicle);
 
 }  // namespace
 
@@ -340,9 +341,11 @@ model::State initial_state(const Scenario& sc) {
   return model::Quadrotor(sc.vehicle).initial_state(sc.initial.p_W, sc.initial.yaw_rad, sc.initial.hover);
 }
 
-Scenario load_scenario(const std::string& path) { return read_scenario(YamlSection::load_file(path), path, nullptr); }
+Scenario load_scenario(const std::string& path, const ScenarioResolvers& resolvers) {
+  return read_scenario(YamlSection::load_file(path), path, resolvers, nullptr);
+}
 
-Scenario defaults_flown_by(const std::string& controller) {
+Scenario defaults_flown_by(const std::string& controller, const ScenarioResolvers& resolvers) {
   Scenario sc;
   if (!controller.empty()) {
     if (parse_controller_choice(controller).kind == ControllerChoice::Kind::kType) {
@@ -350,29 +353,31 @@ Scenario defaults_flown_by(const std::string& controller) {
     } else {
       YAML::Node root(YAML::NodeType::Map);
       set_controller_type(root, controller);
-      sc = load_scenario(root, "--controller");
+      sc = load_scenario(root, "--controller", resolvers);
     }
   }
   sc.name = "defaults";
   return sc;
 }
 
-Scenario load_scenario(const std::string& path, const std::string& controller_type) {
-  if (controller_type.empty()) return load_scenario(path);
+Scenario load_scenario(const std::string& path, const std::string& controller_type,
+                       const ScenarioResolvers& resolvers) {
+  if (controller_type.empty()) return load_scenario(path, resolvers);
   YamlSection file = YamlSection::load_file(path);
   YAML::Node root = YAML::Clone(file.node());
   set_controller_type(root, controller_type);
-  return read_scenario(YamlSection(root, path, ""), path, nullptr);
+  return read_scenario(YamlSection(root, path, ""), path, resolvers, nullptr);
 }
 
-Scenario load_scenario(const YAML::Node& node, const std::string& path,
+Scenario load_scenario(const YAML::Node& node, const std::string& path, const ScenarioResolvers& resolvers,
                        const model::VehicleParams* controller_vehicle) {
   if (!node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
-  return read_scenario(YamlSection(node, path, ""), path, controller_vehicle);
+  return read_scenario(YamlSection(node, path, ""), path, resolvers, controller_vehicle);
 }
 
 namespace {
-Scenario read_scenario(YamlSection root, const std::string& path, const model::VehicleParams* controller_vehicle) {
+Scenario read_scenario(YamlSection root, const std::string& path, const ScenarioResolvers& resolvers,
+                       const model::VehicleParams* controller_vehicle) {
   Scenario sc;
   sc.path = path;
   sc.name = root.text("name", std::filesystem::path(path).stem().string());
@@ -404,7 +409,8 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   }
   const model::VehicleParams& believed = controller_vehicle ? *controller_vehicle : sc.vehicle;
   if (auto c = root.section("controller")) {
-    sc.controller = read_controller(*c, believed, std::filesystem::path(path).parent_path(), &sc.controller_fmu);
+    sc.controller =
+        read_controller(*c, believed, std::filesystem::path(path).parent_path(), &sc.controller_fmu, resolvers);
   } else {
     sc.controller = controllers::make_config(controllers::kDefaultControllerType, believed);
   }
@@ -415,11 +421,11 @@ Scenario read_scenario(YamlSection root, const std::string& path, const model::V
   read_realism(root, sc);
   sc.controller.controller =
       with_px4_site(sc.controller.controller, sc.simulation.plant.realism.extra_sensors, std::move(added));
-  if (std::string err = controller_sensors_error(sc); !err.empty()) root.fail("controller.fmu", err);
+  if (std::string err = controller_sensors_error(sc, resolvers); !err.empty()) root.fail("controller.fmu", err);
   if (auto p = root.section("plant")) {
     sc.plant_fmu = read_fmu_spec(*p, std::filesystem::path(path).parent_path());
     p->reject_unknown_keys();
-    sc.simulation.plant.external = make_plant_fmu(*p, *sc.plant_fmu);
+    sc.simulation.plant.external = make_plant_fmu(*p, *sc.plant_fmu, resolvers);
     if (std::string key = sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle); !key.empty()) {
       root.fail(key, "acts inside quadcosim's own plant model only, not with plant: {fmu: ...}");
     }
@@ -446,9 +452,10 @@ model::VehicleParams load_vehicle(const std::string& path) {
   return v;
 }
 
-control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle) {
+control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle,
+                                          const ScenarioResolvers& resolvers) {
   YamlSection root = YamlSection::load_file(path);
-  return read_controller(root, vehicle, std::filesystem::path(path).parent_path(), nullptr);
+  return read_controller(root, vehicle, std::filesystem::path(path).parent_path(), nullptr, resolvers);
 }
 
 namespace {
@@ -460,9 +467,9 @@ YAML::Node fmu_node(const FmuSpec& spec) {
 }
 }  // namespace
 
-void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source) {
+void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source, const ScenarioResolvers& resolvers) {
   YamlSection s(fmu_node(spec), source, "");
-  sc.simulation.plant.external = make_plant_fmu(s, spec);
+  sc.simulation.plant.external = make_plant_fmu(s, spec, resolvers);
   sc.plant_fmu = spec;
   if (std::string key = sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle); !key.empty()) {
     throw ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) + ": " + key +
@@ -470,16 +477,17 @@ void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source)
   }
 }
 
-void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source) {
+void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source,
+                        const ScenarioResolvers& resolvers) {
   YamlSection s(fmu_node(spec), source, "");
   control::ControllerConfig c;
   c.vehicle = sc.controller.vehicle;
   c.node = sc.controller.node;
   c.trajectory = sc.controller.trajectory;
   c.trajectory_offset_W = sc.controller.trajectory_offset_W;
-  c.controller = make_controller_fmu(s, spec, c.vehicle);
+  c.controller = make_controller_fmu(s, spec, c.vehicle, resolvers);
   sc.controller = std::move(c);
-  if (std::string err = controller_sensors_error(sc); !err.empty()) s.fail("fmu", err);
+  if (std::string err = controller_sensors_error(sc, resolvers); !err.empty()) s.fail("fmu", err);
   sc.controller_fmu = spec;
 }
 

@@ -15,6 +15,7 @@
 #include "control/parameters.hpp"
 #include "controllers/registry.hpp"
 #include "fmi/fmu_mapping.hpp"
+#include "io/scenario_resolvers.hpp"
 #include "model/quadrotor.hpp"
 #include "model/vehicle_params.hpp"
 #include "sim/simulation.hpp"
@@ -153,40 +154,31 @@ struct Scenario {
   std::optional<FmuSpec> controller_fmu;
 };
 
-/// What resolves a scenario's `controller: {python: "module:Class"}` (or `type: python`): from the
-/// target text, the scenario file's folder (imports look there first) and the vehicle the controller is
-/// designed for, the configured controller. Throws to refuse (the message becomes the ConfigError at
-/// controller.python). Installed by whatever hosts a Python interpreter: the Python module
-/// (python::install_python_controller_factory) or an executable that embeds one.
-using PythonControllerFactory = std::function<std::shared_ptr<const control::Controller>(
-    const std::string& target, const std::filesystem::path& folder, const model::VehicleParams& vehicle)>;
-
 /// Whether the scenario has a criterion of `set` (in a step, the hold, the limits or the tracking).
 bool has_criteria(const Scenario& scenario, CriteriaSet set);
-
-/// Sets (or with an empty function, removes) the resolver of `controller: {python: ...}`. Without one,
-/// such a scenario is refused: "controller.python: this quadcosim was built without Python ...".
-void set_python_controller_factory(PythonControllerFactory factory);
 
 /// Makes `sc` fly `spec` as its plant (`quadcosim plant --fmu`): loads the FMU, checks the mapping,
 /// sets simulation.plant.external. Throws ConfigError naming `source` (the flag or file) and what
 /// does not fit, also when the scenario uses what only the native plant has (wind, faults, drag).
-void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source);
+void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source, const ScenarioResolvers& resolvers);
 
 /// Makes `sc` fly `spec` as its controller (`quadcosim controller --fmu`), keeping the node's
 /// settings (setpoints, safety) and the trajectory. Throws ConfigError naming `source`.
-void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source);
+void use_controller_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source,
+                        const ScenarioResolvers& resolvers);
 
 /// The plant state the scenario starts from (its `initial` section on its vehicle).
 model::State initial_state(const Scenario& scenario);
 
-/// Loads and validates a scenario. Throws ConfigError (file unreadable, YAML syntax, unknown key,
-/// wrong type, value out of range, a rate that is not a whole divisor, ...).
-Scenario load_scenario(const std::string& path);
+/// Loads and validates a scenario; the FMUs and Python classes it names are made by `resolvers`
+/// (io/scenario_resolvers.hpp), as in every function below that takes them. Throws ConfigError (file
+/// unreadable, YAML syntax, unknown key, wrong type, value out of range, a rate that is not a whole
+/// divisor, ...).
+Scenario load_scenario(const std::string& path, const ScenarioResolvers& resolvers);
 
 /// The same flown by `controller` when it is not empty (the CLI's --controller; see
 /// set_controller_type for what it may name).
-Scenario load_scenario(const std::string& path, const std::string& controller);
+Scenario load_scenario(const std::string& path, const std::string& controller, const ScenarioResolvers& resolvers);
 
 /// What `--controller` names: a registered type ("se3"), a class written in Python
 /// ("python:MODULE:CLASS"), or a co-simulation FMU ("fmu:PATH", made absolute from the current
@@ -203,7 +195,7 @@ ControllerChoice parse_controller_choice(const std::string& text);
 /// What a command without a scenario file flies: the defaults (the paper's vehicle, named "defaults")
 /// flown by `controller` (parse_controller_choice; "" keeps the paper's). A Python class or an FMU is
 /// made as a scenario's controller section makes it. Throws as load_scenario and parse_controller_choice.
-Scenario defaults_flown_by(const std::string& controller);
+Scenario defaults_flown_by(const std::string& controller, const ScenarioResolvers& resolvers);
 
 /// Makes a parsed scenario (a mapping) fly `controller` (parse_controller_choice; a bare "python"
 /// leaves the class to the caller's controller.python), creating the section if needed. What is
@@ -220,7 +212,7 @@ void set_controller_type(YAML::Node root, const std::string& controller);
 /// run's scenario with this, so a run's value is checked exactly as the same value written in the file.
 /// `controller_vehicle`, when given, is the vehicle the controller is designed for instead of the
 /// scenario's own (a sweep's runs fly a controller designed for the nominal vehicle).
-Scenario load_scenario(const YAML::Node& root, const std::string& source,
+Scenario load_scenario(const YAML::Node& root, const std::string& source, const ScenarioResolvers& resolvers,
                        const model::VehicleParams* controller_vehicle = nullptr);
 
 /// Loads a vehicle file: the keys of a scenario's `vehicle:` section at top level. Throws ConfigError.
@@ -228,6 +220,7 @@ model::VehicleParams load_vehicle(const std::string& path);
 
 /// Loads a controller parameter file: the keys of a scenario's `controller:` section, on top of the
 /// defaults (whose vehicle knowledge comes from `vehicle`). Throws ConfigError.
-control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle);
+control::ControllerConfig load_controller(const std::string& path, const model::VehicleParams& vehicle,
+                                          const ScenarioResolvers& resolvers);
 
 }  // namespace quadcosim::io

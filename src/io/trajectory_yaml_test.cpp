@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "io/scenario.hpp"
 #include "trajectory/piecewise_polynomial.hpp"
 
@@ -30,7 +31,8 @@ std::string write(const fs::path& path, const std::string& text) {
 }
 
 Scenario load(const std::string& trajectory_yaml) {
-  return load_scenario(write(test_dir() / "scenario.yaml", "simulation: {duration_s: 1}\n" + trajectory_yaml));
+  return load_scenario(write(test_dir() / "scenario.yaml", "simulation: {duration_s: 1}\n" + trajectory_yaml),
+                       hosts::test_resolvers());
 }
 
 std::string error_of(const std::string& trajectory_yaml) {

@@ -135,11 +135,6 @@ std::shared_ptr<PyController> load_python_controller(const std::string& target, 
 /// (sys.modules[module].__file__), or "" when it is not imported here or has no file. Takes the GIL.
 std::string loaded_module_file(const std::string& target);
 
-/// Installs load_python_controller as io's resolver of `controller: {python: ...}`. The caller must
-/// have an interpreter running (an extension module; an embedding executable initialises it first or
-/// installs its own function that does and then calls load_python_controller).
-void install_python_controller_factory();
-
 /// The vehicle as the dict a Python controller's __init__ receives: every entry of
 /// model::vehicle_parameters() by its YAML path ("mass_kg", "motor.omega_max_rad_s", ...; a 3-vector
 /// as three entries .x, .y, .z; choices as strings, spin as a tuple), hover_omega_rad_s and

@@ -79,7 +79,7 @@ std::string scenario_source_of(const Origin& o) {
   return fs::is_directory(fs::path(o.scenario_file).parent_path(), ec) ? o.scenario_file : std::string();
 }
 
-Plan plan_of(const fs::path& dir) {
+Plan plan_of(const fs::path& dir, const io::ScenarioResolvers& resolvers) {
   nlohmann::json h;
   fs::path file = dir / "summary.json";
   if (!fs::exists(file)) file = dir / "shard.json";
@@ -97,7 +97,7 @@ Plan plan_of(const fs::path& dir) {
     // (a Python controller's module, ...) is found from any current directory.
     const std::optional<Origin> origin = read_origin(dir);
     Plan p = make_plan(scenario.string(), specs, h.at("seed").get<std::uint64_t>(), h.at("runs_per_point").get<int>(),
-                       h.at("sampler").get<std::string>() == "lhs" ? Sampler::kLhs : Sampler::kRandom,
+                       h.at("sampler").get<std::string>() == "lhs" ? Sampler::kLhs : Sampler::kRandom, resolvers,
                        origin ? scenario_source_of(*origin) : std::string());
     if (p.runs != h.at("runs").get<int>()) throw std::runtime_error("the plan gives another number of runs");
     const std::string judge = h.value("judge", std::string("spec"));

@@ -156,12 +156,14 @@ Vary parse_vary(const std::string& spec) {
 }
 
 Plan make_plan(const std::string& scenario_file, const std::vector<std::string>& specs, std::uint64_t seed,
-               int runs_per_point, Sampler sampler, const std::string& scenario_source) {
+               int runs_per_point, Sampler sampler, const io::ScenarioResolvers& resolvers,
+               const std::string& scenario_source) {
   Plan p;
+  p.resolvers = resolvers;
   p.scenario_file = scenario_file;
   p.scenario_source = scenario_source.empty() ? scenario_file : scenario_source;
   if (scenario_source.empty()) {
-    p.nominal = io::load_scenario(scenario_file);
+    p.nominal = io::load_scenario(scenario_file, resolvers);
     p.root = YAML::LoadFile(scenario_file);  // load_scenario has read it: it parses
   } else {
     try {
@@ -170,7 +172,7 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
       throw io::ConfigError(scenario_file + ": " + e.what());
     }
     if (!p.root.IsMap()) throw io::ConfigError(scenario_file + ": expected a mapping of scenario sections");
-    p.nominal = io::load_scenario(p.root, p.scenario_source);
+    p.nominal = io::load_scenario(p.root, p.scenario_source, resolvers);
     p.nominal.path = scenario_file;
   }
   p.seed = seed;
@@ -187,7 +189,7 @@ Plan make_plan(const std::string& scenario_file, const std::vector<std::string>&
       set_key(root, k.path, v.distribution == Distribution::kPercent ? *k.nominal * value : value, lists);
     }
     try {
-      (void)io::load_scenario(root, p.scenario_source);
+      (void)io::load_scenario(root, p.scenario_source, resolvers);
     } catch (const io::ConfigError& e) {
       throw PlanError(fmt::format("--vary {}: {} {:g} refused: {}", v.spec, what, value, e.what()));
     } catch (const std::invalid_argument& e) {
@@ -302,7 +304,8 @@ io::Scenario scenario_for(const Plan& plan, const Sample& s) {
     YAML::Node root = YAML::Clone(plan.root);
     const auto lists = default_lists(plan.nominal);
     for (const auto& [path, value] : s.values) set_key(root, path, value, lists);
-    sc = io::load_scenario(root, plan.scenario_source, &plan.nominal.vehicle);  // designed for the nominal vehicle
+    sc = io::load_scenario(root, plan.scenario_source, plan.resolvers,
+                           &plan.nominal.vehicle);  // designed for the nominal vehicle
     sc.path = plan.scenario_file;
   }
   sc.simulation.plant.realism.seed = s.seed;

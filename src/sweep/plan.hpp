@@ -79,6 +79,9 @@ struct Plan {
   int runs = 0;                                        ///< product of grid_sizes times repeats
   std::map<std::string, std::vector<int>> lhs_strata;  ///< per random key: run -> stratum
   io::Judge judge = io::Judge::kSpec;                  ///< the criteria set each run is judged against (--judge)
+  /// What the scenario's FMUs and Python classes are made by, for the nominal and each run's scenario
+  /// (scenario_for) and for the runs' provenance.
+  io::ScenarioResolvers resolvers;
 };
 
 /// Loads the scenario, resolves every spec's keys (refusing unknown keys, keys varied twice, a
@@ -86,9 +89,10 @@ struct Plan {
 /// checks each grid value by loading the scenario with it. `runs_per_point` is the number of runs
 /// (no grid) or of runs per grid point. Throws PlanError or io::ConfigError.
 /// With `scenario_source` non-empty, the file is read from `scenario_file` but loaded as if it were
-/// at `scenario_source` (Plan::scenario_source).
+/// at `scenario_source` (Plan::scenario_source). The plan keeps `resolvers` (Plan::resolvers).
 Plan make_plan(const std::string& scenario_file, const std::vector<std::string>& specs, std::uint64_t seed,
-               int runs_per_point, Sampler sampler, const std::string& scenario_source = "");
+               int runs_per_point, Sampler sampler, const io::ScenarioResolvers& resolvers,
+               const std::string& scenario_source = "");
 
 /// The draws of one run.
 struct Sample {

@@ -97,6 +97,7 @@ nlohmann::json run_metrics_json(const Plan& plan, const io::Scenario& flown, con
   // The run context's defaults (in-process, lockstep, no override) are how a sweep flies.
   io::RunContext context;
   context.python_target = io::python_target_of(plan.root);
+  context.python_module = plan.resolvers.python_module;
   j["provenance"] = io::describe_run(flown, context);
   return j;
 }

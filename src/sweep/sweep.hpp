@@ -163,6 +163,6 @@ std::string scenario_source_of(const Origin& origin);
 /// The plan of a sweep directory (its summary.json or shard.json and the scenario.yaml copied into it),
 /// loaded as if at the scenario file origin.json records (scenario_source_of). Throws
 /// std::runtime_error naming the file.
-Plan plan_of(const std::filesystem::path& sweep_dir);
+Plan plan_of(const std::filesystem::path& sweep_dir, const io::ScenarioResolvers& resolvers);
 
 }  // namespace quadcosim::sweep

@@ -17,6 +17,7 @@
 
 #include "control/parameters.hpp"
 #include "controllers/paper/paper_controller.hpp"
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "model/random.hpp"
 #include "sweep/statistics.hpp"
 #include "sweep/sweep.hpp"
@@ -157,7 +158,7 @@ TEST(Plan, RefusesUnknownKeysDoubleVariationAndValuesTheLoaderRefuses) {
   const std::string f = scenario_file().string();
   const auto error_of = [&](const std::vector<std::string>& specs) {
     try {
-      make_plan(f, specs, 1, 4, Sampler::kRandom);
+      make_plan(f, specs, 1, 4, Sampler::kRandom, hosts::test_resolvers());
     } catch (const std::exception& e) {
       return std::string(e.what());
     }
@@ -184,7 +185,7 @@ TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
   const std::string f = scenario_file().string();
   const auto error_of = [&](const std::vector<std::string>& specs) {
     try {
-      make_plan(f, specs, 1, 4, Sampler::kRandom);
+      make_plan(f, specs, 1, 4, Sampler::kRandom, hosts::test_resolvers());
     } catch (const std::exception& e) {
       return std::string(e.what());
     }
@@ -200,7 +201,7 @@ TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
   // A vehicle list entry by its index is the vehicle key .x/.y/.z: the table's range, the plant's key.
   const Plan p =
       make_plan(f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
-                Sampler::kRandom);
+                Sampler::kRandom, hosts::test_resolvers());
   ASSERT_EQ(p.vary.size(), 2u);
   const Key& lin = p.vary[0].keys.at(0);
   EXPECT_EQ(lin.path, "vehicle.aero.linear_drag_N_s_m.x");
@@ -244,8 +245,10 @@ TEST(PassesNeeded, CeilOfRateTimesRunsWithoutTheProductsRoundingError) {
 
 TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
   const std::string f = scenario_file().string();
-  const Plan a = make_plan(f, {"mass=10%", "controller.altitude.kp=uniform(2,6)"}, 42, 100, Sampler::kRandom);
-  const Plan b = make_plan(f, {"controller.altitude.kp=uniform(2,6)", "mass=10%"}, 42, 100, Sampler::kRandom);
+  const Plan a = make_plan(f, {"mass=10%", "controller.altitude.kp=uniform(2,6)"}, 42, 100, Sampler::kRandom,
+                           hosts::test_resolvers());
+  const Plan b = make_plan(f, {"controller.altitude.kp=uniform(2,6)", "mass=10%"}, 42, 100, Sampler::kRandom,
+                           hosts::test_resolvers());
   for (int i : {0, 57, 99}) {
     const Sample s = sample(a, i);
     EXPECT_EQ(sample(a, i).values, s.values);  // same call, same numbers
@@ -267,9 +270,9 @@ TEST(Sample, PureInSeedRunAndKeyAndCompatibleWithRelativeSpread) {
 }
 
 TEST(Sample, GridIsFullFactorialWithTheFirstKeySlowest) {
-  const Plan p =
-      make_plan(scenario_file().string(),
-                {"controller.altitude.kp=grid(2,4)", "controller.altitude.kd=linspace(1,3,3)"}, 1, 2, Sampler::kRandom);
+  const Plan p = make_plan(scenario_file().string(),
+                           {"controller.altitude.kp=grid(2,4)", "controller.altitude.kd=linspace(1,3,3)"}, 1, 2,
+                           Sampler::kRandom, hosts::test_resolvers());
   ASSERT_EQ(p.runs, 2 * 3 * 2);  // two repeats per point
   std::multiset<std::pair<double, double>> points;
   for (int i = 0; i < p.runs; ++i) {
@@ -287,9 +290,9 @@ TEST(Sample, GridIsFullFactorialWithTheFirstKeySlowest) {
 
 TEST(Sample, LatinHypercubePutsOneRunInEveryStratumOfEveryKey) {
   const int n = 50;
-  const Plan p =
-      make_plan(scenario_file().string(),
-                {"controller.altitude.kp=uniform(0,1)", "controller.altitude.kd=uniform(10,20)"}, 3, n, Sampler::kLhs);
+  const Plan p = make_plan(scenario_file().string(),
+                           {"controller.altitude.kp=uniform(0,1)", "controller.altitude.kd=uniform(10,20)"}, 3, n,
+                           Sampler::kLhs, hosts::test_resolvers());
   std::set<int> kp_strata, kd_strata;
   for (int i = 0; i < n; ++i) {
     const Sample s = sample(p, i);
@@ -299,7 +302,8 @@ TEST(Sample, LatinHypercubePutsOneRunInEveryStratumOfEveryKey) {
   EXPECT_EQ(kp_strata.size(), static_cast<std::size_t>(n));
   EXPECT_EQ(kd_strata.size(), static_cast<std::size_t>(n));
   // Plain random draws leave strata empty (50 draws into 50 bins: about 18 stay empty).
-  const Plan r = make_plan(scenario_file().string(), {"controller.altitude.kp=uniform(0,1)"}, 3, n, Sampler::kRandom);
+  const Plan r = make_plan(scenario_file().string(), {"controller.altitude.kp=uniform(0,1)"}, 3, n, Sampler::kRandom,
+                           hosts::test_resolvers());
   std::set<int> random_strata;
   for (int i = 0; i < n; ++i) random_strata.insert(static_cast<int>(std::floor(sample(r, i).values[0].second * n)));
   EXPECT_LT(random_strata.size(), static_cast<std::size_t>(n));
@@ -318,7 +322,7 @@ TEST(Sample, NormalTruncatedToTheDeclaredRangeHasTheClosedFormMean) {
   // altitude.min_cos_tilt is declared in [0.05, 1]: normal(0.1, 0.3) is cut hard at 0.05.
   const Plan p = make_plan(scenario_file().string(),
                            {"controller.altitude.min_cos_tilt=normal(0.1,0.3)", "controller.altitude.kd=normal(3,0.5)"},
-                           9, n, Sampler::kLhs);
+                           9, n, Sampler::kLhs, hosts::test_resolvers());
   double sum = 0.0, sum_kd = 0.0, ss_kd = 0.0;
   for (int i = 0; i < n; ++i) {
     const Sample s = sample(p, i);
@@ -336,7 +340,7 @@ TEST(Sample, NormalTruncatedToTheDeclaredRangeHasTheClosedFormMean) {
 
 TEST(ScenarioFor, PlantFliesTheDrawTheControllerKeepsTheNominalVehicle) {
   const Plan p = make_plan(scenario_file().string(), {"vehicle.mass_kg=grid(1.5)", "controller.altitude.kp=grid(7)"}, 1,
-                           1, Sampler::kRandom);
+                           1, Sampler::kRandom, hosts::test_resolvers());
   const Sample s = sample(p, 0);
   const io::Scenario sc = scenario_for(p, s);
   EXPECT_EQ(sc.vehicle.mass_kg, 1.5);
@@ -350,7 +354,7 @@ TEST(RunOne, ARefusedDrawFailsThatRunNamingKeyAndValue) {
   // initial.yaw_rad declares no range; the loader takes [-10, 10]: normal(0, 20) draws outside it in
   // about 62 % of runs. The mass, declared in [1e-06, 1e12], is truncated there: never refused.
   const Plan p = make_plan(scenario_file().string(), {"initial.yaw_rad=normal(0,20)", "vehicle.mass_kg=normal(0.3,1)"},
-                           5, 20, Sampler::kRandom);
+                           5, 20, Sampler::kRandom, hosts::test_resolvers());
   int refused = 0;
   for (int i = 0; i < p.runs; ++i) {
     const Sample s = sample(p, i);
@@ -370,7 +374,8 @@ TEST(RunOne, ARefusedDrawFailsThatRunNamingKeyAndValue) {
 TEST(RunOne, SaturationIsJudgedAsRunJudgesItFromTheCsv) {
   // A 1 rad yaw step clamps rotors 2 and 4 for about 1.5 s (the allocation's omega limits); 0.2 rad
   // clamps nothing. The limit max_saturated_s 0.5 fails exactly the 1 rad run.
-  const Plan p = make_plan(yaw_scenario_file().string(), {"controller.yaw_des=grid(0.2,1)"}, 1, 1, Sampler::kRandom);
+  const Plan p = make_plan(yaw_scenario_file().string(), {"controller.yaw_des=grid(0.2,1)"}, 1, 1, Sampler::kRandom,
+                           hosts::test_resolvers());
   ASSERT_EQ(p.runs, 2);
   const RunResult small = run_one(p, 0, {});
   const RunResult big = run_one(p, 1, {});
@@ -424,8 +429,8 @@ TEST(RunOne, SaturationIsJudgedAsRunJudgesItFromTheCsv) {
 }
 
 TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {
-  const Plan p =
-      make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 7, 6, Sampler::kRandom);
+  const Plan p = make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 7, 6,
+                           Sampler::kRandom, hosts::test_resolvers());
   std::vector<int> all = shard_indices(p.runs, 1, 1);
   ASSERT_EQ(all, (std::vector<int>{0, 1, 2, 3, 4, 5}));
   const auto one = run_many(p, all, 1, {});
@@ -458,8 +463,8 @@ TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {
 }
 
 TEST(RunMany, StoppedItReturnsTheRunsStartedALeadingPartAndAResumeGivesTheSameSummary) {
-  const Plan p =
-      make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 9, 8, Sampler::kRandom);
+  const Plan p = make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 9, 8,
+                           Sampler::kRandom, hosts::test_resolvers());
   const std::vector<int> all = shard_indices(p.runs, 1, 1);
   const nlohmann::json header = header_json(p);
   std::vector<nlohmann::json> whole;
@@ -503,7 +508,8 @@ TEST(RunMany, StoppedItReturnsTheRunsStartedALeadingPartAndAResumeGivesTheSameSu
 TEST(RunMany, ARunThatFailsOnceStoppedIsNotFinished) {
   // initial.yaw_rad is refused outside [-10, 10], when the run is flown: normal(0, 1000) draws run 0
   // (seed 5) outside it.
-  const Plan p = make_plan(scenario_file().string(), {"initial.yaw_rad=normal(0,1000)"}, 5, 4, Sampler::kRandom);
+  const Plan p = make_plan(scenario_file().string(), {"initial.yaw_rad=normal(0,1000)"}, 5, 4, Sampler::kRandom,
+                           hosts::test_resolvers());
   ASSERT_GT(std::abs(sample(p, 0).values[0].second), 10.0);
   const std::vector<int> all = shard_indices(p.runs, 1, 1);
   const fs::path dir = fs::temp_directory_path() / ("quadcosim_sweep_cut_" + std::to_string(::getpid()));
@@ -518,7 +524,7 @@ TEST(RunMany, ARunThatFailsOnceStoppedIsNotFinished) {
   ASSERT_EQ(failed.size(), 1u);
   EXPECT_THAT(failed[0].error, HasSubstr("initial.yaw_rad"));
   // A run that succeeds while the stop is asked is finished.
-  const Plan good = make_plan(scenario_file().string(), {"mass=5%"}, 5, 4, Sampler::kRandom);
+  const Plan good = make_plan(scenario_file().string(), {"mass=5%"}, 5, 4, Sampler::kRandom, hosts::test_resolvers());
   asked = 0;
   const auto kept = run_many(good, all, 1, dir, Keep::kNone, control);
   ASSERT_EQ(kept.size(), 1u);
@@ -566,7 +572,8 @@ TEST(FailedCriteria, NamesChannelFigureValueAndTheBoundCrossed) {
 TEST(RunOne, AFailedRunNamesItsFailedCriteriaAsItsMetricsJsonHasThem) {
   const fs::path dir = fs::temp_directory_path() / ("sweep_test_failed_" + std::to_string(::getpid()));
   // A 1 rad yaw step clamps rotors for about 1.5 s (more than the 0.5 s allowed), 0.2 rad none.
-  const Plan p = make_plan(yaw_scenario_file().string(), {"controller.yaw_des=grid(1,0.2)"}, 1, 1, Sampler::kRandom);
+  const Plan p = make_plan(yaw_scenario_file().string(), {"controller.yaw_des=grid(1,0.2)"}, 1, 1, Sampler::kRandom,
+                           hosts::test_resolvers());
   const std::vector<RunResult> results = run_many(p, {0, 1}, 1, dir);
   for (const RunResult& r : results) {
     std::ifstream in(dir / fmt::format("{:04d}", r.sample.index) / "metrics.json");

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "control/care.hpp"
+#include "hosts/scenario_resolvers.hpp"
 #include "io/scenario.hpp"
 #include "sim/simulation.hpp"
 
@@ -41,7 +42,7 @@ class MemFile {
 void try_scenario(const std::string& path) {
   io::Scenario sc;
   try {
-    sc = io::load_scenario(path);
+    sc = io::load_scenario(path, hosts::scenario_resolvers());
   } catch (const io::ConfigError&) {
     return;
   }
@@ -66,7 +67,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const io::ConfigError&) {
   }
   try {
-    io::load_controller(path, vehicle);
+    io::load_controller(path, vehicle, hosts::scenario_resolvers());
   } catch (const io::ConfigError&) {
   }
   return 0;

@@ -7,6 +7,7 @@
 
 #include "analysis/step_metrics.hpp"
 #include "controllers/paper/paper_controller.hpp"
+#include "hosts/scenario_resolvers_test_support.hpp"
 #include "io/scenario.hpp"
 #include "model/attitude.hpp"
 #include "sim/simulation.hpp"
@@ -41,7 +42,8 @@ Flight simulate(const io::Scenario& sc) {
 }
 
 io::Scenario paper(const std::string& name) {
-  return io::load_scenario(std::string(QUADCOSIM_SOURCE_DIR) + "/scenarios/paper/" + name + ".yaml");
+  return io::load_scenario(std::string(QUADCOSIM_SOURCE_DIR) + "/scenarios/paper/" + name + ".yaml",
+                           hosts::test_resolvers());
 }
 
 TEST(PaperTest, AltitudeStepMatchesFig4) {

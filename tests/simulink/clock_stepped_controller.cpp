@@ -26,6 +26,7 @@
 
 #include "dds/arrival_executor.hpp"
 #include "dds/dds_transport.hpp"
+#include "hosts/scenario_resolvers.hpp"
 #include "io/scenario.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
@@ -39,7 +40,7 @@ int main(int argc, char** argv) try {
     std::fprintf(stderr, "usage: clock_stepped_controller SCENARIO STEPS_CSV [IDLE_S]\n");
     return 2;
   }
-  const io::Scenario sc = io::load_scenario(argv[1]);
+  const io::Scenario sc = io::load_scenario(argv[1], hosts::scenario_resolvers());
   std::FILE* steps_csv = std::fopen(argv[2], "w");
   if (steps_csv == nullptr) {
     std::fprintf(stderr, "clock_stepped_controller: cannot write %s\n", argv[2]);

@@ -23,6 +23,7 @@
 #include <string>
 
 #include "dds/dds_transport.hpp"
+#include "hosts/scenario_resolvers.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/messages.hpp"
@@ -35,7 +36,7 @@ int main(int argc, char** argv) try {
     std::fprintf(stderr, "usage: waiting_plant SCENARIO TRAJECTORY_CSV [TIMEOUT_S]\n");
     return 2;
   }
-  const io::Scenario sc = io::load_scenario(argv[1]);
+  const io::Scenario sc = io::load_scenario(argv[1], hosts::scenario_resolvers());
   const auto timeout_ns = static_cast<std::int64_t>((argc > 3 ? std::stod(argv[3]) : 10.0) * 1e9);
   const sim::TickClock clock = sc.simulation.plant.clock;
   const sim::Topics topics = sim::Topics::for_namespace(sc.simulation.ns);

@@ -8,7 +8,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/provenance.hpp"
 #include "io/scenario.hpp"
 #include "python/embedded/isolated_controller.hpp"
 #include "python/embedded/python_host.hpp"
@@ -60,13 +59,11 @@ std::shared_ptr<const control::Controller> load(const std::string& target, const
 
 bool built_with_python() { return true; }
 
-void install_python_controllers() {
-  io::set_python_module_locator(python_module_file);
-  io::set_python_controller_factory(
-      [](const std::string& target, const fs::path& folder,
-         const model::VehicleParams& vehicle) -> std::shared_ptr<const control::Controller> {
-        return load(target, folder, vehicle);  // io names the key in its error
-      });
+io::PythonControllerFactory python_controller_factory() {
+  return [](const std::string& target, const fs::path& folder,
+            const model::VehicleParams& vehicle) -> std::shared_ptr<const control::Controller> {
+    return load(target, folder, vehicle);  // io names the key in its error
+  };
 }
 
 std::shared_ptr<const control::Controller> make_python_controller(const std::string& spec, const fs::path& folder,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "control/controller.hpp"
+#include "io/scenario_resolvers.hpp"
 #include "model/vehicle_params.hpp"
 
 namespace quadcosim::embedded_python {
@@ -16,9 +17,10 @@ namespace quadcosim::embedded_python {
 /// True when this quadcosim was built with Python.
 bool built_with_python();
 
-/// Installs the io hook that resolves a scenario's `controller: {python: "module:Class"}` (with Python;
-/// without, io's own error stays: the key names what is missing). Cheap: no interpreter starts here.
-void install_python_controllers();
+/// What resolves a scenario's `controller: {python: "module:Class"}` (io::ScenarioResolvers::python):
+/// make_python_controller's loader with Python; empty without (io's own error then names what is
+/// missing). Cheap: no interpreter starts here.
+io::PythonControllerFactory python_controller_factory();
 
 /// The controller `spec` ("module:Class") names, for the vehicle: starts the interpreter on first use,
 /// imports the module with `folder`, the current directory and PYTHONPATH on sys.path (and the

@@ -1,5 +1,5 @@
 // The CLI built without Python (python/embedded/python_host.hpp): --python says so; a scenario's
-// `controller: {python: ...}` gets io's own error (no hook installed).
+// `controller: {python: ...}` gets io's own error (no factory).
 #include "io/scenario.hpp"
 #include "python/embedded/python_host.hpp"
 
@@ -7,7 +7,7 @@ namespace quadcosim::embedded_python {
 
 bool built_with_python() { return false; }
 
-void install_python_controllers() {}
+io::PythonControllerFactory python_controller_factory() { return {}; }
 
 std::shared_ptr<const control::Controller> make_python_controller(const std::string&, const std::filesystem::path&,
                                                                   const model::VehicleParams&,
