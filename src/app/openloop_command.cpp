@@ -5,6 +5,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "io/recording.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "model/quadrotor.hpp"
@@ -54,17 +55,19 @@ int openloop_command(const OpenloopOptions& opt) {
   const model::Environment* still_air = vehicle.aero.active() ? &idle : nullptr;
   model::State x = plant.initial_state({0.0, 0.0, opt.initial_z_m}, 0.0, false);
   try {
-    io::TrajectoryWriter csv(opt.out);
+    io::RecordingOptions ro;
+    ro.csv = opt.out;
+    io::Recording recording = io::make_recording(ro, nullptr);
     std::size_t next = 0;
     Eigen::Vector4d cmd = Eigen::Vector4d::Zero();  // rotors stopped until the first row
     for (sim::Tick k = 0; k <= last_tick; ++k) {
       const double t = clock.seconds(k);
       while (next < rows.size() && rows[next].t_s <= t + 1e-12) cmd = rows[next++].omega_rad_s;
-      csv.write(t, x, cmd, io::ControlColumns::none());
+      recording.tick({k, t, clock.ns(k), x, cmd, nullptr, false});
       // Still air; the vehicle file's drag (vehicle.aero) acts on the motion through it.
       if (k < last_tick) plant.step(x, t, cmd, clock.period_s(), opt.substeps, still_air);
     }
-    csv.close();
+    recording.finish(true);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << '\n';
     return exit_code::kOutput;

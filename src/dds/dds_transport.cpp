@@ -1,5 +1,7 @@
 #include "dds/dds_transport.hpp"
 
+#include <dds/ddsi/ddsi_serdata.h>
+
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -39,9 +41,9 @@ dds_entity_t DdsTransport::topic_for(const std::string& ros_topic, const sim::To
 }
 
 dds_entity_t DdsTransport::create_endpoint(const std::string& ros_topic, const sim::TopicType& type, bool writer,
-                                           const TypeOps*& ops) {
+                                           const TypeOps*& ops, const sim::QosChoice& qos_given) {
   const dds_entity_t topic = topic_for(ros_topic, type, ops);
-  const QosProfile p = qos_for(ros_topic);
+  const QosProfile p = qos_given ? *qos_given : qos_for(ros_topic);
   const Qos qos(ros_qos(p.depth, p.reliable, p.transient_local));
   set_endpoint_user_data(qos.get(), ops->descriptor->m_typename, user_data_keys_);
   const dds_entity_t e = writer ? dds_create_writer(participant_.handle(), topic, qos.get(), nullptr)
@@ -60,9 +62,10 @@ void DdsTransport::attach(dds_entity_t e, dds_attach_t arg) {
   triggered_.push_back(0);
 }
 
-std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic, const sim::TopicType& type) {
+std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_topic, const sim::TopicType& type,
+                                                         const sim::QosChoice& qos) {
   const TypeOps* ops = nullptr;
-  const dds_entity_t writer = create_endpoint(ros_topic, type, true, ops);
+  const dds_entity_t writer = create_endpoint(ros_topic, type, true, ops, qos);
   writers_[ros_topic].push_back(writer);
   return [writer, ops, ros_topic](const void* message) {
     // The error's text is formed only on an error: a write is on every tick's path.
@@ -70,20 +73,34 @@ std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_
   };
 }
 
-void DdsTransport::add_subscription(const std::string& ros_topic, const sim::TopicType& type,
+void DdsTransport::add_subscription(const std::string& ros_topic, const sim::TopicType& type, const sim::QosChoice& qos,
                                     std::function<void(const void*)> deliver) {
   const TypeOps* ops = nullptr;
-  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
+  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops, qos);
   add_reader(reader, ros_topic, ops, std::move(deliver));
 }
 
 void DdsTransport::add_subscription_with_sender(const std::string& ros_topic, const sim::TopicType& type,
+                                                const sim::QosChoice& qos,
                                                 std::function<void(const void*, sim::SenderId)> deliver) {
   const TypeOps* ops = nullptr;
-  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops);
+  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops, qos);
   // The reader's entry is made by add_reader at this index (entries keep their addresses).
   add_reader(reader, ros_topic, ops,
              [this, index = readers_.size(), d = std::move(deliver)](const void* m) { d(m, readers_[index]->sender); });
+}
+
+void DdsTransport::add_tap(const std::string& ros_topic, const sim::TopicType& type, const sim::QosChoice& qos,
+                           std::function<void(const void*, sim::SenderId, sim::WireBytes)> deliver) {
+  const TypeOps* ops = nullptr;
+  const dds_entity_t reader = create_endpoint(ros_topic, type, false, ops, qos);
+  add_reader(
+      reader, ros_topic, ops,
+      [this, index = readers_.size(), d = std::move(deliver)](const void* m) {
+        const Reader& r = *readers_[index];
+        d(m, r.sender, r.wire);
+      },
+      true);
 }
 
 std::optional<DdsTransport::SenderInfo> DdsTransport::sender_info(const std::string& ros_topic,
@@ -143,7 +160,7 @@ void DdsTransport::subscribe_raw_with_sender(dds_entity_t reader, std::string la
 }
 
 void DdsTransport::add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops,
-                              std::function<void(const void*)> deliver) {
+                              std::function<void(const void*)> deliver, bool tap) {
   auto r = std::make_unique<Reader>();
   r->owner = this;
   r->index = readers_.size();
@@ -152,6 +169,7 @@ void DdsTransport::add_reader(dds_entity_t reader, std::string topic, const Type
   r->condition = check(dds_create_readcondition(reader, DDS_ANY_STATE), "dds_create_readcondition");
   r->ops = ops;
   r->deliver = std::move(deliver);
+  r->tap = tap;
   Reader& added = *r;
   readers_.push_back(std::move(r));
   if (arrival_sink_) {
@@ -198,12 +216,42 @@ void DdsTransport::set_arrival_sink(std::function<void(std::size_t)> sink) {
   if (!on) arrival_sink_ = nullptr;
 }
 
-int DdsTransport::deliver_taken(Reader& r, void* const* samples, const dds_sample_info_t* infos, int n) {
+void DdsTransport::deliver_serialised(Reader& r, ddsi_serdata* sd) {
+  // The bytes as the writer serialised them: XCDR1, encapsulation header first. Cyclone pads them to
+  // a multiple of 4 and counts the pad in the options' low bits; without both they are io::to_cdr's.
+  const std::uint32_t size = ddsi_serdata_size(sd);
+  r.wire_buffer.resize(size);
+  ddsi_serdata_to_ser(sd, 0, size, r.wire_buffer.data());
+  std::size_t n = size;
+  if (size >= 4) {
+    n -= std::min<std::size_t>(r.wire_buffer[3] & 0x3u, size - 4);
+    r.wire_buffer[3] = static_cast<std::uint8_t>(r.wire_buffer[3] & ~0x3u);
+  }
+  r.wire = sim::WireBytes(r.wire_buffer.data(), n);
+  // The message, decoded from the same bytes (the C sample's contents freed after the delivery).
+  alignas(std::max_align_t) unsigned char sample[1024] = {};
+  if (r.ops->descriptor->m_size > sizeof sample) throw DdsError("dds tap " + r.topic + ": sample too large");
+  if (!ddsi_serdata_to_sample(sd, sample, nullptr, nullptr)) throw DdsError("dds tap " + r.topic + ": undecodable");
+  try {
+    r.ops->deliver(sample, r.deliver);
+  } catch (...) {
+    dds_sample_free(sample, r.ops->descriptor, DDS_FREE_CONTENTS);
+    r.wire = {};
+    throw;
+  }
+  dds_sample_free(sample, r.ops->descriptor, DDS_FREE_CONTENTS);
+  r.wire = {};
+}
+
+int DdsTransport::deliver_taken(Reader& r, void* const* samples, ddsi_serdata* const* serdata,
+                                const dds_sample_info_t* infos, int n) {
   int delivered = 0;
   for (int i = 0; i < n; ++i) {
     if (!infos[i].valid_data) continue;
     r.sender = infos[i].publication_handle;
-    if (r.ops != nullptr) {
+    if (r.tap) {
+      deliver_serialised(r, serdata[i]);
+    } else if (r.ops != nullptr) {
       r.ops->deliver(samples[i], r.deliver);
     } else {
       r.deliver(samples[i]);
@@ -213,22 +261,38 @@ int DdsTransport::deliver_taken(Reader& r, void* const* samples, const dds_sampl
   return delivered;
 }
 
+dds_return_t DdsTransport::take_batch(Reader& r, void** samples, ddsi_serdata** serdata, dds_sample_info_t* infos) {
+  const dds_return_t n = r.tap ? dds_takecdr(r.reader, serdata, Held::kBatch, infos, DDS_ANY_STATE)
+                               : dds_take(r.reader, samples, infos, Held::kBatch, Held::kBatch);
+  if (n < 0) check(n, ((r.tap ? "dds_takecdr " : "dds_take ") + r.topic).c_str());
+  return n;
+}
+
+void DdsTransport::give_back(const Reader& r, void** samples, ddsi_serdata** serdata, int n) {
+  if (n <= 0) return;
+  if (r.tap) {
+    for (int i = 0; i < n; ++i) ddsi_serdata_unref(serdata[i]);
+  } else {
+    dds_return_loan(r.reader, samples, n);
+  }
+}
+
 int DdsTransport::drain(Reader& r) {
   constexpr int kBatch = Held::kBatch;
   int delivered = 0;
   for (;;) {
     void* samples[kBatch] = {nullptr};
+    ddsi_serdata* serdata[kBatch] = {nullptr};
     dds_sample_info_t infos[kBatch];
-    const dds_return_t n = dds_take(r.reader, samples, infos, kBatch, kBatch);
-    if (n < 0) check(n, ("dds_take " + r.topic).c_str());
+    const dds_return_t n = take_batch(r, samples, serdata, infos);
     if (n == 0) break;
     try {
-      delivered += deliver_taken(r, samples, infos, n);
+      delivered += deliver_taken(r, samples, serdata, infos, n);
     } catch (...) {
-      dds_return_loan(r.reader, samples, n);  // the loan goes back whatever a delivery throws
+      give_back(r, samples, serdata, n);  // the loan goes back whatever a delivery throws
       throw;
     }
-    dds_return_loan(r.reader, samples, n);
+    give_back(r, samples, serdata, n);
     if (n < kBatch) break;
   }
   return delivered;
@@ -236,13 +300,12 @@ int DdsTransport::drain(Reader& r) {
 
 void DdsTransport::hold(std::size_t index, std::vector<Held>& into) {
   // Cyclone lends its one buffer to the first take and allocates for the others (given back
-  // by dds_return_loan too), so any number may be held at once.
+  // by dds_return_loan too), so any number may be held at once; a tap holds references.
   Reader& r = *readers_[index];
   for (;;) {
     Held h;
     h.index = index;
-    const dds_return_t n = dds_take(r.reader, h.samples, h.infos, Held::kBatch, Held::kBatch);
-    if (n < 0) check(n, ("dds_take " + r.topic).c_str());
+    const dds_return_t n = take_batch(r, h.samples, h.serdata, h.infos);
     if (n == 0) break;
     h.n = n;
     into.push_back(h);
@@ -253,7 +316,7 @@ void DdsTransport::hold(std::size_t index, std::vector<Held>& into) {
 int DdsTransport::deliver_held(Held& held) {
   Reader& r = *readers_[held.index];
   try {
-    const int delivered = deliver_taken(r, held.samples, held.infos, held.n);
+    const int delivered = deliver_taken(r, held.samples, held.serdata, held.infos, held.n);
     drop_held(held);
     return delivered;
   } catch (...) {
@@ -263,7 +326,7 @@ int DdsTransport::deliver_held(Held& held) {
 }
 
 void DdsTransport::drop_held(Held& held) {
-  if (held.n > 0) dds_return_loan(readers_[held.index]->reader, held.samples, held.n);
+  give_back(*readers_[held.index], held.samples, held.serdata, held.n);
   held.n = 0;
 }
 

@@ -20,6 +20,8 @@
 #include "sim/topic_qos.hpp"
 #include "sim/transport.hpp"
 
+struct ddsi_serdata;
+
 namespace quadcosim::dds {
 
 /// The topics' QoS table (sim/topic_qos.hpp).
@@ -36,7 +38,8 @@ class DdsTransport final : public sim::Transport {
   explicit DdsTransport(const RosEnvironment& env);
   ~DdsTransport() override;
 
-  /// QoS for endpoints created later on `ros_topic` (default: QosProfile::for_topic).
+  /// QoS for endpoints created later on `ros_topic` without a QoS of their own (advertise and subscribe
+  /// given none: sim::QosChoice; default: QosProfile::for_topic).
   void set_qos(const std::string& ros_topic, QosProfile qos) { qos_[ros_topic] = qos; }
 
   /// Waits up to timeout_ns for data on any subscription, then delivers the samples of every
@@ -97,12 +100,19 @@ class DdsTransport final : public sim::Transport {
   void remove_extra_work(int id);
 
  protected:
-  std::function<void(const void*)> make_sink(const std::string& topic, const sim::TopicType& type) override;
-  void add_subscription(const std::string& topic, const sim::TopicType& type,
+  std::function<void(const void*)> make_sink(const std::string& topic, const sim::TopicType& type,
+                                             const sim::QosChoice& qos) override;
+  void add_subscription(const std::string& topic, const sim::TopicType& type, const sim::QosChoice& qos,
                         std::function<void(const void*)> deliver) override;
   /// The sender is the publication handle of the sample's writer (dds_sample_info_t).
-  void add_subscription_with_sender(const std::string& topic, const sim::TopicType& type,
+  void add_subscription_with_sender(const std::string& topic, const sim::TopicType& type, const sim::QosChoice& qos,
                                     std::function<void(const void*, sim::SenderId)> deliver) override;
+  /// The wire bytes are the serialised sample the reader holds (dds_takecdr: what the writer's
+  /// serialiser made, not encoded again), with Cyclone's trailing pad taken off and its pad count
+  /// cleared from the encapsulation options, so they are io::to_cdr's bytes (io_mcap_test checks
+  /// the two serialisers agree); the message is decoded from the same bytes.
+  void add_tap(const std::string& topic, const sim::TopicType& type, const sim::QosChoice& qos,
+               std::function<void(const void*, sim::SenderId, sim::WireBytes)> deliver) override;
 
  private:
   friend class ArrivalExecutor;  // delivery on arrival (dds/arrival_executor.hpp): the calls below
@@ -120,6 +130,7 @@ class DdsTransport final : public sim::Transport {
     std::size_t index = 0;
     int n = 0;
     void* samples[kBatch] = {nullptr};
+    ddsi_serdata* serdata[kBatch] = {nullptr};  ///< a tap's samples (dds_takecdr) instead of samples
     dds_sample_info_t infos[kBatch];
   };
   /// Takes what subscription `index` holds into `into` (appended, in order) without delivering it:
@@ -144,21 +155,32 @@ class DdsTransport final : public sim::Transport {
     const TypeOps* ops;  ///< nullptr: a raw reader (subscribe_raw), its C samples delivered as they are
     std::function<void(const void*)> deliver;
     sim::SenderId sender = 0;  ///< the writer of the sample being delivered (its publication handle)
+    bool tap = false;          ///< taken serialised (dds_takecdr): delivered with its wire bytes
+    sim::WireBytes wire;       ///< a tap's sample being delivered: its bytes (into wire_buffer)
+    std::vector<std::uint8_t> wire_buffer;
   };
-  void add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops, std::function<void(const void*)> deliver);
+  void add_reader(dds_entity_t reader, std::string topic, const TypeOps* ops, std::function<void(const void*)> deliver,
+                  bool tap = false);
+  /// Takes up to Held::kBatch samples of `r` into `samples` (loaned) or, for a tap, `serdata`.
+  dds_return_t take_batch(Reader& r, void** samples, ddsi_serdata** serdata, dds_sample_info_t* infos);
+  /// Gives back what take_batch took.
+  static void give_back(const Reader& r, void** samples, ddsi_serdata** serdata, int n);
+  /// Delivers one serialised sample of a tap: its bytes, and the message decoded from them.
+  void deliver_serialised(Reader& r, ddsi_serdata* sd);
   static void on_data_available(dds_entity_t reader, void* arg);
   /// Delivery on arrival for one reader: its listener set, its read condition off the waitset.
   void listen(Reader& r, bool on);
   /// A writer or reader on `ros_topic` with its QoS, attached to the waitset for matching changes.
   dds_entity_t create_endpoint(const std::string& ros_topic, const sim::TopicType& type, bool writer,
-                               const TypeOps*& ops);
+                               const TypeOps*& ops, const sim::QosChoice& qos);
   /// Attaches `e` to the waitset with `arg`, keeping room in triggered_ for every attachment.
   void attach(dds_entity_t e, dds_attach_t arg);
   dds_entity_t topic_for(const std::string& ros_topic, const sim::TopicType& type, const TypeOps*& ops);
   QosProfile qos_for(const std::string& ros_topic) const;
   int drain(Reader& r);
   /// Delivers n taken samples of `r` (the loan stays the caller's to return).
-  int deliver_taken(Reader& r, void* const* samples, const dds_sample_info_t* infos, int n);
+  int deliver_taken(Reader& r, void* const* samples, ddsi_serdata* const* serdata, const dds_sample_info_t* infos,
+                    int n);
 
   Participant participant_;
   dds_entity_t waitset_ = 0;

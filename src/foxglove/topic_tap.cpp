@@ -20,7 +20,7 @@ template <class T>
 void serve(Server& server, sim::Transport& transport, const std::string& topic, const Newest& newest) {
   const std::string type(T::kRosType);
   const std::uint32_t channel = server.add_channel(topic, type, io::ros2msg_definition(type));
-  transport.subscribe<T>(topic, [&server, channel, newest](const T& m) {
+  transport.subscribe_tap<T>(topic, [&server, channel, newest](const T& m, sim::SenderId, sim::WireBytes wire) {
     // Motor commands without a label: the newest header time seen (as the recorder stamps them).
     const std::int64_t t = io::message_time_ns(m, newest->load(std::memory_order_relaxed));
     if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) {
@@ -29,7 +29,8 @@ void serve(Server& server, sim::Transport& transport, const std::string& topic, 
       }
     }
     if (!server.wanted(channel)) return;
-    server.publish(channel, t, io::to_cdr(m));
+    // The bytes the writer serialised where the transport has them (DDS), else encoded here.
+    server.publish(channel, t, wire.empty() ? io::to_cdr(m) : std::vector<std::uint8_t>(wire.begin(), wire.end()));
   });
 }
 

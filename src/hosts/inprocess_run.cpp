@@ -5,9 +5,8 @@
 #include <fstream>
 
 #include "hosts/signals.hpp"
-#include "io/mcap_recorder.hpp"
 #include "io/provenance.hpp"
-#include "io/trajectory_csv.hpp"
+#include "io/recording.hpp"
 #include "sim/simulation.hpp"
 
 namespace quadcosim::hosts {
@@ -18,21 +17,17 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
                    const std::function<bool(double t_s)>& on_tick, const std::function<void()>& on_end,
                    const std::function<void(sim::Transport&, const sim::Topics&)>& attach) {
   struct Stopped {};
-  const std::string csv_path = (out / "trajectory.csv").string();
   sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
-  io::TrajectoryWriter csv(csv_path);
-  io::McapRecorder mcap((out / "run.mcap").string(), simulation.transport(),
-                        sim::Topics::for_namespace(sc.simulation.ns));
-  if (sc.simulation.plant.publish_tf)
-    mcap.record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
-  mcap.record_sensors(simulation.transport(), sc.simulation.ns, sc.simulation.plant.realism.extra_sensors);
+  io::RecordingOptions ro = io::RecordingOptions::for_run(sc);
+  ro.csv = (out / "trajectory.csv").string();
+  ro.mcap = (out / "run.mcap").string();
+  io::Recording recording = io::make_recording(ro, &simulation.transport());
   if (attach) attach(simulation.transport(), sim::Topics::for_namespace(sc.simulation.ns));
   bool watchdog = false;
   bool completed = true;
   std::exception_ptr failure;  // a step that failed (a foreign one crashed): rethrown once the files are finished
   try {
     simulation.run([&](const sim::TickRecord& r) {
-      const io::ControlColumns c = io::ControlColumns::from(r.status);
       const sim::PlantNode& plant = simulation.plant();
       if (plant.watchdog_active() != watchdog) {
         watchdog = plant.watchdog_active();
@@ -42,8 +37,8 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
                                         sim::to_string(plant.options().watchdog_policy))
                           : fmt::format("run: plant watchdog: commands are back at t = {:g} s\n", r.t_s));
       }
-      csv.write(r.t_s, r.state, r.latched_command, c, watchdog);
-      mcap.flush_settled(sc.simulation.plant.clock.ns(r.tick));
+      recording.tick(
+          {r.tick, r.t_s, sc.simulation.plant.clock.ns(r.tick), r.state, r.latched_command, &r.status, watchdog});
       if (on_tick && on_tick(r.t_s)) throw Stopped{};
     });
   } catch (const Stopped&) {
@@ -55,9 +50,7 @@ bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& in
     if (!stop_requested()) failure = std::current_exception();
   }
   if (completed && on_end) on_end();
-  csv.close();
-  mcap.close();
-  mcap.write_bag_metadata(out.string(), "run.mcap");
+  recording.finish(true);  // an interrupted or failed run's recording is described as far as it ran
   if (failure) std::rethrow_exception(failure);  // the outputs hold every tick up to the failed one
   if (!completed) return false;
 

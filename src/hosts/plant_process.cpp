@@ -74,12 +74,10 @@ PlantProcess::PlantProcess(const PlantProcessOptions& o, io::Scenario sc)
                                                             status_ = m;
                                                             have_status_ = true;
                                                           });
-  if (!o_.one_vehicle.record.empty()) csv_ = std::make_unique<io::TrajectoryWriter>(o_.one_vehicle.record);
-  if (!o_.one_vehicle.mcap.empty()) {
-    mcap_ = std::make_unique<io::McapRecorder>(o_.one_vehicle.mcap, transport_, topics_);
-    if (sc_.simulation.plant.publish_tf) mcap_->record_vehicle(sc_.vehicle, sc_.simulation.ns, clock_.ns(0));
-    mcap_->record_sensors(transport_, sc_.simulation.ns, sc_.simulation.plant.realism.extra_sensors);
-  }
+  io::RecordingOptions ro = io::RecordingOptions::for_run(sc_);
+  ro.csv = o_.one_vehicle.record;
+  ro.mcap = o_.one_vehicle.mcap;
+  recording_ = io::make_recording(ro, &transport_);
   foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_, sc_);
   if (!o_.one_vehicle.schedule_node.empty()) {
     scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
@@ -125,7 +123,6 @@ sim::PlantNode PlantProcess::make_plant() {
 void PlantProcess::after_latch(sim::Tick k) {
   log_watchdog(k);
   record(k);
-  if (mcap_) mcap_->flush_settled(clock_.ns(k));
 }
 
 void PlantProcess::log_watchdog(sim::Tick k) {
@@ -145,15 +142,13 @@ void PlantProcess::log_watchdog(sim::Tick k) {
 }
 
 void PlantProcess::record(sim::Tick k) {
-  if (!csv_) return;
-  csv_->write(clock_.seconds(k), plant_.state(), plant_.latched_command(),
-              have_status_ ? io::ControlColumns::from(status_) : io::ControlColumns::none(), plant_.watchdog_active());
+  recording_.tick({k, clock_.seconds(k), clock_.ns(k), plant_.state(), plant_.latched_command(),
+                   have_status_ ? &status_ : nullptr, plant_.watchdog_active()});
 }
 
 int PlantProcess::finish(int code) {
   // Delivery on arrival ended with the driver's run: what is still in the readers is taken below.
-  if (csv_) csv_->close();
-  if (mcap_ && code == kExitOk) {
+  if (recording_.mcap() && code == kExitOk) {
     // What is still in the readers. In lockstep, also what is still arriving: the delivery that
     // answered the last tick may have ended the run before Cyclone put the same sample into the
     // recorder's own reader, so wait for a 20 ms lull (at most 200 ms), or the recording could
@@ -161,10 +156,8 @@ int PlantProcess::finish(int code) {
     const std::int64_t lull_ns = o_.lockstep ? 20'000'000 : 0, until = steady_ns() + 200'000'000;
     while (transport_.spin_once(lull_ns) > 0 && steady_ns() < until) {
     }
-    mcap_->close();
-    const std::filesystem::path p(o_.one_vehicle.mcap);
-    mcap_->write_bag_metadata(p.parent_path().empty() ? "." : p.parent_path().string(), p.filename().string());
   }
+  recording_.finish(code == kExitOk);  // run.mcap's metadata.yaml only for a completed run
   return code;
 }
 

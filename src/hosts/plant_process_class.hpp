@@ -21,9 +21,8 @@
 #include "hosts/exit_code.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/node_options.hpp"
-#include "io/mcap_recorder.hpp"
+#include "io/recording.hpp"
 #include "io/scenario.hpp"
-#include "io/trajectory_csv.hpp"
 #include "sim/plant_node.hpp"
 #include "sim/topics.hpp"
 
@@ -47,7 +46,7 @@ class PlantProcess {
 
   /// Readers of this process's own on each topic (the recorder's, the Foxglove server's): matched
   /// counts include them.
-  int own_readers() const { return (mcap_ ? 1 : 0) + (foxglove_ ? 1 : 0); }
+  int own_readers() const { return (recording_.mcap() ? 1 : 0) + (foxglove_ ? 1 : 0); }
 
   using Guid = std::array<std::uint8_t, 16>;
 
@@ -163,8 +162,7 @@ class PlantProcess {
   dds::NodeAnnouncer announcer_;
   msg::ControllerStatus status_;
   bool have_status_ = false;
-  std::unique_ptr<io::TrajectoryWriter> csv_;
-  std::unique_ptr<io::McapRecorder> mcap_;
+  io::Recording recording_;  ///< trajectory.csv (--record) and run.mcap (--mcap), as asked
   // Served from the transport's deliveries, like the recorder; stopped at the end of run().
   std::unique_ptr<foxglove::Server> foxglove_;
   std::unique_ptr<dds::ParameterClient> scheduler_;

@@ -12,7 +12,7 @@
 #include "dds/dds_transport.hpp"
 #include "hosts/exit_code.hpp"
 #include "hosts/signals.hpp"
-#include "io/mcap_recorder.hpp"
+#include "io/recording.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::hosts {
@@ -38,7 +38,12 @@ int run_recorder(const RecorderOptions& o) {
   const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);  // a bag folder, as ros2 bag makes
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
-  io::McapRecorder recorder(o.out, transport, topics, o.topics);
+  io::RecordingOptions ro;
+  ro.mcap = o.out;
+  ro.ns = o.ns;
+  ro.topics = o.topics;
+  ro.live = true;  // no plant ticks here: written a second of simulated time behind the newest message
+  io::Recording recording = io::make_recording(ro, &transport);
   std::cerr << fmt::format("record: domain {}, writing {} (Ctrl-C to stop)\n", transport.participant().domain_id(),
                            o.out);
   const auto start = std::chrono::steady_clock::now();
@@ -48,15 +53,12 @@ int run_recorder(const RecorderOptions& o) {
       break;
     }
     transport.spin_once(100'000'000);
-    // Header times are simulated time; keep a second of it in memory to put late arrivals in order.
-    recorder.flush_before(recorder.newest_ns() - 1'000'000'000);
+    recording.idle();
   }
   while (transport.spin_once(0) > 0) {
   }
-  recorder.close();
-  const std::filesystem::path p(o.out);
-  recorder.write_bag_metadata(p.parent_path().empty() ? "." : p.parent_path().string(), p.filename().string());
-  std::cerr << fmt::format("record: {} messages\n", recorder.messages());
+  recording.finish(true);
+  std::cerr << fmt::format("record: {} messages\n", recording.mcap()->messages());
   return exit_code::kOk;
 }
 

@@ -11,7 +11,7 @@
 #include "analysis/percentile.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
-#include "io/trajectory_csv.hpp"
+#include "io/recording.hpp"
 #include "sim/swarm.hpp"
 
 namespace quadcosim::hosts {
@@ -85,15 +85,17 @@ bool fly_swarm_inprocess(const io::Scenario& sc, const io::SwarmSpec& spec, cons
   const int n = spec.layout.vehicles;
   sim::Swarm swarm(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule, spec.layout);
   std::vector<bool> recorded(static_cast<std::size_t>(n), false);
-  std::vector<std::unique_ptr<io::TrajectoryWriter>> writers(static_cast<std::size_t>(n));
+  std::vector<io::Recording> recordings(static_cast<std::size_t>(n));
   for (int i : spec.record_vehicles) {
     const std::string dir = sim::vehicle_namespace(spec.layout.ns_prefix, i, n).substr(1);
     recorded[static_cast<std::size_t>(i)] = true;
-    writers[static_cast<std::size_t>(i)] =
-        std::make_unique<io::TrajectoryWriter>((out / dir / "trajectory.csv").string());
+    io::RecordingOptions ro;
+    ro.csv = (out / dir / "trajectory.csv").string();
+    recordings[static_cast<std::size_t>(i)] = io::make_recording(ro, nullptr);
   }
-  const auto record = [&](int i, const sim::TickRecord& r) {
-    writers[static_cast<std::size_t>(i)]->write(r.t_s, r.state, r.latched_command, io::ControlColumns::from(r.status));
+  const auto record = [&](int i, const sim::TickRecord& r) {  // a swarm's rows show no watchdog
+    recordings[static_cast<std::size_t>(i)].tick(
+        {r.tick, r.t_s, sc.simulation.plant.clock.ns(r.tick), r.state, r.latched_command, &r.status, false});
   };
   const auto start = std::chrono::steady_clock::now();
   const bool completed = swarm.run(spec.threads, kSwarmBlockTicks, recorded, record,
@@ -102,9 +104,7 @@ bool fly_swarm_inprocess(const io::Scenario& sc, const io::SwarmSpec& spec, cons
                                    })
                                             : sim::Swarm::StopCheck());
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (auto& w : writers) {
-    if (w) w->close();
-  }
+  for (auto& r : recordings) r.finish(completed);
   if (!completed) return false;
   std::vector<SwarmFinal> rows(static_cast<std::size_t>(n));
   std::vector<std::string> namespaces(static_cast<std::size_t>(n));

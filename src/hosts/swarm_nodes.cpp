@@ -23,7 +23,7 @@
 #include "hosts/node_common.hpp"
 #include "hosts/signals.hpp"
 #include "hosts/swarm_inprocess.hpp"
-#include "io/trajectory_csv.hpp"
+#include "io/recording.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/plant_node.hpp"
 
@@ -88,7 +88,10 @@ class PlantShard {
         const fs::path dir = out / v.simulation.ns.substr(1);
         std::error_code ec;  // a failure shows as the writer's "cannot open" naming the file
         fs::create_directories(dir, ec);
-        node->csv = std::make_unique<io::TrajectoryWriter>((dir / "trajectory.csv").string());
+        io::RecordingOptions ro;
+        ro.csv = (dir / "trajectory.csv").string();
+        node->recording = io::make_recording(ro, nullptr);
+        node->recorded = true;
         Vehicle* raw = node.get();
         transport_.subscribe<msg::ControllerStatus>(node->topics.controller_status,
                                                     [raw](const msg::ControllerStatus& m) { raw->status = m; });
@@ -139,7 +142,7 @@ class PlantShard {
     std::vector<drivers::DrivenPlant> plants;
     for (auto& v : vehicles_) {
       drivers::DrivenPlant p{v->plant.get(), {}, {}};
-      if (v->csv) {  // a recorded vehicle's status is awaited, as the single-vehicle plant's
+      if (v->recorded) {  // a recorded vehicle's status is awaited, as the single-vehicle plant's
         Vehicle* raw = v.get();
         p.status_awaited = [this, raw] { return transport_.matched_writers(raw->topics.controller_status) > 0; };
         p.status_stamp_ns = [raw] { return raw->status.header.stamp.to_ns(); };
@@ -149,10 +152,9 @@ class PlantShard {
     drivers::LockstepHooks h;
     h.after_latch = [this](std::size_t i, sim::Tick k) {
       Vehicle& v = *vehicles_[i];
-      if (!v.csv) return;
-      v.csv->write(
-          clock_.seconds(k), v.plant->state(), v.plant->latched_command(),
-          v.status.header.stamp.to_ns() >= 0 ? io::ControlColumns::from(v.status) : io::ControlColumns::none());
+      if (!v.recorded) return;  // a swarm's rows show no watchdog
+      v.recording.tick({k, clock_.seconds(k), clock_.ns(k), v.plant->state(), v.plant->latched_command(),
+                        v.status.header.stamp.to_ns() >= 0 ? &v.status : nullptr, false});
     };
     h.on_timeout = [&](std::size_t i, sim::Tick k) {
       std::cerr << lockstep_timeout_message(transport_, vehicles_[i]->topics, clock_, k, timeout_s, on_timeout);
@@ -166,9 +168,7 @@ class PlantShard {
     const drivers::LockstepResult r = driver.run();
     end_ns_ = steady_ns();
     host_.on_delivery(nullptr);
-    for (auto& v : vehicles_) {
-      if (v->csv) v->csv->close();
-    }
+    for (auto& v : vehicles_) v->recording.finish(r == drivers::LockstepResult::kDone);
     if (r == drivers::LockstepResult::kTimedOut) return exit_code::kNoPeer;
     return r == drivers::LockstepResult::kStopped ? exit_code::kInterrupted : exit_code::kOk;
   }
@@ -186,7 +186,8 @@ class PlantShard {
   struct Vehicle {
     sim::Topics topics;
     std::unique_ptr<sim::PlantNode> plant;
-    std::unique_ptr<io::TrajectoryWriter> csv;
+    bool recorded = false;
+    io::Recording recording;  ///< trajectory.csv when recorded
     msg::ControllerStatus status;
   };
 

@@ -75,7 +75,7 @@ template <class T>
 void McapRecorder::add(sim::Transport& transport, const std::string& topic) {
   if (!wanted(topic)) return;
   const std::size_t index = open_channel(topic, std::string(T::kRosType), sim::TopicQos::for_topic(topic));
-  transport.subscribe_with_sender<T>(topic, [this, index](const T& m, sim::SenderId sender) {
+  transport.subscribe_tap<T>(topic, [this, index](const T& m, sim::SenderId sender, sim::WireBytes wire) {
     const std::int64_t t = message_time_ns(m, last_stamp_ns_);
     bool stamped = true;  // the message carries its own time (header, clock, or command label)
     if constexpr (std::is_same_v<T, msg::Float64MultiArray>) stamped = msg::command_stamp_ns(m) >= 0;
@@ -106,7 +106,9 @@ void McapRecorder::add(sim::Transport& transport, const std::string& topic) {
       }
     }
     if constexpr (!std::is_same_v<T, msg::Float64MultiArray>) last_stamp_ns_ = std::max(last_stamp_ns_, t);
-    push(static_cast<std::uint16_t>(index), t, to_cdr(m));
+    // The bytes the writer serialised where the transport has them (DDS), else encoded here once.
+    push(static_cast<std::uint16_t>(index), t,
+         wire.empty() ? to_cdr(m) : std::vector<std::uint8_t>(wire.begin(), wire.end()));
   });
 }
 

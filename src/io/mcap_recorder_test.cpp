@@ -100,14 +100,15 @@ class SendersTransport final : public sim::Transport {
   }
 
  protected:
-  std::function<void(const void*)> make_sink(const std::string&, const sim::TopicType&) override {
+  std::function<void(const void*)> make_sink(const std::string&, const sim::TopicType&,
+                                             const sim::QosChoice&) override {
     return [](const void*) {};
   }
-  void add_subscription(const std::string& topic, const sim::TopicType& type,
+  void add_subscription(const std::string& topic, const sim::TopicType& type, const sim::QosChoice& qos,
                         std::function<void(const void*)> d) override {
-    add_subscription_with_sender(topic, type, [d = std::move(d)](const void* m, sim::SenderId) { d(m); });
+    add_subscription_with_sender(topic, type, qos, [d = std::move(d)](const void* m, sim::SenderId) { d(m); });
   }
-  void add_subscription_with_sender(const std::string& topic, const sim::TopicType&,
+  void add_subscription_with_sender(const std::string& topic, const sim::TopicType&, const sim::QosChoice&,
                                     std::function<void(const void*, sim::SenderId)> d) override {
     subs_.emplace_back(topic, std::move(d));
   }

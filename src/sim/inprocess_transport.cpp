@@ -27,7 +27,8 @@ InProcessTransport::Channel& InProcessTransport::channel(const std::string& topi
   return c;
 }
 
-std::function<void(const void*)> InProcessTransport::make_sink(const std::string& topic, const TopicType& type) {
+std::function<void(const void*)> InProcessTransport::make_sink(const std::string& topic, const TopicType& type,
+                                                               const QosChoice&) {  // no QoS in process
   Channel* c = &channel(topic, type);
   return [this, c](const void* message) {
     if (!c->stream) return deliver(*c, message);
@@ -87,7 +88,7 @@ std::uint64_t InProcessTransport::dropped(const std::string& topic) const {
   return it == channels_.end() ? 0 : it->second->dropped;
 }
 
-void InProcessTransport::add_subscription(const std::string& topic, const TopicType& type,
+void InProcessTransport::add_subscription(const std::string& topic, const TopicType& type, const QosChoice&,
                                           std::function<void(const void*)> deliver) {
   Channel& c = channel(topic, type);
   if (!c.first) {

@@ -37,8 +37,9 @@ class InProcessTransport final : public Transport {
   std::uint64_t dropped(const std::string& topic) const;
 
  protected:
-  std::function<void(const void*)> make_sink(const std::string& topic, const TopicType& type) override;
-  void add_subscription(const std::string& topic, const TopicType& type,
+  std::function<void(const void*)> make_sink(const std::string& topic, const TopicType& type,
+                                             const QosChoice& qos) override;
+  void add_subscription(const std::string& topic, const TopicType& type, const QosChoice& qos,
                         std::function<void(const void*)> deliver) override;
 
  private:

@@ -1,5 +1,7 @@
-// The QoS each topic is offered and asked with: one table, for the DDS endpoints (dds/dds_transport.hpp)
-// and the `offered_qos_profiles` recordings state for each channel (io/mcap_recorder.hpp).
+// The QoS each topic is offered and asked with: one table, for the DDS endpoints whose host states no
+// QoS of its own where it advertises or subscribes (sim::QosChoice, sim/transport.hpp;
+// dds/dds_transport.hpp) and the `offered_qos_profiles` recordings state for each channel
+// (io/mcap_recorder.hpp).
 #pragma once
 
 #include <string>

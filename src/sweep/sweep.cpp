@@ -15,9 +15,9 @@
 #include "analysis/step_metrics.hpp"
 #include "analysis/tracking.hpp"
 #include "control/care.hpp"
-#include "io/mcap_recorder.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
+#include "io/recording.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/simulation.hpp"
 #include "sim/topics.hpp"
@@ -36,29 +36,17 @@ namespace {
 const io::Series& simulate(const io::Scenario& sc, io::SeriesRecorder& series, const fs::path* csv,
                            const fs::path* mcap_dir) {
   sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
-  std::optional<io::TrajectoryWriter> writer;
-  if (csv) writer.emplace(csv->string());
-  std::optional<io::McapRecorder> mcap;
-  if (mcap_dir) {
-    mcap.emplace((*mcap_dir / "run.mcap").string(), simulation.transport(),
-                 sim::Topics::for_namespace(sc.simulation.ns));
-    if (sc.simulation.plant.publish_tf)
-      mcap->record_vehicle(sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
-    mcap->record_sensors(simulation.transport(), sc.simulation.ns, sc.simulation.plant.realism.extra_sensors);
-  }
   series.clear(static_cast<std::size_t>(sc.simulation.duration_ticks + 1));
+  io::RecordingOptions ro = io::RecordingOptions::for_run(sc);
+  ro.series = &series;  // the numbers trajectory.csv holds
+  if (csv) ro.csv = csv->string();
+  if (mcap_dir) ro.mcap = (*mcap_dir / "run.mcap").string();
+  io::Recording recording = io::make_recording(ro, &simulation.transport());
   simulation.run([&](const sim::TickRecord& r) {
-    const io::ControlColumns c = io::ControlColumns::from(r.status);
-    const bool watchdog = simulation.plant().watchdog_active();
-    series.add(r.t_s, r.state, r.latched_command, c, watchdog);  // the numbers trajectory.csv holds
-    if (writer) writer->write(r.t_s, r.state, r.latched_command, c, watchdog);
-    if (mcap) mcap->flush_settled(sc.simulation.plant.clock.ns(r.tick));
+    recording.tick({r.tick, r.t_s, sc.simulation.plant.clock.ns(r.tick), r.state, r.latched_command, &r.status,
+                    simulation.plant().watchdog_active()});
   });
-  if (writer) writer->close();
-  if (mcap) {
-    mcap->close();
-    mcap->write_bag_metadata(mcap_dir->string(), "run.mcap");
-  }
+  recording.finish(true);
   return series.series();
 }
 
