@@ -1,5 +1,7 @@
 #include "foxglove/server.hpp"
 
+#include "foxglove/protocol.hpp"
+
 // websocketpp on standalone asio (Debian's libwebsocketpp-dev and libasio-dev), without TLS.
 #define ASIO_STANDALONE
 #include <websocketpp/config/asio_no_tls.hpp>
@@ -8,11 +10,10 @@
 #include <fmt/format.h>
 #include <pthread.h>
 #include <signal.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
-#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <iostream>
@@ -22,6 +23,7 @@
 #include <set>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 namespace quadcosim::foxglove {
 
@@ -29,67 +31,15 @@ namespace {
 
 using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
-using nlohmann::json;
 
-// Binary opcodes (server to client) and status levels of the protocol.
-constexpr std::uint8_t kMessageData = 0x01, kTime = 0x02;
-constexpr int kStatusError = 2;
 // Per client: the first error is logged, the rest only counted; this many close the connection.
 constexpr std::uint64_t kErrorsBeforeDisconnect = 100;
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-void put_le(std::uint8_t* p, std::uint64_t v, int bytes) {
-  for (int i = 0; i < bytes; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-
-// A JSON number that is a whole number fitting a u32 (ids), else nullopt.
-std::optional<std::uint32_t> as_u32(const json& v) {
-  if (v.is_number_unsigned() && v.get<std::uint64_t>() <= UINT32_MAX)
-    return static_cast<std::uint32_t>(v.get<std::uint64_t>());
-  if (v.is_number_integer() && v.get<std::int64_t>() >= 0 && v.get<std::int64_t>() <= UINT32_MAX)
-    return static_cast<std::uint32_t>(v.get<std::int64_t>());
-  return std::nullopt;
-}
-
 }  // namespace
-
-bool origin_allowed(const std::string& origin, const std::vector<std::string>& allowed) {
-  if (origin.empty()) return true;
-  std::string o = lower(origin);
-  while (!o.empty() && o.back() == '/') o.pop_back();
-  for (const std::string& a : allowed) {
-    std::string w = lower(a);
-    while (!w.empty() && w.back() == '/') w.pop_back();
-    if (w == "*" || w == o) return true;
-  }
-  // scheme://host[:port], nothing else (no path, no user info)
-  std::string rest;
-  if (o.rfind("http://", 0) == 0) {
-    rest = o.substr(7);
-  } else if (o.rfind("https://", 0) == 0) {
-    rest = o.substr(8);
-  } else {
-    return false;
-  }
-  for (const char* host : {"localhost", "127.0.0.1", "[::1]"}) {
-    const std::string h(host);
-    if (rest.compare(0, h.size(), h) != 0) continue;
-    const std::string port = rest.substr(h.size());
-    if (port.empty()) return true;
-    if (port.size() >= 2 && port.size() <= 6 && port[0] == ':' &&
-        std::all_of(port.begin() + 1, port.end(), [](char c) { return c >= '0' && c <= '9'; }))
-      return true;
-  }
-  return false;
-}
 
 struct Server::Impl {
   struct Channel {
-    std::string topic, schema_name, schema;
+    protocol::ChannelInfo info;
     std::atomic<int> subscribers{0};
     // Server thread only: the newest message, sent at once to a client that subscribes later.
     std::vector<std::uint8_t> last;
@@ -119,6 +69,7 @@ struct Server::Impl {
   std::thread thread;
   bool started = false, stopped = false;
   std::string session_id;
+  std::string advertised;  // the advertise message (the channels are fixed once started)
 
   // Hand-over from the publishing threads.
   std::mutex handoff_mutex;
@@ -135,6 +86,10 @@ struct Server::Impl {
   std::uint64_t n_refused_in_a_row = 0;  // refusals for the client limit since a connection last opened
 
   std::atomic<std::size_t> open{0};
+  // Wakes Server::stop, which waits for the connections to close: notified (under the mutex, so the
+  // waiter cannot miss it) after the server thread closed one.
+  std::mutex open_mutex;
+  std::condition_variable closed;
   // Wakes Server::wait_subscriptions_change: notified (under the mutex, so no waiter misses it) after
   // the server thread changed a channel's subscriber count.
   mutable std::mutex subscriptions_mutex;
@@ -200,24 +155,8 @@ struct Server::Impl {
     c->set_close_handshake_timeout(1000);  // a client that does not answer a close is cut off after 1 s
     ++n_clients;
     ++open;
-    json info = {{"op", "serverInfo"},
-                 {"name", options.name},
-                 {"capabilities", json::array({"time"})},
-                 {"supportedEncodings", json::array({"cdr"})},
-                 {"metadata", json::object()},
-                 {"sessionId", session_id}};
-    send_text(h, info);
-    json list = json::array();
-    for (std::size_t i = 0; i < channels.size(); ++i) {
-      const Channel& ch = *channels[i];
-      list.push_back({{"id", i},
-                      {"topic", ch.topic},
-                      {"encoding", "cdr"},
-                      {"schemaName", ch.schema_name},
-                      {"schema", ch.schema},
-                      {"schemaEncoding", "ros2msg"}});
-    }
-    send_text(h, json{{"op", "advertise"}, {"channels", list}});
+    send_text(h, protocol::server_info(options.name, session_id));
+    send_text(h, advertised);
     if (time_ns >= 0) send_time(h, cl);
   }
 
@@ -239,6 +178,8 @@ struct Server::Impl {
       log(fmt::format("client {} ({}) left; {} messages dropped for it", cl.id, cl.remote, cl.dropped));
     clients.erase(it);
     --open;
+    { const std::lock_guard<std::mutex> lock(open_mutex); }
+    closed.notify_all();
   }
 
   // --- client requests ---------------------------------------------------------------------------
@@ -251,7 +192,7 @@ struct Server::Impl {
     if (cl.errors == 1)
       log(fmt::format("client {} ({}): {} (further errors of this client are only counted; the {}th disconnects it)",
                       cl.id, cl.remote, what, kErrorsBeforeDisconnect));
-    send_text(h, json{{"op", "status"}, {"level", kStatusError}, {"message", what}});
+    send_text(h, protocol::status_error(what));
     if (cl.errors >= kErrorsBeforeDisconnect) {
       cl.closing = true;
       ++n_disconnected;
@@ -269,34 +210,18 @@ struct Server::Impl {
       error(h, cl, "binary client messages need the clientPublish capability, which this server does not offer");
       return;
     }
-    const json j = json::parse(m->get_payload(), nullptr, /*allow_exceptions=*/false);
-    if (j.is_discarded()) {
-      error(h, cl, "malformed JSON");
-      return;
-    }
-    if (!j.is_object() || !j.contains("op") || !j["op"].is_string()) {
-      error(h, cl, "a JSON message must be an object with a string field \"op\"");
-      return;
-    }
-    const std::string op = j["op"].get<std::string>();
-    if (op == "subscribe") {
-      subscribe(h, cl, j);
-    } else if (op == "unsubscribe") {
-      unsubscribe(h, cl, j);
-    } else {
-      error(h, cl, fmt::format("op \"{}\" is not supported (capabilities: time)", op));
+    const protocol::Request request = protocol::parse_request(m->get_payload());
+    switch (request.op) {
+      case protocol::Request::Op::kSubscribe: subscribe(h, cl, request.subscriptions); break;
+      case protocol::Request::Op::kUnsubscribe: unsubscribe(h, cl, request.subscription_ids); break;
+      case protocol::Request::Op::kInvalid: error(h, cl, request.error); break;
     }
   }
 
-  void subscribe(Hdl h, Client& cl, const json& j) {
-    if (!j.contains("subscriptions") || !j["subscriptions"].is_array()) {
-      error(h, cl, "subscribe: \"subscriptions\" must be an array");
-      return;
-    }
-    for (const json& s : j["subscriptions"]) {
+  void subscribe(Hdl h, Client& cl, const std::vector<protocol::Request::Subscription>& subscriptions) {
+    for (const protocol::Request::Subscription& s : subscriptions) {
       if (cl.closing) return;
-      const auto id = s.is_object() && s.contains("id") ? as_u32(s["id"]) : std::nullopt;
-      const auto channel = s.is_object() && s.contains("channelId") ? as_u32(s["channelId"]) : std::nullopt;
+      const std::optional<std::uint32_t> id = s.id, channel = s.channel;
       if (!id || !channel) {
         error(h, cl, "subscribe: each subscription needs an \"id\" and a \"channelId\" (u32)");
         continue;
@@ -324,17 +249,13 @@ struct Server::Impl {
     }
   }
 
-  void unsubscribe(Hdl h, Client& cl, const json& j) {
-    if (!j.contains("subscriptionIds") || !j["subscriptionIds"].is_array()) {
-      error(h, cl, "unsubscribe: \"subscriptionIds\" must be an array");
-      return;
-    }
-    for (const json& v : j["subscriptionIds"]) {
+  void unsubscribe(Hdl h, Client& cl, const std::vector<protocol::Request::SubscriptionId>& ids) {
+    for (const protocol::Request::SubscriptionId& v : ids) {
       if (cl.closing) return;
-      const auto id = as_u32(v);
+      const std::optional<std::uint32_t> id = v.id;
       const auto it = id ? cl.subscriptions.find(*id) : cl.subscriptions.end();
       if (it == cl.subscriptions.end()) {
-        error(h, cl, fmt::format("unsubscribe: unknown subscription id {}", v.dump()));
+        error(h, cl, fmt::format("unsubscribe: unknown subscription id {}", v.text));
         continue;
       }
       --channels[it->second]->subscribers;
@@ -345,9 +266,9 @@ struct Server::Impl {
   }
 
   // --- sending -------------------------------------------------------------------------------------
-  void send_text(Hdl h, const json& j) {
+  void send_text(Hdl h, const std::string& text) {
     websocketpp::lib::error_code ec;
-    ws.send(h, j.dump(), websocketpp::frame::opcode::text, ec);
+    ws.send(h, text, websocketpp::frame::opcode::text, ec);
   }
 
   // False when the client's queue is full (nothing sent).
@@ -372,11 +293,8 @@ struct Server::Impl {
   void send_time(Hdl h, Client& cl) {
     WsServer::connection_ptr c;
     if (!room(h, cl, c)) return;
-    std::uint8_t frame[9];
-    frame[0] = kTime;
-    put_le(frame + 1, static_cast<std::uint64_t>(time_ns), 8);
-    websocketpp::lib::error_code ec;
-    c->send(frame, sizeof frame, websocketpp::frame::opcode::binary);
+    const std::array<std::uint8_t, 9> frame = protocol::time_frame(time_ns);
+    c->send(frame.data(), frame.size(), websocketpp::frame::opcode::binary);
     ++n_time;
   }
 
@@ -388,11 +306,7 @@ struct Server::Impl {
       ++n_dropped;
       return;
     }
-    std::vector<std::uint8_t> frame(13 + cdr.size());
-    frame[0] = kMessageData;
-    put_le(frame.data() + 1, subscription, 4);
-    put_le(frame.data() + 5, static_cast<std::uint64_t>(std::max<std::int64_t>(t_ns, 0)), 8);
-    std::copy(cdr.begin(), cdr.end(), frame.begin() + 13);
+    const std::vector<std::uint8_t> frame = protocol::message_frame(subscription, t_ns, cdr);
     c->send(frame.data(), frame.size(), websocketpp::frame::opcode::binary);
     ++n_sent;
   }
@@ -445,9 +359,7 @@ Server::~Server() { stop(); }
 std::uint32_t Server::add_channel(const std::string& topic, const std::string& schema_name, const std::string& schema) {
   if (impl_->started) throw std::logic_error("foxglove::Server::add_channel after start()");
   auto ch = std::make_unique<Impl::Channel>();
-  ch->topic = topic;
-  ch->schema_name = schema_name;
-  ch->schema = schema;
+  ch->info = {topic, schema_name, schema};
   impl_->channels.push_back(std::move(ch));
   return static_cast<std::uint32_t>(impl_->channels.size() - 1);
 }
@@ -488,6 +400,9 @@ void Server::start() {
   s.ws.start_accept(ec);
   if (ec) throw std::runtime_error(fmt::format("foxglove: {}: {}", where, ec.message()));
   s.session_id = std::to_string(std::chrono::system_clock::now().time_since_epoch().count());
+  std::vector<const protocol::ChannelInfo*> infos;
+  for (const auto& ch : s.channels) infos.push_back(&ch->info);
+  s.advertised = protocol::advertise(infos);
   s.handoff.reserve(1024);
   s.batch.reserve(1024);
   s.started = true;
@@ -528,9 +443,9 @@ void Server::stop() {
     for (auto& [h, cl] : s.clients) s.ws.close(h, websocketpp::close::status::going_away, "server shutting down", ec);
   });
   // Clients that answer the close are gone within milliseconds; one that does not is cut off.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(1000);
-  while (s.open.load() > 0 && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  {
+    std::unique_lock<std::mutex> lock(s.open_mutex);
+    s.closed.wait_for(lock, std::chrono::milliseconds(1000), [&s] { return s.open.load() == 0; });
   }
   s.io.stop();
   s.thread.join();
