@@ -17,6 +17,18 @@ std::string dds_topic_name(const std::string& ros_topic) { return "rt" + ros_top
 
 DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
   waitset_ = check(dds_create_waitset(participant_.handle()), "dds_create_waitset");
+  // Cyclone packs a writer's writes until it is flushed only by a setting of the whole domain
+  // (Internal/WriteBatch), which reaches the writers made after it (this transport's; the domain
+  // exists now): every write site of quadcosim flushes at once (dds::write_now), except a
+  // transport's held sends.
+  dds_write_set_batch(true);
+}
+
+void DdsTransport::hold_sends(bool on) {
+  holding_ = on;
+  if (on) return;
+  for (const dds_entity_t w : held_writers_) dds_write_flush(w);
+  held_writers_.clear();
 }
 
 DdsTransport::~DdsTransport() {
@@ -67,9 +79,14 @@ std::function<void(const void*)> DdsTransport::make_sink(const std::string& ros_
   const TypeOps* ops = nullptr;
   const dds_entity_t writer = create_endpoint(ros_topic, type, true, ops, qos);
   writers_[ros_topic].push_back(writer);
-  return [writer, ops, ros_topic](const void* message) {
+  return [this, writer, ops, ros_topic](const void* message) {
     // The error's text is formed only on an error: a write is on every tick's path.
     if (const dds_return_t rc = ops->write(writer, message); rc < 0) check(rc, ("dds_write " + ros_topic).c_str());
+    if (!holding_) {
+      dds_write_flush(writer);
+    } else if (std::find(held_writers_.begin(), held_writers_.end(), writer) == held_writers_.end()) {
+      held_writers_.push_back(writer);
+    }
   };
 }
 

@@ -64,6 +64,12 @@ class DdsTransport final : public sim::Transport {
 
   const Participant& participant() const { return participant_; }
 
+  /// While held, what the writers of this transport write is packed into their next datagram
+  /// instead of sent at once (Cyclone's write batching); release sends every writer's pack. Lockstep
+  /// plants hold the outputs of the ticks between control ticks, so the controller gets a writer's
+  /// samples of two ticks in one datagram (docs/performance.md). Off, every write is sent at once.
+  void hold_sends(bool on);
+
   /// What discovery says of `sender`, a writer matched by our reader of `ros_topic` (the SenderId of
   /// a delivery on that topic): nullopt when it is not (or no longer) matched.
   struct SenderInfo {
@@ -207,6 +213,8 @@ class DdsTransport final : public sim::Transport {
   int next_extra_id_ = 1;
   std::function<void(std::size_t)> arrival_sink_;  ///< set_arrival_sink's (empty: delivery by spin_once)
   std::string user_data_keys_;
+  bool holding_ = false;
+  std::vector<dds_entity_t> held_writers_;  ///< written while holding, in first-write order
 };
 
 }  // namespace quadcosim::dds

@@ -78,7 +78,7 @@ void NodeAnnouncer::announce() {
   rmw_dds_common_msg_dds__ParticipantEntitiesInfo_ info{};
   info.gid = gid_of(participant_);
   info.node_entities_info_seq = {1, 1, &node, false};
-  check(dds_write(writer_, &info), "dds_write ros_discovery_info");
+  write_now(writer_, &info, "dds_write ros_discovery_info");
 }
 
 }  // namespace quadcosim::dds

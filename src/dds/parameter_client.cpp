@@ -161,7 +161,7 @@ void ParameterClient::send(ParamService service, void* request) {
   header->guid = e.writer_handle;
   header->seq = ++next_seq_;
   last_ = {header->guid, header->seq};
-  check(dds_write(e.writer, request), ("dds_write " + request_topic(node_, service)).c_str());
+  write_now(e.writer, request, ("dds_write " + request_topic(node_, service)).c_str());
 }
 
 ParameterClient::Header ParameterClient::send_get(const std::vector<std::string>& names) {

@@ -146,7 +146,7 @@ void ParameterServer::publish_event(const std::vector<Param>& changed) {
   wire::to_c(std::vector<Param>{}, ev.new_parameters);
   wire::to_c(changed, ev.changed_parameters);
   wire::to_c(std::vector<Param>{}, ev.deleted_parameters);
-  check(dds_write(events_writer_, sample.get()), "dds_write rt/parameter_events");
+  write_now(events_writer_, sample.get(), "dds_write rt/parameter_events");
   ++stats_.events;
 }
 
@@ -275,7 +275,7 @@ void ParameterServer::send_pending() {
   for (auto it = pending_.begin(); it != pending_.end();) {
     const int ready = client_ready(it->service, it->request_writer);
     if (ready > 0) {
-      check(dds_write(ep_[index(it->service)].writer, it->sample.get()), "dds_write (parameter reply)");
+      write_now(ep_[index(it->service)].writer, it->sample.get(), "dds_write (parameter reply)");
       ++stats_.replies;
     } else if (ready == 0 && now < it->deadline_ns) {
       ++it;

@@ -332,6 +332,7 @@ TEST(ParameterServiceTest, RepliesEchoGuidAndSequenceAndEventsAnnounceChanges) {
   rq.seq = 42;
   rq.names = {1, 1, names, false};
   ASSERT_GE(dds_write(writer, &rq), 0);
+  dds_write_flush(writer);
   bool got = false;
   while (!got && std::chrono::steady_clock::now() < deadline) {
     dds_waitset_wait(ws, nullptr, 0, kSecond);

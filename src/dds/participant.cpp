@@ -16,6 +16,11 @@ dds_return_t check(dds_return_t rc, const char* what) {
   return rc;
 }
 
+void write_now(dds_entity_t writer, const void* sample, const char* what) {
+  check(dds_write(writer, sample), what);
+  dds_write_flush(writer);
+}
+
 namespace {
 std::string env(const char* name) {
   const char* v = std::getenv(name);

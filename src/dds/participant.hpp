@@ -24,6 +24,11 @@ class DdsError : public std::runtime_error {
 /// Throws DdsError when `rc` is a Cyclone error code; returns it otherwise.
 dds_return_t check(dds_return_t rc, const char* what);
 
+/// dds_write, then the writer's datagram sent now. A DdsTransport's domain packs writes until a
+/// flush (DdsTransport::hold_sends), so every write of quadcosim's own is either flushed at once or
+/// held by a transport and flushed at its release. Throws DdsError naming `what` on an error.
+void write_now(dds_entity_t writer, const void* sample, const char* what);
+
 enum class DiscoveryRange { kSubnet, kLocalhost, kOff, kSystemDefault };
 
 /// The ROS 2 environment, parsed (docs/ros2.md, Domain and discovery).

@@ -29,6 +29,11 @@ class DriverHost {
   /// arrive (over DDS on the receive thread, running the driver's on_delivery() after each); off
   /// while a plant driver holds after a timeout, and at the end. Default: nothing to switch.
   virtual void deliver_on_arrival(bool /*on*/) {}
+  /// Lockstep: on, the outputs published from now on may wait to be sent with later ones (over DDS:
+  /// packed into one datagram a writer); off, everything waiting is sent now. A plant holds the
+  /// outputs of the ticks between control ticks, which nothing waits for, and releases them with
+  /// the next control tick's. Default: every output is sent when published.
+  virtual void hold_outputs(bool /*on*/) {}
 };
 
 }  // namespace quadcosim::drivers

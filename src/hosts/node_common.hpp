@@ -62,6 +62,7 @@ class DdsDriverHost final : public drivers::DriverHost {
   void wait_until(std::int64_t deadline_ns) override;
   bool stop_requested() override;
   void deliver_on_arrival(bool on) override;
+  void hold_outputs(bool on) override { transport_.hold_sends(on); }
   /// Runs `blocking()` with deliveries on arrival let through (a blocking service call), or just
   /// runs it.
   template <class F>

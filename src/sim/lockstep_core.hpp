@@ -166,9 +166,16 @@ class LockstepCore {
   /// before_outputs(k), every plant's outputs, after_outputs(k); false when refused.
   bool publish(Tick k) {
     if (!hooks_.before_outputs(k)) return false;
+    // Outputs between control ticks wait for the next control tick's (sent with them), while the
+    // answers are awaited: nothing waits for them before then.
+    const bool hold = waiting_ && !(k % o_.controller_divider == 0 && k >= o_.first_control_tick);
+    if constexpr (!kSynchronous) host_.hold_outputs(true);
     for (std::size_t i = 0; i < plants_.size(); ++i) {
       if constexpr (!kSynchronous) slots_[i].received_before = plants_[i]->command_receipt().received;
       plants_[i]->publish_outputs(k);
+    }
+    if constexpr (!kSynchronous) {
+      if (!hold) host_.hold_outputs(false);
     }
     hooks_.after_outputs(k);
     return true;
@@ -197,7 +204,10 @@ class LockstepCore {
       const Tick k = k_;
       const bool control = k % o_.controller_divider == 0 && k >= o_.first_control_tick;
       if (!published_) {
-        if (k > o_.duration_ticks || host_.stop_requested()) return Phase::kDone;
+        if (k > o_.duration_ticks || host_.stop_requested()) {
+          if constexpr (!kSynchronous) host_.hold_outputs(false);
+          return Phase::kDone;
+        }
         if (on_delivery && (!waiting_ || hooks_.main_thread_due(k))) return Phase::kMainThread;
         if (!publish(k)) return Phase::kRefused;
         asked_ns_ = last_ask_ns_ = host_.now_ns();

@@ -226,6 +226,25 @@ print(c[0], c[1] if len(c) > 1 else c[0])')
     fi
     ;;
 
+  packed_sends)  # lockstep: a writer's sample of the tick between two control ticks goes out in one datagram with
+    # the next control tick's (docs/performance.md): 10 s of the paper's 100 Hz sensors (Pose, Velocity, Imu: 3000
+    # samples, 500 control periods) take about 1500 datagrams, not 3000; counted at the plant's send calls.
+    command -v strace > /dev/null || { echo "SKIP: strace is not installed (it counts the plant's datagrams)"; exit 77; }
+    "$bin" controller --scenario "$paper/altitude_step.yaml" > "$tmp/c.log" 2>&1 &
+    pids+=($!)
+    if ! strace -f -qq -e trace=sendmsg,sendto,sendmmsg -o "$tmp/sends.txt" \
+      "$bin" plant --scenario "$paper/altitude_step.yaml" --duration 10 > "$tmp/p.log" 2>&1; then
+      if grep -q "ptrace\|Operation not permitted" "$tmp/p.log"; then
+        echo "SKIP: strace cannot trace here: $(head -1 "$tmp/p.log")"; exit 77
+      fi
+      fail "plant failed"
+    fi
+    grep -q "1000 ticks" "$tmp/p.log" || fail "unexpected run length"
+    sends=$(grep -c "^[0-9]* *send" "$tmp/sends.txt")
+    echo "the plant's datagrams for 10 s (3000 sensor samples, 500 control periods; status and discovery too): $sends"
+    [ "$sends" -lt 2000 ] || fail "$sends datagrams: the sensor samples between control ticks are not packed"
+    ;;
+
   sensor_qos)  # best-effort sensor topics (ROS sensor-data QoS) on both sides: still the same bytes
     "$bin" run "$paper/roll_step.yaml" --out "$tmp/in" --no-plots > /dev/null
     "$bin" controller --scenario "$paper/roll_step.yaml" --sensor-qos > "$tmp/c.log" 2>&1 &

@@ -43,6 +43,7 @@ struct LocalTopic {
     dds_delete_qos(qos);
     void* zero = dds_alloc(desc->m_size);  // zeroed: empty strings and sequences
     dds::check(dds_write(writer, zero), "dds_write");
+    dds_write_flush(writer);
     dds_sample_free(zero, desc, DDS_FREE_ALL);
     dds_sample_info_t info;
     if (dds_takecdr(reader, &keep, 1, &info, DDS_ANY_STATE) != 1) {
