@@ -90,6 +90,9 @@ void read_extra_sensors(YamlSection& s, const sim::SimulationConfig& cfg, const 
     }
     if constexpr (requires { Kind::at_site(c, site); }) Kind::at_site(c, site);
     section->reject_unknown_keys();
+    if constexpr (requires { Kind::check(c); }) {
+      if (const std::string err = Kind::check(c); !err.empty()) s.fail(std::string(Kind::kName), err);
+    }
     Kind::config(set) = c;
   });
 }

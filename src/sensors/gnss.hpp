@@ -2,10 +2,13 @@
 // velocity in the world frame (ENU), at a receiver's rate (5-10 Hz) and latency. The world frame is the
 // local tangent plane of the site (sensors/geodesy.hpp). Errors are white per sample and per axis in
 // ENU: horizontal (east, north) and vertical sigmas, a velocity sigma; the fix carries their variances
-// as a diagonal ENU covariance. Until fix_after_s (time to first fix) the receiver reports no fix:
-// status NO_FIX, coordinates and velocity NaN. Multipath, atmospheric delays and their slow
-// correlation are not modelled.
+// as a diagonal ENU covariance. Until fix_after_s (time to first fix), and over an outage window
+// [outage_from_s, outage_to_s) (the fix lost in flight: a jammed or shadowed antenna), the receiver
+// reports no fix: status NO_FIX, coordinates and velocity NaN. Multipath, atmospheric delays and
+// their slow correlation are not modelled.
 #pragma once
+
+#include <string>
 
 #include <Eigen/Core>
 
@@ -23,7 +26,12 @@ struct GnssConfig {
   double vertical_sigma_m = 0.0;    ///< per sample [m]
   double velocity_sigma_m_s = 0.0;  ///< per axis and sample [m/s]
   double fix_after_s = 0.0;         ///< no fix before this time [s]
+  double outage_from_s = 0.0;       ///< no fix from this time ... [s]
+  double outage_to_s = 0.0;         ///< ... until this one (an empty window when not after outage_from_s) [s]
 };
+
+/// "" when the outage window is a window (outage_to_s after outage_from_s, or both 0), else why not.
+std::string check(const GnssConfig& c);
 
 struct GnssSample {
   bool fix = false;

@@ -152,14 +152,20 @@ struct GnssKind {
     f("vertical_sigma_m", c.vertical_sigma_m);
     f("velocity_sigma_m_s", c.velocity_sigma_m_s);
     f("fix_after_s", c.fix_after_s);
+    f("outage_from_s", c.outage_from_s);
+    f("outage_to_s", c.outage_to_s);
   }
   static constexpr double kDefaultRateHz = 10.0;
-  static constexpr std::array<ScenarioKey<Config>, 4> kScenarioKeys{{
+  static constexpr std::array<ScenarioKey<Config>, 6> kScenarioKeys{{
       {"horizontal_sigma_m", 0.0, 1000.0, 1.0, &Config::horizontal_sigma_m},
       {"vertical_sigma_m", 0.0, 1000.0, 1.0, &Config::vertical_sigma_m},
       {"velocity_sigma_m_s", 0.0, 100.0, 1.0, &Config::velocity_sigma_m_s},
       {"fix_after_s", 0.0, 1e6, 1.0, &Config::fix_after_s},
+      {"outage_from_s", 0.0, 1e6, 1.0, &Config::outage_from_s},
+      {"outage_to_s", 0.0, 1e6, 1.0, &Config::outage_to_s},
   }};
+  /// What the keys cannot say alone: "" or why the configuration is not one (the reader names it).
+  static std::string check(const Config& c) { return sensors::check(c); }
   /// The world origin is where the receiver's positions are measured from.
   static void at_site(Config& c, const Geodetic& site) { c.site = site; }
   /// Without a fix only the fix flag is a number; the rest is NaN by definition.

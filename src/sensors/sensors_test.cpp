@@ -204,6 +204,36 @@ TEST(GeodesyTest, SmallStepsFollowTheRadiiOfCurvature) {
   EXPECT_NEAR((ltp.to_enu(ltp.to_geodetic({12.5, -40.0, 7.0})) - Eigen::Vector3d(12.5, -40.0, 7.0)).norm(), 0.0, 1e-8);
 }
 
+// An outage loses the fix over [outage_from_s, outage_to_s) of measured time and nowhere else; the
+// noise after it is drawn as if there had been none (the stream is not advanced without a fix).
+TEST(GnssTest, AnOutageLosesTheFixOverItsWindow) {
+  GnssConfig c;
+  c.site = {47.3977 * kDeg, 8.5456 * kDeg, 488.0};
+  c.horizontal_sigma_m = 0.5;
+  GnssConfig with = c;
+  with.outage_from_s = 3.0;
+  with.outage_to_s = 4.5;
+  EXPECT_EQ(check(with), "");
+  Gnss plain(c, model::Rng(7)), lossy(with, model::Rng(7));
+  const Eigen::Vector3d p(5.0, -3.0, 12.0);
+  for (int k = 0; k <= 60; ++k) {
+    const double t = 0.1 * k;
+    const bool lost = k >= 30 && k < 45;  // 3.0 <= t < 4.5, by tenths
+    const GnssSample a = lossy.measure(at(p), t);
+    EXPECT_EQ(a.fix, !lost) << t;
+    if (lost) {
+      EXPECT_TRUE(std::isnan(a.position.latitude_rad) && std::isnan(a.velocity_W.z())) << t;
+      continue;
+    }
+    const GnssSample b = plain.measure(at(p), t);
+    EXPECT_EQ(a.position.latitude_rad, b.position.latitude_rad) << t;
+  }
+  GnssConfig backwards = c;
+  backwards.outage_from_s = 4.0;
+  backwards.outage_to_s = 3.0;
+  EXPECT_NE(check(backwards).find("is not after outage_from_s"), std::string::npos);
+}
+
 TEST(GnssTest, NoFixThenAFixWithItsSpread) {
   GnssConfig c;
   c.site = {47.3977 * kDeg, 8.5456 * kDeg, 488.0};

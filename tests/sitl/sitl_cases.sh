@@ -548,8 +548,8 @@ PY
     # force does not depend on the tilt; no drag); the gyro reads 0 before it and, after it, the rates
     # the lost quarter of rotor 1's thrust and torque drive from rest: tau / I (t - 1 s), none about FRD x,
     # about y l dF / I_yy (nose down: negative) and about z (k_m / k_t) dF / I_zz (less of a clockwise
-    # rotor's reaction: positive); HIL_GPS says no fix (fix_type 1, no satellites) at 0, 0.1, ..., 0.4 s and a 3D fix
-    # with 10 satellites from 0.5 s on, every 0.1 s.
+    # rotor's reaction: positive); HIL_GPS says no fix (fix_type 1, no satellites) at 0, 0.1, ..., 0.4 s, a 3D fix
+    # with 10 satellites from 0.5 s on, every 0.1 s, but none again over the outage [1.2 s, 1.5 s): 1.2, 1.3, 1.4 s.
     px4_scenario fake_px4_open_loop fa --fake-record "$tmp/faults.txt"
     cat >> "$tmp/fa.yaml" <<'YAML'
 environment:
@@ -558,7 +558,8 @@ sensors:
   imu: {gyro_noise_density_rad_s_sqrt_hz: 1.0e-7, accel_noise_density_m_s2_sqrt_hz: 1.0e-7}
   magnetometer: {rate_hz: 50, field_uT: 48.24, inclination_deg: 63.16, declination_deg: 3.41, noise_sigma_uT: 1.0e-6}
   barometer: {rate_hz: 50, noise_sigma_Pa: 1.0e-6}
-  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6, fix_after_s: 0.5}
+  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6, fix_after_s: 0.5,
+         outage_from_s: 1.2, outage_to_s: 1.5}
 faults:
   - {at_s: 1, rotor: 1, efficiency: 0.75}
 YAML
@@ -596,10 +597,11 @@ for n, s in enumerate(S[1:], 1):
 assert len(G) == 21, len(G)
 nofix = [k for k, gps in enumerate(G) if gps[12] == "1" and gps[13] == "0"]
 fix = [k for k, gps in enumerate(G) if gps[12] == "3" and gps[13] == "10"]
-assert nofix == list(range(5)) and fix == list(range(5, 21)), (nofix, fix)
+lost = [12, 13, 14]                  # 1.2, 1.3, 1.4 s
+assert nofix == list(range(5)) + lost and fix == [k for k in range(5, 21) if k not in lost], (nofix, fix)
 print(f"px4 faults: az {-4 * F / m:.6f} -> {-3.75 * F / m:.6f} m/s^2 at t = 1 s (HIL_SENSOR {n_fault}); "
       f"rates at 1.1 s {[round(float(v), 5) for v in S[275][5:8]]} rad/s, worst {worst[0]:.1e} from tau/I t; "
-      f"HIL_GPS without a fix 0..0.4 s (5), with one 0.5..2 s (16)")
+      f"HIL_GPS without a fix 0..0.4 s (5) and over the outage 1.2..1.4 s (3), with one 0.5..2 s (13)")
 PY
     ;;
   px4_spec)
