@@ -276,12 +276,15 @@ TEST(ScenarioTest, ExtraSensorKeysAreReadInTheirUnits) {
     EXPECT_NE(std::string(e.what()).find("100"), std::string::npos) << e.what();
   }
   // The GNSS outage: both ends read in seconds; a window that ends before it starts is named.
-  const Scenario outage =
-      load_scenario(dir.write("outage.yaml", "sensors:\n  gnss: {outage_from_s: 4, outage_to_s: 6.5}\n"));
+  const Scenario outage = load_scenario(
+      dir.write("outage.yaml", "sensors:\n  gnss: {outage_from_s: 4, outage_to_s: 6.5}\n"), hosts::test_resolvers());
   EXPECT_EQ(outage.simulation.plant.realism.extra_sensors.gnss->outage_from_s, 4.0);
   EXPECT_EQ(outage.simulation.plant.realism.extra_sensors.gnss->outage_to_s, 6.5);
   EXPECT_THAT(
-      [&] { load_scenario(dir.write("backwards.yaml", "sensors:\n  gnss: {outage_from_s: 6, outage_to_s: 4}\n")); },
+      [&] {
+        load_scenario(dir.write("backwards.yaml", "sensors:\n  gnss: {outage_from_s: 6, outage_to_s: 4}\n"),
+                      hosts::test_resolvers());
+      },
       ThrowsMessage<std::runtime_error>(
           HasSubstr("sensors.gnss: outage_to_s (4.000000 s) is not after outage_from_s")));
 }
