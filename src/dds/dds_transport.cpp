@@ -24,9 +24,22 @@ DdsTransport::DdsTransport(const RosEnvironment& env) : participant_(env) {
   dds_write_set_batch(true);
 }
 
+bool DdsTransport::clock_is_read() const {
+  const auto it = writers_.find("/clock");
+  if (it == writers_.end()) return false;
+  for (const dds_entity_t w : it->second) {
+    dds_publication_matched_status_t st{};
+    if (dds_get_publication_matched_status(w, &st) == DDS_RETCODE_OK && st.current_count > 0) return true;
+  }
+  return false;
+}
+
 void DdsTransport::hold_sends(bool on) {
-  holding_ = on;
-  if (on) return;
+  // A node on ROS time (a /clock reader) may step at a /clock sample and read the newest of the
+  // others: packing would reorder the topics it sees (/clock of the next tick before the samples
+  // of this one), so with a /clock reader every write goes out at once, in publication order.
+  holding_ = on && !clock_is_read();
+  if (holding_) return;
   for (const dds_entity_t w : held_writers_) dds_write_flush(w);
   held_writers_.clear();
 }

@@ -68,6 +68,8 @@ class DdsTransport final : public sim::Transport {
   /// instead of sent at once (Cyclone's write batching); release sends every writer's pack. Lockstep
   /// plants hold the outputs of the ticks between control ticks, so the controller gets a writer's
   /// samples of two ticks in one datagram (docs/performance.md). Off, every write is sent at once.
+  /// Nothing is held while a reader of this transport's /clock is matched (a node on ROS time sees
+  /// every topic in publication order).
   void hold_sends(bool on);
 
   /// What discovery says of `sender`, a writer matched by our reader of `ros_topic` (the SenderId of
@@ -127,6 +129,8 @@ class DdsTransport final : public sim::Transport {
   /// and no longer delivered by spin_once; empty: back to spin_once (waits for a listener call in
   /// progress). A later subscription's sink is called at once for what came before its listener.
   void set_arrival_sink(std::function<void(std::size_t)> sink);
+  /// A reader is matched by one of our /clock writers.
+  bool clock_is_read() const;
   /// Delivers what subscription `index` holds on the calling thread; returns how many.
   int take(std::size_t index) { return drain(*readers_[index]); }
   /// Samples taken out of a subscription's reader, undelivered (their memory lent by Cyclone until
