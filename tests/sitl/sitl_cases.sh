@@ -43,6 +43,19 @@ px4_scenario() {
   sed -e "s|binary: fake_px4.*|binary: $fake_px4|" -e "s|etc_dir: ETC.*|etc_dir: $tmp/etc|" -e "s|params: |params: $here/|" \
       -e "s|    timeout_s: 2|    timeout_s: 2\n    args: [${args%, }]|" "$here/$base.yaml" > "$tmp/$name.yaml"
 }
+# quiet_sensors FILE GNSS_EXTRA: appends PX4's home site and the sensors PX4 needs, nearly noiseless
+# (PX4 refuses constant readings), the GNSS at 10 Hz with GNSS_EXTRA (", key: value, ...") added.
+quiet_sensors() {
+  cat >> "$1" <<YAML
+environment:
+  site: {latitude_deg: 47.397742, longitude_deg: 8.545594, altitude_m: 488}
+sensors:
+  imu: {gyro_noise_density_rad_s_sqrt_hz: 1.0e-7, accel_noise_density_m_s2_sqrt_hz: 1.0e-7}
+  magnetometer: {rate_hz: 50, field_uT: 48.24, inclination_deg: 63.16, declination_deg: 3.41, noise_sigma_uT: 1.0e-6}
+  barometer: {rate_hz: 50, noise_sigma_Pa: 1.0e-6}
+  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6$2}
+YAML
+}
 gone() {  # the firmware whose pid file is $1 no longer runs
   local pid; pid="$(cat "$1")"
   ! kill -0 "$pid" 2>/dev/null || fail "firmware $pid still runs after the run"
@@ -394,15 +407,7 @@ PY
     # 488 m + z at 50 Hz; HIL_GPS at 10 Hz with latitude and longitude in degE7 from the radii of
     # curvature of the WGS-84 ellipsoid, altitude in mm, vertical speed in cm/s.
     px4_scenario fake_px4_open_loop se --fake-record "$tmp/received.txt"
-    cat >> "$tmp/se.yaml" <<'YAML'
-environment:
-  site: {latitude_deg: 47.397742, longitude_deg: 8.545594, altitude_m: 488}
-sensors:
-  imu: {gyro_noise_density_rad_s_sqrt_hz: 1.0e-7, accel_noise_density_m_s2_sqrt_hz: 1.0e-7}
-  magnetometer: {rate_hz: 50, field_uT: 48.24, inclination_deg: 63.16, declination_deg: 3.41, noise_sigma_uT: 1.0e-6}
-  barometer: {rate_hz: 50, noise_sigma_Pa: 1.0e-6}
-  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6}
-YAML
+    quiet_sensors "$tmp/se.yaml" ""
     run se 0
     "$py" - "$tmp/received.txt" <<'PY' || fail "sensors"
 import math, sys
@@ -551,15 +556,8 @@ PY
     # rotor's reaction: positive); HIL_GPS says no fix (fix_type 1, no satellites) at 0, 0.1, ..., 0.4 s, a 3D fix
     # with 10 satellites from 0.5 s on, every 0.1 s, but none again over the outage [1.2 s, 1.5 s): 1.2, 1.3, 1.4 s.
     px4_scenario fake_px4_open_loop fa --fake-record "$tmp/faults.txt"
+    quiet_sensors "$tmp/fa.yaml" ", fix_after_s: 0.5, outage_from_s: 1.2, outage_to_s: 1.5"
     cat >> "$tmp/fa.yaml" <<'YAML'
-environment:
-  site: {latitude_deg: 47.397742, longitude_deg: 8.545594, altitude_m: 488}
-sensors:
-  imu: {gyro_noise_density_rad_s_sqrt_hz: 1.0e-7, accel_noise_density_m_s2_sqrt_hz: 1.0e-7}
-  magnetometer: {rate_hz: 50, field_uT: 48.24, inclination_deg: 63.16, declination_deg: 3.41, noise_sigma_uT: 1.0e-6}
-  barometer: {rate_hz: 50, noise_sigma_Pa: 1.0e-6}
-  gnss: {rate_hz: 10, horizontal_sigma_m: 1.0e-6, vertical_sigma_m: 1.0e-6, velocity_sigma_m_s: 1.0e-6, fix_after_s: 0.5,
-         outage_from_s: 1.2, outage_to_s: 1.5}
 faults:
   - {at_s: 1, rotor: 1, efficiency: 0.75}
 YAML
