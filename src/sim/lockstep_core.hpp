@@ -168,14 +168,17 @@ class LockstepCore {
     if (!hooks_.before_outputs(k)) return false;
     // Outputs between control ticks wait for the next control tick's (sent with them), while the
     // answers are awaited: nothing waits for them before then.
+    // A control tick's outputs are sent as they are written: each writer's send takes what it held.
     const bool hold = waiting_ && !(k % o_.controller_divider == 0 && k >= o_.first_control_tick);
-    if constexpr (!kSynchronous) host_.hold_outputs(true);
+    if constexpr (!kSynchronous) {
+      if (hold) host_.hold_outputs(true);
+    }
     for (std::size_t i = 0; i < plants_.size(); ++i) {
       if constexpr (!kSynchronous) slots_[i].received_before = plants_[i]->command_receipt().received;
       plants_[i]->publish_outputs(k);
     }
     if constexpr (!kSynchronous) {
-      if (!hold) host_.hold_outputs(false);
+      if (!hold) host_.hold_outputs(false);  // what no write of this tick took
     }
     hooks_.after_outputs(k);
     return true;
