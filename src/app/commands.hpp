@@ -77,6 +77,7 @@ struct ParamsOptions {
   bool list = false;                                            ///< list the controller types instead
   bool vehicle = false;   ///< the vehicle's parameters instead of the controller's
   bool markdown = false;  ///< the vehicle table as Markdown (docs/model.md)
+  std::string preset;     ///< with `vehicle`: the values of this ready vehicle (model/vehicle_presets.hpp)
 };
 /// Lists the controller's (or with `vehicle`, the vehicle's) parameters: name, unit, range, default,
 /// meaning.

@@ -10,6 +10,7 @@
 #include "controllers/paper/paper_controller.hpp"
 #include "controllers/registry.hpp"
 #include "io/scenario.hpp"
+#include "model/vehicle_presets.hpp"
 
 namespace quadcosim::app {
 
@@ -36,9 +37,17 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
       fmt::format("the controller whose parameters follow the node's: a type (default {}; see "
                   "--list), python:MODULE:CLASS (a class's declared parameters) or fmu:PATH (an FMU's)",
                   controllers::kDefaultControllerType)));
-  params_cmd->add_flag("--list", params.list, "list the registered controller types instead");
+  params_cmd->add_flag("--list", params.list,
+                       "list the registered controller types instead (with --vehicle: the vehicle presets)");
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
+      ->needs(params_cmd->get_option("--vehicle"));
+  std::vector<std::string> presets;
+  for (const model::VehiclePreset& p : model::vehicle_presets()) presets.emplace_back(p.name);
+  params_cmd
+      ->add_option("--preset", params.preset,
+                   "with --vehicle: the values of a ready vehicle (" + model::vehicle_preset_names() + ")")
+      ->check(CLI::IsMember(presets))
       ->needs(params_cmd->get_option("--vehicle"));
   return params_cmd;
 }
@@ -79,17 +88,30 @@ int lqr_command(const LqrOptions& opt, const io::ScenarioResolvers& resolvers) {
 
 namespace {
 
+// The vehicle presets: name, vehicle, sources.
+int vehicle_presets_table() {
+  std::cout << fmt::format("{:<12} {}\n", "preset", "vehicle (sources)");
+  for (const model::VehiclePreset& p : model::vehicle_presets()) {
+    std::cout << fmt::format("{:<12} {}\n{:<12} ({})\n", p.name, p.description, "", p.sources);
+  }
+  return exit_code::kOk;
+}
+
 // The vehicle parameter table (model::vehicle_parameters()): as aligned text, or as the Markdown
-// table docs/model.md carries (tests/cli checks the two agree).
-int vehicle_params_table(bool markdown) {
-  const model::VehicleParams defaults;
+// table docs/model.md carries (tests/cli checks the two agree); with a preset, its values in the
+// "default" column.
+int vehicle_params_table(bool markdown, const std::string& preset) {
+  const model::VehicleParams defaults =
+      preset.empty() ? model::VehicleParams{} : model::find_vehicle_preset(preset)->params;
   constexpr const char* text_row = "{:<34} {:<18} {:<18} {:<14} {}\n";
   constexpr const char* md_row = "| {} | {} | {} | {} | {} |\n";
   if (markdown) {
     std::cout << fmt::format(md_row, "key", "unit", "range", "default", "meaning");
     std::cout << "|---|---|---|---|---|\n";
   } else {
-    std::cout << fmt::format(text_row, "name", "unit", "range", "default", "meaning");
+    if (!preset.empty())
+      std::cout << "preset " << preset << ": " << model::find_vehicle_preset(preset)->description << "\n";
+    std::cout << fmt::format(text_row, "name", "unit", "range", preset.empty() ? "default" : "value", "meaning");
   }
   for (const auto& p : model::vehicle_parameters()) {
     std::string range;
@@ -115,7 +137,8 @@ int vehicle_params_table(bool markdown) {
 }  // namespace
 
 int params_command(const ParamsOptions& options, const io::ScenarioResolvers& resolvers) {
-  if (options.vehicle) return vehicle_params_table(options.markdown);
+  if (options.vehicle && options.list) return vehicle_presets_table();
+  if (options.vehicle) return vehicle_params_table(options.markdown, options.preset);
   if (options.list) {
     std::cout << fmt::format("{:<10} {}\n", "type", "controller");
     for (const auto& t : controllers::controller_types())

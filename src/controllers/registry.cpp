@@ -66,9 +66,13 @@ control::ControllerConfig make_config(std::string_view type, const model::Vehicl
 control::ControllerConfig rebind_vehicle(const control::ControllerConfig& config, const model::VehicleParams& vehicle) {
   control::ControllerConfig c = make_config(config.type(), vehicle);
   c.node = config.node;
+  // What was set differs from the type's defaults for the old vehicle; what was not set takes the new
+  // vehicle's defaults (a controller whose defaults are designed from the vehicle: se3's gains).
+  const control::ControllerConfig old_defaults = make_config(config.type(), config.vehicle);
   std::vector<control::Setting> settings;
   for (const control::ParameterSpec& s : config.controller->parameters()) {
-    settings.push_back({std::string(s.name), *config.controller->get_parameter(s.name)});
+    const std::optional<control::ParameterValue> value = config.controller->get_parameter(s.name);
+    if (value != old_defaults.controller->get_parameter(s.name)) settings.push_back({std::string(s.name), *value});
   }
   std::unique_ptr<control::Controller> next = c.controller->clone();
   if (std::string err = next->set_parameters(settings); !err.empty()) throw std::invalid_argument(err);

@@ -45,8 +45,9 @@ const ControllerType* find_controller_type(std::string_view name);
 /// constructor throws when it cannot be designed for the vehicle.
 control::ControllerConfig make_config(std::string_view type, const model::VehicleParams& vehicle);
 
-/// The same controller (type and parameter values) and node settings, for another vehicle: what a
-/// scenario's `controller:` section gives once the vehicle is known. Throws as make_config, and
+/// The same controller (type and the parameter values set on it) and node settings, for another
+/// vehicle: what a scenario's `controller:` section gives once the vehicle is known. A parameter still
+/// at its default for the old vehicle takes its default for the new one. Throws as make_config, and
 /// std::invalid_argument when a parameter value does not apply to the new vehicle's design.
 control::ControllerConfig rebind_vehicle(const control::ControllerConfig& config, const model::VehicleParams& vehicle);
 

@@ -482,6 +482,42 @@ TEST(ScenarioTest, VehicleSectionIsReadAndReachesTheController) {
   EXPECT_EQ(controllers::paper_controller(sc.controller)->vehicle().mass_kg, 2.5);
 }
 
+// `preset:` starts from a ready vehicle; the section's other keys override single values, in a
+// scenario and in a vehicle file alike; the controller is designed for the result.
+TEST(ScenarioTest, VehiclePresetIsReadAndOverridden) {
+  TempDir dir;
+  const Scenario sc = load_scenario(dir.write("preset.yaml", R"(vehicle:
+  preset: crazyflie2
+  mass_kg: 0.03
+  motor: {model: first_order, tau_up_s: 0.01, tau_down_s: 0.01}
+controller: {type: se3}
+)"),
+                                    hosts::test_resolvers());
+  EXPECT_EQ(sc.vehicle.mass_kg, 0.03);  // overridden
+  EXPECT_EQ(sc.vehicle.motor.model, model::MotorModel::kFirstOrder);
+  EXPECT_EQ(sc.vehicle.Ixx_kg_m2, 16.571710e-6);  // from Förster's tensor
+  EXPECT_EQ(sc.vehicle.Iyz_kg_m2, 1.800197e-6);
+  EXPECT_EQ(sc.vehicle.layout, model::RotorLayout::kX);
+  EXPECT_EQ(sc.vehicle.motor.omega_max_rad_s, 2618.0);
+  EXPECT_EQ(sc.controller.vehicle.mass_kg, 0.03);
+  // se3's position gain scaled to the overriding mass: k_x / m as for Table 1 (12.25 N/m / 1.96 kg).
+  EXPECT_NEAR(std::get<double>(*sc.controller.controller->get_parameter("k_x.x")), 0.03 * 12.25 / 1.96, 1e-15);
+
+  const model::VehicleParams f = load_vehicle(dir.write("f450.yaml", "preset: f450\nIzz_kg_m2: 0.04\n"));
+  EXPECT_EQ(f.mass_kg, 1.4);
+  EXPECT_EQ(f.kt_N_per_rad2_s2, 1.105e-5);
+  EXPECT_EQ(f.Izz_kg_m2, 0.04);
+
+  try {
+    load_vehicle(dir.write("bad.yaml", "preset: crazyflie\n"));
+    FAIL() << "an unknown preset was accepted";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("preset"), std::string::npos) << what;
+    EXPECT_NE(what.find("crazyflie2"), std::string::npos) << what;  // the known names, or the nearest
+  }
+}
+
 // Every key of the vehicle parameter table, at its place in the file, reaches its member.
 TEST(ScenarioTest, VehicleFileReadsEveryKey) {
   TempDir dir;
@@ -490,6 +526,9 @@ gravity_m_s2: 3.7
 Ixx_kg_m2: 0.011
 Iyy_kg_m2: 0.012
 Izz_kg_m2: 0.021
+Ixy_kg_m2: 0.001
+Ixz_kg_m2: -0.0005
+Iyz_kg_m2: 0.0002
 arm_length_m: 0.25
 kt_N_per_rad2_s2: 3.0e-7
 km_Nm_per_rad2_s2: 2.0e-9
@@ -513,6 +552,9 @@ aero:
   EXPECT_EQ(v.Ixx_kg_m2, 0.011);
   EXPECT_EQ(v.Iyy_kg_m2, 0.012);
   EXPECT_EQ(v.Izz_kg_m2, 0.021);
+  EXPECT_EQ(v.Ixy_kg_m2, 0.001);
+  EXPECT_EQ(v.Ixz_kg_m2, -0.0005);
+  EXPECT_EQ(v.Iyz_kg_m2, 0.0002);
   EXPECT_EQ(v.arm_length_m, 0.25);
   EXPECT_EQ(v.kt_N_per_rad2_s2, 3.0e-7);
   EXPECT_EQ(v.km_Nm_per_rad2_s2, 2.0e-9);

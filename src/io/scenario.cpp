@@ -17,6 +17,7 @@
 #include "io/sitl_yaml.hpp"
 #include "io/trajectory_yaml.hpp"
 #include "io/yaml_reader.hpp"
+#include "model/vehicle_presets.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::io {
@@ -27,8 +28,14 @@ constexpr double kHuge = 1e12;
 
 // Reads every entry of the vehicle parameter table from its place in `root` (top level, or the
 // `motor:` / `aero:` sections; a 3-vector's .x/.y/.z entries are one list of three), each checked
-// against its declared range, then the rules between fields (model::validate).
+// against its declared range, then the rules between fields (model::validate). A `preset:` key starts
+// from that ready vehicle (model/vehicle_presets.hpp); the other keys then override its values.
 void read_vehicle(YamlSection& root, model::VehicleParams& v) {
+  if (root.has("preset")) {
+    std::vector<std::string> names;
+    for (const model::VehiclePreset& p : model::vehicle_presets()) names.emplace_back(p.name);
+    v = model::find_vehicle_preset(root.choice("preset", names.front(), names))->params;
+  }
   std::map<std::string, std::optional<YamlSection>, std::less<>> sections;
   auto section = [&](std::string_view name) -> YamlSection* {
     if (name.empty()) return &root;

@@ -248,23 +248,26 @@ TEST(VehicleParameterTable, EveryEntryBindsTheMemberItNames) {
     next += 1.0;
     ++numbers;
   }
-  ASSERT_EQ(numbers, 20);
+  ASSERT_EQ(numbers, 23);
   EXPECT_EQ(p.mass_kg, 1.0);
   EXPECT_EQ(p.gravity_m_s2, 2.0);
   EXPECT_EQ(p.Ixx_kg_m2, 3.0);
   EXPECT_EQ(p.Iyy_kg_m2, 4.0);
   EXPECT_EQ(p.Izz_kg_m2, 5.0);
-  EXPECT_EQ(p.arm_length_m, 6.0);
-  EXPECT_EQ(p.kt_N_per_rad2_s2, 7.0);
-  EXPECT_EQ(p.km_Nm_per_rad2_s2, 8.0);
-  EXPECT_EQ(p.motor.tau_up_s, 9.0);
-  EXPECT_EQ(p.motor.tau_down_s, 10.0);
-  EXPECT_EQ(p.motor.omega_min_rad_s, 11.0);
-  EXPECT_EQ(p.motor.omega_max_rad_s, 12.0);
-  EXPECT_EQ(p.aero.linear_drag_N_s_m, Eigen::Vector3d(13, 14, 15));
-  EXPECT_EQ(p.aero.quadratic_drag_N_s2_m2, Eigen::Vector3d(16, 17, 18));
-  EXPECT_EQ(p.aero.rotor_drag_N_s_m_per_rad_s, 19.0);
-  EXPECT_EQ(p.aero.ground_effect_rotor_radius_m, 20.0);
+  EXPECT_EQ(p.Ixy_kg_m2, 6.0);
+  EXPECT_EQ(p.Ixz_kg_m2, 7.0);
+  EXPECT_EQ(p.Iyz_kg_m2, 8.0);
+  EXPECT_EQ(p.arm_length_m, 9.0);
+  EXPECT_EQ(p.kt_N_per_rad2_s2, 10.0);
+  EXPECT_EQ(p.km_Nm_per_rad2_s2, 11.0);
+  EXPECT_EQ(p.motor.tau_up_s, 12.0);
+  EXPECT_EQ(p.motor.tau_down_s, 13.0);
+  EXPECT_EQ(p.motor.omega_min_rad_s, 14.0);
+  EXPECT_EQ(p.motor.omega_max_rad_s, 15.0);
+  EXPECT_EQ(p.aero.linear_drag_N_s_m, Eigen::Vector3d(16, 17, 18));
+  EXPECT_EQ(p.aero.quadratic_drag_N_s2_m2, Eigen::Vector3d(19, 20, 21));
+  EXPECT_EQ(p.aero.rotor_drag_N_s_m_per_rad_s, 22.0);
+  EXPECT_EQ(p.aero.ground_effect_rotor_radius_m, 23.0);
 
   VehicleParams q;
   find_vehicle_parameter("layout")->set_choice(q, "x");
@@ -328,6 +331,10 @@ TEST(VehicleParameterTable, ValidateChecksEveryDeclaredRange) {
       const double outside = std::nextafter(end, low ? -1e300 : 1e300);
       VehicleParams p;
       if (e.name == "motor.omega_max_rad_s" && low) p.motor.omega_min_rad_s = 0.0;
+      // A product of inertia at the end of its range is a body only with moments that large.
+      if (e.name == "Ixy_kg_m2" || e.name == "Ixz_kg_m2" || e.name == "Iyz_kg_m2") {
+        p.Ixx_kg_m2 = p.Iyy_kg_m2 = p.Izz_kg_m2 = 1e7;
+      }
       e.ref(p) = outside;
       expect_rejected(p, std::string(e.name));
       e.ref(p) = end;

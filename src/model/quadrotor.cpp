@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 
+#include <Eigen/LU>
+
 #include "model/attitude.hpp"
 
 namespace quadcosim::model {
@@ -13,6 +15,18 @@ Quadrotor::Quadrotor(const VehicleParams& params)
       mixer_(mixer_matrix(params)),
       reciprocals_(1.0 / params.mass_kg, 1.0 / params.Ixx_kg_m2, 1.0 / params.Iyy_kg_m2, 1.0 / params.Izz_kg_m2) {
   assert(validate(params).empty());
+  if (!params.principal_axes()) {
+    const Eigen::Matrix3d J = params.inertia_tensor();
+    const Eigen::Matrix3d J_inv = J.inverse();
+    std::array<double, 18> packed{};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        packed[static_cast<std::size_t>(3 * r + c)] = J(r, c);
+        packed[static_cast<std::size_t>(9 + 3 * r + c)] = J_inv(r, c);
+      }
+    }
+    full_inertia_ = packed;
+  }
 }
 
 Vector4 Quadrotor::clamp_command(const Vector4& cmd) const {
@@ -79,6 +93,9 @@ struct Quadrotor::RigidInputs {
   double inertia[3];
   double inv_inertia[3];
   bool gyroscopic;
+  /// A vehicle whose body axes are not principal axes: J row by row (9), then J^-1 (9); nullptr for
+  /// the diagonal path (inertia, inv_inertia).
+  const double* full_inertia;
 };
 
 namespace {
@@ -105,9 +122,29 @@ inline Eigen::Vector3d linear_acceleration(const double* y, const RigidInputs& i
   return {ax, ay, az};
 }
 
+/// Eq. (8) (or (11)) with the whole inertia tensor: dw = J^-1 (tau - w x J w), for a body whose axes
+/// are not principal axes.
+void full_angular_acceleration(const RigidInputs& in, double wx, double wy, double wz, double tau_x, double tau_y,
+                               double tau_z, double& dwx, double& dwy, double& dwz) {
+  const double* J = in.full_inertia;
+  const double* Ji = in.full_inertia + 9;
+  if (in.gyroscopic) {
+    const double Iwx = J[0] * wx + J[1] * wy + J[2] * wz;
+    const double Iwy = J[3] * wx + J[4] * wy + J[5] * wz;
+    const double Iwz = J[6] * wx + J[7] * wy + J[8] * wz;
+    tau_x -= wy * Iwz - wz * Iwy;
+    tau_y -= wz * Iwx - wx * Iwz;
+    tau_z -= wx * Iwy - wy * Iwx;
+  }
+  dwx = Ji[0] * tau_x + Ji[1] * tau_y + Ji[2] * tau_z;
+  dwy = Ji[3] * tau_x + Ji[4] * tau_y + Ji[5] * tau_z;
+  dwz = Ji[6] * tau_x + Ji[7] * tau_y + Ji[8] * tau_z;
+}
+
 /// The equations of Quadrotor::derivative() on the rigid body's 13 plain doubles (y -> d):
 /// translation (linear_acceleration); rotation, eq. (8) (or (11)), the gyroscopic term as Eigen's
-/// cross() forms it, times 1/I (a product, not a division: shorter latency on every RK4 stage);
+/// cross() forms it, times 1/I (a product, not a division: shorter latency on every RK4 stage), or
+/// with the whole tensor (full_angular_acceleration) when there are products of inertia;
 /// ground contact; dq/dt = 1/2 q (x) (0, w).
 inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, double* __restrict d) {
   bool held = false;
@@ -115,13 +152,20 @@ inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, 
   const double qw = y[6], qx = y[7], qy = y[8], qz = y[9];
   const double wx = y[10], wy = y[11], wz = y[12];
   double tau_x = in.torque_B[0], tau_y = in.torque_B[1], tau_z = in.torque_B[2];
-  if (in.gyroscopic) {
-    const double Iwx = in.inertia[0] * wx, Iwy = in.inertia[1] * wy, Iwz = in.inertia[2] * wz;
-    tau_x -= wy * Iwz - wz * Iwy;
-    tau_y -= wz * Iwx - wx * Iwz;
-    tau_z -= wx * Iwy - wy * Iwx;
+  double dwx, dwy, dwz;
+  if (in.full_inertia) {
+    full_angular_acceleration(in, wx, wy, wz, tau_x, tau_y, tau_z, dwx, dwy, dwz);
+  } else {
+    if (in.gyroscopic) {
+      const double Iwx = in.inertia[0] * wx, Iwy = in.inertia[1] * wy, Iwz = in.inertia[2] * wz;
+      tau_x -= wy * Iwz - wz * Iwy;
+      tau_y -= wz * Iwx - wx * Iwz;
+      tau_z -= wx * Iwy - wy * Iwx;
+    }
+    dwx = tau_x * in.inv_inertia[0];
+    dwy = tau_y * in.inv_inertia[1];
+    dwz = tau_z * in.inv_inertia[2];
   }
-  double dwx = tau_x * in.inv_inertia[0], dwy = tau_y * in.inv_inertia[1], dwz = tau_z * in.inv_inertia[2];
   if (held) {  // resting on the ground: the normal force and friction cancel the net force and torque
     dwx = dwy = dwz = 0.0;
   }
@@ -187,7 +231,8 @@ Quadrotor::RigidInputs Quadrotor::rigid_inputs(const Wrench& f) const {
           params_.gravity_m_s2,
           {params_.Ixx_kg_m2, params_.Iyy_kg_m2, params_.Izz_kg_m2},
           {reciprocals_[1], reciprocals_[2], reciprocals_[3]},
-          params_.gyroscopic == GyroscopicModel::kFull};
+          params_.gyroscopic == GyroscopicModel::kFull,
+          full_inertia_ ? full_inertia_->data() : nullptr};
 }
 
 Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInput& cmd, const Environment* env) const {

@@ -2,6 +2,9 @@
 // integrator and the measured outputs. Frames: world ENU (W), body FLU (B).
 #pragma once
 
+#include <array>
+#include <optional>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -69,7 +72,8 @@ class Quadrotor {
 
   /// dx/dt at state x under the (already clamped) commanded rotor speeds:
   ///  - translation, eq. (7) in vector form: dv_W = R_WB (0, 0, U1) / m + (0, 0, -g);
-  ///  - rotation, eq. (8): dw_B = I^-1 (tau - w x I w), or eq. (11) without the gyroscopic term;
+  ///  - rotation, eq. (8): dw_B = I^-1 (tau - w x I w), or eq. (11) without the gyroscopic term (I the
+  ///    whole tensor when the vehicle has products of inertia, VehicleParams::inertia_tensor());
   ///  - attitude: dq = 1/2 q (0, w_B);
   ///  - rotors: ideal (derivative 0, speeds = command) or first-order lag.
   /// Ground contact: while resting on z = 0 and the forces would push it down, the ground (with
@@ -123,6 +127,9 @@ class Quadrotor {
   VehicleParams params_;
   Matrix4 mixer_;
   Eigen::Vector4d reciprocals_;  ///< 1/m, 1/Ixx, 1/Iyy, 1/Izz: the model multiplies by them
+  /// J and J^-1 row by row when the body axes are not principal axes (products of inertia); empty
+  /// for the diagonal path.
+  std::optional<std::array<double, 18>> full_inertia_;
 };
 
 }  // namespace quadcosim::model

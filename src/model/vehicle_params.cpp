@@ -6,9 +6,17 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Cholesky>
+
 namespace quadcosim::model {
 
 double VehicleParams::hover_omega_rad_s() const { return std::sqrt(mass_kg * gravity_m_s2 / (4.0 * kt_N_per_rad2_s2)); }
+
+Eigen::Matrix3d VehicleParams::inertia_tensor() const {
+  Eigen::Matrix3d J;
+  J << Ixx_kg_m2, Ixy_kg_m2, Ixz_kg_m2, Ixy_kg_m2, Iyy_kg_m2, Iyz_kg_m2, Ixz_kg_m2, Iyz_kg_m2, Izz_kg_m2;
+  return J;
+}
 
 namespace {
 
@@ -47,6 +55,10 @@ std::vector<VehicleParameter> make_table() {
       QC_NUMBER("Ixx_kg_m2", "kg m^2", closed(1e-12, kHuge), Ixx_kg_m2, "moment of inertia about x_B"),
       QC_NUMBER("Iyy_kg_m2", "kg m^2", closed(1e-12, kHuge), Iyy_kg_m2, "moment of inertia about y_B"),
       QC_NUMBER("Izz_kg_m2", "kg m^2", closed(1e-12, kHuge), Izz_kg_m2, "moment of inertia about z_B"),
+      QC_NUMBER("Ixy_kg_m2", "kg m^2", closed(-1e6, 1e6), Ixy_kg_m2,
+                "product of inertia J_xy = -sum(m x y) (0: principal axes)"),
+      QC_NUMBER("Ixz_kg_m2", "kg m^2", closed(-1e6, 1e6), Ixz_kg_m2, "product of inertia J_xz = -sum(m x z)"),
+      QC_NUMBER("Iyz_kg_m2", "kg m^2", closed(-1e6, 1e6), Iyz_kg_m2, "product of inertia J_yz = -sum(m y z)"),
       QC_NUMBER("arm_length_m", "m", closed(1e-6, 1e3), arm_length_m, "rotor axis to centre of mass, L"),
       QC_NUMBER("kt_N_per_rad2_s2", "N/(rad/s)^2", closed(1e-20, 1.0), kt_N_per_rad2_s2,
                 "thrust coefficient k_t, eq. (1)"),
@@ -180,6 +192,17 @@ std::string validate(const VehicleParams& p) {
       s << f.name << " must be in " << f.range.text();
       if (!f.unit.empty()) s << " " << f.unit;
       s << ", got " << v;
+      return s.str();
+    }
+  }
+  if (!p.principal_axes()) {
+    // A tensor that is not positive definite has no physical body (and no inverse to integrate with).
+    const Eigen::LLT<Eigen::Matrix3d> llt(p.inertia_tensor());
+    if (llt.info() != Eigen::Success) {
+      std::ostringstream s;
+      s << "Ixy_kg_m2 with Ixz_kg_m2 and Iyz_kg_m2 must leave the inertia tensor positive definite, got [["
+        << p.Ixx_kg_m2 << ", " << p.Ixy_kg_m2 << ", " << p.Ixz_kg_m2 << "], [" << p.Ixy_kg_m2 << ", " << p.Iyy_kg_m2
+        << ", " << p.Iyz_kg_m2 << "], [" << p.Ixz_kg_m2 << ", " << p.Iyz_kg_m2 << ", " << p.Izz_kg_m2 << "]] kg m^2";
       return s.str();
     }
   }

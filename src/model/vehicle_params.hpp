@@ -6,6 +6,8 @@
 #include <string_view>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "model/aero.hpp"
 
 namespace quadcosim::model {
@@ -47,6 +49,12 @@ struct VehicleParams {
   double Ixx_kg_m2 = 0.0149;
   double Iyy_kg_m2 = 0.0153;
   double Izz_kg_m2 = 0.0532;
+  /// Products of inertia: the off-diagonal entries of the inertia tensor about the centre of mass in
+  /// the body frame, J_xy = -sum(m x y) (as a URDF <inertia> or an identified tensor gives them). All
+  /// zero (the paper's vehicle): the body axes are principal axes and the model takes the diagonal path.
+  double Ixy_kg_m2 = 0.0;
+  double Ixz_kg_m2 = 0.0;
+  double Iyz_kg_m2 = 0.0;
   double arm_length_m = 0.59;           ///< [m] rotor axis to centre of mass (L).
   double kt_N_per_rad2_s2 = 2.06e-7;    ///< thrust coefficient k_t [N/(rad/s)^2], eq. (1).
   double km_Nm_per_rad2_s2 = 1.01e-10;  ///< drag-torque coefficient k_m [N m/(rad/s)^2], eq. (2).
@@ -61,6 +69,10 @@ struct VehicleParams {
 
   /// [rad/s] speed at which four equal rotors carry the weight: sqrt(m g / (4 k_t)).
   double hover_omega_rad_s() const;
+  /// The inertia tensor J [kg m^2]: Ixx, Iyy, Izz on the diagonal, the products off it.
+  Eigen::Matrix3d inertia_tensor() const;
+  /// True when every product of inertia is zero (the body axes are principal axes).
+  bool principal_axes() const { return Ixy_kg_m2 == 0.0 && Ixz_kg_m2 == 0.0 && Iyz_kg_m2 == 0.0; }
 };
 
 /// An interval of accepted values; each end either includes its value (closed) or not (open).
@@ -118,7 +130,8 @@ const VehicleParameter* find_vehicle_parameter(std::string_view name);
 
 /// Returns an empty string when `p` is physically meaningful, else a message naming the first bad field
 /// (e.g. "mass_kg must be in [1e-06, 1e+12] kg, got -1"): every number within its declared range, then
-/// the rules between fields (omega_min below omega_max, spin signs balanced and alternating).
+/// the rules between fields (omega_min below omega_max, spin signs balanced and alternating, an inertia
+/// tensor that is positive definite).
 std::string validate(const VehicleParams& p);
 
 /// Empty when RK4 with step `step_s` [s] is stable for the motor lag (step <= 2 tau; RK4's limit on a

@@ -62,8 +62,8 @@ std::string vehicle_urdf(const model::VehicleParams& p, const std::string& prefi
   u += fmt::format("  <link name=\"{}base_link\">\n", prefix);
   u += fmt::format(
       "    <inertial>\n      <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n      <mass value=\"{}\"/>\n"
-      "      <inertia ixx=\"{}\" ixy=\"0\" ixz=\"0\" iyy=\"{}\" iyz=\"0\" izz=\"{}\"/>\n    </inertial>\n",
-      p.mass_kg, p.Ixx_kg_m2, p.Iyy_kg_m2, p.Izz_kg_m2);
+      "      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>\n    </inertial>\n",
+      p.mass_kg, p.Ixx_kg_m2, p.Ixy_kg_m2, p.Ixz_kg_m2, p.Iyy_kg_m2, p.Iyz_kg_m2, p.Izz_kg_m2);
   u += fmt::format(
       "    <visual name=\"body\">\n      <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n"
       "      <geometry><box size=\"{} {} {}\"/></geometry>\n      <material name=\"body\"/>\n    </visual>\n",

@@ -112,9 +112,25 @@ Eigen::Vector3d attitude_error_vector(const Eigen::Matrix3d& R_d, const Eigen::M
   return 0.5 * vee(R_d.transpose() * R - R.transpose() * R_d);
 }
 
+GeometricParams GeometricParams::for_vehicle(const model::VehicleParams& v) {
+  const model::VehicleParams table1;
+  GeometricParams p;
+  const double mass_ratio = v.mass_kg / table1.mass_kg;
+  const Eigen::Vector3d inertia_ratio(v.Ixx_kg_m2 / table1.Ixx_kg_m2, v.Iyy_kg_m2 / table1.Iyy_kg_m2,
+                                      v.Izz_kg_m2 / table1.Izz_kg_m2);
+  p.k_x *= mass_ratio;
+  p.k_v *= mass_ratio;
+  p.k_R = p.k_R.cwiseProduct(inertia_ratio);
+  p.k_Omega = p.k_Omega.cwiseProduct(inertia_ratio);
+  return p;
+}
+
+GeometricController::GeometricController(const model::VehicleParams& vehicle)
+    : GeometricController(vehicle, GeometricParams::for_vehicle(vehicle)) {}
+
 GeometricController::GeometricController(const model::VehicleParams& vehicle, const GeometricParams& params)
     : ControllerWith(params), vehicle_(vehicle) {
-  J_ = Eigen::Vector3d(vehicle.Ixx_kg_m2, vehicle.Iyy_kg_m2, vehicle.Izz_kg_m2).asDiagonal();
+  J_ = vehicle.inertia_tensor();
   Eigen::FullPivLU<Eigen::Matrix4d> lu(model::mixer_matrix(vehicle_));
   if (!lu.isInvertible()) throw std::invalid_argument("the vehicle's mixer matrix is singular");
   mixer_inverse_ = lu.inverse();

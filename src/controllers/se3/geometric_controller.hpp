@@ -27,7 +27,8 @@
 //     -99 deg and still swung back to +42 deg at 17 s; at 1 rad/s it settles in 12 s without saturating);
 //   position: omega_p = 2.5 rad/s horizontally and 3 rad/s vertically, zeta = 1 (a quarter or less of
 //     the attitude bandwidth, so the attitude loop follows b3d): k_x = m omega_p^2, k_v = 2 zeta m omega_p.
-// Other vehicles: scale k_R, k_Omega by their inertia and k_x, k_v by their mass.
+// Other vehicles: the same design, k_R and k_Omega scaled by their inertia and k_x, k_v by their mass
+// (GeometricParams::for_vehicle; a controller made for a vehicle starts from these gains).
 #pragma once
 
 #include <Eigen/Core>
@@ -48,6 +49,11 @@ struct GeometricParams {
   double max_tilt_rad = 1.0;
   /// Attitude mode: floor on (R e3)_z in the thrust's tilt compensation [-] (control/altitude_pd.hpp).
   double min_cos_tilt = 0.5;
+
+  /// The default design above for `vehicle`: k_x, k_v times m / m_Table1, k_R and k_Omega per body axis
+  /// times J_ii / J_ii,Table1 (the same loop bandwidths and damping). The Table 1 vehicle gets the
+  /// defaults exactly.
+  static GeometricParams for_vehicle(const model::VehicleParams& vehicle);
 };
 
 /// The parts of one step that tests and tools may want to see (all in the conventions above).
@@ -68,7 +74,9 @@ class GeometricController : public control::ControllerWith<GeometricController, 
 
   /// The controller for `vehicle` (mass, gravity, inertia, mixer, motor speed limits). Throws
   /// std::invalid_argument when the vehicle's mixer is singular.
-  explicit GeometricController(const model::VehicleParams& vehicle, const GeometricParams& params = {});
+  /// With the gains GeometricParams::for_vehicle(vehicle).
+  explicit GeometricController(const model::VehicleParams& vehicle);
+  GeometricController(const model::VehicleParams& vehicle, const GeometricParams& params);
 
   std::string_view type() const override { return kType; }
   /// "e_x.x" .. "e_v.z" [m, m/s], "e_R.x" .. "e_R.z" [rad], "e_Omega.x" .. "e_Omega.z" [rad/s],

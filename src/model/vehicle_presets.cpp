@@ -1,0 +1,112 @@
+#include "model/vehicle_presets.hpp"
+
+#include <array>
+
+namespace quadcosim::model {
+
+namespace {
+
+// The paper's vehicle: Table 1 (the defaults of VehicleParams).
+VehicleParams paper() { return {}; }
+
+// Crazyflie 2.0 (Bitcraze), from the system identification of J. Förster, "System Identification of
+// the Crazyflie 2.0 Nano Quadrocopter", BSc thesis, ETH Zurich, 2015: mass, the whole inertia tensor
+// (products included), the thrust coefficient and the torque-to-thrust ratio.
+VehicleParams crazyflie2() {
+  VehicleParams v;
+  v.mass_kg = 0.027;
+  v.Ixx_kg_m2 = 16.571710e-6;
+  v.Iyy_kg_m2 = 16.655602e-6;
+  v.Izz_kg_m2 = 29.261652e-6;
+  v.Ixy_kg_m2 = 0.830806e-6;
+  v.Ixz_kg_m2 = 0.718277e-6;
+  v.Iyz_kg_m2 = 1.800197e-6;
+  v.layout = RotorLayout::kX;
+  v.arm_length_m = 0.046;                          // half the 92 mm motor-to-motor diagonal
+  v.kt_N_per_rad2_s2 = 1.28192e-8;                 // k_F
+  v.km_Nm_per_rad2_s2 = 1.28192e-8 * 5.964552e-3;  // k_F times the torque-to-thrust ratio k_M [m]
+  v.spin = {+1, -1, +1, -1};                       // front-left (M4) clockwise, front-right (M1) counter-clockwise
+  v.motor.omega_max_rad_s = 2618.0;                // 25,000 rpm
+  return v;
+}
+
+// AscTec Hummingbird, as the RotorS simulator models it (F. Furrer, M. Burri, M. Achtelik, R. Siegwart,
+// "RotorS - A Modular Gazebo MAV Simulator Framework", in Robot Operating System (ROS): The Complete
+// Reference, vol. 1, Springer, 2016; its body properties from J. Wang et al., "Novel Dynamic Inversion
+// Architecture Design for Quadrocopter Control", 2011): '+' frame, 0.17 m arms, the motor and moment
+// constants and first-order motors with their time constants. The mass and inertia add RotorS's four
+// 9 g rotors, as point masses at the hubs, to its 0.68 kg body.
+VehicleParams hummingbird() {
+  constexpr double kRotorMass = 0.009, kArm = 0.17;
+  VehicleParams v;
+  v.mass_kg = 0.68 + 4.0 * kRotorMass;
+  v.Ixx_kg_m2 = 0.007 + 2.0 * kRotorMass * kArm * kArm;  // the rotors on the y axis
+  v.Iyy_kg_m2 = 0.007 + 2.0 * kRotorMass * kArm * kArm;  // the rotors on the x axis
+  v.Izz_kg_m2 = 0.012 + 4.0 * kRotorMass * kArm * kArm;
+  v.layout = RotorLayout::kPlus;
+  v.arm_length_m = kArm;
+  v.kt_N_per_rad2_s2 = 8.54858e-6;           // motor constant
+  v.km_Nm_per_rad2_s2 = 8.54858e-6 * 0.016;  // times the moment constant [m]
+  v.spin = {+1, -1, +1, -1};                 // front and back clockwise, left and right counter-clockwise
+  v.motor.model = MotorModel::kFirstOrder;
+  v.motor.tau_up_s = 0.0125;
+  v.motor.tau_down_s = 0.025;
+  v.motor.omega_max_rad_s = 838.0;
+  return v;
+}
+
+// A 450 mm-class quadrotor (DJI F450 frame), the parameter set of Q. Quan, "Introduction to Multicopter
+// Design and Control", Springer, 2017 (used by its examples and the RflySim platform): mass, inertia,
+// thrust and torque coefficients c_T and c_M, the motor time constant T_m, and the top speed
+// C_R + w_b = 1148 - 141.4 rad/s of its throttle-to-speed line at full throttle.
+VehicleParams f450() {
+  VehicleParams v;
+  v.mass_kg = 1.4;
+  v.Ixx_kg_m2 = 0.0211;
+  v.Iyy_kg_m2 = 0.0219;
+  v.Izz_kg_m2 = 0.0366;
+  v.layout = RotorLayout::kX;
+  v.arm_length_m = 0.225;
+  v.kt_N_per_rad2_s2 = 1.105e-5;
+  v.km_Nm_per_rad2_s2 = 1.779e-7;
+  v.spin = {+1, -1, +1, -1};
+  v.motor.model = MotorModel::kFirstOrder;
+  v.motor.tau_up_s = 0.02;
+  v.motor.tau_down_s = 0.02;
+  v.motor.omega_max_rad_s = 1148.0 - 141.4;
+  return v;
+}
+
+const std::array<VehiclePreset, 4>& table() {
+  static const std::array<VehiclePreset, 4> presets = {{
+      {"paper", "the paper's 1.96 kg '+' quadrotor (Table 1)", "the paper's Table 1", paper()},
+      {"crazyflie2", "Bitcraze Crazyflie 2.0, 27 g 'x' nano quadrotor, full inertia tensor",
+       "J. Foerster, System Identification of the Crazyflie 2.0 Nano Quadrocopter, ETH Zurich, 2015", crazyflie2()},
+      {"hummingbird", "AscTec Hummingbird, 0.72 kg '+' quadrotor with first-order motors",
+       "F. Furrer et al., RotorS - A Modular Gazebo MAV Simulator Framework, Springer, 2016 (body from J. Wang et "
+       "al., 2011)",
+       hummingbird()},
+      {"f450", "450 mm-class 'x' quadrotor (DJI F450 frame), 1.4 kg, first-order motors",
+       "Q. Quan, Introduction to Multicopter Design and Control, Springer, 2017", f450()},
+  }};
+  return presets;
+}
+
+}  // namespace
+
+std::span<const VehiclePreset> vehicle_presets() { return table(); }
+
+const VehiclePreset* find_vehicle_preset(std::string_view name) {
+  for (const VehiclePreset& p : table()) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+std::string vehicle_preset_names() {
+  std::string names;
+  for (const VehiclePreset& p : table()) names.append(names.empty() ? "" : ", ").append(p.name);
+  return names;
+}
+
+}  // namespace quadcosim::model
