@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "dds/dds_test_support.hpp"
 #include "dds/entity.hpp"
 #include "dds/participant.hpp"
 #include "dds/ros_types.hpp"
@@ -29,13 +30,6 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------------------------------------
 // CDR against Cyclone DDS
-
-dds::RosEnvironment test_env() {
-  dds::RosEnvironment e;
-  e.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);  // apart from other test runs
-  e.range = dds::DiscoveryRange::kLocalhost;
-  return e;
-}
 
 // Writes `m` through a Cyclone DDS writer (the generated C type, via the transport's conversion) and
 // returns the serialized sample a reader of the same participant takes with dds_takecdr: Cyclone's
@@ -112,7 +106,7 @@ void expect_same_cdr(const std::vector<std::uint8_t>& ours, const std::vector<st
 
 class CdrTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { participant_ = new dds::Participant(test_env()); }
+  static void SetUpTestSuite() { participant_ = new dds::Participant(dds::test::private_env()); }
   static void TearDownTestSuite() {
     delete participant_;
     participant_ = nullptr;
