@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "dds/arrival_executor.hpp"
+#include "dds/dds_test_support.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/idl_walk.hpp"
 #include "dds/peer_pairing.hpp"
@@ -28,13 +29,6 @@
 
 namespace quadcosim::dds {
 namespace {
-
-RosEnvironment test_env() {
-  RosEnvironment e;
-  e.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);  // apart from other test runs
-  e.range = DiscoveryRange::kLocalhost;
-  return e;
-}
 
 // Every field of a message, from its fields() list: FillFields gives each leaf a value of its own
 // (so a field written to or read from its neighbour shows), Flatten lists them exactly (doubles in
@@ -116,7 +110,7 @@ std::vector<std::string> flatten(const T& m) {
 // arrives, field by field.
 template <class T>
 void expect_round_trip(const std::string& topic) {
-  DdsTransport a(test_env()), b(test_env());
+  DdsTransport a(test::private_env()), b(test::private_env());
   std::optional<T> got;
   b.subscribe<T>(topic, [&](const T& m) { got = m; });
   auto pub = a.advertise<T>(topic);
@@ -149,7 +143,7 @@ TEST(DdsTransportTest, RoundTripsExtremesAndEmpties) {
   cmd.dim = {{"rotors@5", 4, 4}, {"", 0, 0}};
   msg::Clock clock;
   clock.clock = {2147483647, 999999999};
-  DdsTransport a(test_env()), b(test_env());
+  DdsTransport a(test::private_env()), b(test::private_env());
   std::vector<msg::Float64MultiArray> cmds;
   std::optional<msg::Clock> clock_in;
   b.subscribe<msg::Float64MultiArray>("/e/cmd", [&](const msg::Float64MultiArray& m) { cmds.push_back(m); });
@@ -289,7 +283,7 @@ msg::Clock clock_at(std::int64_t ns) {
 
 // Two transports on one domain: `a` publishes /t/in, `b` subscribes (matched before returning).
 struct ArrivalRig {
-  DdsTransport a{test_env()}, b{test_env()};
+  DdsTransport a{test::private_env()}, b{test::private_env()};
   sim::Publisher<msg::Clock> in;
   std::vector<std::int64_t> got;
   std::vector<std::thread::id> threads;
@@ -514,7 +508,7 @@ TEST(DdsTransportTest, OnArrivalTheHookRunsAfterEachDeliveryAndTrueEndsTheWait) 
 }
 
 TEST(PeerFilterTest, TakesOnlyThePairedWritersSamplesByTokenOrByParticipant) {
-  DdsTransport peer(test_env()), stranger(test_env()), me(test_env());
+  DdsTransport peer(test::private_env()), stranger(test::private_env()), me(test::private_env());
   peer.set_user_data_keys(std::string(kPairTokenKey) + "=run-1;");  // before its endpoints exist
   stranger.set_user_data_keys(std::string(kPairTokenKey) + "=run-0;");
   PeerFilter filter(me);
@@ -628,7 +622,7 @@ namespace quadcosim::dds {
 namespace {
 
 TEST(NodeAnnouncerTest, PublishesTheNodeWithItsEndpointGids) {
-  DdsTransport node(test_env());
+  DdsTransport node(test::private_env());
   auto pub = node.advertise<msg::PoseStamped>("/n/Pose");
   node.subscribe<msg::Clock>("/clock_n", [](const msg::Clock&) {});
   NodeAnnouncer announcer(node.participant().handle(), "quadrotor_plant");
@@ -637,7 +631,7 @@ TEST(NodeAnnouncerTest, PublishesTheNodeWithItsEndpointGids) {
   EXPECT_EQ(announcer.readers(), 1u);
 
   // A late-joining reader of ros_discovery_info (transient local) still gets it.
-  Participant other(test_env());
+  Participant other(test::private_env());
   const dds_entity_t topic = dds_create_topic(other.handle(), &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc,
                                               "ros_discovery_info", nullptr, nullptr);
   ASSERT_GT(topic, 0);
@@ -678,7 +672,7 @@ TEST(NodeAnnouncerTest, PublishesTheNodeWithItsEndpointGids) {
 }
 
 TEST(ParticipantTest, UserDataSaysEnclave) {
-  Participant p(test_env());
+  Participant p(test::private_env());
   dds_qos_t* qos = dds_create_qos();
   ASSERT_EQ(dds_get_qos(p.handle(), qos), DDS_RETCODE_OK);
   void* data = nullptr;
@@ -784,11 +778,11 @@ TEST(GraphTest, FindsTheNodeBehindAPublisherByItsParticipantsParameterServices) 
 }
 
 TEST(GraphTest, DiscoversAnotherParticipantsEndpoints) {
-  DdsTransport node(test_env());
+  DdsTransport node(test::private_env());
   auto pub = node.advertise<msg::PoseStamped>("/g/Pose");
   node.set_qos("/g/Imu", QosProfile::sensor_data());
   node.subscribe<msg::Imu>("/g/Imu", [](const msg::Imu&) {});
-  Participant tool(test_env());
+  Participant tool(test::private_env());
   auto has_both = [](const std::vector<Endpoint>& es) {
     int n = 0;
     for (const auto& e : es) n += (e.dds_topic == "rt/g/Pose" && e.writer) + (e.dds_topic == "rt/g/Imu" && !e.writer);

@@ -7,22 +7,16 @@
 
 #include <utility>
 
+#include "dds/dds_test_support.hpp"
 #include "dds/participant.hpp"
 
 namespace quadcosim::dds {
 namespace {
 
-RosEnvironment private_env() {
-  RosEnvironment e;
-  e.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);  // apart from other test runs
-  e.range = DiscoveryRange::kOff;
-  return e;
-}
-
 bool alive(dds_entity_t handle) { return dds_get_parent(handle) > 0; }
 
 TEST(Entity, DeletesItsEntityWhenItGoes) {
-  const Participant participant(private_env());
+  const Participant participant(test::private_env(DiscoveryRange::kOff));
   dds_entity_t handle = 0;
   {
     const Entity guard(check(dds_create_guardcondition(participant.handle()), "dds_create_guardcondition"));
@@ -34,7 +28,7 @@ TEST(Entity, DeletesItsEntityWhenItGoes) {
 }
 
 TEST(Entity, AMoveHandsTheEntityOverAndResetDeletesItNow) {
-  const Participant participant(private_env());
+  const Participant participant(test::private_env(DiscoveryRange::kOff));
   Entity first(check(dds_create_guardcondition(participant.handle()), "dds_create_guardcondition"));
   const dds_entity_t handle = first.get();
   Entity second(std::move(first));
@@ -59,7 +53,7 @@ TEST(Entity, AnErrorCodeOwnsNothing) {
 TEST(Entity, AParticipantsEntitiesGoWithIt) {
   dds_entity_t participant_handle = 0;
   {
-    const Participant participant(private_env());
+    const Participant participant(test::private_env(DiscoveryRange::kOff));
     participant_handle = participant.handle();
     EXPECT_TRUE(alive(participant_handle));
   }

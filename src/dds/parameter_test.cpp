@@ -11,6 +11,7 @@
 #include <mutex>
 #include <thread>
 
+#include "dds/dds_test_support.hpp"
 #include "dds/dds_transport.hpp"
 #include "dds/parameter_client.hpp"
 #include "dds/parameter_service.hpp"
@@ -20,13 +21,6 @@ namespace quadcosim::dds {
 namespace {
 
 constexpr std::int64_t kSecond = 1'000'000'000;
-
-RosEnvironment test_env() {
-  RosEnvironment e;
-  e.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);  // apart from other test runs
-  e.range = DiscoveryRange::kLocalhost;
-  return e;
-}
 
 // Two doubles with ranges and a choice, refusing like control::set_parameter does.
 class FakeTable {
@@ -87,7 +81,7 @@ class FakeTable {
 class ServedNode {
  public:
   explicit ServedNode(FakeTable& table, const std::string& name = "test_controller")
-      : transport_(test_env()), server_(transport_, parse_node_name(name), table.callbacks()) {
+      : transport_(test::private_env()), server_(transport_, parse_node_name(name), table.callbacks()) {
     thread_ = std::thread([this] {
       while (!stop_) transport_.spin_once(20'000'000);
     });
@@ -207,7 +201,7 @@ TEST(ParameterTypesTest, PrintsAndParsesValuesLikeRos2Param) {
 TEST(ParameterServiceTest, GetSetListDescribeTypesRoundTrip) {
   FakeTable table;
   ServedNode node(table);
-  ParameterClient client(test_env(), parse_node_name("/test_controller"));
+  ParameterClient client(test::private_env(), parse_node_name("/test_controller"));
   const std::int64_t t = 10 * kSecond;
 
   // get
@@ -291,7 +285,7 @@ TEST(ParameterServiceTest, RepliesEchoGuidAndSequenceAndEventsAnnounceChanges) {
   const NodeName name = parse_node_name("test_controller");
 
   // A bare DDS requester, without the "clientid" USER_DATA, with its own header values.
-  Participant raw(test_env());
+  Participant raw(test::private_env());
   const dds_entity_t rq_topic = dds_create_topic(raw.handle(), &rcl_interfaces_srv_dds__GetParameters_Request__desc,
                                                  request_topic(name, ParamService::kGet).c_str(), nullptr, nullptr);
   const dds_entity_t rr_topic = dds_create_topic(raw.handle(), &rcl_interfaces_srv_dds__GetParameters_Response__desc,
@@ -354,7 +348,7 @@ TEST(ParameterServiceTest, RepliesEchoGuidAndSequenceAndEventsAnnounceChanges) {
   EXPECT_TRUE(got) << "no reply to a request without clientid";
 
   // Our client: guid is its request writer's instance handle, seq counts up; a set is announced.
-  ParameterClient client(test_env(), name);
+  ParameterClient client(test::private_env(), name);
   client.get({"z_des"}, 10 * kSecond);
   const auto first = client.last_request();
   EXPECT_NE(first.guid, 0u);
@@ -395,7 +389,7 @@ TEST(ParameterServiceTest, AnAsynchronousGetIsAnsweredThroughATransportInOrder) 
   // the requests, each matched to its own request by is_reply_to.
   FakeTable table;
   ServedNode node(table);
-  DdsTransport transport(test_env());
+  DdsTransport transport(test::private_env());
   ParameterClient client(transport.participant().handle(), parse_node_name("/test_controller"));
   ParameterClient nobody(transport.participant().handle(), parse_node_name("/nobody_here"));
   EXPECT_THROW(nobody.send_get({}), ParameterCallError) << "no service matched: refused, not lost";
@@ -432,7 +426,7 @@ TEST(ParameterServiceTest, OnlyFromTakesThePeersRepliesNotANamesakes) {
   FakeTable peer_table, namesake_table;
   ServedNode namesake(namesake_table);  // the same node name on another participant: a leftover
   ServedNode peer(peer_table);
-  ParameterClient client(test_env(), parse_node_name("/test_controller"));
+  ParameterClient client(test::private_env(), parse_node_name("/test_controller"));
   const std::int64_t t = 10 * kSecond;
   client.only_from(peer.participant_guid());
   // Told apart by their answers: the peer's z_des is 7, the namesake's stays 1.
@@ -446,7 +440,7 @@ TEST(ParameterServiceTest, OnlyFromTakesThePeersRepliesNotANamesakes) {
     EXPECT_EQ(v[0], ParamValue::of_double(7.0)) << "call " << i << " took the namesake's reply";
   }
   // A client told to listen to a participant that has no such node waits for it, and says so.
-  ParameterClient lost(test_env(), parse_node_name("/test_controller"));
+  ParameterClient lost(test::private_env(), parse_node_name("/test_controller"));
   std::array<std::uint8_t, 16> nobody{};
   nobody.fill(0xab);
   lost.only_from(nobody);
@@ -454,7 +448,7 @@ TEST(ParameterServiceTest, OnlyFromTakesThePeersRepliesNotANamesakes) {
 }
 
 TEST(ParameterServiceTest, MissingNodeIsAClearTimeout) {
-  ParameterClient client(test_env(), parse_node_name("nobody_here"));
+  ParameterClient client(test::private_env(), parse_node_name("nobody_here"));
   try {
     client.get({"z_des"}, 300'000'000);
     FAIL() << "expected a timeout";

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace quadcosim::dds {
 
@@ -23,29 +24,24 @@ std::string_view type_name(ParamType type) {
   return "unknown";
 }
 
-ParamValue ParamValue::of_bool(bool v) {
+namespace {
+/// A value of `type` with `member` set to `v`, the other members at their defaults.
+template <class T>
+ParamValue value_of(ParamType type, T ParamValue::*member, T v) {
   ParamValue p;
-  p.type = ParamType::kBool;
-  p.bool_value = v;
+  p.type = type;
+  p.*member = std::move(v);
   return p;
 }
+}  // namespace
+
+ParamValue ParamValue::of_bool(bool v) { return value_of(ParamType::kBool, &ParamValue::bool_value, v); }
 ParamValue ParamValue::of_integer(std::int64_t v) {
-  ParamValue p;
-  p.type = ParamType::kInteger;
-  p.integer_value = v;
-  return p;
+  return value_of(ParamType::kInteger, &ParamValue::integer_value, v);
 }
-ParamValue ParamValue::of_double(double v) {
-  ParamValue p;
-  p.type = ParamType::kDouble;
-  p.double_value = v;
-  return p;
-}
+ParamValue ParamValue::of_double(double v) { return value_of(ParamType::kDouble, &ParamValue::double_value, v); }
 ParamValue ParamValue::of_string(std::string v) {
-  ParamValue p;
-  p.type = ParamType::kString;
-  p.string_value = std::move(v);
-  return p;
+  return value_of(ParamType::kString, &ParamValue::string_value, std::move(v));
 }
 
 std::string_view service_suffix(ParamService service) {

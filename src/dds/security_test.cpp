@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 
+#include "dds/dds_test_support.hpp"
 #include "dds/participant.hpp"
 #include "security/keystore.hpp"
 
@@ -90,9 +91,7 @@ TEST(SecurityPlanTest, PluginsFromDebiansDirectoryWhenPresent) {
 // A secured participant: the override selects the files, USER_DATA keeps the enclave the node was
 // given (as rmw_cyclonedds writes options->enclave).
 TEST(SecurityPlanTest, SecuredParticipantWithOverride) {
-  RosEnvironment env;
-  env.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);
-  env.range = DiscoveryRange::kLocalhost;
+  RosEnvironment env = test::private_env();
   const fs::path ks = fs::temp_directory_path() / ("quadcosim_dds_ks_" + std::to_string(getpid()));
   fs::remove_all(ks);
   security::create_keystore(ks, env.domain_id);

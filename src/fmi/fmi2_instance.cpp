@@ -37,13 +37,11 @@ struct Fmi2Functions {
   fmi2SetStringTYPE* set_string;
 };
 
-Status status_of(fmi2Status s) { return static_cast<Status>(static_cast<int>(s)); }
-
-class Fmi2Fmu final : public Fmu {
+class Fmi2Fmu final : public LoadedFmu {
  public:
   Fmi2Fmu(ModelDescription md, std::string path, FmuFiles files)
-      : files_(std::move(files)), library_(binary_path(md, files_.root, path)) {
-    const Library& l = library_;
+      : LoadedFmu(std::move(md), std::move(path), std::move(files)) {
+    const Library& l = library();
     f_ = Fmi2Functions{
         l.function<fmi2GetTypesPlatformTYPE>("fmi2GetTypesPlatform"),
         l.function<fmi2GetVersionTYPE>("fmi2GetVersion"),
@@ -63,50 +61,35 @@ class Fmi2Fmu final : public Fmu {
         l.function<fmi2SetBooleanTYPE>("fmi2SetBoolean"),
         l.function<fmi2SetStringTYPE>("fmi2SetString"),
     };
-    const char* version = f_.get_version();
-    if (version == nullptr || std::string_view(version).substr(0, 2) != "2.") {
-      throw FmuError(fmt::format("{}: fmi2GetVersion() answers '{}', not 2.x as its modelDescription.xml says",
-                                 library_.file(), version != nullptr ? version : "(null)"));
-    }
+    check_version(f_.get_version(), "fmi2GetVersion", "2.");
     const char* platform = f_.get_types_platform();
     if (platform == nullptr || std::string_view(platform) != fmi2TypesPlatform) {
-      throw FmuError(fmt::format("{}: fmi2GetTypesPlatform() answers '{}', not '{}'", library_.file(),
+      throw FmuError(fmt::format("{}: fmi2GetTypesPlatform() answers '{}', not '{}'", l.file(),
                                  platform != nullptr ? platform : "(null)", fmi2TypesPlatform));
     }
-    resource_uri_ = file_uri((std::filesystem::path(files_.root) / "resources").string());
-    description_ = std::move(md);
-    path_ = std::move(path);
+    resource_uri_ = file_uri((std::filesystem::path(root()) / "resources").string());
   }
 
   std::unique_ptr<Instance> instantiate(const std::string& instance_name, LogSink log) override;
 
   const Fmi2Functions& functions() const { return f_; }
   const std::string& resource_uri() const { return resource_uri_; }
-  std::atomic<int> live_instances{0};
 
  private:
-  FmuFiles files_;  // removed after the library is closed (members go in reverse order)
-  Library library_;
   Fmi2Functions f_{};
   std::string resource_uri_;
 };
 
-class Fmi2Instance final : public Instance {
+class Fmi2Instance final : public CheckedInstance {
  public:
-  Fmi2Instance(std::shared_ptr<Fmi2Fmu> fmu, const std::string& name, LogSink log)
-      : Instance(fmu), fmu2_(*fmu), f_(fmu->functions()), core_(*fmu, name, std::move(log)) {
+  Fmi2Instance(const std::shared_ptr<Fmi2Fmu>& fmu, const std::string& name, LogSink log)
+      : CheckedInstance(fmu, name, std::move(log)), fmu2_(*fmu), f_(fmu->functions()) {
     callbacks_.logger = &Fmi2Instance::logger;
     callbacks_.allocateMemory = [](std::size_t n, std::size_t size) { return std::calloc(n, size); };
     callbacks_.freeMemory = [](void* p) { std::free(p); };
     callbacks_.stepFinished = nullptr;
     callbacks_.componentEnvironment = this;
     const ModelDescription& md = fmu->description();
-    if (md.can_be_instantiated_only_once_per_process && fmu2_.live_instances.load() > 0) {
-      throw FmuError(
-          fmt::format("FMU '{}' ({}): can be instantiated only once per process, and an instance "
-                      "exists: refused instance '{}'",
-                      md.model_name, fmu->path(), name));
-    }
     core_.begin("fmi2Instantiate");
     component_ = f_.instantiate(name.c_str(), fmi2CoSimulation, md.guid.c_str(), fmu2_.resource_uri().c_str(),
                                 &callbacks_, fmi2False, fmi2False);
@@ -119,15 +102,7 @@ class Fmi2Instance final : public Instance {
 
   ~Fmi2Instance() override {
     if (component_ == nullptr) return;
-    // Terminate a running instance that did not fail; never after Error or Fatal (FMI 2 allows only
-    // reset and free then). Nothing may escape a destructor.
-    if (!core_.broken() && !core_.errored && core_.phase == InstanceCore::Phase::kStepping) {
-      try {
-        core_.begin("fmi2Terminate");
-        f_.terminate(component_);
-      } catch (...) {
-      }
-    }
+    terminate_quietly_by("fmi2Terminate", [&] { return f_.terminate(component_); });
     f_.free_instance(component_);
     --fmu2_.live_instances;
   }
@@ -142,16 +117,12 @@ class Fmi2Instance final : public Instance {
                              ? fmt::format("fmi2SetupExperiment(start = {}, stop = {})", start_time_s, *stop_time_s)
                              : fmt::format("fmi2SetupExperiment(start = {})", start_time_s);
                 });
-    core_.begin("fmi2EnterInitializationMode");
-    core_.check(status_of(f_.enter_initialization_mode(component_)), [] { return "fmi2EnterInitializationMode"; });
+    call_by("fmi2EnterInitializationMode", [&] { return f_.enter_initialization_mode(component_); });
     core_.phase = InstanceCore::Phase::kInitializing;
   }
 
   void exit_initialization() override {
-    core_.expect(InstanceCore::Phase::kInitializing, "fmi2ExitInitializationMode");
-    core_.begin("fmi2ExitInitializationMode");
-    core_.check(status_of(f_.exit_initialization_mode(component_)), [] { return "fmi2ExitInitializationMode"; });
-    core_.phase = InstanceCore::Phase::kStepping;
+    exit_initialization_by("fmi2ExitInitializationMode", [&] { return f_.exit_initialization_mode(component_); });
   }
 
   void do_step(double t_s, double h_s) override {
@@ -162,65 +133,55 @@ class Fmi2Instance final : public Instance {
   }
 
   void terminate() override {
-    core_.expect(InstanceCore::Phase::kStepping, "fmi2Terminate");
-    core_.begin("fmi2Terminate");
-    core_.phase = InstanceCore::Phase::kTerminated;  // also when it fails: not again at destruction
-    core_.check(status_of(f_.terminate(component_)), [] { return "fmi2Terminate"; });
+    terminate_by("fmi2Terminate", [&] { return f_.terminate(component_); });
   }
 
   void reset() override {
-    core_.begin("fmi2Reset");
-    core_.check(status_of(f_.reset(component_)), [] { return "fmi2Reset"; });
-    core_.phase = InstanceCore::Phase::kInstantiated;
-    core_.errored = false;
+    reset_by("fmi2Reset", [&] { return f_.reset(component_); });
   }
 
   void get_real(std::span<const ValueReference> vr, std::span<double> values) override {
-    prepare("fmi2GetReal", vr, values.size(), VariableType::kReal);
-    core_.check(status_of(f_.get_real(component_, vr.data(), vr.size(), values.data())),
-                [&] { return fmt::format("fmi2GetReal({})", describe(core_, vr, VariableType::kReal)); });
+    get_by("fmi2GetReal", vr, values, VariableType::kReal,
+           [&] { return f_.get_real(component_, vr.data(), vr.size(), values.data()); });
   }
 
   void set_real(std::span<const ValueReference> vr, std::span<const double> values) override {
-    prepare("fmi2SetReal", vr, values.size(), VariableType::kReal);
-    core_.check(status_of(f_.set_real(component_, vr.data(), vr.size(), values.data())),
-                [&] { return fmt::format("fmi2SetReal({})", describe(core_, vr, VariableType::kReal, values)); });
+    set_by("fmi2SetReal", vr, values, VariableType::kReal,
+           [&] { return f_.set_real(component_, vr.data(), vr.size(), values.data()); });
   }
 
   void get_integer(std::span<const ValueReference> vr, std::span<std::int32_t> values) override {
-    prepare("fmi2GetInteger", vr, values.size(), VariableType::kInteger);
-    core_.check(status_of(f_.get_integer(component_, vr.data(), vr.size(), values.data())),
-                [&] { return fmt::format("fmi2GetInteger({})", describe(core_, vr, VariableType::kInteger)); });
+    get_by("fmi2GetInteger", vr, values, VariableType::kInteger,
+           [&] { return f_.get_integer(component_, vr.data(), vr.size(), values.data()); });
   }
 
   void set_integer(std::span<const ValueReference> vr, std::span<const std::int32_t> values) override {
-    prepare("fmi2SetInteger", vr, values.size(), VariableType::kInteger);
-    core_.check(status_of(f_.set_integer(component_, vr.data(), vr.size(), values.data())),
-                [&] { return fmt::format("fmi2SetInteger({})", describe(core_, vr, VariableType::kInteger, values)); });
+    set_by("fmi2SetInteger", vr, values, VariableType::kInteger,
+           [&] { return f_.set_integer(component_, vr.data(), vr.size(), values.data()); });
   }
 
   void get_boolean(std::span<const ValueReference> vr, std::span<bool> values) override {
-    prepare("fmi2GetBoolean", vr, values.size(), VariableType::kBoolean);
-    booleans_.resize(vr.size());
-    core_.check(status_of(f_.get_boolean(component_, vr.data(), vr.size(), booleans_.data())),
-                [&] { return fmt::format("fmi2GetBoolean({})", describe(core_, vr, VariableType::kBoolean)); });
+    get_by("fmi2GetBoolean", vr, values, VariableType::kBoolean, [&] {
+      booleans_.resize(vr.size());
+      return f_.get_boolean(component_, vr.data(), vr.size(), booleans_.data());
+    });
     for (std::size_t i = 0; i < vr.size(); ++i) values[i] = booleans_[i] != fmi2False;
   }
 
   void set_boolean(std::span<const ValueReference> vr, std::span<const bool> values) override {
-    prepare("fmi2SetBoolean", vr, values.size(), VariableType::kBoolean);
-    booleans_.resize(vr.size());
-    for (std::size_t i = 0; i < vr.size(); ++i) booleans_[i] = values[i] ? fmi2True : fmi2False;
-    core_.check(status_of(f_.set_boolean(component_, vr.data(), vr.size(), booleans_.data())),
-                [&] { return fmt::format("fmi2SetBoolean({})", describe(core_, vr, VariableType::kBoolean, values)); });
+    set_by("fmi2SetBoolean", vr, values, VariableType::kBoolean, [&] {
+      booleans_.resize(vr.size());
+      for (std::size_t i = 0; i < vr.size(); ++i) booleans_[i] = values[i] ? fmi2True : fmi2False;
+      return f_.set_boolean(component_, vr.data(), vr.size(), booleans_.data());
+    });
   }
 
   void set_string(std::span<const ValueReference> vr, std::span<const std::string> values) override {
-    prepare("fmi2SetString", vr, values.size(), VariableType::kString);
-    strings_.resize(vr.size());
-    for (std::size_t i = 0; i < vr.size(); ++i) strings_[i] = values[i].c_str();
-    core_.check(status_of(f_.set_string(component_, vr.data(), vr.size(), strings_.data())),
-                [&] { return fmt::format("fmi2SetString({})", describe(core_, vr, VariableType::kString, values)); });
+    set_by("fmi2SetString", vr, values, VariableType::kString, [&] {
+      strings_.resize(vr.size());
+      for (std::size_t i = 0; i < vr.size(); ++i) strings_[i] = values[i].c_str();
+      return f_.set_string(component_, vr.data(), vr.size(), strings_.data());
+    });
   }
 
  private:
@@ -251,19 +212,8 @@ class Fmi2Instance final : public Instance {
     }
   }
 
-  /// Checks the call may be made: the instance is usable, the spans match, the variables exist.
-  void prepare(std::string_view call, std::span<const ValueReference> vr, std::size_t n_values, VariableType type) {
-    core_.begin(call);
-    if (vr.size() != n_values) {
-      throw FmuError(fmt::format("{} of FMU '{}' instance '{}': {} value references but {} values", call,
-                                 description().model_name, core_.instance_name(), vr.size(), n_values));
-    }
-    core_.check_known(call, vr, type);
-  }
-
   Fmi2Fmu& fmu2_;
   const Fmi2Functions& f_;
-  InstanceCore core_;
   fmi2CallbackFunctions callbacks_{};  // the FMU may keep a pointer to it until it is freed
   fmi2Component component_ = nullptr;
   std::vector<fmi2Boolean> booleans_;

@@ -32,13 +32,11 @@ struct Fmi3Functions {
   fmi3SetStringTYPE* set_string;
 };
 
-Status status_of(fmi3Status s) { return static_cast<Status>(static_cast<int>(s)); }
-
-class Fmi3Fmu final : public Fmu {
+class Fmi3Fmu final : public LoadedFmu {
  public:
   Fmi3Fmu(ModelDescription md, std::string path, FmuFiles files)
-      : files_(std::move(files)), library_(binary_path(md, files_.root, path)) {
-    const Library& l = library_;
+      : LoadedFmu(std::move(md), std::move(path), std::move(files)) {
+    const Library& l = library();
     f_ = Fmi3Functions{
         l.function<fmi3GetVersionTYPE>("fmi3GetVersion"),
         l.function<fmi3InstantiateCoSimulationTYPE>("fmi3InstantiateCoSimulation"),
@@ -56,43 +54,28 @@ class Fmi3Fmu final : public Fmu {
         l.function<fmi3SetBooleanTYPE>("fmi3SetBoolean"),
         l.function<fmi3SetStringTYPE>("fmi3SetString"),
     };
-    const char* version = f_.get_version();
-    if (version == nullptr || std::string_view(version).substr(0, 2) != "3.") {
-      throw FmuError(fmt::format("{}: fmi3GetVersion() answers '{}', not 3.x as its modelDescription.xml says",
-                                 library_.file(), version != nullptr ? version : "(null)"));
-    }
+    check_version(f_.get_version(), "fmi3GetVersion", "3.");
     // FMI 3 passes a directory path ending in a separator, or null when there is no resources/.
-    const std::filesystem::path resources = std::filesystem::path(files_.root) / "resources";
+    const std::filesystem::path resources = std::filesystem::path(root()) / "resources";
     std::error_code ec;
     if (std::filesystem::is_directory(resources, ec)) resource_path_ = resources.string() + "/";
-    description_ = std::move(md);
-    path_ = std::move(path);
   }
 
   std::unique_ptr<Instance> instantiate(const std::string& instance_name, LogSink log) override;
 
   const Fmi3Functions& functions() const { return f_; }
   const std::string& resource_path() const { return resource_path_; }
-  std::atomic<int> live_instances{0};
 
  private:
-  FmuFiles files_;  // removed after the library is closed (members go in reverse order)
-  Library library_;
   Fmi3Functions f_{};
   std::string resource_path_;  ///< "" when the FMU has no resources
 };
 
-class Fmi3Instance final : public Instance {
+class Fmi3Instance final : public CheckedInstance {
  public:
-  Fmi3Instance(std::shared_ptr<Fmi3Fmu> fmu, const std::string& name, LogSink log)
-      : Instance(fmu), fmu3_(*fmu), f_(fmu->functions()), core_(*fmu, name, std::move(log)) {
+  Fmi3Instance(const std::shared_ptr<Fmi3Fmu>& fmu, const std::string& name, LogSink log)
+      : CheckedInstance(fmu, name, std::move(log)), fmu3_(*fmu), f_(fmu->functions()) {
     const ModelDescription& md = fmu->description();
-    if (md.can_be_instantiated_only_once_per_process && fmu3_.live_instances.load() > 0) {
-      throw FmuError(
-          fmt::format("FMU '{}' ({}): can be instantiated only once per process, and an instance "
-                      "exists: refused instance '{}'",
-                      md.model_name, fmu->path(), name));
-    }
     core_.begin("fmi3InstantiateCoSimulation");
     const std::string& resources = fmu3_.resource_path();
     instance_ = f_.instantiate(name.c_str(), md.guid.c_str(), resources.empty() ? nullptr : resources.c_str(),
@@ -108,14 +91,7 @@ class Fmi3Instance final : public Instance {
 
   ~Fmi3Instance() override {
     if (instance_ == nullptr) return;
-    // Terminate a running instance that did not fail. Nothing may escape a destructor.
-    if (!core_.broken() && !core_.errored && core_.phase == InstanceCore::Phase::kStepping) {
-      try {
-        core_.begin("fmi3Terminate");
-        f_.terminate(instance_);
-      } catch (...) {
-      }
-    }
+    terminate_quietly_by("fmi3Terminate", [&] { return f_.terminate(instance_); });
     f_.free_instance(instance_);
     --fmu3_.live_instances;
   }
@@ -134,10 +110,7 @@ class Fmi3Instance final : public Instance {
   }
 
   void exit_initialization() override {
-    core_.expect(InstanceCore::Phase::kInitializing, "fmi3ExitInitializationMode");
-    core_.begin("fmi3ExitInitializationMode");
-    core_.check(status_of(f_.exit_initialization_mode(instance_)), [] { return "fmi3ExitInitializationMode"; });
-    core_.phase = InstanceCore::Phase::kStepping;
+    exit_initialization_by("fmi3ExitInitializationMode", [&] { return f_.exit_initialization_mode(instance_); });
   }
 
   void do_step(double t_s, double h_s) override {
@@ -162,61 +135,50 @@ class Fmi3Instance final : public Instance {
   }
 
   void terminate() override {
-    core_.expect(InstanceCore::Phase::kStepping, "fmi3Terminate");
-    core_.begin("fmi3Terminate");
-    core_.phase = InstanceCore::Phase::kTerminated;  // also when it fails: not again at destruction
-    core_.check(status_of(f_.terminate(instance_)), [] { return "fmi3Terminate"; });
+    terminate_by("fmi3Terminate", [&] { return f_.terminate(instance_); });
   }
 
   void reset() override {
-    core_.begin("fmi3Reset");
-    core_.check(status_of(f_.reset(instance_)), [] { return "fmi3Reset"; });
-    core_.phase = InstanceCore::Phase::kInstantiated;
-    core_.errored = false;
+    reset_by("fmi3Reset", [&] { return f_.reset(instance_); });
   }
 
+  // FMI 3 takes the number of values too: one per value reference here (no arrays).
   void get_real(std::span<const ValueReference> vr, std::span<double> values) override {
-    prepare("fmi3GetFloat64", vr, values.size(), VariableType::kReal);
-    core_.check(status_of(f_.get_float64(instance_, vr.data(), vr.size(), values.data(), values.size())),
-                [&] { return fmt::format("fmi3GetFloat64({})", describe(core_, vr, VariableType::kReal)); });
+    get_by("fmi3GetFloat64", vr, values, VariableType::kReal,
+           [&] { return f_.get_float64(instance_, vr.data(), vr.size(), values.data(), values.size()); });
   }
 
   void set_real(std::span<const ValueReference> vr, std::span<const double> values) override {
-    prepare("fmi3SetFloat64", vr, values.size(), VariableType::kReal);
-    core_.check(status_of(f_.set_float64(instance_, vr.data(), vr.size(), values.data(), values.size())),
-                [&] { return fmt::format("fmi3SetFloat64({})", describe(core_, vr, VariableType::kReal, values)); });
+    set_by("fmi3SetFloat64", vr, values, VariableType::kReal,
+           [&] { return f_.set_float64(instance_, vr.data(), vr.size(), values.data(), values.size()); });
   }
 
   void get_integer(std::span<const ValueReference> vr, std::span<std::int32_t> values) override {
-    prepare("fmi3GetInt32", vr, values.size(), VariableType::kInteger);
-    core_.check(status_of(f_.get_int32(instance_, vr.data(), vr.size(), values.data(), values.size())),
-                [&] { return fmt::format("fmi3GetInt32({})", describe(core_, vr, VariableType::kInteger)); });
+    get_by("fmi3GetInt32", vr, values, VariableType::kInteger,
+           [&] { return f_.get_int32(instance_, vr.data(), vr.size(), values.data(), values.size()); });
   }
 
   void set_integer(std::span<const ValueReference> vr, std::span<const std::int32_t> values) override {
-    prepare("fmi3SetInt32", vr, values.size(), VariableType::kInteger);
-    core_.check(status_of(f_.set_int32(instance_, vr.data(), vr.size(), values.data(), values.size())),
-                [&] { return fmt::format("fmi3SetInt32({})", describe(core_, vr, VariableType::kInteger, values)); });
+    set_by("fmi3SetInt32", vr, values, VariableType::kInteger,
+           [&] { return f_.set_int32(instance_, vr.data(), vr.size(), values.data(), values.size()); });
   }
 
   void get_boolean(std::span<const ValueReference> vr, std::span<bool> values) override {
-    prepare("fmi3GetBoolean", vr, values.size(), VariableType::kBoolean);
-    core_.check(status_of(f_.get_boolean(instance_, vr.data(), vr.size(), values.data(), values.size())),
-                [&] { return fmt::format("fmi3GetBoolean({})", describe(core_, vr, VariableType::kBoolean)); });
+    get_by("fmi3GetBoolean", vr, values, VariableType::kBoolean,
+           [&] { return f_.get_boolean(instance_, vr.data(), vr.size(), values.data(), values.size()); });
   }
 
   void set_boolean(std::span<const ValueReference> vr, std::span<const bool> values) override {
-    prepare("fmi3SetBoolean", vr, values.size(), VariableType::kBoolean);
-    core_.check(status_of(f_.set_boolean(instance_, vr.data(), vr.size(), values.data(), values.size())),
-                [&] { return fmt::format("fmi3SetBoolean({})", describe(core_, vr, VariableType::kBoolean, values)); });
+    set_by("fmi3SetBoolean", vr, values, VariableType::kBoolean,
+           [&] { return f_.set_boolean(instance_, vr.data(), vr.size(), values.data(), values.size()); });
   }
 
   void set_string(std::span<const ValueReference> vr, std::span<const std::string> values) override {
-    prepare("fmi3SetString", vr, values.size(), VariableType::kString);
-    strings_.resize(vr.size());
-    for (std::size_t i = 0; i < vr.size(); ++i) strings_[i] = values[i].c_str();
-    core_.check(status_of(f_.set_string(instance_, vr.data(), vr.size(), strings_.data(), strings_.size())),
-                [&] { return fmt::format("fmi3SetString({})", describe(core_, vr, VariableType::kString, values)); });
+    set_by("fmi3SetString", vr, values, VariableType::kString, [&] {
+      strings_.resize(vr.size());
+      for (std::size_t i = 0; i < vr.size(); ++i) strings_[i] = values[i].c_str();
+      return f_.set_string(instance_, vr.data(), vr.size(), strings_.data(), strings_.size());
+    });
   }
 
  private:
@@ -229,19 +191,8 @@ class Fmi3Instance final : public Instance {
     }
   }
 
-  /// Checks the call may be made: the instance is usable, the spans match, the variables exist.
-  void prepare(std::string_view call, std::span<const ValueReference> vr, std::size_t n_values, VariableType type) {
-    core_.begin(call);
-    if (vr.size() != n_values) {
-      throw FmuError(fmt::format("{} of FMU '{}' instance '{}': {} value references but {} values", call,
-                                 description().model_name, core_.instance_name(), vr.size(), n_values));
-    }
-    core_.check_known(call, vr, type);
-  }
-
   Fmi3Fmu& fmu3_;
   const Fmi3Functions& f_;
-  InstanceCore core_;
   fmi3Instance instance_ = nullptr;
   std::vector<fmi3String> strings_;
 };

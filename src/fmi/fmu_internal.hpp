@@ -1,11 +1,12 @@
 // What fmu.cpp, fmi2_instance.cpp and fmi3_instance.cpp share: the FMU's binary (dlopen), the loaded
-// FMU's files, the log an instance keeps of what its FMU said, and the instance's state. Not part of
-// the library's interface.
+// FMU's files, the log an instance keeps of what its FMU said, the instance's state and the checks
+// the master makes around every FMI call, whichever the version. Not part of the library's interface.
 #pragma once
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -138,5 +139,124 @@ std::string describe(const InstanceCore& core, std::span<const ValueReference> v
   if (shown < vrs.size()) text += fmt::format(" and {} more", vrs.size() - shown);
   return text;
 }
+
+/// What the FMI 2 and FMI 3 FMUs share: their files, their binary and the count of live instances.
+class LoadedFmu : public Fmu {
+ public:
+  std::atomic<int> live_instances{0};
+
+ protected:
+  LoadedFmu(ModelDescription md, std::string path, FmuFiles files)
+      : files_(std::move(files)), library_(binary_path(md, files_.root, path)) {
+    description_ = std::move(md);
+    path_ = std::move(path);
+  }
+  const Library& library() const { return library_; }
+  const std::string& root() const { return files_.root; }
+  /// Throws FmuError unless `version`, what `function`() answered, starts with `major` ("2.", "3.").
+  void check_version(const char* version, std::string_view function, std::string_view major) const {
+    if (version == nullptr || std::string_view(version).substr(0, major.size()) != major) {
+      throw FmuError(fmt::format("{}: {}() answers '{}', not {}x as its modelDescription.xml says", library_.file(),
+                                 function, version != nullptr ? version : "(null)", major));
+    }
+  }
+
+ private:
+  FmuFiles files_;  // removed after the library is closed (members go in reverse order)
+  Library library_;
+};
+
+/// What the FMI 2 and FMI 3 instances share: the master's checks around each call (the state
+/// machine, the spans, the variables), the rule of one instance per process and the status checks.
+/// The `*_by` calls take the FMI call itself, a function returning the standard's status.
+class CheckedInstance : public Instance {
+ protected:
+  /// Refuses a second instance of an FMU that can be instantiated only once per process.
+  CheckedInstance(const std::shared_ptr<LoadedFmu>& fmu, const std::string& name, LogSink log)
+      : Instance(fmu), core_(*fmu, name, std::move(log)) {
+    const ModelDescription& md = fmu->description();
+    if (md.can_be_instantiated_only_once_per_process && fmu->live_instances.load() > 0) {
+      throw FmuError(
+          fmt::format("FMU '{}' ({}): can be instantiated only once per process, and an instance "
+                      "exists: refused instance '{}'",
+                      md.model_name, fmu->path(), name));
+    }
+  }
+
+  template <typename FmiStatus>
+  static Status status_of(FmiStatus s) {
+    return static_cast<Status>(static_cast<int>(s));
+  }
+
+  /// The call `name`, made by `call` and checked.
+  template <typename Call>
+  void call_by(std::string_view name, Call&& call) {
+    core_.begin(name);
+    core_.check(status_of(call()), [name] { return name; });
+  }
+
+  template <typename Call>
+  void exit_initialization_by(std::string_view name, Call&& call) {
+    core_.expect(InstanceCore::Phase::kInitializing, name);
+    call_by(name, call);
+    core_.phase = InstanceCore::Phase::kStepping;
+  }
+
+  template <typename Call>
+  void terminate_by(std::string_view name, Call&& call) {
+    core_.expect(InstanceCore::Phase::kStepping, name);
+    core_.begin(name);
+    core_.phase = InstanceCore::Phase::kTerminated;  // also when it fails: not again at destruction
+    core_.check(status_of(call()), [name] { return name; });
+  }
+
+  template <typename Call>
+  void reset_by(std::string_view name, Call&& call) {
+    call_by(name, call);
+    core_.phase = InstanceCore::Phase::kInstantiated;
+    core_.errored = false;
+  }
+
+  /// At destruction: terminates a running instance that did not fail (never after Error or Fatal).
+  /// Nothing may escape a destructor.
+  template <typename Call>
+  void terminate_quietly_by(std::string_view name, Call&& call) noexcept {
+    if (core_.broken() || core_.errored || core_.phase != InstanceCore::Phase::kStepping) return;
+    try {
+      core_.begin(name);
+      call();
+    } catch (...) {
+    }
+  }
+
+  /// A get call: `values` are written by `call`.
+  template <typename T, typename Call>
+  void get_by(std::string_view name, std::span<const ValueReference> vr, std::span<T> values, VariableType type,
+              Call&& call) {
+    prepare(name, vr, values.size(), type);
+    core_.check(status_of(call()), [&] { return fmt::format("{}({})", name, describe(core_, vr, type)); });
+  }
+
+  /// A set call: the message names the values.
+  template <typename T, typename Call>
+  void set_by(std::string_view name, std::span<const ValueReference> vr, std::span<const T> values, VariableType type,
+              Call&& call) {
+    prepare(name, vr, values.size(), type);
+    core_.check(status_of(call()), [&] { return fmt::format("{}({})", name, describe(core_, vr, type, values)); });
+  }
+
+  InstanceCore core_;
+
+ private:
+  /// Checks the call may be made: the instance is usable, the spans match, the variables exist.
+  void prepare(std::string_view call, std::span<const ValueReference> vr, std::size_t n_values, VariableType type) {
+    core_.begin(call);
+    if (vr.size() != n_values) {
+      throw FmuError(fmt::format("{} of FMU '{}' instance '{}': {} value references but {} values", call,
+                                 description().model_name, core_.instance_name(), vr.size(), n_values));
+    }
+    core_.check_known(call, vr, type);
+  }
+};
 
 }  // namespace quadcosim::fmi::detail

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "dds/dds_test_support.hpp"
 #include "dds/entity.hpp"
 #include "dds/participant.hpp"
 #include "dds/ros_types.hpp"
@@ -29,13 +30,6 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------------------------------------
 // CDR against Cyclone DDS
-
-dds::RosEnvironment test_env() {
-  dds::RosEnvironment e;
-  e.domain_id = 100 + static_cast<std::uint32_t>(getpid() % 100);  // apart from other test runs
-  e.range = dds::DiscoveryRange::kLocalhost;
-  return e;
-}
 
 // Writes `m` through a Cyclone DDS writer (the generated C type, via the transport's conversion) and
 // returns the serialized sample a reader of the same participant takes with dds_takecdr: Cyclone's
@@ -112,7 +106,7 @@ void expect_same_cdr(const std::vector<std::uint8_t>& ours, const std::vector<st
 
 class CdrTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { participant_ = new dds::Participant(test_env()); }
+  static void SetUpTestSuite() { participant_ = new dds::Participant(dds::test::private_env()); }
   static void TearDownTestSuite() {
     delete participant_;
     participant_ = nullptr;
@@ -510,6 +504,19 @@ std::vector<std::pair<int, std::size_t>> top_level_records(const std::vector<std
 
 std::vector<std::uint8_t> pose_bytes(int i) { return to_cdr(testing::sample_pose(i)); }
 
+/// Adds the PoseStamped schema and the channel /drone/Pose (CDR) to `w`; the channel's id.
+std::uint16_t add_pose_channel(McapWriter& w) {
+  const std::uint16_t s =
+      w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
+  return w.add_channel("/drone/Pose", s, "cdr");
+}
+
+/// Writes pose_bytes(i) on `channel` as message i + 1, logged and published at tick i.
+void write_pose(McapWriter& w, std::uint16_t channel, int i) {
+  const auto b = pose_bytes(i);
+  w.write(channel, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+}
+
 TEST_F(McapWriterTest, OpeningFailsWithThePathInTheMessage) {
   const std::string bad = path("no/such/dir/x.mcap");
   try {
@@ -546,9 +553,7 @@ TEST_F(McapWriterTest, RejectsUnknownIdsAndEncodingsOutsideTheRos2Profile) {
 TEST_F(McapWriterTest, ChunksReachTheFileAsSoonAsTheyFillAndFlushEndsTheOpenOne) {
   const std::string file = path("safety.mcap");
   McapWriter w(file, {"ros2", 4096, true});
-  const auto s =
-      w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
-  const auto c = w.add_channel("/drone/Pose", s, "cdr");
+  const auto c = add_pose_channel(w);
   const auto count_chunks = [&] {
     int n = 0;
     for (const auto& [op, at] : top_level_records(read_file(file))) n += op == 0x06;
@@ -560,14 +565,12 @@ TEST_F(McapWriterTest, ChunksReachTheFileAsSoonAsTheyFillAndFlushEndsTheOpenOne)
   int i = 0;
   while (count_chunks() == 0) {
     ASSERT_LT(i, 1000) << "no chunk written after 1000 messages of a 4 KiB chunk";
-    const auto b = pose_bytes(i);
-    w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+    write_pose(w, c, i);
     ++i;
   }
   EXPECT_GE(static_cast<std::size_t>(i) * (pose_bytes(0).size() + 31), 4096u);  // only once full
   const std::uintmax_t after_chunk = fs::file_size(file);
-  const auto b = pose_bytes(i);
-  w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+  write_pose(w, c, i);
   EXPECT_EQ(fs::file_size(file), after_chunk) << "a single message went to disk before its chunk filled";
   w.flush();
   EXPECT_EQ(count_chunks(), 2);
@@ -584,12 +587,9 @@ TEST_F(McapWriterTest, ClosedFileHasDataEndSummaryOffsetsFooterAndMagic) {
   const std::string file = path("layout.mcap");
   {
     McapWriter w(file, {"ros2", 2048, false});
-    const auto s =
-        w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
-    const auto c = w.add_channel("/drone/Pose", s, "cdr");
+    const auto c = add_pose_channel(w);
     for (int i = 0; i < 50; ++i) {
-      const auto b = pose_bytes(i);
-      w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+      write_pose(w, c, i);
     }
     // no close(): the destructor finishes the file
   }
@@ -631,12 +631,9 @@ TEST_F(McapWriterTest, ChunkIndexesBeyondTheMemoryBoundGoToASpillFileAndAllReach
   std::uint64_t chunks = 0, spilled = 0;
   {
     McapWriter w(file, {"ros2", 64, false});
-    const auto s =
-        w.add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", ros2msg_definition("geometry_msgs/msg/PoseStamped"));
-    const auto c = w.add_channel("/drone/Pose", s, "cdr");
+    const auto c = add_pose_channel(w);
     for (int i = 0; i < 4000; ++i) {
-      const auto b = pose_bytes(i);
-      w.write(c, static_cast<std::uint32_t>(i + 1), testing::tick_ns(i), testing::tick_ns(i), b.data(), b.size());
+      write_pose(w, c, i);
     }
     chunks = w.chunks();
     spilled = w.spilled_index_bytes();

@@ -62,15 +62,22 @@ struct Column {
   bool boolean = false;  ///< a flag written as 1 or 0 (Python shows a bool where it shows one sample)
 };
 
-struct MagnetometerKind {
-  using Config = MagnetometerConfig;
-  using Model = Magnetometer;
-  using Sample = MagnetometerSample;
-  static constexpr std::string_view kName = "magnetometer";  ///< also its random stream's name
-  static const std::optional<Config>& config(const SensorSet& s) { return s.magnetometer; }
-  static std::optional<Config>& config(SensorSet& s) { return s.magnetometer; }
+/// What a kind states alike for every sensor: its configuration, model and sample types, where its
+/// configuration sits in SensorSet, and by default how the model is made (from the configuration and
+/// its random stream) and measures (from the truth alone). A kind whose model needs more says so.
+template <class C, class M, class S, std::optional<C> SensorSet::*kMember>
+struct KindBase {
+  using Config = C;
+  using Model = M;
+  using Sample = S;
+  static const std::optional<Config>& config(const SensorSet& s) { return s.*kMember; }
+  static std::optional<Config>& config(SensorSet& s) { return s.*kMember; }
   static Model make(const Config& c, model::Rng rng, double /*plant_period_s*/) { return Model(c, rng); }
   static Sample measure(Model& m, const model::Outputs& truth, double /*truth_t_s*/) { return m.measure(truth); }
+};
+
+struct MagnetometerKind : KindBase<MagnetometerConfig, Magnetometer, MagnetometerSample, &SensorSet::magnetometer> {
+  static constexpr std::string_view kName = "magnetometer";  ///< also its random stream's name
   template <class C, class F>
   static void config_fields(C& c, F&& f) {
     timing_fields(c.timing, f);
@@ -96,18 +103,12 @@ struct MagnetometerKind {
   }};
 };
 
-struct BarometerKind {
-  using Config = BarometerConfig;
-  using Model = Barometer;
-  using Sample = BarometerSample;
+struct BarometerKind : KindBase<BarometerConfig, Barometer, BarometerSample, &SensorSet::barometer> {
   static constexpr std::string_view kName = "barometer";
-  static const std::optional<Config>& config(const SensorSet& s) { return s.barometer; }
-  static std::optional<Config>& config(SensorSet& s) { return s.barometer; }
   /// The drift steps once per sample: the model is told the sample period.
   static Model make(const Config& c, model::Rng rng, double plant_period_s) {
     return Model(c, plant_period_s * c.timing.divider, rng);
   }
-  static Sample measure(Model& m, const model::Outputs& truth, double /*truth_t_s*/) { return m.measure(truth); }
   template <class C, class F>
   static void config_fields(C& c, F&& f) {
     timing_fields(c.timing, f);
@@ -133,14 +134,9 @@ struct BarometerKind {
   }};
 };
 
-struct GnssKind {
-  using Config = GnssConfig;
-  using Model = Gnss;
-  using Sample = GnssSample;
+struct GnssKind : KindBase<GnssConfig, Gnss, GnssSample, &SensorSet::gnss> {
   static constexpr std::string_view kName = "gnss";
-  static const std::optional<Config>& config(const SensorSet& s) { return s.gnss; }
-  static std::optional<Config>& config(SensorSet& s) { return s.gnss; }
-  static Model make(const Config& c, model::Rng rng, double /*plant_period_s*/) { return Model(c, rng); }
+  /// The receiver's fix and outages depend on the time.
   static Sample measure(Model& m, const model::Outputs& truth, double truth_t_s) { return m.measure(truth, truth_t_s); }
   template <class C, class F>
   static void config_fields(C& c, F&& f) {

@@ -193,10 +193,13 @@ TEST(ControllerSensorsTest, ALockstepControllerWaitsForTheSamplesDueAtItsTick) {
   fix.status.status = msg::NavSatStatus::kStatusNoFix;
   msg::TwistStamped gnss_v;
   gnss_v.header.stamp = t10;
-  rig.bus.advertise<msg::PoseStamped>("/drone/Pose").publish(p);
-  rig.bus.advertise<msg::TwistStamped>("/drone/Velocity").publish(tw);
-  rig.bus.advertise<msg::Imu>("/drone/Imu").publish(imu);
-  rig.bus.advertise<msg::MagneticField>("/drone/MagneticField").publish(mag);
+  const auto publish_pose_velocity_imu_magnetometer = [&] {
+    rig.bus.advertise<msg::PoseStamped>("/drone/Pose").publish(p);
+    rig.bus.advertise<msg::TwistStamped>("/drone/Velocity").publish(tw);
+    rig.bus.advertise<msg::Imu>("/drone/Imu").publish(imu);
+    rig.bus.advertise<msg::MagneticField>("/drone/MagneticField").publish(mag);
+  };
+  publish_pose_velocity_imu_magnetometer();
   rig.bus.advertise<msg::FluidPressure>("/drone/FluidPressure").publish(baro);
   rig.bus.advertise<msg::NavSatFix>("/drone/NavSatFix").publish(fix);
   EXPECT_EQ(commands.size(), 1u);
@@ -209,10 +212,7 @@ TEST(ControllerSensorsTest, ALockstepControllerWaitsForTheSamplesDueAtItsTick) {
   // sample no step, with it one.
   const msg::Time t12 = msg::Time::from_ns(120'000'000);
   p.header.stamp = tw.header.stamp = imu.header.stamp = mag.header.stamp = baro.header.stamp = t12;
-  rig.bus.advertise<msg::PoseStamped>("/drone/Pose").publish(p);
-  rig.bus.advertise<msg::TwistStamped>("/drone/Velocity").publish(tw);
-  rig.bus.advertise<msg::Imu>("/drone/Imu").publish(imu);
-  rig.bus.advertise<msg::MagneticField>("/drone/MagneticField").publish(mag);
+  publish_pose_velocity_imu_magnetometer();
   EXPECT_EQ(commands.size(), 2u);
   rig.bus.advertise<msg::FluidPressure>("/drone/FluidPressure").publish(baro);
   EXPECT_EQ(commands.size(), 3u);

@@ -54,6 +54,16 @@ analysis:
   return p;
 }
 
+/// What make_plan says to `specs` on scenario_file(): its error, or "accepted".
+std::string plan_error(const std::vector<std::string>& specs) {
+  try {
+    make_plan(scenario_file().string(), specs, 1, 4, Sampler::kRandom, hosts::test_resolvers());
+  } catch (const std::exception& e) {
+    return std::string(e.what());
+  }
+  return std::string("accepted");
+}
+
 // Yaw steps from hover at t = 0 (yaw_des from the controller section), 3 s; at most 0.5 s saturated.
 fs::path yaw_scenario_file() {
   const fs::path dir = fs::temp_directory_path() / ("sweep_test_" + std::to_string(::getpid()));
@@ -155,52 +165,37 @@ TEST(SetKey, DottedNestedListsAndErrors) {
 }
 
 TEST(Plan, RefusesUnknownKeysDoubleVariationAndValuesTheLoaderRefuses) {
-  const std::string f = scenario_file().string();
-  const auto error_of = [&](const std::vector<std::string>& specs) {
-    try {
-      make_plan(f, specs, 1, 4, Sampler::kRandom, hosts::test_resolvers());
-    } catch (const std::exception& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
-  EXPECT_THAT(error_of({"wingspan=5%"}), HasSubstr("unknown parameter 'wingspan'"));
-  EXPECT_THAT(error_of({"controller.altitude.kpp=uniform(1,2)"}),
+  EXPECT_THAT(plan_error({"wingspan=5%"}), HasSubstr("unknown parameter 'wingspan'"));
+  EXPECT_THAT(plan_error({"controller.altitude.kpp=uniform(1,2)"}),
               HasSubstr("unknown controller parameter 'altitude.kpp'"));
-  EXPECT_THAT(error_of({"controller.mode=grid(1)"}), HasSubstr("is a choice"));
-  EXPECT_THAT(error_of({"inertia=5%", "Ixx=5%"}), HasSubstr("already varied"));
-  EXPECT_THAT(error_of({"vehicle.mass_kg=5%", "mass=1%"}), HasSubstr("already varied"));
-  EXPECT_THAT(error_of({"vehicle.mass_kg=grid(1, -2)"}),
+  EXPECT_THAT(plan_error({"controller.mode=grid(1)"}), HasSubstr("is a choice"));
+  EXPECT_THAT(plan_error({"inertia=5%", "Ixx=5%"}), HasSubstr("already varied"));
+  EXPECT_THAT(plan_error({"vehicle.mass_kg=5%", "mass=1%"}), HasSubstr("already varied"));
+  EXPECT_THAT(plan_error({"vehicle.mass_kg=grid(1, -2)"}),
               AllOf(HasSubstr("vehicle.mass_kg = -2"), HasSubstr("declared range [1e-06, 1e+12]")));
-  EXPECT_THAT(error_of({"initial.yaw_rad=grid(0, 12)"}),
+  EXPECT_THAT(plan_error({"initial.yaw_rad=grid(0, 12)"}),
               AllOf(HasSubstr("grid value 12"), HasSubstr("initial.yaw_rad")));
-  EXPECT_THAT(error_of({"simulation.wobble=uniform(1,2)"}), HasSubstr("wobble"));
-  EXPECT_THAT(error_of({"environment.gusts.w20_m_s=10%"}), HasSubstr("has no value in"));
+  EXPECT_THAT(plan_error({"simulation.wobble=uniform(1,2)"}), HasSubstr("wobble"));
+  EXPECT_THAT(plan_error({"environment.gusts.w20_m_s=10%"}), HasSubstr("has no value in"));
   // Outside the controller table's declared range: refused before any run.
-  EXPECT_THAT(error_of({"controller.altitude.min_cos_tilt=uniform(0.01,0.5)"}), HasSubstr("declared range [0.05, 1]"));
-  EXPECT_EQ(error_of({"controller.altitude.kp=uniform(1,2)", "environment.gusts.w20_m_s=uniform(0,2)"}), "accepted");
+  EXPECT_THAT(plan_error({"controller.altitude.min_cos_tilt=uniform(0.01,0.5)"}),
+              HasSubstr("declared range [0.05, 1]"));
+  EXPECT_EQ(plan_error({"controller.altitude.kp=uniform(1,2)", "environment.gusts.w20_m_s=uniform(0,2)"}), "accepted");
 }
 
 TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
-  const std::string f = scenario_file().string();
-  const auto error_of = [&](const std::vector<std::string>& specs) {
-    try {
-      make_plan(f, specs, 1, 4, Sampler::kRandom, hosts::test_resolvers());
-    } catch (const std::exception& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   // initial.position_m[2] and initial.position_m.z are one key (docs/sweeps.md): varied twice, refused.
-  EXPECT_THAT(error_of({"initial.position_m[2]=grid(1)", "initial.position_m.z=grid(2)"}),
+  EXPECT_THAT(plan_error({"initial.position_m[2]=grid(1)", "initial.position_m.z=grid(2)"}),
               AllOf(HasSubstr("--vary initial.position_m.z=grid(2)"), HasSubstr("already varied"),
                     HasSubstr("initial.position_m[2]")));
-  EXPECT_THAT(error_of({"initial.position_m.x=grid(1)", "initial.position_m.0=grid(2)"}), HasSubstr("already varied"));
-  EXPECT_EQ(error_of({"initial.position_m[0]=grid(1)", "initial.position_m.z=grid(2)"}), "accepted");
+  EXPECT_THAT(plan_error({"initial.position_m.x=grid(1)", "initial.position_m.0=grid(2)"}),
+              HasSubstr("already varied"));
+  EXPECT_EQ(plan_error({"initial.position_m[0]=grid(1)", "initial.position_m.z=grid(2)"}), "accepted");
 
   // A vehicle list entry by its index is the vehicle key .x/.y/.z: the table's range, the plant's key.
   const Plan p =
-      make_plan(f, {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
+      make_plan(scenario_file().string(),
+                {"vehicle.aero.linear_drag_N_s_m[0]=normal(0,1)", "aero.quadratic_drag_N_s2_m2[2]=grid(0.5)"}, 3, 50,
                 Sampler::kRandom, hosts::test_resolvers());
   ASSERT_EQ(p.vary.size(), 2u);
   const Key& lin = p.vary[0].keys.at(0);
@@ -217,9 +212,9 @@ TEST(Plan, AListEntryIsOneKeyWhetherWrittenAsIndexOrXyz) {
   const io::Scenario sc = scenario_for(p, sample(p, 7));
   EXPECT_EQ(sc.vehicle.aero.linear_drag_N_s_m.x(), sample(p, 7).values[0].second);
   EXPECT_EQ(sc.vehicle.aero.quadratic_drag_N_s2_m2.z(), 0.5);
-  EXPECT_THAT(error_of({"vehicle.aero.linear_drag_N_s_m[1]=grid(-1)"}),
+  EXPECT_THAT(plan_error({"vehicle.aero.linear_drag_N_s_m[1]=grid(-1)"}),
               AllOf(HasSubstr("vehicle.aero.linear_drag_N_s_m.y = -1"), HasSubstr("declared range [0, 1e+06]")));
-  EXPECT_THAT(error_of({"linear_drag=uniform(0,1)", "vehicle.aero.linear_drag_N_s_m[1]=grid(0.3)"}),
+  EXPECT_THAT(plan_error({"linear_drag=uniform(0,1)", "vehicle.aero.linear_drag_N_s_m[1]=grid(0.3)"}),
               HasSubstr("already varied"));
 }
 

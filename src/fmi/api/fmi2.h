@@ -8,17 +8,10 @@
 
 #include <stddef.h>
 
+#include "fmi/api/fmi_export.h"
+
 #ifdef __cplusplus
 extern "C" {
-#endif
-
-/* Marks the functions an FMU exports; a library built with -fvisibility=hidden exports these only. */
-#ifndef QUADCOSIM_FMI_EXPORT
-#if defined(__GNUC__)
-#define QUADCOSIM_FMI_EXPORT __attribute__((visibility("default")))
-#else
-#define QUADCOSIM_FMI_EXPORT
-#endif
 #endif
 
 /* ---- Platform types ---------------------------------------------------------------------------- */

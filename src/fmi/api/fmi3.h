@@ -12,17 +12,10 @@
 #include <stdbool.h>
 #endif
 
+#include "fmi/api/fmi_export.h"
+
 #ifdef __cplusplus
 extern "C" {
-#endif
-
-/* Marks the functions an FMU exports; a library built with -fvisibility=hidden exports these only. */
-#ifndef QUADCOSIM_FMI_EXPORT
-#if defined(__GNUC__)
-#define QUADCOSIM_FMI_EXPORT __attribute__((visibility("default")))
-#else
-#define QUADCOSIM_FMI_EXPORT
-#endif
 #endif
 
 /* ---- Platform types ---------------------------------------------------------------------------- */

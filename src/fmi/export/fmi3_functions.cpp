@@ -162,38 +162,21 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
 
 // ---- Values -------------------------------------------------------------------------------------
 
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
-                          size_t nValues) {
-  return scalars(instance, "fmi3GetFloat64", nvr, nValues, [&](Slave& s) { return s.get_real(vr, nvr, values); });
-}
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
-                          size_t nValues) {
-  return scalars(instance, "fmi3SetFloat64", nvr, nValues, [&](Slave& s) { return s.set_real(vr, nvr, values); });
-}
-fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[],
-                        size_t nValues) {
-  return scalars(instance, "fmi3GetInt32", nvr, nValues, [&](Slave& s) { return s.get_integer(vr, nvr, values); });
-}
-fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[],
-                        size_t nValues) {
-  return scalars(instance, "fmi3SetInt32", nvr, nValues, [&](Slave& s) { return s.set_integer(vr, nvr, values); });
-}
-fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[],
-                          size_t nValues) {
-  return scalars(instance, "fmi3GetBoolean", nvr, nValues, [&](Slave& s) { return s.get_boolean(vr, nvr, values); });
-}
-fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
-                          size_t nValues) {
-  return scalars(instance, "fmi3SetBoolean", nvr, nValues, [&](Slave& s) { return s.set_boolean(vr, nvr, values); });
-}
-fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
-                         size_t nValues) {
-  return scalars(instance, "fmi3GetString", nvr, nValues, [&](Slave& s) { return s.get_string(vr, nvr, values); });
-}
-fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
-                         size_t nValues) {
-  return scalars(instance, "fmi3SetString", nvr, nValues, [&](Slave& s) { return s.set_string(vr, nvr, values); });
-}
+// The types the FMU has: each get and set checks one value per value reference and hands on.
+#define QC_SCALARS(TYPE, GET, SET)                                                                                \
+  fmi3Status fmi3Get##TYPE(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3##TYPE values[], \
+                           size_t nValues) {                                                                      \
+    return scalars(instance, "fmi3Get" #TYPE, nvr, nValues, [&](Slave& s) { return s.GET(vr, nvr, values); });    \
+  }                                                                                                               \
+  fmi3Status fmi3Set##TYPE(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,                      \
+                           const fmi3##TYPE values[], size_t nValues) {                                           \
+    return scalars(instance, "fmi3Set" #TYPE, nvr, nValues, [&](Slave& s) { return s.SET(vr, nvr, values); });    \
+  }
+QC_SCALARS(Float64, get_real, set_real)
+QC_SCALARS(Int32, get_integer, set_integer)
+QC_SCALARS(Boolean, get_boolean, set_boolean)
+QC_SCALARS(String, get_string, set_string)
+#undef QC_SCALARS
 
 #define QC_NO_SUCH_TYPE(TYPE)                                                                                     \
   fmi3Status fmi3Get##TYPE(fmi3Instance instance, const fmi3ValueReference[], size_t nvr, fmi3##TYPE[], size_t) { \

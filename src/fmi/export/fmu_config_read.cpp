@@ -124,43 +124,40 @@ trajectory::YawMode read_yaw_mode(const Reader& r, bool centre_allowed) {
 
 trajectory::TrajectorySpec read_trajectory(const Reader& r) {
   const std::string kind = r.at("kind").text();
-  const auto start = [&r](Eigen::Vector2d& centre, double& altitude, double& start_s, double& ramp_s) {
-    centre = r.at("centre_m").vector<2>();
-    altitude = r.at("altitude_m").number();
-    start_s = r.at("start_s").number();
-    ramp_s = r.at("ramp_s").number();
+  // The periodic curves: their start (centre, altitude, start and ramp times), then what is their
+  // own (`own` reads it into the parameters), then their yaw (the centre only for the circle).
+  const auto curve = [&r](auto params, bool centre_yaw, const auto& own) -> trajectory::TrajectorySpec {
+    params.centre_m = r.at("centre_m").vector<2>();
+    params.altitude_m = r.at("altitude_m").number();
+    params.start_s = r.at("start_s").number();
+    params.ramp_s = r.at("ramp_s").number();
+    own(params);
+    params.yaw_mode = read_yaw_mode(r.at("yaw_mode"), centre_yaw);
+    params.yaw_rad = r.at("yaw_rad").number();
+    return params;
   };
   if (kind == "circle") {
-    trajectory::CircleParams c;
-    start(c.centre_m, c.altitude_m, c.start_s, c.ramp_s);
-    c.radius_m = r.at("radius_m").number();
-    c.period_s = r.at("period_s").number();
-    const std::string direction = r.at("direction").text();
-    if (direction != "ccw" && direction != "cw") r.at("direction").fail("", "is '" + direction + "', not ccw or cw");
-    c.clockwise = direction == "cw";
-    c.phase_rad = r.at("phase_rad").number();
-    c.yaw_mode = read_yaw_mode(r.at("yaw_mode"), true);
-    c.yaw_rad = r.at("yaw_rad").number();
-    return c;
+    return curve(trajectory::CircleParams(), true, [&r](trajectory::CircleParams& c) {
+      c.radius_m = r.at("radius_m").number();
+      c.period_s = r.at("period_s").number();
+      const std::string direction = r.at("direction").text();
+      if (direction != "ccw" && direction != "cw") r.at("direction").fail("", "is '" + direction + "', not ccw or cw");
+      c.clockwise = direction == "cw";
+      c.phase_rad = r.at("phase_rad").number();
+    });
   }
   if (kind == "lissajous") {
-    trajectory::LissajousParams l;
-    start(l.centre_m, l.altitude_m, l.start_s, l.ramp_s);
-    l.amplitude_m = r.at("amplitude_m").vector<2>();
-    l.period_s = r.at("period_s").vector<2>();
-    l.phase_rad = r.at("phase_rad").vector<2>();
-    l.yaw_mode = read_yaw_mode(r.at("yaw_mode"), false);
-    l.yaw_rad = r.at("yaw_rad").number();
-    return l;
+    return curve(trajectory::LissajousParams(), false, [&r](trajectory::LissajousParams& l) {
+      l.amplitude_m = r.at("amplitude_m").vector<2>();
+      l.period_s = r.at("period_s").vector<2>();
+      l.phase_rad = r.at("phase_rad").vector<2>();
+    });
   }
   if (kind == "figure8") {
-    trajectory::Figure8Params f;
-    start(f.centre_m, f.altitude_m, f.start_s, f.ramp_s);
-    f.amplitude_m = r.at("amplitude_m").vector<2>();
-    f.period_s = r.at("period_s").number();
-    f.yaw_mode = read_yaw_mode(r.at("yaw_mode"), false);
-    f.yaw_rad = r.at("yaw_rad").number();
-    return f;
+    return curve(trajectory::Figure8Params(), false, [&r](trajectory::Figure8Params& f) {
+      f.amplitude_m = r.at("amplitude_m").vector<2>();
+      f.period_s = r.at("period_s").number();
+    });
   }
   if (kind == "waypoints") {
     trajectory::WaypointsSpec w;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <map>
 #include <set>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "fmi/export/fmu_config.hpp"
@@ -45,6 +47,24 @@ FmuConfig unusual() {
   return c;
 }
 
+/// What config_from_json says to `text` as "cfg.json": its FmuError, or "accepted".
+std::string refused(const std::string& text) {
+  try {
+    config_from_json(text, "cfg.json");
+  } catch (const FmuError& e) {
+    return std::string(e.what());
+  }
+  return std::string("accepted");
+}
+
+/// `text` with its first `from` replaced by `to`.
+std::string replaced(std::string text, std::string_view from, std::string_view to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
 TEST(FmuConfig, JsonRoundTripIsExact) {
   const FmuConfig c = unusual();
   const std::string text = to_json(c);
@@ -68,25 +88,12 @@ TEST(FmuConfig, GuidFollowsTheContent) {
 
 TEST(FmuConfig, ErrorsNameTheKey) {
   std::string text = to_json(unusual());
-  auto refused = [](const std::string& t) {
-    try {
-      config_from_json(t, "cfg.json");
-    } catch (const FmuError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_EQ(refused("{"), refused("{")) << "not JSON";
   EXPECT_NE(refused("{").find("cfg.json: not JSON"), std::string::npos);
-  std::string bad = text;
-  bad.replace(bad.find("\"motor.tau_up_s\""), 16, "\"motor.tau_upp\"");
-  EXPECT_EQ(refused(bad), "cfg.json: 'vehicle.motor.tau_up_s' missing");
-  bad = text;
-  bad.replace(bad.find("\"x\""), 3, "\"q\"");
-  EXPECT_EQ(refused(bad), "cfg.json: 'vehicle.layout' is 'q', not one of the choices");
-  bad = text;
-  bad.replace(bad.find("\"controller\""), 12, "\"controllers\"");
-  EXPECT_EQ(refused(bad), "cfg.json: 'controller' missing");
+  EXPECT_EQ(refused(replaced(text, "\"motor.tau_up_s\"", "\"motor.tau_upp\"")),
+            "cfg.json: 'vehicle.motor.tau_up_s' missing");
+  EXPECT_EQ(refused(replaced(text, "\"x\"", "\"q\"")), "cfg.json: 'vehicle.layout' is 'q', not one of the choices");
+  EXPECT_EQ(refused(replaced(text, "\"controller\"", "\"controllers\"")), "cfg.json: 'controller' missing");
 }
 
 TEST(FmuConfig, PlantVariables) {
@@ -222,24 +229,12 @@ TEST(FmuConfig, TrajectoryErrorsNameTheKey) {
   FmuConfig c = unusual();
   c.trajectory = every_kind()[0];
   const std::string text = to_json(c);
-  auto refused = [](const std::string& t) {
-    try {
-      config_from_json(t, "cfg.json");
-    } catch (const FmuError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
-  std::string bad = text;
-  bad.replace(bad.find("\"circle\""), 8, "\"spiral\"");
-  EXPECT_EQ(refused(bad),
+  EXPECT_EQ(refused(replaced(text, "\"circle\"", "\"spiral\"")),
             "cfg.json: 'trajectory.kind' is 'spiral', not circle, lissajous, figure8, waypoints or polynomial");
-  bad = text;
-  bad.replace(bad.find("\"radius_m\": 2.0"), 15, "\"radius_m\": -2.0");
-  EXPECT_EQ(refused(bad), "cfg.json: 'trajectory' is not a valid trajectory: radius must be finite and > 0");
-  bad = text;
-  bad.replace(bad.find("\"centre\""), 8, "\"middle\"");
-  EXPECT_EQ(refused(bad), "cfg.json: 'trajectory.yaw_mode' is 'middle', not fixed, tangent or centre");
+  EXPECT_EQ(refused(replaced(text, "\"radius_m\": 2.0", "\"radius_m\": -2.0")),
+            "cfg.json: 'trajectory' is not a valid trajectory: radius must be finite and > 0");
+  EXPECT_EQ(refused(replaced(text, "\"centre\"", "\"middle\"")),
+            "cfg.json: 'trajectory.yaw_mode' is 'middle', not fixed, tangent or centre");
 }
 
 TEST(FmuConfig, ControllerWithATrajectoryStartsOnIt) {

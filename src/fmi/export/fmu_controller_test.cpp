@@ -18,33 +18,14 @@
 namespace quadcosim::fmi::test {
 namespace {
 
-class Controller {
+class Controller : public Fmi2Instance {
  public:
   /// `external`: sets the parameter ref.external (an FMU with a trajectory) true before initialisation.
-  explicit Controller(const FmuConfig& config, bool external = false) : md_(describe(config)), resources_(config) {
-    callbacks_ = log_.fmi2_callbacks();
-    c_ = QC_FMI(fmi2Instantiate)("controller", fmi2CoSimulation, config.guid.c_str(), resources_.uri().c_str(),
-                                 &callbacks_, fmi2False, fmi2False);
-    if (!c_) throw std::runtime_error("instantiate failed: " + log_.last());
+  explicit Controller(const FmuConfig& config, bool external = false) : Fmi2Instance("controller", config) {
     if (external) {
-      const fmi2ValueReference r = vr(names::kRefExternal);
-      const fmi2Boolean on = fmi2True;
-      EXPECT_EQ(QC_FMI(fmi2SetBoolean)(c_, &r, 1, &on), fmi2OK) << log_.last();
+      EXPECT_EQ(set_boolean(names::kRefExternal, true), fmi2OK) << log_.last();
     }
-    EXPECT_EQ(QC_FMI(fmi2SetupExperiment)(c_, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK) << log_.last();
-    EXPECT_EQ(QC_FMI(fmi2EnterInitializationMode)(c_), fmi2OK) << log_.last();
-    EXPECT_EQ(QC_FMI(fmi2ExitInitializationMode)(c_), fmi2OK) << log_.last();
-  }
-  ~Controller() { QC_FMI(fmi2FreeInstance)(c_); }
-  fmi2ValueReference vr(std::string_view name) const {
-    for (const Variable& v : md_.variables) {
-      if (v.name == name) return v.vr;
-    }
-    throw std::runtime_error("no variable " + std::string(name));
-  }
-  fmi2Status set(std::string_view name, double value) {
-    const fmi2ValueReference r = vr(name);
-    return QC_FMI(fmi2SetReal)(c_, &r, 1, &value);
+    init();
   }
   template <std::size_t N, class V>
   void set_all(const std::array<std::string_view, N>& names, const V& values) {
@@ -62,21 +43,9 @@ class Controller {
   }
   model::Vector4 command() {
     model::Vector4 w;
-    for (int i = 0; i < 4; ++i) {
-      const fmi2ValueReference r = vr(names::kOmegaCmd[static_cast<std::size_t>(i)]);
-      EXPECT_EQ(QC_FMI(fmi2GetReal)(c_, &r, 1, &w[i]), fmi2OK) << log_.last();
-    }
+    for (int i = 0; i < 4; ++i) w[i] = get(names::kOmegaCmd[static_cast<std::size_t>(i)]);
     return w;
   }
-  fmi2Status step(double t, double h) { return QC_FMI(fmi2DoStep)(c_, t, h, fmi2True); }
-
-  fmi2Component c_ = nullptr;
-  Log log_;
-
- private:
-  ModelDescription md_;
-  Resources resources_;
-  fmi2CallbackFunctions callbacks_{};
 };
 
 FmuConfig altitude_step() {

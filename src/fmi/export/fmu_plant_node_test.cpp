@@ -73,18 +73,11 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
   const bool extra = c.realism.extra_sensors.any();
   auto commands = transport.advertise<msg::Float64MultiArray>(topics.motor_commands);
 
-  Resources resources(c);
-  Log log;
-  fmi2CallbackFunctions cb = log.fmi2_callbacks();
-  fmi2Component fmu = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, c.guid.c_str(), resources.uri().c_str(), &cb,
-                                              fmi2False, fmi2False);
-  ASSERT_NE(fmu, nullptr) << log.last();
-  const fmi2ValueReference noise = vr_of(c, "realism.sensor_noise");
-  const fmi2Boolean noise_on = sensor_noise ? fmi2True : fmi2False;
-  ASSERT_EQ(QC_FMI(fmi2SetBoolean)(fmu, &noise, 1, &noise_on), fmi2OK) << log.last();
-  ASSERT_EQ(QC_FMI(fmi2SetupExperiment)(fmu, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
-  ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(fmu), fmi2OK);
-  ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(fmu), fmi2OK) << log.last();
+  Fmi2Instance plant("plant", c);
+  const fmi2Component fmu = plant.c_;
+  const Log& log = plant.log_;
+  ASSERT_EQ(plant.set_boolean("realism.sensor_noise", sensor_noise), fmi2OK) << log.last();
+  ASSERT_NO_FATAL_FAILURE(plant.init());
 
   std::vector<fmi2ValueReference> outputs, cmd_vrs;
   for (auto names : {names::kPosition, names::kVelocity, names::kRates, names::kSpecificForce}) {
@@ -161,7 +154,6 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
     node.integrate(k);
   }
   EXPECT_GT(std::abs(node.state().p_W.x()), 0.01);  // the wind moved it
-  QC_FMI(fmi2FreeInstance)(fmu);
 }
 
 TEST(FmuPlantNode, SensorNoiseLeftToTheMasterKeepsTheTrueStateOfANoisyNode) {
@@ -183,17 +175,11 @@ TEST(FmuPlantNode, SensorNoiseLeftToTheMasterKeepsTheTrueStateOfANoisyNode) {
   o.realism = c.realism;
   sim::PlantNode node(transport, topics, c.vehicle, o, c.initial);
 
-  Resources resources(c);
-  Log log;
-  fmi2CallbackFunctions cb = log.fmi2_callbacks();
-  fmi2Component fmu = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, c.guid.c_str(), resources.uri().c_str(), &cb,
-                                              fmi2False, fmi2False);
-  ASSERT_NE(fmu, nullptr) << log.last();
-  const fmi2ValueReference noise = vr_of(c, "realism.sensor_noise");
-  const fmi2Boolean off = fmi2False;
-  ASSERT_EQ(QC_FMI(fmi2SetBoolean)(fmu, &noise, 1, &off), fmi2OK) << log.last();
-  ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(fmu), fmi2OK);
-  ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(fmu), fmi2OK) << log.last();
+  Fmi2Instance plant("plant", c);
+  const fmi2Component fmu = plant.c_;
+  const Log& log = plant.log_;
+  ASSERT_EQ(plant.set_boolean("realism.sensor_noise", false), fmi2OK) << log.last();
+  ASSERT_NO_FATAL_FAILURE(plant.init(/*setup_experiment=*/false));
   std::vector<fmi2ValueReference> vrs;
   for (auto names : {names::kPosition, names::kVelocity, names::kRates}) {
     for (auto n : names) vrs.push_back(vr_of(c, n));
@@ -218,7 +204,6 @@ TEST(FmuPlantNode, SensorNoiseLeftToTheMasterKeepsTheTrueStateOfANoisyNode) {
     node.integrate(k);
   }
   EXPECT_GT(node.state().p_W.z(), 1.1);  // it climbed on the initial speeds
-  QC_FMI(fmi2FreeInstance)(fmu);
 }
 
 TEST(FmuPlantNode, WindGustsFaultsAndDragGiveThePlantNodesNumbers) {

@@ -16,51 +16,14 @@ namespace quadcosim::fmi::test {
 namespace {
 
 /// One FMI 2 plant instance, instantiated and (by default) initialised.
-class Plant {
+class Plant : public Fmi2Instance {
  public:
-  explicit Plant(const FmuConfig& config, bool initialise = true) : md_(describe(config)), resources_(config) {
-    callbacks_ = log_.fmi2_callbacks();
-    c_ = QC_FMI(fmi2Instantiate)("plant", fmi2CoSimulation, config.guid.c_str(), resources_.uri().c_str(), &callbacks_,
-                                 fmi2False, fmi2False);
-    if (!c_) throw std::runtime_error("instantiate failed: " + log_.last());
+  explicit Plant(const FmuConfig& config, bool initialise = true) : Fmi2Instance("plant", config) {
     if (initialise) init();
-  }
-  ~Plant() {
-    if (c_) QC_FMI(fmi2FreeInstance)(c_);
-  }
-  void init() {
-    ASSERT_EQ(QC_FMI(fmi2SetupExperiment)(c_, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK) << log_.last();
-    ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(c_), fmi2OK) << log_.last();
-    ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(c_), fmi2OK) << log_.last();
-  }
-  fmi2ValueReference vr(std::string_view name) const {
-    for (const Variable& v : md_.variables) {
-      if (v.name == name) return v.vr;
-    }
-    throw std::runtime_error("no variable " + std::string(name));
-  }
-  fmi2Status set(std::string_view name, double value) {
-    const fmi2ValueReference r = vr(name);
-    return QC_FMI(fmi2SetReal)(c_, &r, 1, &value);
-  }
-  double get(std::string_view name) {
-    const fmi2ValueReference r = vr(name);
-    double value = std::numeric_limits<double>::quiet_NaN();
-    EXPECT_EQ(QC_FMI(fmi2GetReal)(c_, &r, 1, &value), fmi2OK) << log_.last();
-    return value;
   }
   void command(const model::Vector4& omega) {
     for (int i = 0; i < 4; ++i) ASSERT_EQ(set(names::kOmegaCmd[static_cast<std::size_t>(i)], omega[i]), fmi2OK);
   }
-  fmi2Status step(double t, double h) { return QC_FMI(fmi2DoStep)(c_, t, h, fmi2True); }
-
-  fmi2Component c_ = nullptr;
-  Log log_;
-
- private:
-  ModelDescription md_;
-  Resources resources_;
-  fmi2CallbackFunctions callbacks_{};
 };
 
 /// The FMU's outputs equal `y` (and euler, omega from `x`) bit for bit.

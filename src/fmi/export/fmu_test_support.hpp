@@ -8,9 +8,11 @@
 #include <cstdarg>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fmi/api/fmi2.h"
@@ -82,6 +84,61 @@ struct Log {
     static_cast<Log*>(env)->lines.push_back(std::to_string(status) + " " + category + ": " + message);
   }
   fmi2CallbackFunctions fmi2_callbacks() { return {&fmi2_logger, nullptr, nullptr, nullptr, this}; }
+};
+
+/// One FMI 2 co-simulation instance of the FMU binary with `config` in a temporary resources folder,
+/// what it logs in log_; freed with this.
+class Fmi2Instance {
+ public:
+  Fmi2Instance(const char* instance_name, const FmuConfig& config) : md_(describe(config)), resources_(config) {
+    callbacks_ = log_.fmi2_callbacks();
+    c_ = QC_FMI(fmi2Instantiate)(instance_name, fmi2CoSimulation, config.guid.c_str(), resources_.uri().c_str(),
+                                 &callbacks_, fmi2False, fmi2False);
+    if (!c_) throw std::runtime_error("instantiate failed: " + log_.last());
+  }
+  ~Fmi2Instance() { QC_FMI(fmi2FreeInstance)(c_); }
+  Fmi2Instance(const Fmi2Instance&) = delete;
+  Fmi2Instance& operator=(const Fmi2Instance&) = delete;
+
+  /// fmi2SetupExperiment (unless `setup_experiment` is false: an importer may leave it out), then
+  /// fmi2EnterInitializationMode and fmi2ExitInitializationMode, each asserted fmi2OK.
+  void init(bool setup_experiment = true) {
+    if (setup_experiment) {
+      ASSERT_EQ(QC_FMI(fmi2SetupExperiment)(c_, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK) << log_.last();
+    }
+    ASSERT_EQ(QC_FMI(fmi2EnterInitializationMode)(c_), fmi2OK) << log_.last();
+    ASSERT_EQ(QC_FMI(fmi2ExitInitializationMode)(c_), fmi2OK) << log_.last();
+  }
+  fmi2ValueReference vr(std::string_view name) const {
+    for (const Variable& v : md_.variables) {
+      if (v.name == name) return v.vr;
+    }
+    throw std::runtime_error("no variable " + std::string(name));
+  }
+  fmi2Status set(std::string_view name, double value) {
+    const fmi2ValueReference r = vr(name);
+    return QC_FMI(fmi2SetReal)(c_, &r, 1, &value);
+  }
+  fmi2Status set_boolean(std::string_view name, bool value) {
+    const fmi2ValueReference r = vr(name);
+    const fmi2Boolean b = value ? fmi2True : fmi2False;
+    return QC_FMI(fmi2SetBoolean)(c_, &r, 1, &b);
+  }
+  double get(std::string_view name) {
+    const fmi2ValueReference r = vr(name);
+    double value = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(QC_FMI(fmi2GetReal)(c_, &r, 1, &value), fmi2OK) << log_.last();
+    return value;
+  }
+  fmi2Status step(double t, double h) { return QC_FMI(fmi2DoStep)(c_, t, h, fmi2True); }
+
+  fmi2Component c_ = nullptr;
+  Log log_;
+
+ private:
+  ModelDescription md_;
+  Resources resources_;
+  fmi2CallbackFunctions callbacks_{};
 };
 
 /// The value reference of `name` in the description of `config`.

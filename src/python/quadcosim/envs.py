@@ -298,7 +298,30 @@ def _env_kwargs(kind: str, scenario, trajectory, target, max_episode_steps, max_
                 termination_penalty=termination_penalty, randomize=randomize)
 
 
-class _Env:
+class _BatchEnv:
+    """What _Env and _VectorEnv share: the Batch they step and Gymnasium's unwrapped, close and
+    context-manager contract."""
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def batch(self) -> Batch:
+        """The Batch the env steps (its vehicles' state, sensors, vehicle parameters)."""
+        return self._e.batch
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *args):
+        self.close()
+
+
+class _Env(_BatchEnv):
     """One vehicle (a Batch of 1): Gymnasium's Env contract."""
 
     metadata: Dict[str, Any] = {"render_modes": []}
@@ -311,15 +334,6 @@ class _Env:
         self.action_space = self._e.action_space
         self.np_random = np.random.default_rng()
         self._target_option = None
-
-    @property
-    def unwrapped(self):
-        return self
-
-    @property
-    def batch(self) -> Batch:
-        """The Batch of one vehicle the env steps (its state, sensors, vehicle parameters)."""
-        return self._e.batch
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None):
         """Starts an episode: the scenario's initial state, a fresh noise seed and (with randomize) new
@@ -366,15 +380,6 @@ class _Env:
     def render(self):
         return None
 
-    def close(self):
-        pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *args):
-        self.close()
-
 
 class HoverEnv(_Env):
     """Hold a position with the four rotor speeds (see the module's docstring for spaces, reward, termination).
@@ -419,7 +424,7 @@ class TrackingEnv(_Env):
                                                    max_rate_rad_s, reward_weights, termination_penalty, randomize))
 
 
-class _VectorEnv:
+class _VectorEnv(_BatchEnv):
     """n sub-envs on one Batch: Gymnasium's VectorEnv contract, auto-reset included.
 
     autoreset_mode "next_step" (Gymnasium 1.x's default, AutoresetMode.NEXT_STEP): the step after a
@@ -449,14 +454,6 @@ class _VectorEnv:
         self.action_space = Box(-1.0, 1.0, (self.num_envs, ACTION_SIZE), dtype=a.dtype)
         self._rngs = [np.random.default_rng() for _ in range(self.num_envs)]
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
-
-    @property
-    def unwrapped(self):
-        return self
-
-    @property
-    def batch(self) -> Batch:
-        return self._e.batch
 
     def reset(self, *, seed: Any = None, options: Optional[Dict[str, Any]] = None):
         """Resets every sub-env (or those of options["reset_mask"]). seed: an int s seeds sub-env i with
@@ -515,15 +512,6 @@ class _VectorEnv:
 
     def _info(self, crashed: np.ndarray, out: np.ndarray) -> Dict[str, np.ndarray]:
         return {"t": self._e.batch.t, "crashed": crashed, "out_of_bounds": out}
-
-    def close(self):
-        pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *args):
-        self.close()
 
 
 class VectorHoverEnv(_VectorEnv):
