@@ -146,6 +146,7 @@ void full_angular_acceleration(const RigidInputs& in, double wx, double wy, doub
 /// cross() forms it, times 1/I (a product, not a division: shorter latency on every RK4 stage), or
 /// with the whole tensor (full_angular_acceleration) when there are products of inertia;
 /// ground contact; dq/dt = 1/2 q (x) (0, w).
+template <bool kFullInertia>
 inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, double* __restrict d) {
   bool held = false;
   const Eigen::Vector3d a = linear_acceleration(y, in, held);
@@ -153,7 +154,7 @@ inline void rigid_derivative(const double* __restrict y, const RigidInputs& in, 
   const double wx = y[10], wy = y[11], wz = y[12];
   double tau_x = in.torque_B[0], tau_y = in.torque_B[1], tau_z = in.torque_B[2];
   double dwx, dwy, dwz;
-  if (in.full_inertia) {
+  if constexpr (kFullInertia) {
     full_angular_acceleration(in, wx, wy, wz, tau_x, tau_y, tau_z, dwx, dwy, dwz);
   } else {
     if (in.gyroscopic) {
@@ -252,13 +253,13 @@ Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInp
   return in;
 }
 
-template <bool kVaryingInputs, bool kRotorLag>
+template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
 void Quadrotor::stage_derivative(const double* __restrict y, const RotorInput& cmd, const Environment* env,
                                  const RigidInputs& held_inputs, double* __restrict d) const {
   if constexpr (kVaryingInputs) {
-    rigid_derivative(y, varying_inputs(y, cmd, env), d);
+    rigid_derivative<kFullInertia>(y, varying_inputs(y, cmd, env), d);
   } else {
-    rigid_derivative(y, held_inputs, d);
+    rigid_derivative<kFullInertia>(y, held_inputs, d);
   }
   if constexpr (kRotorLag) {  // first-order lag towards the command, its own time constant each way
     for (int i = 0; i < 4; ++i) {
@@ -269,7 +270,7 @@ void Quadrotor::stage_derivative(const double* __restrict y, const RotorInput& c
   }
 }
 
-template <bool kVaryingInputs, bool kRotorLag>
+template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
 [[gnu::always_inline]] inline void Quadrotor::integrate(State& x, const RotorInput& cmd, double h, int substeps,
                                                         const Environment* env) const {
   constexpr int n = kRotorLag ? kWithRotors : kRigid;  // ideal rotors: their speeds are the command
@@ -279,13 +280,13 @@ template <bool kVaryingInputs, bool kRotorLag>
   const RigidInputs held_inputs = kVaryingInputs ? RigidInputs{} : rigid_inputs(cmd.wrench);
   double k1[n], k2[n], k3[n], k4[n], y[n];
   for (int s = 0; s < substeps; ++s) {
-    stage_derivative<kVaryingInputs, kRotorLag>(r, cmd, env, held_inputs, k1);
+    stage_derivative<kVaryingInputs, kRotorLag, kFullInertia>(r, cmd, env, held_inputs, k1);
     for (int i = 0; i < n; ++i) y[i] = r[i] + (0.5 * h) * k1[i];
-    stage_derivative<kVaryingInputs, kRotorLag>(y, cmd, env, held_inputs, k2);
+    stage_derivative<kVaryingInputs, kRotorLag, kFullInertia>(y, cmd, env, held_inputs, k2);
     for (int i = 0; i < n; ++i) y[i] = r[i] + (0.5 * h) * k2[i];
-    stage_derivative<kVaryingInputs, kRotorLag>(y, cmd, env, held_inputs, k3);
+    stage_derivative<kVaryingInputs, kRotorLag, kFullInertia>(y, cmd, env, held_inputs, k3);
     for (int i = 0; i < n; ++i) y[i] = r[i] + h * k3[i];
-    stage_derivative<kVaryingInputs, kRotorLag>(y, cmd, env, held_inputs, k4);
+    stage_derivative<kVaryingInputs, kRotorLag, kFullInertia>(y, cmd, env, held_inputs, k4);
     for (int i = 0; i < n; ++i) r[i] = r[i] + h * ((k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) * (1.0 / 6.0));
     end_substep(r);
   }
@@ -306,10 +307,16 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
   pack(x, lag, y);
   if (!lag) {
     input.wrench = wrench(cmd);
-    stage_derivative<true, false>(y, input, env, RigidInputs{}, r);
+    if (full_inertia_) {
+      stage_derivative<true, false, true>(y, input, env, RigidInputs{}, r);
+    } else {
+      stage_derivative<true, false, false>(y, input, env, RigidInputs{}, r);
+    }
     for (int i = 0; i < 4; ++i) r[13 + i] = 0.0;
+  } else if (full_inertia_) {
+    stage_derivative<true, true, true>(y, input, env, RigidInputs{}, r);
   } else {
-    stage_derivative<true, true>(y, input, env, RigidInputs{}, r);
+    stage_derivative<true, true, false>(y, input, env, RigidInputs{}, r);
   }
   StateDerivative d;
   d.p_W = {r[0], r[1], r[2]};
@@ -364,12 +371,21 @@ void Quadrotor::step(State& x, double /*t_s*/, const RotorInput& input, double d
   // One integrator, compiled for what varies over a step's stages: nothing for ideal motors without
   // an Environment (the rotors' wrench was formed with the command), the wrench and drag at each
   // stage's state otherwise, and the rotor speeds too for a lagging motor.
-  if (params_.motor.model == MotorModel::kFirstOrder) {
-    integrate<true, true>(x, input, h, substeps, env);
+  // A body with products of inertia takes the whole tensor (a path of its own, so that the paper's
+  // diagonal one is compiled as before).
+  const bool lag = params_.motor.model == MotorModel::kFirstOrder;
+  if (full_inertia_) {
+    if (lag) {
+      integrate<true, true, true>(x, input, h, substeps, env);
+    } else {
+      integrate<true, false, true>(x, input, h, substeps, env);
+    }
+  } else if (lag) {
+    integrate<true, true, false>(x, input, h, substeps, env);
   } else if (env) {
-    integrate<true, false>(x, input, h, substeps, env);
+    integrate<true, false, false>(x, input, h, substeps, env);
   } else {
-    integrate<false, false>(x, input, h, substeps, nullptr);
+    integrate<false, false, false>(x, input, h, substeps, nullptr);
   }
 }
 

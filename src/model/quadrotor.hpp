@@ -114,11 +114,11 @@ class Quadrotor {
   /// acceleration. Without either, the command's own wrench (RotorInput) is used instead.
   RigidInputs varying_inputs(const double* y, const RotorInput& cmd, const Environment* env) const;
   /// dy/dt at the packed state y; `held_inputs` are used when kVaryingInputs is false.
-  template <bool kVaryingInputs, bool kRotorLag>
+  template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
   void stage_derivative(const double* y, const RotorInput& cmd, const Environment* env, const RigidInputs& held_inputs,
                         double* d) const;
   /// The RK4 integrator of step(): `substeps` steps of h on x packed into plain doubles.
-  template <bool kVaryingInputs, bool kRotorLag>
+  template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
   void integrate(State& x, const RotorInput& cmd, double h, int substeps, const Environment* env) const;
   /// The specific force at x in the world frame, a_W - g_W (Outputs::specific_force_B rotated).
   template <bool kVaryingInputs>
