@@ -5,7 +5,7 @@
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
-#include "io/recording.hpp"
+#include "hosts/recording.hpp"
 #include "io/scenario.hpp"
 #include "io/trajectory_csv.hpp"
 #include "model/quadrotor.hpp"
@@ -55,9 +55,9 @@ int openloop_command(const OpenloopOptions& opt) {
   const model::Environment* still_air = vehicle.aero.active() ? &idle : nullptr;
   model::State x = plant.initial_state({0.0, 0.0, opt.initial_z_m}, 0.0, false);
   try {
-    io::RecordingOptions ro;
+    hosts::RecordingOptions ro;
     ro.csv = opt.out;
-    io::Recording recording = io::make_recording(ro, nullptr);
+    io::Recording recording = hosts::make_recording(ro, nullptr);
     std::size_t next = 0;
     Eigen::Vector4d cmd = Eigen::Vector4d::Zero();  // rotors stopped until the first row
     for (sim::Tick k = 0; k <= last_tick; ++k) {

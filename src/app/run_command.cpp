@@ -13,7 +13,6 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
-#include <thread>
 
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
@@ -199,27 +198,14 @@ int run_command(const RunOptions& opt, const io::ScenarioResolvers& resolvers) {
     } else {
       hosts::install_stop_handlers();
       Progress progress(sc.simulation.plant.clock.seconds(sc.simulation.duration_ticks));
-      // --foxglove: served from the simulation's transport; --foxglove-pace holds each tick back
-      // until its time on the wall clock (scaled), so a viewer sees the run as it would fly.
-      std::unique_ptr<foxglove::Server> fox;
-      std::chrono::steady_clock::time_point paced_from;
-      const auto attach = [&](sim::Transport& transport, const sim::Topics& topics) {
-        fox = hosts::start_foxglove(opt.foxglove, "run", transport, topics, sc);
-        if (fox) hosts::wait_for_foxglove_client(opt.foxglove, "run", *fox);
-        paced_from = std::chrono::steady_clock::now();
-      };
+      // --foxglove: one more of the run's recorders (hosts/recording.hpp), served from the
+      // simulation's transport; --foxglove-pace holds each tick back until its time on the wall clock.
       const auto on_tick = [&](double t_s) {
         progress.update(t_s);
-        if (opt.foxglove.pace > 0.0) {
-          std::this_thread::sleep_until(paced_from + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                         std::chrono::duration<double>(t_s / opt.foxglove.pace)));
-        }
         return hosts::stop_requested();
       };
       const bool completed = hosts::fly_inprocess(
-          sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); },
-          opt.foxglove.listen.empty() ? nullptr : std::function(attach));
-      if (fox) hosts::finish_foxglove(opt.foxglove, "run", *fox);
+          sc, out, std::cout, std::cerr, on_tick, [&] { progress.done(); }, opt.foxglove);
       io::add_provenance_to_bag_metadata(out, provenance);
       if (!completed) {
         // Everything recorded so far stays valid: the CSV is flushed, the MCAP file finished.

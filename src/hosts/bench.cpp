@@ -26,10 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 void note(const std::string& s) { std::cerr << "bench: " << s << std::endl; }
 
 double baseline_rtf(const io::Scenario& sc, double sim_s) {

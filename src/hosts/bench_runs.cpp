@@ -19,11 +19,11 @@ namespace quadcosim::hosts {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+namespace {
 
 nlohmann::json read_json(const fs::path& p) {
   std::ifstream f(p);

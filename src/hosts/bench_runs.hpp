@@ -2,6 +2,7 @@
 // docs/performance.md).
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -9,6 +10,9 @@
 #include "io/scenario.hpp"
 
 namespace quadcosim::hosts {
+
+/// Wall-clock seconds from `t0` to now.
+double seconds_since(std::chrono::steady_clock::time_point t0);
 
 /// One vehicle in-process (any controller) for sim_s simulated seconds, recording off [x real time].
 double inproc_rtf(const io::Scenario& sc, double sim_s);

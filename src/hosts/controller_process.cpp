@@ -17,9 +17,9 @@
 #include "dds/peer_pairing.hpp"
 #include "drivers/controller_drivers.hpp"
 #include "hosts/exit_code.hpp"
-#include "hosts/foxglove_serving.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/parameter_binding.hpp"
+#include "hosts/recording.hpp"
 #include "hosts/signals.hpp"
 #include "isolation/child.hpp"
 #include "sim/controller_node.hpp"
@@ -86,7 +86,11 @@ int run_controller_process(const ControllerProcessOptions& o, io::Scenario sc,
   dds::ParameterServer parameters(transport, ros_name, controller_parameter_callbacks(node));
   if (!o.apply_schedule) sc.schedule.clear();
   // After the node's own readers, so a plant that counts this process's readers finds the node's first.
-  std::unique_ptr<foxglove::Server> fox = start_foxglove(o.foxglove, "controller", transport, topics, sc);
+  // --foxglove: the controller's one recorder (it has no plant ticks: only built and finished).
+  RecordingOptions ro(io::RecordingOptions::for_run(sc));
+  ro.foxglove = o.foxglove;
+  ro.who = "controller";
+  io::Recording recording = make_recording(ro, &transport);
   dds::NodeAnnouncer announcer(transport.participant().handle(), ros_name.name, ros_name.ns);
   announcer.announce();  // after every endpoint exists: `ros2 node list` shows /attitude_controller
   std::cerr << fmt::format("controller: domain {}, namespace {}, {} mode, period {} s, controller {}\n",
@@ -146,7 +150,7 @@ int run_controller_process(const ControllerProcessOptions& o, io::Scenario sc,
                              node.foreign_samples());
   }
   std::cerr << "controller: stopped\n";
-  if (fox) finish_foxglove(o.foxglove, "controller", *fox);
+  recording.finish(true);
   return exit_code::kOk;
 }
 

@@ -6,10 +6,12 @@
 #include <charconv>
 #include <chrono>
 #include <iostream>
+#include <thread>
 
 #include "foxglove/topic_tap.hpp"
 #include "hosts/signals.hpp"
 #include "io/scenario.hpp"
+#include "sim/topics.hpp"
 
 namespace quadcosim::hosts {
 
@@ -37,10 +39,9 @@ std::string parse_listen(const std::string& text, std::string& address, std::uin
   return "";
 }
 
-std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveOptions& o, const std::string& who,
-                                                 sim::Transport& transport, const sim::Topics& topics,
-                                                 const io::Scenario& sc) {
-  if (o.listen.empty()) return nullptr;
+FoxgloveRecording::FoxgloveRecording(const FoxgloveOptions& o, const std::string& who, const io::RecordingOptions& ro,
+                                     sim::Transport& bus)
+    : o_(o), who_(who) {
   foxglove::ServerOptions so;
   if (std::string err = parse_listen(o.listen, so.address, so.port); !err.empty()) {
     throw io::ConfigError("--foxglove " + err);
@@ -56,22 +57,32 @@ std::unique_ptr<foxglove::Server> start_foxglove(const FoxgloveOptions& o, const
           origin));
   }
   so.allowed_origins = o.allow_origins;
-  auto server = std::make_unique<foxglove::Server>(so);
-  foxglove::serve_vehicle_topics(*server, transport, topics);
-  foxglove::serve_sensor_topics(*server, transport, sc.simulation.ns, sc.simulation.plant.realism.extra_sensors);
-  // As the recorders of run.mcap do (app/inprocess_run.cpp, the plant's --mcap): the vehicle drawn
-  // where its plant publishes its /tf.
-  if (sc.simulation.plant.publish_tf)
-    foxglove::serve_vehicle_description(*server, sc.vehicle, sc.simulation.ns, sc.simulation.plant.clock.ns(0));
-  server->start();
+  server_ = std::make_unique<foxglove::Server>(so);
+  foxglove::serve_vehicle_topics(*server_, bus, sim::Topics::for_namespace(ro.ns));
+  if (ro.sensors) foxglove::serve_sensor_topics(*server_, bus, ro.ns, *ro.sensors);
+  // As run.mcap records it (io::McapRecording): the vehicle drawn where its plant publishes its /tf.
+  if (ro.vehicle) foxglove::serve_vehicle_description(*server_, *ro.vehicle, ro.ns, ro.start_ns);
+  server_->start();
   const bool v6 = so.address.find(':') != std::string::npos;
   std::cerr << fmt::format("{}: foxglove: serving ws://{}{}{}:{}\n", who, v6 ? "[" : "", so.address, v6 ? "]" : "",
-                           server->port())
+                           server_->port())
             << std::flush;
-  return server;
+  wait_for_client();
+  paced_from_ = std::chrono::steady_clock::now();
 }
 
-void wait_for_foxglove_client(const FoxgloveOptions& o, const std::string& who, foxglove::Server& server) {
+void FoxgloveRecording::tick(const sim::RecordedTick& t) {
+  // --foxglove-pace: the run at this many times real time, so a viewer sees it as it would fly.
+  if (o_.pace > 0.0) {
+    std::this_thread::sleep_until(paced_from_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                    std::chrono::duration<double>(t.t_s / o_.pace)));
+  }
+}
+
+void FoxgloveRecording::wait_for_client() {
+  const FoxgloveOptions& o = o_;
+  const std::string& who = who_;
+  foxglove::Server& server = *server_;
   if (o.wait_s <= 0.0) return;
   std::cerr << fmt::format("{}: foxglove: waiting up to {:g} s for a client to subscribe\n", who, o.wait_s)
             << std::flush;
@@ -107,7 +118,12 @@ void wait_for_foxglove_client(const FoxgloveOptions& o, const std::string& who, 
   }
 }
 
-void finish_foxglove(const FoxgloveOptions& o, const std::string& who, foxglove::Server& server) {
+void FoxgloveRecording::finish(bool) {
+  if (finished_) return;
+  finished_ = true;
+  const FoxgloveOptions& o = o_;
+  const std::string& who = who_;
+  foxglove::Server& server = *server_;
   if (o.linger_s > 0.0 && !stop_requested()) {
     std::cerr << fmt::format("{}: foxglove: run ended; serving its last state for {:g} s (Ctrl-C ends)\n", who,
                              o.linger_s)

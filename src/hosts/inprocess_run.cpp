@@ -4,9 +4,9 @@
 
 #include <fstream>
 
+#include "hosts/recording.hpp"
 #include "hosts/signals.hpp"
 #include "io/provenance.hpp"
-#include "io/recording.hpp"
 #include "sim/simulation.hpp"
 
 namespace quadcosim::hosts {
@@ -15,14 +15,14 @@ namespace fs = std::filesystem;
 
 bool fly_inprocess(const io::Scenario& sc, const fs::path& out, std::ostream& info, std::ostream& warn,
                    const std::function<bool(double t_s)>& on_tick, const std::function<void()>& on_end,
-                   const std::function<void(sim::Transport&, const sim::Topics&)>& attach) {
+                   const FoxgloveOptions& foxglove) {
   struct Stopped {};
   sim::Simulation simulation(sc.simulation, sc.vehicle, io::initial_state(sc), sc.controller, sc.schedule);
-  io::RecordingOptions ro = io::RecordingOptions::for_run(sc);
+  RecordingOptions ro(io::RecordingOptions::for_run(sc));
   ro.csv = (out / "trajectory.csv").string();
   ro.mcap = (out / "run.mcap").string();
-  io::Recording recording = io::make_recording(ro, &simulation.transport());
-  if (attach) attach(simulation.transport(), sim::Topics::for_namespace(sc.simulation.ns));
+  ro.foxglove = foxglove;
+  io::Recording recording = make_recording(ro, &simulation.transport());
   bool watchdog = false;
   bool completed = true;
   std::exception_ptr failure;  // a step that failed (a foreign one crashed): rethrown once the files are finished

@@ -11,10 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "hosts/node_options.hpp"
 #include "io/scenario.hpp"
 #include "io/step_report.hpp"
-#include "sim/topics.hpp"
-#include "sim/transport.hpp"
 
 namespace quadcosim::hosts {
 
@@ -23,14 +22,13 @@ namespace quadcosim::hosts {
 /// watchdog, injected-fault and command-rejection counts to `info` at the end. `on_tick`, when set, is
 /// called with each recorded tick's time [s]; when it returns true the run stops there (what ran stays
 /// recorded: the CSV flushed, the MCAP file finished) and fly_inprocess returns false. `on_end`, when set,
-/// is called after the last tick of a completed run, before the counts are written. `attach`, when set,
-/// is called with the simulation's transport and topics before the first tick (after the recorder
-/// subscribed), e.g. to serve the topics live. Throws std::invalid_argument when the controller refuses
-/// a scheduled parameter, std::runtime_error on I/O.
+/// is called after the last tick of a completed run, before the recordings finish and the counts are written.
+/// `foxglove`: with `listen` set, the run's topics are also served live (one more recorder: hosts/recording.hpp; it
+/// waits for a client, paces and lingers as asked). Throws std::invalid_argument when the controller refuses a
+/// scheduled parameter, std::runtime_error on I/O (io::ConfigError for a bad --foxglove).
 bool fly_inprocess(const io::Scenario& scenario, const std::filesystem::path& out, std::ostream& info,
                    std::ostream& warn, const std::function<bool(double t_s)>& on_tick = {},
-                   const std::function<void()>& on_end = {},
-                   const std::function<void(sim::Transport&, const sim::Topics&)>& attach = {});
+                   const std::function<void()>& on_end = {}, const FoxgloveOptions& foxglove = {});
 
 /// A run's figures and verdicts, judged from its recorded trajectory.csv.
 struct RunJudgement {

@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "hosts/foxglove_serving.hpp"
 #include "hosts/plant_process_class.hpp"
+#include "hosts/recording.hpp"
 #include "hosts/signals.hpp"
 #include "sim/sensor_wire.hpp"
 
@@ -74,11 +74,12 @@ PlantProcess::PlantProcess(const PlantProcessOptions& o, io::Scenario sc)
                                                             status_ = m;
                                                             have_status_ = true;
                                                           });
-  io::RecordingOptions ro = io::RecordingOptions::for_run(sc_);
+  RecordingOptions ro(io::RecordingOptions::for_run(sc_));
   ro.csv = o_.one_vehicle.record;
   ro.mcap = o_.one_vehicle.mcap;
-  recording_ = io::make_recording(ro, &transport_);
-  foxglove_ = start_foxglove(o_.foxglove, "plant", transport_, topics_, sc_);
+  ro.foxglove = o_.foxglove;
+  ro.who = "plant";
+  recording_ = make_recording(ro, &transport_);
   if (!o_.one_vehicle.schedule_node.empty()) {
     scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
                                                         dds::parse_node_name(o_.one_vehicle.schedule_node));
@@ -104,7 +105,6 @@ int PlantProcess::run() {
   const int rc = o_.lockstep ? run_lockstep() : run_realtime();
   finish(rc);
   if (rc == kExitOk) report();
-  if (foxglove_) finish_foxglove(o_.foxglove, "plant", *foxglove_);
   if (rc != kExitOk) return rc;
   return stop_requested() ? kExitInterrupted : kExitOk;
 }

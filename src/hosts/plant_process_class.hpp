@@ -17,7 +17,6 @@
 #include "dds/peer_pairing.hpp"
 #include "drivers/lockstep_plant_driver.hpp"
 #include "drivers/realtime_plant_driver.hpp"
-#include "foxglove/server.hpp"
 #include "hosts/exit_code.hpp"
 #include "hosts/node_common.hpp"
 #include "hosts/node_options.hpp"
@@ -46,7 +45,7 @@ class PlantProcess {
 
   /// Readers of this process's own on each topic (the recorder's, the Foxglove server's): matched
   /// counts include them.
-  int own_readers() const { return (recording_.mcap() ? 1 : 0) + (foxglove_ ? 1 : 0); }
+  int own_readers() const { return (recording_.mcap() ? 1 : 0) + (o_.foxglove.listen.empty() ? 0 : 1); }
 
   using Guid = std::array<std::uint8_t, 16>;
 
@@ -162,9 +161,8 @@ class PlantProcess {
   dds::NodeAnnouncer announcer_;
   msg::ControllerStatus status_;
   bool have_status_ = false;
-  io::Recording recording_;  ///< trajectory.csv (--record) and run.mcap (--mcap), as asked
-  // Served from the transport's deliveries, like the recorder; stopped at the end of run().
-  std::unique_ptr<foxglove::Server> foxglove_;
+  /// trajectory.csv (--record), run.mcap (--mcap) and the live view (--foxglove), as asked
+  io::Recording recording_;
   std::unique_ptr<dds::ParameterClient> scheduler_;
   std::vector<sim::ScheduledParameter>::const_iterator next_event_;
   bool watchdog_logged_ = false;

@@ -11,8 +11,8 @@
 
 #include "dds/dds_transport.hpp"
 #include "hosts/exit_code.hpp"
+#include "hosts/recording.hpp"
 #include "hosts/signals.hpp"
-#include "io/recording.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::hosts {
@@ -38,12 +38,12 @@ int run_recorder(const RecorderOptions& o) {
   const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);  // a bag folder, as ros2 bag makes
   dds::DdsTransport transport(dds::read_ros_environment(o.enclave));
-  io::RecordingOptions ro;
+  RecordingOptions ro;
   ro.mcap = o.out;
   ro.ns = o.ns;
   ro.topics = o.topics;
   ro.live = true;  // no plant ticks here: written a second of simulated time behind the newest message
-  io::Recording recording = io::make_recording(ro, &transport);
+  io::Recording recording = make_recording(ro, &transport);
   std::cerr << fmt::format("record: domain {}, writing {} (Ctrl-C to stop)\n", transport.participant().domain_id(),
                            o.out);
   const auto start = std::chrono::steady_clock::now();

@@ -9,9 +9,9 @@
 #include <memory>
 
 #include "analysis/percentile.hpp"
+#include "hosts/recording.hpp"
 #include "io/output_folder.hpp"
 #include "io/provenance.hpp"
-#include "io/recording.hpp"
 #include "sim/swarm.hpp"
 
 namespace quadcosim::hosts {
@@ -89,9 +89,9 @@ bool fly_swarm_inprocess(const io::Scenario& sc, const io::SwarmSpec& spec, cons
   for (int i : spec.record_vehicles) {
     const std::string dir = sim::vehicle_namespace(spec.layout.ns_prefix, i, n).substr(1);
     recorded[static_cast<std::size_t>(i)] = true;
-    io::RecordingOptions ro;
+    RecordingOptions ro;
     ro.csv = (out / dir / "trajectory.csv").string();
-    recordings[static_cast<std::size_t>(i)] = io::make_recording(ro, nullptr);
+    recordings[static_cast<std::size_t>(i)] = make_recording(ro, nullptr);
   }
   const auto record = [&](int i, const sim::TickRecord& r) {  // a swarm's rows show no watchdog
     recordings[static_cast<std::size_t>(i)].tick(

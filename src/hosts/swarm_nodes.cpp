@@ -21,9 +21,9 @@
 #include "drivers/lockstep_plant_driver.hpp"
 #include "hosts/exit_code.hpp"
 #include "hosts/node_common.hpp"
+#include "hosts/recording.hpp"
 #include "hosts/signals.hpp"
 #include "hosts/swarm_inprocess.hpp"
-#include "io/recording.hpp"
 #include "sim/controller_node.hpp"
 #include "sim/plant_node.hpp"
 
@@ -88,9 +88,9 @@ class PlantShard {
         const fs::path dir = out / v.simulation.ns.substr(1);
         std::error_code ec;  // a failure shows as the writer's "cannot open" naming the file
         fs::create_directories(dir, ec);
-        io::RecordingOptions ro;
+        RecordingOptions ro;
         ro.csv = (dir / "trajectory.csv").string();
-        node->recording = io::make_recording(ro, nullptr);
+        node->recording = make_recording(ro, nullptr);
         node->recorded = true;
         Vehicle* raw = node.get();
         transport_.subscribe<msg::ControllerStatus>(node->topics.controller_status,

@@ -67,6 +67,9 @@ Batch::Batch(const std::string& yaml, const std::string& source, const std::vect
   command_.assign(4 * n_, 0.0);
   omega_cmd_.assign(4 * n_, 0.0);
   t_.assign(n_, 0.0);
+  state_rows_.reserve(n_);  // recorders_ points into it
+  for (std::size_t i = 0; i < n_; ++i) state_rows_.emplace_back(*this, i);
+  for (StateRow& row : state_rows_) recorders_.push_back(&row);
   pose_t_.assign(n_, kNaN);
   pose_p_.assign(3 * n_, kNaN);
   pose_q_.assign(4 * n_, kNaN);

@@ -147,7 +147,7 @@ void Batch::step_lean(std::size_t i, bool bypass, int periods) {
       L.plant.take_command(k, o.command_delay_ticks, command);
     }
     // The latch (PlantNode::latch_command): the newest due command, then the watchdog.
-    L.plant.latch(k, L.plant.command_age_ns(o.clock, k), watchdog_ns, o.watchdog_policy);
+    L.watchdog = L.plant.latch(k, L.plant.command_age_ns(o.clock, k), watchdog_ns, o.watchdog_policy);
     // The integration to t_k+1 (PlantNode::integrate).
     L.plant.integrate(o.clock, k, o.substeps);
   }
@@ -182,17 +182,26 @@ void Batch::write_imu(std::size_t i, double t, const msg::Quaternion& q, const m
   set3(imu_a_, i, a.x, a.y, a.z);
 }
 
+void Batch::StateRow::tick(const sim::RecordedTick& t) {
+  const model::State& x = t.state;
+  const std::size_t i = i_;
+  set3(b_->p_, i, x.p_W.x(), x.p_W.y(), x.p_W.z());
+  set3(b_->v_, i, x.v_W.x(), x.v_W.y(), x.v_W.z());
+  set4(b_->q_, i, x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z());
+  set3(b_->w_, i, x.w_B.x(), x.w_B.y(), x.w_B.z());
+  set4(b_->omega_, i, x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]);
+  const model::Vector4& c = t.command;
+  set4(b_->command_, i, c[0], c[1], c[2], c[3]);
+  b_->t_[i] = t.t_s;
+}
+
 void Batch::fill_state(std::size_t i) {
   const Vehicle& v = vehicles_[i];
-  const model::State& x = v.sim ? v.sim->plant().state() : lean_[i].plant.state();
-  set3(p_, i, x.p_W.x(), x.p_W.y(), x.p_W.z());
-  set3(v_, i, x.v_W.x(), x.v_W.y(), x.v_W.z());
-  set4(q_, i, x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z());
-  set3(w_, i, x.w_B.x(), x.w_B.y(), x.w_B.z());
-  set4(omega_, i, x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]);
-  const model::Vector4& c = v.sim ? v.sim->plant().latched_command() : lean_[i].plant.latched();
-  set4(command_, i, c[0], c[1], c[2], c[3]);
-  t_[i] = v.scenario->simulation.plant.clock.seconds(v.next_tick);
+  if (v.sim) {
+    record(i, v.next_tick, v.sim->plant().state(), v.sim->plant().latched_command(), v.sim->plant().watchdog_active());
+  } else {
+    record(i, v.next_tick, lean_[i].plant.state(), lean_[i].plant.latched(), lean_[i].watchdog);
+  }
 }
 
 }  // namespace quadcosim::python

@@ -1,6 +1,8 @@
-// The seam every recording of a run plugs into (trajectory.csv, run.mcap, a Python run's series):
-// a recorder is fed the run's truth once per plant tick and taps the messages the nodes publish on
-// the bus; io/recording.hpp builds the recorders a run asks for, the same way for every host.
+// The seam every recording of a run plugs into (trajectory.csv, run.mcap, a Python run's series, the
+// Foxglove live view, a quadcosim.Batch's state rows): a recorder is fed the run's truth once per plant
+// tick and taps the messages the nodes publish on the bus; hosts/recording.hpp builds the recorders a
+// run asks for (io/recording.hpp's and the live view), the same way for every host. A Batch feeds its
+// vehicles' rows once per step instead (python/batch_class.hpp).
 #pragma once
 
 #include <cstdint>
