@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
+double elapsed_s(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -40,7 +40,7 @@ double baseline_rtf(const io::Scenario& sc, double sim_s) {
   baseline::BaselineLoop loop = baseline::make_baseline(sc.controller.vehicle, paper->params(), 10.0);
   const auto t0 = std::chrono::steady_clock::now();
   for (long k = 0; k <= ticks; ++k) loop.tick(k, dt);
-  const double rtf = sim_s / seconds_since(t0);
+  const double rtf = sim_s / elapsed_s(t0);
   if (!std::isfinite(loop.state().x[2])) note("baseline loop diverged");
   return rtf;
 }
@@ -195,7 +195,7 @@ nlohmann::json run_bench(const BenchOptions& o, const io::ScenarioResolvers& res
     }
     j["swarm_dds_trial_s"] = s;
   }
-  j["bench_wall_s"] = seconds_since(all_start);
+  j["bench_wall_s"] = elapsed_s(all_start);
   std::error_code ec;
   fs::remove_all(tmp, ec);
   return j;
