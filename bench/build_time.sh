@@ -6,6 +6,8 @@
 #   bench/build_time.sh BUILD_DIR [TARGET...] [-- CMAKE_ARGS...]   (default target: all; -j from
 #   QUADCOSIM_JOBS, default 2; BUILD_DIR is deleted first)
 #   BUILD_TIME_TOP=N lists the N heaviest units (default 20).
+#   The compiler is the build's own choice (clang when installed, CMakeLists.txt); to measure GCC:
+#   bench/build_time.sh BUILD quadcosim -- -DCMAKE_CXX_COMPILER=g++ -DCMAKE_C_COMPILER=gcc
 # Launcher mode (internal): bench/build_time.sh --log LOG COMMAND... runs COMMAND, appending
 # "user sys max_rss_kB wall CC|LD output" to LOG.
 set -euo pipefail
@@ -53,6 +55,7 @@ cmake -S "$source_dir" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPIL
 start=$(date +%s)
 cmake --build "$build" -j"${QUADCOSIM_JOBS:-2}" "${targets[@]}" > "$build/build_time.build.txt" 2>&1
 echo "build_time: $(($(date +%s) - start)) s wall; the build's output in $build/build_time.build.txt"
+echo "build_time: $(sed -n 's/^-- The CXX compiler identification is //p' "$build/build_time.configure.txt")"
 python3 - "$log" "${BUILD_TIME_TOP:-20}" << 'EOF'
 import collections, re, sys
 rows, by_target, units = [], collections.Counter(), collections.Counter()

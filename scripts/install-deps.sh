@@ -20,8 +20,8 @@ packages=(
   nftables  # nft: packet loss, bursts and cuts on the veth between the namespaces (tests/faults)
   chromium  # headless rendering check of report.html (tools/test_report.py)
   clang-format  # the C++ style, checked by the test style.clang_format (scripts/format.sh)
-  clang libclang-rt-dev  # sanitizer build and libFuzzer targets (scripts/sanitize.sh); clang-14 and
-                         # libclang-rt-14-dev on Debian 12
+  clang libclang-rt-dev  # the compiler the build prefers (CMakeLists.txt), the sanitizer build and libFuzzer
+                         # targets (scripts/sanitize.sh); clang-14 and libclang-rt-14-dev on Debian 12
 )
 
 missing=()

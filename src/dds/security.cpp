@@ -10,7 +10,7 @@ namespace quadcosim::dds {
 namespace fs = std::filesystem;
 
 namespace {
-std::string env(const char* name) {
+std::string env_or_empty(const char* name) {
   const char* v = std::getenv(name);
   return v ? v : "";
 }
@@ -18,12 +18,12 @@ std::string env(const char* name) {
 
 SecurityEnvironment read_security_environment() {
   SecurityEnvironment e;
-  const std::string enable = env("ROS_SECURITY_ENABLE");
-  const std::string strategy = env("ROS_SECURITY_STRATEGY");
+  const std::string enable = env_or_empty("ROS_SECURITY_ENABLE");
+  const std::string strategy = env_or_empty("ROS_SECURITY_STRATEGY");
   e.enabled = enable == "true";
   e.strategy = strategy == "Enforce" ? SecurityStrategy::kEnforce : SecurityStrategy::kPermissive;
-  e.keystore = env("ROS_SECURITY_KEYSTORE");
-  e.enclave_override = env("ROS_SECURITY_ENCLAVE_OVERRIDE");
+  e.keystore = env_or_empty("ROS_SECURITY_KEYSTORE");
+  e.enclave_override = env_or_empty("ROS_SECURITY_ENCLAVE_OVERRIDE");
   if (!enable.empty() && enable != "true" && enable != "false") {
     e.warning = "ROS_SECURITY_ENABLE='" + enable + "' is not \"true\": security is off (as in ROS 2)";
   } else if (e.enabled && !strategy.empty() && strategy != "Enforce" && strategy != "Permissive") {

@@ -11,14 +11,8 @@
 #include <variant>
 
 #include "controllers/registry.hpp"
+#include "io/build_stamp.hpp"
 #include "io/output_folder.hpp"
-
-#ifndef QUADCOSIM_VERSION
-#define QUADCOSIM_VERSION "unknown"
-#endif
-#ifndef QUADCOSIM_GIT_COMMIT
-#define QUADCOSIM_GIT_COMMIT "unknown"
-#endif
 
 namespace quadcosim::io {
 
@@ -162,8 +156,8 @@ nlohmann::json describe_run(const Scenario& flown, const RunContext& context) {
           {"transport", context.transport},
           {"clock", context.clock},
           {"command_line", process_command_line()},
-          {"quadcosim_version", QUADCOSIM_VERSION},
-          {"git_commit", QUADCOSIM_GIT_COMMIT},
+          {"quadcosim_version", build_version()},
+          {"git_commit", build_git_commit()},
           {"host", host_name()},
           {"scenario", scenario}};
 }

@@ -21,7 +21,12 @@ Eigen::Vector3d Vector3Noise::sample(const Eigen::Vector3d& truth) {
 
 Eigen::Quaterniond perturb_attitude(const Eigen::Quaterniond& q, double sigma_rad, Rng& rng) {
   if (sigma_rad <= 0.0) return q;
-  const Eigen::Vector3d d(sigma_rad * rng.normal(), sigma_rad * rng.normal(), sigma_rad * rng.normal());
+  // Drawn z, y, x, one statement each: the order of a function's arguments is the compiler's choice,
+  // and this is the order GCC took when the three draws were the constructor's arguments.
+  const double dz = sigma_rad * rng.normal();
+  const double dy = sigma_rad * rng.normal();
+  const double dx = sigma_rad * rng.normal();
+  const Eigen::Vector3d d(dx, dy, dz);
   const double angle = d.norm();
   if (angle == 0.0) return q;
   return (q * Eigen::Quaterniond(Eigen::AngleAxisd(angle, d / angle))).normalized();

@@ -42,7 +42,7 @@ void prepare_sensors(SensorViews& v, const py::object& obs_dict, const sensors::
   sensors::for_each_kind([&]<class Kind>() {
     SensorView& s = v.views[sensors::kind_index<Kind>()];
     s = SensorView{};
-    const py::str name(std::string(Kind::kName));
+    const py::str name{std::string(Kind::kName)};
     if (!readings.carries<Kind>()) {
       obs_dict[name] = py::none();
       return;

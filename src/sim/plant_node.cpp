@@ -5,14 +5,10 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "sim/msg_eigen.hpp"
 #include "sim/vehicle_description.hpp"
 
 namespace quadcosim::sim {
-
-namespace {
-msg::Vector3 to_msg(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
-}  // namespace
 
 std::string external_plant_conflict(const RealismConfig& realism, const model::VehicleParams& vehicle) {
   if (realism.wind.active()) return "environment";

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <utility>
 
+#include "sim/msg_eigen.hpp"
+
 namespace quadcosim::sim {
 
 namespace {
-msg::Vector3 to_msg(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-msg::Quaternion to_msg(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 
 void set_diagonal(std::array<double, 9>& cov, double sigma) {
   cov = {};
