@@ -131,9 +131,15 @@ TEST(FmuConfig, PlantVariables) {
       EXPECT_EQ(v.variability, Variability::kFixed);
       EXPECT_EQ(v.min, 1e-6);
     }
-    if (v.name == "omega_cmd[1]") EXPECT_EQ(v.causality, Causality::kInput);
-    if (v.name == "realism.seed") EXPECT_EQ(v.type, VariableType::kInteger);
-    if (v.name == "initial.q_WB[1]") EXPECT_EQ(v.start, "1");
+    if (v.name == "omega_cmd[1]") {
+      EXPECT_EQ(v.causality, Causality::kInput);
+    }
+    if (v.name == "realism.seed") {
+      EXPECT_EQ(v.type, VariableType::kInteger);
+    }
+    if (v.name == "initial.q_WB[1]") {
+      EXPECT_EQ(v.start, "1");
+    }
   }
 }
 
@@ -158,8 +164,12 @@ TEST(FmuConfig, ControllerVariablesAreTheTypesParameters) {
       EXPECT_EQ(v.start, "5");
       EXPECT_EQ(v.variability, Variability::kTunable);
     }
-    if (v.name == "ref.p_W[3]") EXPECT_EQ(v.start, "2");
-    if (v.name == "ref.yaw") EXPECT_EQ(v.start, "0.5");
+    if (v.name == "ref.p_W[3]") {
+      EXPECT_EQ(v.start, "2");
+    }
+    if (v.name == "ref.yaw") {
+      EXPECT_EQ(v.start, "0.5");
+    }
   }
   EXPECT_TRUE(k_x);
   FmuConfig bad = c;
