@@ -471,7 +471,8 @@ def test_every_kind_of_vehicle_equals_its_single_simulation(case, tmp_path):
     scenario, lean = PATHS[case]
     n = 3
     seeds = [5, 6, 2**33 + 1]
-    vehicles = [None, {"mass_kg": 0.47}, {"Izz_kg_m2": 0.012}]
+    # The third has products of inertia: the model's whole-tensor path (docs/model.md).
+    vehicles = [None, {"mass_kg": 0.47}, {"Izz_kg_m2": 0.012, "Ixy_kg_m2": 0.001, "Iyz_kg_m2": -0.0005}]
     batch = quadcosim.Batch(quadcosim.load_scenario(scenario), n, seeds=seeds, vehicles=vehicles, threads=2)
     assert batch._b.lean_vehicles() == lean
     singles = []

@@ -433,3 +433,13 @@ def test_run_result_outputs_are_the_controllers_own_figures():
     assert e_z[0] == 10.0
     assert abs(e_z[-1]) < 0.1  # settled by 15 s
     assert np.all(result.outputs["error.roll"] == 0.0)  # level flight: nothing disturbs roll
+
+
+def test_a_vehicle_preset_from_a_dict_with_an_override():
+    """`vehicle: {preset: NAME}` starts from a ready vehicle (docs/model.md); other keys override it."""
+    sc = quadcosim.load_scenario({"vehicle": {"preset": "crazyflie2", "mass_kg": 0.03}, "controller": {"type": "se3"}})
+    assert sc.vehicle["mass_kg"] == 0.03
+    assert sc.vehicle["Ixy_kg_m2"] == 0.830806e-6  # Förster's identified tensor
+    assert sc.vehicle["layout"] == "x"
+    with pytest.raises(quadcosim.ConfigError, match="preset"):
+        quadcosim.load_scenario({"vehicle": {"preset": "crazyfly"}})
