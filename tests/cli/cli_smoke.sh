@@ -181,6 +181,25 @@ case $CASE in
       fail "docs/model.md's vehicle table differs from 'quadcosim params --vehicle --markdown' (paste its output)"
     ;;
 
+  params_presets)
+    # The ready vehicles: listed with their sources, one printed with its own values (the Crazyflie's
+    # 27 g and Förster's product of inertia), the preset named in the scenario flying the circle, and
+    # an unknown name refused as a usage error naming the known ones.
+    expect_rc 0 "$QC" params --vehicle --list
+    for p in paper crazyflie2 hummingbird f450; do
+      grep -qE "^$p[[:space:]]" "$TMP/out" || { cat "$TMP/out" >&2; fail "preset $p not listed"; }
+    done
+    grep -q "System Identification of the Crazyflie 2.0" "$TMP/out" || fail "the crazyflie2 source is not listed"
+    expect_rc 0 "$QC" params --vehicle --preset crazyflie2
+    grep -qE '^mass_kg[[:space:]].*[[:space:]]0\.027[[:space:]]' "$TMP/out" || { cat "$TMP/out" >&2; fail "crazyflie2 mass"; }
+    grep -qE '^Ixy_kg_m2[[:space:]].*[[:space:]]8\.30806e-07[[:space:]]' "$TMP/out" ||
+      { cat "$TMP/out" >&2; fail "crazyflie2 Ixy"; }
+    expect_rc 2 "$QC" params --vehicle --preset crazyfly
+    grep -q "crazyflie2" "$TMP/err" || { cat "$TMP/err" >&2; fail "the refusal does not name the presets"; }
+    expect_rc 0 "$QC" run "$SRC/scenarios/tracking/circle_se3_crazyflie2.yaml" --out "$TMP/cf" --no-plots
+    grep -q "tracking from t = 12 s .*: PASS" "$TMP/cf/metrics.txt" || { cat "$TMP/cf/metrics.txt" >&2; fail "crazyflie2 circle"; }
+    ;;
+
   *)
     echo "unknown case '$CASE'" >&2
     exit 2
