@@ -42,12 +42,10 @@ CLI::App* add_params_subcommand(CLI::App& app, ParamsOptions& params) {
   params_cmd->add_flag("--vehicle", params.vehicle, "the vehicle's parameters (scenario `vehicle:`, vehicle files)");
   params_cmd->add_flag("--markdown", params.markdown, "the vehicle table as Markdown, as docs/model.md shows it")
       ->needs(params_cmd->get_option("--vehicle"));
-  std::vector<std::string> presets;
-  for (const model::VehiclePreset& p : model::vehicle_presets()) presets.emplace_back(p.name);
   params_cmd
       ->add_option("--preset", params.preset,
                    "with --vehicle: the values of a ready vehicle (" + model::vehicle_preset_names() + ")")
-      ->check(CLI::IsMember(presets))
+      ->check(CLI::IsMember(model::vehicle_preset_list()))
       ->needs(params_cmd->get_option("--vehicle"));
   return params_cmd;
 }
@@ -101,17 +99,16 @@ int vehicle_presets_table() {
 // table docs/model.md carries (tests/cli checks the two agree); with a preset, its values in the
 // "default" column.
 int vehicle_params_table(bool markdown, const std::string& preset) {
-  const model::VehicleParams defaults =
-      preset.empty() ? model::VehicleParams{} : model::find_vehicle_preset(preset)->params;
+  const model::VehiclePreset* chosen = preset.empty() ? nullptr : model::find_vehicle_preset(preset);
+  const model::VehicleParams defaults = chosen ? chosen->params : model::VehicleParams{};
   constexpr const char* text_row = "{:<34} {:<18} {:<18} {:<14} {}\n";
   constexpr const char* md_row = "| {} | {} | {} | {} | {} |\n";
   if (markdown) {
     std::cout << fmt::format(md_row, "key", "unit", "range", "default", "meaning");
     std::cout << "|---|---|---|---|---|\n";
   } else {
-    if (!preset.empty())
-      std::cout << "preset " << preset << ": " << model::find_vehicle_preset(preset)->description << "\n";
-    std::cout << fmt::format(text_row, "name", "unit", "range", preset.empty() ? "default" : "value", "meaning");
+    if (chosen) std::cout << "preset " << chosen->name << ": " << chosen->description << "\n";
+    std::cout << fmt::format(text_row, "name", "unit", "range", chosen ? "value" : "default", "meaning");
   }
   for (const auto& p : model::vehicle_parameters()) {
     std::string range;

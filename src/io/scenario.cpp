@@ -32,8 +32,7 @@ constexpr double kHuge = 1e12;
 // from that ready vehicle (model/vehicle_presets.hpp); the other keys then override its values.
 void read_vehicle(YamlSection& root, model::VehicleParams& v) {
   if (root.has("preset")) {
-    std::vector<std::string> names;
-    for (const model::VehiclePreset& p : model::vehicle_presets()) names.emplace_back(p.name);
+    const std::vector<std::string> names = model::vehicle_preset_list();
     v = model::find_vehicle_preset(root.choice("preset", names.front(), names))->params;
   }
   std::map<std::string, std::optional<YamlSection>, std::less<>> sections;

@@ -16,16 +16,10 @@ Quadrotor::Quadrotor(const VehicleParams& params)
       reciprocals_(1.0 / params.mass_kg, 1.0 / params.Ixx_kg_m2, 1.0 / params.Iyy_kg_m2, 1.0 / params.Izz_kg_m2) {
   assert(validate(params).empty());
   if (!params.principal_axes()) {
-    const Eigen::Matrix3d J = params.inertia_tensor();
-    const Eigen::Matrix3d J_inv = J.inverse();
-    std::array<double, 18> packed{};
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        packed[static_cast<std::size_t>(3 * r + c)] = J(r, c);
-        packed[static_cast<std::size_t>(9 + 3 * r + c)] = J_inv(r, c);
-      }
-    }
-    full_inertia_ = packed;
+    using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+    std::array<double, 18>& packed = full_inertia_.emplace();
+    Eigen::Map<RowMajor3>(packed.data()) = params.inertia_tensor();
+    Eigen::Map<RowMajor3>(packed.data() + 9) = params.inertia_tensor().inverse();
   }
 }
 

@@ -103,9 +103,15 @@ const VehiclePreset* find_vehicle_preset(std::string_view name) {
   return nullptr;
 }
 
+std::vector<std::string> vehicle_preset_list() {
+  std::vector<std::string> names;
+  for (const VehiclePreset& p : table()) names.emplace_back(p.name);
+  return names;
+}
+
 std::string vehicle_preset_names() {
   std::string names;
-  for (const VehiclePreset& p : table()) names.append(names.empty() ? "" : ", ").append(p.name);
+  for (const std::string& n : vehicle_preset_list()) names.append(names.empty() ? "" : ", ").append(n);
   return names;
 }
 

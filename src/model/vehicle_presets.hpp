@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "model/vehicle_params.hpp"
 
@@ -23,6 +24,9 @@ std::span<const VehiclePreset> vehicle_presets();
 
 /// The preset named `name`, or nullptr.
 const VehiclePreset* find_vehicle_preset(std::string_view name);
+
+/// The names, the paper's vehicle first (for choices and flag checks).
+std::vector<std::string> vehicle_preset_list();
 
 /// "paper, crazyflie2, ...": the names, for messages.
 std::string vehicle_preset_names();
