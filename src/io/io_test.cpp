@@ -546,6 +546,10 @@ aero:
   quadratic_drag_N_s2_m2: [0.01, 0.02, 0.03]
   rotor_drag_N_s_m_per_rad_s: 1.0e-5
   ground_effect_rotor_radius_m: 0.12
+  rotor_aero: true
+  inflow_k_z: 2.0e-4
+  flapping_k_flap: 3.0e-6
+  translational_lift_k_h: 0.02
 )"));
   EXPECT_EQ(v.mass_kg, 1.5);
   EXPECT_EQ(v.gravity_m_s2, 3.7);
@@ -570,6 +574,18 @@ aero:
   EXPECT_EQ(v.aero.quadratic_drag_N_s2_m2, Eigen::Vector3d(0.01, 0.02, 0.03));
   EXPECT_EQ(v.aero.rotor_drag_N_s_m_per_rad_s, 1.0e-5);
   EXPECT_EQ(v.aero.ground_effect_rotor_radius_m, 0.12);
+  EXPECT_EQ(v.aero.rotor_aero, model::RotorAero::kOn);
+  EXPECT_EQ(v.aero.inflow_k_z, 2.0e-4);
+  EXPECT_EQ(v.aero.flapping_k_flap, 3.0e-6);
+  EXPECT_EQ(v.aero.translational_lift_k_h, 0.02);
+  // The hub drag beside the lumped rotor drag is the same drag twice: refused at the lumped key.
+  try {
+    load_vehicle(
+        dir.write("twice.yaml", "aero: {rotor_aero: true, rotor_drag_k_d: 1e-5, rotor_drag_N_s_m_per_rad_s: 1e-5}\n"));
+    FAIL() << "the hub and the lumped rotor drag were accepted together";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("rotor_drag_N_s_m_per_rad_s"), std::string::npos) << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -25,6 +25,7 @@ using quadcosim::model::GyroscopicModel;
 using quadcosim::model::MotorModel;
 using quadcosim::model::Outputs;
 using quadcosim::model::Quadrotor;
+using quadcosim::model::RotorAero;
 using quadcosim::model::RotorLayout;
 using quadcosim::model::State;
 using quadcosim::model::StateDerivative;
@@ -248,7 +249,7 @@ TEST(VehicleParameterTable, EveryEntryBindsTheMemberItNames) {
     next += 1.0;
     ++numbers;
   }
-  ASSERT_EQ(numbers, 23);
+  ASSERT_EQ(numbers, 27);
   EXPECT_EQ(p.mass_kg, 1.0);
   EXPECT_EQ(p.gravity_m_s2, 2.0);
   EXPECT_EQ(p.Ixx_kg_m2, 3.0);
@@ -268,11 +269,17 @@ TEST(VehicleParameterTable, EveryEntryBindsTheMemberItNames) {
   EXPECT_EQ(p.aero.quadratic_drag_N_s2_m2, Eigen::Vector3d(19, 20, 21));
   EXPECT_EQ(p.aero.rotor_drag_N_s_m_per_rad_s, 22.0);
   EXPECT_EQ(p.aero.ground_effect_rotor_radius_m, 23.0);
+  EXPECT_EQ(p.aero.rotor_drag_k_d, 24.0);
+  EXPECT_EQ(p.aero.inflow_k_z, 25.0);
+  EXPECT_EQ(p.aero.flapping_k_flap, 26.0);
+  EXPECT_EQ(p.aero.translational_lift_k_h, 27.0);
 
   VehicleParams q;
   find_vehicle_parameter("layout")->set_choice(q, "x");
   find_vehicle_parameter("gyroscopic")->set_choice(q, "simplified");
   find_vehicle_parameter("motor.model")->set_choice(q, "first_order");
+  find_vehicle_parameter("aero.rotor_aero")->set_choice(q, "true");
+  EXPECT_EQ(q.aero.rotor_aero, RotorAero::kOn);
   EXPECT_EQ(q.layout, RotorLayout::kX);
   EXPECT_EQ(q.gyroscopic, GyroscopicModel::kSimplified);
   EXPECT_EQ(q.motor.model, MotorModel::kFirstOrder);

@@ -15,6 +15,9 @@ Quadrotor::Quadrotor(const VehicleParams& params)
       mixer_(mixer_matrix(params)),
       reciprocals_(1.0 / params.mass_kg, 1.0 / params.Ixx_kg_m2, 1.0 / params.Iyy_kg_m2, 1.0 / params.Izz_kg_m2) {
   assert(validate(params).empty());
+  rotor_positions_B_.resize(3, mixer_.cols());
+  for (Eigen::Index i = 0; i < mixer_.cols(); ++i)
+    rotor_positions_B_.col(i) = rotor_position_B(params, static_cast<int>(i));
   if (!params.principal_axes()) {
     using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
     std::array<double, 18>& packed = full_inertia_.emplace();
@@ -239,9 +242,15 @@ Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInp
   const Vector4 u = mixer_ * env->rotor_efficiency.cwiseProduct(omega.cwiseProduct(omega));
   RigidInputs in = rigid_inputs({u[0] * ground_effect_factor(params_.aero, y[2]), u.tail<3>()});
   const Eigen::Quaterniond q_WB(y[6], y[7], y[8], y[9]);
-  const Eigen::Vector3d accel_W =
-      aero_force_W(params_.aero, q_WB.toRotationMatrix(), Eigen::Vector3d(y[3], y[4], y[5]), env->wind_W, omega) *
-      reciprocals_[0];
+  const Eigen::Matrix3d R_WB = q_WB.toRotationMatrix();
+  const Eigen::Vector3d v_W(y[3], y[4], y[5]);
+  Eigen::Vector3d accel_W = aero_force_W(params_.aero, R_WB, v_W, env->wind_W, omega) * reciprocals_[0];
+  if (params_.aero.rotor_aero_active()) {  // at the hubs: a force and a moment
+    const BodyWrench w = rotor_aero_wrench_B(params_.aero, rotor_positions_B_, R_WB.transpose() * (v_W - env->wind_W),
+                                             Eigen::Vector3d(y[10], y[11], y[12]), omega, env->rotor_efficiency);
+    accel_W += R_WB * w.force_B * reciprocals_[0];
+    for (int i = 0; i < 3; ++i) in.torque_B[i] += w.torque_B[i];
+  }
   in.has_accel_W = true;
   for (int i = 0; i < 3; ++i) in.accel_W[i] = accel_W[i];
   return in;

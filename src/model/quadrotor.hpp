@@ -80,7 +80,9 @@ class Quadrotor {
   /// friction) holds the vehicle: all accelerations are zero.
   /// With an Environment (model/aero.hpp) the rotors' thrust and drag torque are scaled by their
   /// efficiencies, the collective thrust by the ground effect, and the drag of the air moving at
-  /// env->wind_W enters the translation; without one (nullptr) the model is exactly the paper's.
+  /// env->wind_W enters the translation, and with aero.rotor_aero on each rotor's drag, inflow,
+  /// flapping and translational lift at its hub enter both (force and moment); without one (nullptr)
+  /// the model is exactly the paper's.
   StateDerivative derivative(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
                              const Environment* env = nullptr) const;
 
@@ -130,6 +132,8 @@ class Quadrotor {
   /// J and J^-1 row by row when the body axes are not principal axes (products of inertia); empty
   /// for the diagonal path.
   std::optional<std::array<double, 18>> full_inertia_;
+  /// The hubs r_i [m] as columns, one per rotor (the per-rotor aerodynamics act there).
+  Eigen::Matrix3Xd rotor_positions_B_;
 };
 
 }  // namespace quadcosim::model

@@ -100,6 +100,16 @@ std::vector<VehicleParameter> make_table() {
                 aero.rotor_drag_N_s_m_per_rad_s, "rotor (induced) drag k_rd, summed over the rotors"),
       QC_NUMBER("aero.ground_effect_rotor_radius_m", "m", closed(0.0, 100.0), aero.ground_effect_rotor_radius_m,
                 "rotor radius R for ground effect (0: off)"),
+      QC_CHOICE("aero.rotor_aero", aero.rotor_aero, RotorAero, RotorAero::kOff, RotorAero::kOn,
+                "per-rotor aerodynamics at the hubs (rotor drag, inflow, flapping, translational lift): true or false"),
+      QC_NUMBER("aero.rotor_drag_k_d", "N/((m/s) (rad/s))", closed(0.0, 1.0), aero.rotor_drag_k_d,
+                "rotor drag (H-force) k_d per rotor, in its plane, at its hub (with rotor_aero)"),
+      QC_NUMBER("aero.inflow_k_z", "N/((m/s) (rad/s))", closed(0.0, 1.0), aero.inflow_k_z,
+                "induced-inflow thrust change k_z per rotor, along its axis (with rotor_aero)"),
+      QC_NUMBER("aero.flapping_k_flap", "N m/((m/s) (rad/s))", closed(0.0, 1.0), aero.flapping_k_flap,
+                "blade-flapping moment k_flap per rotor (with rotor_aero)"),
+      QC_NUMBER("aero.translational_lift_k_h", "N/(m/s)^2", closed(0.0, 1e3), aero.translational_lift_k_h,
+                "translational lift k_h per rotor, on in-plane airspeed squared (with rotor_aero)"),
   };
 }
 #undef QC_NUMBER
@@ -205,6 +215,11 @@ std::string validate(const VehicleParams& p) {
         << ", " << p.Iyz_kg_m2 << "], [" << p.Ixz_kg_m2 << ", " << p.Iyz_kg_m2 << ", " << p.Izz_kg_m2 << "]] kg m^2";
       return s.str();
     }
+  }
+  if (p.aero.rotor_aero == RotorAero::kOn && p.aero.rotor_drag_k_d != 0.0 && p.aero.rotor_drag_N_s_m_per_rad_s != 0.0) {
+    // The same drag twice: the lumped coefficient at the centre of mass and k_d at the hubs.
+    return must("aero.rotor_drag_N_s_m_per_rad_s", "0 when aero.rotor_drag_k_d acts (the same rotor drag, at the hubs)",
+                p.aero.rotor_drag_N_s_m_per_rad_s);
   }
   if (p.motor.omega_min_rad_s >= p.motor.omega_max_rad_s) {
     return must("motor.omega_min_rad_s", "below motor.omega_max_rad_s", p.motor.omega_min_rad_s);

@@ -27,6 +27,11 @@ VehicleParams crazyflie2() {
   v.km_Nm_per_rad2_s2 = 1.28192e-8 * 5.964552e-3;  // k_F times the torque-to-thrust ratio k_M [m]
   v.spin = {+1, -1, +1, -1};                       // front-left (M4) clockwise, front-right (M1) counter-clockwise
   v.motor.omega_max_rad_s = 2618.0;                // 25,000 rpm
+  // Förster's identified rotor drag (the diagonal of his K_aero, on the sum of the rotor speeds, which
+  // is k_d per rotor at the hubs; RotorPy's crazyflie_params.py carries the same two numbers). Off
+  // until aero.rotor_aero is turned on; he identified no flapping moment or translational lift.
+  v.aero.rotor_drag_k_d = 10.2506e-7;
+  v.aero.inflow_k_z = 7.5530e-7;
   return v;
 }
 
@@ -52,6 +57,11 @@ VehicleParams hummingbird() {
   v.motor.tau_up_s = 0.0125;
   v.motor.tau_down_s = 0.025;
   v.motor.omega_max_rad_s = 838.0;
+  // Rotor drag and inflow as RotorPy models the Hummingbird (Folk, Paulos, Kumar, 2023,
+  // hummingbird_params.py, after Svacha, Mohta, Kumar, ICUAS 2017, an order of magnitude below the
+  // 1e-3 it found too large). Off until aero.rotor_aero is turned on; no flapping or translational lift.
+  v.aero.rotor_drag_k_d = 1.19e-4;
+  v.aero.inflow_k_z = 2.32e-4;
   return v;
 }
 

@@ -6,9 +6,17 @@ R="$SRC/scenarios/realism"
 
 case "$CASE" in
   scenarios)  # each realism scenario meets its criteria; same seed, same bytes; another seed differs
-    for s in hover_wind_gusts roll_step_noisy_imu motor_failure; do
+    for s in hover_wind_gusts roll_step_noisy_imu motor_failure rotor_drag_hummingbird; do
       "$QC" run "$R/$s.yaml" --out "$TMP/$s" --no-plots > "$TMP/$s.log" 2>&1 || { cat "$TMP/$s.log"; fail "$s missed its criteria"; }
     done
+    # Per-rotor drag: the fast circle lags with it (ten times the error) and tracks within 2 cm without.
+    sed 's/rotor_aero: true/rotor_aero: false/' "$R/rotor_drag_hummingbird.yaml" > "$TMP/no_rotor_aero.yaml"
+    "$QC" run "$TMP/no_rotor_aero.yaml" --out "$TMP/no_rotor_aero" --no-plots > /dev/null || fail "the circle without rotor drag"
+    "$PY" - "$TMP/rotor_drag_hummingbird/metrics.json" "$TMP/no_rotor_aero/metrics.json" <<'PYEOF' || fail "rotor drag"
+import json, sys
+on, off = (json.load(open(f))["tracking"]["figures"]["position_rmse_m"] for f in sys.argv[1:3])
+assert off < 0.02 and on > 10 * off, (on, off)
+PYEOF
     grep -q '"hold"' "$TMP/hover_wind_gusts/metrics.json" || fail "no hold figures in metrics.json"
     "$QC" run "$R/hover_wind_gusts.yaml" --out "$TMP/again" --no-plots > /dev/null
     for f in trajectory.csv run.mcap; do
