@@ -103,6 +103,8 @@ MarginsSetup margins_setup(const std::string& path, const std::string& controlle
     s.notes.push_back("quadratic drag vanishes at hover in still air");
   if (s.plant.aero.ground_effect_rotor_radius_m > 0.0)
     s.notes.push_back("ground effect is not part of the linearisation (out of ground effect)");
+  if (s.plant.aero.rotor_aero_active())
+    s.notes.push_back("per-rotor aerodynamics (aero.rotor_aero) are not part of the linearisation");
   if (s.plant.motor.model == model::MotorModel::kFirstOrder && s.plant.motor.tau_up_s != s.plant.motor.tau_down_s)
     s.notes.push_back(fmt::format("motor lag linearised with the larger time constant, {:g} s",
                                   std::max(s.plant.motor.tau_up_s, s.plant.motor.tau_down_s)));
