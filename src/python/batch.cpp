@@ -95,7 +95,8 @@ Batch::Batch(const std::string& yaml, const std::string& source, const std::vect
 
 void Batch::reset(const std::optional<std::vector<long long>>& indices,
                   const std::optional<std::vector<std::uint64_t>>& seeds,
-                  const std::optional<std::vector<std::string>>& vehicle_keys) {
+                  const std::optional<std::vector<std::string>>& vehicle_keys,
+                  const std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>& states) {
   std::vector<std::size_t> which;
   if (indices) {
     std::vector<bool> seen(n_, false);
@@ -136,7 +137,27 @@ void Batch::reset(const std::optional<std::vector<long long>>& indices,
     }
     k = *vehicle_keys;
   }
-  reset_vehicles(which, s, k);
+  const double* rows = nullptr;
+  if (states) {
+    if (states->ndim() != 2 || states->shape(0) != static_cast<py::ssize_t>(which.size()) ||
+        states->shape(1) != kStateColumns) {
+      throw py::value_error("Batch.reset: states: expected an array of shape (" + std::to_string(which.size()) + ", " +
+                            std::to_string(kStateColumns) + "); nothing was reset");
+    }
+    rows = states->data();
+  }
+  reset_vehicles(which, s, k, rows);
+}
+
+model::State Batch::start_state(const io::Scenario& s, const double* row) {
+  model::State x = io::initial_state(s);
+  if (row == nullptr) return x;
+  const auto given = [row](int from) { return !std::isnan(row[from]); };
+  if (given(0)) x.p_W = Eigen::Vector3d(row[0], row[1], row[2]);
+  if (given(3)) x.v_W = Eigen::Vector3d(row[3], row[4], row[5]);
+  if (given(6)) x.q_WB = Eigen::Quaterniond(row[6], row[7], row[8], row[9]);  // unit (Batch.reset)
+  if (given(10)) x.w_B = Eigen::Vector3d(row[10], row[11], row[12]);
+  return x;
 }
 
 std::shared_ptr<const io::Scenario> Batch::load(const std::string& keys, std::size_t index) {
@@ -173,7 +194,8 @@ std::shared_ptr<const io::Scenario> Batch::load_checked(const YAML::Node& root, 
   }
 }
 
-std::unique_ptr<sim::Simulation> Batch::build(const io::Scenario& s, std::uint64_t seed, std::size_t i) {
+std::unique_ptr<sim::Simulation> Batch::build(const io::Scenario& s, std::uint64_t seed, std::size_t i,
+                                              const model::State& initial) {
   sim::SimulationConfig cfg = s.simulation;
   cfg.plant.realism.seed = seed;
   cfg.faults.seed = seed;
@@ -184,7 +206,7 @@ std::unique_ptr<sim::Simulation> Batch::build(const io::Scenario& s, std::uint64
   cfg.plant.publish_tf = false;
   std::unique_ptr<sim::Simulation> sim;
   try {
-    sim = std::make_unique<sim::Simulation>(cfg, s.vehicle, io::initial_state(s), s.controller, s.schedule);
+    sim = std::make_unique<sim::Simulation>(cfg, s.vehicle, initial, s.controller, s.schedule);
   } catch (const std::invalid_argument& e) {
     throw io::ConfigError("vehicle " + std::to_string(i) + ": " + s.path + ": " + e.what());
   }
@@ -204,7 +226,7 @@ std::unique_ptr<sim::Simulation> Batch::build(const io::Scenario& s, std::uint64
 }
 
 void Batch::reset_vehicles(const std::vector<std::size_t>& which, const std::vector<std::uint64_t>& seeds,
-                           const std::vector<std::string>& keys) {
+                           const std::vector<std::string>& keys, const double* states) {
   std::lock_guard lock(mutex_);
   std::vector<std::shared_ptr<const io::Scenario>> scenarios;
   scenarios.reserve(which.size());
@@ -212,14 +234,16 @@ void Batch::reset_vehicles(const std::vector<std::size_t>& which, const std::vec
   std::vector<std::unique_ptr<sim::Simulation>> sims(which.size());
   std::vector<LeanVehicle> lean(lean_vehicles_ ? which.size() : 0);
   for (std::size_t j = 0; j < which.size(); ++j) {
+    const model::State initial =
+        start_state(*scenarios[j], states == nullptr ? nullptr : states + j * static_cast<std::size_t>(kStateColumns));
     if (lean_vehicles_) {
       try {
-        lean[j] = LeanVehicle(*scenarios[j], seeds[j], !plant_only_);
+        lean[j] = LeanVehicle(*scenarios[j], seeds[j], !plant_only_, initial);
       } catch (const std::invalid_argument& e) {
         throw io::ConfigError("vehicle " + std::to_string(which[j]) + ": " + scenarios[j]->path + ": " + e.what());
       }
     } else {
-      sims[j] = build(*scenarios[j], seeds[j], which[j]);
+      sims[j] = build(*scenarios[j], seeds[j], which[j], initial);
     }
   }
   for (std::size_t j = 0; j < which.size(); ++j) {
@@ -295,7 +319,7 @@ void bind_batch(py::module_& m) {
            py::arg("nominal_controller"), py::arg("plant_only") = false)
       .def("step", &Batch::step, py::arg("omega_cmd") = py::none(), py::arg("periods") = 1)
       .def("reset", &Batch::reset, py::arg("indices") = py::none(), py::arg("seeds") = py::none(),
-           py::arg("vehicle_keys") = py::none())
+           py::arg("vehicle_keys") = py::none(), py::arg("states") = py::none())
       .def("set_setpoints", &Batch::set_setpoints, py::arg("indices") = py::none())
       .def("setpoints", &Batch::setpoints)
       .def("reference", &Batch::reference)

@@ -85,9 +85,16 @@ class Batch {
       int periods);
 
   /// Back to t = 0 for `indices` (all when empty) with new seeds and vehicle keys where given.
-  void reset(const std::optional<std::vector<long long>>& indices,
-             const std::optional<std::vector<std::uint64_t>>& seeds,
-             const std::optional<std::vector<std::string>>& vehicle_keys);
+  /// states: one row of kStateColumns per index (p, v, q as w x y z, w), the vehicle's start in place
+  /// of the scenario's initial state; a NaN part (all its entries) keeps the scenario's. The rotor
+  /// speeds are always the scenario's (stopped, or hover with `initial: hover: true`).
+  void reset(
+      const std::optional<std::vector<long long>>& indices, const std::optional<std::vector<std::uint64_t>>& seeds,
+      const std::optional<std::vector<std::string>>& vehicle_keys,
+      const std::optional<pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>>& states);
+
+  /// Columns of a row of reset's states: p (3), v (3), q (4: w, x, y, z), w (3).
+  static constexpr int kStateColumns = 13;
 
   /// Sets setpoints of `indices` (all when None) by keyword: a value for all or one per vehicle.
   void set_setpoints(const std::optional<std::vector<long long>>& indices, const pybind11::kwargs& values);
@@ -130,12 +137,12 @@ class Batch {
   /// controller node's ControllerCore and the scenario's schedule of parameter changes.
   struct LeanVehicle {
     LeanVehicle() = default;
-    LeanVehicle(const io::Scenario& s, std::uint64_t seed, bool with_controller) {
+    LeanVehicle(const io::Scenario& s, std::uint64_t seed, bool with_controller, const model::State& initial) {
       const sim::Topics topics = sim::Topics::for_namespace(s.simulation.ns);
       sim::RealismConfig realism = s.simulation.plant.realism;
       realism.seed = seed;
       // The noise streams named as PlantNode names them: by the vehicle's namespace.
-      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, io::initial_state(s), topics.ns);
+      plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, initial, topics.ns);
       if (with_controller) {
         controller.emplace(s.controller, topics, realism.extra_sensors);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);
@@ -170,11 +177,16 @@ class Batch {
 
   /// Vehicle i's simulation as quadcosim.Simulation builds it (sim/simulation.hpp), its seed for
   /// the realism and the injected faults, stepped for as long as the caller likes.
-  std::unique_ptr<sim::Simulation> build(const io::Scenario& s, std::uint64_t seed, std::size_t i);
+  std::unique_ptr<sim::Simulation> build(const io::Scenario& s, std::uint64_t seed, std::size_t i,
+                                         const model::State& initial);
+
+  /// The scenario's initial state with the parts of `row` (kStateColumns values, or none) that are
+  /// not NaN in its place.
+  static model::State start_state(const io::Scenario& s, const double* row);
 
   /// Rebuilds vehicles `which` at t = 0; all are built before any is replaced, so an error changes nothing.
   void reset_vehicles(const std::vector<std::size_t>& which, const std::vector<std::uint64_t>& seeds,
-                      const std::vector<std::string>& keys);
+                      const std::vector<std::string>& keys, const double* states = nullptr);
 
   /// Asks the CPU to load the next vehicle's simulation object (plant, controller node and bus are
   /// members of it) while this one steps: with many vehicles their state no longer fits the core's

@@ -145,6 +145,44 @@ def _seeds(seeds: Any, n: int, what: str) -> List[int]:
     return out
 
 
+_STATE_PARTS = (("p", 3), ("v", 3), ("q", 4), ("w", 3))
+
+
+def _start_states(states: Any, m: int) -> np.ndarray:
+    """Batch.reset's states as the (m, 13) rows _Batch.reset takes: p, v, q, w; NaN where not given."""
+    if not isinstance(states, dict):
+        raise ValueError(f"Batch.reset: states: expected a dict of arrays p, v, q, w, got {type(states).__name__}")
+    unknown = set(states) - {k for k, _ in _STATE_PARTS}
+    if unknown:
+        raise ValueError(f"Batch.reset: states: unknown keys {sorted(unknown)}; expected some of p, v, q, w")
+    rows = np.full((m, 13), np.nan)
+    col = 0
+    for key, width in _STATE_PARTS:
+        if key in states:
+            try:
+                a = np.asarray(states[key], dtype=np.float64)
+            except (TypeError, ValueError):
+                raise ValueError(f"Batch.reset: states[{key!r}]: expected numbers") from None
+            if a.shape == (width,):
+                a = np.broadcast_to(a, (m, width))
+            if a.shape != (m, width):
+                raise ValueError(f"Batch.reset: states[{key!r}]: expected shape ({m}, {width}), got {a.shape}")
+            if not np.all(np.isfinite(a)):
+                i = int(np.argwhere(~np.isfinite(a))[0][0])
+                raise ValueError(f"Batch.reset: states[{key!r}][{i}] = {a[i].tolist()}: expected finite numbers")
+            if key == "q":
+                norm = np.linalg.norm(a, axis=1)
+                if np.any(norm < 1e-9):
+                    i = int(np.argmax(norm < 1e-9))
+                    raise ValueError(f"Batch.reset: states['q'][{i}] = {a[i].tolist()}: not a rotation (norm 0)")
+                # Normalised, but a unit one (to 1e-12) is taken as it is: the same bits fly.
+                off = np.abs(norm - 1.0) > 1e-12
+                a = np.where(off[:, None], a / norm[:, None], a)
+            rows[:, col:col + width] = a
+        col += width
+    return rows
+
+
 def _default_threads() -> int:
     try:
         return len(os.sched_getaffinity(0))
@@ -222,19 +260,26 @@ class Batch:
         """
         self._b.step(omega_cmd, int(periods))
 
-    def reset(self, indices: Optional[Sequence[int]] = None, seeds: Any = None, vehicles: Any = None) -> None:
+    def reset(self, indices: Optional[Sequence[int]] = None, seeds: Any = None, vehicles: Any = None,
+              states: Optional[Dict[str, Any]] = None) -> None:
         """Back to t = 0 for the vehicles `indices` (None: all), with their scenario's initial state and
         setpoints.
 
         seeds: new seeds for those vehicles (an int, or one per index; None keeps each one's, so the
         numbers repeat). vehicles: new vehicle keys for them (as for the constructor, one per index;
-        None keeps each one's). Everything is checked before anything is reset.
+        None keeps each one's). states: where they start instead of the scenario's initial state, a
+        dict of arrays with one row per index (keys as Batch.state's): p (m, 3) [m, world], v (m, 3)
+        [m/s, world], q (m, 4) w, x, y, z body -> world (normalised unless its norm is 1 to 1e-12; a
+        zero or non-finite one raises), w (m, 3) [rad/s, body]; a key left out keeps the scenario's value (position and yaw of
+        its `initial:` section, at rest). The rotor speeds are the scenario's (hover speed with
+        `initial: hover: true`, else stopped). Everything is checked before anything is reset.
         """
         idx = None if indices is None else [int(i) for i in np.atleast_1d(np.asarray(indices)).tolist()]
         m = self.n if idx is None else len(idx)
         s = None if seeds is None else _seeds(seeds, m, "reset")
         k = None if vehicles is None else _vehicle_keys(vehicles, m)
-        self._b.reset(idx, s, k)
+        x = None if states is None else _start_states(states, m)
+        self._b.reset(idx, s, k, x)
 
     def set_setpoints(self, indices: Optional[Sequence[int]] = None, **values: Any) -> None:
         """Sets the controller nodes' setpoints by keyword, from the next step on: x, y, z [m], roll,

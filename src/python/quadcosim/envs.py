@@ -8,7 +8,8 @@ HoverEnv holds a position; TrackingEnv follows a trajectory (the scenario's `tra
 given). VectorHoverEnv(n) and VectorTrackingEnv(n) run n of them on one Batch with Gymnasium's
 vector-env contract and auto-reset. The API follows Gymnasium 1.x (reset(seed, options) -> (obs,
 info); step(action) -> (obs, reward, terminated, truncated, info); observation_space, action_space,
-np_random); nothing is registered with gymnasium even when it is installed. See docs/python.md,
+np_random); quadcosim.rl registers them with gymnasium when it is installed and adapts the vector
+envs to Stable-Baselines3. See docs/python.md,
 "Gymnasium-style environments".
 
 Spaces (float32):
@@ -24,6 +25,10 @@ Reward per step: 1 - (w_p |e_p|^2 + w_v |e_v|^2 + w_w |w|^2 + w_a |a - a_hover|^
   that terminates. Weights default to w_p 1, w_v 0.1, w_w 0.01, w_a 0.01.
 Terminated: a crash (z below crash_altitude_m, or tilted more than max_tilt_rad) or leaving the box
   |e_p| <= max_position_error_m on every axis. Truncated: after max_episode_steps steps.
+Start: the scenario's initial state, or with random_start={"position_m": 1.0, "attitude_rad": 0.52,
+  "velocity_m_s": 0.2, "rate_rad_s": 0.2} (starts.RECOVER_START; half-widths of uniform draws per axis,
+  docs in quadcosim/starts.py) anywhere near the target: hover-and-recover. Step period: the scenario's
+  control period (HOVER_SCENARIO: 20 ms, 50 Hz). Stable-Baselines3 and gymnasium: quadcosim.rl.
 """
 
 import math
@@ -34,82 +39,10 @@ import numpy as np
 
 from ._quadcosim import ConfigError
 from .batch import Batch
+from .spaces import Box
+from .starts import RECOVER_START, check_start, draw_start
 
 __all__ = ["Box", "HoverEnv", "TrackingEnv", "VectorHoverEnv", "VectorTrackingEnv"]
-
-
-class Box:
-    """A box in R^shape: every entry between low and high (gymnasium.spaces.Box's contract, a small version).
-
-    low, high: numbers or arrays (broadcast to shape; -inf/inf for unbounded); shape: taken from them
-    when None; dtype: of the samples and of the bounds. sample() draws with the space's numpy
-    Generator (np_random; seed() reseeds it): uniform where both bounds are finite, a normal draw where
-    neither is, an exponential one beyond a single finite bound.
-    """
-
-    def __init__(self, low: Any, high: Any, shape: Optional[Sequence[int]] = None, dtype: Any = np.float32,
-                 seed: Optional[int] = None):
-        self.dtype = np.dtype(dtype)
-        if shape is None:
-            shape = np.broadcast(np.asarray(low), np.asarray(high)).shape
-        self.shape: Tuple[int, ...] = tuple(int(s) for s in shape)
-        self.low = np.broadcast_to(np.asarray(low, dtype=self.dtype), self.shape).copy()
-        self.high = np.broadcast_to(np.asarray(high, dtype=self.dtype), self.shape).copy()
-        if np.any(self.low > self.high) or np.any(np.isnan(self.low)) or np.any(np.isnan(self.high)):
-            raise ValueError("Box: low must not exceed high (and neither be NaN)")
-        self._np_random: Optional[np.random.Generator] = None
-        if seed is not None:
-            self.seed(seed)
-
-    @property
-    def np_random(self) -> np.random.Generator:
-        if self._np_random is None:
-            self._np_random = np.random.default_rng()
-        return self._np_random
-
-    def seed(self, seed: Optional[int] = None) -> list:
-        """Reseeds the space's Generator (None: fresh entropy)."""
-        self._np_random = np.random.default_rng(seed)
-        return [seed]
-
-    def is_bounded(self, manner: str = "both") -> bool:
-        below, above = bool(np.all(np.isfinite(self.low))), bool(np.all(np.isfinite(self.high)))
-        return {"both": below and above, "below": below, "above": above}[manner]
-
-    def sample(self) -> np.ndarray:
-        rng = self.np_random
-        low, high = self.low.astype(np.float64), self.high.astype(np.float64)
-        out = np.empty(self.shape, dtype=np.float64)
-        fl, fh = np.isfinite(low), np.isfinite(high)
-        both, none_, lo_only, hi_only = fl & fh, ~fl & ~fh, fl & ~fh, ~fl & fh
-        out[both] = rng.uniform(low[both], high[both])
-        out[none_] = rng.normal(size=int(none_.sum()))
-        out[lo_only] = low[lo_only] + rng.exponential(size=int(lo_only.sum()))
-        out[hi_only] = high[hi_only] - rng.exponential(size=int(hi_only.sum()))
-        if np.issubdtype(self.dtype, np.integer):
-            out = np.floor(out)
-        return np.clip(out.astype(self.dtype), self.low, self.high)
-
-    def contains(self, x: Any) -> bool:
-        """x has the space's shape, a dtype that casts to its dtype, and every entry within the bounds."""
-        if not isinstance(x, np.ndarray):
-            try:
-                x = np.asarray(x, dtype=self.dtype)
-            except (ValueError, TypeError):
-                return False
-        if x.shape != self.shape or not np.can_cast(x.dtype, self.dtype):
-            return False
-        return bool(np.all(x >= self.low) and np.all(x <= self.high))
-
-    def __contains__(self, x: Any) -> bool:
-        return self.contains(x)
-
-    def __eq__(self, other: Any) -> bool:
-        return (isinstance(other, Box) and self.shape == other.shape and self.dtype == other.dtype
-                and np.array_equal(self.low, other.low) and np.array_equal(self.high, other.high))
-
-    def __repr__(self) -> str:
-        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
 
 
 OBS_SIZE = 18
@@ -156,7 +89,8 @@ class _Episodes:
                  target: Any, max_episode_steps: int, max_position_error_m: float, crash_altitude_m: float,
                  max_tilt_rad: float, max_speed_m_s: float, max_rate_rad_s: float,
                  reward_weights: Optional[Dict[str, float]], termination_penalty: float,
-                 randomize: Optional[Dict[str, Any]], threads: Optional[int]):
+                 randomize: Optional[Dict[str, Any]], threads: Optional[int],
+                 random_start: Optional[Dict[str, Any]] = None):
         if scenario is None:
             scenario = TRACKING_SCENARIO if tracking else HOVER_SCENARIO
         sections = {"trajectory": trajectory} if trajectory is not None else None
@@ -187,6 +121,8 @@ class _Episodes:
             raise ValueError(f"reward_weights: unknown {sorted(unknown)}; expected {sorted(_REWARD_WEIGHTS)}")
         self.weights = dict(_REWARD_WEIGHTS, **(reward_weights or {}))
         self.randomize = self._check_randomize(randomize)
+        self.start_half_widths = check_start(random_start)
+        self.home_p, self.home_q = self.batch.p, self.batch.q  # the scenario's initial position and attitude
         self.default_target = None if target is None else np.broadcast_to(np.asarray(target, float), (3,)).copy()
         # The position each hover episode holds: the target given, else the scenario's initial position.
         self.target = self.batch.p if self.default_target is None else np.repeat(self.default_target[None], n, 0)
@@ -233,18 +169,23 @@ class _Episodes:
         return seed, keys
 
     def reset(self, indices: np.ndarray, rngs: Sequence[np.random.Generator], targets: Optional[np.ndarray]) -> None:
-        seeds, vehicles = [], []
+        if targets is not None:
+            self.target[indices] = targets
+        elif self.default_target is None and not self.tracking:
+            self.target[indices] = self.home_p[indices]  # the scenario's initial position
+        seeds, vehicles, starts = [], [], []
         for i in indices:
             s, v = self.draw(rngs[i])
             seeds.append(s)
             vehicles.append(v)
-        self.batch.reset(list(indices), seeds=seeds, vehicles=vehicles if self.randomize else None)
+            if self.start_half_widths is not None:
+                # Around the position held (hover) or the scenario's initial position (tracking).
+                starts.append(draw_start(rngs[i], self.start_half_widths,
+                                         self.home_p[i] if self.tracking else self.target[i], self.home_q[i]))
+        states = None if not starts else {k: np.array([st[k] for st in starts]) for k in ("p", "v", "q", "w")}
+        self.batch.reset(list(indices), seeds=seeds, vehicles=vehicles if self.randomize else None, states=states)
         if self.randomize:
             self._refresh_vehicles()
-        if targets is not None:
-            self.target[indices] = targets
-        elif self.default_target is None and not self.tracking:
-            self.target[indices] = self.batch.p[indices]  # the scenario's initial position
         self.steps[indices] = 0
         self.ended[indices] = False
 
@@ -290,12 +231,13 @@ class _Episodes:
 
 
 def _env_kwargs(kind: str, scenario, trajectory, target, max_episode_steps, max_position_error_m, crash_altitude_m,
-                max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights, termination_penalty, randomize):
+                max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights, termination_penalty, randomize,
+                random_start=None):
     return dict(tracking=kind == "tracking", scenario=scenario, trajectory=trajectory, target=target,
                 max_episode_steps=max_episode_steps, max_position_error_m=max_position_error_m,
                 crash_altitude_m=crash_altitude_m, max_tilt_rad=max_tilt_rad, max_speed_m_s=max_speed_m_s,
                 max_rate_rad_s=max_rate_rad_s, reward_weights=reward_weights,
-                termination_penalty=termination_penalty, randomize=randomize)
+                termination_penalty=termination_penalty, randomize=randomize, random_start=random_start)
 
 
 class _BatchEnv:
@@ -391,17 +333,21 @@ class HoverEnv(_Env):
     (pi/2): what counts as a crash; max_speed_m_s (10), max_rate_rad_s (20): observation bounds;
     reward_weights: {"position", "velocity", "rate", "action"}; termination_penalty (10);
     randomize: domain randomisation on every reset, {vehicle key: (low, high)} drawn uniformly, e.g.
-    {"mass_kg": (0.4, 0.55), "motor.tau_up_s": (0.02, 0.05)} (vector keys take arrays of 3).
+    {"mass_kg": (0.4, 0.55), "motor.tau_up_s": (0.02, 0.05)} (vector keys take arrays of 3);
+    random_start: a random start on every reset around the target, {"position_m", "attitude_rad",
+    "velocity_m_s", "rate_rad_s"}: half-widths of uniform draws per axis (starts.RECOVER_START: 1 m,
+    30 deg, 0.2 m/s, 0.2 rad/s; see quadcosim/starts.py); None: the scenario's initial state.
     """
 
     def __init__(self, scenario: Any = None, target: Any = None, max_episode_steps: int = 500,
                  max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05, max_tilt_rad: float = math.pi / 2,
                  max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
-                 randomize: Optional[Dict[str, Any]] = None):
+                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None):
         super().__init__("hover", **_env_kwargs("hover", scenario, None, target, max_episode_steps,
                                                 max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
-                                                max_rate_rad_s, reward_weights, termination_penalty, randomize))
+                                                max_rate_rad_s, reward_weights, termination_penalty, randomize,
+                                                random_start))
 
 
 class TrackingEnv(_Env):
@@ -418,10 +364,11 @@ class TrackingEnv(_Env):
                  max_episode_steps: int = 1000, max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05,
                  max_tilt_rad: float = math.pi / 2, max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
-                 randomize: Optional[Dict[str, Any]] = None):
+                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None):
         super().__init__("tracking", **_env_kwargs("tracking", scenario, trajectory, None, max_episode_steps,
                                                    max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
-                                                   max_rate_rad_s, reward_weights, termination_penalty, randomize))
+                                                   max_rate_rad_s, reward_weights, termination_penalty, randomize,
+                                                   random_start))
 
 
 class _VectorEnv(_BatchEnv):
@@ -521,12 +468,12 @@ class VectorHoverEnv(_VectorEnv):
                  max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05, max_tilt_rad: float = math.pi / 2,
                  max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
-                 randomize: Optional[Dict[str, Any]] = None, autoreset_mode: str = "next_step",
-                 threads: Optional[int] = None):
+                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None,
+                 autoreset_mode: str = "next_step", threads: Optional[int] = None):
         super().__init__("hover", num_envs, autoreset_mode, threads,
                          **_env_kwargs("hover", scenario, None, target, max_episode_steps, max_position_error_m,
                                        crash_altitude_m, max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights,
-                                       termination_penalty, randomize))
+                                       termination_penalty, randomize, random_start))
 
 
 class VectorTrackingEnv(_VectorEnv):
@@ -536,9 +483,9 @@ class VectorTrackingEnv(_VectorEnv):
                  max_episode_steps: int = 1000, max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05,
                  max_tilt_rad: float = math.pi / 2, max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
-                 randomize: Optional[Dict[str, Any]] = None, autoreset_mode: str = "next_step",
-                 threads: Optional[int] = None):
+                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None,
+                 autoreset_mode: str = "next_step", threads: Optional[int] = None):
         super().__init__("tracking", num_envs, autoreset_mode, threads,
                          **_env_kwargs("tracking", scenario, trajectory, None, max_episode_steps,
                                        max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
-                                       max_rate_rad_s, reward_weights, termination_penalty, randomize))
+                                       max_rate_rad_s, reward_weights, termination_penalty, randomize, random_start))
