@@ -209,6 +209,19 @@ py::array_t<double> Batch::get(const std::string& name) {
   };
   const auto it = arrays.find(name);
   if (it != arrays.end()) return to_array(this->*(it->second.first), n_, it->second.second);
+  if (name == "R") {
+    // The rotation matrices body -> world of q, row by row (what an RL observation holds: in numpy
+    // they cost a step of a few dozen vehicles more than the stepping itself).
+    std::vector<double> r(9 * n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      const Eigen::Matrix3d m =
+          Eigen::Quaterniond(q_[4 * i], q_[4 * i + 1], q_[4 * i + 2], q_[4 * i + 3]).toRotationMatrix();
+      for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 3; ++col) r[9 * i + 3 * row + col] = m(row, col);
+      }
+    }
+    return to_array(r, n_, 9);
+  }
   // "<sensor>.t" and "<sensor>.<column>" of the extra sensors the scenario configures.
   std::optional<py::array_t<double>> found;
   sensors::for_each_kind([&]<class Kind>() {

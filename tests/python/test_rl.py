@@ -208,3 +208,15 @@ def test_without_gymnasium_nothing_is_registered():
     from quadcosim import rl
     assert rl.register_envs() is False
     assert type(SB3VecEnv(1).observation_space).__name__ == "Box"
+
+
+def test_rotation_matrices_of_the_attitudes():
+    env = VectorHoverEnv(50, scenario=hover_at([0, 0, 2]), random_start=RECOVER_START)
+    obs, _ = env.reset(seed=1)
+    q = env.batch.q
+    w, x, y, z = q.T  # the textbook formula, in numpy
+    expected = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                         2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                         2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)
+    np.testing.assert_allclose(env.batch.R, expected, atol=1e-15)
+    np.testing.assert_allclose(obs[:, 6:15], expected, atol=1e-7)

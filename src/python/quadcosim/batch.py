@@ -270,8 +270,8 @@ class Batch:
         None keeps each one's). states: where they start instead of the scenario's initial state, a
         dict of arrays with one row per index (keys as Batch.state's): p (m, 3) [m, world], v (m, 3)
         [m/s, world], q (m, 4) w, x, y, z body -> world (normalised unless its norm is 1 to 1e-12; a
-        zero or non-finite one raises), w (m, 3) [rad/s, body]; a key left out keeps the scenario's value (position and yaw of
-        its `initial:` section, at rest). The rotor speeds are the scenario's (hover speed with
+        zero or non-finite one raises), w (m, 3) [rad/s, body]; a key left out keeps the scenario's
+        value (position and yaw of its `initial:` section, at rest). The rotor speeds are the scenario's (hover speed with
         `initial: hover: true`, else stopped). Everything is checked before anything is reset.
         """
         idx = None if indices is None else [int(i) for i in np.atleast_1d(np.asarray(indices)).tolist()]
@@ -306,6 +306,11 @@ class Batch:
     def q(self) -> np.ndarray:
         """(n, 4) attitudes body -> world as w, x, y, z."""
         return self._b.get("q")
+
+    @property
+    def R(self) -> np.ndarray:
+        """(n, 9) rotation matrices body -> world of q, row by row (R[0,0], R[0,1], ..., R[2,2])."""
+        return self._b.get("R")
 
     @property
     def w(self) -> np.ndarray:
