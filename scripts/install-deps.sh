@@ -13,6 +13,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
   pybind11-dev python3-dev python3-pytest  # the Python module (src/python) and its tests (tests/python)
+  python3-torch libopenblas0-serial  # examples/learn_hover.py: PPO learns to hover (tests/python/test_learn_hover.py);
+                                     # OpenBLAS makes torch's matrix products several times faster than the reference BLAS
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` into a venv (tests/install)
   colcon python3-colcon-ros python3-colcon-cmake python3-colcon-package-information  # package.xml as a ROS 2 workspace reads it; `colcon list` (tests/install)
   slurm-wlm munge  # a private single-node Slurm cluster for the sweep job array test (tests/sweep/slurm_test.sh)
