@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Learns to hover and recover with the rotor speeds alone: a compact PPO on quadcosim.envs.VectorHoverEnv.
 
-    PYTHONPATH=build/python nice -n 10 /usr/bin/python3 examples/learn_hover.py [--iterations 150]
-        [--minutes M] [--envs 64] [--seed 0] [--eval-episodes 100] [--out results/learn_hover]
+    PYTHONPATH=build/python nice -n 10 /usr/bin/python3 examples/learn_hover.py [--iterations 400]
+        [--minutes M] [--envs 64] [--seed 0] [--eval-episodes 100] [--out results/learn_hover] [--action KIND]
 
 The task: hold (0, 0, 2) m from a random start up to 1 m off on every axis, up to 30 deg off in roll,
 pitch and yaw, moving at up to 0.2 m/s per axis and turning at up to 0.2 rad/s per axis
@@ -86,11 +86,12 @@ def _torch():
     return torch
 
 
-def hover_offset(env: VectorHoverEnv) -> np.ndarray:
-    """The action that commands the hover speed of the first vehicle (rotor-speed actions), else zeros:
-    where the policy's mean starts."""
+def hover_offset(env: VectorHoverEnv, action: Optional[str] = None) -> np.ndarray:
+    """Where the policy's mean starts: with the rotor speeds as the action (the envs' default, action
+    None), the action that commands the first vehicle's hover speed on every rotor; with another kind of
+    action (the envs' action= argument), zeros."""
     n = env.single_action_space.shape[0]
-    if getattr(env, "action_kind", "rotor_speeds") != "rotor_speeds":
+    if action is not None and action not in ("rotor_speeds", "rotors", "omega"):
         return np.zeros(n, dtype=np.float32)
     vp = env.batch.vehicle_params
     lo, hi, hover = vp["motor.omega_min_rad_s"][0], vp["motor.omega_max_rad_s"][0], vp["hover_omega_rad_s"][0]
@@ -169,7 +170,8 @@ def train(config: Optional[Dict[str, Any]] = None, log=print) -> Dict[str, Any]:
     env = make_env(cfg["envs"], cfg["sim_threads"], **cfg["env_kwargs"])
     n, T = cfg["envs"], cfg["rollout_steps"]
     obs_size, act_size = env.single_observation_space.shape[0], env.single_action_space.shape[0]
-    policy = make_policy(obs_size, act_size, cfg["hidden"], cfg["log_std_init"], hover_offset(env))
+    offset = hover_offset(env, cfg["env_kwargs"].get("action"))
+    policy = make_policy(obs_size, act_size, cfg["hidden"], cfg["log_std_init"], offset)
     opt = torch.optim.Adam(policy.parameters(), lr=cfg["lr"], eps=1e-5)
     norm = RunningNorm(obs_size)
     raw, _ = env.reset(seed=cfg["seed"] * 100_003)  # sub-env i: seed * 100003 + i
@@ -340,6 +342,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     ap.add_argument("--eval-episodes", type=int, default=100)
     ap.add_argument("--sim-threads", type=int, default=1, help="threads stepping the vehicles (numbers unchanged)")
     ap.add_argument("--out", default="results/learn_hover")
+    ap.add_argument("--action", default=None,
+                    help="the envs' action= (default: theirs, the normalised rotor speeds); passed through as it is")
     args = ap.parse_args(argv)
     if args.iterations < 1 or args.envs < 1 or args.eval_episodes < 1:
         ap.error("--iterations, --envs and --eval-episodes must be at least 1")
@@ -348,11 +352,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"torch {torch.__version__}, load average {load:.2f} "
           f"on {os.cpu_count()} CPUs")
+    env_kwargs = {} if args.action is None else {"action": args.action}
     r = train({"iterations": args.iterations, "envs": args.envs, "seed": args.seed, "minutes": args.minutes,
-               "sim_threads": args.sim_threads})
+               "sim_threads": args.sim_threads, "env_kwargs": env_kwargs})
     policy, norm = r["policy"], r["norm"]
     t0 = time.perf_counter()
-    ev = evaluate(lambda o: policy_action(policy, norm, o), args.eval_episodes, record=8)
+    ev = evaluate(lambda o: policy_action(policy, norm, o), args.eval_episodes, record=8, env_kwargs=env_kwargs)
     eval_s = time.perf_counter() - t0
     load_end = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     n_ok = int(ev["success"].sum())

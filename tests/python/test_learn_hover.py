@@ -32,7 +32,7 @@ def test_ppo_beats_holding_the_hover_command():
     r = lh.train(SHORT, log=lambda *_: None)
     policy, norm = r["policy"], r["norm"]
     trained = lh.evaluate(lambda o: lh.policy_action(policy, norm, o), episodes=32)
-    hover = lh.hover_offset(lh.make_env(1))
+    hover = lh.hover_offset(lh.make_env(1))  # the rotor speeds of hover
     baseline = lh.evaluate(lambda o: np.repeat(hover[None], len(o), axis=0), episodes=32)
     # Holding the hover command leaves every tilted start to drift off until it leaves the 2 m box or
     # crashes (measured: all 32 terminate, mean return about -455); the policy must earn clearly more
