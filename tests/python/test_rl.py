@@ -220,3 +220,28 @@ def test_rotation_matrices_of_the_attitudes():
                          2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)
     np.testing.assert_allclose(env.batch.R, expected, atol=1e-15)
     np.testing.assert_allclose(obs[:, 6:15], expected, atol=1e-7)
+
+
+def test_reset_states_on_whole_simulations():
+    # Message faults make every vehicle a whole Simulation (not the lean plant): its start is set there too,
+    # bit for bit as a scenario starting there, with its controller flying.
+    faulty = dict(hover_at([0, 0, 2]), message_faults={"topics": {"Imu": {"delay_ticks": 1}}})
+    a = quadcosim.Batch(faulty, 1, seeds=5)
+    assert not a._b.lean_vehicles()
+    a.reset(states={"p": [[0.2, 0.1, 1.8]]})
+    b = quadcosim.Batch(dict(faulty, initial={"position_m": [0.2, 0.1, 1.8], "hover": True}), 1, seeds=5)
+    for _ in range(25):
+        a.step()
+        b.step()
+    for k in ("p", "v", "q", "w", "omega"):
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k), err_msg=k)
+    assert abs(a.p[0, 2] - 1.8) > 1e-3  # its controller (z_des 2 m) flies it
+
+
+def test_random_start_of_tracking_envs_is_around_the_scenarios_start():
+    from quadcosim.envs import VectorTrackingEnv
+    env = VectorTrackingEnv(50, random_start={"position_m": [0.5, 0.5, 0.2]})
+    env.reset(seed=2)
+    off = env.batch.p - [1.0, 0.0, 1.0]  # TRACKING_SCENARIO starts at (1, 0, 1)
+    assert np.all(np.abs(off) <= [0.5, 0.5, 0.2]) and np.all(np.abs(off).max(axis=0) > [0.4, 0.4, 0.15])
+    np.testing.assert_array_equal(env.batch.q, np.tile([1.0, 0, 0, 0], (50, 1)))  # attitude_rad left out: 0
