@@ -51,15 +51,10 @@ std::string check_setpoint(CommandLevel level, const double* values, std::size_t
     err << "expected 4 values, got " << count;
     return err.str();
   }
-  const bool rotor = level == CommandLevel::kRotorSpeeds || level == CommandLevel::kRotorThrusts;
   for (std::size_t i = 0; i < 4; ++i) {
     const double v = values[i];
     if (!std::isfinite(v)) {
       err << "value " << i + 1 << " (" << setpoint_fields(level)[i] << ") is " << v << ", expected a finite number";
-      return err.str();
-    }
-    if (rotor && v < 0.0) {
-      err << "value " << i + 1 << " (" << setpoint_fields(level)[i] << ") is " << v << ", expected >= 0";
       return err.str();
     }
   }

@@ -55,9 +55,10 @@ struct LevelCommand {
   Eigen::Vector4d value = Eigen::Vector4d::Zero();
 };
 
-/// "" when `values` (as sent: `count` of them) can be a setpoint of `level`: exactly 4 finite values,
-/// and for rotor_speeds / rotor_thrusts none negative. Else why not, naming the level, the value and
-/// its field ("ctbr: value 3 (q [rad/s]) is nan, expected a finite number").
+/// "" when `values` (as sent: `count` of them) can be a setpoint of `level`: exactly 4 finite values.
+/// Else why not, naming the level, the value and its field ("ctbr: value 3 (q [rad/s]) is nan,
+/// expected a finite number"). Values beyond what the vehicle can do (a negative rotor thrust, a torque
+/// the rotors cannot make) are not refused: the inner loops clamp them and flag it.
 std::string check_setpoint(CommandLevel level, const double* values, std::size_t count);
 
 }  // namespace quadcosim::control

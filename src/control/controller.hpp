@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "control/command_level.hpp"
 #include "control/parameters.hpp"
 #include "sensors/readings.hpp"
 
@@ -71,10 +72,16 @@ struct Reference {
 };
 
 /// Everything one step decided. The node publishes omega_rad_s as the motor command and the rest in
-/// the controller's status (quadcosim_msgs/ControllerStatus).
+/// the controller's status (quadcosim_msgs/ControllerStatus). A controller that commands at a level
+/// above rotor speeds (control/command_level.hpp) sets `level` and `setpoint`: the node then publishes
+/// the setpoint at that level, and the plant's inner loops (control/inner_loops.hpp) turn it into rotor
+/// speeds on every plant tick; omega_rad_s is then not sent.
 struct ControllerOutput {
   Eigen::Vector4d omega_rad_s = Eigen::Vector4d::Zero();  ///< rotor speed commands [rad/s]
-  Eigen::Vector4d U = Eigen::Vector4d::Zero();            ///< requested U1 [N], U2..U4 [N m]
+  /// The level commanded; rotor speeds (omega_rad_s) unless the controller says otherwise.
+  CommandLevel level = CommandLevel::kRotorSpeeds;
+  Eigen::Vector4d setpoint = Eigen::Vector4d::Zero();  ///< the values of `level` (not rotor speeds)
+  Eigen::Vector4d U = Eigen::Vector4d::Zero();         ///< requested U1 [N], U2..U4 [N m]
   /// The attitude actually tracked (Z-Y-X angles of the desired attitude R_d) [rad]. In attitude mode
   /// a controller reports the reference's roll and pitch here.
   double roll_des_rad = 0.0, pitch_des_rad = 0.0, yaw_des_rad = 0.0;

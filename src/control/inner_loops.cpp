@@ -27,6 +27,18 @@ Eigen::Vector3d vee(const Eigen::Matrix3d& m) { return {m(2, 1), m(0, 2), m(1, 0
 
 }  // namespace
 
+InnerLoopParams InnerLoopParams::for_vehicle(const model::VehicleParams& vehicle, double period_s) {
+  InnerLoopParams p;
+  double kw = std::min(30.0, 0.3 / period_s);
+  if (vehicle.motor.model != model::MotorModel::kIdeal) {
+    kw = std::min(kw, 0.75 / std::max(vehicle.motor.tau_up_s, vehicle.motor.tau_down_s));
+  }
+  p.rate_bandwidth_rad_s = kw;
+  p.attitude_bandwidth_rad_s = kw / 4.0;
+  p.velocity_bandwidth_rad_s = kw / 20.0;
+  return p;
+}
+
 const ParameterTable<InnerLoopParams>& inner_loop_table() {
   using T = ParameterTable<InnerLoopParams>;
   static const T table({

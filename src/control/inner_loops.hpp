@@ -35,6 +35,11 @@ struct InnerLoopParams {
   double attitude_bandwidth_rad_s = 7.5;  ///< K_R: attitude error -> rate setpoint
   double velocity_bandwidth_rad_s = 1.5;  ///< K_v: velocity loop, time constant 1 / K_v
   double max_tilt_rad = 0.7;              ///< tilt limit of the velocity and acceleration levels
+
+  /// The defaults for a vehicle flown at plant period `period_s`: K_w = min(30 rad/s, 0.3 / h,
+  /// 0.75 / tau_motor with a first-order motor), K_R = K_w / 4 (the cascade critically damped),
+  /// K_v = K_R / 5. At the paper's 100 Hz on its ideal motors: 30, 7.5 and 1.5 rad/s.
+  static InnerLoopParams for_vehicle(const model::VehicleParams& vehicle, double period_s);
 };
 
 /// The declared parameters: inner.rate_bandwidth, inner.attitude_bandwidth, inner.velocity_bandwidth,

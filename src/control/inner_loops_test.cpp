@@ -61,8 +61,7 @@ TEST(CommandLevel, BadSetpointsAreRefusedNamingTheValue) {
   EXPECT_EQ(check_setpoint(CommandLevel::kVelocity, inf, 4),
             "velocity: value 4 (yaw [rad]) is inf, expected a finite number");
   const double negative[4] = {1.0, -0.5, 1.0, 1.0};
-  EXPECT_EQ(check_setpoint(CommandLevel::kRotorThrusts, negative, 4),
-            "rotor_thrusts: value 2 (T_2 [N]) is -0.5, expected >= 0");
+  EXPECT_EQ(check_setpoint(CommandLevel::kRotorThrusts, negative, 4), "");  // clamped by the loops, flagged
   // Torques and rates may be negative.
   const double signs[4] = {1.0, -0.5, -1.0, -1.0};
   EXPECT_EQ(check_setpoint(CommandLevel::kCttm, signs, 4), "");
@@ -250,6 +249,21 @@ TEST(InnerLoops, GainsTheSampledLoopCannotHoldAreRefusedByName) {
   lag.motor.model = model::MotorModel::kFirstOrder;
   EXPECT_EQ(check_inner_loops({}, lag, kPeriod).rfind("inner.rate_bandwidth 30 rad/s is too fast for the motors'", 0),
             0u);
+  // The defaults designed for a vehicle fit it: the paper's at 100 Hz are the struct's; a 0.04 s motor
+  // gets K_w = 0.75 / 0.04 = 18.75 rad/s; a 50 Hz plant K_w = 0.3 / 0.02 = 15 rad/s.
+  const InnerLoopParams d = InnerLoopParams::for_vehicle(v, kPeriod);
+  EXPECT_EQ(d.rate_bandwidth_rad_s, 30.0);
+  EXPECT_EQ(d.attitude_bandwidth_rad_s, 7.5);
+  EXPECT_EQ(d.velocity_bandwidth_rad_s, 1.5);
+  EXPECT_EQ(InnerLoopParams::for_vehicle(lag, kPeriod).rate_bandwidth_rad_s, 18.75);
+  EXPECT_EQ(check_inner_loops(InnerLoopParams::for_vehicle(lag, kPeriod), lag, kPeriod), "");
+  EXPECT_DOUBLE_EQ(InnerLoopParams::for_vehicle(v, 0.02).rate_bandwidth_rad_s, 15.0);
+  for (const model::VehiclePreset& preset : model::vehicle_presets()) {
+    for (double h : {0.001, 0.004, 0.01, 0.02, 0.05}) {
+      EXPECT_EQ(check_inner_loops(InnerLoopParams::for_vehicle(preset.params, h), preset.params, h), "")
+          << preset.name << " " << h;
+    }
+  }
   // The table's names and ranges.
   InnerLoopParams q;
   EXPECT_EQ(inner_loop_table().set(q, "inner.rate_bandwidth", 20.0), "");

@@ -69,6 +69,7 @@ void ControllerCore::safety_output(const control::Reference& ref, control::Contr
   // Algorithm 1, lines 3-5: every rotor at one speed; nothing else is decided. The attitude shown as
   // tracked is the reference's in attitude mode and level in position mode.
   out.omega_rad_s.setConstant(settings_.safety == control::SafetyMode::kHover ? hover_omega_rad_s_ : omega_min_rad_s_);
+  out.level = control::CommandLevel::kRotorSpeeds;  // the safety speeds, whatever level the controller flies
   out.U.setZero();
   const bool attitude = ref.mode == control::Mode::kAttitude;
   out.roll_des_rad = attitude ? ref.roll_rad : 0.0;

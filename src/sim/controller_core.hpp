@@ -31,6 +31,17 @@
 
 namespace quadcosim::sim {
 
+/// The motor command message of a step's output: its rotor speeds, or the setpoint of the level it
+/// commands, named in the layout (msg::set_command_level). `m.dim[0]` (the lockstep label) is kept.
+inline void write_command(const control::ControllerOutput& out, msg::Float64MultiArray& m) {
+  const bool speeds = out.level == control::CommandLevel::kRotorSpeeds;
+  const Eigen::Vector4d& v = speeds ? out.omega_rad_s : out.setpoint;
+  m.data.resize(4);
+  for (int i = 0; i < 4; ++i) m.data[static_cast<std::size_t>(i)] = v[i];
+  // Rotor speeds carry no level dimension (the message as before levels existed).
+  if (!speeds || !msg::command_level_name(m).empty()) msg::set_command_level(m, control::to_string(out.level));
+}
+
 class ControllerCore {
  public:
   /// Flies a clone of config.controller (which must be set: std::invalid_argument otherwise). The

@@ -139,8 +139,8 @@ void ControllerNode::publish(const control::Observation& obs, const control::Ref
   status_.outputs = out.outputs;
   status_pub_.publish(status_);
 
-  for (int i = 0; i < 4; ++i) command_msg_.data[i] = out.omega_rad_s[i];
   msg::write_command_label(command_msg_.dim[0].label, sim_now_ns);
+  write_command(out, command_msg_);
   command_pub_.publish(command_msg_);
 }
 

@@ -91,8 +91,34 @@ std::int64_t eight_digits(const char* p) {
 }
 }  // namespace
 
+std::string_view command_level_name(const Float64MultiArray& m) {
+  for (const MultiArrayDimension& d : m.dim) {
+    if (d.label.size() >= kCommandLevelPrefix.size() &&
+        d.label.compare(0, kCommandLevelPrefix.size(), kCommandLevelPrefix) == 0) {
+      return std::string_view(d.label).substr(kCommandLevelPrefix.size());
+    }
+  }
+  return {};
+}
+
+void set_command_level(Float64MultiArray& m, std::string_view name) {
+  const bool stamped = !m.dim.empty() && m.dim[0].label.compare(0, kLabelPrefix.size(), kLabelPrefix) == 0;
+  const std::size_t at = stamped ? 1 : 0;
+  if (name.empty() || name == "rotor_speeds") {
+    if (m.dim.size() > at) m.dim.resize(at);
+    return;
+  }
+  if (m.dim.size() <= at) m.dim.resize(at + 1);
+  MultiArrayDimension& d = m.dim[at];
+  d.label.assign(kCommandLevelPrefix);
+  d.label.append(name);
+  d.size = static_cast<std::uint32_t>(m.data.size());
+  d.stride = d.size;
+}
+
 std::int64_t command_stamp_ns(const Float64MultiArray& m) {
-  if (m.dim.size() != 1) return -1;
+  // The lockstep label alone, or followed by a level (set_command_level).
+  if (m.dim.empty() || (m.dim.size() == 2 ? command_level_name(m).empty() : m.dim.size() != 1)) return -1;
   const std::string& l = m.dim[0].label;
   if (l.size() <= kLabelPrefix.size() || l.compare(0, kLabelPrefix.size(), kLabelPrefix) != 0) return -1;
   std::size_t digits = l.size() - kLabelPrefix.size();

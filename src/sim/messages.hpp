@@ -285,6 +285,16 @@ void write_command_label(std::string& label, std::int64_t stamp_ns);
 /// The stamp of a command's label, or -1 when it has none.
 std::int64_t command_stamp_ns(const Float64MultiArray& m);
 
+/// A command at a level above rotor speeds (control/command_level.hpp: ctbr, velocity, ...) names it in
+/// a layout dimension labelled "level=<name>" ("level=ctbr"), after the lockstep label when there is
+/// one; `data` then holds that level's values. A command without one is rotor speeds, as always.
+inline constexpr std::string_view kCommandLevelPrefix = "level=";
+/// The level a command names ("" when it names none: rotor speeds).
+std::string_view command_level_name(const Float64MultiArray& m);
+/// Names the level in `m`'s layout (dim[1], or dim[0] when it has no lockstep label); "" or
+/// "rotor_speeds" removes the level dimension. Reuses the label's storage.
+void set_command_level(Float64MultiArray& m, std::string_view name);
+
 /// quadcosim_msgs/msg/ControllerStatus: what the controller decided in one step (for recording and
 /// monitoring). Published by the controller node after every step, before its motor command. A generic
 /// part that every controller fills (through the node), then the controller's own named figures.

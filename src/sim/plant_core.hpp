@@ -12,6 +12,11 @@
 // (src/python/batch.cpp); the plant FMU (src/fmi/export/plant_model.cpp) takes its rotor speeds as an
 // FMI input acting over the step (set_latched: no queue, no watchdog). The options are the caller's
 // (a node keeps its own copy; a batch's vehicles share their scenario's).
+//
+// A command may be at a level above rotor speeds (control/command_level.hpp: ctbr, velocity, ...): it
+// is checked and queued the same way, and once latched it is held, and the inner loops
+// (control/inner_loops.hpp) turn it into the rotor speeds of every tick from the true state at that
+// tick, until a newer command or the watchdog's stop replaces it.
 #pragma once
 
 #include <algorithm>
@@ -20,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "control/command_level.hpp"
+#include "control/inner_loops.hpp"
 #include "model/quadrotor.hpp"
 #include "sensors/suite.hpp"
 #include "sim/clock.hpp"
@@ -65,7 +72,11 @@ class PlantCore {
   /// realism off, the plant FMU, keeps the model's path through an Environment, whatever it holds).
   PlantCore(const model::VehicleParams& vehicle, const RealismConfig& realism, const TickClock& clock,
             const model::State& initial, const std::string& ns, bool environment = false)
-      : model_(vehicle), state_(initial), latched_(initial.omega_rad_s), rotor_input_(model_->rotor_input(latched_)) {
+      : model_(vehicle),
+        state_(initial),
+        latched_(initial.omega_rad_s),
+        rotor_input_(model_->rotor_input(latched_)),
+        period_s_(clock.period_s()) {
     if (environment || realism.active() || vehicle.aero.active()) {
       realism_ = std::make_unique<PlantRealism>(realism, vehicle, ns, clock);
     }
@@ -81,6 +92,9 @@ class PlantCore {
         latched_(o.latched_),
         rotor_input_(o.rotor_input_),
         last_valid_tick_(o.last_valid_tick_),
+        period_s_(o.period_s_),
+        held_(o.held_),
+        inner_(o.inner_ ? std::make_unique<Inner>(*o.inner_) : nullptr),
         pending_(o.pending_),
         pending_head_(o.pending_head_),
         realism_(o.realism_ ? std::make_unique<PlantRealism>(*o.realism_) : nullptr),
@@ -121,23 +135,48 @@ class PlantCore {
   /// A command message received during tick k: checked (sim::check_command against the vehicle's
   /// omega_max: a rejected one changes nothing, an out-of-range one is clamped), then queued to take
   /// effect at tick k + delay_ticks. Returns the check, for the caller's statistics.
+  /// A command at another level (its layout names it: msg::command_level_name) is checked as that
+  /// level's values and queued at its level.
   CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
     const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s);
-    if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s);
+    if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
     return check;
   }
-  /// A valid command (speeds within [0, omega_max]) received during tick k takes effect at tick
-  /// k + delay_ticks.
-  void queue(Tick k, Tick delay_ticks, const model::Vector4& omega_rad_s) {
+  /// A valid command (speeds within [0, omega_max]; or 4 finite values of another level) received
+  /// during tick k takes effect at tick k + delay_ticks.
+  void queue(Tick k, Tick delay_ticks, const model::Vector4& values,
+             control::CommandLevel level = control::CommandLevel::kRotorSpeeds) {
     last_valid_tick_ = k;
-    pending_.push_back({k + delay_ticks, omega_rad_s});
+    pending_.push_back({k + delay_ticks, values, level});
   }
+  /// The inner loops' gains (InnerLoopParams::for_vehicle when never set): checked for the vehicle and
+  /// the plant period, std::invalid_argument naming the gain that does not fit.
+  void set_inner_loops(const control::InnerLoopParams& params) {
+    auto next = std::make_unique<Inner>(Inner{control::InnerLoops(model_->params(), params, period_s_), {}});
+    inner_ = std::move(next);
+  }
+  /// The inner loops flying a level command (made at the first such command when never set); null
+  /// before.
+  const control::InnerLoops* inner_loops() const { return inner_ ? &inner_->loops : nullptr; }
+  /// The level command held (level kRotorSpeeds: the rotor speeds are latched as they came).
+  const control::LevelCommand& held() const { return held_; }
+  /// What the inner loops decided for the current tick (meaningful while held() is above rotor speeds).
+  const control::InnerLoopOutput* inner_output() const { return inner_ ? &inner_->last : nullptr; }
   /// Latches the newest command due by tick k (the others due are dropped); false when none is due.
   bool latch_due(Tick k) {
     const std::size_t first = pending_head_;
     while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
     const bool latched = pending_head_ > first;
-    if (latched) set_latched(pending_[pending_head_ - 1].omega);  // the newest one due
+    if (latched) {  // the newest one due
+      const Pending& p = pending_[pending_head_ - 1];
+      if (p.level == control::CommandLevel::kRotorSpeeds) {
+        held_.level = p.level;
+        set_latched(p.omega);
+      } else {
+        held_ = {p.level, p.omega};
+      }
+    }
+    if (held_.level != control::CommandLevel::kRotorSpeeds) fly_held();
     if (pending_head_ == pending_.size()) {
       pending_.clear();  // keeps the capacity
       pending_head_ = 0;
@@ -163,7 +202,10 @@ class PlantCore {
     return stale;
   }
   /// Latches every motor at the vehicle's omega_min_rad_s (the watchdog's stop policy).
-  void latch_omega_min() { set_latched(model::Vector4::Constant(model_->params().motor.omega_min_rad_s)); }
+  void latch_omega_min() {
+    held_.level = control::CommandLevel::kRotorSpeeds;
+    set_latched(model::Vector4::Constant(model_->params().motor.omega_min_rad_s));
+  }
   /// Time [ns] at tick k since the tick of the newest valid command (0 before any: from tick 0).
   std::int64_t command_age_ns(const TickClock& clock, Tick k) const {
     return clock.ns(k - std::min(last_valid_tick_, k));
@@ -185,15 +227,29 @@ class PlantCore {
 
  private:
   const model::Environment* environment(Tick k) { return realism_ ? &realism_->environment(k) : nullptr; }
+  /// The held level command through the inner loops on the current state, latched for this tick.
+  void fly_held() {
+    if (!inner_) set_inner_loops(control::InnerLoopParams::for_vehicle(model_->params(), period_s_));
+    inner_->last = inner_->loops.step(held_, state_);
+    set_latched(inner_->last.allocation.omega_rad_s);
+  }
+  struct Inner {
+    control::InnerLoops loops;
+    control::InnerLoopOutput last;
+  };
 
   std::optional<model::Quadrotor> model_;  ///< optional only to be default-constructible (a batch's array)
   model::State state_;
   model::Vector4 latched_ = model::Vector4::Zero();  ///< the command acting over [t_k, t_k+1)
   model::RotorInput rotor_input_;                    ///< latched_ as the model applies it
   Tick last_valid_tick_ = 0;                         ///< tick during which the newest valid command arrived
+  double period_s_ = 0.0;                            ///< the plant period the inner loops are designed for
+  control::LevelCommand held_;                       ///< the level command held (rotor speeds: latched_ is it)
+  std::unique_ptr<Inner> inner_;                     ///< the inner loops, made at the first level command
   struct Pending {
     Tick effective_tick;
-    model::Vector4 omega;
+    model::Vector4 omega;  ///< rotor speeds, or the 4 values of `level`
+    control::CommandLevel level;
   };
   // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
   // dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a

@@ -144,6 +144,8 @@ class PlantNode final : public SteppablePlant {
   /// The command latched for the current interval, as received after check_command (speeds within
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
   const model::Vector4& latched_command() const { return core_.latched(); }
+  /// The plant core (the level command held, the inner loops flying it).
+  const PlantCore& core() const { return core_; }
   const PlantStats& stats() const { return stats_; }
   /// The controller's commands (foreign and stale ones aside); its label_ns is the stamp label of the
   /// newest of them, accepted or rejected (a rejected command answers its tick: the last good one is

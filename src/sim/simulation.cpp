@@ -56,13 +56,22 @@ void Simulation::tick(Tick k, const std::function<void(const TickRecord&)>& on_t
 }
 
 void Simulation::override_command(const std::optional<model::Vector4>& omega_rad_s) {
-  override_ = omega_rad_s.has_value();
+  if (!omega_rad_s) {
+    override_level_command(std::nullopt);
+    return;
+  }
+  override_level_command(control::LevelCommand{control::CommandLevel::kRotorSpeeds, *omega_rad_s});
+}
+
+void Simulation::override_level_command(const std::optional<control::LevelCommand>& command) {
+  override_ = command.has_value();
   if (!override_) return;
   if (!override_pub_) {
     override_pub_ = transport_.advertise<msg::Float64MultiArray>(Topics::for_namespace(config_.ns).motor_commands);
-    override_msg_.dim = {{"", 4, 4}};
+    override_msg_.dim = {{std::string(msg::command_label(0)), 4, 4}};  // the lockstep label first
   }
-  override_msg_.data.assign(omega_rad_s->data(), omega_rad_s->data() + 4);
+  override_msg_.data.assign(command->value.data(), command->value.data() + 4);
+  msg::set_command_level(override_msg_, control::to_string(command->level));
 }
 
 void Simulation::publish_override(Tick k) {

@@ -86,6 +86,8 @@ class Simulation {
   /// nullopt. The plant checks and latches them as any command (a stepping front end flying its own
   /// commands).
   void override_command(const std::optional<model::Vector4>& omega_rad_s);
+  /// The same at any command level (control/command_level.hpp): the plant's inner loops fly it.
+  void override_level_command(const std::optional<control::LevelCommand>& command);
 
  private:
   /// The lockstep loop's hooks for this run (inlined: the loop's type names them).

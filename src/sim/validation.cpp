@@ -1,7 +1,9 @@
 #include "sim/validation.hpp"
 
 #include <fmt/format.h>
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace quadcosim::sim {
 
@@ -36,11 +38,53 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
   }
 }
 
+// A command at a level above rotor speeds (out of line: rotor speeds are the common case).
+[[gnu::noinline]] void check_level_command(const msg::Float64MultiArray& m, std::string_view name, CommandCheck& out) {
+  const std::optional<control::CommandLevel> level = control::command_level_from_string(name);
+  if (!level) {
+    out.fault = CommandFault::kUnknownLevel;
+    const std::size_t n = std::min(name.size(), out.unknown_level.size() - 1);
+    std::copy_n(name.data(), n, out.unknown_level.data());
+    return;
+  }
+  out.level = *level;
+  if (m.data.size() != 4) {
+    out.fault = CommandFault::kWrongLength;
+    out.values = m.data.size();
+    return;
+  }
+  for (int i = 0; i < 4; ++i) {
+    const double v = m.data[static_cast<std::size_t>(i)];
+    out.omega_rad_s[i] = v;
+    if (!std::isfinite(v)) {
+      out.fault = CommandFault::kNonFinite;
+      out.rotor = i;
+      out.value = v;
+      out.omega_rad_s.setZero();
+      return;
+    }
+  }
+  if (out.level != control::CommandLevel::kRotorThrusts) return;
+  for (int i = 3; i >= 0; --i) {  // downwards, so that the first rotor out of range is the one named
+    if (out.omega_rad_s[i] >= 0.0) continue;
+    out.fault = CommandFault::kOutOfRange;
+    out.rotor = i;
+    out.value = out.omega_rad_s[i];
+    out.omega_rad_s[i] = 0.0;
+  }
+}
+
 }  // namespace
 
 CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
   CommandCheck out;
   out.omega_max_rad_s = omega_max_rad_s;
+  if (!m.dim.empty()) {
+    if (const std::string_view level = msg::command_level_name(m); !level.empty()) {
+      check_level_command(m, level, out);
+      return out;
+    }
+  }
   if (m.data.size() != 4) {
     out.fault = CommandFault::kWrongLength;
     out.values = m.data.size();
@@ -59,14 +103,30 @@ CommandVerdict CommandCheck::verdict() const {
     case CommandFault::kNone: return CommandVerdict::kAccepted;
     case CommandFault::kOutOfRange: return CommandVerdict::kClamped;
     case CommandFault::kWrongLength:
-    case CommandFault::kNonFinite: break;
+    case CommandFault::kNonFinite:
+    case CommandFault::kUnknownLevel: break;
   }
   return CommandVerdict::kRejected;
 }
 
 std::string CommandCheck::reason() const {
+  if (fault == CommandFault::kUnknownLevel) return control::unknown_command_level(unknown_level.data());
+  if (level != control::CommandLevel::kRotorSpeeds) {
+    const std::string_view name = control::to_string(level);
+    switch (fault) {
+      case CommandFault::kNone: return "";
+      case CommandFault::kWrongLength: return fmt::format("{} values, expected 4 for level {}", values, name);
+      case CommandFault::kNonFinite:
+        return fmt::format("{} value {} ({}) is {}, expected a finite number", name, rotor + 1,
+                           control::setpoint_fields(level)[static_cast<std::size_t>(rotor)], value);
+      case CommandFault::kOutOfRange: return fmt::format("rotor {} thrust {:g} N clamped to 0", rotor + 1, value);
+      case CommandFault::kUnknownLevel: break;
+    }
+    return "?";
+  }
   switch (fault) {
     case CommandFault::kNone: return "";
+    case CommandFault::kUnknownLevel: return "?";
     case CommandFault::kWrongLength: return fmt::format("{} values, expected 4 rotor speeds", values);
     case CommandFault::kNonFinite:
       return fmt::format("rotor {} speed is {}, expected a finite number", rotor + 1, value);

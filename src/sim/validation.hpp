@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "control/command_level.hpp"
 #include "model/mixer.hpp"
 #include "sensors/registry.hpp"
 #include "sim/messages.hpp"
@@ -31,9 +32,10 @@ enum class CommandVerdict {
 /// What was wrong with a motor command; kNone when it was used as sent.
 enum class CommandFault : std::uint8_t {
   kNone,
-  kWrongLength,  ///< not exactly 4 values (kRejected)
-  kNonFinite,    ///< a NaN or Inf speed (kRejected)
-  kOutOfRange,   ///< four finite speeds, some < 0 or > omega_max (kClamped)
+  kWrongLength,   ///< not exactly 4 values (kRejected)
+  kNonFinite,     ///< a NaN or Inf speed (kRejected)
+  kOutOfRange,    ///< four finite speeds, some < 0 or > omega_max (kClamped); rotor thrusts < 0
+  kUnknownLevel,  ///< the layout names a command level quadcosim does not know (kRejected)
 };
 
 /// The outcome of check_command: plain data, no allocation; reason() says it in words.
@@ -44,6 +46,9 @@ struct CommandCheck {
   int rotor = 0;                 ///< the rotor at fault, 0..3: the first non-finite one, or the first clamped one
   double value = 0.0;            ///< that rotor's speed as sent [rad/s] (kNonFinite, kOutOfRange)
   double omega_max_rad_s = 0.0;  ///< the upper end of the range checked against [rad/s]
+  /// The command's level (msg::command_level_name); omega_rad_s then holds that level's 4 values.
+  control::CommandLevel level = control::CommandLevel::kRotorSpeeds;
+  std::array<char, 24> unknown_level{};  ///< the start of an unknown level's name (kUnknownLevel)
 
   CommandVerdict verdict() const;
   /// Why rejected or clamped, naming the rotor (1..4) and its value, e.g. "rotor 2 speed is nan, expected a
@@ -56,6 +61,10 @@ struct CommandCheck {
 /// Checked in this order, the first fault reported: the length, then each speed for NaN/Inf (rotor 1
 /// first), then the range. The layout (dim, data_offset) is not checked: it only carries the lockstep
 /// label (msg::command_stamp_ns). Allocates nothing.
+/// A command whose layout names a level above rotor speeds (msg::command_level_name: "level=ctbr")
+/// holds that level's 4 values instead: the level must be known (else kUnknownLevel), the values 4
+/// (kWrongLength) and finite (kNonFinite); rotor thrusts below 0 become 0 (kOutOfRange). The plant's
+/// inner loops turn it into rotor speeds every tick (control/inner_loops.hpp).
 CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s);
 
 // ---------------------------------------------------------------------------------------------
