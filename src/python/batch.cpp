@@ -34,12 +34,16 @@ void merge(YAML::Node into, const YAML::Node& keys) {
 }  // namespace
 
 Batch::Batch(const std::string& yaml, const std::string& source, const std::vector<std::string>& vehicle_keys,
-             const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller, bool plant_only)
+             const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller, bool plant_only,
+             const std::string& action)
     : source_(source),
       nominal_controller_(nominal_controller),
       plant_only_(plant_only),
       pool_(std::max(1, std::min<int>(threads, static_cast<int>(vehicle_keys.size())))) {
   if (vehicle_keys.empty()) throw py::value_error("Batch: n must be at least 1");
+  const std::optional<control::CommandLevel> level = control::command_level_from_string(action);
+  if (!level) throw py::value_error("Batch: action: " + control::unknown_command_level(action));
+  level_ = *level;
   if (seeds.size() != vehicle_keys.size()) throw py::value_error("Batch: one seed per vehicle expected");
   root_ = YAML::Load(yaml);
   base_ = load_checked(root_, "");
@@ -314,9 +318,10 @@ std::string replace_sections(const std::string& yaml, const std::string& section
 void bind_batch(py::module_& m) {
   py::class_<Batch>(m, "_Batch", "N vehicles of one scenario; use quadcosim.Batch.")
       .def(py::init<const std::string&, const std::string&, const std::vector<std::string>&,
-                    const std::vector<std::uint64_t>&, int, bool, bool>(),
+                    const std::vector<std::uint64_t>&, int, bool, bool, const std::string&>(),
            py::arg("yaml"), py::arg("source"), py::arg("vehicle_keys"), py::arg("seeds"), py::arg("threads"),
-           py::arg("nominal_controller"), py::arg("plant_only") = false)
+           py::arg("nominal_controller"), py::arg("plant_only") = false, py::arg("action") = "rotor_speeds")
+      .def("action", &Batch::action)
       .def("step", &Batch::step, py::arg("omega_cmd") = py::none(), py::arg("periods") = 1)
       .def("reset", &Batch::reset, py::arg("indices") = py::none(), py::arg("seeds") = py::none(),
            py::arg("vehicle_keys") = py::none(), py::arg("states") = py::none())

@@ -69,17 +69,21 @@ class Batch {
   /// nominal_controller: every controller is designed for the scenario's own vehicle (as a sweep's
   /// runs are) instead of for its vehicle's parameters.
   Batch(const std::string& yaml, const std::string& source, const std::vector<std::string>& vehicle_keys,
-        const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller, bool plant_only);
+        const std::vector<std::uint64_t>& seeds, int threads, bool nominal_controller, bool plant_only,
+        const std::string& action = "rotor_speeds");
 
   std::size_t size() const { return n_; }
   int threads() const { return pool_.size(); }
   bool plant_only() const { return plant_only_; }
+  /// The command level of step()'s commands (control/command_level.hpp): "rotor_speeds", "ctbr", ...
+  std::string action() const { return std::string(control::to_string(level_)); }
   /// The vehicles are LeanVehicles (no bus), not whole Simulations.
   bool lean_vehicles() const { return lean_vehicles_; }
 
   /// Advances every vehicle `periods` control periods (back to back, each vehicle's data staying in
   /// the cache); with omega_cmd ((N, 4) rotor speeds [rad/s]) the controllers are bypassed and the
-  /// command held for them, as Simulation.step(omega_cmd=).
+  /// command held for them, as Simulation.step(omega_cmd=). With an action level above rotor speeds
+  /// the rows are that level's setpoints, which each plant's inner loops fly every tick.
   void step(
       const std::optional<pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>>& omega_cmd,
       int periods);
@@ -205,6 +209,10 @@ class Batch {
   }
 
   void step_vehicle(std::size_t i, bool bypass, int periods);
+  /// step()'s commands at level_ (above rotor speeds): shape (n, 4), finite; else ValueError naming
+  /// the level, the row and the field.
+  void check_level_commands(
+      const pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>& cmd) const;
 
   /// Lean vehicle i over `periods` control periods: per tick k what Simulation::tick(k) does to its
   /// nodes (sim/simulation.hpp, sim/plant_node.cpp, sim/controller_node.cpp), each model, realism and
@@ -268,6 +276,7 @@ class Batch {
   std::string source_;
   bool nominal_controller_ = false;
   bool plant_only_ = false;
+  control::CommandLevel level_ = control::CommandLevel::kRotorSpeeds;  ///< what step()'s commands are
   bool lean_vehicles_ = false;                ///< vehicles are LeanVehicles in lean_ (else whole Simulations)
   std::shared_ptr<const io::Scenario> base_;  ///< the scenario itself (vehicles without keys fly it)
   YAML::Node root_;

@@ -16,7 +16,9 @@ void Batch::step(const std::optional<py::array_t<double, py::array::c_style | py
         "Batch.step: this batch is plant_only (no controllers): give omega_cmd, an (n, 4) array of rotor speeds "
         "[rad/s]; nothing was stepped");
   }
-  if (omega_cmd) {
+  if (omega_cmd && level_ != control::CommandLevel::kRotorSpeeds) {
+    check_level_commands(*omega_cmd);
+  } else if (omega_cmd) {
     if (omega_cmd->ndim() != 2 || omega_cmd->shape(0) != static_cast<py::ssize_t>(n_) || omega_cmd->shape(1) != 4) {
       throw py::value_error("Batch.step: omega_cmd: expected an array of shape (" + std::to_string(n_) +
                             ", 4) (4 rotor speeds [rad/s] per vehicle), got shape " +
@@ -55,11 +57,32 @@ void Batch::step(const std::optional<py::array_t<double, py::array::c_style | py
   });
 }
 
+void Batch::check_level_commands(const py::array_t<double, py::array::c_style | py::array::forcecast>& cmd) const {
+  const std::string_view level = control::to_string(level_);
+  const auto& fields = control::setpoint_fields(level_);
+  if (cmd.ndim() != 2 || cmd.shape(0) != static_cast<py::ssize_t>(n_) || cmd.shape(1) != 4) {
+    std::string names;
+    for (std::string_view f : fields) names += (names.empty() ? "" : ", ") + std::string(f);
+    throw py::value_error("Batch.step: " + std::string(level) + " commands: expected an array of shape (" +
+                          std::to_string(n_) + ", 4) (" + names + " per vehicle), got shape " +
+                          py::repr(cmd.attr("shape")).cast<std::string>() + "; nothing was stepped");
+  }
+  const double* c = cmd.data();
+  for (std::size_t j = 0; j < 4 * n_; ++j) {
+    if (!std::isfinite(c[j])) {
+      throw py::value_error("Batch.step: " + std::string(level) + " commands[" + std::to_string(j / 4) + ", " +
+                            std::to_string(j % 4) + "] (" + std::string(fields[j % 4]) +
+                            ") = " + py::repr(py::float_(c[j])).cast<std::string>() +
+                            ": commands must be finite; nothing was stepped");
+    }
+  }
+}
+
 void Batch::step_vehicle(std::size_t i, bool bypass, int periods) {
   Vehicle& v = vehicles_[i];
   if (bypass) {
     const double* c = &omega_cmd_[4 * i];
-    v.sim->override_command(model::Vector4(c[0], c[1], c[2], c[3]));
+    v.sim->override_level_command(control::LevelCommand{level_, model::Vector4(c[0], c[1], c[2], c[3])});
   }
   const int ticks = v.scenario->simulation.controller_divider * periods;
   const sensors::Suite* extra = v.sim->plant().extra_sensors();
@@ -85,6 +108,10 @@ void Batch::step_lean(std::size_t i, bool bypass, int periods) {
   thread_local msg::Float64MultiArray command;  // the command message, as the controller node or Simulation sends it
   if (bypass) {
     command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
+    // As Simulation::override_level_command sends it: the level named in the layout (none for speeds).
+    if (level_ != control::CommandLevel::kRotorSpeeds || !command.dim.empty()) {
+      msg::set_command_level(command, control::to_string(level_));
+    }
   } else {
     command.data.resize(4);
   }
@@ -141,8 +168,7 @@ void Batch::step_lean(std::size_t i, bool bypass, int periods) {
       if (!bypass) {
         const sim::ControllerCore::Begun begun = controller->begin_step(o.clock.ns(k));
         controller->decide(begun.safety, control_dt_s);
-        const model::Vector4& omega = controller->output().omega_rad_s;
-        for (int r = 0; r < 4; ++r) command.data[r] = omega[r];
+        sim::write_command(controller->output(), command);  // its rotor speeds, or its level's setpoint
       }
       L.plant.take_command(k, o.command_delay_ticks, command);
     }

@@ -5,6 +5,9 @@
     batch.set_setpoints(z=np.linspace(1, 3, 1000))
     batch.step()                              # every controller flies one control period
     batch.step(omega_cmd=np.full((1000, 4), 450.0))   # or rotor speeds [rad/s], controllers bypassed
+
+    ctbr = quadcosim.Batch("scenarios/paper/altitude_step.yaml", 1000, plant_only=True, action="ctbr")
+    ctbr.step(np.tile([19.2276, 0.0, 0.0, 0.1], (1000, 1)))   # thrust [N], body rates [rad/s]
     batch.p, batch.q, batch.sensors["imu"]["a"]        # (1000, 3), (1000, 4), (1000, 3)
 
 Each vehicle flies the scenario with its own seed and vehicle parameters: vehicle i gives exactly
@@ -216,6 +219,14 @@ class Batch:
         with their noise), with less memory per step (docs/python.md). set_setpoints raises;
         setpoints and reference give the scenario's. Scenarios with injected message faults or
         external dynamics (an FMU) are refused (ConfigError).
+    action: the command level of step()'s commands (docs/python.md, "Action levels"): "rotor_speeds"
+        (default: omega_i [rad/s]), "rotor_thrusts" (T_i [N]), "ctbr" (collective thrust [N], body
+        rates p, q, r [rad/s] FLU), "ctatt" (thrust [N], roll, pitch, yaw [rad] Z-Y-X), "cttm" (thrust
+        [N], body torques [N m]), "velocity" (v_x, v_y, v_z [m/s] world ENU, yaw [rad]),
+        "acceleration" (a_x, a_y, a_z [m/s^2] world, gravity excluded, yaw [rad]). Above rotor
+        speeds, each plant's inner loops (control/inner_loops.hpp, docs/controllers.md) turn the
+        command into rotor speeds on every plant tick from the vehicle's true state. An unknown name
+        raises ValueError listing the levels.
 
     Arrays come back as copies: (n, 3) p, v [m, m/s world], w [rad/s body]; (n, 4) q (w, x, y, z body
     -> world), omega, command [rad/s]; (n,) t [s], tick.
@@ -223,7 +234,7 @@ class Batch:
 
     def __init__(self, scenario: Union[Scenario, dict, str, "os.PathLike[str]"], n: int, seeds: Any = None,
                  vehicles: Any = None, threads: Optional[int] = None, controller_vehicle: str = "own",
-                 plant_only: bool = False, _sections: Optional[Dict[str, Any]] = None):
+                 plant_only: bool = False, action: str = "rotor_speeds", _sections: Optional[Dict[str, Any]] = None):
         from . import load_scenario  # the package's loader (a file, a dict or a Scenario)
 
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
@@ -243,22 +254,32 @@ class Batch:
         if controller_vehicle not in ("own", "nominal"):
             raise ValueError(f"Batch: controller_vehicle = {controller_vehicle!r}: expected 'own' or 'nominal'")
         self._b = _quadcosim._Batch(yaml, sc.source, _vehicle_keys(vehicles, n), _seeds(seeds, n, "__init__"),
-                                    int(threads), controller_vehicle == "nominal", bool(plant_only))
+                                    int(threads), controller_vehicle == "nominal", bool(plant_only), str(action))
         self.n = n
 
     # --- stepping ----------------------------------------------------------------------------------
 
-    def step(self, omega_cmd: Optional[np.ndarray] = None, periods: int = 1) -> None:
+    def step(self, command: Optional[np.ndarray] = None, periods: int = 1, *,
+             omega_cmd: Optional[np.ndarray] = None) -> None:
         """Advances every vehicle one control period (dt seconds, ticks_per_step plant ticks).
 
-        omega_cmd: None (each vehicle's controller flies) or an (n, 4) array of rotor speeds [rad/s]
-        for this period, the controllers bypassed (as Simulation.step(omega_cmd=)). A wrong shape or a
-        value that is not finite raises ValueError and steps nothing; so does None in a plant_only batch.
+        command: None (each vehicle's controller flies) or an (n, 4) array of commands at the batch's
+        action level (rotor speeds [rad/s] by default; see `action`) for this period, the controllers
+        bypassed (as Simulation.step(omega_cmd=)). A wrong shape or a value that is not finite raises
+        ValueError naming the row and the field, and steps nothing; so does None in a plant_only batch.
+        omega_cmd: the same, by its older name (rotor-speed batches only).
         periods: control periods to advance in this call (the command, if given, held over all of
         them). The numbers equal `periods` calls of step(); each vehicle runs them back to back while
         its data is in the CPU's cache, which is faster for many vehicles (docs/performance.md).
         """
-        self._b.step(omega_cmd, int(periods))
+        if omega_cmd is not None:
+            if command is not None:
+                raise ValueError("Batch.step: give command or omega_cmd, not both")
+            if self.action != "rotor_speeds":
+                raise ValueError(f"Batch.step: omega_cmd: this batch's action is {self.action!r}: give its commands "
+                                 "as command=")
+            command = omega_cmd
+        self._b.step(command, int(periods))
 
     def reset(self, indices: Optional[Sequence[int]] = None, seeds: Any = None, vehicles: Any = None,
               states: Optional[Dict[str, Any]] = None) -> None:
@@ -410,6 +431,11 @@ class Batch:
         return self._b.plant_only()
 
     @property
+    def action(self) -> str:
+        """The command level of step()'s commands ("rotor_speeds", "ctbr", ...)."""
+        return self._b.action()
+
+    @property
     def threads(self) -> int:
         """Worker threads in use (at most n)."""
         return self._b.threads()
@@ -419,4 +445,5 @@ class Batch:
 
     def __repr__(self) -> str:
         lean = " plant_only" if self.plant_only else ""
-        return f"<quadcosim.Batch '{self.scenario.name}' n={self.n} threads={self.threads}{lean}>"
+        action = "" if self.action == "rotor_speeds" else f" action={self.action}"
+        return f"<quadcosim.Batch '{self.scenario.name}' n={self.n} threads={self.threads}{lean}{action}>"

@@ -13,15 +13,26 @@ envs to Stable-Baselines3. See docs/python.md,
 "Gymnasium-style environments".
 
 Spaces (float32):
-  action (4,): normalised rotor commands in [-1, 1] (values outside are clipped), rotor i's speed
-      omega_i = omega_min + (a_i + 1) / 2 * (omega_max - omega_min) [rad/s] with the vehicle's
-      motor.omega_min_rad_s and motor.omega_max_rad_s; the controller is bypassed.
+  action (4,): normalised commands in [-1, 1] (values outside are clipped) at the env's action level
+      (action=, default "rotor_speeds"), each mapped linearly from [-1, 1] onto its range [lo, hi]:
+      c_i = lo_i + (a_i + 1) / 2 * (hi_i - lo_i); the controller is bypassed. The ranges (ACTION_RANGES,
+      the vehicle's k_t, k_m, arm length L, omega_min, omega_max):
+        rotor_speeds   omega_i in [omega_min, omega_max] [rad/s]
+        rotor_thrusts  T_i in [k_t omega_min^2, k_t omega_max^2] [N]
+        ctbr           thrust in [0, 4 k_t omega_max^2] [N]; p, q, r in [-3, 3] rad/s (body FLU)
+        ctatt          thrust as ctbr; roll, pitch in [-0.5, 0.5] rad; yaw in [-pi, pi] rad
+        cttm           thrust as ctbr; torque x, y in [-L k_t omega_max^2, +] [N m]; z in
+                       [-2 k_m omega_max^2, +] [N m]
+        velocity       v_x, v_y, v_z in [-2, 2] m/s (world ENU); yaw in [-pi, pi] rad
+        acceleration   a_x, a_y, a_z in [-4, 4] m/s^2 (world, gravity excluded); yaw in [-pi, pi] rad
+      Above rotor speeds the plant's inner loops fly the command every plant tick (docs/controllers.md).
   observation (18,): [0:3] position error p - p_ref [m, world]; [3:6] velocity error v - v_ref
       [m/s, world] (v_ref = 0 for hovering); [6:15] attitude as the rotation matrix body -> world, row
       by row (R[0,0], R[0,1], ..., R[2,2]); [15:18] body rates [rad/s]. Clipped to the space's bounds
       (+-max_position_error_m, +-max_speed_m_s, +-1, +-max_rate_rad_s).
 Reward per step: 1 - (w_p |e_p|^2 + w_v |e_v|^2 + w_w |w|^2 + w_a |a - a_hover|^2), a_hover the action
-  that commands the vehicle's hover speed sqrt(m g / (4 k_t)); minus termination_penalty on the step
+  that commands hover (rotor speeds sqrt(m g / (4 k_t)); rotor thrusts m g / 4; thrust m g with zero
+  rates, angles or torques; zero velocity or acceleration); minus termination_penalty on the step
   that terminates. Weights default to w_p 1, w_v 0.1, w_w 0.01, w_a 0.01.
 Terminated: a crash (z below crash_altitude_m, or tilted more than max_tilt_rad) or leaving the box
   |e_p| <= max_position_error_m on every axis. Truncated: after max_episode_steps steps.
@@ -47,6 +58,9 @@ __all__ = ["Box", "HoverEnv", "TrackingEnv", "VectorHoverEnv", "VectorTrackingEn
 
 OBS_SIZE = 18
 ACTION_SIZE = 4
+ACTION_LEVELS = ("rotor_speeds", "rotor_thrusts", "ctbr", "ctatt", "cttm", "velocity", "acceleration")
+# The half-ranges of the normalised actions that are not set by the vehicle (see the module's docstring).
+ACTION_RANGES = {"rate_rad_s": 3.0, "angle_rad": 0.5, "speed_m_s": 2.0, "accel_m_s2": 4.0}
 
 # A trimmed hover 1 m above the ground with the paper's vehicle, no noise (the default of HoverEnv).
 HOVER_SCENARIO: Dict[str, Any] = {
@@ -80,19 +94,23 @@ class _Episodes:
                  max_tilt_rad: float, max_speed_m_s: float, max_rate_rad_s: float,
                  reward_weights: Optional[Dict[str, float]], termination_penalty: float,
                  randomize: Optional[Dict[str, Any]], threads: Optional[int],
-                 random_start: Optional[Dict[str, Any]] = None):
+                 random_start: Optional[Dict[str, Any]] = None, action: str = "rotor_speeds"):
+        if action not in ACTION_LEVELS:
+            raise ValueError(f"action = {action!r}: expected one of {', '.join(ACTION_LEVELS)}")
+        self.action = action
         if scenario is None:
             scenario = TRACKING_SCENARIO if tracking else HOVER_SCENARIO
         sections = {"trajectory": trajectory} if trajectory is not None else None
         threads = 1 if threads is None and n < 64 else threads
         try:
             # The actions are the rotor speeds: the plants alone (much faster per step, the same numbers).
-            self.batch = Batch(scenario, n, seeds=0, threads=threads, plant_only=True, _sections=sections)
+            self.batch = Batch(scenario, n, seeds=0, threads=threads, plant_only=True, action=action,
+                               _sections=sections)
         except ConfigError as e:
             if "plant_only" not in str(e):
                 raise
             # Message faults or external dynamics need the whole vehicle with its bus.
-            self.batch = Batch(scenario, n, seeds=0, threads=threads, _sections=sections)
+            self.batch = Batch(scenario, n, seeds=0, threads=threads, action=action, _sections=sections)
         if tracking and not self.batch.tracks_trajectory:
             raise ValueError(f"TrackingEnv: scenario '{self.batch.scenario.name}' has no trajectory: section; give "
                              "one with trajectory={...} (the keys of a scenario's trajectory:, docs/scenarios.md)")
@@ -145,7 +163,8 @@ class _Episodes:
         vp = self.batch.vehicle_params
         self.omega_min = vp["motor.omega_min_rad_s"]
         self.omega_max = vp["motor.omega_max_rad_s"]
-        self.hover_action = 2 * (vp["hover_omega_rad_s"] - self.omega_min) / (self.omega_max - self.omega_min) - 1
+        self.lo, self.hi, hover = _action_ranges(self.action, vp)
+        self.hover_action = 2 * (hover - self.lo) / (self.hi - self.lo) - 1
 
     def draw(self, rng: np.random.Generator) -> Tuple[int, Optional[Dict[str, Any]]]:
         """An episode's noise seed and vehicle keys (uniform within the randomisation ranges)."""
@@ -179,7 +198,8 @@ class _Episodes:
         self.steps[indices] = 0
         self.ended[indices] = False
 
-    def omega_cmd(self, action: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    def command(self, action: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """The clipped actions and the commands they map to at the env's level."""
         a = np.asarray(action, dtype=np.float64)
         if a.shape != (self.n, ACTION_SIZE):
             raise ValueError(f"action: expected shape {(ACTION_SIZE,) if self.n == 1 else (self.n, ACTION_SIZE)}, "
@@ -189,8 +209,7 @@ class _Episodes:
             raise ValueError(f"action{tuple(bad.tolist()) if self.n > 1 else (int(bad[1]),)} = "
                              f"{a[tuple(bad)]}: expected finite numbers in [-1, 1]")
         a = np.clip(a, -1.0, 1.0)
-        omega = self.omega_min[:, None] + (a + 1.0) * 0.5 * (self.omega_max - self.omega_min)[:, None]
-        return a, omega
+        return a, self.lo + (a + 1.0) * 0.5 * (self.hi - self.lo)
 
     def observe(self) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:
         """Observations of all n vehicles and the parts the reward and termination use."""
@@ -211,7 +230,7 @@ class _Episodes:
         w = self.weights
         cost = (w["position"] * np.sum(parts["e_p"] ** 2, axis=1) + w["velocity"] * np.sum(parts["e_v"] ** 2, axis=1)
                 + w["rate"] * np.sum(parts["w"] ** 2, axis=1)
-                + w["action"] * np.sum((a - self.hover_action[:, None]) ** 2, axis=1))
+                + w["action"] * np.sum((a - self.hover_action) ** 2, axis=1))
         crashed = (parts["z"] < self.crash_altitude_m) | (parts["r22"] < self.cos_max_tilt)
         out = np.any(np.abs(parts["e_p"]) > self.max_position_error_m, axis=1)
         terminated = crashed | out
@@ -220,14 +239,43 @@ class _Episodes:
         return reward, terminated, truncated, crashed, out
 
 
+def _action_ranges(level: str, vp: Dict[str, np.ndarray]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(n, 4) lower and upper ends of each action's command and the hover command, for each vehicle."""
+    n = len(vp["mass_kg"])
+    w_lo, w_hi = vp["motor.omega_min_rad_s"], vp["motor.omega_max_rad_s"]
+    kt = vp["kt_N_per_rad2_s2"]
+    weight = vp["mass_kg"] * vp["gravity_m_s2"]
+    zero, one = np.zeros(n), np.ones(n)
+    cols = lambda *c: np.stack(c, axis=1)  # noqa: E731
+    if level == "rotor_speeds":
+        return cols(*[w_lo] * 4), cols(*[w_hi] * 4), cols(*[vp["hover_omega_rad_s"]] * 4)
+    if level == "rotor_thrusts":
+        return cols(*[kt * w_lo**2] * 4), cols(*[kt * w_hi**2] * 4), cols(*[weight / 4] * 4)
+    if level in ("velocity", "acceleration"):
+        r = ACTION_RANGES["speed_m_s" if level == "velocity" else "accel_m_s2"] * one
+        return cols(-r, -r, -r, -math.pi * one), cols(r, r, r, math.pi * one), cols(zero, zero, zero, zero)
+    t_max = 4 * kt * w_hi**2
+    if level == "ctbr":
+        r = ACTION_RANGES["rate_rad_s"] * one
+        half = (r, r, r)
+    elif level == "ctatt":
+        r = ACTION_RANGES["angle_rad"] * one
+        half = (r, r, math.pi * one)
+    else:  # cttm: what one rotor at full speed against its opposite stopped makes; yaw two rotors' drag
+        xy = vp["arm_length_m"] * kt * w_hi**2
+        half = (xy, xy, 2 * vp["km_Nm_per_rad2_s2"] * w_hi**2)
+    return cols(zero, *[-h for h in half]), cols(t_max, *half), cols(weight, zero, zero, zero)
+
+
 def _env_kwargs(kind: str, scenario, trajectory, target, max_episode_steps, max_position_error_m, crash_altitude_m,
                 max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights, termination_penalty, randomize,
-                random_start=None):
+                random_start=None, action="rotor_speeds"):
     return dict(tracking=kind == "tracking", scenario=scenario, trajectory=trajectory, target=target,
                 max_episode_steps=max_episode_steps, max_position_error_m=max_position_error_m,
                 crash_altitude_m=crash_altitude_m, max_tilt_rad=max_tilt_rad, max_speed_m_s=max_speed_m_s,
                 max_rate_rad_s=max_rate_rad_s, reward_weights=reward_weights,
-                termination_penalty=termination_penalty, randomize=randomize, random_start=random_start)
+                termination_penalty=termination_penalty, randomize=randomize, random_start=random_start,
+                action=action)
 
 
 class _BatchEnv:
@@ -288,22 +336,24 @@ class _Env(_BatchEnv):
         return obs[0], self._info(np.zeros(1, bool), np.zeros(1, bool))
 
     def step(self, action: Any):
-        """Flies one control period with the rotor speeds the action maps to. Returns (obs, reward,
-        terminated, truncated, info); info: t [s], crashed, out_of_bounds, omega_cmd [rad/s]."""
+        """Flies one control period with the command the action maps to. Returns (obs, reward,
+        terminated, truncated, info); info: t [s], crashed, out_of_bounds, command (at the env's action
+        level), omega_cmd [rad/s] (the rotor speeds latched in the period's last tick)."""
         e = self._e
         if e.ended[0]:
             raise RuntimeError("step: the episode has ended (or never began): call reset() first")
         a = np.asarray(action, dtype=np.float64)
         if a.shape != (ACTION_SIZE,):
             raise ValueError(f"step: action: expected shape ({ACTION_SIZE},), got {a.shape}")
-        a, omega = e.omega_cmd(a[None])
-        e.batch.step(omega_cmd=omega)
+        a, command = e.command(a[None])
+        e.batch.step(command)
         e.steps += 1
         obs, parts = e.observe()
         reward, terminated, truncated, crashed, out = e.evaluate(parts, a)
         e.ended[0] = bool(terminated[0] or truncated[0])
         info = self._info(crashed, out)
-        info["omega_cmd"] = omega[0]
+        info["command"] = command[0]
+        info["omega_cmd"] = command[0] if e.action == "rotor_speeds" else e.batch.command[0]
         return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), info
 
     def _info(self, crashed: np.ndarray, out: np.ndarray) -> Dict[str, Any]:
@@ -322,6 +372,8 @@ class HoverEnv(_Env):
     max_position_error_m: the box around the target (2 m); crash_altitude_m (0.05 m) and max_tilt_rad
     (pi/2): what counts as a crash; max_speed_m_s (10), max_rate_rad_s (20): observation bounds;
     reward_weights: {"position", "velocity", "rate", "action"}; termination_penalty (10);
+    action: the command level of the actions ("rotor_speeds", default; "rotor_thrusts", "ctbr", "ctatt",
+    "cttm", "velocity", "acceleration": ranges in the module's docstring);
     randomize: domain randomisation on every reset, {vehicle key: (low, high)} drawn uniformly, e.g.
     {"mass_kg": (0.4, 0.55), "motor.tau_up_s": (0.02, 0.05)} (vector keys take arrays of 3);
     random_start: a random start on every reset around the target, {"position_m", "attitude_rad",
@@ -333,11 +385,12 @@ class HoverEnv(_Env):
                  max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05, max_tilt_rad: float = math.pi / 2,
                  max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
-                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None):
+                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None,
+                 action: str = "rotor_speeds"):
         super().__init__("hover", **_env_kwargs("hover", scenario, None, target, max_episode_steps,
                                                 max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
                                                 max_rate_rad_s, reward_weights, termination_penalty, randomize,
-                                                random_start))
+                                                random_start, action))
 
 
 class TrackingEnv(_Env):
@@ -354,11 +407,12 @@ class TrackingEnv(_Env):
                  max_episode_steps: int = 1000, max_position_error_m: float = 2.0, crash_altitude_m: float = 0.05,
                  max_tilt_rad: float = math.pi / 2, max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
-                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None):
+                 randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None,
+                 action: str = "rotor_speeds"):
         super().__init__("tracking", **_env_kwargs("tracking", scenario, trajectory, None, max_episode_steps,
                                                    max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
                                                    max_rate_rad_s, reward_weights, termination_penalty, randomize,
-                                                   random_start))
+                                                   random_start, action))
 
 
 class _VectorEnv(_BatchEnv):
@@ -419,11 +473,11 @@ class _VectorEnv(_BatchEnv):
         rewards (n,) float64, terminated (n,) bool, truncated (n,) bool, info: dict of (n,) arrays t,
         crashed, out_of_bounds)."""
         e, n = self._e, self.num_envs
-        a, omega = e.omega_cmd(actions)
+        a, command = e.command(actions)
         pending = self._autoreset.copy()
         if np.any(e.ended & ~pending):
             raise RuntimeError("step: call reset() first")
-        e.batch.step(omega_cmd=omega)
+        e.batch.step(command)
         e.steps += 1
         if self.autoreset_mode == "next_step" and np.any(pending):
             e.reset(np.flatnonzero(pending), self._rngs, None)  # the step just made for them is discarded
@@ -459,11 +513,12 @@ class VectorHoverEnv(_VectorEnv):
                  max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
                  randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None,
-                 autoreset_mode: str = "next_step", threads: Optional[int] = None):
+                 autoreset_mode: str = "next_step", threads: Optional[int] = None,
+                 action: str = "rotor_speeds"):
         super().__init__("hover", num_envs, autoreset_mode, threads,
                          **_env_kwargs("hover", scenario, None, target, max_episode_steps, max_position_error_m,
                                        crash_altitude_m, max_tilt_rad, max_speed_m_s, max_rate_rad_s, reward_weights,
-                                       termination_penalty, randomize, random_start))
+                                       termination_penalty, randomize, random_start, action))
 
 
 class VectorTrackingEnv(_VectorEnv):
@@ -474,8 +529,10 @@ class VectorTrackingEnv(_VectorEnv):
                  max_tilt_rad: float = math.pi / 2, max_speed_m_s: float = 10.0, max_rate_rad_s: float = 20.0,
                  reward_weights: Optional[Dict[str, float]] = None, termination_penalty: float = 10.0,
                  randomize: Optional[Dict[str, Any]] = None, random_start: Optional[Dict[str, Any]] = None,
-                 autoreset_mode: str = "next_step", threads: Optional[int] = None):
+                 autoreset_mode: str = "next_step", threads: Optional[int] = None,
+                 action: str = "rotor_speeds"):
         super().__init__("tracking", num_envs, autoreset_mode, threads,
                          **_env_kwargs("tracking", scenario, trajectory, None, max_episode_steps,
                                        max_position_error_m, crash_altitude_m, max_tilt_rad, max_speed_m_s,
-                                       max_rate_rad_s, reward_weights, termination_penalty, randomize, random_start))
+                                       max_rate_rad_s, reward_weights, termination_penalty, randomize, random_start,
+                                       action))
