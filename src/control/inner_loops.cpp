@@ -188,13 +188,13 @@ InnerLoopOutput InnerLoops::step(const LevelCommand& sp, const model::State& x) 
     out.allocation = rotor_thrusts(s);
     return out;
   }
-  const Eigen::Matrix3d R = x.q_WB.toRotationMatrix();
   double thrust = s[0];
   Eigen::Vector3d w_des = s.tail<3>();
   Eigen::Vector3d torque = s.tail<3>();
   switch (sp.level) {
     case CommandLevel::kVelocity:
     case CommandLevel::kAcceleration: {
+      const Eigen::Matrix3d R = x.q_WB.toRotationMatrix();
       const Eigen::Vector3d a_des = sp.level == CommandLevel::kVelocity ? velocity_acceleration(s.head<3>(), x.v_W)
                                                                         : Eigen::Vector3d(s.head<3>());
       const ThrustAttitude ta = thrust_attitude(a_des, s[3], R);
@@ -205,6 +205,7 @@ InnerLoopOutput InnerLoops::step(const LevelCommand& sp, const model::State& x) 
       break;
     }
     case CommandLevel::kCtatt: {
+      const Eigen::Matrix3d R = x.q_WB.toRotationMatrix();
       const Eigen::Matrix3d R_des = model::quaternion_from_euler({s[1], s[2], s[3]}).toRotationMatrix();
       w_des = attitude_rates(R_des, R);
       torque = rate_torques(w_des, x.w_B);

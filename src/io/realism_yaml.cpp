@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 
+#include "control/inner_loops.hpp"
 #include "model/wind.hpp"
 #include "sensors/registry.hpp"
 
@@ -165,6 +166,26 @@ void read_realism(YamlSection& root, Scenario& sc) {
   }
   std::stable_sort(r.faults.begin(), r.faults.end(), [](const auto& a, const auto& b) { return a.tick < b.tick; });
   if (std::string err = model::validate(r.wind); !err.empty()) root.fail("environment", err);
+  read_inner_loops(root, sc);
+}
+
+void read_inner_loops(YamlSection& root, Scenario& sc) {
+  auto s = root.section("inner_loops");
+  if (!s) return;
+  const double period_s = sc.simulation.plant.clock.period_s();
+  const auto& table = control::inner_loop_table();
+  control::InnerLoopParams p = control::InnerLoopParams::for_vehicle(sc.vehicle, period_s);
+  constexpr std::string_view kPrefix = "inner.";
+  for (const control::ParameterSpec& spec : table.specs()) {
+    const std::string key(spec.name.substr(kPrefix.size()));  // the section's keys drop "inner."
+    const double value = s->number(key, std::get<double>(*table.get(p, spec.name)), spec.min, spec.max);
+    table.set(p, spec.name, value);
+  }
+  s->reject_unknown_keys();
+  if (std::string err = control::check_inner_loops(p, sc.vehicle, period_s); !err.empty()) {
+    root.fail("inner_loops", err);
+  }
+  sc.simulation.plant.inner_loops = p;
 }
 
 HoldSpec read_hold(YamlSection& s, double duration_s) {

@@ -147,6 +147,7 @@ class Batch {
       realism.seed = seed;
       // The noise streams named as PlantNode names them: by the vehicle's namespace.
       plant = sim::PlantCore(s.vehicle, realism, s.simulation.plant.clock, initial, topics.ns);
+      if (s.simulation.plant.inner_loops) plant.set_inner_loops(*s.simulation.plant.inner_loops);
       if (with_controller) {
         controller.emplace(s.controller, topics, realism.extra_sensors);
         if (!s.schedule.empty()) schedule.emplace(s.schedule, s.simulation.plant.clock);

@@ -31,6 +31,7 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
             topics.ns),
       options_(options) {
   log_ = [](const std::string& line) { std::cerr << line << '\n'; };
+  if (options.inner_loops) core_.set_inner_loops(*options.inner_loops);
   if (options.external) {
     if (std::string key = external_plant_conflict(options.realism, vehicle); !key.empty()) {
       throw std::invalid_argument(key + ": acts inside quadcosim's own plant model only, not with " +

@@ -37,6 +37,9 @@ struct PlantOptions {
   /// receipt clock after use_receipt_clock().
   Tick watchdog_ticks = 50;
   WatchdogPolicy watchdog_policy = WatchdogPolicy::kStop;
+  /// The gains of the inner loops that fly commands above rotor speeds (the scenario's `inner_loops:`);
+  /// none: control::InnerLoopParams::for_vehicle. Checked for the vehicle and period when the node is made.
+  std::optional<control::InnerLoopParams> inner_loops;
   /// Sensor noise, rates and latency, wind, rotor faults (sim/realism.hpp); all off by default.
   RealismConfig realism;
   /// /<ns>/plant_status goes out on every tick whose counters changed and at least every this many

@@ -116,3 +116,16 @@ def test_env_ctbr_actions_map_onto_their_documented_ranges():
     assert np.allclose(command, [[t_max, -3.0, 1.5, 3.0], [0.0, 0.0, 0.0, -1.5]])  # clipped to [-1, 1]
     with pytest.raises(ValueError, match=r"action = 'ctrb': expected one of rotor_speeds"):
         HoverEnv(action="ctrb")
+
+
+def test_the_scenarios_inner_loops_set_the_gains_and_unstable_ones_are_refused():
+    """inner_loops: {rate_bandwidth: 20}: a roll-rate step settles as 1 - exp(-20 t) at the ticks."""
+    tuned = dict(HOVER, inner_loops={"rate_bandwidth": 20.0})
+    b = quadcosim.Batch(tuned, 1, plant_only=True, action="ctbr")
+    for _ in range(10):
+        b.step(np.array([[WEIGHT_N, 0.3, 0.0, 0.0]]))
+        assert abs(b.w[0, 0] - 0.3 * (1 - math.exp(-20.0 * b.t[0]))) < 1e-12
+    with pytest.raises(quadcosim.ConfigError, match=r"inner_loops.*inner.attitude_bandwidth 300 rad/s is unstable"):
+        quadcosim.Batch(dict(HOVER, inner_loops={"attitude_bandwidth": 300.0}), 1, plant_only=True, action="ctbr")
+    with pytest.raises(quadcosim.ConfigError, match=r"rate_bandwith"):
+        quadcosim.Batch(dict(HOVER, inner_loops={"rate_bandwith": 20.0}), 1, plant_only=True)
