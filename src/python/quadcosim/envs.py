@@ -49,6 +49,7 @@ from typing import Any, Dict, Optional, Sequence, Tuple
 import numpy as np
 
 from ._quadcosim import ConfigError
+from .action_levels import ACTION_LEVELS, ACTION_RANGES, action_ranges as _action_ranges
 from .batch import Batch
 from .spaces import Box
 from .starts import RECOVER_START, check_start, draw_start  # noqa: F401  (RECOVER_START: envs.RECOVER_START)
@@ -58,9 +59,6 @@ __all__ = ["Box", "HoverEnv", "TrackingEnv", "VectorHoverEnv", "VectorTrackingEn
 
 OBS_SIZE = 18
 ACTION_SIZE = 4
-ACTION_LEVELS = ("rotor_speeds", "rotor_thrusts", "ctbr", "ctatt", "cttm", "velocity", "acceleration")
-# The half-ranges of the normalised actions that are not set by the vehicle (see the module's docstring).
-ACTION_RANGES = {"rate_rad_s": 3.0, "angle_rad": 0.5, "speed_m_s": 2.0, "accel_m_s2": 4.0}
 
 # A trimmed hover 1 m above the ground with the paper's vehicle, no noise (the default of HoverEnv).
 HOVER_SCENARIO: Dict[str, Any] = {
@@ -237,34 +235,6 @@ class _Episodes:
         reward = 1.0 - cost - self.termination_penalty * terminated
         truncated = self.steps >= self.max_episode_steps
         return reward, terminated, truncated, crashed, out
-
-
-def _action_ranges(level: str, vp: Dict[str, np.ndarray]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(n, 4) lower and upper ends of each action's command and the hover command, for each vehicle."""
-    n = len(vp["mass_kg"])
-    w_lo, w_hi = vp["motor.omega_min_rad_s"], vp["motor.omega_max_rad_s"]
-    kt = vp["kt_N_per_rad2_s2"]
-    weight = vp["mass_kg"] * vp["gravity_m_s2"]
-    zero, one = np.zeros(n), np.ones(n)
-    cols = lambda *c: np.stack(c, axis=1)  # noqa: E731
-    if level == "rotor_speeds":
-        return cols(*[w_lo] * 4), cols(*[w_hi] * 4), cols(*[vp["hover_omega_rad_s"]] * 4)
-    if level == "rotor_thrusts":
-        return cols(*[kt * w_lo**2] * 4), cols(*[kt * w_hi**2] * 4), cols(*[weight / 4] * 4)
-    if level in ("velocity", "acceleration"):
-        r = ACTION_RANGES["speed_m_s" if level == "velocity" else "accel_m_s2"] * one
-        return cols(-r, -r, -r, -math.pi * one), cols(r, r, r, math.pi * one), cols(zero, zero, zero, zero)
-    t_max = 4 * kt * w_hi**2
-    if level == "ctbr":
-        r = ACTION_RANGES["rate_rad_s"] * one
-        half = (r, r, r)
-    elif level == "ctatt":
-        r = ACTION_RANGES["angle_rad"] * one
-        half = (r, r, math.pi * one)
-    else:  # cttm: what one rotor at full speed against its opposite stopped makes; yaw two rotors' drag
-        xy = vp["arm_length_m"] * kt * w_hi**2
-        half = (xy, xy, 2 * vp["km_Nm_per_rad2_s2"] * w_hi**2)
-    return cols(zero, *[-h for h in half]), cols(t_max, *half), cols(weight, zero, zero, zero)
 
 
 def _env_kwargs(kind: str, scenario, trajectory, target, max_episode_steps, max_position_error_m, crash_altitude_m,
