@@ -86,16 +86,10 @@ def _torch():
     return torch
 
 
-def hover_offset(env: VectorHoverEnv, action: Optional[str] = None) -> np.ndarray:
-    """Where the policy's mean starts: with the rotor speeds as the action (the envs' default, action
-    None), the action that commands the first vehicle's hover speed on every rotor; with another kind of
-    action (the envs' action= argument), zeros."""
-    n = env.single_action_space.shape[0]
-    if action is not None and action not in ("rotor_speeds", "rotors", "omega"):
-        return np.zeros(n, dtype=np.float32)
-    vp = env.batch.vehicle_params
-    lo, hi, hover = vp["motor.omega_min_rad_s"][0], vp["motor.omega_max_rad_s"][0], vp["hover_omega_rad_s"][0]
-    return np.full(n, 2 * (hover - lo) / (hi - lo) - 1, dtype=np.float32)
+def hover_offset(env: VectorHoverEnv) -> np.ndarray:
+    """Where the policy's mean starts: the action that commands hover at the env's action level (for
+    the rotor speeds, the envs' default, the first vehicle's hover speed on every rotor)."""
+    return env.hover_action[0].astype(np.float32)
 
 
 class RunningNorm:
@@ -170,7 +164,7 @@ def train(config: Optional[Dict[str, Any]] = None, log=print) -> Dict[str, Any]:
     env = make_env(cfg["envs"], cfg["sim_threads"], **cfg["env_kwargs"])
     n, T = cfg["envs"], cfg["rollout_steps"]
     obs_size, act_size = env.single_observation_space.shape[0], env.single_action_space.shape[0]
-    offset = hover_offset(env, cfg["env_kwargs"].get("action"))
+    offset = hover_offset(env)
     policy = make_policy(obs_size, act_size, cfg["hidden"], cfg["log_std_init"], offset)
     opt = torch.optim.Adam(policy.parameters(), lr=cfg["lr"], eps=1e-5)
     norm = RunningNorm(obs_size)

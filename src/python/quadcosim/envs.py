@@ -158,10 +158,7 @@ class _Episodes:
         return out
 
     def _refresh_vehicles(self) -> None:
-        vp = self.batch.vehicle_params
-        self.omega_min = vp["motor.omega_min_rad_s"]
-        self.omega_max = vp["motor.omega_max_rad_s"]
-        self.lo, self.hi, hover = _action_ranges(self.action, vp)
+        self.lo, self.hi, hover = _action_ranges(self.action, self.batch.vehicle_params)
         self.hover_action = 2 * (hover - self.lo) / (self.hi - self.lo) - 1
 
     def draw(self, rng: np.random.Generator) -> Tuple[int, Optional[Dict[str, Any]]]:
@@ -260,6 +257,12 @@ class _BatchEnv:
     def batch(self) -> Batch:
         """The Batch the env steps (its vehicles' state, sensors, vehicle parameters)."""
         return self._e.batch
+
+    @property
+    def hover_action(self) -> np.ndarray:
+        """(n, k) the normalised action that commands hover at the env's action level, one row per
+        (sub-)env (the reward's a_hover)."""
+        return self._e.hover_action
 
     def close(self):
         pass
