@@ -109,9 +109,7 @@ void Batch::step_lean(std::size_t i, bool bypass, int periods) {
   if (bypass) {
     command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
     // As Simulation::override_level_command sends it: the level named in the layout (none for speeds).
-    if (level_ != control::CommandLevel::kRotorSpeeds || !command.dim.empty()) {
-      msg::set_command_level(command, control::to_string(level_));
-    }
+    msg::set_command_level(command, control::to_string(level_));
   } else {
     command.data.resize(4);
   }

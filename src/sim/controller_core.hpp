@@ -38,8 +38,9 @@ inline void write_command(const control::ControllerOutput& out, msg::Float64Mult
   const Eigen::Vector4d& v = speeds ? out.omega_rad_s : out.setpoint;
   m.data.resize(4);
   for (int i = 0; i < 4; ++i) m.data[static_cast<std::size_t>(i)] = v[i];
-  // Rotor speeds carry no level dimension (the message as before levels existed).
-  if (!speeds || !msg::command_level_name(m).empty()) msg::set_command_level(m, control::to_string(out.level));
+  // Rotor speeds carry no level dimension (the message as before levels existed): set_command_level
+  // removes one left from an earlier step.
+  msg::set_command_level(m, control::to_string(out.level));
 }
 
 class ControllerCore {

@@ -152,8 +152,7 @@ class PlantCore {
   /// The inner loops' gains (InnerLoopParams::for_vehicle when never set): checked for the vehicle and
   /// the plant period, std::invalid_argument naming the gain that does not fit.
   void set_inner_loops(const control::InnerLoopParams& params) {
-    auto next = std::make_unique<Inner>(Inner{control::InnerLoops(model_->params(), params, period_s_), {}});
-    inner_ = std::move(next);
+    inner_ = std::make_unique<Inner>(Inner{control::InnerLoops(model_->params(), params, period_s_), {}});
   }
   /// The inner loops flying a level command (made at the first such command when never set); null
   /// before.
