@@ -9,8 +9,8 @@ steps x num_envs / wall seconds. Per num_envs, the median over --repetitions of:
 
   env          VectorHoverEnv.step(actions) (the hover action, no episode ends): all it does
   batch        Batch.step(omega_cmd=...) alone, the same rotor speeds: the C++ stepping and the call
-  python       the rest: the action checks and the rotor speeds, reading the state arrays, observation,
-               reward and termination in numpy (env minus batch, measured as those calls alone)
+  python       the rest: the action checks and the rotor speeds in numpy, the observation, reward and
+               termination (Batch.env_terms, one pass in C++) (measured as those calls alone)
 
 and the share of `python` in `env`. --threads: the Batch's worker threads (numbers unchanged).
 """
@@ -34,13 +34,12 @@ def measure(n: int, steps: int, repetitions: int, threads: int):
     env = VectorHoverEnv(n, max_episode_steps=10 ** 9, threads=threads)
     env.reset(seed=0)
     e = env.unwrapped._e
-    actions = np.repeat(e.hover_action[:, None], 4, axis=1).astype(np.float32)
-    a, omega = e.omega_cmd(actions)
+    actions = e.hover_action.astype(np.float32)
+    a, omega = e.command(actions)
 
     def python_part():
-        e.omega_cmd(actions)
-        obs, parts = e.observe()
-        e.evaluate(parts, a)
+        e.command(actions)
+        e.terms(a)
 
     out = {"env": [], "batch": [], "python": []}
     for _ in range(repetitions):

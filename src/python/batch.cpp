@@ -16,6 +16,8 @@ namespace quadcosim::python {
 
 namespace {
 
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Merges the mapping `keys` into the mapping `into` (nested mappings key by key; anything else replaces).
@@ -340,7 +342,25 @@ void bind_batch(py::module_& m) {
       .def("size", &Batch::size)
       .def("threads", &Batch::threads)
       .def("plant_only", &Batch::plant_only)
-      .def("lean_vehicles", &Batch::lean_vehicles);
+      .def("lean_vehicles", &Batch::lean_vehicles)
+      .def(
+          "env_terms",
+          [](Batch& b, const Array& p_ref, const std::optional<Array>& v_ref, const Array& action,
+             const Array& hover_action, const Array& obs_bound, const py::dict& weights, const py::dict& limits) {
+            Batch::EnvWeights w;
+            w.position = weights["position"].cast<double>();
+            w.velocity = weights["velocity"].cast<double>();
+            w.rate = weights["rate"].cast<double>();
+            w.action = weights["action"].cast<double>();
+            Batch::EnvLimits l;
+            l.crash_altitude_m = limits["crash_altitude_m"].cast<double>();
+            l.cos_max_tilt = limits["cos_max_tilt"].cast<double>();
+            l.max_position_error_m = limits["max_position_error_m"].cast<double>();
+            l.termination_penalty = limits["termination_penalty"].cast<double>();
+            return b.env_terms(p_ref, v_ref, action, hover_action, obs_bound, w, l);
+          },
+          py::arg("p_ref"), py::arg("v_ref"), py::arg("action"), py::arg("hover_action"), py::arg("obs_bound"),
+          py::arg("weights"), py::arg("limits"));
   m.def("_swarm_wall_s", &swarm_wall_s, py::arg("yaml"), py::arg("source"), py::arg("n"), py::arg("ticks"),
         py::arg("threads"), py::arg("block_ticks"), py::arg("warmup_ticks"),
         "Wall seconds of n vehicles of the in-process swarm (sim::Swarm) over `ticks` plant ticks.");

@@ -128,6 +128,31 @@ class Batch {
   int ticks_per_step();
   double plant_period_s();
 
+  /// The environments' reward weights (quadcosim/envs.py, _REWARD_WEIGHTS).
+  struct EnvWeights {
+    double position = 1.0, velocity = 0.1, rate = 0.01, action = 0.01;
+  };
+  /// The environments' termination limits and penalty; cos_max_tilt is cos(max_tilt_rad).
+  struct EnvLimits {
+    double crash_altitude_m = 0.0, cos_max_tilt = 0.0, max_position_error_m = 0.0, termination_penalty = 0.0;
+  };
+  /// Entries of an environment's observation: position error, velocity error, rotation matrix, body rates.
+  static constexpr std::size_t kEnvObservationSize = 18;
+  /// One environment step's terms for every vehicle as it stands (batch_env.cpp): the observation
+  /// [p - p_ref, v - v_ref (v_ref none: 0), R_WB row by row, w_B] clipped to +-obs_bound, as float32
+  /// (n, 18); the reward 1 - (w_p |e_p|^2 + w_v |e_v|^2 + w_w |w|^2 + w_a |action - hover_action|^2)
+  /// - penalty on termination (n,); terminated = crashed | out (n,), crashed (z below the crash altitude
+  /// or R_WB[2,2] below cos_max_tilt) and out (|e_p| beyond the limit on an axis). p_ref, v_ref: (n, 3);
+  /// action, hover_action: (n, 4) (action already clipped to [-1, 1]); obs_bound: (18,). A wrong shape
+  /// raises ValueError naming the argument.
+  pybind11::tuple env_terms(
+      const pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>& p_ref,
+      const std::optional<pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>>& v_ref,
+      const pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>& action,
+      const pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>& hover_action,
+      const pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>& obs_bound,
+      const EnvWeights& weights, const EnvLimits& limits);
+
  private:
   struct Vehicle {
     std::shared_ptr<const io::Scenario> scenario;

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "control/care.hpp"
+#include "control/command_level.hpp"
 #include "hosts/inprocess_run.hpp"
 #include "hosts/swarm_inprocess.hpp"
 #include "io/output_folder.hpp"
@@ -66,14 +67,21 @@ class PySimulation {
     build();
   }
 
-  void step(const std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>& omega_cmd) {
-    std::optional<model::Vector4> command;
-    if (omega_cmd) {
-      if (omega_cmd->ndim() != 1 || omega_cmd->shape(0) != 4) {
-        throw py::value_error("Simulation.step: omega_cmd: expected 4 rotor speeds [rad/s], got an array of shape " +
-                              py::repr(omega_cmd->attr("shape")).cast<std::string>());
-      }
-      command = model::Vector4(omega_cmd->at(0), omega_cmd->at(1), omega_cmd->at(2), omega_cmd->at(3));
+  using Values = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+  void step(const std::optional<Values>& omega_cmd, const std::optional<Values>& command,
+            const std::optional<std::string>& level) {
+    std::optional<control::LevelCommand> given;
+    if (omega_cmd && command) {
+      throw py::value_error("Simulation.step: give omega_cmd (rotor speeds) or command (with level), not both");
+    }
+    if (level && !command) throw py::value_error("Simulation.step: level='" + *level + "' needs command=");
+    if (omega_cmd) given = level_command(*omega_cmd, control::CommandLevel::kRotorSpeeds, "omega_cmd");
+    if (command) {
+      const std::string name = level.value_or("rotor_speeds");
+      const std::optional<control::CommandLevel> l = control::command_level_from_string(name);
+      if (!l) throw py::value_error("Simulation.step: " + control::unknown_command_level(name));
+      given = level_command(*command, *l, "command");
     }
     auto lock = guard();
     py::gil_scoped_release release;
@@ -81,12 +89,34 @@ class PySimulation {
     struct Done {
       PySimulation& s;
       ~Done() {
-        s.sim_->override_command(std::nullopt);
+        s.sim_->override_level_command(std::nullopt);
         s.stepping_ = std::thread::id();
       }
     } done{*this};
-    sim_->override_command(command);
+    sim_->override_level_command(given);
     for (int i = 0; i < divider(); ++i) sim_->tick(next_tick_++);
+  }
+
+  /// `values` as a command at `level`: one-dimensional, 4 values (rotor_speeds: one per rotor) that
+  /// control::check_setpoint accepts (finite); else ValueError naming `arg`. Rotor speeds out of
+  /// range are not refused here: the plant checks and limits them as any command it receives.
+  static control::LevelCommand level_command(const Values& values, control::CommandLevel level, const char* arg) {
+    if (values.ndim() != 1 || values.shape(0) != 4) {
+      throw py::value_error(std::string("Simulation.step: ") + arg + ": expected 4 values (" +
+                            std::string(control::to_string(level)) + ": " + fields_text(level) +
+                            "), got an array of shape " + py::repr(values.attr("shape")).cast<std::string>());
+    }
+    if (level != control::CommandLevel::kRotorSpeeds) {
+      if (std::string why = control::check_setpoint(level, values.data(), 4); !why.empty()) {
+        throw py::value_error(std::string("Simulation.step: ") + arg + ": " + why);
+      }
+    }
+    return {level, Eigen::Vector4d(values.at(0), values.at(1), values.at(2), values.at(3))};
+  }
+  static std::string fields_text(control::CommandLevel level) {
+    std::string text;
+    for (std::string_view f : control::setpoint_fields(level)) text += (text.empty() ? "" : ", ") + std::string(f);
+    return text;
   }
 
   void set_setpoint(const py::kwargs& values) {
@@ -299,12 +329,17 @@ controller written in Python, an instance or a class (see docs/python.md, "Write
 Python"): each Simulation flies its own copy.deepcopy of the configured object.
 seed replaces the scenario's seed of sensor noise, wind and injected message faults (None keeps
 realism.seed). step_timeout_s: the per-step time limit of a Python controller (0: none).)")
-      .def("step", &PySimulation::step, py::arg("omega_cmd") = py::none(),
+      .def("step", &PySimulation::step, py::arg("omega_cmd") = py::none(), py::kw_only(),
+           py::arg("command") = py::none(), py::arg("level") = py::none(),
            R"(Advances one control period (sim.dt seconds, several plant ticks).
 
 With omega_cmd (4 rotor speeds [rad/s], rotors 1..4) the controller is bypassed for this period:
 the command goes to the plant on the motor command topic and is checked, limited and latched by the
-plant like the controller's (the controller neither steps nor publishes a status).)")
+plant like the controller's (the controller neither steps nor publishes a status).
+With command= and level= (a command level: "rotor_thrusts", "ctbr", "ctatt", "cttm", "velocity",
+"acceleration"; its 4 values in quadcosim.action_levels' order and units) the controller is bypassed
+the same way and the plant's inner loops fly that level at the plant rate, as for a controller that
+outputs it. A level command is held until the next command.)")
       .def("set_setpoint", &PySimulation::set_setpoint,
            R"(Sets the controller node's setpoints by keyword, from the next step on:
 x, y, z [m] (x and y in position mode), roll, pitch [rad] (attitude mode), yaw [rad], and

@@ -129,3 +129,32 @@ def test_the_scenarios_inner_loops_set_the_gains_and_unstable_ones_are_refused()
         quadcosim.Batch(dict(HOVER, inner_loops={"attitude_bandwidth": 300.0}), 1, plant_only=True, action="ctbr")
     with pytest.raises(quadcosim.ConfigError, match=r"rate_bandwith"):
         quadcosim.Batch(dict(HOVER, inner_loops={"rate_bandwith": 20.0}), 1, plant_only=True)
+
+
+def test_simulation_step_at_a_level_equals_a_batch_vehicle_bit_for_bit():
+    """Simulation.step(command=, level=) bypasses the controller like omega_cmd= and hands the plant a
+    level command: the same bits as a Batch vehicle (the plant core stepped without a bus) flying it."""
+    sim = quadcosim.Simulation(HOVER)
+    lean = quadcosim.Batch(HOVER, 1, plant_only=True, action="ctbr")
+    for command in ctbr_sequence(40, 1):
+        sim.step(command=command[0], level="ctbr")
+        lean.step(command)
+        state = sim.state
+        for name in ("p", "v", "q", "w", "omega"):
+            assert state[name].tobytes() == getattr(lean, name)[0].tobytes(), name
+    assert np.abs(sim.state["w"]).max() > 0.01  # the rates were flown
+
+
+def test_simulation_step_at_a_level_refuses_what_is_wrong():
+    sim = quadcosim.Simulation(HOVER)
+    with pytest.raises(ValueError, match="unknown command level 'ctrb'.*did you mean 'ctbr'"):
+        sim.step(command=np.zeros(4), level="ctrb")
+    with pytest.raises(ValueError, match=r"ctbr: value 3 \(q \[rad/s\]\) is nan"):
+        sim.step(command=np.array([WEIGHT_N, 0.0, math.nan, 0.0]), level="ctbr")
+    with pytest.raises(ValueError, match=r"command: expected 4 values \(velocity: .*got an array of shape \(3,\)"):
+        sim.step(command=np.zeros(3), level="velocity")
+    with pytest.raises(ValueError, match="not both"):
+        sim.step(np.zeros(4), command=np.zeros(4), level="ctbr")
+    with pytest.raises(ValueError, match="needs command="):
+        sim.step(level="ctbr")
+    assert sim.t == 0.0  # nothing refused was flown
