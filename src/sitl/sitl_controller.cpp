@@ -79,6 +79,10 @@ struct SitlController::Link {
   // The mission: the item in progress, when it was last sent (simulated time), the answers to it.
   MissionProgress mission;
   long long decisions = 0;
+  // Its heartbeat's armed bit and custom_mode as seen at the last 0.25 s decision (out.armed,
+  // out.mode): a heartbeat arrives over TCP at a wall time, so the newest one at a given frame can
+  // differ between two runs; at the decisions, which the mission already waits on, it does not.
+  double shown_armed = 0.0, shown_mode = -1.0;
   std::ofstream statustext;
 
   void send(std::uint32_t msgid, const std::vector<std::uint8_t>& payload) {
@@ -309,6 +313,8 @@ void SitlController::service_mavlink() {
   const long long decision = static_cast<long long>(std::floor(t_s_ / 0.25 + 1e-9));
   if (decision < l.decisions) return;
   l.decisions = decision + 1;
+  l.shown_armed = l.heartbeat.armed() ? 1.0 : 0.0;
+  l.shown_mode = static_cast<double>(l.heartbeat.custom_mode);
   if (decision % 4 == 0) l.send(mavlink::kHeartbeat, mavlink::heartbeat(6, 8, 0, 0, 4));  // a GCS, at 1 Hz
   // Accepted, and for a mode or arming, shown so by the firmware's heartbeat: the next one.
   const MissionItem* due = l.mission.due(t_s_, spec_.mission, [&](const MissionItem& m) {
@@ -471,8 +477,8 @@ void SitlController::step(const control::Observation& obs, const control::Refere
     for (int c = 0; c < 4; ++c) out.outputs[1 + c] = c < static_cast<int>(packet.pwm_us.size()) ? packet.pwm_us[c] : 0;
     out.outputs[5] = static_cast<double>(counts_.repeated);
     out.outputs[6] = static_cast<double>(counts_.skipped);
-    out.outputs[7] = l.have_heartbeat && l.heartbeat.armed() ? 1.0 : 0.0;
-    out.outputs[8] = l.have_heartbeat ? static_cast<double>(l.heartbeat.custom_mode) : -1.0;
+    out.outputs[7] = l.shown_armed;
+    out.outputs[8] = l.shown_mode;
     out.outputs[9] = static_cast<double>(l.mission.item);
     control::rotor_speeds_output(model_, reference, omega, reported_, out);
     break;

@@ -313,6 +313,11 @@ assert abs(float(at(13.5)["z"]) - 5) < 0.3, at(13.5)["z"]
 last = rows[-1]
 assert float(last["z"]) == 0.0 and last["out.armed"] == "0" and last["out.mode"] == "9", last
 assert float(last["out.mission"]) == 5
+# out.armed and out.mode are the heartbeat as seen at the 0.25 s decisions: after the first one (the
+# first heartbeat's frame) they change only at whole multiples of 0.25 s.
+shown = [(float(r["t"]), r["out.armed"], r["out.mode"]) for r in rows]
+changes = [t for (t, *a), (_, *b) in zip(shown[1:], shown) if a != b][1:]
+assert changes and all(abs(t * 4 - round(t * 4)) < 1e-9 for t in changes), changes
 print(f"mission: armed at {armed[0]:.4f} s, z(7.5 s) = {float(at(7.5)['z']):.3f} m, "
       f"z(13.5 s) = {float(at(13.5)['z']):.3f} m, landed and disarmed; two runs identical")
 PY
