@@ -105,6 +105,33 @@ assert float(last["out.frame"]) == len(rows) - 1 and float(last["out.repeated"])
 print(f"hover: z(12 s) = {z:.4f} m, mean rotor speed over the last 2 s {mean_w:.1f} rad/s (closed form {hover:.1f})")
 PY
     ;;
+  swarm)
+    # A swarm of four vehicles, each flown by a test firmware process of its own on its own ports
+    # (2x2 grid, 3 m apart): vehicle 0 gives the single vehicle's trajectory.csv bytes, vehicle 3 the
+    # same numbers 3 m over in x and y; every firmware gone afterwards.
+    scenario fake_hover one --fake-pid-file "$tmp/one.pid"
+    scenario fake_hover sw --fake-pid-file "$tmp/sw.pid"
+    printf 'swarm:\n  vehicles: 4\n  spacing_m: 3.0\n  threads: 2\n  record_vehicles: [0, 3]\n' >> "$tmp/sw.yaml"
+    run one 0
+    run sw 0
+    ! pgrep -f -- "--fake-pid-file $tmp/sw.pid" > /dev/null || fail "a swarm firmware still runs after the run"
+    cmp "$tmp/one/trajectory.csv" "$tmp/sw/uav0000/trajectory.csv" || fail "swarm vehicle 0 differs from the single run"
+    "$py" - "$tmp/one/trajectory.csv" "$tmp/sw/uav0003/trajectory.csv" "$tmp/sw/vehicles.csv" <<'PY' || fail "swarm"
+import csv, sys
+one, v3 = (list(csv.DictReader(open(f))) for f in sys.argv[1:3])
+assert len(one) == len(v3) == 4801, (len(one), len(v3))
+for a, b in zip(one, v3):
+    for k in a:
+        if k in ("x", "y", "x_des", "y_des"):
+            assert abs(float(b[k]) - float(a[k]) - 3.0) < 1e-12, (a["t"], k, a[k], b[k])
+        else:
+            assert a[k] == b[k], (a["t"], k, a[k], b[k])
+vehicles = list(csv.DictReader(open(sys.argv[3])))
+assert len(vehicles) == 4 and all(abs(float(v["z_m"]) - 2.0) < 0.05 for v in vehicles), vehicles
+print(f"swarm: 4 firmware processes, z(12 s) = {[round(float(v['z_m']), 4) for v in vehicles]} m; "
+      "vehicle 0 = the single run's bytes, vehicle 3 the same 3 m over")
+PY
+    ;;
   repeated_frames)
     # Frames sent twice (the first three times) are dropped and counted, never answered or flown twice:
     # the trajectory is the open-loop one, column for column, with 2 + 114 (frames 7, 14, ..., 798)
