@@ -73,6 +73,7 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   for (std::size_t i = 0; i < topics.level_commands.size(); ++i) command_topics_[1 + i] = topics.level_commands[i];
   transport.subscribe_with_sender<msg::Float64MultiArray>(
       topics.motor_commands, [this](const msg::Float64MultiArray& m, SenderId sender) { on_command(m, sender); });
+  if (!options.typed_command_topics) return;
   msg::for_each_level_message([&]<class T>() {
     transport.subscribe_with_sender<T>(topics.level_commands[static_cast<std::size_t>(T::kLevel)],
                                        [this](const T& m, SenderId sender) { on_level_command(m, sender); });

@@ -66,6 +66,9 @@ struct PlantOptions {
   /// (noise, rates, latency) are the node's either way; wind, rotor faults and aerodynamic drag act
   /// inside the native model only (external_plant_conflict refuses them).
   std::shared_ptr<const ExternalDynamicsFactory> external;
+  /// Subscribe the typed command topics /<ns>/cmd/<level> beside motor_commands. Off for a host whose
+  /// controllers are quadcosim's own (a DDS swarm: seven readers fewer per vehicle to discover).
+  bool typed_command_topics = true;
 };
 
 /// "" when the native-only features (wind, rotor faults, the vehicle's aerodynamics) are all off,
