@@ -11,8 +11,9 @@
 //                 kv (z_des - z)), yaw 0
 //   reject        as fly-ctbr, but the control tick at t = 0 gets a NaN thrust, t = 0.02 s a RotorThrusts
 //                 of 3 values (rt/drone/cmd/rotor_thrusts), t = 0.04 s is answered on ctbr and then on
-//                 rt/drone/cmd/velocity too, t = 0.06 s gets a ThrustAttitude (rt/drone/cmd/ctatt) whose
-//                 quaternion has norm 0.5
+//                 rt/drone/cmd/velocity too, t = 1 s gets a ThrustAttitude (rt/drone/cmd/ctatt) whose
+//                 quaternion has norm 0.5 (apart from the others: plant_status.last_problem names the
+//                 newest, and the second topic's refusal may come a tick late)
 // header.stamp of each command is the stamp of the samples it answers (the control tick's time). Each
 // tick is answered once, after the writers have matched the plant's readers. The participant ends
 // once it answered the tick at END_S and nothing arrived for 1 s (or after 60 s of wall time), and
@@ -261,7 +262,7 @@ int main(int argc, char** argv) {
       m.thrust_n._length = m.thrust_n._maximum = 3;
       m.thrust_n._buffer = three;
       if (const dds_return_t rc = dds_write(e.thrusts, &m); rc < 0) die("dds_write rotor_thrusts", rc);
-    } else if (mode == "reject" && s == 3 * kControlPeriodNs) {
+    } else if (mode == "reject" && s == 50 * kControlPeriodNs) {
       quadcosim_msgs_msg_dds__ThrustAttitude_ m{};
       m.header.stamp = time_of(s);
       m.thrust_n = thrust_n;
