@@ -66,6 +66,53 @@ TEST(TypedCommands, TopicsAreNamedAfterTheLevels) {
   EXPECT_EQ(Topics::for_namespace("/").level_commands[3], "/cmd/ctatt");
 }
 
+// Each typed message's fields are its level's four values in command_level.hpp's order (setpoint_fields).
+TEST(TypedCommands, EachMessageIsItsLevelsFourValuesInOrder) {
+  const auto values = [](const msg::LevelValues& v) { return std::vector<double>(v.data(), v.data() + v.count()); };
+  msg::RotorSpeeds speeds;
+  speeds.omega_rad_s = {1.0, 2.0, 3.0, 4.0};
+  EXPECT_EQ(msg::level_values(speeds).level, control::CommandLevel::kRotorSpeeds);
+  EXPECT_EQ(values(msg::level_values(speeds)), (std::vector<double>{1.0, 2.0, 3.0, 4.0}));
+  msg::RotorThrusts thrusts;
+  thrusts.thrust_n = {5.0, 6.0, 7.0};
+  EXPECT_EQ(msg::level_values(thrusts).level, control::CommandLevel::kRotorThrusts);
+  EXPECT_EQ(values(msg::level_values(thrusts)), (std::vector<double>{5.0, 6.0, 7.0}));  // the length as sent
+  msg::ThrustRates rates;
+  rates.thrust_n = 19.0;
+  rates.body_rates_rad_s = {0.1, 0.2, 0.3};
+  EXPECT_EQ(msg::level_values(rates).level, control::CommandLevel::kCtbr);
+  EXPECT_EQ(values(msg::level_values(rates)), (std::vector<double>{19.0, 0.1, 0.2, 0.3}));  // U1, p, q, r
+  msg::ThrustTorque torque;
+  torque.thrust_n = 20.0;
+  torque.torque_nm = {0.01, 0.02, 0.03};
+  EXPECT_EQ(msg::level_values(torque).level, control::CommandLevel::kCttm);
+  EXPECT_EQ(values(msg::level_values(torque)), (std::vector<double>{20.0, 0.01, 0.02, 0.03}));  // U1, U2..U4
+  msg::VelocityYaw velocity;
+  velocity.velocity_m_s = {1.0, -2.0, 0.5};
+  velocity.yaw_rad = 0.7;
+  EXPECT_EQ(msg::level_values(velocity).level, control::CommandLevel::kVelocity);
+  EXPECT_EQ(values(msg::level_values(velocity)), (std::vector<double>{1.0, -2.0, 0.5, 0.7}));
+  msg::AccelerationYaw acceleration;
+  acceleration.acceleration_m_s2 = {0.3, 0.2, -0.1};
+  acceleration.yaw_rad = -1.0;
+  EXPECT_EQ(msg::level_values(acceleration).level, control::CommandLevel::kAcceleration);
+  EXPECT_EQ(values(msg::level_values(acceleration)), (std::vector<double>{0.3, 0.2, -0.1, -1.0}));
+  // ctatt: U1 and the Z-Y-X angles of the quaternion; a yaw of pi/2 alone is q = (0, 0, sin(pi/4), cos(pi/4)).
+  msg::ThrustAttitude attitude;
+  attitude.thrust_n = 18.0;
+  attitude.attitude = {0.0, 0.0, std::sin(std::numbers::pi / 4.0), std::cos(std::numbers::pi / 4.0)};
+  const msg::LevelValues a = msg::level_values(attitude);
+  EXPECT_EQ(a.level, control::CommandLevel::kCtatt);
+  ASSERT_EQ(a.count(), 4u);
+  EXPECT_EQ(a.data()[0], 18.0);
+  EXPECT_NEAR(a.data()[1], 0.0, 1e-15);
+  EXPECT_NEAR(a.data()[2], 0.0, 1e-15);
+  EXPECT_NEAR(a.data()[3], std::numbers::pi / 2.0, 1e-15);
+  EXPECT_NEAR(a.attitude_norm, 1.0, 1e-15);
+  // The default ThrustAttitude (w = 1, as the .msg default) is level flight.
+  EXPECT_EQ(values(msg::level_values(msg::ThrustAttitude{})), (std::vector<double>{0.0, 0.0, 0.0, 0.0}));
+}
+
 // ctbr on /drone/cmd/ctbr and the same four values labelled level=ctbr on motor_commands: the same
 // states, bit for bit, over 300 ticks of a varying setpoint.
 TEST(TypedCommands, ATypedCommandFliesAsTheSameValuesNamedInTheLayout) {
