@@ -14,6 +14,7 @@
 #include "model/attitude.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/level_messages.hpp"
+#include "sim/message_schema.hpp"
 #include "sim/plant_node.hpp"
 #include "sim/topics.hpp"
 
@@ -111,6 +112,24 @@ TEST(TypedCommands, EachMessageIsItsLevelsFourValuesInOrder) {
   EXPECT_NEAR(a.attitude_norm, 1.0, 1e-15);
   // The default ThrustAttitude (w = 1, as the .msg default) is level flight.
   EXPECT_EQ(values(msg::level_values(msg::ThrustAttitude{})), (std::vector<double>{0.0, 0.0, 0.0, 0.0}));
+}
+
+// The schema text recordings carry for a typed command (the ros2msg convention, written out by hand):
+// the fields, then each type they use.
+TEST(TypedCommands, RecordingsDescribeTheTypedMessagesAsTheirMsgFiles) {
+  EXPECT_EQ(msg::ros2msg_definition("quadcosim_msgs/msg/ThrustAttitude"),
+            "std_msgs/Header header\nfloat64 thrust_n\ngeometry_msgs/Quaternion attitude\n"
+            "================================================================================\n"
+            "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
+            "================================================================================\n"
+            "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+            "================================================================================\n"
+            "MSG: geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n");
+  const std::string& v = msg::ros2msg_definition("quadcosim_msgs/msg/VelocityYaw");
+  EXPECT_EQ(v.substr(0, v.find("====")),
+            "std_msgs/Header header\ngeometry_msgs/Vector3 velocity_m_s\nfloat64 yaw_rad\n");
+  const std::string& r = msg::ros2msg_definition("quadcosim_msgs/msg/RotorThrusts");
+  EXPECT_EQ(r.substr(0, r.find("====")), "std_msgs/Header header\nfloat64[] thrust_n\n");
 }
 
 // ctbr on /drone/cmd/ctbr and the same four values labelled level=ctbr on motor_commands: the same
