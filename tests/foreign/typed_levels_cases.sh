@@ -23,7 +23,9 @@ EOF
 # fly MODE: the plant (lockstep, recording) driven by foreign_levels MODE; leaves $tmp/plant.csv and
 # $tmp/foreign.json.
 fly() {
-  "$bin" plant --scenario "$tmp/climb.yaml" --timeout 20 --record "$tmp/plant.csv" > "$tmp/plant.log" 2>&1 &
+  mkdir -p "$tmp/bag"
+  "$bin" plant --scenario "$tmp/climb.yaml" --timeout 20 --record "$tmp/plant.csv" --mcap "$tmp/bag/run.mcap" \
+    > "$tmp/plant.log" 2>&1 &
   local plant_pid=$!
   pids+=("$plant_pid")
   "$foreign" "$1" 4 > "$tmp/foreign.json" 2> "$tmp/foreign.log" &
@@ -61,6 +63,17 @@ case "$case_name" in
   typed_ctbr_identical)
     fly fly-ctbr
     same_states ctbr
+    # run.mcap records the typed topic: one ThrustRates per control tick (t = 0 .. 4 s).
+    /usr/bin/python3 - "$tmp/bag/metadata.yaml" <<'PY' || fail "run.mcap does not hold the typed commands"
+import sys, yaml
+meta = yaml.safe_load(open(sys.argv[1]))["rosbag2_bagfile_information"]
+topics = {t["topic_metadata"]["name"]: t for t in meta["topics_with_message_count"]}
+ctbr = topics["/drone/cmd/ctbr"]
+assert ctbr["topic_metadata"]["type"] == "quadcosim_msgs/msg/ThrustRates", ctbr
+assert ctbr["message_count"] == 201, ctbr
+assert "/drone/cmd/velocity" not in topics, sorted(topics)
+print(f"run.mcap: {ctbr['message_count']} messages on /drone/cmd/ctbr")
+PY
     ;;
   typed_velocity_identical)
     fly fly-velocity
