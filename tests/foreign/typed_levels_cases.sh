@@ -8,6 +8,9 @@
 #     on ThrustRates (VelocityYaw); the plant's recorded states, every tick, bit for bit those of the
 #     same law at the same level flown in-process (typed_levels_reference: sim::Simulation, the level
 #     named in the command's layout on motor_commands).
+#   typed_realtime: the ctbr law against `quadcosim plant --realtime` (4 s of wall time; the stamps are
+#     not read): nothing refused, and the climb to 2 m flown (the answers come a little late and the first
+#     ones before discovery are lost, so within 0.3 m of 2 m at the end, not bit for bit).
 #   typed_rejections: a NaN, a RotorThrusts of 3 values, a tick commanded on two topics (t = 0, 0.02,
 #     0.04 s) and a ThrustAttitude with a quaternion of norm 0.5 (t = 1 s): refused, each counted once in
 #     plant_status under its own counter and named in last_problem; the run goes on and climbs.
@@ -105,6 +108,28 @@ print(f"refused and named: {problems}")
 PY
     grep -q "rejected 3, clamped 0, stale 0; foreign (not the controller's writers) 0; on a second topic 1" \
       "$tmp/plant.log" || fail "plant summary: $(grep 'plant: done' "$tmp/plant.log")"
+    ;;
+  typed_realtime)
+    "$bin" plant --realtime --duration 4 --watchdog-policy hold --record "$tmp/plant.csv" > "$tmp/plant.log" 2>&1 &
+    plant_pid=$!
+    pids+=("$plant_pid")
+    "$foreign" fly-ctbr 4 > "$tmp/foreign.json" 2> "$tmp/foreign.log" &
+    foreign_pid=$!
+    pids+=("$foreign_pid")
+    rc=0
+    wait "$plant_pid" || rc=$?
+    [ "$rc" -eq 0 ] || fail "plant exited $rc"
+    rc=0
+    wait "$foreign_pid" || rc=$?
+    [ "$rc" -eq 0 ] || fail "foreign_levels exited $rc"
+    grep -Eq "commands received [1-9][0-9]+, rejected 0, clamped 0, stale 0; foreign \(not the controller's writers\) 0; on a second topic 0" \
+      "$tmp/plant.log" || fail "plant summary: $(grep 'plant: done' "$tmp/plant.log")"
+    /usr/bin/python3 - "$tmp/plant.csv" <<'PY' || fail "the climb was not flown"
+import csv, sys
+z = [float(r["z"]) for r in csv.DictReader(open(sys.argv[1]))]
+assert abs(z[-1] - 2.0) < 0.3 and max(z) < 3.0, (z[-1], max(z))
+print(f"real time: z {z[0]} -> {z[-1]:.3f} m over {len(z)} rows")
+PY
     ;;
   *) fail "unknown case $case_name" ;;
 esac
