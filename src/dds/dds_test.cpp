@@ -1066,6 +1066,8 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
   ps.watchdog_ticks = 250;
   ps.commands_stale = 7;
   ps.commands_foreign = 1;
+  ps.commands_rejected_second_topic = 2;
+  ps.commands_rejected_bad_quaternion = 3;
   EXPECT_EQ(to_yaml(ps),
             "header:\n"
             "  stamp:\n"
@@ -1081,7 +1083,9 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "watchdog_trips: 3\n"
             "watchdog_ticks: 250\n"
             "commands_stale: 7\n"
-            "commands_foreign: 1\n");
+            "commands_foreign: 1\n"
+            "commands_rejected_second_topic: 2\n"
+            "commands_rejected_bad_quaternion: 3\n");
 }
 
 // The sensor types, written out by hand as `ros2 topic echo` prints them (int8 and uint16 as plain

@@ -1,11 +1,12 @@
 // The DDS wire layout (src/dds/idl/*.idl, what idlc compiles into the C types Cyclone serialises)
 // against the one statement of each message's fields (sim/message_schema.hpp, from fields()): every
-// message type quadcosim writes that the IDL declares has the same fields, in the same order, with the
+// message type quadcosim writes or takes that the IDL declares has the same fields, in the same order, with the
 // same types, as rmw maps .msg types to IDL (float64 -> double, bool -> boolean, T[] -> sequence<T>,
 // T[N] -> a field with [N], pkg/msg/Type -> pkg::msg::dds_::Type_).
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <set>
@@ -70,10 +71,13 @@ TEST(IdlSchemaTest, TheWireLayoutIsTheMessagesFields) {
   const auto idl = idl_structs();
   // What quadcosim's nodes publish on DDS (docs/ros2.md), and every type those contain.
   std::vector<std::string> todo = {
-      "geometry_msgs/msg/PoseStamped",  "geometry_msgs/msg/TwistStamped", "sensor_msgs/msg/Imu",
-      "sensor_msgs/msg/MagneticField",  "sensor_msgs/msg/FluidPressure",  "sensor_msgs/msg/NavSatFix",
-      "std_msgs/msg/Float64MultiArray", "rosgraph_msgs/msg/Clock",        "quadcosim_msgs/msg/ControllerStatus",
-      "quadcosim_msgs/msg/PlantStatus", "tf2_msgs/msg/TFMessage",         "std_msgs/msg/String"};
+      "geometry_msgs/msg/PoseStamped",     "geometry_msgs/msg/TwistStamped",  "sensor_msgs/msg/Imu",
+      "sensor_msgs/msg/MagneticField",     "sensor_msgs/msg/FluidPressure",   "sensor_msgs/msg/NavSatFix",
+      "std_msgs/msg/Float64MultiArray",    "rosgraph_msgs/msg/Clock",         "quadcosim_msgs/msg/ControllerStatus",
+      "quadcosim_msgs/msg/PlantStatus",    "tf2_msgs/msg/TFMessage",          "std_msgs/msg/String",
+      "quadcosim_msgs/msg/RotorSpeeds",    "quadcosim_msgs/msg/RotorThrusts", "quadcosim_msgs/msg/ThrustRates",
+      "quadcosim_msgs/msg/ThrustAttitude", "quadcosim_msgs/msg/ThrustTorque", "quadcosim_msgs/msg/VelocityYaw",
+      "quadcosim_msgs/msg/AccelerationYaw"};
   std::set<std::string> done;
   while (!todo.empty()) {
     const std::string name = todo.back();
@@ -90,7 +94,59 @@ TEST(IdlSchemaTest, TheWireLayoutIsTheMessagesFields) {
   }
   // Header, Time, Pose, Point, Quaternion, Twist, Vector3, NavSatStatus, MultiArrayLayout,
   // MultiArrayDimension, TransformStamped, Transform.
-  EXPECT_EQ(done.size(), 24u) << "the twelve types and the twelve they contain";
+  EXPECT_EQ(done.size(), 31u) << "the nineteen types and the twelve they contain";
+}
+
+// A .msg file's fields as "TYPE NAME" in the terms above: comments, constants and defaults dropped,
+// "pkg/Type" as "pkg/msg/Type", a bare type as the package's own (Header: std_msgs's, as rosidl has it).
+std::vector<std::string> msg_file_fields(const std::string& path, const std::string& package) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::vector<std::string> out;
+  const std::set<std::string> primitives = {"bool",   "byte",  "char",   "float32", "float64",
+                                            "int8",   "uint8", "int16",  "uint16",  "int32",
+                                            "uint32", "int64", "uint64", "string",  "wstring"};
+  for (std::string line; std::getline(in, line);) {
+    if (const auto c = line.find('#'); c != std::string::npos) line.erase(c);
+    std::istringstream words(line);
+    std::string type, name;
+    if (!(words >> type >> name) || name.find('=') != std::string::npos) continue;  // blank or a constant
+    std::smatch m;
+    std::regex_match(type, m, std::regex(R"(([\w/]+)(\[\d*\])?)"));
+    std::string base = m[1];
+    if (primitives.count(base) == 0) {
+      if (base == "Header") base = "std_msgs/Header";
+      if (base.find('/') == std::string::npos) base = package + "/" + base;
+      base.insert(base.find('/'), "/msg");
+    }
+    out.push_back(base + m[2].str() + " " + name);
+  }
+  return out;
+}
+
+// The ROS 2 package a ROS 2 user builds (ros2/quadcosim_msgs): one .msg file per quadcosim_msgs struct
+// of the IDL, each stating the same fields in the same order with the same types, and every one in
+// its CMakeLists.txt's rosidl_generate_interfaces.
+TEST(IdlSchemaTest, TheRosPackagesMsgFilesAreTheIdl) {
+  const std::string dir = std::string(QUADCOSIM_SOURCE_DIR) + "/ros2/quadcosim_msgs";
+  std::ifstream cmake_in(dir + "/CMakeLists.txt");
+  ASSERT_TRUE(cmake_in) << dir << "/CMakeLists.txt";
+  const std::string cmake((std::istreambuf_iterator<char>(cmake_in)), std::istreambuf_iterator<char>());
+  int types = 0;
+  for (const auto& [name, idl_fields] : idl_structs()) {
+    if (name.rfind("quadcosim_msgs/msg/", 0) != 0) continue;
+    ++types;
+    const std::string type = name.substr(name.rfind('/') + 1);
+    EXPECT_EQ(msg_file_fields(dir + "/msg/" + type + ".msg", "quadcosim_msgs"), idl_fields) << type << ".msg";
+    EXPECT_NE(cmake.find("\"msg/" + type + ".msg\""), std::string::npos) << type << ".msg not in CMakeLists.txt";
+    // The same fields as the C++ message's fields() (sim/message_schema.hpp).
+    const auto schema = msg::message_schemas().find(name);
+    ASSERT_NE(schema, msg::message_schemas().end()) << name;
+    std::vector<std::string> fields;
+    for (const msg::SchemaField& f : schema->second.fields) fields.push_back(f.type + " " + f.name);
+    EXPECT_EQ(fields, idl_fields) << name;
+  }
+  EXPECT_EQ(types, 9) << "ControllerStatus, PlantStatus and the seven typed commands";
 }
 
 }  // namespace

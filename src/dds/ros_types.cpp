@@ -12,6 +12,7 @@
 #include "quadcosim_msgs.h"
 #include "rosgraph_msgs.h"
 #include "sensor_msgs.h"
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 #include "std_msgs.h"
 #include "tf2_msgs.h"
@@ -82,6 +83,35 @@ const dds_topic_descriptor_t& idl<msg::String>() {
   return std_msgs_msg_dds__String__desc;
 }
 
+template <>
+const dds_topic_descriptor_t& idl<msg::RotorSpeeds>() {
+  return quadcosim_msgs_msg_dds__RotorSpeeds__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::RotorThrusts>() {
+  return quadcosim_msgs_msg_dds__RotorThrusts__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::ThrustRates>() {
+  return quadcosim_msgs_msg_dds__ThrustRates__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::ThrustAttitude>() {
+  return quadcosim_msgs_msg_dds__ThrustAttitude__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::ThrustTorque>() {
+  return quadcosim_msgs_msg_dds__ThrustTorque__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::VelocityYaw>() {
+  return quadcosim_msgs_msg_dds__VelocityYaw__desc;
+}
+template <>
+const dds_topic_descriptor_t& idl<msg::AccelerationYaw>() {
+  return quadcosim_msgs_msg_dds__AccelerationYaw__desc;
+}
+
 // Room for the C sample of any message type on the stack (checked per type by ops_for).
 constexpr std::size_t kMaxSample = 1024;
 
@@ -128,6 +158,13 @@ const TypeOps* type_ops(std::type_index type) {
       {typeid(msg::Clock), ops_for<msg::Clock>()},
       {typeid(msg::ControllerStatus), ops_for<msg::ControllerStatus>()},
       {typeid(msg::PlantStatus), ops_for<msg::PlantStatus>()},
+      {typeid(msg::RotorSpeeds), ops_for<msg::RotorSpeeds>()},
+      {typeid(msg::RotorThrusts), ops_for<msg::RotorThrusts>()},
+      {typeid(msg::ThrustRates), ops_for<msg::ThrustRates>()},
+      {typeid(msg::ThrustAttitude), ops_for<msg::ThrustAttitude>()},
+      {typeid(msg::ThrustTorque), ops_for<msg::ThrustTorque>()},
+      {typeid(msg::VelocityYaw), ops_for<msg::VelocityYaw>()},
+      {typeid(msg::AccelerationYaw), ops_for<msg::AccelerationYaw>()},
       {typeid(msg::TFMessage), ops_for<msg::TFMessage>()},
       {typeid(msg::String), ops_for<msg::String>()},
   };

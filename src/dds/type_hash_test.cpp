@@ -20,6 +20,7 @@
 #include "dds/type_hash.hpp"
 #include "rcl_interfaces.h"
 #include "rmw_dds_common.h"
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::dds {
@@ -242,7 +243,11 @@ TEST(TypeHashTest, EveryTypeOnTheWireIsDescribed) {
         std::type_index(typeid(msg::Imu)), std::type_index(typeid(msg::Float64MultiArray)),
         std::type_index(typeid(msg::Clock)), std::type_index(typeid(msg::ControllerStatus)),
         std::type_index(typeid(msg::PlantStatus)), std::type_index(typeid(msg::MagneticField)),
-        std::type_index(typeid(msg::FluidPressure)), std::type_index(typeid(msg::NavSatFix))}) {
+        std::type_index(typeid(msg::FluidPressure)), std::type_index(typeid(msg::NavSatFix)),
+        std::type_index(typeid(msg::RotorSpeeds)), std::type_index(typeid(msg::RotorThrusts)),
+        std::type_index(typeid(msg::ThrustRates)), std::type_index(typeid(msg::ThrustAttitude)),
+        std::type_index(typeid(msg::ThrustTorque)), std::type_index(typeid(msg::VelocityYaw)),
+        std::type_index(typeid(msg::AccelerationYaw))}) {
     ASSERT_NE(type_ops(t), nullptr);
     types.push_back(type_ops(t)->descriptor);
   }

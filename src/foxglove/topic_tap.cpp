@@ -6,6 +6,7 @@
 
 #include "io/mcap_recorder.hpp"
 #include "io/ros2_cdr.hpp"
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 #include "sim/sensor_wire.hpp"
 
@@ -46,6 +47,10 @@ void serve_vehicle_topics(Server& server, sim::Transport& transport, const sim::
   serve<msg::PlantStatus>(server, transport, topics.plant_status, newest);
   serve<msg::Float64MultiArray>(server, transport, topics.motor_commands, newest);
   serve<msg::TFMessage>(server, transport, topics.tf, newest);
+  // The typed commands (/<ns>/cmd/<level>), for a controller that commands on one of them.
+  msg::for_each_level_message([&]<class T>() {
+    serve<T>(server, transport, topics.level_commands[static_cast<std::size_t>(T::kLevel)], newest);
+  });
 }
 
 void serve_sensor_topics(Server& server, sim::Transport& transport, const std::string& ns,

@@ -16,7 +16,8 @@
 namespace quadcosim::foxglove {
 
 /// Adds one channel per topic of `topics` (/clock, Pose, Velocity, Imu, controller_status,
-/// plant_status, motor_commands, /tf) to `server` (before its start()) and subscribes to each through
+/// plant_status, motor_commands, /tf, the typed commands /<ns>/cmd/<level>) to `server` (before its
+/// start()) and subscribes to each through
 /// `transport`. The subscriptions cost one relaxed atomic load per message while no client subscribes
 /// (unless ServerOptions::keep_last). `server` must outlive the transport's deliveries.
 void serve_vehicle_topics(Server& server, sim::Transport& transport, const sim::Topics& topics);

@@ -90,10 +90,17 @@ void DdsDriverHost::wait_until(std::int64_t deadline_ns) {
 std::string lockstep_timeout_message(const dds::DdsTransport& transport, const sim::Topics& topics,
                                      const sim::TickClock& clock, sim::Tick k, double timeout_s,
                                      const std::string& policy) {
+  int typed = 0;  // writers of the typed command topics, whose header.stamp must name the tick
+  for (const std::string& t : topics.level_commands) typed += transport.matched_writers(t);
   return fmt::format(
       "plant: lockstep timeout: no motor command on {} for tick {} (t = {} s) after {} s; "
-      "matched command writers: {}; policy: {}\n",
-      topics.motor_commands, k, clock.seconds(k), timeout_s, transport.matched_writers(topics.motor_commands), policy);
+      "matched command writers: {}{}; policy: {}\n",
+      topics.motor_commands, k, clock.seconds(k), timeout_s, transport.matched_writers(topics.motor_commands),
+      typed == 0 ? std::string()
+                 : fmt::format(" (and {} on {}/cmd/<level>: a typed command answers the tick its header.stamp "
+                               "names, {} ns here)",
+                               typed, topics.ns, clock.ns(k)),
+      policy);
 }
 
 bool DdsDriverHost::stop_requested() { return hosts::stop_requested(); }

@@ -40,7 +40,11 @@ int PlantProcess::choose_sync() {
         for (const dds::Endpoint& e : endpoints) {
           if (!peer_ || e.participant == *peer_) own.push_back(e);
         }
-        nodes = dds::parameter_nodes_writing(own, topics_.motor_commands);
+        for (const std::string& topic : command_topics()) {
+          for (std::string& n : dds::parameter_nodes_writing(own, topic)) {
+            if (std::find(nodes.begin(), nodes.end(), n) == nodes.end()) nodes.push_back(std::move(n));
+          }
+        }
         return !nodes.empty();
       });
     });

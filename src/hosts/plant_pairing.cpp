@@ -22,14 +22,23 @@ std::string PlantProcess::hex(const Guid& g) {
   return s;
 }
 
+std::vector<std::string> PlantProcess::command_topics() const {
+  std::vector<std::string> all{topics_.motor_commands};
+  all.insert(all.end(), topics_.level_commands.begin(), topics_.level_commands.end());
+  return all;
+}
+
 std::vector<PlantProcess::Guid> PlantProcess::controller_candidates() const {
   std::vector<Guid> found;
-  for (const sim::SenderId s : transport_.matched_senders(topics_.motor_commands)) {
-    const auto info = transport_.sender_info(topics_.motor_commands, s);
-    if (!info) continue;
-    if (pair_token_.empty() ? !info->pair_token.empty() : info->pair_token != pair_token_) continue;
-    if (node_participant_ && info->participant != *node_participant_) continue;
-    if (std::find(found.begin(), found.end(), info->participant) == found.end()) found.push_back(info->participant);
+  // A controller commands on motor_commands or on a typed /<ns>/cmd/<level> topic.
+  for (const std::string& topic : command_topics()) {
+    for (const sim::SenderId s : transport_.matched_senders(topic)) {
+      const auto info = transport_.sender_info(topic, s);
+      if (!info) continue;
+      if (pair_token_.empty() ? !info->pair_token.empty() : info->pair_token != pair_token_) continue;
+      if (node_participant_ && info->participant != *node_participant_) continue;
+      if (std::find(found.begin(), found.end(), info->participant) == found.end()) found.push_back(info->participant);
+    }
   }
   return found;
 }
@@ -121,9 +130,9 @@ bool PlantProcess::wait_for_controller() {
   return true;
 }
 
-bool PlantProcess::take_over(sim::SenderId s) {
+bool PlantProcess::take_over(const std::string& topic, sim::SenderId s) {
   if (!pair_token_.empty() || !peer_ || !plant_.watchdog_active()) return false;
-  const auto info = transport_.sender_info(topics_.motor_commands, s);
+  const auto info = transport_.sender_info(topic, s);
   if (!info || !info->pair_token.empty() || info->participant == *peer_) return false;
   if (node_participant_) return false;  // --controller-node names one participant, the one found at the start
   std::vector<Guid> others = controller_candidates();
@@ -132,7 +141,7 @@ bool PlantProcess::take_over(sim::SenderId s) {
   std::cerr << fmt::format(
       "plant: the controller's participant {} has been silent past the watchdog's limit; participant {} "
       "publishes {} now and is taken as the controller\n",
-      hex(*peer_), hex(info->participant), topics_.motor_commands);
+      hex(*peer_), hex(info->participant), topic);
   peer_ = info->participant;
   pairing_.pair_by_participant(*peer_);
   status_writers_seen_ = -1;  // whose statuses count changed with the controller

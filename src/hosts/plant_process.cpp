@@ -31,7 +31,7 @@ PlantProcess::PlantProcess(const PlantProcessOptions& o, io::Scenario sc)
       announcer_(transport_.participant().handle(), "quadrotor_plant") {
   status_.header.stamp = msg::Time::from_ns(-1);
   plant_.set_command_filter(
-      [this](sim::SenderId s) { return pairing_.accepts(topics_.motor_commands, s) || take_over(s); });
+      [this](const std::string& topic, sim::SenderId s) { return pairing_.accepts(topic, s) || take_over(topic, s); });
   plant_.on_early_command([this](sim::Tick k) {
     if (!ambiguous_.empty()) return;
     // The /clock of the tick before went out unheld when that tick is no control tick: a timer on ROS
@@ -184,9 +184,9 @@ void PlantProcess::report() {
   const double sim_s = clock_.seconds(std::min(completed, asked));
   std::cerr << fmt::format(
       "plant: done; {:g} s simulated in {:.3f} s ({:.1f}x real time); commands received {}, "
-      "rejected {}, clamped {}, stale {}; foreign (not the controller's writers) {}\n",
+      "rejected {}, clamped {}, stale {}; foreign (not the controller's writers) {}; on a second topic {}\n",
       sim_s, wall_s, sim_s / wall_s, st.commands_received, st.commands_rejected, st.commands_clamped, st.commands_stale,
-      st.commands_foreign);
+      st.commands_foreign, st.commands_rejected_second_topic);
   std::cerr << fmt::format("plant: watchdog ({:g} s, policy {}) took over {} times for {} ticks\n",
                            clock_.seconds(plant_.options().watchdog_ticks),
                            sim::to_string(plant_.options().watchdog_policy), st.watchdog_trips, st.watchdog_ticks);

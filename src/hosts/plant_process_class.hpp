@@ -75,7 +75,9 @@ class PlantProcess {
   /// vehicle is concerned), only when it carries no token, and only when it is the one participant
   /// besides the old one that could be the controller. So a stranger cannot take over from a
   /// controller that is alive, nor two newcomers race. True when `s` is now the controller's.
-  bool take_over(sim::SenderId s);
+  bool take_over(const std::string& topic, sim::SenderId s);
+  /// The topics a controller commands on: motor_commands and every /<ns>/cmd/<level>.
+  std::vector<std::string> command_topics() const;
 
   /// --controller-node without a pairing token: the participant hosting that node's parameter
   /// services is the controller's. False, with the reason on stderr, when it is not found in time.

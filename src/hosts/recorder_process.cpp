@@ -24,9 +24,10 @@ int run_recorder(const RecorderOptions& o) {
     return exit_code::kBadInput;
   }
   const sim::Topics topics = sim::Topics::for_namespace(o.ns);
-  const std::vector<std::string> known = {
+  std::vector<std::string> known = {
       topics.clock,        topics.pose,           topics.velocity, topics.imu, topics.controller_status,
       topics.plant_status, topics.motor_commands, topics.tf};
+  known.insert(known.end(), topics.level_commands.begin(), topics.level_commands.end());
   for (const auto& t : o.topics) {
     if (std::find(known.begin(), known.end(), t) == known.end()) {
       std::string list;

@@ -82,7 +82,8 @@ class PlantShard {
       if (sensor_qos) use_sensor_qos(transport_, node->topics);
       sim::PlantOptions po = v.simulation.plant;
       po.drop_stale_commands = true;
-      po.publish_clock = i == 0;  // one /clock for the whole swarm
+      po.publish_clock = i == 0;        // one /clock for the whole swarm
+      po.typed_command_topics = false;  // the swarm's controllers are its own, on motor_commands
       node->plant = std::make_unique<sim::PlantNode>(transport_, node->topics, sc.vehicle, po, v.initial);
       if (recorded[static_cast<std::size_t>(i)]) {
         const fs::path dir = out / v.simulation.ns.substr(1);

@@ -46,7 +46,10 @@ const std::map<std::string, Subscriber>& known_types() {
       entry<msg::PoseStamped>(),       entry<msg::TwistStamped>(),  entry<msg::Imu>(),
       entry<msg::Float64MultiArray>(), entry<msg::Clock>(),         entry<msg::ControllerStatus>(),
       entry<msg::PlantStatus>(),       entry<msg::TFMessage>(),     entry<msg::String>(),
-      entry<msg::MagneticField>(),     entry<msg::FluidPressure>(), entry<msg::NavSatFix>()};
+      entry<msg::MagneticField>(),     entry<msg::FluidPressure>(), entry<msg::NavSatFix>(),
+      entry<msg::RotorSpeeds>(),       entry<msg::RotorThrusts>(),  entry<msg::ThrustRates>(),
+      entry<msg::ThrustAttitude>(),    entry<msg::ThrustTorque>(),  entry<msg::VelocityYaw>(),
+      entry<msg::AccelerationYaw>()};
   return table;
 }
 

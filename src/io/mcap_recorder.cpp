@@ -2,16 +2,22 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
 #include "io/output_folder.hpp"
 #include "io/ros2_cdr.hpp"
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 #include "sim/sensor_wire.hpp"
 #include "sim/vehicle_description.hpp"
 
 namespace quadcosim::io {
+
+namespace {
+constexpr std::size_t kUnopened = static_cast<std::size_t>(-1);  ///< a lazy channel before its first message
+}  // namespace
 
 std::vector<LatchedMessage> vehicle_description_messages(const model::VehicleParams& vehicle, const std::string& ns,
                                                          std::int64_t t_ns) {
@@ -35,6 +41,8 @@ McapRecorder::McapRecorder(const std::string& path, sim::Transport& transport, c
   add<msg::PlantStatus>(transport, topics.plant_status);
   add<msg::Float64MultiArray>(transport, topics.motor_commands);
   add<msg::TFMessage>(transport, topics.tf);
+  msg::for_each_level_message(
+      [&]<class T>() { add<T>(transport, topics.level_commands[static_cast<std::size_t>(T::kLevel)], /*lazy=*/true); });
 }
 
 bool McapRecorder::wanted(const std::string& topic) const {
@@ -72,10 +80,14 @@ std::size_t McapRecorder::open_channel(const std::string& topic, const std::stri
 }
 
 template <class T>
-void McapRecorder::add(sim::Transport& transport, const std::string& topic) {
+void McapRecorder::add(sim::Transport& transport, const std::string& topic, bool lazy) {
   if (!wanted(topic)) return;
-  const std::size_t index = open_channel(topic, std::string(T::kRosType), sim::TopicQos::for_topic(topic));
-  transport.subscribe_tap<T>(topic, [this, index](const T& m, sim::SenderId sender, sim::WireBytes wire) {
+  // The channel's index in channels_; lazy: opened at the first message.
+  auto at = std::make_shared<std::size_t>(
+      lazy ? kUnopened : open_channel(topic, std::string(T::kRosType), sim::TopicQos::for_topic(topic)));
+  transport.subscribe_tap<T>(topic, [this, at, topic](const T& m, sim::SenderId sender, sim::WireBytes wire) {
+    if (*at == kUnopened) *at = open_channel(topic, std::string(T::kRosType), sim::TopicQos::for_topic(topic));
+    const std::size_t index = *at;
     const std::int64_t t = message_time_ns(m, last_stamp_ns_);
     bool stamped = true;  // the message carries its own time (header, clock, or command label)
     if constexpr (std::is_same_v<T, msg::Float64MultiArray>) stamped = msg::command_stamp_ns(m) >= 0;

@@ -122,8 +122,10 @@ class McapRecorder {
   };
   /// The channel of `topic` with the schema of `type` ("pkg/msg/Type"); its index in channels_.
   std::size_t open_channel(const std::string& topic, const std::string& type, sim::TopicQos qos);
+  /// Records `topic`; `lazy`: its channel is opened at its first message (the typed command topics: a
+  /// recording shows the one a controller used, not seven empty ones).
   template <class T>
-  void add(sim::Transport& transport, const std::string& topic);
+  void add(sim::Transport& transport, const std::string& topic, bool lazy = false);
   bool wanted(const std::string& topic) const;
   void push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr);
 

@@ -9,6 +9,7 @@
 
 #include "io/mcap_recorder.hpp"
 #include "sim/inprocess_transport.hpp"
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::io {
@@ -138,6 +139,32 @@ TEST(McapRecorderTest, RepeatsArePerWriterSoAStrangersStampDropsNothing) {
   rec.close();
   EXPECT_EQ(rec.messages(), 100u + 1u);
   EXPECT_EQ(rec.repeats(), 10u + 1u);
+  std::filesystem::remove_all(dir);
+}
+
+// A typed command topic is recorded from its first message on; the others stay out of the file.
+TEST(McapRecorderTest, ATypedCommandTopicIsRecordedOnceItCarriesMessages) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mcap_typed_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  sim::InProcessTransport bus;
+  const sim::Topics topics = sim::Topics::for_namespace("/drone");
+  McapRecorder rec((dir / "run.mcap").string(), bus, topics);
+  auto ctbr = bus.advertise<msg::ThrustRates>("/drone/cmd/ctbr");
+  msg::ThrustRates m;
+  m.thrust_n = 19.2;
+  for (int k = 0; k < 3; ++k) {
+    m.header.stamp = msg::Time::from_ns(20'000'000 * k);
+    ctbr.publish(m);
+    ctbr.publish(m);  // a lockstep repeat: recorded once
+  }
+  rec.close();
+  EXPECT_EQ(rec.messages(), 3u);
+  rec.write_bag_metadata(dir.string(), "run.mcap");
+  std::ifstream y(dir / "metadata.yaml");
+  const std::string meta((std::istreambuf_iterator<char>(y)), std::istreambuf_iterator<char>());
+  EXPECT_NE(meta.find("name: /drone/cmd/ctbr\n        type: quadcosim_msgs/msg/ThrustRates"), std::string::npos)
+      << meta;
+  EXPECT_EQ(meta.find("/drone/cmd/velocity"), std::string::npos) << "a typed topic without messages: no channel";
   std::filesystem::remove_all(dir);
 }
 

@@ -87,7 +87,9 @@ json j(const msg::PlantStatus& m) {
           {"watchdog_trips", std::to_string(m.watchdog_trips)},
           {"watchdog_ticks", std::to_string(m.watchdog_ticks)},
           {"commands_stale", std::to_string(m.commands_stale)},
-          {"commands_foreign", std::to_string(m.commands_foreign)}};
+          {"commands_foreign", std::to_string(m.commands_foreign)},
+          {"commands_rejected_second_topic", std::to_string(m.commands_rejected_second_topic)},
+          {"commands_rejected_bad_quaternion", std::to_string(m.commands_rejected_bad_quaternion)}};
 }
 
 json j(const msg::MagneticField& m) {

@@ -424,7 +424,8 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
             "std_msgs/Header header\nuint64 commands_accepted\nuint64 commands_clamped\n"
             "uint64 commands_rejected_length\nuint64 commands_rejected_non_finite\nstring last_problem\n"
             "bool watchdog_active\nuint64 watchdog_trips\nuint64 watchdog_ticks\nuint64 commands_stale\n"
-            "uint64 commands_foreign\n");
+            "uint64 commands_foreign\nuint64 commands_rejected_second_topic\n"
+            "uint64 commands_rejected_bad_quaternion\n");
   const std::string& tf = ros2msg_definition(msg::TFMessage::kRosType);
   EXPECT_EQ(msg_blocks(tf), (V{"geometry_msgs/TransformStamped", "std_msgs/Header", "builtin_interfaces/Time",
                                "geometry_msgs/Transform", "geometry_msgs/Vector3", "geometry_msgs/Quaternion"}));

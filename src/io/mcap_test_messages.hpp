@@ -99,6 +99,8 @@ inline msg::PlantStatus sample_plant_status(int i) {
   m.watchdog_ticks = 0x0123456789abcdefull + static_cast<std::uint64_t>(i);
   m.commands_stale = static_cast<std::uint64_t>(i) * 3;
   m.commands_foreign = 0x8000000000000000ull + static_cast<std::uint64_t>(i);
+  m.commands_rejected_second_topic = static_cast<std::uint64_t>(i) % 5;
+  m.commands_rejected_bad_quaternion = 0xffffffffffffffffull - static_cast<std::uint64_t>(i);
   return m;
 }
 

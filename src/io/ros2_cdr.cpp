@@ -119,6 +119,13 @@ std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m) { return cdr_of(m); 
 std::vector<std::uint8_t> to_cdr(const msg::TFMessage& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::String& m) { return cdr_of(m); }
 std::vector<std::uint8_t> to_cdr(const msg::SceneUpdate& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::RotorSpeeds& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::RotorThrusts& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::ThrustRates& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::ThrustAttitude& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::ThrustTorque& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::VelocityYaw& m) { return cdr_of(m); }
+std::vector<std::uint8_t> to_cdr(const msg::AccelerationYaw& m) { return cdr_of(m); }
 
 const std::string& ros2msg_definition(std::string_view ros_type) { return msg::ros2msg_definition(ros_type); }
 

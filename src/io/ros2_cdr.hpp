@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 #include "sim/scene_messages.hpp"
 
@@ -33,6 +34,13 @@ std::vector<std::uint8_t> to_cdr(const msg::PlantStatus& m);
 std::vector<std::uint8_t> to_cdr(const msg::TFMessage& m);
 std::vector<std::uint8_t> to_cdr(const msg::String& m);
 std::vector<std::uint8_t> to_cdr(const msg::SceneUpdate& m);
+std::vector<std::uint8_t> to_cdr(const msg::RotorSpeeds& m);
+std::vector<std::uint8_t> to_cdr(const msg::RotorThrusts& m);
+std::vector<std::uint8_t> to_cdr(const msg::ThrustRates& m);
+std::vector<std::uint8_t> to_cdr(const msg::ThrustAttitude& m);
+std::vector<std::uint8_t> to_cdr(const msg::ThrustTorque& m);
+std::vector<std::uint8_t> to_cdr(const msg::VelocityYaw& m);
+std::vector<std::uint8_t> to_cdr(const msg::AccelerationYaw& m);
 
 /// The full `ros2msg` schema text of a ROS 2 message type named "pkg/msg/Type" (e.g.
 /// "geometry_msgs/msg/PoseStamped", as each message struct's kRosType), as msg::ros2msg_definition

@@ -210,6 +210,7 @@ std::unique_ptr<sim::Simulation> Batch::build(const io::Scenario& s, std::uint64
   // robot description), which feed no number, would only cost every tick memory and time.
   cfg.plant.publish_clock = false;
   cfg.plant.publish_tf = false;
+  cfg.plant.typed_command_topics = false;  // nobody publishes a typed command on it either
   std::unique_ptr<sim::Simulation> sim;
   try {
     sim = std::make_unique<sim::Simulation>(cfg, s.vehicle, initial, s.controller, s.schedule);

@@ -6,6 +6,7 @@
 #include <string>
 #include <type_traits>
 
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 #include "sim/scene_messages.hpp"
 
@@ -138,6 +139,7 @@ const std::map<std::string, MessageSchema, std::less<>>& message_schemas() {
     add<Clock>(s);
     add<ControllerStatus>(s);
     add<PlantStatus>(s);
+    for_each_level_message([&]<class T>() { add<T>(s); });
     add<TFMessage>(s);
     add<String>(s);
     add<SceneUpdate>(s);

@@ -1,4 +1,5 @@
-// The ROS 2 interface definition of every message type quadcosim writes (sim/messages.hpp,
+// The ROS 2 interface definition of every message type quadcosim writes or takes (sim/messages.hpp,
+// sim/level_messages.hpp,
 // sim/scene_messages.hpp), derived from each type's fields() list: the one statement of a message's
 // fields. Recordings carry it as `ros2msg` schema text (io/ros2_cdr.hpp, MCAP), and the type
 // hashes ROS 2 tools check are computed from it (dds/type_hash.hpp). The DDS wire layout in

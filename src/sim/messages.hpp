@@ -361,6 +361,10 @@ struct PlantStatus {
   std::uint64_t watchdog_ticks = 0;    ///< ticks latched under the watchdog's policy
   std::uint64_t commands_stale = 0;    ///< lockstep repeats of an answered tick: dropped
   std::uint64_t commands_foreign = 0;  ///< from a writer other than the paired controller's: ignored
+  /// On a second command topic (/<ns>/motor_commands, /<ns>/cmd/<level>) for a tick another topic already
+  /// commanded (one writer per tick, docs/ros2.md): ignored
+  std::uint64_t commands_rejected_second_topic = 0;
+  std::uint64_t commands_rejected_bad_quaternion = 0;  ///< ThrustAttitude's attitude not a unit quaternion: ignored
   template <class M, class V>
   static void fields(M& m, V& v) {
     v.field("header", m.header);
@@ -374,6 +378,8 @@ struct PlantStatus {
     v.field("watchdog_ticks", m.watchdog_ticks);
     v.field("commands_stale", m.commands_stale);
     v.field("commands_foreign", m.commands_foreign);
+    v.field("commands_rejected_second_topic", m.commands_rejected_second_topic);
+    v.field("commands_rejected_bad_quaternion", m.commands_rejected_bad_quaternion);
   }
 };
 

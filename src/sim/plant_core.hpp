@@ -139,9 +139,15 @@ class PlantCore {
   /// level's values and queued at its level.
   CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
     const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s);
-    if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
+    take_checked(k, delay_ticks, check);
     return check;
   }
+  /// A command already checked (check_command, e.g. of a typed command's values): queued unless rejected.
+  void take_checked(Tick k, Tick delay_ticks, const CommandCheck& check) {
+    if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
+  }
+  /// The upper end of the rotor speeds a command is checked against [rad/s].
+  double omega_max_rad_s() const { return model_->params().motor.omega_max_rad_s; }
   /// A valid command (speeds within [0, omega_max]; or 4 finite values of another level) received
   /// during tick k takes effect at tick k + delay_ticks.
   void queue(Tick k, Tick delay_ticks, const model::Vector4& values,

@@ -1,5 +1,7 @@
 #include "sim/plant_node.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -67,15 +69,26 @@ PlantNode::PlantNode(Transport& transport, const Topics& topics, const model::Ve
   }
   status_period_ticks_ = options.status_period_ticks > 0 ? options.status_period_ticks
                                                          : std::max<Tick>(1, 1'000'000'000 / options.clock.period_ns);
+  command_topics_[0] = topics.motor_commands;
+  for (std::size_t i = 0; i < topics.level_commands.size(); ++i) command_topics_[1 + i] = topics.level_commands[i];
   transport.subscribe_with_sender<msg::Float64MultiArray>(
       topics.motor_commands, [this](const msg::Float64MultiArray& m, SenderId sender) { on_command(m, sender); });
+  if (!options.typed_command_topics) return;
+  msg::for_each_level_message([&]<class T>() {
+    transport.subscribe_with_sender<T>(topics.level_commands[static_cast<std::size_t>(T::kLevel)],
+                                       [this](const T& m, SenderId sender) { on_level_command(m, sender); });
+  });
 }
 
-void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
-  if (command_filter_ && !command_filter_(sender)) {
+template <class Check>
+void PlantNode::intake(int source, SenderId sender, std::int64_t stamp, Check check) {
+  const std::string& topic = command_topics_[static_cast<std::size_t>(source)];
+  // How the logs name it (built only when one is written).
+  const auto what = [&] { return source == 0 ? std::string("motor command") : "command on " + topic; };
+  if (command_filter_ && !command_filter_(topic, sender)) {
     ++stats_.commands_foreign;
     if (foreign_log_.count()) {
-      log_("plant: motor command from a writer other than the controller's ignored; " +
+      log_("plant: " + what() + " from a writer other than the controller's ignored; " +
            std::to_string(foreign_log_.total()) + " ignored so far (logged: 1st, then every 100th)");
     }
     return;
@@ -85,6 +98,22 @@ void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
     if (on_early_command_) on_early_command_(clock_held_);
     return;
   }
+  // One topic commands a tick: a command on another topic than the one that answered this plant tick
+  // (or, in lockstep, the tick its label names) is refused, so no tick is commanded twice.
+  if (last_source_ >= 0 && source != last_source_ &&
+      (last_source_tick_ == current_tick_ || (stamp >= 0 && stamp == last_source_label_))) {
+    ++stats_.commands_rejected_second_topic;
+    stats_.last_problem = fmt::format(
+        "a command on {} for the tick (t = {:g} s) that {} already commanded: one "
+        "topic commands a tick",
+        topic, options_.clock.seconds(stamp >= 0 ? stamp / options_.clock.period_ns : current_tick_),
+        command_topics_[static_cast<std::size_t>(last_source_)]);
+    if (second_topic_log_.count()) {
+      log_("plant: " + stats_.last_problem + "; ignored, " + std::to_string(second_topic_log_.total()) +
+           " so far (logged: 1st, then every 100th)");
+    }
+    return;
+  }
   ++stats_.commands_received;
   // Lockstep repeats, whatever their content: an answer to an earlier tick, or a second copy of the
   // accepted answer to this one (the controller sends its last command again when the plant repeats
@@ -92,37 +121,56 @@ void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
   // The label is read only in lockstep, where commands cross a network and may come twice or late;
   // delivered in-process, every command answers the tick it arrives in. What a label says counts
   // for later commands only once the command is accepted (below).
-  const std::int64_t stamp = options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1;
   if (stamp >= 0 && (stamp < options_.clock.ns(current_tick_) || stamp == last_label_accepted_ns_)) {
     ++stats_.commands_stale;
     if (on_label_behind_ && stamp < options_.clock.ns(current_tick_)) on_label_behind_(stamp, current_tick_);
     return;
   }
   last_command_stamp_ns_ = stamp;  // the controller's answer to its tick, whatever its verdict
-  // Checked, and queued unless rejected (PlantCore::take_command).
-  const CommandCheck check = core_.take_command(current_tick_, options_.command_delay_ticks, m);
-  if (check.verdict() == CommandVerdict::kRejected) {
-    stats_.last_problem = check.reason();
+  last_source_ = source;
+  last_source_tick_ = current_tick_;
+  last_source_label_ = stamp;
+  // Checked, and queued unless rejected (PlantCore::take_checked).
+  const CommandCheck c = check();
+  core_.take_checked(current_tick_, options_.command_delay_ticks, c);
+  if (c.verdict() == CommandVerdict::kRejected) {
+    stats_.last_problem = c.reason();
     ++stats_.commands_rejected;
-    ++(check.fault == CommandFault::kWrongLength ? stats_.commands_rejected_length
+    ++(c.fault == CommandFault::kWrongLength     ? stats_.commands_rejected_length
+       : c.fault == CommandFault::kBadQuaternion ? stats_.commands_rejected_bad_quaternion
                                                  : stats_.commands_rejected_non_finite);
     if (rejected_log_.count()) {
-      log_("plant: motor command rejected (" + stats_.last_problem + "), last good command held; " +
+      log_("plant: " + what() + " rejected (" + stats_.last_problem + "), last good command held; " +
            std::to_string(rejected_log_.total()) + " rejected so far (logged: 1st, then every 100th)");
     }
     return;
   }
   if (stamp >= 0) last_label_accepted_ns_ = stamp;
   ++stats_.commands_accepted;
-  if (check.fault == CommandFault::kOutOfRange) {
-    stats_.last_problem = check.reason();
+  if (c.fault == CommandFault::kOutOfRange) {
+    stats_.last_problem = c.reason();
     ++stats_.commands_clamped;
     if (clamped_log_.count()) {
-      log_("plant: motor command clamped (" + stats_.last_problem + "); " + std::to_string(clamped_log_.total()) +
+      log_("plant: " + what() + " clamped (" + stats_.last_problem + "); " + std::to_string(clamped_log_.total()) +
            " clamped so far (logged: 1st, then every 100th)");
     }
   }
   if (receipt_clock_) last_valid_receipt_ns_ = receipt_clock_();
+}
+
+void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
+  intake(0, sender, options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1,
+         [&] { return check_command(m, core_.omega_max_rad_s()); });
+}
+
+template <class T>
+void PlantNode::on_level_command(const T& m, SenderId sender) {
+  // header.stamp is the label (a stamp before 0 is none).
+  const std::int64_t stamp = options_.drop_stale_commands ? std::max<std::int64_t>(-1, m.header.stamp.to_ns()) : -1;
+  intake(1 + static_cast<int>(T::kLevel), sender, stamp, [&] {
+    const msg::LevelValues v = msg::level_values(m);
+    return check_command(v.level, v.data(), v.count(), core_.omega_max_rad_s(), v.attitude_norm);
+  });
 }
 
 void PlantNode::publish_status(Tick k) {
@@ -130,6 +178,8 @@ void PlantNode::publish_status(Tick k) {
                        stats_.commands_rejected_non_finite != status_.commands_rejected_non_finite ||
                        stats_.commands_clamped != status_.commands_clamped ||
                        stats_.commands_foreign != status_.commands_foreign ||
+                       stats_.commands_rejected_second_topic != status_.commands_rejected_second_topic ||
+                       stats_.commands_rejected_bad_quaternion != status_.commands_rejected_bad_quaternion ||
                        watchdog_active_ != status_.watchdog_active;
   if (!problem && k % status_period_ticks_ != 0) return;
   if (k == last_status_tick_) return;  // one status per tick, also when a tick's outputs are repeated
@@ -145,6 +195,8 @@ void PlantNode::publish_status(Tick k) {
   status_.watchdog_ticks = stats_.watchdog_ticks;
   status_.commands_stale = stats_.commands_stale;
   status_.commands_foreign = stats_.commands_foreign;
+  status_.commands_rejected_second_topic = stats_.commands_rejected_second_topic;
+  status_.commands_rejected_bad_quaternion = stats_.commands_rejected_bad_quaternion;
   status_pub_.publish(status_);
 }
 

@@ -1,7 +1,10 @@
 // The plant as a node: integrates the model on integer ticks, publishes the paper's sensor topics and
-// /clock, and takes rotor speed commands from /<ns>/motor_commands (zero-order hold).
+// /clock, and takes rotor speed commands from /<ns>/motor_commands (zero-order hold), or a command at
+// any level: named in that topic's layout ("level=ctbr") or typed on /<ns>/cmd/<level>
+// (sim/level_messages.hpp). All go through one intake; one topic commands a tick.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -11,6 +14,7 @@
 #include "model/quadrotor.hpp"
 #include "sim/clock.hpp"
 #include "sim/external_dynamics.hpp"
+#include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 #include "sim/plant_core.hpp"
 #include "sim/realism.hpp"
@@ -62,6 +66,9 @@ struct PlantOptions {
   /// (noise, rates, latency) are the node's either way; wind, rotor faults and aerodynamic drag act
   /// inside the native model only (external_plant_conflict refuses them).
   std::shared_ptr<const ExternalDynamicsFactory> external;
+  /// Subscribe the typed command topics /<ns>/cmd/<level> beside motor_commands. Off for a host whose
+  /// controllers are quadcosim's own (a DDS swarm: seven readers fewer per vehicle to discover).
+  bool typed_command_topics = true;
 };
 
 /// "" when the native-only features (wind, rotor faults, the vehicle's aerodynamics) are all off,
@@ -81,6 +88,11 @@ struct PlantStats {
       0;  ///< lockstep repeats (an earlier tick's command, or a second copy of this one), dropped
   /// From a writer other than the paired controller's (set_command_filter): ignored, in no other count
   std::uint64_t commands_foreign = 0;
+  /// On a second command topic for a tick another already commanded (the same plant tick, or in lockstep
+  /// the same label): ignored, in no other count (not received, no answer)
+  std::uint64_t commands_rejected_second_topic = 0;
+  /// A ThrustAttitude whose attitude is not a unit quaternion: also in commands_rejected
+  std::uint64_t commands_rejected_bad_quaternion = 0;
   /// The controller's, arriving while before_clock held a tick's /clock back: not a timer's answer on
   /// ROS time (it came before the time that fires the timer). Ignored, in no other count; reported to
   /// the early-command callback.
@@ -102,10 +114,13 @@ class PlantNode final : public SteppablePlant {
   /// every 100th, each line with the count so far). Default: stderr.
   void set_log(std::function<void(const std::string&)> log) { log_ = std::move(log); }
 
-  /// Commands whose sender `accepts` refuses are foreign: counted (commands_foreign), logged
-  /// rate-limited, and otherwise ignored (not received, not an answer, no label seen). Unset: every
-  /// sender is the controller (in-process, where every message is the process's own).
-  void set_command_filter(std::function<bool(SenderId)> accepts) { command_filter_ = std::move(accepts); }
+  /// Commands whose sender `accepts` (with the command's topic: motor_commands or a /<ns>/cmd/<level>)
+  /// refuses are foreign: counted (commands_foreign), logged rate-limited, and otherwise ignored (not
+  /// received, not an answer, no label seen). Unset: every sender is the controller (in-process, where
+  /// every message is the process's own).
+  void set_command_filter(std::function<bool(const std::string&, SenderId)> accepts) {
+    command_filter_ = std::move(accepts);
+  }
 
   /// With clock_after_sensors: runs after tick k's Pose, Velocity and Imu went out, before its /clock
   /// (a lockstep plant over DDS waits there at tick 0 until the peer has the samples). Returning false
@@ -164,6 +179,14 @@ class PlantNode final : public SteppablePlant {
 
  private:
   void on_command(const msg::Float64MultiArray& m, SenderId sender);
+  /// A typed command (/<ns>/cmd/<level>).
+  template <class T>
+  void on_level_command(const T& m, SenderId sender);
+  /// The one intake of every command, whatever its topic (`source`: 0 motor_commands, 1 + level for
+  /// /<ns>/cmd/<level>): the sender filter, a held /clock, the one-topic-per-tick rule, lockstep
+  /// repeats by `stamp` (the label; -1: none), then `check()`'s verdict counted, the command queued.
+  template <class Check>
+  void intake(int source, SenderId sender, std::int64_t stamp, Check check);
   void publish_status(Tick k);
   /// The external dynamics' outputs at tick k; the core's state becomes the state they report.
   model::Outputs external_outputs(Tick k);
@@ -181,7 +204,13 @@ class PlantNode final : public SteppablePlant {
   bool watchdog_active_ = false;
   std::function<void(const std::string&)> log_;
   LogThrottle rejected_log_, clamped_log_, foreign_log_;
-  std::function<bool(SenderId)> command_filter_;
+  std::function<bool(const std::string&, SenderId)> command_filter_;
+  /// The command topics: [0] motor_commands, [1 + level] /<ns>/cmd/<level>.
+  std::array<std::string, 1 + control::kCommandLevelCount> command_topics_;
+  int last_source_ = -1;                 ///< the topic of the newest command that answered a tick
+  Tick last_source_tick_ = -1;           ///< the tick it arrived in
+  std::int64_t last_source_label_ = -1;  ///< its label (lockstep), -1 for none
+  LogThrottle second_topic_log_;
   msg::PlantStatus status_;
   Tick status_period_ticks_ = 1;  ///< ticks between periodic statuses (options or one simulated second)
   msg::PoseStamped pose_;         ///< the outgoing sensor messages, reused from tick to tick

@@ -8,18 +8,24 @@ Topics Topics::for_namespace(const std::string& ns) {
   std::string base = ns;
   while (base.size() > 1 && base.back() == '/') base.pop_back();
   if (base == "/") base.clear();
-  return {base + "/motor_commands",
-          base + "/Pose",
-          base + "/Velocity",
-          base + "/Imu",
-          "/clock",
-          base + "/controller_status",
-          base + "/plant_status",
-          "/tf",
-          "/tf_static",
-          base + "/robot_description",
-          base + "/scene",
-          base};
+  Topics t{base + "/motor_commands",
+           base + "/Pose",
+           base + "/Velocity",
+           base + "/Imu",
+           "/clock",
+           base + "/controller_status",
+           base + "/plant_status",
+           "/tf",
+           "/tf_static",
+           base + "/robot_description",
+           base + "/scene",
+           base,
+           {}};
+  for (int i = 0; i < control::kCommandLevelCount; ++i) {
+    t.level_commands[static_cast<std::size_t>(i)] =
+        base + "/cmd/" + std::string(control::to_string(static_cast<control::CommandLevel>(i)));
+  }
+  return t;
 }
 
 std::string validate_namespace(const std::string& ns) {

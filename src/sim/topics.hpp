@@ -1,7 +1,10 @@
 // Topic names of one vehicle. The namespace is a setting so several vehicles share a domain.
 #pragma once
 
+#include <array>
 #include <string>
+
+#include "control/command_level.hpp"
 
 namespace quadcosim::sim {
 
@@ -21,6 +24,10 @@ struct Topics {
   /// The namespace the vehicle's topics are under ("/drone"; "" for "/"): the extra sensors' topics
   /// are formed under it (sim/sensor_wire.hpp).
   std::string ns;
+  /// controller -> plant, the typed commands: /<ns>/cmd/<level> ("/drone/cmd/ctbr"), one per command
+  /// level in control/command_level.hpp's order, quadcosim_msgs/RotorSpeeds ... AccelerationYaw
+  /// (sim/level_messages.hpp)
+  std::array<std::string, control::kCommandLevelCount> level_commands;
 
   /// Topics under `ns` ("/drone" gives "/drone/Pose", ...). `ns` must start with '/'.
   static Topics for_namespace(const std::string& ns = "/drone");

@@ -39,22 +39,16 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
 }
 
 // A command at a level above rotor speeds (out of line: rotor speeds are the common case).
-[[gnu::noinline]] void check_level_command(const msg::Float64MultiArray& m, std::string_view name, CommandCheck& out) {
-  const std::optional<control::CommandLevel> level = control::command_level_from_string(name);
-  if (!level) {
-    out.fault = CommandFault::kUnknownLevel;
-    const std::size_t n = std::min(name.size(), out.unknown_level.size() - 1);
-    std::copy_n(name.data(), n, out.unknown_level.data());
-    return;
-  }
-  out.level = *level;
-  if (m.data.size() != 4) {
+[[gnu::noinline]] void check_level_values(control::CommandLevel level, const double* values, std::size_t count,
+                                          CommandCheck& out) {
+  out.level = level;
+  if (count != 4) {
     out.fault = CommandFault::kWrongLength;
-    out.values = m.data.size();
+    out.values = count;
     return;
   }
   for (int i = 0; i < 4; ++i) {
-    const double v = m.data[static_cast<std::size_t>(i)];
+    const double v = values[i];
     out.omega_rad_s[i] = v;
     if (!std::isfinite(v)) {
       out.fault = CommandFault::kNonFinite;
@@ -74,27 +68,58 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
   }
 }
 
+// Exactly 4 rotor speeds, each in [0, omega_max] (clamped) and finite (else rejected).
+void check_rotor_speeds(const double* w, std::size_t count, CommandCheck& out) {
+  if (count != 4) {
+    out.fault = CommandFault::kWrongLength;
+    out.values = count;
+    return;
+  }
+  out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
+  bool ok = true;
+  for (int i = 0; i < 4; ++i) ok &= in_range(w[i], out.omega_max_rad_s);  // no branch per speed
+  if (!ok) find_command_fault(w, out);
+}
+
 }  // namespace
 
 CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
   CommandCheck out;
   out.omega_max_rad_s = omega_max_rad_s;
   if (!m.dim.empty()) {
-    if (const std::string_view level = msg::command_level_name(m); !level.empty()) {
-      check_level_command(m, level, out);
-      return out;
+    if (const std::string_view name = msg::command_level_name(m); !name.empty()) {
+      const std::optional<control::CommandLevel> level = control::command_level_from_string(name);
+      if (!level) {
+        out.fault = CommandFault::kUnknownLevel;
+        const std::size_t n = std::min(name.size(), out.unknown_level.size() - 1);
+        std::copy_n(name.data(), n, out.unknown_level.data());
+        return out;
+      }
+      // "level=rotor_speeds" is rotor speeds, as no level dimension is.
+      if (*level != control::CommandLevel::kRotorSpeeds) {
+        check_level_values(*level, m.data.data(), m.data.size(), out);
+        return out;
+      }
     }
   }
-  if (m.data.size() != 4) {
-    out.fault = CommandFault::kWrongLength;
-    out.values = m.data.size();
+  check_rotor_speeds(m.data.data(), m.data.size(), out);
+  return out;
+}
+
+CommandCheck check_command(control::CommandLevel level, const double* values, std::size_t count, double omega_max_rad_s,
+                           double attitude_norm) {
+  CommandCheck out;
+  out.omega_max_rad_s = omega_max_rad_s;
+  if (level == control::CommandLevel::kRotorSpeeds) {
+    check_rotor_speeds(values, count, out);
     return out;
   }
-  const double* w = m.data.data();
-  out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
-  bool ok = true;
-  for (int i = 0; i < 4; ++i) ok &= in_range(w[i], omega_max_rad_s);  // no branch per speed
-  if (!ok) find_command_fault(w, out);
+  check_level_values(level, values, count, out);
+  if (out.verdict() != CommandVerdict::kRejected && !(std::abs(attitude_norm - 1.0) <= kQuaternionNormTolerance)) {
+    out.fault = CommandFault::kBadQuaternion;
+    out.quaternion_norm = attitude_norm;
+    out.omega_rad_s.setZero();
+  }
   return out;
 }
 
@@ -104,7 +129,8 @@ CommandVerdict CommandCheck::verdict() const {
     case CommandFault::kOutOfRange: return CommandVerdict::kClamped;
     case CommandFault::kWrongLength:
     case CommandFault::kNonFinite:
-    case CommandFault::kUnknownLevel: break;
+    case CommandFault::kUnknownLevel:
+    case CommandFault::kBadQuaternion: break;
   }
   return CommandVerdict::kRejected;
 }
@@ -120,13 +146,16 @@ std::string CommandCheck::reason() const {
         return fmt::format("{} value {} ({}) is {}, expected a finite number", name, rotor + 1,
                            control::setpoint_fields(level)[static_cast<std::size_t>(rotor)], value);
       case CommandFault::kOutOfRange: return fmt::format("rotor {} thrust {:g} N clamped to 0", rotor + 1, value);
+      case CommandFault::kBadQuaternion:
+        return fmt::format("{} attitude has norm {:g}, expected a unit quaternion (x, y, z, w)", name, quaternion_norm);
       case CommandFault::kUnknownLevel: break;
     }
     return "?";
   }
   switch (fault) {
     case CommandFault::kNone: return "";
-    case CommandFault::kUnknownLevel: return "?";
+    case CommandFault::kUnknownLevel:
+    case CommandFault::kBadQuaternion: return "?";
     case CommandFault::kWrongLength: return fmt::format("{} values, expected 4 rotor speeds", values);
     case CommandFault::kNonFinite:
       return fmt::format("rotor {} speed is {}, expected a finite number", rotor + 1, value);

@@ -32,10 +32,11 @@ enum class CommandVerdict {
 /// What was wrong with a motor command; kNone when it was used as sent.
 enum class CommandFault : std::uint8_t {
   kNone,
-  kWrongLength,   ///< not exactly 4 values (kRejected)
-  kNonFinite,     ///< a NaN or Inf speed (kRejected)
-  kOutOfRange,    ///< four finite speeds, some < 0 or > omega_max (kClamped); rotor thrusts < 0
-  kUnknownLevel,  ///< the layout names a command level quadcosim does not know (kRejected)
+  kWrongLength,    ///< not exactly 4 values (kRejected)
+  kNonFinite,      ///< a NaN or Inf speed (kRejected)
+  kOutOfRange,     ///< four finite speeds, some < 0 or > omega_max (kClamped); rotor thrusts < 0
+  kUnknownLevel,   ///< the layout names a command level quadcosim does not know (kRejected)
+  kBadQuaternion,  ///< a ThrustAttitude whose attitude is not a unit quaternion (kRejected)
 };
 
 /// The outcome of check_command: plain data, no allocation; reason() says it in words.
@@ -49,6 +50,7 @@ struct CommandCheck {
   /// The command's level (msg::command_level_name); omega_rad_s then holds that level's 4 values.
   control::CommandLevel level = control::CommandLevel::kRotorSpeeds;
   std::array<char, 24> unknown_level{};  ///< the start of an unknown level's name (kUnknownLevel)
+  double quaternion_norm = 1.0;          ///< the attitude's norm as sent (kBadQuaternion)
 
   CommandVerdict verdict() const;
   /// Why rejected or clamped, naming the rotor (1..4) and its value, e.g. "rotor 2 speed is nan, expected a
@@ -66,6 +68,11 @@ struct CommandCheck {
 /// (kWrongLength) and finite (kNonFinite); rotor thrusts below 0 become 0 (kOutOfRange). The plant's
 /// inner loops turn it into rotor speeds every tick (control/inner_loops.hpp).
 CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s);
+/// The same checks for `count` values at `level` (a typed command, msg::level_values: the one rule for
+/// both ways of sending a level). `attitude_norm`: a ThrustAttitude's quaternion norm as sent, refused
+/// (kBadQuaternion) when not within kQuaternionNormTolerance of 1, after the values' own checks.
+CommandCheck check_command(control::CommandLevel level, const double* values, std::size_t count, double omega_max_rad_s,
+                           double attitude_norm = 1.0);
 
 // ---------------------------------------------------------------------------------------------
 // Sensor messages into the controller

@@ -492,7 +492,7 @@ TEST(PlantValidationTest, CommandsOfAnotherWriterAreForeignAndChangeNothing) {
   options.drop_stale_commands = true;
   Rig rig(options);
   // The in-process transport says 0 for every sender: a filter refusing it makes every command foreign.
-  rig.plant->set_command_filter([](SenderId s) { return s != 0; });
+  rig.plant->set_command_filter([](const std::string&, SenderId s) { return s != 0; });
   const model::Vector4 before = rig.plant->latched_command();
   msg::Float64MultiArray m = command({100, 200, 300, 400});
   m.dim.push_back({msg::command_label(0), 4, 4});
