@@ -1,12 +1,12 @@
 // The inner loops' stability check (check_inner_loops, control/inner_loops.hpp): one-off design
 // numerics on Eigen's eigen-solver, compiled with the other design code (quadcosim_design,
 // src/control/CMakeLists.txt) rather than with the per-tick loops.
+#include "control/inner_loops.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#include "control/inner_loops.hpp"
 
 namespace quadcosim::control {
 
