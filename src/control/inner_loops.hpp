@@ -21,6 +21,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 
 #include "control/allocation.hpp"
@@ -45,6 +46,10 @@ struct InnerLoopParams {
 /// The declared parameters: inner.rate_bandwidth, inner.attitude_bandwidth, inner.velocity_bandwidth,
 /// inner.max_tilt.
 const ParameterTable<InnerLoopParams>& inner_loop_table();
+
+/// The pole-matched discrete gain K' = (1 - exp(-K h)) / h of a first-order loop of bandwidth k [rad/s]
+/// at period h [s]: its error decays as exp(-K t) exactly at the ticks.
+inline double pole_matched(double k_rad_s, double h_s) { return -std::expm1(-k_rad_s * h_s) / h_s; }
 
 /// "" when the loops are stable at the plant period `period_s` on `vehicle`, else the gain at fault and
 /// why: K_w h <= 1 (the rate loop's time constant at least one tick); K_w tau_motor <= 1 with a

@@ -35,6 +35,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::StartsWith;
 using ::testing::ThrowsMessage;
 
 const fs::path kSourceDir = QUADCOSIM_SOURCE_DIR;
@@ -75,6 +76,18 @@ class TempDir {
  private:
   fs::path path_;
 };
+
+/// The message of the E that `f()` throws; a test failure and "" when it throws none.
+template <class E, class F>
+std::string error_message(F&& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error";
+  return "";
+}
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -268,13 +281,11 @@ TEST(ScenarioTest, ExtraSensorKeysAreReadInTheirUnits) {
   EXPECT_DOUBLE_EQ(s.gnss->site.longitude_rad, 8.25 * 3.14159265358979323846 / 180.0);
   EXPECT_EQ(s.gnss->site.height_m, 420.0);
   // A key out of its range is named with its range, in the key's unit.
-  try {
+  const std::string range = error_message<std::exception>([&] {
     load_scenario(dir.write("bad.yaml", "sensors:\n  magnetometer: {field_uT: 500}\n"), hosts::test_resolvers());
-    FAIL() << "accepted";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("sensors.magnetometer.field_uT"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("100"), std::string::npos) << e.what();
-  }
+  });
+  EXPECT_THAT(range, HasSubstr("sensors.magnetometer.field_uT"));
+  EXPECT_THAT(range, HasSubstr("100"));
   // The GNSS outage: both ends read in seconds; a window that ends before it starts is named.
   const Scenario outage = load_scenario(
       dir.write("outage.yaml", "sensors:\n  gnss: {outage_from_s: 4, outage_to_s: 6.5}\n"), hosts::test_resolvers());
@@ -409,20 +420,12 @@ schedule:
   }
   // A typo in the gains of a type that does not fly is still an error, named at its key.
   const std::string typo = dir.write("typo.yaml", "controller:\n  paper:\n    lqr: {roll: {q_angel: 2}}\n");
-  try {
-    (void)load_scenario(typo, "se3", hosts::test_resolvers());
-    ADD_FAILURE() << "a misspelt paper gain was accepted while se3 flies";
-  } catch (const ConfigError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel'"));
-  }
+  EXPECT_THAT(error_message<ConfigError>([&] { (void)load_scenario(typo, "se3", hosts::test_resolvers()); }),
+              HasSubstr("controller.paper.lqr.roll.q_angel: unknown parameter 'lqr.roll.q_angel'"));
   // The node's parameters belong to what is flown, not to a type's gains.
   const std::string node = dir.write("node.yaml", "controller:\n  se3: {z_des: 3}\n");
-  try {
-    (void)load_scenario(node, hosts::test_resolvers());
-    ADD_FAILURE() << "z_des inside se3: was accepted";
-  } catch (const ConfigError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("controller.se3.z_des: 'z_des' is the node's"));
-  }
+  EXPECT_THAT(error_message<ConfigError>([&] { (void)load_scenario(node, hosts::test_resolvers()); }),
+              HasSubstr("controller.se3.z_des: 'z_des' is the node's"));
 }
 
 // A file that writes the paper controller's gains directly under controller: (the older form) flies
@@ -508,14 +511,10 @@ controller: {type: se3}
   EXPECT_EQ(f.kt_N_per_rad2_s2, 1.105e-5);
   EXPECT_EQ(f.Izz_kg_m2, 0.04);
 
-  try {
-    load_vehicle(dir.write("bad.yaml", "preset: crazyflie\n"));
-    FAIL() << "an unknown preset was accepted";
-  } catch (const ConfigError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("preset"), std::string::npos) << what;
-    EXPECT_NE(what.find("crazyflie2"), std::string::npos) << what;  // the known names, or the nearest
-  }
+  const std::string unknown =
+      error_message<ConfigError>([&] { load_vehicle(dir.write("bad.yaml", "preset: crazyflie\n")); });
+  EXPECT_THAT(unknown, HasSubstr("preset"));
+  EXPECT_THAT(unknown, HasSubstr("crazyflie2"));  // the known names, or the nearest
 }
 
 // Every key of the vehicle parameter table, at its place in the file, reaches its member.
@@ -579,13 +578,12 @@ aero:
   EXPECT_EQ(v.aero.flapping_k_flap, 3.0e-6);
   EXPECT_EQ(v.aero.translational_lift_k_h, 0.02);
   // The hub drag beside the lumped rotor drag is the same drag twice: refused at the lumped key.
-  try {
-    load_vehicle(
-        dir.write("twice.yaml", "aero: {rotor_aero: true, rotor_drag_k_d: 1e-5, rotor_drag_N_s_m_per_rad_s: 1e-5}\n"));
-    FAIL() << "the hub and the lumped rotor drag were accepted together";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("rotor_drag_N_s_m_per_rad_s"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT(
+      error_message<ConfigError>([&] {
+        load_vehicle(dir.write("twice.yaml",
+                               "aero: {rotor_aero: true, rotor_drag_k_d: 1e-5, rotor_drag_N_s_m_per_rad_s: 1e-5}\n"));
+      }),
+      HasSubstr("rotor_drag_N_s_m_per_rad_s"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -603,16 +601,9 @@ TEST_P(BadScenarioTest, ConfigErrorNamesFileKeyAndValue) {
   const BadScenario& b = GetParam();
   TempDir dir;
   const std::string path = dir.write(b.label + ".yaml", b.yaml);
-  try {
-    load_scenario(path, hosts::test_resolvers());
-    FAIL() << "no error for\n" << b.yaml;
-  } catch (const ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << "message does not start with the file: " << msg;
-    for (const std::string& s : b.must_mention) {
-      EXPECT_NE(msg.find(s), std::string::npos) << "'" << s << "' missing from: " << msg;
-    }
-  }
+  const std::string msg = error_message<ConfigError>([&] { load_scenario(path, hosts::test_resolvers()); });
+  EXPECT_THAT(msg, StartsWith(path + ": ")) << "for\n" << b.yaml;
+  for (const std::string& s : b.must_mention) EXPECT_THAT(msg, HasSubstr(s));
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -789,12 +780,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(ScenarioTest, MissingFileIsAConfigErrorNamingIt) {
   TempDir dir;
   const std::string path = dir.file("does_not_exist.yaml");
-  try {
-    load_scenario(path, hosts::test_resolvers());
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-  }
+  EXPECT_THAT(error_message<ConfigError>([&] { load_scenario(path, hosts::test_resolvers()); }), HasSubstr(path));
 }
 
 TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
@@ -810,23 +796,14 @@ TEST(ScenarioTest, VehicleAndControllerFilesUseTheSameChecks) {
   EXPECT_EQ(controllers::paper_controller(c)->vehicle().mass_kg, 3.0);
 
   const std::string bad_vehicle = dir.write("bad_v.yaml", "mass_kg: 0\n");
-  try {
-    load_vehicle(bad_vehicle);
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(bad_vehicle + ": mass_kg: "), std::string::npos) << msg;
-    EXPECT_NE(msg.find("'0'"), std::string::npos) << msg;
-  }
+  const std::string vehicle_error = error_message<ConfigError>([&] { load_vehicle(bad_vehicle); });
+  EXPECT_THAT(vehicle_error, HasSubstr(bad_vehicle + ": mass_kg: "));
+  EXPECT_THAT(vehicle_error, HasSubstr("'0'"));
   const std::string bad_controller = dir.write("bad_c.yaml", "lqr:\n  roll: {r: -1}\n");
-  try {
-    load_controller(bad_controller, v, hosts::test_resolvers());
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(bad_controller + ": lqr.roll.r: "), std::string::npos) << msg;
-    EXPECT_NE(msg.find("-1"), std::string::npos) << msg;
-  }
+  const std::string controller_error =
+      error_message<ConfigError>([&] { load_controller(bad_controller, v, hosts::test_resolvers()); });
+  EXPECT_THAT(controller_error, HasSubstr(bad_controller + ": lqr.roll.r: "));
+  EXPECT_THAT(controller_error, HasSubstr("-1"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1092,12 +1069,7 @@ TEST(TrajectoryWriterTest, DestructorFlushesWithoutClose) {
 TEST(TrajectoryWriterTest, UnwritablePathThrowsNamingIt) {
   TempDir dir;
   const std::string path = dir.file("no/such/dir/trajectory.csv");
-  try {
-    TrajectoryWriter w(path);
-    FAIL() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-  }
+  EXPECT_THAT(error_message<std::runtime_error>([&] { TrajectoryWriter w(path); }), HasSubstr(path));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1134,14 +1106,9 @@ TEST_P(BadScheduleTest, RejectedWithFileAndLine) {
   const BadSchedule& b = GetParam();
   TempDir dir;
   const std::string path = dir.write(b.label + ".csv", b.text);
-  try {
-    read_command_schedule(path);
-    FAIL() << "no error for\n" << b.text;
-  } catch (const std::runtime_error& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind(path + ":" + std::to_string(b.line) + ": ", 0), 0u) << msg;
-    EXPECT_NE(msg.find(b.must_mention), std::string::npos) << msg;
-  }
+  const std::string msg = error_message<std::runtime_error>([&] { read_command_schedule(path); });
+  EXPECT_THAT(msg, StartsWith(path + ":" + std::to_string(b.line) + ": ")) << "for\n" << b.text;
+  EXPECT_THAT(msg, HasSubstr(b.must_mention));
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -1169,12 +1136,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(CommandScheduleTest, MissingFileNamesIt) {
   TempDir dir;
   const std::string path = dir.file("none.csv");
-  try {
-    read_command_schedule(path);
-    FAIL() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-  }
+  EXPECT_THAT(error_message<std::runtime_error>([&] { read_command_schedule(path); }), HasSubstr(path));
 }
 
 // ---------------------------------------------------------------------------------------------

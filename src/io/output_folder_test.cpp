@@ -9,6 +9,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace quadcosim::io {
 namespace {
@@ -35,6 +37,17 @@ class TempDir {
 void write(const fs::path& p, const std::string& text = "x") {
   fs::create_directories(p.parent_path());
   std::ofstream(p) << text;
+}
+
+/// What `quadcosim run` leaves in `dir`: `outputs` written and recorded as the group "outputs", then
+/// `figures` as the group "figures" (paths relative to dir).
+void write_run(const fs::path& dir, const std::vector<std::string>& outputs, const std::vector<std::string>& figures) {
+  std::ostringstream notes;
+  OutputFolder f = OutputFolder::claim(dir, "run", {}, notes);
+  for (const std::string& p : outputs) write(dir / p);
+  f.record("outputs");
+  for (const std::string& p : figures) write(dir / p);
+  f.record("figures");
 }
 
 nlohmann::json manifest_json(const fs::path& dir) {
@@ -72,14 +85,7 @@ TEST(OutputFolder, NewFolderIsCreatedAndItsManifestListsExactlyWhatWasWritten) {
 
 TEST(OutputFolder, GroupsSplitTheFilesByWhenTheyWereWritten) {
   TempDir t;
-  std::ostringstream notes;
-  {
-    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
-    write(t.path() / "trajectory.csv");
-    f.record("outputs");
-    write(t.path() / "overview.png");
-    f.record("figures");
-  }
+  write_run(t.path(), {"trajectory.csv"}, {"overview.png"});
   const nlohmann::json j = manifest_json(t.path());
   EXPECT_EQ(j["files"]["outputs"], nlohmann::json({"trajectory.csv"}));
   EXPECT_EQ(j["files"]["figures"], nlohmann::json({"overview.png"}));
@@ -157,15 +163,7 @@ TEST(OutputFolder, ReplaceOwnReplacesTheSameCommandsOutputsOnly) {
 
 TEST(OutputFolder, ReopenReplacesOneGroupOfTheFolder) {
   TempDir t;
-  std::ostringstream notes;
-  {
-    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
-    write(t.path() / "trajectory.csv");
-    f.record("outputs");
-    write(t.path() / "step_x.png");
-    write(t.path() / "overview.png");
-    f.record("figures");
-  }
+  write_run(t.path(), {"trajectory.csv"}, {"step_x.png", "overview.png"});
   {
     OutputFolder f = OutputFolder::reopen(t.path(), "plot", "figures");
     EXPECT_FALSE(fs::exists(t.path() / "step_x.png"));
@@ -181,16 +179,8 @@ TEST(OutputFolder, ReopenReplacesOneGroupOfTheFolder) {
 
 TEST(OutputFolder, ReopenOfASubFolderUsesTheEnclosingManifest) {
   TempDir t;
-  std::ostringstream notes;
-  {
-    OutputFolder f = OutputFolder::claim(t.path(), "run", {}, notes);
-    write(t.path() / "uav0000" / "trajectory.csv");
-    write(t.path() / "uav0001" / "trajectory.csv");
-    f.record("outputs");
-    write(t.path() / "uav0000" / "step_x.png");
-    write(t.path() / "uav0001" / "step_x.png");
-    f.record("figures");
-  }
+  write_run(t.path(), {"uav0000/trajectory.csv", "uav0001/trajectory.csv"},
+            {"uav0000/step_x.png", "uav0001/step_x.png"});
   {
     OutputFolder f = OutputFolder::reopen(t.path() / "uav0000", "plot", "figures");
     EXPECT_FALSE(fs::exists(t.path() / "uav0000" / "step_x.png"));

@@ -28,6 +28,15 @@ struct WatchdogRig {
     cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
     plant = std::make_unique<PlantNode>(bus, topics, vehicle, opt, model::State{});
   }
+  /// A watchdog of `ticks` ticks with `policy`, the other options their defaults.
+  explicit WatchdogRig(Tick ticks, WatchdogPolicy policy = PlantOptions{}.watchdog_policy)
+      : WatchdogRig(watchdog(ticks, policy)) {}
+  static PlantOptions watchdog(Tick ticks, WatchdogPolicy policy) {
+    PlantOptions opt;
+    opt.watchdog_ticks = ticks;
+    opt.watchdog_policy = policy;
+    return opt;
+  }
   void send(double w) {
     msg::Float64MultiArray m;
     m.data = {w, w, w, w};
@@ -42,10 +51,7 @@ struct WatchdogRig {
 };
 
 TEST(PlantWatchdogTest, StopPolicyActsAtTheLimitInTicksAndReleasesOnTheNextCommand) {
-  PlantOptions opt;
-  opt.watchdog_ticks = 5;
-  opt.watchdog_policy = WatchdogPolicy::kStop;
-  WatchdogRig rig(opt);
+  WatchdogRig rig(5, WatchdogPolicy::kStop);
   rig.tick(0, 4000.0);
   for (Tick k = 1; k < 5; ++k) {  // 4 ticks without a command: within the limit
     rig.tick(k);
@@ -68,9 +74,7 @@ TEST(PlantWatchdogTest, StopPolicyActsAtTheLimitInTicksAndReleasesOnTheNextComma
 }
 
 TEST(PlantWatchdogTest, InvalidCommandsDoNotFeedTheWatchdog) {
-  PlantOptions opt;
-  opt.watchdog_ticks = 3;
-  WatchdogRig rig(opt);
+  WatchdogRig rig(3);
   rig.tick(0, 4000.0);
   for (Tick k = 1; k <= 3; ++k) {
     rig.plant->publish_outputs(k);
@@ -84,10 +88,7 @@ TEST(PlantWatchdogTest, InvalidCommandsDoNotFeedTheWatchdog) {
 }
 
 TEST(PlantWatchdogTest, HoldPolicyKeepsTheLastCommandButCountsTheEvent) {
-  PlantOptions opt;
-  opt.watchdog_ticks = 2;
-  opt.watchdog_policy = WatchdogPolicy::kHold;
-  WatchdogRig rig(opt);
+  WatchdogRig rig(2, WatchdogPolicy::kHold);
   rig.tick(0, 4321.0);
   for (Tick k = 1; k <= 4; ++k) rig.tick(k);
   EXPECT_TRUE(rig.plant->watchdog_active());
@@ -97,9 +98,7 @@ TEST(PlantWatchdogTest, HoldPolicyKeepsTheLastCommandButCountsTheEvent) {
 }
 
 TEST(PlantWatchdogTest, ZeroSwitchesItOff) {
-  PlantOptions opt;
-  opt.watchdog_ticks = 0;
-  WatchdogRig rig(opt);
+  WatchdogRig rig(0);
   rig.tick(0, 4000.0);
   for (Tick k = 1; k < 1000; ++k) rig.tick(k);
   EXPECT_FALSE(rig.plant->watchdog_active());
@@ -107,9 +106,7 @@ TEST(PlantWatchdogTest, ZeroSwitchesItOff) {
 }
 
 TEST(PlantWatchdogTest, ReceiptClockMeasuresWallTimeNotTicks) {
-  PlantOptions opt;
-  opt.watchdog_ticks = 5;  // 50 ms
-  WatchdogRig rig(opt);
+  WatchdogRig rig(5);  // 50 ms
   std::int64_t now_ns = 1'000'000'000;
   rig.plant->use_receipt_clock([&] { return now_ns; });
   rig.tick(0, 4000.0);
@@ -130,9 +127,7 @@ TEST(PlantWatchdogTest, ReceiptClockMeasuresWallTimeNotTicks) {
 }
 
 TEST(PlantWatchdogTest, ReceiptClockStartsAtTheFirstTickWhenNothingArrives) {
-  PlantOptions opt;
-  opt.watchdog_ticks = 5;
-  WatchdogRig rig(opt);
+  WatchdogRig rig(5);
   std::int64_t now_ns = 7'000'000'000;
   rig.plant->use_receipt_clock([&] { return now_ns; });
   rig.tick(0);

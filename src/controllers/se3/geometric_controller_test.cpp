@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "control/observation_test_support.hpp"
 #include "model/attitude.hpp"
 #include "model/mixer.hpp"
 #include "model/quadrotor.hpp"
@@ -21,6 +22,7 @@ using control::Mode;
 using control::Observation;
 using control::Reference;
 using control::Setting;
+using control::test::observe;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kControlDt = 0.02;       // 50 Hz
@@ -45,20 +47,6 @@ int output_index(const control::Controller& c, const std::string& name) {
   }
   ADD_FAILURE() << "no output " << name;
   return 0;
-}
-
-Observation observe(const model::State& x) {
-  Observation o;
-  o.p_W = x.p_W;
-  o.v_W = x.v_W;
-  o.q_WB = x.q_WB;
-  const model::Euler e = model::euler_from_quaternion(x.q_WB);
-  o.roll_rad = e.roll_rad;
-  o.pitch_rad = e.pitch_rad;
-  o.yaw_rad = e.yaw_rad;
-  o.w_B = x.w_B;
-  o.age_s = 0.0;
-  return o;
 }
 
 Reference hold_position(const Eigen::Vector3d& p_W, double yaw_rad) {

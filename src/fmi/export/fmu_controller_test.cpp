@@ -7,6 +7,7 @@
 #include <iostream>
 #include <limits>
 
+#include "control/observation_test_support.hpp"
 #include "controllers/registry.hpp"
 #include "fmi/export/fmu_test_support.hpp"
 #include "fmi/quadrotor_variables.hpp"
@@ -17,6 +18,8 @@
 
 namespace quadcosim::fmi::test {
 namespace {
+
+using quadcosim::control::test::observe;
 
 class Controller : public Fmi2Instance {
  public:
@@ -55,22 +58,6 @@ FmuConfig altitude_step() {
   c.setpoint.p_des_W = {0.0, 0.0, 10.0};
   c.guid = make_guid(c);
   return c;
-}
-
-/// The observation sim::ControllerNode builds from the plant's outputs `y`.
-control::Observation observe(const model::Outputs& y) {
-  control::Observation o;
-  o.p_W = y.p_W;
-  o.v_W = y.v_W;
-  o.q_WB = y.q_WB;
-  const model::Euler e = model::euler_from_quaternion(y.q_WB);
-  o.roll_rad = e.roll_rad;
-  o.pitch_rad = e.pitch_rad;
-  o.yaw_rad = e.yaw_rad;
-  o.w_B = y.w_B;
-  o.specific_force_B = y.specific_force_B;
-  o.age_s = 0.0;
-  return o;
 }
 
 TEST(FmuController, FliesThePapersAltitudeStepAsTheNativeControllerDoes) {
