@@ -138,16 +138,19 @@ class PlantCore {
   /// A command at another level (its layout names it: msg::command_level_name) is checked as that
   /// level's values and queued at its level.
   CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
-    const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s);
+    const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s, model_->rotor_count());
     if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
     return check;
   }
   /// A valid command (speeds within [0, omega_max]; or 4 finite values of another level) received
   /// during tick k takes effect at tick k + delay_ticks.
-  void queue(Tick k, Tick delay_ticks, const model::Vector4& values,
+  void queue(Tick k, Tick delay_ticks, const model::RotorVector& values,
              control::CommandLevel level = control::CommandLevel::kRotorSpeeds) {
     last_valid_tick_ = k;
-    pending_.push_back({k + delay_ticks, values, level});
+    Pending& p = pending_.emplace_back();  // filled in place: no copy of the rotor vector
+    p.effective_tick = k + delay_ticks;
+    model::assign_rotors(p.omega, values);
+    p.level = level;
   }
   /// The inner loops' gains (InnerLoopParams::for_vehicle when never set): checked for the vehicle and
   /// the plant period, std::invalid_argument naming the gain that does not fit.
@@ -172,7 +175,7 @@ class PlantCore {
         held_.level = p.level;
         set_latched(p.omega);
       } else {
-        held_ = {p.level, p.omega};
+        held_ = {p.level, p.omega.head<4>()};
       }
     }
     if (held_.level != control::CommandLevel::kRotorSpeeds) fly_held();
@@ -186,8 +189,8 @@ class PlantCore {
     return latched;
   }
   /// Latches a command: the speeds and, formed once here, the model's rotor input.
-  void set_latched(const model::Vector4& omega_rad_s) {
-    latched_ = omega_rad_s;
+  void set_latched(const model::RotorVector& omega_rad_s) {
+    model::assign_rotors(latched_, omega_rad_s);
     rotor_input_ = model_->rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
   }
   /// The command acting over [t_k, t_k+1): the newest due by tick k (latch_due), then the watchdog:
@@ -203,7 +206,7 @@ class PlantCore {
   /// Latches every motor at the vehicle's omega_min_rad_s (the watchdog's stop policy).
   void latch_omega_min() {
     held_.level = control::CommandLevel::kRotorSpeeds;
-    set_latched(model::Vector4::Constant(model_->params().motor.omega_min_rad_s));
+    set_latched(model::RotorVector::Constant(model_->rotor_count(), model_->params().motor.omega_min_rad_s));
   }
   /// Time [ns] at tick k since the tick of the newest valid command (0 before any: from tick 0).
   std::int64_t command_age_ns(const TickClock& clock, Tick k) const {
@@ -222,7 +225,7 @@ class PlantCore {
   const model::State& state() const { return state_; }
   /// The state, for dynamics computed elsewhere to report (PlantNode's external dynamics).
   model::State& state() { return state_; }
-  const model::Vector4& latched() const { return latched_; }
+  const model::RotorVector& latched() const { return latched_; }
 
  private:
   const model::Environment* environment(Tick k) { return realism_ ? &realism_->environment(k) : nullptr; }
@@ -239,15 +242,15 @@ class PlantCore {
 
   std::optional<model::Quadrotor> model_;  ///< optional only to be default-constructible (a batch's array)
   model::State state_;
-  model::Vector4 latched_ = model::Vector4::Zero();  ///< the command acting over [t_k, t_k+1)
-  model::RotorInput rotor_input_;                    ///< latched_ as the model applies it
-  Tick last_valid_tick_ = 0;                         ///< tick during which the newest valid command arrived
-  double period_s_ = 0.0;                            ///< the plant period the inner loops are designed for
-  control::LevelCommand held_;                       ///< the level command held (rotor speeds: latched_ is it)
-  std::unique_ptr<Inner> inner_;                     ///< the inner loops, made at the first level command
+  model::RotorVector latched_ = model::RotorVector::Zero(4);  ///< the command acting over [t_k, t_k+1)
+  model::RotorInput rotor_input_;                             ///< latched_ as the model applies it
+  Tick last_valid_tick_ = 0;                                  ///< tick during which the newest valid command arrived
+  double period_s_ = 0.0;                                     ///< the plant period the inner loops are designed for
+  control::LevelCommand held_;                                ///< the level command held (rotor speeds: latched_ is it)
+  std::unique_ptr<Inner> inner_;                              ///< the inner loops, made at the first level command
   struct Pending {
     Tick effective_tick;
-    model::Vector4 omega;  ///< rotor speeds, or the 4 values of `level`
+    model::RotorVector omega;  ///< rotor speeds (one per rotor), or the 4 values of `level`
     control::CommandLevel level;
   };
   // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is

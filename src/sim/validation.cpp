@@ -20,7 +20,8 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
 // of range are clamped to the nearer end and the first of them is named. Out of line: the common
 // case (all four in range) never comes here.
 [[gnu::noinline, gnu::cold]] void find_command_fault(const double* w, CommandCheck& out) {
-  for (int i = 0; i < 4; ++i) {
+  const int n = out.rotors;
+  for (int i = 0; i < n; ++i) {
     if (!std::isfinite(w[i])) {
       out.fault = CommandFault::kNonFinite;
       out.rotor = i;
@@ -29,7 +30,7 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
       return;
     }
   }
-  for (int i = 3; i >= 0; --i) {  // downwards, so that the first rotor out of range is the one named
+  for (int i = n - 1; i >= 0; --i) {  // downwards, so that the first rotor out of range is the one named
     if (in_range(w[i], out.omega_max_rad_s)) continue;
     out.omega_rad_s[i] = w[i] > out.omega_max_rad_s ? out.omega_max_rad_s : 0.0;
     out.fault = CommandFault::kOutOfRange;
@@ -48,11 +49,16 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
     return;
   }
   out.level = *level;
+  if (out.level == control::CommandLevel::kRotorThrusts && out.rotors != 4) {
+    out.fault = CommandFault::kLevelNotForVehicle;
+    return;
+  }
   if (m.data.size() != 4) {
     out.fault = CommandFault::kWrongLength;
     out.values = m.data.size();
     return;
   }
+  out.omega_rad_s.resize(4);
   for (int i = 0; i < 4; ++i) {
     const double v = m.data[static_cast<std::size_t>(i)];
     out.omega_rad_s[i] = v;
@@ -76,24 +82,30 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
 
 }  // namespace
 
-CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
+CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s, int rotor_count) {
   CommandCheck out;
   out.omega_max_rad_s = omega_max_rad_s;
+  out.rotors = rotor_count;
   if (!m.dim.empty()) {
     if (const std::string_view level = msg::command_level_name(m); !level.empty()) {
       check_level_command(m, level, out);
       return out;
     }
   }
-  if (m.data.size() != 4) {
+  if (m.data.size() != static_cast<std::size_t>(rotor_count)) {
     out.fault = CommandFault::kWrongLength;
     out.values = m.data.size();
     return out;
   }
   const double* w = m.data.data();
-  out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
   bool ok = true;
-  for (int i = 0; i < 4; ++i) ok &= in_range(w[i], omega_max_rad_s);  // no branch per speed
+  if (rotor_count == 4) {  // the quadrotor's command, unrolled
+    out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
+    for (int i = 0; i < 4; ++i) ok &= in_range(w[i], omega_max_rad_s);  // no branch per speed
+  } else {
+    out.omega_rad_s = Eigen::Map<const model::RotorVector>(w, rotor_count);
+    for (int i = 0; i < rotor_count; ++i) ok &= in_range(w[i], omega_max_rad_s);
+  }
   if (!ok) find_command_fault(w, out);
   return out;
 }
@@ -104,7 +116,8 @@ CommandVerdict CommandCheck::verdict() const {
     case CommandFault::kOutOfRange: return CommandVerdict::kClamped;
     case CommandFault::kWrongLength:
     case CommandFault::kNonFinite:
-    case CommandFault::kUnknownLevel: break;
+    case CommandFault::kUnknownLevel:
+    case CommandFault::kLevelNotForVehicle: break;
   }
   return CommandVerdict::kRejected;
 }
@@ -120,14 +133,20 @@ std::string CommandCheck::reason() const {
         return fmt::format("{} value {} ({}) is {}, expected a finite number", name, rotor + 1,
                            control::setpoint_fields(level)[static_cast<std::size_t>(rotor)], value);
       case CommandFault::kOutOfRange: return fmt::format("rotor {} thrust {:g} N clamped to 0", rotor + 1, value);
+      case CommandFault::kLevelNotForVehicle:
+        return fmt::format(
+            "level {} takes one thrust per rotor of a four-rotor vehicle; this vehicle has {} rotors "
+            "(command it at rotor_speeds or a level above)",
+            name, rotors);
       case CommandFault::kUnknownLevel: break;
     }
     return "?";
   }
   switch (fault) {
     case CommandFault::kNone: return "";
-    case CommandFault::kUnknownLevel: return "?";
-    case CommandFault::kWrongLength: return fmt::format("{} values, expected 4 rotor speeds", values);
+    case CommandFault::kUnknownLevel:
+    case CommandFault::kLevelNotForVehicle: return "?";
+    case CommandFault::kWrongLength: return fmt::format("{} values, expected {} rotor speeds", values, rotors);
     case CommandFault::kNonFinite:
       return fmt::format("rotor {} speed is {}, expected a finite number", rotor + 1, value);
     case CommandFault::kOutOfRange:

@@ -109,6 +109,7 @@ model::VehicleParams read_vehicle(const Reader& r) {
         }
         break;
       }
+      case model::VehicleParameter::Kind::kRotors: break;  // an exported FMU flies four rotors
     }
   }
   return v;
