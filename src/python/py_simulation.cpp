@@ -48,6 +48,12 @@ py::array_t<double> array(std::initializer_list<double> v) {
   return a;
 }
 
+py::array_t<double> array(const model::RotorVector& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
 double stamp_s(const msg::Header& h) { return h.stamp.sec + h.stamp.nanosec * 1e-9; }
 
 /// One vehicle of a scenario, advanced one control period at a time.
@@ -67,13 +73,15 @@ class PySimulation {
   }
 
   void step(const std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>& omega_cmd) {
-    std::optional<model::Vector4> command;
+    std::optional<model::RotorVector> command;
     if (omega_cmd) {
-      if (omega_cmd->ndim() != 1 || omega_cmd->shape(0) != 4) {
-        throw py::value_error("Simulation.step: omega_cmd: expected 4 rotor speeds [rad/s], got an array of shape " +
+      const int rotors = scenario_.vehicle.rotor_count;
+      if (omega_cmd->ndim() != 1 || omega_cmd->shape(0) != rotors) {
+        throw py::value_error("Simulation.step: omega_cmd: expected " + std::to_string(rotors) +
+                              " rotor speeds [rad/s], got an array of shape " +
                               py::repr(omega_cmd->attr("shape")).cast<std::string>());
       }
-      command = model::Vector4(omega_cmd->at(0), omega_cmd->at(1), omega_cmd->at(2), omega_cmd->at(3));
+      command = Eigen::Map<const model::RotorVector>(omega_cmd->data(), rotors);
     }
     auto lock = guard();
     py::gil_scoped_release release;
@@ -135,14 +143,14 @@ class PySimulation {
     d["v"] = array({x.v_W.x(), x.v_W.y(), x.v_W.z()});
     d["q"] = array({x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()});
     d["w"] = array({x.w_B.x(), x.w_B.y(), x.w_B.z()});
-    d["omega"] = array({x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]});
+    d["omega"] = array(x.omega_rad_s);
     return d;
   }
 
   py::array_t<double> command() {
     auto lock = guard();
-    const model::Vector4& c = sim_->plant().latched_command();
-    return array({c[0], c[1], c[2], c[3]});
+    const model::RotorVector& c = sim_->plant().latched_command();
+    return array(c);
   }
 
   py::dict sensors() {
