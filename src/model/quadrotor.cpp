@@ -356,6 +356,11 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Roto
 
 RotorInput Quadrotor::rotor_input(const RotorVector& cmd) const {
   RotorInput a;
+  rotor_input(cmd, a);
+  return a;
+}
+
+void Quadrotor::rotor_input(const RotorVector& cmd, RotorInput& a) const {
   if (cmd.size() == 4) {  // the quadrotor's: clamp and eq. (4) on fixed-size vectors, as before other counts
     Vector4 w;
     for (int i = 0; i < 4; ++i) {
@@ -366,11 +371,10 @@ RotorInput Quadrotor::rotor_input(const RotorVector& cmd) const {
     a.omega_rad_s.head<4>() = w;
     const Vector4 u = mixer4_ * w.cwiseProduct(w);
     a.wrench = {u[0], u.tail<3>()};
-    return a;
+    return;
   }
   a.omega_rad_s = clamp_command(cmd);
   a.wrench = wrench(a.omega_rad_s);
-  return a;
 }
 
 Outputs Quadrotor::outputs(double t_s, const State& x, const RotorVector& cmd, const Environment* env) const {

@@ -72,6 +72,8 @@ class Quadrotor {
 
   /// The command clamped and its wrench, for the step() and outputs() overloads that take it.
   RotorInput rotor_input(const RotorVector& omega_cmd_rad_s) const;
+  /// The same into `out` (a holder of the latched command: no rotor vector copied).
+  void rotor_input(const RotorVector& omega_cmd_rad_s, RotorInput& out) const;
 
   /// dx/dt at state x under the (already clamped) commanded rotor speeds:
   ///  - translation, eq. (7) in vector form: dv_W = R_WB (0, 0, U1) / m + (0, 0, -g);

@@ -137,7 +137,7 @@ class PlantCore {
   /// effect at tick k + delay_ticks. Returns the check, for the caller's statistics.
   /// A command at another level (its layout names it: msg::command_level_name) is checked as that
   /// level's values and queued at its level.
-  CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
+  [[gnu::always_inline]] CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
     const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s, model_->rotor_count());
     if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
     return check;
@@ -191,7 +191,7 @@ class PlantCore {
   /// Latches a command: the speeds and, formed once here, the model's rotor input.
   void set_latched(const model::RotorVector& omega_rad_s) {
     model::assign_rotors(latched_, omega_rad_s);
-    rotor_input_ = model_->rotor_input(omega_rad_s);  // clamped and turned into a wrench once per latch
+    model_->rotor_input(omega_rad_s, rotor_input_);  // clamped and turned into a wrench once per latch
   }
   /// The command acting over [t_k, t_k+1): the newest due by tick k (latch_due), then the watchdog:
   /// when limit_ns > 0 and the command's age `age_ns` (command_age_ns in simulated time; a host in

@@ -44,6 +44,7 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
   const std::optional<control::CommandLevel> level = control::command_level_from_string(name);
   if (!level) {
     out.fault = CommandFault::kUnknownLevel;
+    out.omega_rad_s.setZero(4);
     const std::size_t n = std::min(name.size(), out.unknown_level.size() - 1);
     std::copy_n(name.data(), n, out.unknown_level.data());
     return;
@@ -51,11 +52,13 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
   out.level = *level;
   if (out.level == control::CommandLevel::kRotorThrusts && out.rotors != 4) {
     out.fault = CommandFault::kLevelNotForVehicle;
+    out.omega_rad_s.setZero(4);
     return;
   }
   if (m.data.size() != 4) {
     out.fault = CommandFault::kWrongLength;
     out.values = m.data.size();
+    out.omega_rad_s.setZero(4);
     return;
   }
   out.omega_rad_s.resize(4);
@@ -95,6 +98,7 @@ CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad
   if (m.data.size() != static_cast<std::size_t>(rotor_count)) {
     out.fault = CommandFault::kWrongLength;
     out.values = m.data.size();
+    out.omega_rad_s.setZero(rotor_count);
     return out;
   }
   const double* w = m.data.data();

@@ -43,7 +43,7 @@ enum class CommandFault : std::uint8_t {
 struct CommandCheck {
   CommandFault fault = CommandFault::kNone;
   /// The speeds to use (not kRejected) [rad/s], one per rotor; a level's 4 values.
-  model::RotorVector omega_rad_s;  ///< (empty when rejected before the values were read)
+  model::RotorVector omega_rad_s;  ///< zeros when rejected
   std::size_t values = 4;          ///< how many values the message held
   int rotors = 4;                  ///< the vehicle's rotor count: how many speeds were expected
   int rotor = 0;                   ///< the rotor at fault, 0..3: the first non-finite one, or the first clamped one

@@ -49,10 +49,10 @@ def test_a_hex_batch_refuses_rotor_thrusts_and_another_rotor_count():
 def test_a_hex_simulation_takes_six_speeds():
     sim = quadcosim.Simulation(quadcosim.load_scenario(hex_hover()))
     sim.step()
-    assert sim.state()["omega"].shape == (6,)
-    assert sim.command().shape == (6,)
+    assert sim.state["omega"].shape == (6,)
+    assert sim.command.shape == (6,)
     sim.step(omega_cmd=np.full(6, 560.0))
-    np.testing.assert_allclose(sim.command(), np.full(6, 560.0))
+    np.testing.assert_allclose(sim.command, np.full(6, 560.0))
     with pytest.raises(ValueError, match="expected 6 rotor speeds"):
         sim.step(omega_cmd=np.full(4, 560.0))
 
