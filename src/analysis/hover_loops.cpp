@@ -167,7 +167,7 @@ std::vector<HoverLoop> hover_loops(const model::VehicleParams& plant, const cont
 
   // The allocation hands the plant Omega^2 = M_c^-1 U (thrust is k_t omega^2), so the plant's
   // generalised input is M_p M_c^-1 U: the identity when controller and plant agree on the vehicle.
-  const Eigen::Matrix4d alloc = model::mixer_matrix(plant) * model::mixer_matrix(fc.vehicle()).inverse();
+  const Eigen::Matrix4d alloc = model::mixer_matrix4(plant) * model::mixer_matrix4(fc.vehicle()).inverse();
   const double tau = plant.motor.model == model::MotorModel::kFirstOrder
                          ? std::max(plant.motor.tau_up_s, plant.motor.tau_down_s)
                          : 0.0;

@@ -69,7 +69,7 @@ class InjectionRun {
         plant_(transport_, topics_, setup.vehicle, plant_options(cfg_),
                model::Quadrotor(setup.vehicle).initial_state(setup.trim_p_W, 0.0, true)),
         controller_(transport_, controller_topics_, trimmed(setup)),
-        mixer_(model::mixer_matrix(setup.vehicle)),
+        mixer_(model::mixer_matrix4(setup.vehicle)),
         mixer_inverse_(mixer_.inverse()),
         index_(wrench_index(axis)),
         window_(w),
@@ -212,7 +212,7 @@ class InjectionRun {
 /// The amplitude on `axis` [N or N m] that moves no rotor by more than `fraction` of its hover speed
 /// (to first order: d(omega^2) = 2 omega d(omega)).
 double axis_amplitude(const model::VehicleParams& v, HoverAxis axis, double fraction) {
-  const Eigen::Matrix4d mi = model::mixer_matrix(v).inverse();
+  const Eigen::Matrix4d mi = model::mixer_matrix4(v).inverse();
   Eigen::Vector4d hover_U = Eigen::Vector4d::Zero();
   hover_U(0) = v.mass_kg * v.gravity_m_s2;
   const Eigen::Vector4d omega_sq = mi * hover_U;

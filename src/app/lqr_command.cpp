@@ -120,7 +120,8 @@ int vehicle_params_table(bool markdown, const std::string& preset) {
           range.append(c);
         }
         break;
-      case model::VehicleParameter::Kind::kSigns: range = "+1 or -1 each"; break;
+      case model::VehicleParameter::Kind::kSigns: range = "+1 or -1 each, one per rotor"; break;
+      case model::VehicleParameter::Kind::kRotors: range = "4 to 8 {position_m, spin}"; break;
     }
     if (markdown) {
       std::cout << fmt::format(md_row, fmt::format("`{}`", p.name), p.unit, range, p.text(defaults), p.meaning);

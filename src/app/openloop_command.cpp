@@ -1,4 +1,5 @@
 // `quadcosim openloop --commands FILE --out FILE [--vehicle FILE]`: the plant alone.
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <iostream>
@@ -32,6 +33,12 @@ int openloop_command(const OpenloopOptions& opt) {
   model::VehicleParams vehicle;
   std::vector<io::CommandRow> rows;
   if (!opt.vehicle.empty()) vehicle = io::load_vehicle(opt.vehicle);
+  if (vehicle.rotor_count != 4) {  // the schedule's columns are t,w1,w2,w3,w4
+    throw io::ConfigError(
+        fmt::format("--vehicle {}: openloop's command schedule holds four rotor speeds; the vehicle "
+                    "has {} rotors (layout {})",
+                    opt.vehicle, vehicle.rotor_count, model::to_string(vehicle.layout)));
+  }
   try {
     rows = io::read_command_schedule(opt.commands);
   } catch (const std::runtime_error& e) {  // the file is input: a bad one is a bad input
@@ -59,7 +66,7 @@ int openloop_command(const OpenloopOptions& opt) {
     ro.csv = opt.out;
     io::Recording recording = hosts::make_recording(ro, nullptr);
     std::size_t next = 0;
-    Eigen::Vector4d cmd = Eigen::Vector4d::Zero();  // rotors stopped until the first row
+    model::RotorVector cmd = model::RotorVector::Zero(4);  // rotors stopped until the first row
     for (sim::Tick k = 0; k <= last_tick; ++k) {
       const double t = clock.seconds(k);
       while (next < rows.size() && rows[next].t_s <= t + 1e-12) cmd = rows[next++].omega_rad_s;

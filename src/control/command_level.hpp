@@ -5,8 +5,8 @@
 // Frames as everywhere in quadcosim: world W is ENU (z up), body B is FLU (x forward, z up).
 //
 //   level           values                                   units
-//   rotor_speeds    omega_1..omega_4                          [rad/s]   (the default; today's command)
-//   rotor_thrusts   T_1..T_4                                  [N]       omega_i = sqrt(T_i / k_t)
+//   rotor_speeds    omega_1..omega_N, one per rotor           [rad/s]   (the default; today's command)
+//   rotor_thrusts   T_1..T_4 (four-rotor vehicles only)       [N]       omega_i = sqrt(T_i / k_t)
 //   ctbr            U1, p, q, r: collective thrust along +z_B, body rates about x_B, y_B, z_B
 //                                                             [N], [rad/s]
 //   ctatt           U1, roll, pitch, yaw: thrust and the attitude R_WB as Z-Y-X angles
@@ -49,7 +49,8 @@ const std::array<std::string_view, kCommandLevelCount>& command_level_names();
 /// The names and units of a level's values, in order ("thrust [N]", "p [rad/s]", ...).
 const std::array<std::string_view, 4>& setpoint_fields(CommandLevel level);
 
-/// A command at one level (a "setpoint" of that level): four values (rotor levels: one per rotor).
+/// A command at one level (a "setpoint" of that level): four values (rotor_thrusts: one per rotor of a
+/// four-rotor vehicle). Rotor speeds, N of them, are latched as they are and never held as one.
 struct LevelCommand {
   CommandLevel level = CommandLevel::kRotorSpeeds;
   Eigen::Vector4d value = Eigen::Vector4d::Zero();

@@ -21,8 +21,9 @@ ReportedOutputs ReportedOutputs::find(std::span<const std::string> output_names)
   return r;
 }
 
-void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference, const Eigen::Vector4d& omega_rad_s,
-                         const ReportedOutputs& reported, ControllerOutput& out) {
+void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference,
+                         const model::RotorVector& omega_rad_s, const ReportedOutputs& reported,
+                         ControllerOutput& out) {
   out.omega_rad_s = omega_rad_s;
   const model::Wrench u = model.wrench(omega_rad_s);
   out.U = {u.thrust_N, u.torque_B_Nm.x(), u.torque_B_Nm.y(), u.torque_B_Nm.z()};
@@ -36,7 +37,8 @@ void rotor_speeds_output(const model::Quadrotor& model, const Reference& referen
   out.yaw_des_rad = figure(reported.yaw_des, reference.yaw_rad);
   out.attitude_error = nan;
   const model::MotorParams& motor = model.params().motor;
-  for (int i = 0; i < 4; ++i)
+  out.rotor_saturated.reset(static_cast<int>(omega_rad_s.size()));
+  for (int i = 0; i < static_cast<int>(omega_rad_s.size()); ++i)
     out.rotor_saturated[i] = omega_rad_s[i] >= motor.omega_max_rad_s || omega_rad_s[i] <= motor.omega_min_rad_s;
   out.tilt_saturated = figure(reported.tilt_saturated, 0.0) != 0.0;
 }

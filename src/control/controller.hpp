@@ -1,6 +1,6 @@
 // The interface every flight controller implements (docs/controllers.md). A controller is a step
 // function with explicit state: from what the sensors observed and what the vehicle is asked to do
-// (the reference), over one control period, to four rotor speed commands and the figures it wants
+// (the reference), over one control period, to one rotor speed command per rotor and the figures it wants
 // recorded. It declares its parameters in a table (name, unit, range, meaning), which become the
 // ROS 2 parameters of the controller node, the keys of a scenario's `controller:` section and the
 // sweepable `controller.*` keys. The node around it (sim::ControllerNode) keeps the latest sensor
@@ -23,6 +23,7 @@
 
 #include "control/command_level.hpp"
 #include "control/parameters.hpp"
+#include "model/rotor_vector.hpp"
 #include "sensors/readings.hpp"
 
 namespace quadcosim::model {
@@ -77,7 +78,8 @@ struct Reference {
 /// the setpoint at that level, and the plant's inner loops (control/inner_loops.hpp) turn it into rotor
 /// speeds on every plant tick; omega_rad_s is then not sent.
 struct ControllerOutput {
-  Eigen::Vector4d omega_rad_s = Eigen::Vector4d::Zero();  ///< rotor speed commands [rad/s]
+  /// Rotor speed commands [rad/s], one per rotor of the vehicle (4, 6 or 8 ...).
+  model::RotorVector omega_rad_s = model::RotorVector::Zero(4);
   /// The level commanded; rotor speeds (omega_rad_s) unless the controller says otherwise.
   CommandLevel level = CommandLevel::kRotorSpeeds;
   Eigen::Vector4d setpoint = Eigen::Vector4d::Zero();  ///< the values of `level` (not rotor speeds)
@@ -87,9 +89,9 @@ struct ControllerOutput {
   double roll_des_rad = 0.0, pitch_des_rad = 0.0, yaw_des_rad = 0.0;
   /// Psi = 1/2 tr(I - R_d^T R) in [0, 2], for a controller that has a desired attitude R_d; NaN if not.
   double attitude_error = std::numeric_limits<double>::quiet_NaN();
-  std::array<bool, 4> rotor_saturated{};  ///< the allocation clamped rotor i at omega_min or omega_max
-  bool tilt_saturated = false;            ///< a tilt limit cut the commanded attitude
-  bool safety = false;                    ///< set by the node: the stale-data safety command was sent
+  model::RotorFlags rotor_saturated;  ///< the allocation clamped rotor i at omega_min or omega_max
+  bool tilt_saturated = false;        ///< a tilt limit cut the commanded attitude
+  bool safety = false;                ///< set by the node: the stale-data safety command was sent
   /// The controller's own figures, in the order of Controller::output_names() (sized by the node).
   std::vector<double> outputs;
 };
@@ -201,8 +203,8 @@ struct ReportedOutputs {
 /// and its yaw in position mode, with roll and pitch NaN there (unknown, not 0). A rotor is saturated
 /// when its command is at or beyond the vehicle's speed limits (omega_min, omega_max); the tilt flag is
 /// the reported one, else false. Leaves `out.outputs` as it is.
-void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference, const Eigen::Vector4d& omega_rad_s,
-                         const ReportedOutputs& reported, ControllerOutput& out);
+void rotor_speeds_output(const model::Quadrotor& model, const Reference& reference,
+                         const model::RotorVector& omega_rad_s, const ReportedOutputs& reported, ControllerOutput& out);
 
 /// Psi = 1/2 tr(I - R_d^T R), the attitude error of Lee, Leok and McClamroch (2010), in [0, 2]:
 /// 1 - cos(angle of the rotation between them).

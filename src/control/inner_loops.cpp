@@ -58,7 +58,7 @@ InnerLoops::InnerLoops(const model::VehicleParams& vehicle, const InnerLoopParam
       omega_min_(vehicle.motor.omega_min_rad_s),
       omega_max_(vehicle.motor.omega_max_rad_s),
       J_(vehicle.inertia_tensor()),
-      mixer_inverse_(model::mixer_matrix(vehicle).inverse()),
+      allocation_(vehicle),
       k_rate_(pole_matched(params.rate_bandwidth_rad_s, period_s)),
       k_velocity_(pole_matched(params.velocity_bandwidth_rad_s, period_s)) {
   if (std::string err = check_inner_loops(params, vehicle, period_s); !err.empty()) throw std::invalid_argument(err);
@@ -101,11 +101,11 @@ InnerLoops::ThrustAttitude InnerLoops::thrust_attitude(const Eigen::Vector3d& a_
 }
 
 Allocation InnerLoops::allocate_wrench(const Eigen::Vector4d& U) const {
-  return allocate(mixer_inverse_, U, omega_min_, omega_max_);
+  return allocation_.allocate(U, omega_min_, omega_max_);
 }
 
 Allocation InnerLoops::rotor_thrusts(const Eigen::Vector4d& T_N) const {
-  Allocation out;
+  Allocation out;  // four rotors: the level is refused for other vehicles (sim::check_command)
   for (int i = 0; i < 4; ++i) {
     const double omega = std::sqrt(std::max(0.0, T_N[i]) / kt_);
     out.omega_rad_s[i] = std::clamp(omega, omega_min_, omega_max_);

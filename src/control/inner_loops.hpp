@@ -8,8 +8,9 @@
 //                               R_des = [b1 b2 b3], b3 = F / |F|, b1 from the yaw (as the se3 controller)
 //   ctatt -> ctbr:              w_des = -K_R e_R, e_R = 1/2 vee(R_des^T R - R^T R_des)
 //   ctbr -> cttm:               M = J K_w' (w_des - w) + w x J w
-//   cttm -> rotor speeds:       allocate(M^-1, U) (control/allocation.hpp): the only place that knows
-//                               the rotors; rotor_thrusts: omega_i = sqrt(T_i / k_t)
+//   cttm -> rotor speeds:       the layout's allocation, M^-1 U for four rotors and M^+ U for more
+//                               (control/allocation.hpp): the only place that knows the rotors;
+//                               rotor_thrusts (four-rotor vehicles only): omega_i = sqrt(T_i / k_t)
 //
 // The gains are bandwidths [rad/s], scaled by the vehicle's mass and inertia tensor, so one set serves
 // every vehicle. The first-order loops (velocity, body rate) use the pole-matched discrete gain
@@ -63,7 +64,7 @@ struct InnerLoopOutput {
   Allocation allocation;                        ///< rotor speeds and which rotors were clamped
   Eigen::Vector4d U = Eigen::Vector4d::Zero();  ///< U1 [N], U2..U4 [N m] asked of the allocation
   bool tilt_saturated = false;                  ///< the tilt limit cut a velocity/acceleration setpoint
-  bool saturated() const { return tilt_saturated || allocation.saturated != std::array<bool, 4>{}; }
+  bool saturated() const { return tilt_saturated || allocation.saturated.any(); }
 };
 
 class InnerLoops {
@@ -90,7 +91,7 @@ class InnerLoops {
   ThrustAttitude thrust_attitude(const Eigen::Vector3d& a_des_W, double yaw_rad, const Eigen::Matrix3d& R_WB) const;
   /// Rotor speeds for a wrench U (clamped to the motors' range, flagged).
   Allocation allocate_wrench(const Eigen::Vector4d& U) const;
-  /// Rotor speeds for rotor thrusts T_i [N]: sqrt(T_i / k_t), clamped, flagged.
+  /// Rotor speeds for rotor thrusts T_i [N] of a four-rotor vehicle: sqrt(T_i / k_t), clamped, flagged.
   Allocation rotor_thrusts(const Eigen::Vector4d& T_N) const;
 
   const InnerLoopParams& params() const { return params_; }
@@ -101,7 +102,7 @@ class InnerLoops {
   double period_s_;
   double mass_kg_, gravity_m_s2_, kt_, omega_min_, omega_max_;
   Eigen::Matrix3d J_;
-  Eigen::Matrix4d mixer_inverse_;
+  RotorAllocation allocation_;
   double k_rate_, k_velocity_;  ///< the pole-matched discrete gains [1/s]
 };
 

@@ -896,7 +896,8 @@ TEST(TopicToolsTest, MessagesAsRos2TopicEcho) {
   s.rotor_saturated[1] = true;
   const std::string sy = to_yaml(s);
   EXPECT_NE(sy.find("mode: attitude\nsetpoint:\n- 0.0\n"), std::string::npos);
-  EXPECT_NE(sy.find("rotor_saturated:\n- false\n- true\n- false\n- false\ntilt_saturated: false\nsafety: false\n"),
+  EXPECT_NE(sy.find("rotor_saturated:\n- false\n- true\n- false\n- false\n- false\n- false\n- false\n- false\n"
+                    "tilt_saturated: false\nsafety: false\n"),
             std::string::npos);
   EXPECT_NE(to_yaml(msg::TwistStamped{}).find("twist:\n  linear:\n    x: 0.0\n"), std::string::npos);
 }
@@ -1040,7 +1041,7 @@ TEST(TopicToolsTest, EveryMessageTypeAsRos2TopicEcho) {
             "yaw_error: 1.0e-06\n"
             "attitude_error: 0.0078125\n"
             "rotor_saturated:\n"
-            "- true\n- false\n- false\n- true\n"
+            "- true\n- false\n- false\n- true\n- false\n- false\n- false\n- false\n"
             "tilt_saturated: true\n"
             "safety: false\n"
             "rejected_non_finite: 1\n"

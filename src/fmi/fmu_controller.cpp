@@ -174,6 +174,12 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
   sh->description = describe_fmu(*sh->fmu);
   const ModelDescription& md = sh->fmu->description();
   const std::string name = fmu_name(*sh->fmu);
+  if (vehicle.rotor_count != 4) {
+    throw FmuError(
+        fmt::format("{}: an FMU controller commands four rotors (omega_cmd[1..4]); the vehicle has {} "
+                    "(layout {})",
+                    name, vehicle.rotor_count, model::to_string(vehicle.layout)));
+  }
   check_signal_keys(mapping.inputs, all_inputs(), "inputs");
   check_signal_keys(mapping.outputs, kOutputs, "outputs");
   bool observes = false;

@@ -74,7 +74,7 @@ void set_vehicle(Instance& instance, const ModelDescription& md, const model::Ve
       }
       case model::VehicleParameter::Kind::kSigns: {
         model::VehicleParams copy = vehicle;
-        const std::array<int, 4>& signs = p.signs(copy);
+        const std::array<int, model::kMaxRotors>& signs = p.signs(copy);
         for (std::size_t r = 0; r < 4; ++r) {
           const Variable* v = md.find(fmt::format("{}[{}]", name, r + 1));
           if (!settable(v)) continue;
@@ -82,6 +82,7 @@ void set_vehicle(Instance& instance, const ModelDescription& md, const model::Ve
         }
         break;
       }
+      case model::VehicleParameter::Kind::kRotors: break;  // four-rotor FMUs only: the layout says it
     }
   }
   if (!vrs.empty()) instance.set_real(vrs, values);
@@ -151,19 +152,19 @@ class FmuDynamics final : public sim::ExternalDynamics {
     x.omega_rad_s = at_omega_ >= 0 ? omega_ : command_;
   }
 
-  void step(sim::Tick k, const model::Vector4& omega_rad_s) override {
+  void step(sim::Tick k, const model::RotorVector& omega_rad_s) override {
     const double cmd[4] = {omega_rad_s[0], omega_rad_s[1], omega_rad_s[2], omega_rad_s[3]};
     try {
       // Inputs hold their value: the command is set when it changed (every control period, not
       // every plant tick); command_ is the one the FMU holds (the initial speeds at first).
-      if (omega_rad_s != command_) instance_->set_real(omega_cmd_, cmd);
+      if (model::Vector4(omega_rad_s.head<4>()) != command_) instance_->set_real(omega_cmd_, cmd);
       instance_->do_step(clock_.seconds(k), clock_.period_s());
     } catch (const InstanceInterrupted&) {
       throw;  // a stop request, not the FMU's failure
     } catch (const std::exception& e) {
       throw FmuError(fmt::format("{}: step at tick {} (t = {:g} s) failed: {}", name_, k, clock_.seconds(k), e.what()));
     }
-    command_ = omega_rad_s;
+    command_ = omega_rad_s.head<4>();
     read(k + 1);
   }
 
@@ -232,6 +233,10 @@ std::unique_ptr<sim::ExternalDynamics> FmuPlant::make(const model::VehicleParams
                                                       const sim::TickClock& clock) const {
   const ModelDescription& md = fmu_->description();
   const std::string name = fmu_name(*fmu_);
+  if (vehicle.rotor_count != 4) {
+    throw FmuError(fmt::format("{}: an FMU plant flies four rotors (omega_cmd[1..4]); the vehicle has {} (layout {})",
+                               name, vehicle.rotor_count, model::to_string(vehicle.layout)));
+  }
   if (md.can_be_instantiated_only_once_per_process && alive_->load() > 0) {
     throw FmuError(
         fmt::format("{} can be instantiated only once per process (canBeInstantiatedOnlyOncePerProcess); "

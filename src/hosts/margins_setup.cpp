@@ -59,6 +59,12 @@ MarginsSetup margins_setup(const std::string& path, const std::string& controlle
     return s;
   }
   const io::Scenario sc = io::load_scenario(path, controller_type, resolvers);
+  if (sc.vehicle.rotor_count != 4) {
+    throw io::ConfigError(
+        fmt::format("{}: margins linearise a four-rotor vehicle's loops; this one has {} rotors "
+                    "(layout {})",
+                    path, sc.vehicle.rotor_count, model::to_string(sc.vehicle.layout)));
+  }
   s.source = path;
   s.plant = sc.vehicle;
   s.controller = sc.controller;

@@ -46,7 +46,7 @@ class NativeDynamics final : public sim::ExternalDynamics {
     x = x_;
     ++calls_.outputs;
   }
-  void step(sim::Tick k, const model::Vector4& omega_rad_s) override {
+  void step(sim::Tick k, const model::RotorVector& omega_rad_s) override {
     cmd_ = model_.rotor_input(omega_rad_s);
     model_.step(x_, clock_.seconds(k), cmd_, clock_.period_s(), substeps_);
     ++calls_.steps;

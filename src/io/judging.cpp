@@ -125,6 +125,12 @@ const std::vector<std::string>& saturation_figure_names() {
   return names;
 }
 
+std::vector<std::string> saturation_figure_names(int rotors) {
+  std::vector<std::string> names = saturation_figure_names();
+  for (int k = rotors; k > 4; --k) names.insert(names.begin() + 5, SaturationResult::fmt_rotor(k));
+  return names;
+}
+
 std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Series& series, Judge judge) {
   const auto& v = series.values;
   for (const char* c : {"sat1", "sat2", "sat3", "sat4", "tilt_sat"}) {
@@ -137,30 +143,38 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
     if (n < 2) return 0.0;
     return i + 1 < n ? series.t_s[i + 1] - series.t_s[i] : series.t_s[i] - series.t_s[i - 1];
   };
-  std::array<double, 4> rotor{};
+  // The rotors: sat1..sat4 always, sat5.. for a vehicle with more (present with as many rows as t).
+  int rotors = 4;
+  while (rotors < model::kMaxRotors) {
+    const auto it = v.find("sat" + std::to_string(rotors + 1));
+    if (it == v.end() || it->second.size() != n) break;
+    ++rotors;
+  }
+  std::array<double, model::kMaxRotors> rotor{};
   double any = 0.0, tilt = 0.0, sum_du2 = 0.0;
   std::size_t n_u = 0;
   const double hover_n = sc.vehicle.mass_kg * sc.vehicle.gravity_m_s2;
   const auto u1 = v.find("U1");
   // Measured at the plant: the command acting over each tick against the vehicle's limits.
-  std::array<const std::vector<double>*, 4> command{};
-  for (int k = 0; k < 4; ++k) {
+  std::array<const std::vector<double>*, model::kMaxRotors> command{};
+  bool all_commands = true;
+  for (int k = 0; k < rotors; ++k) {
     const auto it = v.find("cmd" + std::to_string(k + 1));
     command[k] = it == v.end() ? nullptr : &it->second;
+    all_commands = all_commands && command[k];
   }
   const auto safety = v.find("safety"), watchdog = v.find("watchdog");
-  const bool measured =
-      command[0] && command[1] && command[2] && command[3] && safety != v.end() && watchdog != v.end() && u1 != v.end();
+  const bool measured = all_commands && safety != v.end() && watchdog != v.end() && u1 != v.end();
   const model::MotorParams& motor = sc.vehicle.motor;
   // A vehicle at rest on the ground (z = 0 and vz = 0: the ground contact holds it) with every rotor
   // commanded to omega_min has its motors off (a flight stack disarmed before take-off or after
   // landing, a controller waiting to start): no controller pushes against a limit there, so those
   // rows count as no saturation.
   const auto z = v.find("z"), vz = v.find("vz");
-  const bool rests_known = command[0] && command[1] && command[2] && command[3] && z != v.end() && vz != v.end();
+  const bool rests_known = all_commands && z != v.end() && vz != v.end();
   const auto motors_off_on_ground = [&](std::size_t i) {
     if (!rests_known || z->second[i] > 0.0 || vz->second[i] != 0.0) return false;
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < rotors; ++k) {
       if ((*command[k])[i] > motor.omega_min_rad_s) return false;
     }
     return true;
@@ -170,7 +184,7 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
     const double dt = period(i);
     const bool off = motors_off_on_ground(i);
     bool some = false;
-    for (int k = 0; k < 4 && !off; ++k) {
+    for (int k = 0; k < rotors && !off; ++k) {
       if (v.at("sat" + std::to_string(k + 1))[i] != 0.0) {
         rotor[k] += dt;
         some = true;
@@ -181,7 +195,7 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
     // The controller's commands only: not before its first step (no U1 yet), nor the stale-data safety
     // command or the plant watchdog's (they stop the rotors on purpose).
     if (measured && !off && std::isfinite(u1->second[i]) && safety->second[i] == 0.0 && watchdog->second[i] == 0.0) {
-      for (int k = 0; k < 4; ++k) {
+      for (int k = 0; k < rotors; ++k) {
         const double w = (*command[k])[i];
         if (w >= motor.omega_max_rad_s || w <= motor.omega_min_rad_s) {
           at_limit += dt;
@@ -195,7 +209,8 @@ std::optional<SaturationResult> evaluate_saturation(const Scenario& sc, const Se
     }
   }
   r.figures["saturated_s"] = any;
-  for (int k = 0; k < 4; ++k) r.figures[SaturationResult::fmt_rotor(k + 1)] = rotor[k];
+  r.rotors = rotors;
+  for (int k = 0; k < rotors; ++k) r.figures[SaturationResult::fmt_rotor(k + 1)] = rotor[k];
   r.figures["tilt_saturated_s"] = tilt;
   if (n_u > 0) r.figures["rms_u1_deviation_n"] = std::sqrt(sum_du2 / static_cast<double>(n_u));
   if (measured) r.figures["command_at_limit_s"] = at_limit;
@@ -208,15 +223,17 @@ std::string saturation_warning(const SaturationResult& s) {
   const double at_limit = measured == s.figures.end() ? 0.0 : measured->second;
   if (s.saturated_s() <= 0.0 && s.tilt_saturated_s() <= 0.0 && at_limit <= 0.0) return "";
   std::string rotors, times;
-  for (int k = 1; k <= 4; ++k) {
+  std::string numbers;
+  for (int k = 1; k <= s.rotors; ++k) {
     if (s.rotor_saturated_s(k) > 0.0) rotors += (rotors.empty() ? "" : ", ") + std::to_string(k);
     times += fmt::format("{}{:.3f}", k == 1 ? "" : "/", s.rotor_saturated_s(k));
+    numbers += fmt::format("{}{}", k == 1 ? "" : "/", k);
   }
   std::string line = "warning: rotor saturation: ";
   std::string said;
   if (s.saturated_s() > 0.0) {
-    said = fmt::format("rotor{} {} at omega_min/omega_max for {:.3f} s in total (rotors 1/2/3/4: {} s)",
-                       rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), times);
+    said = fmt::format("rotor{} {} at omega_min/omega_max for {:.3f} s in total (rotors {}: {} s)",
+                       rotors.size() > 1 ? "s" : "", rotors, s.saturated_s(), numbers, times);
   } else if (at_limit > 0.0) {
     // The controller reported nothing, but the commands the plant received say otherwise.
     said = fmt::format(
@@ -229,7 +246,7 @@ std::string saturation_warning(const SaturationResult& s) {
     line += fmt::format("{}tilt limit acted for {:.3f} s", said.empty() ? "" : "; ", s.tilt_saturated_s());
   }
   return line +
-         "; the response is the limits', not the controller's alone (sat1..4, tilt_sat, cmd1..4 in trajectory.csv)";
+         "; the response is the limits', not the controller's alone (sat1..N, tilt_sat, cmd1..N in trajectory.csv)";
 }
 
 bool all_passed(const std::vector<StepResult>& results) {

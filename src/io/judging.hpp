@@ -67,21 +67,28 @@ struct SaturationResult {
   bool passed = true;
   double saturated_s() const { return figures.at("saturated_s"); }
   double tilt_saturated_s() const { return figures.at("tilt_saturated_s"); }
-  double rotor_saturated_s(int rotor) const { return figures.at(fmt_rotor(rotor)); }  ///< rotor 1..4
+  double rotor_saturated_s(int rotor) const { return figures.at(fmt_rotor(rotor)); }  ///< rotor 1..N
+  int rotors = 4;  ///< N: the rotors with a figure rotor<k>_saturated_s
   static std::string fmt_rotor(int rotor) { return "rotor" + std::to_string(rotor) + "_saturated_s"; }
 };
 
-/// "saturated_s", "rotor1_saturated_s" .. "rotor4_saturated_s", "tilt_saturated_s" (as the controller
+/// "saturated_s", "rotor1_saturated_s" .. "rotor4_saturated_s" (.. "rotor8_saturated_s" for a vehicle with
+/// more rotors: figures only its rotors have), "tilt_saturated_s" (as the controller
 /// reports them), "rms_u1_deviation_n", then "command_at_limit_s": how long some rotor's command acting
 /// at the plant was at or beyond the vehicle's speed limits, measured by quadcosim whatever the
 /// controller reports (absent for a trajectory without the cmd columns).
 const std::vector<std::string>& saturation_figure_names();
+/// The same for a vehicle with `rotors` rotors: rotor5_saturated_s .. after rotor4_saturated_s.
+std::vector<std::string> saturation_figure_names(int rotors);
 
 /// The columns a Series holds besides t, in this order: the judged channels and their setpoints (x .. yaw,
 /// x_des .. yaw_des), then the saturation flags sat1..sat4, tilt_sat, U1, the attitude error att_err and
 /// the rotor commands acting at the plant cmd1..cmd4 (absent from a trajectory.csv written before they
-/// existed).
+/// existed), safety, watchdog, vz; then, for a vehicle with more than four rotors only, sat5..sat8 and
+/// cmd5..cmd8 (those of its rotors).
 const std::vector<std::string>& series_columns();
+/// How many of series_columns() every Series of a four-rotor vehicle holds (up to vz).
+inline constexpr std::size_t kSeriesColumnsOfFourRotors = 26;
 
 /// Whether `channel` is judged as an angle (roll, pitch, yaw: shortest-path steps, unwrapped response).
 bool is_angle_channel(const std::string& channel);

@@ -414,7 +414,7 @@ TEST(Ros2MsgTest, EveryRecordedTypeListsItsDependencies) {
   EXPECT_EQ(status.substr(0, status.find("====")),
             "std_msgs/Header header\nstring controller\nstring mode\nfloat64[6] setpoint\nfloat64[4] u\n"
             "float64[3] position_error\nfloat64 yaw_error\nfloat64 attitude_error\n"
-            "bool[4] rotor_saturated\nbool tilt_saturated\nbool safety\nuint64 rejected_non_finite\n"
+            "bool[8] rotor_saturated\nbool tilt_saturated\nbool safety\nuint64 rejected_non_finite\n"
             "uint64 rejected_bad_quaternion\nuint64 rejected_bad_stamp\nuint64 rejected_stamp_backwards\n"
             "uint64 rejected_stamp_ahead\n"
             "string[] output_names\nfloat64[] outputs\n");

@@ -16,8 +16,8 @@
 #include "io/scenario_limits.hpp"
 #include "io/sitl_yaml.hpp"
 #include "io/trajectory_yaml.hpp"
+#include "io/vehicle_yaml.hpp"
 #include "io/yaml_reader.hpp"
-#include "model/vehicle_presets.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::io {
@@ -25,79 +25,6 @@ namespace quadcosim::io {
 namespace {
 
 constexpr double kHuge = 1e12;
-
-// Reads every entry of the vehicle parameter table from its place in `root` (top level, or the
-// `motor:` / `aero:` sections; a 3-vector's .x/.y/.z entries are one list of three), each checked
-// against its declared range, then the rules between fields (model::validate). A `preset:` key starts
-// from that ready vehicle (model/vehicle_presets.hpp); the other keys then override its values.
-void read_vehicle(YamlSection& root, model::VehicleParams& v) {
-  if (root.has("preset")) {
-    const std::vector<std::string> names = model::vehicle_preset_list();
-    v = model::find_vehicle_preset(root.choice("preset", names.front(), names))->params;
-  }
-  std::map<std::string, std::optional<YamlSection>, std::less<>> sections;
-  auto section = [&](std::string_view name) -> YamlSection* {
-    if (name.empty()) return &root;
-    auto it = sections.find(name);
-    if (it == sections.end()) it = sections.emplace(std::string(name), root.section(std::string(name))).first;
-    return it->second ? &*it->second : nullptr;
-  };
-  const auto& table = model::vehicle_parameters();
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    const model::VehicleParameter& p = table[i];
-    YamlSection* s = section(p.section());
-    if (!s) continue;
-    const std::string key(p.key());
-    switch (p.kind) {
-      case model::VehicleParameter::Kind::kNumber:
-        if (p.component() < 0) {
-          p.ref(v) = s->number(key, p.get(v), p.range);
-        } else if (p.component() == 0) {
-          // Entries i, i+1, i+2 are the vector's x, y, z.
-          const auto got = s->numbers(key, {p.get(v), table[i + 1].get(v), table[i + 2].get(v)}, 3);
-          for (int c = 0; c < 3; ++c) {
-            const model::VehicleParameter& e = table[i + static_cast<std::size_t>(c)];
-            if (!e.range.contains(got[static_cast<std::size_t>(c)])) {
-              s->fail(key, fmt::format("got an entry {:g}, expected numbers in {}", got[static_cast<std::size_t>(c)],
-                                       e.range.text()));
-            }
-            e.ref(v) = got[static_cast<std::size_t>(c)];
-          }
-        }
-        break;
-      case model::VehicleParameter::Kind::kChoice: {
-        const std::vector<std::string> choices(p.choices.begin(), p.choices.end());
-        p.set_choice(v, s->choice(key, std::string(p.choice_of(v)), choices));
-        break;
-      }
-      case model::VehicleParameter::Kind::kSigns:
-        if (s->has(key)) {
-          const auto got = s->numbers(key, {}, 4);
-          for (int r = 0; r < 4; ++r) {
-            const double g = got[static_cast<std::size_t>(r)];
-            if (g != 1.0 && g != -1.0) {
-              s->fail(key, fmt::format("got [{:g}, {:g}, {:g}, {:g}], expected four entries, each 1 or -1", got[0],
-                                       got[1], got[2], got[3]));
-            }
-            p.signs(v)[static_cast<std::size_t>(r)] = static_cast<int>(g);
-          }
-        }
-        break;
-    }
-  }
-  for (auto& [name, s] : sections) {
-    if (s) s->reject_unknown_keys();
-  }
-  root.reject_unknown_keys();
-  if (std::string err = model::validate(v); !err.empty()) {
-    // validate() names the field first ("spin must ..."): report it at that key.
-    const std::string field = err.substr(0, err.find(' '));
-    if (model::find_vehicle_parameter(field) && field.size() < err.size()) {
-      root.fail(field, err.substr(field.size() + 1));
-    }
-    root.fail("", err);
-  }
-}
 
 // A time in seconds that must fall on a whole plant tick.
 sim::Tick tick_at(YamlSection& s, const std::string& key, double seconds, std::int64_t period_ns) {
@@ -186,7 +113,7 @@ void read_faults(YamlSection& f, const sim::SimulationConfig& cfg, sim::FaultCon
 // analysis.limits: each key an upper bound >= 0 on a saturation or control-effort figure, at the top
 // of the section (a specification, as the keys were read before the two sets existed) or under its
 // `spec:` and `paper:`.
-LimitsSpec read_limits(YamlSection& limits, double duration_s) {
+LimitsSpec read_limits(YamlSection& limits, double duration_s, int rotors) {
   LimitsSpec spec;
   const auto read_set = [&](YamlSection& l, CriteriaSet set) {
     auto bound = [&](const std::string& key, double hi, const std::vector<std::string>& figures) {
@@ -195,8 +122,9 @@ LimitsSpec read_limits(YamlSection& limits, double duration_s) {
       for (const auto& f : figures) spec.criteria.push_back(Criterion{f, std::nullopt, v, set});
     };
     bound("max_saturated_s", duration_s, {"saturated_s"});
-    bound("max_rotor_saturated_s", duration_s,
-          {"rotor1_saturated_s", "rotor2_saturated_s", "rotor3_saturated_s", "rotor4_saturated_s"});
+    std::vector<std::string> per_rotor;  // one bound per rotor of the vehicle
+    for (int k = 1; k <= rotors; ++k) per_rotor.push_back("rotor" + std::to_string(k) + "_saturated_s");
+    bound("max_rotor_saturated_s", duration_s, per_rotor);
     bound("max_tilt_saturated_s", duration_s, {"tilt_saturated_s"});
     bound("max_rms_u1_deviation_n", kHuge, {"rms_u1_deviation_n"});
   };
@@ -238,7 +166,7 @@ TrackingSpec read_tracking(YamlSection& s, double duration_s) {
 void read_steps(YamlSection& analysis, Scenario& sc, double duration_s) {
   std::vector<StepSpec>& steps = sc.steps;
   if (auto h = analysis.section("hold")) sc.hold = read_hold(*h, duration_s);
-  if (auto l = analysis.section("limits")) sc.limits = read_limits(*l, duration_s);
+  if (auto l = analysis.section("limits")) sc.limits = read_limits(*l, duration_s, sc.vehicle.rotor_count);
   if (auto t = analysis.section("tracking")) sc.tracking = read_tracking(*t, duration_s);
   const std::vector<std::string> channels = {"x", "y", "z", "roll", "pitch", "yaw"};
   int index = 0;

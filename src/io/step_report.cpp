@@ -26,7 +26,8 @@ const std::vector<std::string>& series_columns() {
   static const std::vector<std::string> names = {"x",     "y",     "z",        "roll",      "pitch",   "yaw",  "x_des",
                                                  "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "sat1", "sat2",
                                                  "sat3",  "sat4",  "tilt_sat", "U1",        "att_err", "cmd1", "cmd2",
-                                                 "cmd3",  "cmd4",  "safety",   "watchdog",  "vz"};
+                                                 "cmd3",  "cmd4",  "safety",   "watchdog",  "vz",      "sat5", "sat6",
+                                                 "sat7",  "sat8",  "cmd5",     "cmd6",      "cmd7",    "cmd8"};
   return names;
 }
 
@@ -158,7 +159,7 @@ nlohmann::json metrics_json(const Scenario& scenario, const std::vector<StepResu
     j["hold"] = h;
   }
   if (saturation) {
-    j["saturation"] = {{"figures", figures_json(saturation_figure_names(), saturation->figures)},
+    j["saturation"] = {{"figures", figures_json(saturation_figure_names(saturation->rotors), saturation->figures)},
                        {"criteria", criteria_json(saturation->criteria)},
                        {"passed", verdict_json(judge, saturation->passed)}};
   }
@@ -283,7 +284,7 @@ std::string format_step_table(const Scenario& scenario, const std::vector<StepRe
   if (saturation) {
     s +=
         fmt::format("limits (rotor speed and tilt saturation, control effort): {}\n", verdict_text(*saturation, judge));
-    s += figure_rows(saturation_figure_names(), saturation->figures, saturation->criteria, fixed3);
+    s += figure_rows(saturation_figure_names(saturation->rotors), saturation->figures, saturation->criteria, fixed3);
   }
   if (tracking) {
     s += fmt::format("tracking from t = {:g} s ({} samples, at the controller's steps every {:g} s): {}\n",

@@ -41,17 +41,25 @@ ControlColumns ControlColumns::from(const msg::ControllerStatus& m) {
           m.outputs};
 }
 
-std::array<int, 5> ControlColumns::saturation_columns() const {
-  const auto& sat = rotor_saturated;
-  return {sat[0] ? 1 : 0, sat[1] ? 1 : 0, sat[2] ? 1 : 0, sat[3] ? 1 : 0, tilt_saturated ? 1 : 0};
+std::array<int, 9> ControlColumns::saturation_columns() const {
+  std::array<int, 9> out{};
+  for (std::size_t i = 0; i < 8; ++i) out[i] = rotor_saturated[i] ? 1 : 0;
+  out[8] = tilt_saturated ? 1 : 0;
+  return out;
 }
 
-const std::vector<std::string>& TrajectoryWriter::columns() {
-  static const std::vector<std::string> c = {
-      "t",    "x",     "y",      "z",        "vx",    "vy",    "vz",       "qw",        "qx",       "qy",     "qz",
-      "roll", "pitch", "yaw",    "p",        "q",     "r",     "w1",       "w2",        "w3",       "w4",     "cmd1",
-      "cmd2", "cmd3",  "cmd4",   "x_des",    "y_des", "z_des", "roll_des", "pitch_des", "yaw_des",  "U1",     "U2",
-      "U3",   "U4",    "safety", "watchdog", "sat1",  "sat2",  "sat3",     "sat4",      "tilt_sat", "att_err"};
+std::vector<std::string> TrajectoryWriter::columns(int rotors) {
+  std::vector<std::string> c = {"t",  "x",  "y",    "z",     "vx",  "vy", "vz", "qw", "qx",
+                                "qy", "qz", "roll", "pitch", "yaw", "p",  "q",  "r"};
+  for (int i = 1; i <= rotors; ++i) c.push_back("w" + std::to_string(i));
+  for (int i = 1; i <= rotors; ++i) c.push_back("cmd" + std::to_string(i));
+  for (const char* n :
+       {"x_des", "y_des", "z_des", "roll_des", "pitch_des", "yaw_des", "U1", "U2", "U3", "U4", "safety", "watchdog"}) {
+    c.emplace_back(n);
+  }
+  for (int i = 1; i <= rotors; ++i) c.push_back("sat" + std::to_string(i));
+  c.emplace_back("tilt_sat");
+  c.emplace_back("att_err");
   return c;
 }
 
@@ -61,10 +69,11 @@ TrajectoryWriter::TrajectoryWriter(const std::string& path) : path_(path) {
   file_ = open_output_file(path);  // never through a link planted at `path`
 }
 
-void TrajectoryWriter::write_header(std::span<const std::string> output_names) {
+void TrajectoryWriter::write_header(std::span<const std::string> output_names, int rotors) {
   output_names_.assign(output_names.begin(), output_names.end());
+  rotors_ = rotors;
   std::string header;
-  for (const auto& c : columns()) header += (header.empty() ? "" : ",") + c;
+  for (const auto& c : columns(rotors)) header += (header.empty() ? "" : ",") + c;
   // A name with a comma or a line break would break the CSV's columns: those are written with "_".
   for (const std::string& name : output_names_) {
     std::string column = output_column(name);
@@ -84,26 +93,36 @@ bool TrajectoryWriter::same_outputs(std::span<const std::string> names) const {
 
 TrajectoryWriter::~TrajectoryWriter() {
   if (file_) {
-    if (!header_written_) write_header({});
+    if (!header_written_) write_header({}, rotors_);
     std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
     std::fclose(file_);
   }
 }
 
-void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vector4d& cmd, const ControlColumns& c,
+void TrajectoryWriter::write(double t, const model::State& x, const model::RotorVector& cmd, const ControlColumns& c,
                              bool watchdog) {
-  if (!header_written_) write_header(c.output_names);
+  if (!header_written_) write_header(c.output_names, static_cast<int>(cmd.size()));
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   auto out = std::back_inserter(buffer_);
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},", t, x.p_W.x(), x.p_W.y(), x.p_W.z(),
                  x.v_W.x(), x.v_W.y(), x.v_W.z(), x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z(), e.roll_rad,
                  e.pitch_rad, e.yaw_rad, x.w_B.x(), x.w_B.y(), x.w_B.z());
-  fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2],
-                 x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
+  if (rotors_ == 4) {
+    fmt::format_to(out, "{},{},{},{},{},{},{},{},", x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2],
+                   x.omega_rad_s[3], cmd[0], cmd[1], cmd[2], cmd[3]);
+  } else {
+    for (int i = 0; i < rotors_; ++i) fmt::format_to(out, "{},", x.omega_rad_s[i]);
+    for (int i = 0; i < rotors_; ++i) fmt::format_to(out, "{},", cmd[i]);
+  }
   fmt::format_to(out, "{},{},{},{},{},{},{},{},{},{},{},{},", c.x_des, c.y_des, c.z_des, c.roll_des, c.pitch_des,
                  c.yaw_des, c.U[0], c.U[1], c.U[2], c.U[3], c.safety ? 1 : 0, watchdog ? 1 : 0);
   const auto sat = c.saturation_columns();
-  fmt::format_to(out, "{},{},{},{},{},{}", sat[0], sat[1], sat[2], sat[3], sat[4], c.attitude_error);
+  if (rotors_ == 4) {
+    fmt::format_to(out, "{},{},{},{},{},{}", sat[0], sat[1], sat[2], sat[3], sat[8], c.attitude_error);
+  } else {
+    for (int i = 0; i < rotors_; ++i) fmt::format_to(out, "{},", sat[static_cast<std::size_t>(i)]);
+    fmt::format_to(out, "{},{}", sat[8], c.attitude_error);
+  }
   if (!output_names_.empty()) {
     const bool known = same_outputs(c.output_names) && c.outputs.size() == output_names_.size();
     for (std::size_t i = 0; i < output_names_.size(); ++i) {
@@ -119,7 +138,7 @@ void TrajectoryWriter::write(double t, const model::State& x, const Eigen::Vecto
 
 void TrajectoryWriter::close() {
   if (!file_) return;
-  if (!header_written_) write_header({});
+  if (!header_written_) write_header({}, rotors_);
   const bool ok = std::fwrite(buffer_.data(), 1, buffer_.size(), file_) == buffer_.size();
   int err = ok ? 0 : errno;
   buffer_.clear();
@@ -131,7 +150,8 @@ void TrajectoryWriter::close() {
 }
 
 SeriesRecorder::SeriesRecorder() {
-  for (const std::string& name : series_columns()) columns_.push_back(&series_.values[name]);
+  const std::vector<std::string>& all = series_columns();
+  for (std::size_t i = 0; i < kSeriesColumnsOfFourRotors; ++i) columns_.push_back(&series_.values[all[i]]);
 }
 
 void SeriesRecorder::clear(std::size_t rows) {
@@ -141,10 +161,20 @@ void SeriesRecorder::clear(std::size_t rows) {
     column->clear();
     column->reserve(rows);
   }
+  for (std::vector<double>* column : extra_rotor_columns_) {
+    column->clear();
+    column->reserve(rows);
+  }
 }
 
-void SeriesRecorder::add(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
+void SeriesRecorder::add(double t_s, const model::State& x, const model::RotorVector& command, const ControlColumns& c,
                          bool watchdog) {
+  const auto rotors = static_cast<int>(command.size());
+  if (rotors > 4 && extra_rotor_columns_.empty()) {
+    for (int i = 5; i <= rotors; ++i) extra_rotor_columns_.push_back(&series_.values["sat" + std::to_string(i)]);
+    for (int i = 5; i <= rotors; ++i) extra_rotor_columns_.push_back(&series_.values["cmd" + std::to_string(i)]);
+    for (std::vector<double>* column : extra_rotor_columns_) column->assign(series_.t_s.size(), 0.0);
+  }
   // The values of TrajectoryWriter::write's columns of the same names.
   const model::Euler e = model::euler_from_quaternion(x.q_WB);
   const auto sat = c.saturation_columns();
@@ -164,7 +194,7 @@ void SeriesRecorder::add(double t_s, const model::State& x, const Eigen::Vector4
                         static_cast<double>(sat[1]),
                         static_cast<double>(sat[2]),
                         static_cast<double>(sat[3]),
-                        static_cast<double>(sat[4]),
+                        static_cast<double>(sat[8]),
                         c.U[0],
                         c.attitude_error,
                         command[0],
@@ -178,6 +208,11 @@ void SeriesRecorder::add(double t_s, const model::State& x, const Eigen::Vector4
   assert(columns_.size() == std::size(row));
   series_.t_s.push_back(t_s);
   for (std::size_t i = 0; i < columns_.size(); ++i) columns_[i]->push_back(row[i]);
+  const std::size_t extra = extra_rotor_columns_.size() / 2;
+  for (std::size_t i = 0; i < extra; ++i) {
+    extra_rotor_columns_[i]->push_back(static_cast<double>(sat[4 + i]));
+    extra_rotor_columns_[extra + i]->push_back(command[static_cast<Eigen::Index>(4 + i)]);
+  }
 }
 
 std::vector<CommandRow> read_command_schedule(const std::string& path) {

@@ -24,7 +24,7 @@ struct ControlColumns {
   bool safety;
   /// The controller's allocation clamped rotor i's demanded speed at omega_min or omega_max
   /// (ControllerStatus.rotor_saturated); the position loop's tilt limit acted (tilt_saturated).
-  std::array<bool, 4> rotor_saturated{};
+  std::array<bool, 8> rotor_saturated{};  ///< one per rotor (those past the rotor count false)
   bool tilt_saturated = false;
   /// The controller's attitude error Psi = 1/2 tr(I - R_d^T R) (ControllerStatus.attitude_error; NaN
   /// when it has no desired attitude, and in open loop): the column att_err.
@@ -33,8 +33,8 @@ struct ControlColumns {
   /// columns out.<name>. They view the status they came from.
   std::span<const std::string> output_names;
   std::span<const double> outputs;
-  /// The columns sat1..sat4, tilt_sat: 1 where the flag is set, else 0.
-  std::array<int, 5> saturation_columns() const;
+  /// The columns sat1..sat8 (the first N written), then tilt_sat (index 8): 1 where the flag is set, else 0.
+  std::array<int, 9> saturation_columns() const;
   static ControlColumns none();
   /// The columns of a controller status message.
   static ControlColumns from(const msg::ControllerStatus& status);
@@ -48,22 +48,24 @@ class TrajectoryWriter {
   TrajectoryWriter(const TrajectoryWriter&) = delete;
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
 
-  /// The columns every trajectory.csv has, in order; the controller's own figures follow them.
-  static const std::vector<std::string>& columns();
+  /// The columns every trajectory.csv of a vehicle with `rotors` rotors has, in order (w1..wN,
+  /// cmd1..cmdN, sat1..satN); the controller's own figures follow them.
+  static std::vector<std::string> columns(int rotors = 4);
   /// The column of a controller's own figure: "out." + its name ("out.error.z").
   static std::string output_column(std::string_view name);
 
-  /// `command` is the rotor command acting over the next interval [rad/s]; `watchdog`: the plant's
+  /// `command` is the rotor command acting over the next interval [rad/s], one per rotor (its size, N,
+  /// fixed by the first row, sets the rotor columns); `watchdog`: the plant's
   /// watchdog set it (no valid command for its limit). The first row fixes the columns: columns() and
   /// one out.<name> for each of c.output_names; a later row whose controller declares other names (or
   /// none: a restarted or replaced controller, the safety command) has NaN in them.
-  void write(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
+  void write(double t_s, const model::State& x, const model::RotorVector& command, const ControlColumns& c,
              bool watchdog = false);
   /// Flushes and closes; throws std::runtime_error on a write error.
   void close();
 
  private:
-  void write_header(std::span<const std::string> output_names);
+  void write_header(std::span<const std::string> output_names, int rotors);
   bool same_outputs(std::span<const std::string> names) const;
 
   std::FILE* file_ = nullptr;
@@ -71,6 +73,7 @@ class TrajectoryWriter {
   std::string buffer_;
   bool header_written_ = false;
   std::vector<std::string> output_names_;  ///< the out.<name> columns, fixed by the first row
+  int rotors_ = 4;                         ///< the rotor columns, fixed by the first row
 };
 
 /// Builds in memory the Series that read_series() gives for the trajectory.csv TrajectoryWriter writes from
@@ -80,7 +83,7 @@ class SeriesRecorder {
  public:
   SeriesRecorder();
   /// Adds the row TrajectoryWriter::write(t_s, x, command, c, watchdog) writes.
-  void add(double t_s, const model::State& x, const Eigen::Vector4d& command, const ControlColumns& c,
+  void add(double t_s, const model::State& x, const model::RotorVector& command, const ControlColumns& c,
            bool watchdog = false);
   const Series& series() const { return series_; }
   /// Empties the series for another run of `rows` ticks, keeping its memory (a sweep's worker
@@ -89,7 +92,9 @@ class SeriesRecorder {
 
  private:
   Series series_;
-  std::vector<std::vector<double>*> columns_;  ///< into series_.values, in series_columns() order
+  std::vector<std::vector<double>*> columns_;  ///< into series_.values, in series_columns() order (4 rotors)
+  /// Rotors 5..N: sat5..satN, then cmd5..cmdN, made at the first row of a vehicle with more rotors.
+  std::vector<std::vector<double>*> extra_rotor_columns_;
 };
 
 /// One row of a motor command schedule (openloop input).

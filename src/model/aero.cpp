@@ -17,12 +17,15 @@ bool AeroParams::active() const {
 }
 
 Eigen::Vector3d aero_force_W(const AeroParams& a, const Eigen::Matrix3d& R_WB, const Eigen::Vector3d& v_W,
-                             const Eigen::Vector3d& wind_W, const Eigen::Vector4d& omega_rad_s) {
+                             const Eigen::Vector3d& wind_W, const RotorVector& omega_rad_s) {
   const Eigen::Vector3d v_rB = R_WB.transpose() * (v_W - wind_W);
   Eigen::Vector3d F_B = -a.linear_drag_N_s_m.cwiseProduct(v_rB) -
                         a.quadratic_drag_N_s2_m2.cwiseProduct(v_rB.cwiseAbs()).cwiseProduct(v_rB);
   if (a.rotor_drag_N_s_m_per_rad_s != 0.0) {
-    const double k = a.rotor_drag_N_s_m_per_rad_s * omega_rad_s.cwiseAbs().sum();
+    // Four rotors: summed as the fixed-size vector sums (the paper-era numbers, bit for bit).
+    const double sum = omega_rad_s.size() == 4 ? Eigen::Vector4d(omega_rad_s.head<4>()).cwiseAbs().sum()
+                                               : omega_rad_s.cwiseAbs().sum();
+    const double k = a.rotor_drag_N_s_m_per_rad_s * sum;
     F_B.x() -= k * v_rB.x();
     F_B.y() -= k * v_rB.y();
   }

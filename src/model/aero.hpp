@@ -25,7 +25,9 @@
 
 #include <Eigen/Core>
 #include <string>
+
 #include <string_view>
+#include "model/rotor_vector.hpp"
 
 namespace quadcosim::model {
 
@@ -57,13 +59,14 @@ struct BodyWrench {
 
 /// What the air and the rotors do to the vehicle over one plant tick (held constant across it).
 struct Environment {
-  Eigen::Vector3d wind_W = Eigen::Vector3d::Zero();            ///< air velocity in the world frame [m/s]
-  Eigen::Vector4d rotor_efficiency = Eigen::Vector4d::Ones();  ///< per-rotor factor on thrust and drag torque [0, 1]
+  Eigen::Vector3d wind_W = Eigen::Vector3d::Zero();  ///< air velocity in the world frame [m/s]
+  /// Per-rotor factor on thrust and drag torque [0, 1]; all kMaxRotors entries (the model reads its N).
+  RotorVector rotor_efficiency = RotorVector::Ones(kMaxRotors);
 };
 
 /// Drag force in the world frame [N] for attitude R_WB, velocity v_W, wind wind_W, rotor speeds.
 Eigen::Vector3d aero_force_W(const AeroParams& a, const Eigen::Matrix3d& R_WB, const Eigen::Vector3d& v_W,
-                             const Eigen::Vector3d& wind_W, const Eigen::Vector4d& omega_rad_s);
+                             const Eigen::Vector3d& wind_W, const RotorVector& omega_rad_s);
 
 /// Ground-effect thrust factor at height z_m [m] (1 when off).
 double ground_effect_factor(const AeroParams& a, double z_m);

@@ -192,7 +192,7 @@ TEST(Validate, RejectsBadSpinSigns) {
     for (auto spin : {std::array<int, 4>{+1, +1, -1, -1}, std::array<int, 4>{+1, -1, -1, +1}}) {
       VehicleParams p;
       p.layout = layout;
-      p.spin = spin;
+      std::copy(spin.begin(), spin.end(), p.spin.begin());
       const Eigen::Matrix4d M = quadcosim::model::mixer_matrix(p);
       Eigen::Matrix4d rows = M;
       for (int r = 0; r < 4; ++r) rows.row(r).normalize();

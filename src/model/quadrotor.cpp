@@ -13,6 +13,7 @@ namespace quadcosim::model {
 Quadrotor::Quadrotor(const VehicleParams& params)
     : params_(params),
       mixer_(mixer_matrix(params)),
+      mixer4_(params.rotor_count == 4 ? mixer_matrix4(params) : Matrix4::Zero()),
       reciprocals_(1.0 / params.mass_kg, 1.0 / params.Ixx_kg_m2, 1.0 / params.Iyy_kg_m2, 1.0 / params.Izz_kg_m2) {
   assert(validate(params).empty());
   rotor_positions_B_.resize(3, mixer_.cols());
@@ -26,26 +27,47 @@ Quadrotor::Quadrotor(const VehicleParams& params)
   }
 }
 
-Vector4 Quadrotor::clamp_command(const Vector4& cmd) const {
-  Vector4 out;
-  for (int i = 0; i < 4; ++i) {
+RotorVector Quadrotor::clamp_command(const RotorVector& cmd) const {
+  assert(cmd.size() == mixer_.cols());
+  if (cmd.size() == 4) {  // the quadrotor's, unrolled
+    Vector4 out;
+    for (int i = 0; i < 4; ++i) {
+      const double c = std::isfinite(cmd[i]) ? cmd[i] : params_.motor.omega_min_rad_s;
+      out[i] = std::clamp(c, params_.motor.omega_min_rad_s, params_.motor.omega_max_rad_s);
+    }
+    return out;
+  }
+  RotorVector out(cmd.size());
+  for (Eigen::Index i = 0; i < cmd.size(); ++i) {
     const double c = std::isfinite(cmd[i]) ? cmd[i] : params_.motor.omega_min_rad_s;
     out[i] = std::clamp(c, params_.motor.omega_min_rad_s, params_.motor.omega_max_rad_s);
   }
   return out;
 }
 
-Wrench Quadrotor::wrench(const Vector4& omega) const {
-  const Vector4 u = mixer_ * omega.cwiseProduct(omega);
+Eigen::Vector4d Quadrotor::mix(const RotorVector& omega, const RotorVector* efficiency) const {
+  if (mixer_.cols() == 4) {  // the fixed-size product of eq. (4), as before other rotor counts
+    const Vector4 w = omega.head<4>();
+    if (!efficiency) return mixer4_ * w.cwiseProduct(w);
+    const Vector4 eta = efficiency->head<4>();
+    return mixer4_ * eta.cwiseProduct(w.cwiseProduct(w));
+  }
+  const Eigen::Index n = mixer_.cols();
+  if (!efficiency) return mixer_ * omega.cwiseProduct(omega);
+  return mixer_ * efficiency->head(n).cwiseProduct(omega.cwiseProduct(omega));
+}
+
+Wrench Quadrotor::wrench(const RotorVector& omega) const {
+  const Vector4 u = mix(omega, nullptr);
   return {u[0], u.tail<3>()};
 }
 
 namespace {
 
 // The state as plain doubles for the integrator: the rigid body, p_W (0-2), v_W (3-5), q_WB as w, x,
-// y, z (6-9), w_B (10-12), then the rotor speeds (13-16), which only a lagging motor integrates.
+// y, z (6-9), w_B (10-12), then the rotor speeds (13-13+N), which only a lagging motor integrates.
 constexpr int kRigid = 13;
-constexpr int kWithRotors = 17;
+constexpr int kWithRotors = kRigid + kMaxRotors;
 using Packed = double[kWithRotors];
 
 inline void pack_rigid(const State& x, Packed r) {
@@ -65,7 +87,7 @@ inline void pack_rigid(const State& x, Packed r) {
 inline void pack(const State& x, bool rotor_lag, Packed r) {
   pack_rigid(x, r);
   if (rotor_lag) {
-    for (int i = 0; i < 4; ++i) r[13 + i] = x.omega_rad_s[i];
+    for (Eigen::Index i = 0; i < x.omega_rad_s.size(); ++i) r[13 + i] = x.omega_rad_s[i];
   }
 }
 
@@ -235,11 +257,12 @@ Quadrotor::RigidInputs Quadrotor::rigid_inputs(const Wrench& f) const {
 
 Quadrotor::RigidInputs Quadrotor::varying_inputs(const double* y, const RotorInput& cmd, const Environment* env) const {
   const bool ideal = params_.motor.model == MotorModel::kIdeal;
-  if (!env) return rigid_inputs(ideal ? cmd.wrench : wrench(Vector4(y[13], y[14], y[15], y[16])));
+  const Eigen::Index n = mixer_.cols();
+  if (!env) return rigid_inputs(ideal ? cmd.wrench : wrench(Eigen::Map<const RotorVector>(y + 13, n)));
   // The rotors turn at the command (ideal) or at the state's speeds (lag); the air's drag acts on the
   // velocity relative to the wind in the body frame.
-  const Vector4 omega = ideal ? cmd.omega_rad_s : Vector4(y[13], y[14], y[15], y[16]);
-  const Vector4 u = mixer_ * env->rotor_efficiency.cwiseProduct(omega.cwiseProduct(omega));
+  const RotorVector omega = ideal ? cmd.omega_rad_s : RotorVector(Eigen::Map<const RotorVector>(y + 13, n));
+  const Vector4 u = mix(omega, &env->rotor_efficiency);
   RigidInputs in = rigid_inputs({u[0] * ground_effect_factor(params_.aero, y[2]), u.tail<3>()});
   const Eigen::Quaterniond q_WB(y[6], y[7], y[8], y[9]);
   const Eigen::Matrix3d R_WB = q_WB.toRotationMatrix();
@@ -265,7 +288,7 @@ void Quadrotor::stage_derivative(const double* __restrict y, const RotorInput& c
     rigid_derivative<kFullInertia>(y, held_inputs, d);
   }
   if constexpr (kRotorLag) {  // first-order lag towards the command, its own time constant each way
-    for (int i = 0; i < 4; ++i) {
+    for (Eigen::Index i = 0; i < mixer_.cols(); ++i) {
       const double err = cmd.omega_rad_s[i] - y[13 + i];
       const double tau = err > 0.0 ? params_.motor.tau_up_s : params_.motor.tau_down_s;
       d[13 + i] = err / tau;
@@ -276,12 +299,13 @@ void Quadrotor::stage_derivative(const double* __restrict y, const RotorInput& c
 template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
 [[gnu::always_inline]] inline void Quadrotor::integrate(State& x, const RotorInput& cmd, double h, int substeps,
                                                         const Environment* env) const {
-  constexpr int n = kRotorLag ? kWithRotors : kRigid;  // ideal rotors: their speeds are the command
+  // Ideal rotors: their speeds are the command; lagging ones are N more states.
+  const int n = kRotorLag ? kRigid + static_cast<int>(mixer_.cols()) : kRigid;
   Packed r;
   pack(x, kRotorLag, r);
   // Formed once when it is the same in every stage (ideal motors, no Environment: the paper's plant).
   const RigidInputs held_inputs = kVaryingInputs ? RigidInputs{} : rigid_inputs(cmd.wrench);
-  double k1[n], k2[n], k3[n], k4[n], y[n];
+  double k1[kWithRotors], k2[kWithRotors], k3[kWithRotors], k4[kWithRotors], y[kWithRotors];
   for (int s = 0; s < substeps; ++s) {
     stage_derivative<kVaryingInputs, kRotorLag, kFullInertia>(r, cmd, env, held_inputs, k1);
     for (int i = 0; i < n; ++i) y[i] = r[i] + (0.5 * h) * k1[i];
@@ -295,13 +319,13 @@ template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
   }
   unpack(r, x);
   if constexpr (kRotorLag) {
-    x.omega_rad_s = clamp_command(Vector4(r[13], r[14], r[15], r[16]));
+    x.omega_rad_s = clamp_command(Eigen::Map<const RotorVector>(r + 13, mixer_.cols()));
   } else {
-    x.omega_rad_s = cmd.omega_rad_s;
+    assign_rotors(x.omega_rad_s, cmd.omega_rad_s);
   }
 }
 
-StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vector4& cmd,
+StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const RotorVector& cmd,
                                       const Environment* env) const {
   RotorInput input;
   input.omega_rad_s = cmd;  // already clamped, as the caller promises
@@ -315,7 +339,7 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
     } else {
       stage_derivative<true, false, false>(y, input, env, RigidInputs{}, r);
     }
-    for (int i = 0; i < 4; ++i) r[13 + i] = 0.0;
+    for (Eigen::Index i = 0; i < mixer_.cols(); ++i) r[13 + i] = 0.0;
   } else if (full_inertia_) {
     stage_derivative<true, true, true>(y, input, env, RigidInputs{}, r);
   } else {
@@ -326,18 +350,34 @@ StateDerivative Quadrotor::derivative(double /*t_s*/, const State& x, const Vect
   d.v_W = {r[3], r[4], r[5]};
   d.q_WB_wxyz = {r[6], r[7], r[8], r[9]};
   d.w_B = {r[10], r[11], r[12]};
-  d.omega_rad_s = {r[13], r[14], r[15], r[16]};
+  d.omega_rad_s = Eigen::Map<const RotorVector>(r + 13, mixer_.cols());
   return d;
 }
 
-RotorInput Quadrotor::rotor_input(const Vector4& cmd) const {
+RotorInput Quadrotor::rotor_input(const RotorVector& cmd) const {
   RotorInput a;
-  a.omega_rad_s = clamp_command(cmd);
-  a.wrench = wrench(a.omega_rad_s);
+  rotor_input(cmd, a);
   return a;
 }
 
-Outputs Quadrotor::outputs(double t_s, const State& x, const Vector4& cmd, const Environment* env) const {
+void Quadrotor::rotor_input(const RotorVector& cmd, RotorInput& a) const {
+  if (cmd.size() == 4) {  // the quadrotor's: clamp and eq. (4) on fixed-size vectors, as before other counts
+    Vector4 w;
+    for (int i = 0; i < 4; ++i) {
+      const double c = std::isfinite(cmd[i]) ? cmd[i] : params_.motor.omega_min_rad_s;
+      w[i] = std::clamp(c, params_.motor.omega_min_rad_s, params_.motor.omega_max_rad_s);
+    }
+    a.omega_rad_s.resize(4);
+    a.omega_rad_s.head<4>() = w;
+    const Vector4 u = mixer4_ * w.cwiseProduct(w);
+    a.wrench = {u[0], u.tail<3>()};
+    return;
+  }
+  a.omega_rad_s = clamp_command(cmd);
+  a.wrench = wrench(a.omega_rad_s);
+}
+
+Outputs Quadrotor::outputs(double t_s, const State& x, const RotorVector& cmd, const Environment* env) const {
   return outputs(t_s, x, rotor_input(cmd), env);
 }
 
@@ -362,7 +402,7 @@ Outputs Quadrotor::outputs(double /*t_s*/, const State& x, const RotorInput& cmd
   return {x.p_W, x.q_WB, x.v_W, x.w_B, rotate_by_inverse(x.q_WB, a_minus_g_W)};
 }
 
-void Quadrotor::step(State& x, double t_s, const Vector4& cmd, double dt_s, int substeps,
+void Quadrotor::step(State& x, double t_s, const RotorVector& cmd, double dt_s, int substeps,
                      const Environment* env) const {
   step(x, t_s, rotor_input(cmd), dt_s, substeps, env);
 }
@@ -394,6 +434,7 @@ void Quadrotor::step(State& x, double /*t_s*/, const RotorInput& input, double d
 
 State Quadrotor::initial_state(const Eigen::Vector3d& p_W, double yaw_rad, bool hover) const {
   State x;
+  x.omega_rad_s = RotorVector::Zero(mixer_.cols());
   x.p_W = p_W;
   x.q_WB = quaternion_from_euler({0.0, 0.0, yaw_rad});
   if (hover) x.omega_rad_s.setConstant(params_.hover_omega_rad_s());

@@ -19,7 +19,7 @@ struct State {
   Eigen::Vector3d v_W = Eigen::Vector3d::Zero();             ///< velocity [m/s]
   Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();  ///< attitude, body -> world
   Eigen::Vector3d w_B = Eigen::Vector3d::Zero();             ///< body angular velocity [rad/s]
-  Vector4 omega_rad_s = Vector4::Zero();                     ///< rotor speeds [rad/s]
+  RotorVector omega_rad_s = RotorVector::Zero(4);            ///< rotor speeds [rad/s], one per rotor
 };
 
 /// Time derivative of State; the quaternion derivative is kept as 4 raw coefficients (w, x, y, z).
@@ -28,7 +28,7 @@ struct StateDerivative {
   Eigen::Vector3d v_W;
   Eigen::Vector4d q_WB_wxyz;
   Eigen::Vector3d w_B;
-  Vector4 omega_rad_s;
+  RotorVector omega_rad_s;
 };
 
 /// What the plant's sensors see at one instant (noise-free).
@@ -50,7 +50,7 @@ struct Wrench {
 /// wrench for those speeds (eq. (4)). Formed once by Quadrotor::rotor_input and reused while the command
 /// holds, so that neither step() nor outputs() forms it again on every tick.
 struct RotorInput {
-  Vector4 omega_rad_s = Vector4::Zero();
+  RotorVector omega_rad_s = RotorVector::Zero(4);
   Wrench wrench{0.0, Eigen::Vector3d::Zero()};
 };
 
@@ -59,16 +59,21 @@ class Quadrotor {
   explicit Quadrotor(const VehicleParams& params);
 
   const VehicleParams& params() const { return params_; }
-  const Matrix4& mixer() const { return mixer_; }
+  /// The 4 x N mixer (model/mixer.hpp).
+  const MixerMatrix& mixer() const { return mixer_; }
+  /// N, the vehicle's rotor count: every rotor vector the model takes and gives has N entries.
+  int rotor_count() const { return static_cast<int>(mixer_.cols()); }
 
   /// Command clamped to [omega_min, omega_max]; non-finite entries become omega_min.
-  Vector4 clamp_command(const Vector4& omega_cmd_rad_s) const;
+  RotorVector clamp_command(const RotorVector& omega_cmd_rad_s) const;
 
   /// Eq. (4) for the given rotor speeds.
-  Wrench wrench(const Vector4& omega_rad_s) const;
+  Wrench wrench(const RotorVector& omega_rad_s) const;
 
   /// The command clamped and its wrench, for the step() and outputs() overloads that take it.
-  RotorInput rotor_input(const Vector4& omega_cmd_rad_s) const;
+  RotorInput rotor_input(const RotorVector& omega_cmd_rad_s) const;
+  /// The same into `out` (a holder of the latched command: no rotor vector copied).
+  void rotor_input(const RotorVector& omega_cmd_rad_s, RotorInput& out) const;
 
   /// dx/dt at state x under the (already clamped) commanded rotor speeds:
   ///  - translation, eq. (7) in vector form: dv_W = R_WB (0, 0, U1) / m + (0, 0, -g);
@@ -83,19 +88,20 @@ class Quadrotor {
   /// env->wind_W enters the translation, and with aero.rotor_aero on each rotor's drag, inflow,
   /// flapping and translational lift at its hub enter both (force and moment); without one (nullptr)
   /// the model is exactly the paper's.
-  StateDerivative derivative(double t_s, const State& x, const Vector4& omega_cmd_rad_s,
+  StateDerivative derivative(double t_s, const State& x, const RotorVector& omega_cmd_rad_s,
                              const Environment* env = nullptr) const;
 
   /// Sensor outputs at state x under the given command (the command sets the acceleration that the
   /// accelerometer measures).
-  Outputs outputs(double t_s, const State& x, const Vector4& omega_cmd_rad_s, const Environment* env = nullptr) const;
+  Outputs outputs(double t_s, const State& x, const RotorVector& omega_cmd_rad_s,
+                  const Environment* env = nullptr) const;
   /// The same for a command already turned into its rotor input (rotor_input(omega_cmd_rad_s)): the same numbers.
   Outputs outputs(double t_s, const State& x, const RotorInput& cmd, const Environment* env = nullptr) const;
 
   /// Advances x by dt_s with `substeps` classical RK4 steps, command held constant. After each step
   /// the quaternion is renormalised and ground contact is enforced (z >= 0; an impact is inelastic).
   /// `env` (optional) is held constant over the step.
-  void step(State& x, double t_s, const Vector4& omega_cmd_rad_s, double dt_s, int substeps,
+  void step(State& x, double t_s, const RotorVector& omega_cmd_rad_s, double dt_s, int substeps,
             const Environment* env = nullptr) const;
   /// The same for a command already turned into its rotor input (rotor_input(omega_cmd_rad_s)): the same numbers.
   void step(State& x, double t_s, const RotorInput& cmd, double dt_s, int substeps,
@@ -119,6 +125,9 @@ class Quadrotor {
   template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
   void stage_derivative(const double* y, const RotorInput& cmd, const Environment* env, const RigidInputs& held_inputs,
                         double* d) const;
+  /// The rotors' wrench for the squared speeds scaled by `efficiency` (the first N entries), eq. (4):
+  /// the fixed-size 4x4 product for four rotors (the paper's arithmetic), the 4 x N one otherwise.
+  Eigen::Vector4d mix(const RotorVector& omega, const RotorVector* efficiency) const;
   /// The RK4 integrator of step(): `substeps` steps of h on x packed into plain doubles.
   template <bool kVaryingInputs, bool kRotorLag, bool kFullInertia>
   void integrate(State& x, const RotorInput& cmd, double h, int substeps, const Environment* env) const;
@@ -127,7 +136,8 @@ class Quadrotor {
   Eigen::Vector3d specific_force_W(const State& x, const RotorInput& cmd, const Environment* env) const;
 
   VehicleParams params_;
-  Matrix4 mixer_;
+  MixerMatrix mixer_;
+  Matrix4 mixer4_;               ///< mixer_ as a fixed-size matrix when N = 4 (zero otherwise)
   Eigen::Vector4d reciprocals_;  ///< 1/m, 1/Ixx, 1/Iyy, 1/Izz: the model multiplies by them
   /// J and J^-1 row by row when the body axes are not principal axes (products of inertia); empty
   /// for the diagonal path.

@@ -7,10 +7,33 @@
 #include <sstream>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "model/mixer.hpp"
 
 namespace quadcosim::model {
 
-double VehicleParams::hover_omega_rad_s() const { return std::sqrt(mass_kg * gravity_m_s2 / (4.0 * kt_N_per_rad2_s2)); }
+double VehicleParams::hover_omega_rad_s() const {
+  return std::sqrt(mass_kg * gravity_m_s2 / (static_cast<double>(rotor_count) * kt_N_per_rad2_s2));
+}
+
+void VehicleParams::set_layout(RotorLayout l) {
+  layout = l;
+  if (const int n = layout_rotor_count(l); n > 0) rotor_count = n;
+}
+
+int layout_rotor_count(RotorLayout layout) {
+  switch (layout) {
+    case RotorLayout::kPlus:
+    case RotorLayout::kX: return 4;
+    case RotorLayout::kHexPlus:
+    case RotorLayout::kHexX: return 6;
+    case RotorLayout::kOctoPlus:
+    case RotorLayout::kOctoX: return 8;
+    case RotorLayout::kCustom: break;
+  }
+  return 0;
+}
 
 Eigen::Matrix3d VehicleParams::inertia_tensor() const {
   Eigen::Matrix3d J;
@@ -47,6 +70,30 @@ std::string number_text(double v) {
         [](VehicleParams& v, std::string_view c) { v.MEMBER = c == to_string(FIRST) ? FIRST : SECOND; }, nullptr \
   }
 
+std::string signs_text(const std::array<int, kMaxRotors>& s, int n) {
+  std::string text = "[";  // appended piece by piece: GCC 12 warns (-Wrestrict) on "[" + std::string
+  for (int i = 0; i < n; ++i) text.append(i ? ", " : "").append(std::to_string(s[static_cast<std::size_t>(i)]));
+  return text.append("]");
+}
+
+std::string rotors_text(const VehicleParams& v) {
+  std::string text = "[";
+  for (int i = 0; i < v.rotor_count; ++i) {
+    const Eigen::Vector3d r = rotor_position_B(v, i);
+    text.append(i ? ", " : "")
+        .append("{position_m: [")
+        .append(number_text(r.x()))
+        .append(", ")
+        .append(number_text(r.y()))
+        .append(", ")
+        .append(number_text(r.z()))
+        .append("], spin: ")
+        .append(std::to_string(v.spin[static_cast<std::size_t>(i)]))
+        .append("}");
+  }
+  return text.append("]");
+}
+
 std::vector<VehicleParameter> make_table() {
   const Range drag = closed(0.0, 1e6);
   return {
@@ -64,18 +111,45 @@ std::vector<VehicleParameter> make_table() {
                 "thrust coefficient k_t, eq. (1)"),
       QC_NUMBER("km_Nm_per_rad2_s2", "N m/(rad/s)^2", closed(1e-20, 1.0), km_Nm_per_rad2_s2,
                 "drag-torque coefficient k_m, eq. (2)"),
-      QC_CHOICE("layout", layout, RotorLayout, RotorLayout::kPlus, RotorLayout::kX,
-                "rotor arrangement: plus (rotor 1 on the nose, eq. (4)) or x (turned 45 deg)"),
+      VehicleParameter{"layout",
+                       "",
+                       "rotor arrangement: plus (rotor 1 on the nose, eq. (4)) or x (turned 45 deg), hex_plus, hex_x, "
+                       "octo_plus, octo_x (6 or 8 rotors on the arm circle), custom (the rotors: list)",
+                       VehicleParameter::Kind::kChoice,
+                       {},
+                       {to_string(RotorLayout::kPlus), to_string(RotorLayout::kX), to_string(RotorLayout::kHexPlus),
+                        to_string(RotorLayout::kHexX), to_string(RotorLayout::kOctoPlus),
+                        to_string(RotorLayout::kOctoX), to_string(RotorLayout::kCustom)},
+                       nullptr,
+                       [](const VehicleParams& v) -> std::string_view { return to_string(v.layout); },
+                       [](VehicleParams& v, std::string_view c) {
+                         for (RotorLayout l : kRotorLayouts) {
+                           if (c == to_string(l)) v.set_layout(l);
+                         }
+                       },
+                       nullptr},
+      VehicleParameter{"rotors",
+                       "m",
+                       "custom layout: 4 to 8 rotors, each {position_m: [x, y, z], spin: 1 or -1} in the body frame "
+                       "(thrust along +z_B); sets layout custom",
+                       VehicleParameter::Kind::kRotors,
+                       {},
+                       {},
+                       nullptr,
+                       nullptr,
+                       nullptr,
+                       nullptr},
       VehicleParameter{"spin",
                        "",
-                       "reaction-torque sign of rotors 1..4 (+1: clockwise from above); two of each, alternating",
+                       "reaction-torque sign of each rotor, one per rotor (+1: clockwise from above); alternating by "
+                       "default, any pattern whose mixer has full rank (a quadrotor's: two of each, alternating)",
                        VehicleParameter::Kind::kSigns,
                        {},
                        {},
                        nullptr,
                        nullptr,
                        nullptr,
-                       [](VehicleParams& v) -> std::array<int, 4>& { return v.spin; }},
+                       [](VehicleParams& v) -> std::array<int, kMaxRotors>& { return v.spin; }},
       QC_CHOICE("gyroscopic", gyroscopic, GyroscopicModel, GyroscopicModel::kFull, GyroscopicModel::kSimplified,
                 "rotational dynamics: full (eq. (10), with w x I w) or simplified (eq. (11))"),
       QC_CHOICE("motor.model", motor.model, MotorModel, MotorModel::kIdeal, MotorModel::kFirstOrder,
@@ -115,12 +189,6 @@ std::vector<VehicleParameter> make_table() {
 #undef QC_NUMBER
 #undef QC_CHOICE
 
-std::string signs_text(const std::array<int, 4>& s) {
-  std::string text = "[";  // appended piece by piece: GCC 12 warns (-Wrestrict) on "[" + std::string
-  for (std::size_t i = 0; i < s.size(); ++i) text.append(i ? ", " : "").append(std::to_string(s[i]));
-  return text.append("]");
-}
-
 }  // namespace
 
 bool Range::contains(double v) const {
@@ -146,7 +214,8 @@ std::string VehicleParameter::text(const VehicleParams& v) const {
   switch (kind) {
     case Kind::kNumber: return number_text(get(v));
     case Kind::kChoice: return std::string(choice_of(v));
-    case Kind::kSigns: return signs_text(signs(const_cast<VehicleParams&>(v)));
+    case Kind::kSigns: return signs_text(v.spin, v.rotor_count);
+    case Kind::kRotors: return rotors_text(v);
   }
   return {};
 }
@@ -186,6 +255,10 @@ const VehicleParameter* find_vehicle_parameter(std::string_view name) {
 }
 
 namespace {
+std::string fmt_count(const char* name, int n, const char* layout) {
+  return std::string(name) + " must be in [4, 8] (layout " + layout + "), got " + std::to_string(n);
+}
+
 std::string must(const char* name, const char* what, double got) {
   std::ostringstream s;
   s << name << " must be " << what << ", got " << got;
@@ -224,16 +297,64 @@ std::string validate(const VehicleParams& p) {
   if (p.motor.omega_min_rad_s >= p.motor.omega_max_rad_s) {
     return must("motor.omega_min_rad_s", "below motor.omega_max_rad_s", p.motor.omega_min_rad_s);
   }
-  for (int s : p.spin) {
-    if (s != 1 && s != -1) return "spin must be four values, each +1 or -1, got " + signs_text(p.spin);
+  return validate_rotors(p);
+}
+
+std::string validate_rotors(const VehicleParams& p) {
+  const int n = p.rotor_count;
+  if (n < kMinRotors || n > kMaxRotors) {
+    return fmt_count("rotor_count", n, to_string(p.layout));
   }
-  int sum = p.spin[0] + p.spin[1] + p.spin[2] + p.spin[3];
-  if (sum != 0) return "spin must have two +1 and two -1 entries (sum 0), got " + signs_text(p.spin);
-  // Adjacent rotors turning the same way make the yaw row of eq. (4) a combination of the other
-  // rows (for either layout): the mixer is singular and yaw cannot be allocated.
-  if (p.spin[0] != p.spin[2]) {
-    return "spin must alternate around the frame (rotors 1 and 3 one way, 2 and 4 the other), got " +
-           signs_text(p.spin);
+  if (p.layout != RotorLayout::kCustom && n != layout_rotor_count(p.layout)) {
+    return "rotor_count must be " + std::to_string(layout_rotor_count(p.layout)) + " for layout " +
+           to_string(p.layout) + ", got " + std::to_string(n);
+  }
+  for (int i = 0; i < n; ++i) {
+    const int s = p.spin[static_cast<std::size_t>(i)];
+    if (s != 1 && s != -1) {
+      return "spin must be " + std::to_string(n) + " values (one per rotor of layout " + to_string(p.layout) +
+             "), each +1 or -1, got " + signs_text(p.spin, n);
+    }
+  }
+  if (p.layout == RotorLayout::kCustom) {
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d& r = p.rotor_positions_m[static_cast<std::size_t>(i)];
+      if (!r.allFinite()) {
+        return "rotors must have finite positions, got rotor " + std::to_string(i + 1) + " at [" + number_text(r.x()) +
+               ", " + number_text(r.y()) + ", " + number_text(r.z()) + "] m";
+      }
+      for (int j = 0; j < i; ++j) {
+        if ((r - p.rotor_positions_m[static_cast<std::size_t>(j)]).norm() < 1e-6) {
+          return "rotors must be at distinct positions, got rotors " + std::to_string(j + 1) + " and " +
+                 std::to_string(i + 1) + " both at [" + number_text(r.x()) + ", " + number_text(r.y()) + ", " +
+                 number_text(r.z()) + "] m";
+        }
+      }
+    }
+  }
+  if (n == 4 && p.layout != RotorLayout::kCustom) {
+    const int sum = p.spin[0] + p.spin[1] + p.spin[2] + p.spin[3];
+    if (sum != 0) return "spin must have two +1 and two -1 entries (sum 0), got " + signs_text(p.spin, n);
+    // Adjacent rotors turning the same way make the yaw row of eq. (4) a combination of the other
+    // rows (for either layout): the mixer is singular and yaw cannot be allocated.
+    if (p.spin[0] != p.spin[2]) {
+      return "spin must alternate around the frame (rotors 1 and 3 one way, 2 and 4 the other), got " +
+             signs_text(p.spin, n);
+    }
+  }
+  // Full row rank: each row scaled to its largest entry (k_t, k_t L and k_m differ by orders of
+  // magnitude), then the rank of the 4 x N matrix.
+  MixerMatrix M = mixer_matrix(p);
+  for (int r = 0; r < 4; ++r) {
+    const double m = M.row(r).cwiseAbs().maxCoeff();
+    if (m > 0.0) M.row(r) /= m;
+  }
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(Eigen::MatrixXd(M.transpose()));
+  lu.setThreshold(1e-9);
+  if (lu.rank() < 4) {
+    return "spin with the rotor positions of layout " + std::string(to_string(p.layout)) +
+           " leaves the mixer singular (rank " + std::to_string(lu.rank()) +
+           " of 4: thrust, roll, pitch and yaw cannot all be commanded), spin " + signs_text(p.spin, n);
   }
   return {};
 }
@@ -250,7 +371,18 @@ std::string validate_step(const VehicleParams& p, double period_s, int substeps)
   return s.str();
 }
 
-const char* to_string(RotorLayout layout) { return layout == RotorLayout::kPlus ? "plus" : "x"; }
+const char* to_string(RotorLayout layout) {
+  switch (layout) {
+    case RotorLayout::kPlus: return "plus";
+    case RotorLayout::kX: return "x";
+    case RotorLayout::kHexPlus: return "hex_plus";
+    case RotorLayout::kHexX: return "hex_x";
+    case RotorLayout::kOctoPlus: return "octo_plus";
+    case RotorLayout::kOctoX: return "octo_x";
+    case RotorLayout::kCustom: return "custom";
+  }
+  return "?";
+}
 const char* to_string(MotorModel model) { return model == MotorModel::kIdeal ? "ideal" : "first_order"; }
 const char* to_string(GyroscopicModel model) { return model == GyroscopicModel::kFull ? "full" : "simplified"; }
 

@@ -87,8 +87,39 @@ VehicleParams f450() {
   return v;
 }
 
-const std::array<VehiclePreset, 4>& table() {
-  static const std::array<VehiclePreset, 4> presets = {{
+// AscTec Firefly hexarotor, as the RotorS simulator models it (F. Furrer, M. Burri, M. Achtelik,
+// R. Siegwart, "RotorS - A Modular Gazebo MAV Simulator Framework", in Robot Operating System (ROS): The
+// Complete Reference, vol. 1, Springer, 2016; rotors_description/urdf/firefly.xacro of
+// github.com/ethz-asl/rotors_simulator): six rotors on 0.215 m arms at 30, 90, ..., 330 deg (hex_x),
+// front-left turning counter-clockwise and the others alternating, its 1.5 kg body and body inertia,
+// the motor constant 8.54858e-6 N/(rad/s)^2 and moment constant 0.016 m, first-order motors of
+// 0.0125 s up and 0.025 s down (the revision of the file most of its history carries; a later one sets
+// both to 0.025 s), 838 rad/s at most. As for the Hummingbird above, the mass and inertia add its six
+// 5 g rotors as point masses at the hubs.
+VehicleParams firefly() {
+  constexpr double kRotorMass = 0.005, kArm = 0.215;
+  VehicleParams v;
+  v.set_layout(RotorLayout::kHexX);
+  v.arm_length_m = kArm;
+  // Hubs at (L cos a, L sin a), a = 30 + 60 k deg: sum y^2 = 3 L^2, sum x^2 = 3 L^2, sum r^2 = 6 L^2.
+  v.mass_kg = 1.5 + 6.0 * kRotorMass;
+  v.Ixx_kg_m2 = 0.0347563 + 3.0 * kRotorMass * kArm * kArm;
+  v.Iyy_kg_m2 = 0.0458929 + 3.0 * kRotorMass * kArm * kArm;
+  v.Izz_kg_m2 = 0.0977 + 6.0 * kRotorMass * kArm * kArm;
+  v.kt_N_per_rad2_s2 = 8.54858e-6;           // motor constant
+  v.km_Nm_per_rad2_s2 = 8.54858e-6 * 0.016;  // times the moment constant [m]
+  // Rotor 1 front-left (RotorS's front_left, ccw), 2 front-right (cw), 3 right (ccw), 4 rear-right
+  // (cw), 5 rear-left (ccw), 6 left (cw): +1 is clockwise seen from above.
+  v.spin = {-1, +1, -1, +1, -1, +1, +1, -1};
+  v.motor.model = MotorModel::kFirstOrder;
+  v.motor.tau_up_s = 0.0125;
+  v.motor.tau_down_s = 0.025;
+  v.motor.omega_max_rad_s = 838.0;
+  return v;
+}
+
+const std::array<VehiclePreset, 5>& table() {
+  static const std::array<VehiclePreset, 5> presets = {{
       {"paper", "the paper's 1.96 kg '+' quadrotor (Table 1)", "the paper's Table 1", paper()},
       {"crazyflie2", "Bitcraze Crazyflie 2.0, 27 g 'x' nano quadrotor, full inertia tensor",
        "J. Foerster, System Identification of the Crazyflie 2.0 Nano Quadrocopter, ETH Zurich, 2015", crazyflie2()},
@@ -98,6 +129,10 @@ const std::array<VehiclePreset, 4>& table() {
        hummingbird()},
       {"f450", "450 mm-class 'x' quadrotor (DJI F450 frame), 1.4 kg, first-order motors",
        "Q. Quan, Introduction to Multicopter Design and Control, Springer, 2017", f450()},
+      {"firefly", "AscTec Firefly, 1.53 kg hexarotor (hex_x) with first-order motors",
+       "F. Furrer et al., RotorS - A Modular Gazebo MAV Simulator Framework, Springer, 2016 (firefly.xacro of "
+       "ethz-asl/rotors_simulator)",
+       firefly()},
   }};
   return presets;
 }

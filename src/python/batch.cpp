@@ -63,15 +63,21 @@ Batch::Batch(const std::string& yaml, const std::string& source, const std::vect
                             "has none of");
     }
   }
+  rotors_ = static_cast<std::size_t>(base_->vehicle.rotor_count);
+  if (level_ == control::CommandLevel::kRotorThrusts && rotors_ != 4) {
+    throw py::value_error("Batch: action: rotor_thrusts is a four-rotor level; the scenario's vehicle has " +
+                          std::to_string(rotors_) + " rotors (use rotor_speeds or a level above)");
+  }
+  command_width_ = level_ == control::CommandLevel::kRotorSpeeds ? rotors_ : 4;
   lean_vehicles_ = !c.plant.external && !c.faults.active();
   if (lean_vehicles_) lean_.resize(n_);
   p_.assign(3 * n_, 0.0);
   v_.assign(3 * n_, 0.0);
   q_.assign(4 * n_, 0.0);
   w_.assign(3 * n_, 0.0);
-  omega_.assign(4 * n_, 0.0);
-  command_.assign(4 * n_, 0.0);
-  omega_cmd_.assign(4 * n_, 0.0);
+  omega_.assign(rotors_ * n_, 0.0);
+  command_.assign(rotors_ * n_, 0.0);
+  omega_cmd_.assign(command_width_ * n_, 0.0);
   t_.assign(n_, 0.0);
   state_rows_.reserve(n_);  // recorders_ points into it
   for (std::size_t i = 0; i < n_; ++i) state_rows_.emplace_back(*this, i);
@@ -183,6 +189,10 @@ std::shared_ptr<const io::Scenario> Batch::load(const std::string& keys, std::si
     merge(root["vehicle"], given);
   }
   const std::shared_ptr<const io::Scenario> sc = load_checked(root, who);
+  if (static_cast<std::size_t>(sc->vehicle.rotor_count) != rotors_) {
+    throw io::ConfigError(who + "vehicle keys " + keys + " give " + std::to_string(sc->vehicle.rotor_count) +
+                          " rotors; every vehicle of a batch has the scenario's " + std::to_string(rotors_));
+  }
   loaded_.emplace(keys, sc);
   return sc;
 }

@@ -183,6 +183,7 @@ py::dict Batch::vehicle_params() {
   std::vector<double> hover(n_);
   for (std::size_t i = 0; i < n_; ++i) hover[i] = vehicles_[i].scenario->vehicle.hover_omega_rad_s();
   d["hover_omega_rad_s"] = to_array(hover, n_, 0);
+  d["rotor_count"] = to_array(std::vector<double>(n_, static_cast<double>(rotors_)), n_, 0);
   return d;
 }
 
@@ -208,7 +209,11 @@ py::array_t<double> Batch::get(const std::string& name) {
       {"imu.a", {&Batch::imu_a_, 3}},
   };
   const auto it = arrays.find(name);
-  if (it != arrays.end()) return to_array(this->*(it->second.first), n_, it->second.second);
+  if (it != arrays.end()) {
+    // The rotor arrays are one column per rotor.
+    const bool per_rotor = name == "omega" || name == "command";
+    return to_array(this->*(it->second.first), n_, per_rotor ? rotors_ : it->second.second);
+  }
   if (name == "R") {
     // The rotation matrices body -> world of q, row by row (what an RL observation holds: in numpy
     // they cost a step of a few dozen vehicles more than the stepping itself).

@@ -276,7 +276,7 @@ class Batch {
 
   /// Feeds vehicle i's recorder with its state and command after `ticks` ticks (`watchdog`: the
   /// watchdog held the motors in the last of them).
-  void record(std::size_t i, sim::Tick ticks, const model::State& x, const model::Vector4& command, bool watchdog) {
+  void record(std::size_t i, sim::Tick ticks, const model::State& x, const model::RotorVector& command, bool watchdog) {
     const sim::TickClock& clock = vehicles_[i].scenario->simulation.plant.clock;
     recorders_[i]->tick({ticks, clock.seconds(ticks), clock.ns(ticks), x, command, nullptr, watchdog});
   }
@@ -307,6 +307,8 @@ class Batch {
   std::shared_ptr<const io::Scenario> base_;  ///< the scenario itself (vehicles without keys fly it)
   YAML::Node root_;
   std::size_t n_ = 0;
+  std::size_t rotors_ = 4;         ///< the vehicles' rotor count (the scenario's: every vehicle has it)
+  std::size_t command_width_ = 4;  ///< values per vehicle in a step's commands: rotors_ at rotor_speeds, else 4
   std::map<std::string, std::shared_ptr<const io::Scenario>> loaded_;
   std::vector<Vehicle> vehicles_;
   std::vector<LeanVehicle> lean_;  ///< lean_vehicles_: the vehicles (else empty)

@@ -12,22 +12,24 @@ void Batch::step(const std::optional<py::array_t<double, py::array::c_style | py
     throw py::value_error("Batch.step: periods = " + std::to_string(periods) + ": expected at least 1");
   }
   if (plant_only_ && !omega_cmd) {
-    throw py::value_error(
-        "Batch.step: this batch is plant_only (no controllers): give omega_cmd, an (n, 4) array of rotor speeds "
-        "[rad/s]; nothing was stepped");
+    throw py::value_error("Batch.step: this batch is plant_only (no controllers): give omega_cmd, an (n, " +
+                          std::to_string(rotors_) + ") array of rotor speeds [rad/s]; nothing was stepped");
   }
   if (omega_cmd && level_ != control::CommandLevel::kRotorSpeeds) {
     check_level_commands(*omega_cmd);
   } else if (omega_cmd) {
-    if (omega_cmd->ndim() != 2 || omega_cmd->shape(0) != static_cast<py::ssize_t>(n_) || omega_cmd->shape(1) != 4) {
-      throw py::value_error("Batch.step: omega_cmd: expected an array of shape (" + std::to_string(n_) +
-                            ", 4) (4 rotor speeds [rad/s] per vehicle), got shape " +
+    const std::size_t r = rotors_;
+    if (omega_cmd->ndim() != 2 || omega_cmd->shape(0) != static_cast<py::ssize_t>(n_) ||
+        omega_cmd->shape(1) != static_cast<py::ssize_t>(r)) {
+      throw py::value_error("Batch.step: omega_cmd: expected an array of shape (" + std::to_string(n_) + ", " +
+                            std::to_string(r) + ") (" + std::to_string(r) +
+                            " rotor speeds [rad/s] per vehicle), got shape " +
                             py::repr(omega_cmd->attr("shape")).cast<std::string>() + "; nothing was stepped");
     }
     const double* c = omega_cmd->data();
-    for (std::size_t j = 0; j < 4 * n_; ++j) {
+    for (std::size_t j = 0; j < r * n_; ++j) {
       if (!std::isfinite(c[j])) {
-        throw py::value_error("Batch.step: omega_cmd[" + std::to_string(j / 4) + ", " + std::to_string(j % 4) +
+        throw py::value_error("Batch.step: omega_cmd[" + std::to_string(j / r) + ", " + std::to_string(j % r) +
                               "] = " + py::repr(py::float_(c[j])).cast<std::string>() +
                               ": rotor speeds must be finite; nothing was stepped");
       }
@@ -37,7 +39,7 @@ void Batch::step(const std::optional<py::array_t<double, py::array::c_style | py
   const double* c = bypass ? omega_cmd->data() : nullptr;
   py::gil_scoped_release release;
   std::lock_guard lock(mutex_);
-  if (bypass) std::copy(c, c + 4 * n_, omega_cmd_.begin());
+  if (bypass) std::copy(c, c + command_width_ * n_, omega_cmd_.begin());
   if (lean_vehicles_) {
     pool_.run(chunks(), [&](std::uint32_t c) {
       const std::size_t last = std::min(n_, (c + 1) * kChunk);
@@ -58,6 +60,7 @@ void Batch::step(const std::optional<py::array_t<double, py::array::c_style | py
 }
 
 void Batch::check_level_commands(const py::array_t<double, py::array::c_style | py::array::forcecast>& cmd) const {
+  // rotor_thrusts is refused for a vehicle without four rotors when the batch is made.
   const std::string_view level = control::to_string(level_);
   const auto& fields = control::setpoint_fields(level_);
   if (cmd.ndim() != 2 || cmd.shape(0) != static_cast<py::ssize_t>(n_) || cmd.shape(1) != 4) {
@@ -81,8 +84,13 @@ void Batch::check_level_commands(const py::array_t<double, py::array::c_style | 
 void Batch::step_vehicle(std::size_t i, bool bypass, int periods) {
   Vehicle& v = vehicles_[i];
   if (bypass) {
-    const double* c = &omega_cmd_[4 * i];
-    v.sim->override_level_command(control::LevelCommand{level_, model::Vector4(c[0], c[1], c[2], c[3])});
+    const double* c = &omega_cmd_[command_width_ * i];
+    if (level_ == control::CommandLevel::kRotorSpeeds) {
+      v.sim->override_command(
+          model::RotorVector(Eigen::Map<const model::RotorVector>(c, static_cast<Eigen::Index>(rotors_))));
+    } else {
+      v.sim->override_level_command(control::LevelCommand{level_, model::Vector4(c[0], c[1], c[2], c[3])});
+    }
   }
   const int ticks = v.scenario->simulation.controller_divider * periods;
   const sensors::Suite* extra = v.sim->plant().extra_sensors();
@@ -107,11 +115,11 @@ void Batch::step_lean(std::size_t i, bool bypass, int periods) {
   sim::ControllerCore* const controller = L.controller ? &*L.controller : nullptr;
   thread_local msg::Float64MultiArray command;  // the command message, as the controller node or Simulation sends it
   if (bypass) {
-    command.data.assign(&omega_cmd_[4 * i], &omega_cmd_[4 * i] + 4);
+    command.data.assign(&omega_cmd_[command_width_ * i], &omega_cmd_[command_width_ * i] + command_width_);
     // As Simulation::override_level_command sends it: the level named in the layout (none for speeds).
     msg::set_command_level(command, control::to_string(level_));
   } else {
-    command.data.resize(4);
+    command.data.resize(rotors_);
   }
   thread_local msg::PoseStamped pose;  // the samples, as the plant node publishes them
   thread_local msg::TwistStamped twist;
@@ -213,9 +221,17 @@ void Batch::StateRow::tick(const sim::RecordedTick& t) {
   set3(b_->v_, i, x.v_W.x(), x.v_W.y(), x.v_W.z());
   set4(b_->q_, i, x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z());
   set3(b_->w_, i, x.w_B.x(), x.w_B.y(), x.w_B.z());
-  set4(b_->omega_, i, x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]);
-  const model::Vector4& c = t.command;
-  set4(b_->command_, i, c[0], c[1], c[2], c[3]);
+  const model::RotorVector& c = t.command;
+  if (b_->rotors_ == 4) {
+    set4(b_->omega_, i, x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]);
+    set4(b_->command_, i, c[0], c[1], c[2], c[3]);
+  } else {
+    const std::size_t r = b_->rotors_;
+    for (std::size_t k = 0; k < r; ++k) {
+      b_->omega_[r * i + k] = x.omega_rad_s[static_cast<Eigen::Index>(k)];
+      b_->command_[r * i + k] = c[static_cast<Eigen::Index>(k)];
+    }
+  }
   b_->t_[i] = t.t_s;
 }
 

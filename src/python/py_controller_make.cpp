@@ -32,18 +32,31 @@ py::dict vehicle_dict(const model::VehicleParams& vehicle) {
       case model::VehicleParameter::Kind::kNumber: d[key] = p.get(vehicle); break;
       case model::VehicleParameter::Kind::kChoice: d[key] = std::string(p.choice_of(vehicle)); break;
       case model::VehicleParameter::Kind::kSigns: {
-        model::VehicleParams copy = vehicle;
-        const std::array<int, 4> s = p.signs(copy);
-        d[key] = py::make_tuple(s[0], s[1], s[2], s[3]);
+        py::list s;
+        for (int i = 0; i < vehicle.rotor_count; ++i) s.append(vehicle.spin[static_cast<std::size_t>(i)]);
+        d[key] = py::tuple(s);
+        break;
+      }
+      case model::VehicleParameter::Kind::kRotors: {
+        py::list rotors;
+        for (int i = 0; i < vehicle.rotor_count; ++i) {
+          const Eigen::Vector3d r = model::rotor_position_B(vehicle, i);
+          rotors.append(py::make_tuple(r.x(), r.y(), r.z()));
+        }
+        d[key] = py::tuple(rotors);  // every layout's rotor positions [m]
         break;
       }
     }
   }
   d["hover_omega_rad_s"] = vehicle.hover_omega_rad_s();
-  // The inverse of the mixer (eq. (4)): rotor speeds squared from U, as the C++ controllers allocate.
-  const Eigen::Matrix4d inverse = model::mixer_matrix(vehicle).inverse();
+  d["rotor_count"] = vehicle.rotor_count;
+  // The allocation (eq. (4) inverted; the pseudo-inverse for more than four rotors): rotor speeds
+  // squared from U, one row per rotor, as the C++ controllers allocate.
+  const model::AllocationMatrix inverse = model::allocation_matrix(vehicle);
   py::list rows;
-  for (int r = 0; r < 4; ++r) rows.append(py::make_tuple(inverse(r, 0), inverse(r, 1), inverse(r, 2), inverse(r, 3)));
+  for (Eigen::Index r = 0; r < inverse.rows(); ++r) {
+    rows.append(py::make_tuple(inverse(r, 0), inverse(r, 1), inverse(r, 2), inverse(r, 3)));
+  }
   d["mixer_inverse"] = py::tuple(rows);
   return d;
 }

@@ -165,9 +165,12 @@ void PyController::step(const control::Observation& o, const control::Reference&
       }
     }
   };
-  double omega_values[4];
-  read(omega, 4, "4 rotor speeds [rad/s]", omega_values);
-  for (int i = 0; i < 4; ++i) {
+  // One speed per rotor of the vehicle (4 for a quadrotor).
+  const int rotors = model_.rotor_count();
+  double omega_values[model::kMaxRotors];
+  const std::string speeds = fmt::format("{} rotor speeds [rad/s]", rotors);
+  read(omega, static_cast<std::size_t>(rotors), speeds.c_str(), omega_values);
+  for (int i = 0; i < rotors; ++i) {
     if (!std::isfinite(omega_values[i])) {
       fail_step(fmt::format("returned rotor speed {} = {}; not commanded", i + 1, omega_values[i]), t);
     }
@@ -186,9 +189,8 @@ void PyController::step(const control::Observation& o, const control::Reference&
               t);
   }
   ++steps_;
-  control::rotor_speeds_output(model_, r,
-                               Eigen::Vector4d(omega_values[0], omega_values[1], omega_values[2], omega_values[3]),
-                               shared_->reported, out);
+  control::rotor_speeds_output(model_, r, Eigen::Map<const model::RotorVector>(omega_values, rotors), shared_->reported,
+                               out);
 }
 
 }  // namespace quadcosim::python

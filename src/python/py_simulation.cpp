@@ -49,6 +49,12 @@ py::array_t<double> array(std::initializer_list<double> v) {
   return a;
 }
 
+py::array_t<double> array(const model::RotorVector& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
 double stamp_s(const msg::Header& h) { return h.stamp.sec + h.stamp.nanosec * 1e-9; }
 
 /// One vehicle of a scenario, advanced one control period at a time.
@@ -71,17 +77,22 @@ class PySimulation {
 
   void step(const std::optional<Values>& omega_cmd, const std::optional<Values>& command,
             const std::optional<std::string>& level) {
-    std::optional<control::LevelCommand> given;
     if (omega_cmd && command) {
       throw py::value_error("Simulation.step: give omega_cmd (rotor speeds) or command (with level), not both");
     }
     if (level && !command) throw py::value_error("Simulation.step: level='" + *level + "' needs command=");
-    if (omega_cmd) given = level_command(*omega_cmd, control::CommandLevel::kRotorSpeeds, "omega_cmd");
+    std::optional<model::RotorVector> speeds;
+    std::optional<control::LevelCommand> given;
+    if (omega_cmd) speeds = rotor_speeds(*omega_cmd, "omega_cmd");
     if (command) {
       const std::string name = level.value_or("rotor_speeds");
       const std::optional<control::CommandLevel> l = control::command_level_from_string(name);
       if (!l) throw py::value_error("Simulation.step: " + control::unknown_command_level(name));
-      given = level_command(*command, *l, "command");
+      if (*l == control::CommandLevel::kRotorSpeeds) {
+        speeds = rotor_speeds(*command, "command");
+      } else {
+        given = level_command(*command, *l);
+      }
     }
     auto lock = guard();
     py::gil_scoped_release release;
@@ -93,23 +104,39 @@ class PySimulation {
         s.stepping_ = std::thread::id();
       }
     } done{*this};
-    sim_->override_level_command(given);
+    if (speeds) {
+      sim_->override_command(speeds);
+    } else {
+      sim_->override_level_command(given);
+    }
     for (int i = 0; i < divider(); ++i) sim_->tick(next_tick_++);
   }
 
-  /// `values` as a command at `level`: one-dimensional, 4 values (rotor_speeds: one per rotor) that
-  /// control::check_setpoint accepts (finite); else ValueError naming `arg`. Rotor speeds out of
-  /// range are not refused here: the plant checks and limits them as any command it receives.
-  static control::LevelCommand level_command(const Values& values, control::CommandLevel level, const char* arg) {
-    if (values.ndim() != 1 || values.shape(0) != 4) {
-      throw py::value_error(std::string("Simulation.step: ") + arg + ": expected 4 values (" +
-                            std::string(control::to_string(level)) + ": " + fields_text(level) +
-                            "), got an array of shape " + py::repr(values.attr("shape")).cast<std::string>());
+  /// `values` as rotor speeds: one-dimensional, one per rotor of the vehicle; else ValueError naming
+  /// `arg`. Speeds out of range are not refused here: the plant checks and limits them as any command.
+  model::RotorVector rotor_speeds(const Values& values, const char* arg) const {
+    const int rotors = scenario_.vehicle.rotor_count;
+    if (values.ndim() != 1 || values.shape(0) != rotors) {
+      throw py::value_error(std::string("Simulation.step: ") + arg + ": expected " + std::to_string(rotors) +
+                            " rotor speeds [rad/s], got an array of shape " +
+                            py::repr(values.attr("shape")).cast<std::string>());
     }
-    if (level != control::CommandLevel::kRotorSpeeds) {
-      if (std::string why = control::check_setpoint(level, values.data(), 4); !why.empty()) {
-        throw py::value_error(std::string("Simulation.step: ") + arg + ": " + why);
-      }
+    return Eigen::Map<const model::RotorVector>(values.data(), rotors);
+  }
+  /// `values` as a command at `level` (above rotor speeds): one-dimensional, the level's 4 values, finite
+  /// (control::check_setpoint); rotor_thrusts only for a four-rotor vehicle. Else ValueError.
+  control::LevelCommand level_command(const Values& values, control::CommandLevel level) const {
+    if (values.ndim() != 1 || values.shape(0) != 4) {
+      throw py::value_error("Simulation.step: command: expected 4 values (" + std::string(control::to_string(level)) +
+                            ": " + fields_text(level) + "), got an array of shape " +
+                            py::repr(values.attr("shape")).cast<std::string>());
+    }
+    if (level == control::CommandLevel::kRotorThrusts && scenario_.vehicle.rotor_count != 4) {
+      throw py::value_error("Simulation.step: rotor_thrusts is a four-rotor level; the vehicle has " +
+                            std::to_string(scenario_.vehicle.rotor_count) + " rotors");
+    }
+    if (std::string why = control::check_setpoint(level, values.data(), 4); !why.empty()) {
+      throw py::value_error("Simulation.step: command: " + why);
     }
     return {level, Eigen::Vector4d(values.at(0), values.at(1), values.at(2), values.at(3))};
   }
@@ -165,14 +192,14 @@ class PySimulation {
     d["v"] = array({x.v_W.x(), x.v_W.y(), x.v_W.z()});
     d["q"] = array({x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()});
     d["w"] = array({x.w_B.x(), x.w_B.y(), x.w_B.z()});
-    d["omega"] = array({x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]});
+    d["omega"] = array(x.omega_rad_s);
     return d;
   }
 
   py::array_t<double> command() {
     auto lock = guard();
-    const model::Vector4& c = sim_->plant().latched_command();
-    return array({c[0], c[1], c[2], c[3]});
+    const model::RotorVector& c = sim_->plant().latched_command();
+    return array(c);
   }
 
   py::dict sensors() {
@@ -333,7 +360,7 @@ realism.seed). step_timeout_s: the per-step time limit of a Python controller (0
            py::arg("command") = py::none(), py::arg("level") = py::none(),
            R"(Advances one control period (sim.dt seconds, several plant ticks).
 
-With omega_cmd (4 rotor speeds [rad/s], rotors 1..4) the controller is bypassed for this period:
+With omega_cmd (one speed per rotor [rad/s], rotors 1..N) the controller is bypassed for this period:
 the command goes to the plant on the motor command topic and is checked, limited and latched by the
 plant like the controller's (the controller neither steps nor publishes a status).
 With command= and level= (a command level: "rotor_thrusts", "ctbr", "ctatt", "cttm", "velocity",

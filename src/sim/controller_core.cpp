@@ -76,7 +76,7 @@ void ControllerCore::safety_output(const control::Reference& ref, control::Contr
   out.pitch_des_rad = attitude ? ref.pitch_rad : 0.0;
   out.yaw_des_rad = 0.0;
   out.attitude_error = std::numeric_limits<double>::quiet_NaN();
-  out.rotor_saturated = {};
+  out.rotor_saturated.reset(static_cast<int>(out.omega_rad_s.size()));
   out.tilt_saturated = false;
   std::fill(out.outputs.begin(), out.outputs.end(), std::numeric_limits<double>::quiet_NaN());
 }

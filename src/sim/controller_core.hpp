@@ -35,9 +35,14 @@ namespace quadcosim::sim {
 /// commands, named in the layout (msg::set_command_level). `m.dim[0]` (the lockstep label) is kept.
 inline void write_command(const control::ControllerOutput& out, msg::Float64MultiArray& m) {
   const bool speeds = out.level == control::CommandLevel::kRotorSpeeds;
-  const Eigen::Vector4d& v = speeds ? out.omega_rad_s : out.setpoint;
-  m.data.resize(4);
-  for (int i = 0; i < 4; ++i) m.data[static_cast<std::size_t>(i)] = v[i];
+  const auto n = static_cast<std::size_t>(speeds ? out.omega_rad_s.size() : 4);  // one per rotor, or 4
+  const double* v = speeds ? out.omega_rad_s.data() : out.setpoint.data();
+  if (n == 4) {
+    m.data.resize(4);
+    for (std::size_t i = 0; i < 4; ++i) m.data[i] = v[i];
+  } else {
+    m.data.assign(v, v + n);
+  }
   // Rotor speeds carry no level dimension (the message as before levels existed): set_command_level
   // removes one left from an earlier step.
   msg::set_command_level(m, control::to_string(out.level));

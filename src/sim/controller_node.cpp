@@ -125,10 +125,8 @@ void ControllerNode::publish(const control::Observation& obs, const control::Ref
   for (int i = 0; i < 3; ++i) status_.position_error[i] = ref.p_W[i] - obs.p_W[i];
   status_.yaw_error = model::wrap_pi(ref.yaw_rad - obs.yaw_rad);
   status_.attitude_error = out.attitude_error;
-  for (int i = 0; i < 4; ++i) {
-    status_.u[i] = out.U[i];
-    status_.rotor_saturated[i] = out.rotor_saturated[i];
-  }
+  for (int i = 0; i < 4; ++i) status_.u[i] = out.U[i];
+  status_.rotor_saturated = out.rotor_saturated.value;  // entries past the rotor count are false
   status_.tilt_saturated = out.tilt_saturated;
   status_.safety = out.safety;
   status_.rejected_non_finite = core_.rejected(SensorFault::kNonFinite);

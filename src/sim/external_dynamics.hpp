@@ -23,7 +23,7 @@ class ExternalDynamics {
   /// Advances from t_k to t_k+1 (one plant period) under the rotor speed command `omega_rad_s`
   /// [rad/s], already checked and clamped to [0, omega_max] by the node. Throws
   /// std::runtime_error naming the tick when the dynamics fail (the run ends with that message).
-  virtual void step(Tick k, const model::Vector4& omega_rad_s) = 0;
+  virtual void step(Tick k, const model::RotorVector& omega_rad_s) = 0;
 };
 
 /// Makes one ExternalDynamics per plant (a swarm makes one per vehicle), starting at `initial`.

@@ -113,7 +113,7 @@ TEST(CommandLevels, TheWatchdogsStopEndsALevelCommand) {
   const model::VehicleParams v;
   const TickClock clock{10'000'000};
   PlantCore p(v, {}, clock, hover_at(v, 10.0), "/drone");
-  p.queue(0, 0, {v.mass_kg * v.gravity_m_s2, 0.0, 0.0, 0.0}, control::CommandLevel::kCtbr);
+  p.queue(0, 0, model::Vector4(v.mass_kg * v.gravity_m_s2, 0.0, 0.0, 0.0), control::CommandLevel::kCtbr);
   EXPECT_FALSE(p.latch(0, 0, clock.ns(50), WatchdogPolicy::kStop));
   EXPECT_EQ(p.held().level, control::CommandLevel::kCtbr);
   EXPECT_NEAR(v.kt_N_per_rad2_s2 * p.latched().cwiseAbs2().sum(), v.mass_kg * v.gravity_m_s2, 1e-12);
@@ -157,7 +157,7 @@ TEST(CommandLevels, LevelCommandsOnTheWireAreCheckedNamingWhatIsWrong) {
   EXPECT_EQ(m.dim.size(), 1u);
   // A controller's output at rotor speeds leaves the message as it always was.
   control::ControllerOutput out;
-  out.omega_rad_s = {1.0, 2.0, 3.0, 4.0};
+  out.omega_rad_s = model::Vector4(1.0, 2.0, 3.0, 4.0);
   msg::Float64MultiArray w;
   w.dim = {{msg::command_label(0), 4, 4}};
   write_command(out, w);

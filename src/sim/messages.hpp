@@ -309,7 +309,8 @@ struct ControllerStatus {
   double yaw_error = 0.0;                  ///< reference minus observed yaw, wrapped to [-pi, pi] [rad]
   /// Psi = 1/2 tr(I - R_d^T R) in [0, 2] for a controller with a desired attitude R_d, NaN otherwise.
   double attitude_error = 0.0;
-  std::array<bool, 4> rotor_saturated{};
+  /// The allocation clamped rotor i (one entry per rotor of the vehicle; those past its count false).
+  std::array<bool, 8> rotor_saturated{};
   bool tilt_saturated = false;
   bool safety = false;  ///< the stale-data safety command was sent
   /// Sensor messages refused so far, by reason (sim/validation.hpp, docs/reliability.md); a refused

@@ -160,7 +160,7 @@ void PlantNode::intake(int source, SenderId sender, std::int64_t stamp, Check ch
 
 void PlantNode::on_command(const msg::Float64MultiArray& m, SenderId sender) {
   intake(0, sender, options_.drop_stale_commands ? msg::command_stamp_ns(m) : -1,
-         [&] { return check_command(m, core_.omega_max_rad_s()); });
+         [&] { return check_command(m, core_.omega_max_rad_s(), core_.rotor_count()); });
 }
 
 template <class T>
@@ -169,7 +169,7 @@ void PlantNode::on_level_command(const T& m, SenderId sender) {
   const std::int64_t stamp = options_.drop_stale_commands ? std::max<std::int64_t>(-1, m.header.stamp.to_ns()) : -1;
   intake(1 + static_cast<int>(T::kLevel), sender, stamp, [&] {
     const msg::LevelValues v = msg::level_values(m);
-    return check_command(v.level, v.data(), v.count(), core_.omega_max_rad_s(), v.attitude_norm);
+    return check_command(v.level, v.data(), v.count(), core_.omega_max_rad_s(), core_.rotor_count(), v.attitude_norm);
   });
 }
 

@@ -161,7 +161,7 @@ class PlantNode final : public SteppablePlant {
   const model::Quadrotor& model() const { return core_.model(); }
   /// The command latched for the current interval, as received after check_command (speeds within
   /// [0, omega_max]; the model still limits them to [omega_min, omega_max]).
-  const model::Vector4& latched_command() const { return core_.latched(); }
+  const model::RotorVector& latched_command() const { return core_.latched(); }
   /// The plant core (the level command held, the inner loops flying it).
   const PlantCore& core() const { return core_; }
   const PlantStats& stats() const { return stats_; }

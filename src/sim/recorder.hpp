@@ -21,7 +21,7 @@ struct RecordedTick {
   double t_s;         ///< simulated time of the tick [s]
   std::int64_t t_ns;  ///< the same [ns] (the plant clock's ns(tick))
   const model::State& state;
-  const model::Vector4& command;        ///< rotor speeds latched for [t_k, t_k+1) [rad/s]
+  const model::RotorVector& command;    ///< rotor speeds latched for [t_k, t_k+1) [rad/s], one per rotor
   const msg::ControllerStatus* status;  ///< the controller's newest status; nullptr when none came (open loop)
   bool watchdog = false;                ///< the plant's watchdog holds the motors (no valid command)
 };

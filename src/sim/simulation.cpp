@@ -55,12 +55,18 @@ void Simulation::tick(Tick k, const std::function<void(const TickRecord&)>& on_t
   loop_.tick(k);
 }
 
-void Simulation::override_command(const std::optional<model::Vector4>& omega_rad_s) {
+void Simulation::override_command(const std::optional<model::RotorVector>& omega_rad_s) {
   if (!omega_rad_s) {
     override_level_command(std::nullopt);
     return;
   }
-  override_level_command(control::LevelCommand{control::CommandLevel::kRotorSpeeds, *omega_rad_s});
+  if (omega_rad_s->size() == 4) {
+    override_level_command(control::LevelCommand{control::CommandLevel::kRotorSpeeds, omega_rad_s->head<4>()});
+    return;
+  }
+  // Another rotor count: its N speeds as they are (a level command holds four values).
+  override_level_command(control::LevelCommand{control::CommandLevel::kRotorSpeeds, Eigen::Vector4d::Zero()});
+  override_msg_.data.assign(omega_rad_s->data(), omega_rad_s->data() + omega_rad_s->size());
 }
 
 void Simulation::override_level_command(const std::optional<control::LevelCommand>& command) {

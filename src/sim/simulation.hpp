@@ -47,8 +47,8 @@ struct TickRecord {
   Tick tick;
   double t_s;
   const model::State& state;
-  const model::Vector4& latched_command;  ///< rotor command acting over [t_k, t_k+1) [rad/s]
-  const msg::ControllerStatus& status;    ///< the controller's latest step, as published
+  const model::RotorVector& latched_command;  ///< rotor command acting over [t_k, t_k+1) [rad/s]
+  const msg::ControllerStatus& status;        ///< the controller's latest step, as published
 };
 
 class Simulation {
@@ -85,7 +85,7 @@ class Simulation {
   /// stepping the controller (which then neither runs nor publishes a status), until cleared with
   /// nullopt. The plant checks and latches them as any command (a stepping front end flying its own
   /// commands).
-  void override_command(const std::optional<model::Vector4>& omega_rad_s);
+  void override_command(const std::optional<model::RotorVector>& omega_rad_s);
   /// The same at any command level (control/command_level.hpp): the plant's inner loops fly it.
   void override_level_command(const std::optional<control::LevelCommand>& command);
 

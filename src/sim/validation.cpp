@@ -20,7 +20,8 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
 // of range are clamped to the nearer end and the first of them is named. Out of line: the common
 // case (all four in range) never comes here.
 [[gnu::noinline, gnu::cold]] void find_command_fault(const double* w, CommandCheck& out) {
-  for (int i = 0; i < 4; ++i) {
+  const int n = out.rotors;
+  for (int i = 0; i < n; ++i) {
     if (!std::isfinite(w[i])) {
       out.fault = CommandFault::kNonFinite;
       out.rotor = i;
@@ -29,7 +30,7 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
       return;
     }
   }
-  for (int i = 3; i >= 0; --i) {  // downwards, so that the first rotor out of range is the one named
+  for (int i = n - 1; i >= 0; --i) {  // downwards, so that the first rotor out of range is the one named
     if (in_range(w[i], out.omega_max_rad_s)) continue;
     out.omega_rad_s[i] = w[i] > out.omega_max_rad_s ? out.omega_max_rad_s : 0.0;
     out.fault = CommandFault::kOutOfRange;
@@ -42,11 +43,18 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
 [[gnu::noinline]] void check_level_values(control::CommandLevel level, const double* values, std::size_t count,
                                           CommandCheck& out) {
   out.level = level;
+  if (level == control::CommandLevel::kRotorThrusts && out.rotors != 4) {
+    out.fault = CommandFault::kLevelNotForVehicle;
+    out.omega_rad_s.setZero(4);
+    return;
+  }
   if (count != 4) {
     out.fault = CommandFault::kWrongLength;
     out.values = count;
+    out.omega_rad_s.setZero(4);
     return;
   }
+  out.omega_rad_s.resize(4);
   for (int i = 0; i < 4; ++i) {
     const double v = values[i];
     out.omega_rad_s[i] = v;
@@ -68,29 +76,38 @@ bool in_range(double w, double omega_max_rad_s) { return w >= 0.0 && w <= omega_
   }
 }
 
-// Exactly 4 rotor speeds, each in [0, omega_max] (clamped) and finite (else rejected).
+// Exactly out.rotors rotor speeds, each in [0, omega_max] (clamped) and finite (else rejected).
 void check_rotor_speeds(const double* w, std::size_t count, CommandCheck& out) {
-  if (count != 4) {
+  const int n = out.rotors;
+  if (count != static_cast<std::size_t>(n)) {
     out.fault = CommandFault::kWrongLength;
     out.values = count;
+    out.omega_rad_s.setZero(n);
     return;
   }
-  out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
   bool ok = true;
-  for (int i = 0; i < 4; ++i) ok &= in_range(w[i], out.omega_max_rad_s);  // no branch per speed
+  if (n == 4) {  // the quadrotor's command, unrolled
+    out.omega_rad_s = model::Vector4(w[0], w[1], w[2], w[3]);
+    for (int i = 0; i < 4; ++i) ok &= in_range(w[i], out.omega_max_rad_s);  // no branch per speed
+  } else {
+    out.omega_rad_s = Eigen::Map<const model::RotorVector>(w, n);
+    for (int i = 0; i < n; ++i) ok &= in_range(w[i], out.omega_max_rad_s);
+  }
   if (!ok) find_command_fault(w, out);
 }
 
 }  // namespace
 
-CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s) {
+CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s, int rotor_count) {
   CommandCheck out;
   out.omega_max_rad_s = omega_max_rad_s;
+  out.rotors = rotor_count;
   if (!m.dim.empty()) {
     if (const std::string_view name = msg::command_level_name(m); !name.empty()) {
       const std::optional<control::CommandLevel> level = control::command_level_from_string(name);
       if (!level) {
         out.fault = CommandFault::kUnknownLevel;
+        out.omega_rad_s.setZero(4);
         const std::size_t n = std::min(name.size(), out.unknown_level.size() - 1);
         std::copy_n(name.data(), n, out.unknown_level.data());
         return out;
@@ -107,9 +124,10 @@ CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad
 }
 
 CommandCheck check_command(control::CommandLevel level, const double* values, std::size_t count, double omega_max_rad_s,
-                           double attitude_norm) {
+                           int rotor_count, double attitude_norm) {
   CommandCheck out;
   out.omega_max_rad_s = omega_max_rad_s;
+  out.rotors = rotor_count;
   if (level == control::CommandLevel::kRotorSpeeds) {
     check_rotor_speeds(values, count, out);
     return out;
@@ -130,7 +148,8 @@ CommandVerdict CommandCheck::verdict() const {
     case CommandFault::kWrongLength:
     case CommandFault::kNonFinite:
     case CommandFault::kUnknownLevel:
-    case CommandFault::kBadQuaternion: break;
+    case CommandFault::kBadQuaternion:
+    case CommandFault::kLevelNotForVehicle: break;
   }
   return CommandVerdict::kRejected;
 }
@@ -148,6 +167,11 @@ std::string CommandCheck::reason() const {
       case CommandFault::kOutOfRange: return fmt::format("rotor {} thrust {:g} N clamped to 0", rotor + 1, value);
       case CommandFault::kBadQuaternion:
         return fmt::format("{} attitude has norm {:g}, expected a unit quaternion (x, y, z, w)", name, quaternion_norm);
+      case CommandFault::kLevelNotForVehicle:
+        return fmt::format(
+            "level {} takes one thrust per rotor of a four-rotor vehicle; this vehicle has {} rotors "
+            "(command it at rotor_speeds or a level above)",
+            name, rotors);
       case CommandFault::kUnknownLevel: break;
     }
     return "?";
@@ -155,8 +179,9 @@ std::string CommandCheck::reason() const {
   switch (fault) {
     case CommandFault::kNone: return "";
     case CommandFault::kUnknownLevel:
-    case CommandFault::kBadQuaternion: return "?";
-    case CommandFault::kWrongLength: return fmt::format("{} values, expected 4 rotor speeds", values);
+    case CommandFault::kBadQuaternion:
+    case CommandFault::kLevelNotForVehicle: return "?";
+    case CommandFault::kWrongLength: return fmt::format("{} values, expected {} rotor speeds", values, rotors);
     case CommandFault::kNonFinite:
       return fmt::format("rotor {} speed is {}, expected a finite number", rotor + 1, value);
     case CommandFault::kOutOfRange:

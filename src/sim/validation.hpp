@@ -32,21 +32,24 @@ enum class CommandVerdict {
 /// What was wrong with a motor command; kNone when it was used as sent.
 enum class CommandFault : std::uint8_t {
   kNone,
-  kWrongLength,    ///< not exactly 4 values (kRejected)
-  kNonFinite,      ///< a NaN or Inf speed (kRejected)
-  kOutOfRange,     ///< four finite speeds, some < 0 or > omega_max (kClamped); rotor thrusts < 0
-  kUnknownLevel,   ///< the layout names a command level quadcosim does not know (kRejected)
-  kBadQuaternion,  ///< a ThrustAttitude whose attitude is not a unit quaternion (kRejected)
+  kWrongLength,         ///< not exactly N rotor speeds (the vehicle's rotor count) or 4 level values (kRejected)
+  kNonFinite,           ///< a NaN or Inf speed (kRejected)
+  kOutOfRange,          ///< four finite speeds, some < 0 or > omega_max (kClamped); rotor thrusts < 0
+  kUnknownLevel,        ///< the layout names a command level quadcosim does not know (kRejected)
+  kBadQuaternion,       ///< a ThrustAttitude whose attitude is not a unit quaternion (kRejected)
+  kLevelNotForVehicle,  ///< rotor_thrusts for a vehicle without four rotors (kRejected)
 };
 
 /// The outcome of check_command: plain data, no allocation; reason() says it in words.
 struct CommandCheck {
   CommandFault fault = CommandFault::kNone;
-  model::Vector4 omega_rad_s = model::Vector4::Zero();  ///< the speeds to use (not kRejected) [rad/s]
-  std::size_t values = 4;                               ///< how many values the message held
-  int rotor = 0;                 ///< the rotor at fault, 0..3: the first non-finite one, or the first clamped one
-  double value = 0.0;            ///< that rotor's speed as sent [rad/s] (kNonFinite, kOutOfRange)
-  double omega_max_rad_s = 0.0;  ///< the upper end of the range checked against [rad/s]
+  /// The speeds to use (not kRejected) [rad/s], one per rotor; a level's 4 values.
+  model::RotorVector omega_rad_s;  ///< zeros when rejected
+  std::size_t values = 4;          ///< how many values the message held
+  int rotors = 4;                  ///< the vehicle's rotor count: how many speeds were expected
+  int rotor = 0;                   ///< the rotor at fault, 0..3: the first non-finite one, or the first clamped one
+  double value = 0.0;              ///< that rotor's speed as sent [rad/s] (kNonFinite, kOutOfRange)
+  double omega_max_rad_s = 0.0;    ///< the upper end of the range checked against [rad/s]
   /// The command's level (msg::command_level_name); omega_rad_s then holds that level's 4 values.
   control::CommandLevel level = control::CommandLevel::kRotorSpeeds;
   std::array<char, 24> unknown_level{};  ///< the start of an unknown level's name (kUnknownLevel)
@@ -58,7 +61,8 @@ struct CommandCheck {
   std::string reason() const;
 };
 
-/// Checks a /<ns>/motor_commands message: `data` must hold exactly 4 finite rotor speeds [rad/s].
+/// Checks a /<ns>/motor_commands message: `data` must hold exactly `rotor_count` finite rotor speeds
+/// [rad/s] (the vehicle's; 4 for a quadrotor).
 /// Finite speeds below 0 become 0 and above `omega_max_rad_s` become omega_max (kOutOfRange, kClamped).
 /// Checked in this order, the first fault reported: the length, then each speed for NaN/Inf (rotor 1
 /// first), then the range. The layout (dim, data_offset) is not checked: it only carries the lockstep
@@ -66,13 +70,15 @@ struct CommandCheck {
 /// A command whose layout names a level above rotor speeds (msg::command_level_name: "level=ctbr")
 /// holds that level's 4 values instead: the level must be known (else kUnknownLevel), the values 4
 /// (kWrongLength) and finite (kNonFinite); rotor thrusts below 0 become 0 (kOutOfRange). The plant's
-/// inner loops turn it into rotor speeds every tick (control/inner_loops.hpp).
-CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s);
+/// inner loops turn it into rotor speeds every tick (control/inner_loops.hpp). rotor_thrusts is a
+/// four-rotor level: refused (kLevelNotForVehicle) for another rotor count.
+CommandCheck check_command(const msg::Float64MultiArray& m, double omega_max_rad_s, int rotor_count = 4);
 /// The same checks for `count` values at `level` (a typed command, msg::level_values: the one rule for
-/// both ways of sending a level). `attitude_norm`: a ThrustAttitude's quaternion norm as sent, refused
-/// (kBadQuaternion) when not within kQuaternionNormTolerance of 1, after the values' own checks.
+/// both ways of sending a level); rotor speeds `rotor_count` of them. `attitude_norm`: a ThrustAttitude's
+/// quaternion norm as sent, refused (kBadQuaternion) when not within kQuaternionNormTolerance of 1,
+/// after the values' own checks.
 CommandCheck check_command(control::CommandLevel level, const double* values, std::size_t count, double omega_max_rad_s,
-                           double attitude_norm = 1.0);
+                           int rotor_count, double attitude_norm = 1.0);
 
 // ---------------------------------------------------------------------------------------------
 // Sensor messages into the controller

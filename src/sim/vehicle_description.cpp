@@ -43,7 +43,13 @@ VehicleShape vehicle_shape(const model::VehicleParams& p) {
   s.rotor_radius = p.aero.ground_effect_rotor_radius_m > 0 ? p.aero.ground_effect_rotor_radius_m : 0.4 * L;
   s.rotor_height = 0.02 * L;
   s.rotor_lift = s.arm_width / 2.0 + s.rotor_height / 2.0;
-  for (int i = 0; i < 4; ++i) s.rotor_B[static_cast<std::size_t>(i)] = model::rotor_position_B(p, i);
+  s.rotor_count = p.rotor_count;
+  for (int i = 0; i < p.rotor_count; ++i) {
+    const Eigen::Vector3d r = model::rotor_position_B(p, i);
+    s.rotor_B[static_cast<std::size_t>(i)] = r;
+    // A custom layout's arm reaches its rotor; the standard ones are all arm_length_m long.
+    s.arm_B[static_cast<std::size_t>(i)] = p.layout == model::RotorLayout::kCustom ? r.head<2>().norm() : s.arm_length;
+  }
   return s;
 }
 
@@ -68,15 +74,15 @@ std::string vehicle_urdf(const model::VehicleParams& p, const std::string& prefi
       "    <visual name=\"body\">\n      <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n"
       "      <geometry><box size=\"{} {} {}\"/></geometry>\n      <material name=\"body\"/>\n    </visual>\n",
       s.body_side, s.body_side, s.body_height);
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < s.rotor_count; ++i) {
     const Eigen::Vector3d& r = s.rotor_B[static_cast<std::size_t>(i)];
     u += fmt::format(
         "    <visual name=\"arm_{}\">\n      <origin xyz=\"{} {} 0\" rpy=\"0 0 {}\"/>\n"
         "      <geometry><box size=\"{} {} {}\"/></geometry>\n      <material name=\"arm\"/>\n    </visual>\n",
-        i + 1, r.x() / 2.0, r.y() / 2.0, arm_yaw(r), s.arm_length, s.arm_width, s.arm_width);
+        i + 1, r.x() / 2.0, r.y() / 2.0, arm_yaw(r), s.arm_B[static_cast<std::size_t>(i)], s.arm_width, s.arm_width);
   }
   u += "  </link>\n";
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < s.rotor_count; ++i) {
     const Eigen::Vector3d& r = s.rotor_B[static_cast<std::size_t>(i)];
     u += fmt::format(
         "  <link name=\"{}rotor_{}\">\n    <visual name=\"disc\">\n      <origin xyz=\"0 0 {}\" rpy=\"0 0 0\"/>\n"
@@ -95,7 +101,7 @@ std::string vehicle_urdf(const model::VehicleParams& p, const std::string& prefi
 
 msg::TFMessage rotor_transforms(const model::VehicleParams& p, const std::string& prefix, const msg::Time& stamp) {
   msg::TFMessage m;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < p.rotor_count; ++i) {
     const Eigen::Vector3d r = model::rotor_position_B(p, i);
     msg::TransformStamped t;
     t.header = msg::Header{stamp, prefix + "base_link"};
@@ -119,12 +125,12 @@ msg::SceneUpdate vehicle_scene(const model::VehicleParams& p, const std::string&
   body.size = {s.body_side, s.body_side, s.body_height};
   body.color = kBodyColor;
   e.cubes.push_back(body);
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < s.rotor_count; ++i) {
     const Eigen::Vector3d& r = s.rotor_B[static_cast<std::size_t>(i)];
     msg::CubePrimitive arm;
     arm.pose.position = {r.x() / 2.0, r.y() / 2.0, 0.0};
     arm.pose.orientation = yaw_quaternion(arm_yaw(r));
-    arm.size = {s.arm_length, s.arm_width, s.arm_width};
+    arm.size = {s.arm_B[static_cast<std::size_t>(i)], s.arm_width, s.arm_width};
     arm.color = kArmColor;
     e.cubes.push_back(arm);
     msg::CylinderPrimitive rotor;

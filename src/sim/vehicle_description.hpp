@@ -30,12 +30,14 @@ struct VehicleShape {
   double rotor_radius = 0;  ///< aero.ground_effect_rotor_radius_m when set, else 0.4 of the arm length
   double rotor_height = 0;  ///< rotor disc thickness: 0.02 of the arm length
   double rotor_lift = 0;    ///< rotor disc centre above its rotor link (the arm's top): arm_width/2 + rotor_height/2
-  std::array<Eigen::Vector3d, 4> rotor_B;  ///< rotor i+1 position, model::rotor_position_B (z = 0)
+  int rotor_count = 4;      ///< the first rotor_count entries below are used
+  std::array<Eigen::Vector3d, model::kMaxRotors> rotor_B;  ///< rotor i+1 position, model::rotor_position_B
+  std::array<double, model::kMaxRotors> arm_B{};           ///< arm i+1's drawn length (centre to the rotor axis)
 };
 VehicleShape vehicle_shape(const model::VehicleParams& p);
 
-/// A URDF of the vehicle: link `<prefix>base_link` (the body and the four arms as visuals, the mass
-/// and inertia of the vehicle) and four links `<prefix>rotor_<i>` (i = 1..4, the paper's numbering),
+/// A URDF of the vehicle: link `<prefix>base_link` (the body and one arm per rotor as visuals, the mass
+/// and inertia of the vehicle) and one link `<prefix>rotor_<i>` per rotor (i = 1..N, the layout's numbering),
 /// each a rotor disc, attached to base_link by fixed joints at the rotor positions. Link names carry
 /// the frame prefix, so RViz's RobotModel finds them in /tf without a TF prefix setting.
 std::string vehicle_urdf(const model::VehicleParams& p, const std::string& prefix, const std::string& robot_name);
@@ -44,7 +46,7 @@ std::string vehicle_urdf(const model::VehicleParams& p, const std::string& prefi
 msg::TFMessage rotor_transforms(const model::VehicleParams& p, const std::string& prefix, const msg::Time& stamp);
 
 /// One SceneEntity (id "<prefix>vehicle", frame_id `<prefix>base_link`, frame_locked, lifetime zero:
-/// kept until replaced) drawing vehicle_urdf's shapes: the body and four arms as cubes, the four
+/// kept until replaced) drawing vehicle_urdf's shapes: the body and the arms as cubes, the
 /// rotor discs as cylinders, and an arrow along +x_B marking the nose.
 msg::SceneUpdate vehicle_scene(const model::VehicleParams& p, const std::string& prefix, const msg::Time& stamp);
 

@@ -24,7 +24,14 @@ double MotorMap::pwm_from_omega(double omega_rad_s) const {
 }
 
 MotorMap motor_map_for(const model::VehicleParams& vehicle, double pwm_min_us, double pwm_max_us) {
-  if (vehicle.spin != std::array<int, 4>{+1, -1, +1, -1}) {
+  if (vehicle.rotor_count != 4 ||
+      (vehicle.layout != model::RotorLayout::kPlus && vehicle.layout != model::RotorLayout::kX)) {
+    throw std::invalid_argument(fmt::format(
+        "vehicle layout {} with {} rotors: the SITL bridges fly quadrotor frames only (ArduPilot FRAME_CLASS 1, "
+        "PX4's quad airframes; layout plus or x)",
+        model::to_string(vehicle.layout), vehicle.rotor_count));
+  }
+  if (vehicle.spin[0] != 1 || vehicle.spin[1] != -1 || vehicle.spin[2] != 1 || vehicle.spin[3] != -1) {
     throw std::invalid_argument(fmt::format(
         "vehicle spin signs [{}, {}, {}, {}]: an ArduPilot quad (FRAME_TYPE 0 plus, 1 x) needs [1, -1, 1, -1] "
         "(rotors 1 and 3 clockwise seen from above)",

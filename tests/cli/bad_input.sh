@@ -30,6 +30,8 @@ printf 'mass_kg: .nan\n' > vehicle_nan.yaml
 printf 'vehicle: {mass_kg: "1.2"}\n' > quoted_mass.yaml
 printf "simulation: {duration_s: '10'}\n" > quoted_duration.yaml
 printf '? [a, b]\n: 1\n' > list_key.yaml
+printf 'vehicle: {preset: firefly}\ncontroller: {sitl: {firmware: ardupilot, binary: /bin/true}}\n' > sitl_hex.yaml
+printf 'layout: hex_x\nspin: [1, 1, 1, 1, 1, 1]\n' > hex_singular.yaml
 printf 't,w1,w2,w3,w4\n0,1,2,3\n' > short.csv
 printf 't,w1,w2,w3,w4\n0,1,nan,3,4\n' > nan.csv
 printf 'time,a,b,c,d\n0,1,2,3,4\n' > header.csv
@@ -163,6 +165,10 @@ expect 2 "run_dirs is required" summary
 # lqr, openloop, params
 expect 2 "param_range.yaml: controller.roll_des: unknown parameter 'controller.roll_des' of the node or of controller type 'paper'" lqr --params param_range.yaml
 expect 2 "vehicle_bad.yaml: layout: got 'h'" lqr --vehicle vehicle_bad.yaml
+# Vehicles with other rotor counts: a singular rotor set, and the paths that fly quadrotors only.
+expect 2 "hex_singular.yaml: spin: ;;layout hex_x leaves the mixer singular" lqr --vehicle hex_singular.yaml
+expect 2 "carry four rotors;;has 6 (layout hex_x)" fmu export plant --scenario "$SRC/scenarios/tracking/circle_se3_firefly.yaml" --out ff.fmu
+expect 2 "layout hex_x with 6 rotors;;quadrotor frames only" run sitl_hex.yaml --out sitl_hex --no-plots
 expect 2 "--commands: File does not exist: missing.csv" openloop --commands missing.csv --out t.csv
 expect 2 "short.csv:2: expected 5 values (t,w1,w2,w3,w4), got 4" openloop --commands short.csv --out t.csv
 expect 2 "nan.csv:2: values must be finite" openloop --commands nan.csv --out t.csv

@@ -186,7 +186,7 @@ case $CASE in
     # 27 g and Förster's product of inertia), the preset named in the scenario flying the circle, and
     # an unknown name refused as a usage error naming the known ones.
     expect_rc 0 "$QC" params --vehicle --list
-    for p in paper crazyflie2 hummingbird f450; do
+    for p in paper crazyflie2 hummingbird f450 firefly; do
       grep -qE "^$p[[:space:]]" "$TMP/out" || { cat "$TMP/out" >&2; fail "preset $p not listed"; }
     done
     grep -q "System Identification of the Crazyflie 2.0" "$TMP/out" || fail "the crazyflie2 source is not listed"
@@ -198,6 +198,13 @@ case $CASE in
     grep -q "crazyflie2" "$TMP/err" || { cat "$TMP/err" >&2; fail "the refusal does not name the presets"; }
     expect_rc 0 "$QC" run "$SRC/scenarios/tracking/circle_se3_crazyflie2.yaml" --out "$TMP/cf" --no-plots
     grep -q "tracking from t = 12 s .*: PASS" "$TMP/cf/metrics.txt" || { cat "$TMP/cf/metrics.txt" >&2; fail "crazyflie2 circle"; }
+    # The hexarotor preset on the same circle (six rotor columns), and a custom octorotor's step.
+    expect_rc 0 "$QC" run "$SRC/scenarios/tracking/circle_se3_firefly.yaml" --out "$TMP/ff" --no-plots
+    grep -q "tracking from t = 12 s .*: PASS" "$TMP/ff/metrics.txt" || { cat "$TMP/ff/metrics.txt" >&2; fail "firefly circle"; }
+    head -1 "$TMP/ff/trajectory.csv" | grep -q ",w6,cmd1," || fail "firefly trajectory.csv has no w6 column"
+    expect_rc 0 "$QC" run "$SRC/scenarios/examples/octo_custom_step.yaml" --out "$TMP/octo" --no-plots
+    grep -q "hold from t = 10 s: PASS" "$TMP/octo/metrics.txt" || { cat "$TMP/octo/metrics.txt" >&2; fail "octorotor step"; }
+    head -1 "$TMP/octo/trajectory.csv" | grep -q ",sat8,tilt_sat," || fail "octorotor trajectory.csv has no sat8 column"
     ;;
 
   *)

@@ -6,7 +6,7 @@ R="$SRC/scenarios/realism"
 
 case "$CASE" in
   scenarios)  # each realism scenario meets its criteria; same seed, same bytes; another seed differs
-    for s in hover_wind_gusts roll_step_noisy_imu motor_failure rotor_drag_hummingbird; do
+    for s in hover_wind_gusts roll_step_noisy_imu motor_failure rotor_drag_hummingbird hexarotor_rotor_loss; do
       "$QC" run "$R/$s.yaml" --out "$TMP/$s" --no-plots > "$TMP/$s.log" 2>&1 || { cat "$TMP/$s.log"; fail "$s missed its criteria"; }
     done
     # Per-rotor drag: the fast circle lags with it (ten times the error) and tracks within 2 cm without.

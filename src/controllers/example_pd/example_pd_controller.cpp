@@ -17,7 +17,7 @@ const std::array<std::string, 1> kOutputs = {"thrust_N"};
 }  // namespace
 
 ExamplePdController::ExamplePdController(const model::VehicleParams& vehicle)
-    : ControllerWith(ExamplePdParams{}), vehicle_(vehicle), mixer_inverse_(model::mixer_matrix(vehicle).inverse()) {}
+    : ControllerWith(ExamplePdParams{}), vehicle_(vehicle), allocation_(vehicle) {}
 
 const Table& ExamplePdController::table() const {
   static const Table table({
@@ -66,8 +66,8 @@ void ExamplePdController::step(const control::Observation& o, const control::Ref
   out.U.tail<3>() = J.cwiseProduct(k.attitude_kp * e - k.attitude_kd * o.w_B);
 
   const control::Allocation alloc =
-      control::allocate(mixer_inverse_, out.U, vehicle_.motor.omega_min_rad_s, vehicle_.motor.omega_max_rad_s);
-  out.omega_rad_s = alloc.omega_rad_s;
+      allocation_.allocate(out.U, vehicle_.motor.omega_min_rad_s, vehicle_.motor.omega_max_rad_s);
+  model::assign_rotors(out.omega_rad_s, alloc.omega_rad_s);
   out.rotor_saturated = alloc.saturated;
   out.roll_des_rad = roll_des;
   out.pitch_des_rad = pitch_des;

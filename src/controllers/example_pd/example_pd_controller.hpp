@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "control/allocation.hpp"
 #include "control/controller.hpp"
 #include "model/vehicle_params.hpp"
 
@@ -36,7 +37,7 @@ class ExamplePdController : public control::ControllerWith<ExamplePdController, 
 
  private:
   model::VehicleParams vehicle_;
-  Eigen::Matrix4d mixer_inverse_;
+  control::RotorAllocation allocation_;  ///< the layout's: M^-1 (four rotors) or M^+
 };
 
 }  // namespace quadcosim::controllers

@@ -86,7 +86,7 @@ void PaperController::configure(const PaperParams& next) {
   std::array<control::AxisLqr, 3> axes = {control::design_axis_lqr(v.Ixx_kg_m2, next.roll),
                                           control::design_axis_lqr(v.Iyy_kg_m2, next.pitch),
                                           control::design_axis_lqr(v.Izz_kg_m2, next.yaw)};
-  mixer_inverse_ = model::mixer_matrix(v).inverse();
+  allocation_ = control::RotorAllocation(v);
   axes_ = axes;
 }
 
@@ -127,9 +127,8 @@ void PaperController::step(const control::Observation& obs, const control::Refer
       control::attitude_error(model::quaternion_from_euler({c.roll_des_rad, c.pitch_des_rad, c.yaw_des_rad}), obs.q_WB);
 
   // Lines 15-20.
-  const control::Allocation a =
-      control::allocate(mixer_inverse_, c.U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
-  c.omega_rad_s = a.omega_rad_s;
+  const control::Allocation a = allocation_.allocate(c.U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
+  model::assign_rotors(c.omega_rad_s, a.omega_rad_s);
   c.rotor_saturated = a.saturated;
 }
 

@@ -54,7 +54,7 @@ class PaperController : public control::ControllerWith<PaperController, PaperPar
  private:
   model::VehicleParams vehicle_;
   std::array<control::AxisLqr, 3> axes_;
-  Eigen::Matrix4d mixer_inverse_;
+  control::RotorAllocation allocation_;  ///< the layout's: M^-1 (four rotors) or M^+
   control::PositionPidState position_state_;
 };
 

@@ -65,14 +65,17 @@ Eigen::Vector3d vee(const Eigen::Matrix3d& m) { return {m(2, 1), m(0, 2), m(1, 0
 /// [omega_min^2, omega_max^2] or, for a rotor that (f, M_x, M_y) alone already puts outside, no further
 /// out: the yaw torque gives way first, since the drag torque gives little of it and asking for more
 /// than the rotors can give would distort the thrust and the roll/pitch torques through the clamp.
-double limit_yaw_torque(const Eigen::Matrix4d& mixer_inverse, const Eigen::Vector4d& U, double omega_min_rad_s,
+/// `Alloc` and `Vec`: Eigen::Matrix4d and Eigen::Vector4d for four rotors (the products as before other
+/// rotor counts), the N x 4 allocation and a rotor vector otherwise.
+template <class Alloc, class Vec>
+double limit_yaw_torque(const Alloc& allocation, const Eigen::Vector4d& U, double omega_min_rad_s,
                         double omega_max_rad_s) {
   Eigen::Vector4d without_yaw = U;
   without_yaw[3] = 0.0;
-  const Eigen::Vector4d base = mixer_inverse * without_yaw;
-  const Eigen::Vector4d per_Nm = mixer_inverse.col(3);
+  const Vec base = allocation * without_yaw;
+  const Vec per_Nm = allocation.col(3);
   double lo_Mz = -std::numeric_limits<double>::infinity(), hi_Mz = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 4; ++i) {
+  for (Eigen::Index i = 0; i < base.size(); ++i) {
     if (per_Nm[i] == 0.0) continue;
     const double lo = std::min(omega_min_rad_s * omega_min_rad_s, base[i]);
     const double hi = std::max(omega_max_rad_s * omega_max_rad_s, base[i]);
@@ -131,9 +134,15 @@ GeometricController::GeometricController(const model::VehicleParams& vehicle)
 GeometricController::GeometricController(const model::VehicleParams& vehicle, const GeometricParams& params)
     : ControllerWith(params), vehicle_(vehicle) {
   J_ = vehicle.inertia_tensor();
-  Eigen::FullPivLU<Eigen::Matrix4d> lu(model::mixer_matrix(vehicle_));
-  if (!lu.isInvertible()) throw std::invalid_argument("the vehicle's mixer matrix is singular");
-  mixer_inverse_ = lu.inverse();
+  if (vehicle_.rotor_count == 4) {
+    Eigen::FullPivLU<Eigen::Matrix4d> lu(model::mixer_matrix4(vehicle_));
+    if (!lu.isInvertible()) throw std::invalid_argument("the vehicle's mixer matrix is singular");
+    mixer_inverse_ = lu.inverse();
+    allocation_ = control::RotorAllocation(mixer_inverse_);
+  } else {
+    if (std::string err = model::validate_rotors(vehicle_); !err.empty()) throw std::invalid_argument(err);
+    allocation_ = control::RotorAllocation(vehicle_);  // the pseudo-inverse M^+
+  }
 }
 
 const control::ParameterTable<GeometricParams>& GeometricController::table() const {
@@ -221,11 +230,15 @@ void GeometricController::step(const control::Observation& obs, const control::R
                             J_ * (Omega.cross(Omega_d_in_B));
 
   Eigen::Vector4d U(f, M.x(), M.y(), M.z());
-  U[3] = limit_yaw_torque(mixer_inverse_, U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
+  U[3] = allocation_.rotor_count() == 4
+             ? limit_yaw_torque<Eigen::Matrix4d, Eigen::Vector4d>(mixer_inverse_, U, v.motor.omega_min_rad_s,
+                                                                  v.motor.omega_max_rad_s)
+             : limit_yaw_torque<model::AllocationMatrix, model::RotorVector>(
+                   allocation_.matrix(), U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
   t.yaw_torque_cut_Nm = M.z() - U[3];
-  const control::Allocation a = control::allocate(mixer_inverse_, U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
+  const control::Allocation a = allocation_.allocate(U, v.motor.omega_min_rad_s, v.motor.omega_max_rad_s);
   c.U = U;
-  c.omega_rad_s = a.omega_rad_s;
+  model::assign_rotors(c.omega_rad_s, a.omega_rad_s);
   c.rotor_saturated = a.saturated;
   c.attitude_error = control::attitude_error(Eigen::Quaterniond(t.R_d), obs.q_WB.normalized());
 

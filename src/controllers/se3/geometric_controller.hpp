@@ -13,7 +13,8 @@
 // Both: e_R = 1/2 vee(R_d^T R - R^T R_d), e_Omega = Omega - R^T R_d Omega_d,
 // M = -k_R o e_R - k_Omega o e_Omega + Omega x J Omega - J (hat(Omega) R^T R_d Omega_d) [N m], then the
 // yaw torque is cut to what the rotors can give besides (f, M_x, M_y) and U = (f, M) is allocated
-// (control::allocate: mixer inverse, clamped speeds).
+// (control::RotorAllocation: the mixer inverse, or its pseudo-inverse for more than four rotors;
+// clamped speeds).
 //
 // Default gains, for the paper's Table 1 vehicle (model::VehicleParams{}) flown at a 50 Hz control
 // rate with first-order motors (tau 0.02 s up, 0.04 s down): the loop sees about 0.01 s of hold delay
@@ -34,6 +35,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "control/allocation.hpp"
 #include "control/controller.hpp"
 #include "model/vehicle_params.hpp"
 
@@ -99,7 +101,8 @@ class GeometricController : public control::ControllerWith<GeometricController, 
  private:
   model::VehicleParams vehicle_;
   Eigen::Matrix3d J_;
-  Eigen::Matrix4d mixer_inverse_;
+  Eigen::Matrix4d mixer_inverse_ = Eigen::Matrix4d::Zero();  ///< four rotors: M^-1 by full-pivot LU
+  control::RotorAllocation allocation_;  ///< the layout's allocation (mixer_inverse_'s, or M^+ for more rotors)
   GeometricTerms terms_;
 };
 

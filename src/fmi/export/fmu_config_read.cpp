@@ -90,6 +90,7 @@ sim::SensorTiming read_timing(const Reader& r) {
 model::VehicleParams read_vehicle(const Reader& r) {
   model::VehicleParams v;
   for (const auto& p : model::vehicle_parameters()) {
+    if (p.kind == model::VehicleParameter::Kind::kRotors) continue;  // an exported FMU flies four rotors
     const Reader e = r.at(std::string(p.name));
     switch (p.kind) {
       case model::VehicleParameter::Kind::kNumber: p.ref(v) = e.number(); break;
@@ -109,6 +110,7 @@ model::VehicleParams read_vehicle(const Reader& r) {
         }
         break;
       }
+      case model::VehicleParameter::Kind::kRotors: break;  // an exported FMU flies four rotors
     }
   }
   return v;

@@ -30,7 +30,7 @@ FmuConfig unusual() {
   c.vehicle.aero.linear_drag_N_s_m = {0.1, 0.2, 0.3};
   c.initial.p_W = {1.0, 2.0, 3.0};
   c.initial.q_WB = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
-  c.initial.omega_rad_s = {1.0, 2.0, 3.0, 4.0};
+  c.initial.omega_rad_s = model::Vector4(1.0, 2.0, 3.0, 4.0);
   c.realism.seed = 99;
   c.realism.imu.timing = {2, 1};
   c.realism.pose.position_sigma_m = 0.01;

@@ -76,7 +76,10 @@ json vehicle_json(const model::VehicleParams& v) {
     switch (p.kind) {
       case model::VehicleParameter::Kind::kNumber: j[name] = p.get(v); break;
       case model::VehicleParameter::Kind::kChoice: j[name] = std::string(p.choice_of(v)); break;
-      case model::VehicleParameter::Kind::kSigns: j[name] = v.spin; break;
+      case model::VehicleParameter::Kind::kSigns:  // an exported FMU flies four rotors (fmu_export refuses others)
+        j[name] = std::array<int, 4>{v.spin[0], v.spin[1], v.spin[2], v.spin[3]};
+        break;
+      case model::VehicleParameter::Kind::kRotors: break;
     }
   }
   return j;

@@ -106,8 +106,11 @@ void serve(int fd, const python::PyController& prototype, const std::vector<cont
           const auto ref = r.get<control::Reference>();
           const auto dt = r.get<double>();
           c->step(o, ref, dt, out);
-          w.put(out.omega_rad_s).put(out.U).put(out.roll_des_rad).put(out.pitch_des_rad).put(out.yaw_des_rad);
-          w.put(out.attitude_error).put(out.rotor_saturated).put(out.tilt_saturated);
+          // The rotor speeds as their count and values (one per rotor), the flags as a bool[8] and the count.
+          w.span<double>({out.omega_rad_s.data(), static_cast<std::size_t>(out.omega_rad_s.size())});
+          w.put(out.U).put(out.roll_des_rad).put(out.pitch_des_rad).put(out.yaw_des_rad);
+          w.put(out.attitude_error).put(out.rotor_saturated.value).put(out.rotor_saturated.count);
+          w.put(out.tilt_saturated);
           w.span<double>(out.outputs);
           break;
         }
@@ -203,13 +206,19 @@ class IsolatedPythonController final : public control::Controller {
       throw sim::ControllerFailure(e.what());  // exit 5, as for any controller whose step failed
     }
     Reader& r = *answer;
-    out.omega_rad_s = r.get<Eigen::Vector4d>();
+    const std::vector<double> omega = r.vec<double>();
+    if (omega.empty() || omega.size() > static_cast<std::size_t>(model::kMaxRotors)) {
+      throw std::runtime_error(
+          fmt::format("{}.step: {} rotor speeds from its process, expected 4 to 8", prototype_->name(), omega.size()));
+    }
+    out.omega_rad_s = Eigen::Map<const model::RotorVector>(omega.data(), static_cast<Eigen::Index>(omega.size()));
     out.U = r.get<Eigen::Vector4d>();
     out.roll_des_rad = r.get<double>();
     out.pitch_des_rad = r.get<double>();
     out.yaw_des_rad = r.get<double>();
     out.attitude_error = r.get<double>();
-    out.rotor_saturated = r.get<std::array<bool, 4>>();
+    out.rotor_saturated.value = r.get<std::array<bool, model::kMaxRotors>>();
+    out.rotor_saturated.count = r.get<int>();
     out.tilt_saturated = r.get<bool>();
     const std::vector<double> figures = r.vec<double>();
     if (figures.size() != out.outputs.size()) {

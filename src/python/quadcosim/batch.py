@@ -264,7 +264,8 @@ class Batch:
         """Advances every vehicle one control period (dt seconds, ticks_per_step plant ticks).
 
         command: None (each vehicle's controller flies) or an (n, 4) array of commands at the batch's
-        action level (rotor speeds [rad/s] by default; see `action`) for this period, the controllers
+        action level (rotor speeds [rad/s] by default, then (n, N): one per rotor of the vehicle, N = 6
+        for a hexarotor; see `action`) for this period, the controllers
         bypassed (as Simulation.step(omega_cmd=)). A wrong shape or a value that is not finite raises
         ValueError naming the row and the field, and steps nothing; so does None in a plant_only batch.
         omega_cmd: the same, by its older name (rotor-speed batches only).
@@ -340,12 +341,12 @@ class Batch:
 
     @property
     def omega(self) -> np.ndarray:
-        """(n, 4) rotor speeds [rad/s]."""
+        """(n, N) rotor speeds [rad/s], one column per rotor (N = 4 for a quadrotor)."""
         return self._b.get("omega")
 
     @property
     def command(self) -> np.ndarray:
-        """(n, 4) the rotor commands [rad/s] the plants latched in their last tick."""
+        """(n, N) the rotor commands [rad/s] the plants latched in their last tick, one column per rotor."""
         return self._b.get("command")
 
     @property
@@ -392,7 +393,8 @@ class Batch:
     @property
     def vehicle_params(self) -> Dict[str, np.ndarray]:
         """Each vehicle's numeric parameters by their YAML path (mass_kg, kt_N_per_rad2_s2,
-        motor.omega_max_rad_s, aero.linear_drag_N_s_m.x, ...) and hover_omega_rad_s = sqrt(m g / (4 k_t)),
+        motor.omega_max_rad_s, aero.linear_drag_N_s_m.x, ...), rotor_count N and hover_omega_rad_s =
+        sqrt(m g / (N k_t)),
         (n,) arrays."""
         return self._b.vehicle_params()
 

@@ -13,13 +13,14 @@ envs to Stable-Baselines3. See docs/python.md,
 "Gymnasium-style environments".
 
 Spaces (float32):
-  action (4,): normalised commands in [-1, 1] (values outside are clipped) at the env's action level
+  action (4,) (at rotor_speeds (N,), one per rotor of the vehicle: 6 for a hexarotor): normalised
+  commands in [-1, 1] (values outside are clipped) at the env's action level
       (action=, default "rotor_speeds"), each mapped linearly from [-1, 1] onto its range [lo, hi]:
       c_i = lo_i + (a_i + 1) / 2 * (hi_i - lo_i); the controller is bypassed. The ranges (ACTION_RANGES,
       the vehicle's k_t, k_m, arm length L, omega_min, omega_max):
         rotor_speeds   omega_i in [omega_min, omega_max] [rad/s]
         rotor_thrusts  T_i in [k_t omega_min^2, k_t omega_max^2] [N]
-        ctbr           thrust in [0, 4 k_t omega_max^2] [N]; p, q, r in [-3, 3] rad/s (body FLU)
+        ctbr           thrust in [0, N k_t omega_max^2] [N]; p, q, r in [-3, 3] rad/s (body FLU)
         ctatt          thrust as ctbr; roll, pitch in [-0.5, 0.5] rad; yaw in [-pi, pi] rad
         cttm           thrust as ctbr; torque x, y in [-L k_t omega_max^2, +] [N m]; z in
                        [-2 k_m omega_max^2, +] [N m]
@@ -58,7 +59,7 @@ __all__ = ["Box", "HoverEnv", "TrackingEnv", "VectorHoverEnv", "VectorTrackingEn
 
 
 OBS_SIZE = 18
-ACTION_SIZE = 4
+ACTION_SIZE = 4  # a quadrotor's; an env's own is action_space.shape (the rotor count N at rotor_speeds)
 
 # A trimmed hover 1 m above the ground with the paper's vehicle, no noise (the default of HoverEnv).
 HOVER_SCENARIO: Dict[str, Any] = {
@@ -141,7 +142,7 @@ class _Episodes:
         bound = np.concatenate([np.full(3, self.max_position_error_m), np.full(3, float(max_speed_m_s)),
                                 np.ones(9), np.full(3, float(max_rate_rad_s))])
         self.observation_space = Box(-bound, bound, dtype=np.float32)
-        self.action_space = Box(-1.0, 1.0, (ACTION_SIZE,), dtype=np.float32)
+        self.action_space = Box(-1.0, 1.0, (self.action_size,), dtype=np.float32)
 
     @staticmethod
     def _check_randomize(randomize: Optional[Dict[str, Any]]) -> Optional[Dict[str, Tuple[np.ndarray, np.ndarray]]]:
@@ -163,6 +164,7 @@ class _Episodes:
     def _refresh_vehicles(self) -> None:
         self.lo, self.hi, hover = _action_ranges(self.action, self.batch.vehicle_params)
         self.hover_action = 2 * (hover - self.lo) / (self.hi - self.lo) - 1
+        self.action_size = self.lo.shape[1]  # 4, or the rotor count at rotor_speeds
 
     def draw(self, rng: np.random.Generator) -> Tuple[int, Optional[Dict[str, Any]]]:
         """An episode's noise seed and vehicle keys (uniform within the randomisation ranges)."""
@@ -199,8 +201,8 @@ class _Episodes:
     def command(self, action: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
         """The clipped actions and the commands they map to at the env's level."""
         a = np.asarray(action, dtype=np.float64)
-        if a.shape != (self.n, ACTION_SIZE):
-            raise ValueError(f"action: expected shape {(ACTION_SIZE,) if self.n == 1 else (self.n, ACTION_SIZE)}, "
+        if a.shape != (self.n, self.action_size):
+            raise ValueError(f"action: expected shape {(self.action_size,) if self.n == 1 else (self.n, self.action_size)}, "
                              f"got {np.shape(action)}")
         if not np.all(np.isfinite(a)):
             bad = np.argwhere(~np.isfinite(a))[0]
@@ -313,8 +315,8 @@ class _Env(_BatchEnv):
         if e.ended[0]:
             raise RuntimeError("step: the episode has ended (or never began): call reset() first")
         a = np.asarray(action, dtype=np.float64)
-        if a.shape != (ACTION_SIZE,):
-            raise ValueError(f"step: action: expected shape ({ACTION_SIZE},), got {a.shape}")
+        if a.shape != (e.action_size,):
+            raise ValueError(f"step: action: expected shape ({e.action_size},), got {a.shape}")
         a, command = e.command(a[None])
         e.batch.step(command)
         e.steps += 1
@@ -411,7 +413,7 @@ class _VectorEnv(_BatchEnv):
         o, a = self.single_observation_space, self.single_action_space
         self.observation_space = Box(np.broadcast_to(o.low, (self.num_envs,) + o.shape),
                                      np.broadcast_to(o.high, (self.num_envs,) + o.shape), dtype=o.dtype)
-        self.action_space = Box(-1.0, 1.0, (self.num_envs, ACTION_SIZE), dtype=a.dtype)
+        self.action_space = Box(-1.0, 1.0, (self.num_envs, self._e.action_size), dtype=a.dtype)
         self._rngs = [np.random.default_rng() for _ in range(self.num_envs)]
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
 
