@@ -137,139 +137,140 @@ class PlantCore {
   /// effect at tick k + delay_ticks. Returns the check, for the caller's statistics.
   /// A command at another level (its layout names it: msg::command_level_name) is checked as that
   /// level's values and queued at its level.
-  const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s, model_->rotor_count());
-  take_checked(k, delay_ticks, check);
-  return check;
-}
+  [[gnu::always_inline]] CommandCheck take_command(Tick k, Tick delay_ticks, const msg::Float64MultiArray& m) {
+    const CommandCheck check = check_command(m, model_->params().motor.omega_max_rad_s, model_->rotor_count());
+    take_checked(k, delay_ticks, check);
+    return check;
+  }
   /// A command already checked (check_command, e.g. of a typed command's values): queued unless rejected.
   void take_checked(Tick k, Tick delay_ticks, const CommandCheck& check) {
-  if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
-}
-/// The upper end of the rotor speeds a command is checked against [rad/s].
-double omega_max_rad_s() const { return model_->params().motor.omega_max_rad_s; }
-/// How many rotor speeds a rotor-speed command holds: the vehicle's rotor count.
-int rotor_count() const { return model_->rotor_count(); }
-/// A valid command (speeds within [0, omega_max]; or 4 finite values of another level) received
-/// during tick k takes effect at tick k + delay_ticks.
-void queue(Tick k, Tick delay_ticks, const model::RotorVector& values,
-           control::CommandLevel level = control::CommandLevel::kRotorSpeeds) {
-  last_valid_tick_ = k;
-  Pending& p = pending_.emplace_back();  // filled in place: no copy of the rotor vector
-  p.effective_tick = k + delay_ticks;
-  model::assign_rotors(p.omega, values);
-  p.level = level;
-}
-/// The inner loops' gains (InnerLoopParams::for_vehicle when never set): checked for the vehicle and
-/// the plant period, std::invalid_argument naming the gain that does not fit.
-void set_inner_loops(const control::InnerLoopParams& params) {
-  inner_ = std::make_unique<Inner>(Inner{control::InnerLoops(model_->params(), params, period_s_), {}});
-}
-/// The inner loops flying a level command (made at the first such command when never set); null
-/// before.
-const control::InnerLoops* inner_loops() const { return inner_ ? &inner_->loops : nullptr; }
-/// The level command held (level kRotorSpeeds: the rotor speeds are latched as they came).
-const control::LevelCommand& held() const { return held_; }
-/// What the inner loops decided for the current tick (meaningful while held() is above rotor speeds).
-const control::InnerLoopOutput* inner_output() const { return inner_ ? &inner_->last : nullptr; }
-/// Latches the newest command due by tick k (the others due are dropped); false when none is due.
-bool latch_due(Tick k) {
-  const std::size_t first = pending_head_;
-  while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
-  const bool latched = pending_head_ > first;
-  if (latched) {  // the newest one due
-    const Pending& p = pending_[pending_head_ - 1];
-    if (p.level == control::CommandLevel::kRotorSpeeds) {
-      held_.level = p.level;
-      set_latched(p.omega);
-    } else {
-      held_ = {p.level, p.omega.head<4>()};
+    if (check.verdict() != CommandVerdict::kRejected) queue(k, delay_ticks, check.omega_rad_s, check.level);
+  }
+  /// The upper end of the rotor speeds a command is checked against [rad/s].
+  double omega_max_rad_s() const { return model_->params().motor.omega_max_rad_s; }
+  /// How many rotor speeds a rotor-speed command holds: the vehicle's rotor count.
+  int rotor_count() const { return model_->rotor_count(); }
+  /// A valid command (speeds within [0, omega_max]; or 4 finite values of another level) received
+  /// during tick k takes effect at tick k + delay_ticks.
+  void queue(Tick k, Tick delay_ticks, const model::RotorVector& values,
+             control::CommandLevel level = control::CommandLevel::kRotorSpeeds) {
+    last_valid_tick_ = k;
+    Pending& p = pending_.emplace_back();  // filled in place: no copy of the rotor vector
+    p.effective_tick = k + delay_ticks;
+    model::assign_rotors(p.omega, values);
+    p.level = level;
+  }
+  /// The inner loops' gains (InnerLoopParams::for_vehicle when never set): checked for the vehicle and
+  /// the plant period, std::invalid_argument naming the gain that does not fit.
+  void set_inner_loops(const control::InnerLoopParams& params) {
+    inner_ = std::make_unique<Inner>(Inner{control::InnerLoops(model_->params(), params, period_s_), {}});
+  }
+  /// The inner loops flying a level command (made at the first such command when never set); null
+  /// before.
+  const control::InnerLoops* inner_loops() const { return inner_ ? &inner_->loops : nullptr; }
+  /// The level command held (level kRotorSpeeds: the rotor speeds are latched as they came).
+  const control::LevelCommand& held() const { return held_; }
+  /// What the inner loops decided for the current tick (meaningful while held() is above rotor speeds).
+  const control::InnerLoopOutput* inner_output() const { return inner_ ? &inner_->last : nullptr; }
+  /// Latches the newest command due by tick k (the others due are dropped); false when none is due.
+  bool latch_due(Tick k) {
+    const std::size_t first = pending_head_;
+    while (pending_head_ < pending_.size() && pending_[pending_head_].effective_tick <= k) ++pending_head_;
+    const bool latched = pending_head_ > first;
+    if (latched) {  // the newest one due
+      const Pending& p = pending_[pending_head_ - 1];
+      if (p.level == control::CommandLevel::kRotorSpeeds) {
+        held_.level = p.level;
+        set_latched(p.omega);
+      } else {
+        held_ = {p.level, p.omega.head<4>()};
+      }
     }
+    if (held_.level != control::CommandLevel::kRotorSpeeds) fly_held();
+    if (pending_head_ == pending_.size()) {
+      pending_.clear();  // keeps the capacity
+      pending_head_ = 0;
+    } else if (pending_head_ > 64 && pending_head_ * 2 > pending_.size()) {
+      pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
+      pending_head_ = 0;
+    }
+    return latched;
   }
-  if (held_.level != control::CommandLevel::kRotorSpeeds) fly_held();
-  if (pending_head_ == pending_.size()) {
-    pending_.clear();  // keeps the capacity
-    pending_head_ = 0;
-  } else if (pending_head_ > 64 && pending_head_ * 2 > pending_.size()) {
-    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
-    pending_head_ = 0;
+  /// Latches a command: the speeds and, formed once here, the model's rotor input.
+  void set_latched(const model::RotorVector& omega_rad_s) {
+    model::assign_rotors(latched_, omega_rad_s);
+    model_->rotor_input(omega_rad_s, rotor_input_);  // clamped and turned into a wrench once per latch
   }
-  return latched;
-}
-/// Latches a command: the speeds and, formed once here, the model's rotor input.
-void set_latched(const model::RotorVector& omega_rad_s) {
-  model::assign_rotors(latched_, omega_rad_s);
-  model_->rotor_input(omega_rad_s, rotor_input_);  // clamped and turned into a wrench once per latch
-}
-/// The command acting over [t_k, t_k+1): the newest due by tick k (latch_due), then the watchdog:
-/// when limit_ns > 0 and the command's age `age_ns` (command_age_ns in simulated time; a host in
-/// real time measures it on its receipt clock) has reached it, the command is stale and kStop
-/// latches every motor at omega_min. Returns whether it is stale.
-bool latch(Tick k, std::int64_t age_ns, std::int64_t limit_ns, WatchdogPolicy policy) {
-  latch_due(k);
-  const bool stale = limit_ns > 0 && age_ns >= limit_ns;
-  if (stale && policy == WatchdogPolicy::kStop) latch_omega_min();
-  return stale;
-}
-/// Latches every motor at the vehicle's omega_min_rad_s (the watchdog's stop policy).
-void latch_omega_min() {
-  held_.level = control::CommandLevel::kRotorSpeeds;
-  set_latched(model::RotorVector::Constant(model_->rotor_count(), model_->params().motor.omega_min_rad_s));
-}
-/// Time [ns] at tick k since the tick of the newest valid command (0 before any: from tick 0).
-std::int64_t command_age_ns(const TickClock& clock, Tick k) const {
-  return clock.ns(k - std::min(last_valid_tick_, k));
-}
-/// Integrates the state from t_k to t_k+1 under the latched command, in `substeps` RK4 steps.
-void integrate(const TickClock& clock, Tick k, int substeps) {
-  model_->step(state_, clock.seconds(k), rotor_input_, clock.period_s(), substeps, environment(k));
-}
+  /// The command acting over [t_k, t_k+1): the newest due by tick k (latch_due), then the watchdog:
+  /// when limit_ns > 0 and the command's age `age_ns` (command_age_ns in simulated time; a host in
+  /// real time measures it on its receipt clock) has reached it, the command is stale and kStop
+  /// latches every motor at omega_min. Returns whether it is stale.
+  bool latch(Tick k, std::int64_t age_ns, std::int64_t limit_ns, WatchdogPolicy policy) {
+    latch_due(k);
+    const bool stale = limit_ns > 0 && age_ns >= limit_ns;
+    if (stale && policy == WatchdogPolicy::kStop) latch_omega_min();
+    return stale;
+  }
+  /// Latches every motor at the vehicle's omega_min_rad_s (the watchdog's stop policy).
+  void latch_omega_min() {
+    held_.level = control::CommandLevel::kRotorSpeeds;
+    set_latched(model::RotorVector::Constant(model_->rotor_count(), model_->params().motor.omega_min_rad_s));
+  }
+  /// Time [ns] at tick k since the tick of the newest valid command (0 before any: from tick 0).
+  std::int64_t command_age_ns(const TickClock& clock, Tick k) const {
+    return clock.ns(k - std::min(last_valid_tick_, k));
+  }
+  /// Integrates the state from t_k to t_k+1 under the latched command, in `substeps` RK4 steps.
+  void integrate(const TickClock& clock, Tick k, int substeps) {
+    model_->step(state_, clock.seconds(k), rotor_input_, clock.period_s(), substeps, environment(k));
+  }
 
-/// Asks the CPU to load the command queue's buffer, the one part of a tick's data outside the
-/// object (a batch steps many plants in turn, each long out of the cache).
-void prefetch() const { __builtin_prefetch(pending_.data()); }
+  /// Asks the CPU to load the command queue's buffer, the one part of a tick's data outside the
+  /// object (a batch steps many plants in turn, each long out of the cache).
+  void prefetch() const { __builtin_prefetch(pending_.data()); }
 
-const model::Quadrotor& model() const { return *model_; }
-const model::State& state() const { return state_; }
-/// The state, for dynamics computed elsewhere to report (PlantNode's external dynamics).
-model::State& state() { return state_; }
-const model::RotorVector& latched() const { return latched_; }
+  const model::Quadrotor& model() const { return *model_; }
+  const model::State& state() const { return state_; }
+  /// The state, for dynamics computed elsewhere to report (PlantNode's external dynamics).
+  model::State& state() { return state_; }
+  const model::RotorVector& latched() const { return latched_; }
 
-private:
-const model::Environment* environment(Tick k) { return realism_ ? &realism_->environment(k) : nullptr; }
-/// The held level command through the inner loops on the current state, latched for this tick.
-void fly_held() {
-  if (!inner_) set_inner_loops(control::InnerLoopParams::for_vehicle(model_->params(), period_s_));
-  inner_->last = inner_->loops.step(held_, state_);
-  set_latched(inner_->last.allocation.omega_rad_s);
-}
-struct Inner {
-  control::InnerLoops loops;
-  control::InnerLoopOutput last;
-};
+ private:
+  const model::Environment* environment(Tick k) { return realism_ ? &realism_->environment(k) : nullptr; }
+  /// The held level command through the inner loops on the current state, latched for this tick.
+  void fly_held() {
+    if (!inner_) set_inner_loops(control::InnerLoopParams::for_vehicle(model_->params(), period_s_));
+    inner_->last = inner_->loops.step(held_, state_);
+    set_latched(inner_->last.allocation.omega_rad_s);
+  }
+  struct Inner {
+    control::InnerLoops loops;
+    control::InnerLoopOutput last;
+  };
 
-std::optional<model::Quadrotor> model_;  ///< optional only to be default-constructible (a batch's array)
-model::State state_;
-model::RotorVector latched_ = model::RotorVector::Zero(4);  ///< the command acting over [t_k, t_k+1)
-model::RotorInput rotor_input_;                             ///< latched_ as the model applies it
-Tick last_valid_tick_ = 0;                                  ///< tick during which the newest valid command arrived
-double period_s_ = 0.0;                                     ///< the plant period the inner loops are designed for
-control::LevelCommand held_;                                ///< the level command held (rotor speeds: latched_ is it)
-std::unique_ptr<Inner> inner_;                              ///< the inner loops, made at the first level command
-struct Pending {
-  Tick effective_tick;
-  model::RotorVector omega;  ///< rotor speeds (one per rotor), or the 4 values of `level`
-  control::CommandLevel level;
-};
-// Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
-// dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a
-// block every few commands).
-std::vector<Pending> pending_;
-std::size_t pending_head_ = 0;
-/// Present when the realism or the vehicle's drag asks for it; null keeps the paper's plant.
-std::unique_ptr<PlantRealism> realism_;
-/// The magnetometer, barometer, GNSS configured; null for none (held out of line: a batch's plant
-/// stays the few cache lines a step of many vehicles touches).
-std::unique_ptr<sensors::Suite> extra_;
+  std::optional<model::Quadrotor> model_;  ///< optional only to be default-constructible (a batch's array)
+  model::State state_;
+  model::RotorVector latched_ = model::RotorVector::Zero(4);  ///< the command acting over [t_k, t_k+1)
+  model::RotorInput rotor_input_;                             ///< latched_ as the model applies it
+  Tick last_valid_tick_ = 0;                                  ///< tick during which the newest valid command arrived
+  double period_s_ = 0.0;                                     ///< the plant period the inner loops are designed for
+  control::LevelCommand held_;                                ///< the level command held (rotor speeds: latched_ is it)
+  std::unique_ptr<Inner> inner_;                              ///< the inner loops, made at the first level command
+  struct Pending {
+    Tick effective_tick;
+    model::RotorVector omega;  ///< rotor speeds (one per rotor), or the 4 values of `level`
+    control::CommandLevel level;
+  };
+  // Commands waiting for their tick, oldest first from pending_head_. A vector whose consumed front is
+  // dropped in place (no allocation per command once its capacity suffices; a std::deque allocates a
+  // block every few commands).
+  std::vector<Pending> pending_;
+  std::size_t pending_head_ = 0;
+  /// Present when the realism or the vehicle's drag asks for it; null keeps the paper's plant.
+  std::unique_ptr<PlantRealism> realism_;
+  /// The magnetometer, barometer, GNSS configured; null for none (held out of line: a batch's plant
+  /// stays the few cache lines a step of many vehicles touches).
+  std::unique_ptr<sensors::Suite> extra_;
 };
 
 }  // namespace quadcosim::sim
