@@ -25,10 +25,13 @@
 #include <cstring>
 #include <string>
 
+#include "foreign_participant.hpp"
 #include "geometry_msgs.h"
 #include "rosgraph_msgs.h"
 #include "sensor_msgs.h"
 #include "std_msgs.h"
+
+using namespace foreign;
 
 namespace {
 
@@ -43,53 +46,6 @@ constexpr double kZDes = 2.0;                          // [m]
 constexpr double kKp = 4.0;                            // [N/m]
 constexpr double kKd = 2.7;                            // [N s/m]
 constexpr std::int64_t kControlPeriodNs = 20'000'000;  // 50 Hz
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-[[noreturn]] void die(const char* what, dds_return_t rc) {
-  std::fprintf(stderr, "foreign_controller: %s failed: %s\n", what, dds_strretcode(rc));
-  std::exit(2);
-}
-
-dds_entity_t check(dds_entity_t e, const char* what) {
-  if (e < 0) die(what, e);
-  return e;
-}
-
-// ROS_DOMAIN_ID as rcl reads it: strtoul base 0; unset or empty means 0.
-dds_domainid_t ros_domain_id() {
-  const char* s = std::getenv("ROS_DOMAIN_ID");
-  if (s == nullptr || *s == '\0') return 0;
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long v = std::strtoul(s, &end, 0);
-  if (errno != 0 || *end != '\0' || v > 232) {
-    std::fprintf(stderr, "foreign_controller: ROS_DOMAIN_ID '%s' is not a domain id\n", s);
-    std::exit(2);
-  }
-  return static_cast<dds_domainid_t>(v);
-}
-
-// rmw_cyclonedds' configuration for ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST (docs/ros2.md, Domain and discovery):
-// participant index auto (max 32), no multicast, localhost as the static peer; CYCLONEDDS_URI is
-// appended after it.
-std::string localhost_config() {
-  std::string xml =
-      "<CycloneDDS><Domain id=\"any\">"
-      "<General><AllowMulticast>false</AllowMulticast></General>"
-      "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
-      "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
-      "<Peers><Peer address=\"localhost\"/></Peers></Discovery>"
-      "</Domain></CycloneDDS>";
-  if (const char* uri = std::getenv("CYCLONEDDS_URI"); uri != nullptr && *uri != '\0') {
-    xml += ",";
-    xml += uri;
-  }
-  return xml;
-}
 
 // Every QoS policy rmw_cyclonedds sets, set explicitly (Cyclone's own defaults differ).
 dds_qos_t* ros_qos(bool reliable, int32_t depth) {
@@ -239,6 +195,7 @@ std::string remote_discovery(dds_entity_t participant) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  foreign::program = "foreign_controller";
   if (argc < 2 || argc > 3) {
     std::fprintf(stderr, "usage: %s SECONDS [NO_DATA_TIMEOUT_S]\n", argv[0]);
     return 2;

@@ -32,9 +32,12 @@
 #include <string>
 #include <vector>
 
+#include "foreign_participant.hpp"
 #include "geometry_msgs.h"
 #include "quadcosim_msgs.h"
 #include "std_msgs.h"
+
+using namespace foreign;
 
 namespace {
 
@@ -46,45 +49,6 @@ constexpr double kKp = 4.0;                            // [N/m]
 constexpr double kKd = 2.7;                            // [N s/m]
 constexpr double kKv = 1.2;                            // [1/s]
 constexpr std::int64_t kControlPeriodNs = 20'000'000;  // 50 Hz
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-[[noreturn]] void die(const char* what, dds_return_t rc) {
-  std::fprintf(stderr, "foreign_levels: %s failed: %s\n", what, dds_strretcode(rc));
-  std::exit(2);
-}
-
-dds_entity_t check(dds_entity_t e, const char* what) {
-  if (e < 0) die(what, e);
-  return e;
-}
-
-// ROS_DOMAIN_ID as rcl reads it: strtoul base 0; unset or empty means 0.
-dds_domainid_t ros_domain_id() {
-  const char* s = std::getenv("ROS_DOMAIN_ID");
-  if (s == nullptr || *s == '\0') return 0;
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long v = std::strtoul(s, &end, 0);
-  if (errno != 0 || *end != '\0' || v > 232) {
-    std::fprintf(stderr, "foreign_levels: ROS_DOMAIN_ID '%s' is not a domain id\n", s);
-    std::exit(2);
-  }
-  return static_cast<dds_domainid_t>(v);
-}
-
-// rmw_cyclonedds' configuration for ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
-std::string localhost_config() {
-  return "<CycloneDDS><Domain id=\"any\">"
-         "<General><AllowMulticast>false</AllowMulticast></General>"
-         "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
-         "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
-         "<Peers><Peer address=\"localhost\"/></Peers></Discovery>"
-         "</Domain></CycloneDDS>";
-}
 
 // The ROS default profile, every policy rmw_cyclonedds sets, set explicitly.
 dds_qos_t* ros_default_qos() {
@@ -167,6 +131,7 @@ void send_velocity(const Endpoints& e, std::int64_t stamp, double vz_m_s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  foreign::program = "foreign_levels";
   const std::string mode = argc == 3 ? argv[1] : "";
   if (mode != "fly-ctbr" && mode != "fly-velocity" && mode != "reject") {
     std::fprintf(stderr, "usage: %s fly-ctbr|fly-velocity|reject END_S\n", argv[0]);
