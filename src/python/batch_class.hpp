@@ -143,7 +143,8 @@ class Batch {
   /// (n, 18); the reward 1 - (w_p |e_p|^2 + w_v |e_v|^2 + w_w |w|^2 + w_a |action - hover_action|^2)
   /// - penalty on termination (n,); terminated = crashed | out (n,), crashed (z below the crash altitude
   /// or R_WB[2,2] below cos_max_tilt) and out (|e_p| beyond the limit on an axis). p_ref, v_ref: (n, 3);
-  /// action, hover_action: (n, 4) (action already clipped to [-1, 1]); obs_bound: (18,). A wrong shape
+  /// action, hover_action: (n, k), k the env's action size (4, or the rotor count at rotor speeds; action
+  /// already clipped to [-1, 1]); obs_bound: (18,). A wrong shape
   /// raises ValueError naming the argument.
   pybind11::tuple env_terms(
       const pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>& p_ref,

@@ -39,8 +39,14 @@ py::tuple Batch::env_terms(const Array& p_ref, const std::optional<Array>& v_ref
   const std::size_t n = n_;
   const double* pr = checked(p_ref, "p_ref", n, 3);
   const double* vr = v_ref ? checked(*v_ref, "v_ref", n, 3) : nullptr;
-  const double* a = checked(action, "action", n, 4);
-  const double* h = checked(hover_action, "hover_action", n, 4);
+  // The action's columns: 4, or the rotor count at rotor speeds (4 to 8).
+  const std::size_t k = action.ndim() == 2 ? static_cast<std::size_t>(action.shape(1)) : 0;
+  if (k < 4 || k > 8) {
+    throw py::value_error("env_terms: action: expected shape (" + std::to_string(n) + ", 4..8), got " +
+                          py::repr(action.attr("shape")).cast<std::string>());
+  }
+  const double* a = checked(action, "action", n, k);
+  const double* h = checked(hover_action, "hover_action", n, k);
   const double* bound = checked(obs_bound, "obs_bound", kEnvObservationSize, 0);
 
   py::array_t<float> obs({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(kEnvObservationSize)});
@@ -61,10 +67,10 @@ py::tuple Batch::env_terms(const Array& p_ref, const std::optional<Array>& v_ref
     double* e_v = row + 3;
     double* rot = row + 6;
     double* w = row + 15;
-    for (int k = 0; k < 3; ++k) {
-      e_p[k] = p_[3 * i + k] - pr[3 * i + k];
-      e_v[k] = vr ? v_[3 * i + k] - vr[3 * i + k] : v_[3 * i + k] - 0.0;
-      w[k] = w_[3 * i + k];
+    for (int c = 0; c < 3; ++c) {
+      e_p[c] = p_[3 * i + c] - pr[3 * i + c];
+      e_v[c] = vr ? v_[3 * i + c] - vr[3 * i + c] : v_[3 * i + c] - 0.0;
+      w[c] = w_[3 * i + c];
     }
     // The rotation matrix body -> world of q, row by row (as Batch.R gives it).
     const Eigen::Matrix3d m =
@@ -72,13 +78,13 @@ py::tuple Batch::env_terms(const Array& p_ref, const std::optional<Array>& v_ref
     for (int rr = 0; rr < 3; ++rr) {
       for (int c = 0; c < 3; ++c) rot[3 * rr + c] = m(rr, c);
     }
-    for (std::size_t k = 0; k < kEnvObservationSize; ++k) {
-      o[kEnvObservationSize * i + k] = static_cast<float>(std::clamp(row[k], -bound[k], bound[k]));
+    for (std::size_t c = 0; c < kEnvObservationSize; ++c) {
+      o[kEnvObservationSize * i + c] = static_cast<float>(std::clamp(row[c], -bound[c], bound[c]));
     }
     double action_sq = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      const double d = a[4 * i + k] - h[4 * i + k];
-      action_sq = k == 0 ? d * d : action_sq + d * d;
+    for (std::size_t j = 0; j < k; ++j) {
+      const double d = a[k * i + j] - h[k * i + j];
+      action_sq = j == 0 ? d * d : action_sq + d * d;
     }
     const double cost = weights.position * sum_sq3(e_p) + weights.velocity * sum_sq3(e_v) + weights.rate * sum_sq3(w) +
                         weights.action * action_sq;

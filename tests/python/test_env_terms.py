@@ -113,3 +113,21 @@ def test_wrong_shapes_are_refused_by_name():
                       ("v_ref", np.zeros(3))):
         with pytest.raises(ValueError, match=f"env_terms: {name}: expected shape"):
             b.env_terms(**dict(ok, **{name: bad}))
+
+
+def test_a_hexarotor_envs_reward_counts_its_six_actions():
+    """At rotor speeds a hexarotor's action has six entries, and all six enter the action cost."""
+    scenario = {"name": "hex_terms", "simulation": {"plant_rate_hz": 100, "controller_rate_hz": 50, "duration_s": 10},
+                "vehicle": {"preset": "firefly"}, "initial": {"position_m": [0.0, 0.0, 1.0], "hover": True},
+                "controller": {"mode": "attitude", "z_des": 1.0}}
+    env = VectorHoverEnv(5, scenario=scenario, max_episode_steps=10**6, target=[0.0, 0.0, 1.0])
+    assert env.action_space.shape == (5, 6)
+    env.reset(seed=0)
+    rng = np.random.default_rng(11)
+    for _ in range(10):
+        a = np.clip(env.hover_action + rng.normal(0, 0.01, (5, 6)), -1, 1)
+        live = ~env._autoreset
+        obs, reward, terminated, truncated, info = env.step(a)
+        want_obs, want_reward, _, _ = expected(env, a, np.tile([0.0, 0.0, 1.0], (5, 1)), 0.0)
+        assert np.array_equal(obs, want_obs)
+        np.testing.assert_allclose(reward[live], want_reward[live], rtol=0, atol=1e-12)

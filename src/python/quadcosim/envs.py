@@ -222,15 +222,15 @@ class _Episodes:
             p_ref, v_ref = ref["p"], ref["v"]
         else:
             p_ref, v_ref = self.target, None
-        obs, reward, terminated, crashed, out = b._b.env_terms(
-            p_ref, v_ref, a, np.broadcast_to(self.hover_action, (self.n, ACTION_SIZE)), self.observation_space.high,
-            self.weights, self.limits)
+        hover = np.broadcast_to(self.hover_action, (self.n, self.action_size))
+        obs, reward, terminated, crashed, out = b._b.env_terms(p_ref, v_ref, a, hover, self.observation_space.high,
+                                                               self.weights, self.limits)
         truncated = self.steps >= self.max_episode_steps
         return obs, reward, terminated, truncated, crashed, out
 
     def observe(self) -> np.ndarray:
         """The observations (n, 18) float32 of all n vehicles as they stand."""
-        return self.terms(np.broadcast_to(self.hover_action, (self.n, ACTION_SIZE)))[0]
+        return self.terms(np.broadcast_to(self.hover_action, (self.n, self.action_size)))[0]
 
 
 def _env_kwargs(kind: str, scenario, trajectory, target, max_episode_steps, max_position_error_m, crash_altitude_m,
