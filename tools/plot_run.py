@@ -84,7 +84,9 @@ REQUIRED_COLUMNS = (
 # Read when present (saturation flags, the attitude error Psi, the commands at the plant; docs/outputs.md);
 # older trajectories lack them.
 SATURATION_COLUMNS = ("sat1", "sat2", "sat3", "sat4", "tilt_sat")
-OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err", "cmd1", "cmd2", "cmd3", "cmd4")
+# Rotors 5..8 of a hexarotor or octorotor (docs/outputs.md: w1..wN, cmd1..cmdN, sat1..satN).
+EXTRA_ROTOR_COLUMNS = tuple(f"{c}{k}" for k in range(5, 9) for c in ("w", "cmd", "sat"))
+OPTIONAL_COLUMNS = SATURATION_COLUMNS + ("att_err", "cmd1", "cmd2", "cmd3", "cmd4") + EXTRA_ROTOR_COLUMNS
 # The controller's own figures: trajectory.csv's columns out.<name>, read when present.
 OUTPUT_PREFIX = "out."
 # At most this many panels in outputs.png; the names beyond are listed in its title.
@@ -166,6 +168,10 @@ class Trajectory:
 
     def __len__(self):
         return self._data.shape[0]
+
+    def rotor_count(self):
+        """How many rotors the run's vehicle has: the w1..wN columns (4 to 8)."""
+        return max(k for k in range(1, 9) if self.has(f"w{k}"))
 
 
 def _find_bad_line(path, header_len, indices):
@@ -285,11 +291,11 @@ def shade_saturation(ax, traj, lo=None, hi=None):
     off = np.zeros(len(t), dtype=bool)
     if all(traj.has(c) for c in ("z", "vz", "cmd1", "cmd2", "cmd3", "cmd4")):
         off = (traj["z"] <= 0.0) & (traj["vz"] == 0.0)
-        for k in range(1, 5):
+        for k in range(1, traj.rotor_count() + 1):
             off &= traj[f"cmd{k}"] <= 0.0
     any_rotor = np.zeros(len(t), dtype=bool)
     rotors = []
-    for k in range(1, 5):
+    for k in range(1, traj.rotor_count() + 1):
         sat = (traj[f"sat{k}"] != 0) & ~off
         if np.any(sat):
             rotors.append(str(k))
@@ -875,8 +881,10 @@ def plot_overview(traj, out_path, metrics, run_dir):
              ("roll_des", "pitch_des", "yaw_des"))
     timeplot(fig.add_subplot(gs[1, 0]), ("p", "q", "r"), ("p", "q", "r"), xyz_colors,
              "body rate [rad/s]", "Body rates")
-    timeplot(fig.add_subplot(gs[1, 1]), ("w1", "w2", "w3", "w4"), ("ω1", "ω2", "ω3", "ω4"),
-             ("#d62728", "#2ca02c", "#1f4fd6", "#ff7f0e"), "rotor speed [rad/s]", "Rotor speeds")
+    rotors = range(1, traj.rotor_count() + 1)
+    timeplot(fig.add_subplot(gs[1, 1]), tuple(f"w{k}" for k in rotors), tuple(f"ω{k}" for k in rotors),
+             ("#d62728", "#2ca02c", "#1f4fd6", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"),
+             "rotor speed [rad/s]", "Rotor speeds")
     timeplot(fig.add_subplot(gs[1, 2]), ("vz",), ("vz",), ("#1f4fd6",),
              "vertical speed vz [m/s]", "Vertical speed")
 
