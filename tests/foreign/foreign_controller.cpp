@@ -112,24 +112,6 @@ struct Seen {
   }
 };
 
-// Takes every available sample of `reader` (loaned) and hands each valid one to `f`.
-template <typename T, typename F>
-void take_all(dds_entity_t reader, F&& f) {
-  constexpr int kBatch = 16;
-  void* samples[kBatch];
-  dds_sample_info_t infos[kBatch];
-  for (;;) {
-    std::fill(std::begin(samples), std::end(samples), nullptr);
-    const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
-    if (n < 0) die("dds_take", n);
-    for (int i = 0; i < n; ++i) {
-      if (infos[i].valid_data) f(*static_cast<const T*>(samples[i]));
-    }
-    if (n > 0) dds_return_loan(reader, samples, n);
-    if (n < kBatch) return;
-  }
-}
-
 // What the other side announced in discovery (the DDS built-in topics), as a JSON object:
 // {"participants":[user_data...], "endpoints":[{topic, kind, type, reliable, transient_local, xcdr}]}
 // for the remote endpoints on the topics we use. All of it is what any ROS 2 tool would see.

@@ -70,23 +70,6 @@ builtin_interfaces_msg_dds__Time_ time_of(std::int64_t ns) {
   return {static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
 }
 
-template <typename T, typename F>
-void take_all(dds_entity_t reader, F&& f) {
-  constexpr int kBatch = 16;
-  void* samples[kBatch];
-  dds_sample_info_t infos[kBatch];
-  for (;;) {
-    std::fill(std::begin(samples), std::end(samples), nullptr);
-    const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
-    if (n < 0) die("dds_take", n);
-    for (int i = 0; i < n; ++i) {
-      if (infos[i].valid_data) f(*static_cast<const T*>(samples[i]));
-    }
-    if (n > 0) dds_return_loan(reader, samples, n);
-    if (n < kBatch) return;
-  }
-}
-
 std::string json_string(const char* s) {
   std::string out = "\"";
   for (const char* p = s ? s : ""; *p; ++p) {

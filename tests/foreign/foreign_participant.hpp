@@ -4,11 +4,13 @@
 
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <string>
 
 namespace foreign {
@@ -61,6 +63,24 @@ inline std::string localhost_config() {
     xml += uri;
   }
   return xml;
+}
+
+/// Takes every available sample of `reader` (loaned) and hands each valid one to `f`.
+template <typename T, typename F>
+void take_all(dds_entity_t reader, F&& f) {
+  constexpr int kBatch = 16;
+  void* samples[kBatch];
+  dds_sample_info_t infos[kBatch];
+  for (;;) {
+    std::fill(std::begin(samples), std::end(samples), nullptr);
+    const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
+    if (n < 0) die("dds_take", n);
+    for (int i = 0; i < n; ++i) {
+      if (infos[i].valid_data) f(*static_cast<const T*>(samples[i]));
+    }
+    if (n > 0) dds_return_loan(reader, samples, n);
+    if (n < kBatch) return;
+  }
 }
 
 }  // namespace foreign
