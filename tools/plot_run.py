@@ -170,8 +170,10 @@ class Trajectory:
         return self._data.shape[0]
 
     def rotor_count(self):
-        """How many rotors the run's vehicle has: the w1..wN columns (4 to 8)."""
-        return max(k for k in range(1, 9) if self.has(f"w{k}"))
+        """How many rotors the run's vehicle has: the highest k of its per-rotor columns (wk, cmdk,
+        satk; 4 to 8), 0 when the file has none."""
+        return max((k for k in range(1, 9) if any(self.has(f"{c}{k}") for c in ("w", "cmd", "sat"))),
+                   default=0)
 
 
 def _find_bad_line(path, header_len, indices):

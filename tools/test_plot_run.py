@@ -416,6 +416,23 @@ class UnwrapAndSaturationTest(unittest.TestCase):
         self.assertEqual(len(handles), 1)
         self.assertIn("rotors 2, 4 saturated", handles[0].get_label())
 
+    def test_a_hexarotors_fifth_and_sixth_rotors_are_shaded(self):
+        # Only sat1..sat6 columns (no w, no cmd): the rotor count comes from whichever per-rotor
+        # columns the file has, so rotor 6 saturating is drawn and named.
+        import matplotlib.pyplot as plt
+        t = np.arange(101) / 100.0
+        cols = {"t": t, "tilt_sat": np.zeros(101)}
+        for k in range(1, 7):
+            cols[f"sat{k}"] = ((k == 6) & (t >= 0.3) & (t < 0.4)).astype(float)
+        names = list(cols)
+        traj = self.pr.Trajectory("mem", names, np.column_stack([cols[n] for n in names]))
+        self.assertEqual(traj.rotor_count(), 6)
+        fig, ax = plt.subplots()
+        handles = self.pr.shade_saturation(ax, traj)
+        plt.close(fig)
+        self.assertEqual(len(handles), 1)
+        self.assertIn("rotor 6 saturated", handles[0].get_label())
+
     def test_motors_off_on_the_ground_are_not_shaded(self):
         # Rows 0..49 rest on the ground with every command 0 (a disarmed flight stack): not shaded; rows
         # 100..119 have the same commands in the air (z > 0): shaded, as the limits figures count them.
