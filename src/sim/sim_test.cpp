@@ -13,6 +13,7 @@
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
+#include "sim/plant_rig_test_support.hpp"
 #include "sim/simulation.hpp"
 
 namespace quadcosim::sim {
@@ -67,36 +68,25 @@ TEST(InProcessTransportTest, RefusesASecondTypeOnOneTopic) {
   EXPECT_THROW(bus.subscribe<msg::Imu>("/x", [](const msg::Imu&) {}), std::logic_error);
 }
 
-// A plant on its own bus, with a test probe that plays the controller.
-struct PlantRig {
-  InProcessTransport bus;
-  Topics topics = Topics::for_namespace("/drone");
-  model::VehicleParams vehicle;
+// A plant on its own bus (its options as given), with a test probe that plays the controller and
+// collects the poses, IMU samples and clock messages.
+struct ProbeRig : test::PlantRig {
   std::vector<msg::PoseStamped> poses;
   std::vector<msg::Imu> imus;
   std::vector<msg::Clock> clocks;
-  Publisher<msg::Float64MultiArray> cmd;
-  std::unique_ptr<PlantNode> plant;
 
-  explicit PlantRig(PlantOptions opt = {}, model::State x0 = {}) {
+  explicit ProbeRig(const PlantOptions& opt = {}, const model::State& x0 = {}) : PlantRig(opt, x0) {
     bus.subscribe<msg::PoseStamped>(topics.pose, [this](const msg::PoseStamped& m) { poses.push_back(m); });
     bus.subscribe<msg::Imu>(topics.imu, [this](const msg::Imu& m) { imus.push_back(m); });
     bus.subscribe<msg::Clock>(topics.clock, [this](const msg::Clock& m) { clocks.push_back(m); });
-    cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
-    plant = std::make_unique<PlantNode>(bus, topics, vehicle, opt, x0);
-  }
-  void send(std::vector<double> w) {
-    msg::Float64MultiArray m;
-    m.data = std::move(w);
-    cmd.publish(m);
   }
 };
 
 TEST(PlantNodeTest, PublishesStampedOutputsOfTheState) {
   model::State x0;
   x0.p_W = {1.0, 2.0, 3.0};
-  PlantRig rig({}, x0);
-  rig.plant->publish_outputs(7);
+  ProbeRig rig({}, x0);
+  rig.plant.publish_outputs(7);
   ASSERT_EQ(rig.poses.size(), 1u);
   EXPECT_EQ(rig.poses[0].header.stamp.to_ns(), 70'000'000);
   EXPECT_EQ(rig.clocks[0].clock.to_ns(), 70'000'000);
@@ -129,44 +119,44 @@ TEST(PlantNodeTest, PublishesClockBeforeOrAfterTheSensors) {
 }
 
 TEST(PlantNodeTest, RejectsMalformedCommandsAndHoldsTheLastGoodOne) {
-  PlantRig rig;
-  rig.plant->publish_outputs(0);
+  ProbeRig rig;
+  rig.plant.publish_outputs(0);
   rig.send({100, 200, 300, 400});
   rig.send({1, 2, 3});                // wrong length
   rig.send({});                       // empty
   rig.send({1, std::nan(""), 3, 4});  // NaN
   rig.send({1, 2, INFINITY, 4});      // Inf
-  rig.plant->latch_command(0);
-  EXPECT_EQ(rig.plant->stats().commands_received, 5u);
-  EXPECT_EQ(rig.plant->stats().commands_rejected, 4u);
-  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+  rig.plant.latch_command(0);
+  EXPECT_EQ(rig.plant.stats().commands_received, 5u);
+  EXPECT_EQ(rig.plant.stats().commands_rejected, 4u);
+  EXPECT_EQ(rig.plant.latched_command(), model::Vector4(100, 200, 300, 400));
 }
 
 TEST(PlantNodeTest, OutOfRangeCommandsAreClampedByTheModel) {
   model::State x0;
   x0.p_W.z() = 50.0;
-  PlantRig rig({}, x0);
-  rig.plant->publish_outputs(0);
+  ProbeRig rig({}, x0);
+  rig.plant.publish_outputs(0);
   rig.send({-5.0, 1e9, 0.0, 0.0});
-  rig.plant->latch_command(0);
-  rig.plant->integrate(0);
-  EXPECT_EQ(rig.plant->state().omega_rad_s[0], rig.vehicle.motor.omega_min_rad_s);
-  EXPECT_EQ(rig.plant->state().omega_rad_s[1], rig.vehicle.motor.omega_max_rad_s);
-  EXPECT_TRUE(rig.plant->state().p_W.allFinite());
+  rig.plant.latch_command(0);
+  rig.plant.integrate(0);
+  EXPECT_EQ(rig.plant.state().omega_rad_s[0], rig.vehicle.motor.omega_min_rad_s);
+  EXPECT_EQ(rig.plant.state().omega_rad_s[1], rig.vehicle.motor.omega_max_rad_s);
+  EXPECT_TRUE(rig.plant.state().p_W.allFinite());
 }
 
 TEST(PlantNodeTest, CommandDelayShiftsTheEffectByWholeTicks) {
   PlantOptions opt;
   opt.command_delay_ticks = 3;
-  PlantRig rig(opt);
-  rig.plant->publish_outputs(10);
+  ProbeRig rig(opt);
+  rig.plant.publish_outputs(10);
   rig.send({1, 1, 1, 1});
   for (Tick k = 10; k < 13; ++k) {
-    rig.plant->latch_command(k);
-    EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Zero()) << "tick " << k;
+    rig.plant.latch_command(k);
+    EXPECT_EQ(rig.plant.latched_command(), model::Vector4::Zero()) << "tick " << k;
   }
-  rig.plant->latch_command(13);
-  EXPECT_EQ(rig.plant->latched_command(), model::Vector4::Ones());
+  rig.plant.latch_command(13);
+  EXPECT_EQ(rig.plant.latched_command(), model::Vector4::Ones());
 }
 
 TEST(ControllerNodeTest, PublishesTheSafetyCommandUntilSensorsArrive) {

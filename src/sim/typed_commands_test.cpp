@@ -16,6 +16,7 @@
 #include "sim/level_messages.hpp"
 #include "sim/message_schema.hpp"
 #include "sim/plant_node.hpp"
+#include "sim/plant_rig_test_support.hpp"
 #include "sim/topics.hpp"
 
 namespace quadcosim::sim {
@@ -23,40 +24,18 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// A plant alone on an in-process bus with a publisher on motor_commands and on each typed topic.
-struct TypedRig {
-  InProcessTransport bus;
-  Topics topics = Topics::for_namespace("/drone");
-  model::VehicleParams vehicle;
-  std::vector<msg::PlantStatus> statuses;
-  std::vector<std::string> log;
-  Publisher<msg::Float64MultiArray> cmd;
-  Publisher<msg::ThrustRates> ctbr;
-  Publisher<msg::RotorThrusts> thrusts;
-  Publisher<msg::ThrustAttitude> ctatt;
-  Publisher<msg::VelocityYaw> velocity;
-  std::unique_ptr<PlantNode> plant;
+// A plant hovering at z_m without a watchdog, with a publisher on motor_commands and on four of the
+// typed topics.
+struct TypedRig : test::PlantRig {
+  Publisher<msg::ThrustRates> ctbr = level_publisher<msg::ThrustRates>(control::CommandLevel::kCtbr);
+  Publisher<msg::RotorThrusts> thrusts = level_publisher<msg::RotorThrusts>(control::CommandLevel::kRotorThrusts);
+  Publisher<msg::ThrustAttitude> ctatt = level_publisher<msg::ThrustAttitude>(control::CommandLevel::kCtatt);
+  Publisher<msg::VelocityYaw> velocity = level_publisher<msg::VelocityYaw>(control::CommandLevel::kVelocity);
 
-  explicit TypedRig(PlantOptions options = {}, double z_m = 10.0) {
-    bus.subscribe<msg::PlantStatus>(topics.plant_status, [this](const msg::PlantStatus& m) { statuses.push_back(m); });
-    cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
-    ctbr =
-        bus.advertise<msg::ThrustRates>(topics.level_commands[static_cast<std::size_t>(control::CommandLevel::kCtbr)]);
-    thrusts = bus.advertise<msg::RotorThrusts>(
-        topics.level_commands[static_cast<std::size_t>(control::CommandLevel::kRotorThrusts)]);
-    ctatt = bus.advertise<msg::ThrustAttitude>(
-        topics.level_commands[static_cast<std::size_t>(control::CommandLevel::kCtatt)]);
-    velocity = bus.advertise<msg::VelocityYaw>(
-        topics.level_commands[static_cast<std::size_t>(control::CommandLevel::kVelocity)]);
-    const model::State x0 = model::Quadrotor(vehicle).initial_state({0.0, 0.0, z_m}, 0.0, true);
-    options.watchdog_ticks = 0;
-    plant = std::make_unique<PlantNode>(bus, topics, vehicle, options, x0);
-    plant->set_log([this](const std::string& line) { log.push_back(line); });
-  }
-  void tick(Tick k) {
-    plant->latch_command(k);
-    plant->integrate(k);
-  }
+  explicit TypedRig(PlantOptions options = {}, double z_m = 10.0)
+      : PlantRig(without_watchdog(options),
+                 model::Quadrotor(model::VehicleParams{}).initial_state({0.0, 0.0, z_m}, 0.0, true)) {}
+  void tick(Tick k) { latch_and_integrate(k); }
 };
 
 TEST(TypedCommands, TopicsAreNamedAfterTheLevels) {
@@ -138,8 +117,8 @@ TEST(TypedCommands, ATypedCommandFliesAsTheSameValuesNamedInTheLayout) {
   TypedRig typed, labelled;
   const double hover_n = typed.vehicle.mass_kg * typed.vehicle.gravity_m_s2;
   for (Tick k = 0; k < 300; ++k) {
-    typed.plant->publish_outputs(k);
-    labelled.plant->publish_outputs(k);
+    typed.plant.publish_outputs(k);
+    labelled.plant.publish_outputs(k);
     if (k % 2 == 0) {
       const double t = 0.01 * static_cast<double>(k);
       const double u[4] = {hover_n * (1.0 + 0.05 * std::sin(t)), t < 0.5 ? 0.3 : -0.1, 0.2 * std::cos(3.0 * t), 0.05};
@@ -154,15 +133,15 @@ TEST(TypedCommands, ATypedCommandFliesAsTheSameValuesNamedInTheLayout) {
     }
     typed.tick(k);
     labelled.tick(k);
-    const model::State& x = typed.plant->state();
-    const model::State& y = labelled.plant->state();
+    const model::State& x = typed.plant.state();
+    const model::State& y = labelled.plant.state();
     ASSERT_EQ(std::memcmp(x.p_W.data(), y.p_W.data(), sizeof(double) * 3), 0) << "tick " << k;
     ASSERT_EQ(std::memcmp(x.q_WB.coeffs().data(), y.q_WB.coeffs().data(), sizeof(double) * 4), 0) << "tick " << k;
   }
-  EXPECT_EQ(typed.plant->core().held().level, control::CommandLevel::kCtbr);
-  EXPECT_EQ(typed.plant->stats().commands_accepted, 150u);
+  EXPECT_EQ(typed.plant.core().held().level, control::CommandLevel::kCtbr);
+  EXPECT_EQ(typed.plant.stats().commands_accepted, 150u);
   // The rate step turned the vehicle: roll well away from 0.
-  EXPECT_GT(std::abs(model::euler_from_quaternion(typed.plant->state().q_WB).roll_rad), 0.05);
+  EXPECT_GT(std::abs(model::euler_from_quaternion(typed.plant.state().q_WB).roll_rad), 0.05);
 }
 
 // The attitude of a ThrustAttitude is held as its Z-Y-X angles (level ctatt's values).
@@ -173,10 +152,10 @@ TEST(TypedCommands, AnAttitudeQuaternionIsFlownAsItsEulerAngles) {
   msg::ThrustAttitude m;
   m.thrust_n = 19.0;
   m.attitude = {q.x(), q.y(), q.z(), q.w()};
-  rig.plant->publish_outputs(0);
+  rig.plant.publish_outputs(0);
   rig.ctatt.publish(m);
   rig.tick(0);
-  const control::LevelCommand& held = rig.plant->core().held();
+  const control::LevelCommand& held = rig.plant.core().held();
   ASSERT_EQ(held.level, control::CommandLevel::kCtatt);
   EXPECT_EQ(held.value[0], 19.0);
   EXPECT_NEAR(held.value[1], 0.1, 1e-12);
@@ -188,30 +167,30 @@ TEST(TypedCommands, AnAttitudeQuaternionIsFlownAsItsEulerAngles) {
 // in one tick: refused, counted, named, and the first topic's command is the one flown.
 TEST(TypedCommands, BadTypedCommandsAndASecondTopicInOneTickAreRefusedByName) {
   TypedRig rig;
-  rig.plant->publish_outputs(0);
+  rig.plant.publish_outputs(0);
   msg::ThrustRates nan_rates;
   nan_rates.thrust_n = 19.0;
   nan_rates.body_rates_rad_s = {0.0, kNaN, 0.0};
   rig.ctbr.publish(nan_rates);
-  EXPECT_EQ(rig.plant->stats().last_problem, "ctbr value 3 (q [rad/s]) is nan, expected a finite number");
+  EXPECT_EQ(rig.plant.stats().last_problem, "ctbr value 3 (q [rad/s]) is nan, expected a finite number");
   rig.tick(0);
 
-  rig.plant->publish_outputs(1);
+  rig.plant.publish_outputs(1);
   msg::RotorThrusts three;
   three.thrust_n = {4.0, 4.0, 4.0};
   rig.thrusts.publish(three);
-  EXPECT_EQ(rig.plant->stats().last_problem, "3 values, expected 4 for level rotor_thrusts");
+  EXPECT_EQ(rig.plant.stats().last_problem, "3 values, expected 4 for level rotor_thrusts");
   rig.tick(1);
 
-  rig.plant->publish_outputs(2);
+  rig.plant.publish_outputs(2);
   msg::ThrustAttitude half;
   half.thrust_n = 19.0;
   half.attitude = {0.0, 0.0, 0.0, 0.5};
   rig.ctatt.publish(half);
-  EXPECT_EQ(rig.plant->stats().last_problem, "ctatt attitude has norm 0.5, expected a unit quaternion (x, y, z, w)");
+  EXPECT_EQ(rig.plant.stats().last_problem, "ctatt attitude has norm 0.5, expected a unit quaternion (x, y, z, w)");
   rig.tick(2);
 
-  rig.plant->publish_outputs(3);
+  rig.plant.publish_outputs(3);
   msg::VelocityYaw up;
   up.velocity_m_s = {0.0, 0.0, 1.0};
   rig.velocity.publish(up);  // answers tick 3
@@ -221,18 +200,18 @@ TEST(TypedCommands, BadTypedCommandsAndASecondTopicInOneTickAreRefusedByName) {
   msg::Float64MultiArray speeds;
   speeds.data = {100.0, 100.0, 100.0, 100.0};
   rig.cmd.publish(speeds);  // and a third
-  EXPECT_EQ(rig.plant->stats().last_problem,
+  EXPECT_EQ(rig.plant.stats().last_problem,
             "a command on /drone/motor_commands for the tick (t = 0.03 s) that /drone/cmd/velocity already "
             "commanded: one topic commands a tick");
   rig.tick(3);
-  EXPECT_EQ(rig.plant->core().held().level, control::CommandLevel::kVelocity);
+  EXPECT_EQ(rig.plant.core().held().level, control::CommandLevel::kVelocity);
   // The next tick another topic may command.
-  rig.plant->publish_outputs(4);
+  rig.plant.publish_outputs(4);
   rig.ctbr.publish(rates);
   rig.tick(4);
-  EXPECT_EQ(rig.plant->core().held().level, control::CommandLevel::kCtbr);
+  EXPECT_EQ(rig.plant.core().held().level, control::CommandLevel::kCtbr);
 
-  const PlantStats& st = rig.plant->stats();
+  const PlantStats& st = rig.plant.stats();
   EXPECT_EQ(st.commands_received, 5u);  // the three bad ones, velocity, ctbr; not the two refused
   EXPECT_EQ(st.commands_rejected, 3u);
   EXPECT_EQ(st.commands_rejected_non_finite, 1u);
@@ -248,7 +227,7 @@ TEST(TypedCommands, BadTypedCommandsAndASecondTopicInOneTickAreRefusedByName) {
             "plant: a command on /drone/cmd/ctbr for the tick (t = 0.03 s) that /drone/cmd/velocity already "
             "commanded: one topic commands a tick; ignored, 1 so far (logged: 1st, then every 100th)");
   // The counts go out in the plant status.
-  rig.plant->publish_outputs(5);
+  rig.plant.publish_outputs(5);
   ASSERT_FALSE(rig.statuses.empty());
   EXPECT_EQ(rig.statuses.back().commands_rejected_second_topic, 2u);
   EXPECT_EQ(rig.statuses.back().commands_rejected_bad_quaternion, 1u);
@@ -260,24 +239,24 @@ TEST(TypedCommands, InLockstepTheStampIsTheLabelAndASecondTopicForItIsRefused) {
   PlantOptions o;
   o.drop_stale_commands = true;
   TypedRig rig(o);
-  rig.plant->publish_outputs(0);
+  rig.plant.publish_outputs(0);
   msg::ThrustRates rates;
   rates.thrust_n = 19.0;
   rates.header.stamp = msg::Time::from_ns(0);
   rig.ctbr.publish(rates);
-  EXPECT_EQ(rig.plant->command_receipt().label_ns, 0);
+  EXPECT_EQ(rig.plant.command_receipt().label_ns, 0);
   rig.tick(0);
-  rig.plant->publish_outputs(1);
+  rig.plant.publish_outputs(1);
   rig.ctbr.publish(rates);  // a repeat of tick 0's answer
   msg::VelocityYaw v;
   v.header.stamp = msg::Time::from_ns(0);
   rig.velocity.publish(v);  // tick 0 again, from another topic
   rig.tick(1);
-  rig.plant->publish_outputs(2);
+  rig.plant.publish_outputs(2);
   rates.header.stamp = msg::Time::from_ns(20'000'000);
   rig.ctbr.publish(rates);
-  EXPECT_EQ(rig.plant->command_receipt().label_ns, 20'000'000);
-  const PlantStats& st = rig.plant->stats();
+  EXPECT_EQ(rig.plant.command_receipt().label_ns, 20'000'000);
+  const PlantStats& st = rig.plant.stats();
   EXPECT_EQ(st.commands_stale, 1u);
   EXPECT_EQ(st.commands_rejected_second_topic, 1u);
   EXPECT_EQ(st.commands_accepted, 2u);

@@ -12,6 +12,7 @@
 #include "sim/controller_node.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/plant_node.hpp"
+#include "sim/plant_rig_test_support.hpp"
 #include "sim/validation.hpp"
 
 namespace quadcosim::sim {
@@ -344,29 +345,18 @@ TEST(LogThrottleTest, LogsTheFirstThenEveryNth) {
   EXPECT_EQ(logged, (std::vector<std::uint64_t>{1, 101, 201}));
 }
 
-// A plant on its own bus; the test plays the controller and watches the plant status.
-struct Rig {
-  InProcessTransport bus;
-  Topics topics = Topics::for_namespace("/drone");
-  model::VehicleParams vehicle;
-  std::vector<msg::PlantStatus> statuses;
-  std::vector<std::string> log;
-  Publisher<msg::Float64MultiArray> cmd;
-  std::unique_ptr<PlantNode> plant;
-
-  explicit Rig(PlantOptions options = {}) {
-    bus.subscribe<msg::PlantStatus>(topics.plant_status, [this](const msg::PlantStatus& m) { statuses.push_back(m); });
-    cmd = bus.advertise<msg::Float64MultiArray>(topics.motor_commands);
+// A plant on its own bus, 10 m up and at rest, without a watchdog; the test plays the controller and
+// watches the plant status.
+struct Rig : test::PlantRig {
+  explicit Rig(PlantOptions options = {}) : PlantRig(without_watchdog(options), at_rest_10_m()) {}
+  static model::State at_rest_10_m() {
     model::State x0;
     x0.p_W.z() = 10.0;
-    options.watchdog_ticks = 0;  // these ticks go long without commands; the watchdog has its own tests
-    plant = std::make_unique<PlantNode>(bus, topics, vehicle, options, x0);
-    plant->set_log([this](const std::string& line) { log.push_back(line); });
+    return x0;
   }
   void tick(Tick k) {
-    plant->publish_outputs(k);
-    plant->latch_command(k);
-    plant->integrate(k);
+    plant.publish_outputs(k);
+    latch_and_integrate(k);
   }
 };
 
@@ -394,7 +384,7 @@ TEST(PlantValidationTest, StatusCountsRefusedAndClampedCommandsAndGoesOutOnTheNe
                          "held; 1 rejected so far (logged: 1st, then every 100th)",
                          "plant: motor command clamped (rotor 1 speed -1 rad/s clamped to 0 (range [0, 12000])); 1 "
                          "clamped so far (logged: 1st, then every 100th)"}));
-  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(0, 2, 3, 4));
+  EXPECT_EQ(rig.plant.latched_command(), model::Vector4(0, 2, 3, 4));
   for (Tick k = 3; k < 100; ++k) rig.tick(k);
   EXPECT_EQ(rig.statuses.size(), 2u);
   rig.tick(100);
@@ -413,27 +403,27 @@ TEST(PlantValidationTest, LockstepRepeatsOfACommandAreNotCountedTwice) {
     m.dim.push_back({msg::command_label(stamp_ns), 4, 4});
     return m;
   };
-  rig.plant->publish_outputs(0);
+  rig.plant.publish_outputs(0);
   rig.cmd.publish(labelled({100, 200, 300, 400}, 0));
   rig.cmd.publish(labelled({100, 200, 300, 400}, 0));  // the same answer again
-  rig.plant->latch_command(0);
-  rig.plant->integrate(0);
+  rig.plant.latch_command(0);
+  rig.plant.integrate(0);
   rig.tick(1);
-  rig.plant->publish_outputs(2);
+  rig.plant.publish_outputs(2);
   // A refused answer, and its copy: the label of a refused command is not remembered (what a command
   // says of its tick counts only once it is known to be a command), so the copy is refused again, not
   // dropped as a repeat.
   rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));
   rig.cmd.publish(labelled({1, 2, 3}, 20'000'000));
   rig.cmd.publish(labelled({5, 6, 7, 8}, 0));  // an answer to an earlier tick
-  const PlantStats& st = rig.plant->stats();
+  const PlantStats& st = rig.plant.stats();
   EXPECT_EQ(st.commands_received, 5u);
   EXPECT_EQ(st.commands_accepted, 1u);
   EXPECT_EQ(st.commands_rejected_length, 2u);
   EXPECT_EQ(st.commands_stale, 2u);
-  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+  EXPECT_EQ(rig.plant.latched_command(), model::Vector4(100, 200, 300, 400));
   // The refused answer answered tick 2 (the last good command held, as in-process).
-  EXPECT_EQ(rig.plant->command_receipt().label_ns, 20'000'000);
+  EXPECT_EQ(rig.plant.command_receipt().label_ns, 20'000'000);
 }
 
 // A command labelled with a stamp behind the current tick is told to the host with that label and
@@ -444,23 +434,23 @@ TEST(PlantValidationTest, ALabelBehindTheTickIsToldWithTheTick) {
   options.drop_stale_commands = true;
   Rig rig(options);
   std::vector<std::pair<std::int64_t, Tick>> told;
-  rig.plant->on_label_behind([&](std::int64_t label_ns, Tick k) { told.emplace_back(label_ns, k); });
+  rig.plant.on_label_behind([&](std::int64_t label_ns, Tick k) { told.emplace_back(label_ns, k); });
   auto labelled = [](std::vector<double> w, std::int64_t stamp_ns) {
     msg::Float64MultiArray m = command(std::move(w));
     m.dim.push_back({msg::command_label(stamp_ns), 4, 4});
     return m;
   };
   for (Tick k = 0; k < 4; ++k) rig.tick(k);
-  rig.plant->publish_outputs(4);                                // t = 0.04 s
+  rig.plant.publish_outputs(4);                                 // t = 0.04 s
   rig.cmd.publish(labelled({100, 200, 300, 400}, 40'000'000));  // the tick's answer
   rig.cmd.publish(labelled({100, 200, 300, 400}, 40'000'000));  // its copy: a repeat, not behind
   EXPECT_TRUE(told.empty());
   rig.cmd.publish(labelled({1, 2, 3, 4}, 30'000'000));  // on the samples of tick 3
   ASSERT_EQ(told.size(), 1u);
   EXPECT_EQ(told[0], (std::pair<std::int64_t, Tick>{30'000'000, 4}));
-  EXPECT_EQ(rig.plant->stats().commands_stale, 2u);
-  rig.plant->latch_command(4);
-  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+  EXPECT_EQ(rig.plant.stats().commands_stale, 2u);
+  rig.plant.latch_command(4);
+  EXPECT_EQ(rig.plant.latched_command(), model::Vector4(100, 200, 300, 400));
 }
 
 // A NaN command labelled with the current tick, then the valid answer with the same label: the valid
@@ -474,15 +464,15 @@ TEST(PlantValidationTest, ANonFiniteCommandLabelledWithTheTickDoesNotMakeTheAnsw
     m.dim.push_back({msg::command_label(stamp_ns), 4, 4});
     return m;
   };
-  rig.plant->publish_outputs(0);
+  rig.plant.publish_outputs(0);
   rig.cmd.publish(labelled({kNaN, 1, 1, 1}, 0));
   rig.cmd.publish(labelled({100, 200, 300, 400}, 0));
-  rig.plant->latch_command(0);
-  const PlantStats& st = rig.plant->stats();
+  rig.plant.latch_command(0);
+  const PlantStats& st = rig.plant.stats();
   EXPECT_EQ(st.commands_rejected_non_finite, 1u);
   EXPECT_EQ(st.commands_accepted, 1u);
   EXPECT_EQ(st.commands_stale, 0u);
-  EXPECT_EQ(rig.plant->latched_command(), model::Vector4(100, 200, 300, 400));
+  EXPECT_EQ(rig.plant.latched_command(), model::Vector4(100, 200, 300, 400));
 }
 
 // Commands whose sender the filter refuses are foreign: counted, logged once per 100, and nothing
@@ -492,21 +482,21 @@ TEST(PlantValidationTest, CommandsOfAnotherWriterAreForeignAndChangeNothing) {
   options.drop_stale_commands = true;
   Rig rig(options);
   // The in-process transport says 0 for every sender: a filter refusing it makes every command foreign.
-  rig.plant->set_command_filter([](const std::string&, SenderId s) { return s != 0; });
-  const model::Vector4 before = rig.plant->latched_command();
+  rig.plant.set_command_filter([](const std::string&, SenderId s) { return s != 0; });
+  const model::Vector4 before = rig.plant.latched_command();
   msg::Float64MultiArray m = command({100, 200, 300, 400});
   m.dim.push_back({msg::command_label(0), 4, 4});
-  rig.plant->publish_outputs(0);
+  rig.plant.publish_outputs(0);
   for (int i = 0; i < 150; ++i) rig.cmd.publish(m);
-  rig.plant->latch_command(0);
-  const PlantStats& st = rig.plant->stats();
+  rig.plant.latch_command(0);
+  const PlantStats& st = rig.plant.stats();
   EXPECT_EQ(st.commands_foreign, 150u);
   EXPECT_EQ(st.commands_received, 0u);
   EXPECT_EQ(st.commands_accepted, 0u);
   EXPECT_EQ(st.commands_stale, 0u);
-  EXPECT_EQ(rig.plant->command_receipt().received, 0u);
-  EXPECT_EQ(rig.plant->command_receipt().label_ns, -1);
-  EXPECT_EQ(rig.plant->latched_command(), before);
+  EXPECT_EQ(rig.plant.command_receipt().received, 0u);
+  EXPECT_EQ(rig.plant.command_receipt().label_ns, -1);
+  EXPECT_EQ(rig.plant.latched_command(), before);
   ASSERT_EQ(rig.log.size(), 2u);  // the 1st and the 101st
   EXPECT_EQ(rig.log[0],
             "plant: motor command from a writer other than the controller's ignored; 1 ignored so far (logged: 1st, "
@@ -525,7 +515,7 @@ TEST(PlantValidationTest, LogIsRateLimitedAndSaysHowMany) {
   EXPECT_NE(rig.log[0].find("0 values, expected 4 rotor speeds"), std::string::npos) << rig.log[0];
   EXPECT_NE(rig.log[0].find("1 rejected so far"), std::string::npos) << rig.log[0];
   EXPECT_NE(rig.log[2].find("201 rejected so far"), std::string::npos) << rig.log[2];
-  EXPECT_EQ(rig.plant->stats().commands_rejected, 250u);
+  EXPECT_EQ(rig.plant.stats().commands_rejected, 250u);
 }
 
 TEST(PlantValidationTest, HostileCommandStreamNeverMakesTheStateNonFinite) {
@@ -537,7 +527,7 @@ TEST(PlantValidationTest, HostileCommandStreamNeverMakesTheStateNonFinite) {
   for (Tick k = 0; k < 400; ++k) {
     rig.cmd.publish(command(evil[static_cast<std::size_t>(k) % evil.size()]));
     rig.tick(k);
-    const model::State& x = rig.plant->state();
+    const model::State& x = rig.plant.state();
     ASSERT_TRUE(x.p_W.allFinite() && x.v_W.allFinite() && x.w_B.allFinite() && x.omega_rad_s.allFinite() &&
                 x.q_WB.coeffs().allFinite())
         << "tick " << k;
