@@ -4,8 +4,10 @@
 Each `#include "folder/..."` line of a non-test source (not *_test.*, not *test_support*) is an edge
 from the folder the file is in to the folder it names. A folder may include folders of its own layer
 or of a layer above it in the table, never one below; and the folders may form no cycle of includes
-(within a layer as well). Prints every edge that breaks a rule, each with the lines behind it, and
-exits 1 if there is one; with --graph, also prints every folder edge and how many lines make it.
+(within a layer as well). Also the size rule: no non-test source under src/ (C++ or Python) over
+MAX_LINES lines, the vendored FMI headers (src/fmi/api/) aside. Prints every edge and file that
+breaks a rule, each edge with the lines behind it, and exits 1 if there is one; with --graph, also
+prints every folder edge and how many lines make it.
 
 Usage: scripts/check_layers.py [--graph] [REPOSITORY]   (default: the repository this script is in)
 """
@@ -23,6 +25,7 @@ LAYERS = [
     ("hosts", ["hosts"]),
     ("front ends", ["app", "python"]),
 ]
+MAX_LINES = 500
 RANK = {folder: i for i, (_, folders) in enumerate(LAYERS) for folder in folders}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"/]+)/[^"]+"')
 
@@ -77,6 +80,23 @@ def cycles_of(edges):
     return found
 
 
+def oversized(src):
+    """(path, lines) of the non-test sources over MAX_LINES lines."""
+    out = []
+    for top, _, files in os.walk(src):
+        for name in sorted(files):
+            path = os.path.join(top, name)
+            rel = os.path.relpath(path, src)
+            if not name.endswith((".cpp", ".hpp", ".h", ".py")) or rel.startswith(os.path.join("fmi", "api")) \
+                    or "_test" in name or name.startswith("test_") or "test_support" in name:
+                continue
+            with open(path, encoding="utf-8", errors="replace") as f:
+                n = sum(1 for _ in f)
+            if n > MAX_LINES:
+                out.append((rel, n))
+    return sorted(out)
+
+
 def main(argv):
     graph = "--graph" in argv
     args = [a for a in argv if a != "--graph"]
@@ -103,8 +123,11 @@ def main(argv):
         for (a, b), lines in sorted(edges.items()):
             if a in component and b in component:
                 print(f"  {a} -> {b}: {lines[0]}" + (f" (and {len(lines) - 1} more)" if len(lines) > 1 else ""))
+    for rel, n in oversized(src):
+        problems += 1
+        print(f"src/{rel}: {n} lines, over {MAX_LINES} (split it by job)")
     if problems == 0:
-        print(f"layers: {len(edges)} folder edges, none upward, no cycle")
+        print(f"layers: {len(edges)} folder edges, none upward, no cycle; no source over {MAX_LINES} lines")
     return 1 if problems else 0
 
 
