@@ -46,7 +46,7 @@ std::vector<std::pair<std::string, std::optional<double>>> figures_of(const RunR
     }
   };
   if (sc.hold) add("hold", io::hold_figure_names(), r.hold);
-  add("saturation", io::saturation_figure_names(), r.saturation);
+  add("saturation", io::saturation_figure_names(sc.vehicle.rotor_count), r.saturation);
   if (sc.tracking) add("tracking", analysis::tracking_figure_names(), r.tracking);
   return out;
 }

@@ -423,6 +423,39 @@ TEST(RunOne, SaturationIsJudgedAsRunJudgesItFromTheCsv) {
   fs::remove_all(dir);
 }
 
+// A hexarotor's sweep lists the saturation of each of its six rotors (rotor5, rotor6 beyond the four of a
+// quadrotor) in every run's figures. The Firefly's six rotors lift at most 6 k_t omega_max^2 = 36.0 N
+// (k_t 8.54858e-6 N s^2, 838 rad/s): at its own 1.53 kg it hovers at 541 rad/s, unsaturated; at 4.5 kg
+// (44.1 N of weight) every rotor reaches its limit as the controller (which keeps the nominal 1.53 kg)
+// pushes against the sinking.
+TEST(Summary, AHexarotorsSweepListsEachOfItsRotors) {
+  const fs::path dir = fs::temp_directory_path() / ("sweep_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path f = dir / "hex.yaml";
+  std::ofstream(f) << R"(name: hex
+vehicle: {preset: firefly}
+simulation: {plant_rate_hz: 100, controller_rate_hz: 50, duration_s: 1}
+initial: {position_m: [0, 0, 5], hover: true}
+controller: {type: se3, mode: position, z_des: 5}
+)";
+  const Plan p =
+      make_plan(f.string(), {"vehicle.mass_kg=grid(1.53,4.5)"}, 1, 1, Sampler::kRandom, hosts::test_resolvers());
+  ASSERT_EQ(p.nominal.vehicle.rotor_count, 6);
+  ASSERT_EQ(p.runs, 2);
+  const RunResult light = run_one(p, 0, {});
+  const RunResult heavy = run_one(p, 1, {});
+  ASSERT_TRUE(light.error.empty()) << light.error;
+  ASSERT_TRUE(heavy.error.empty()) << heavy.error;
+  const nlohmann::json fig = per_run_json(p, heavy)["figures"];
+  for (int k = 1; k <= 6; ++k) {
+    const std::string name = fmt::format("saturation.rotor{}_saturated_s", k);
+    ASSERT_TRUE(fig.contains(name)) << name;
+    EXPECT_GT(fig[name].get<double>(), 0.25) << name;
+    EXPECT_EQ(per_run_json(p, light)["figures"][name].get<double>(), 0.0) << name;
+  }
+  EXPECT_FALSE(fig.contains("saturation.rotor7_saturated_s"));
+}
+
 TEST(Summary, SameBytesWhateverTheThreadsAndTheOrderOfRuns) {
   const Plan p = make_plan(scenario_file().string(), {"mass=20%", "controller.altitude.kd=uniform(1,4)"}, 7, 6,
                            Sampler::kRandom, hosts::test_resolvers());
