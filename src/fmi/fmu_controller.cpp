@@ -149,7 +149,8 @@ struct FmuController::Shared {
   /// Per kind of the registry, the first FMU variable among its inputs (empty: the FMU has none).
   std::array<std::string, kSensorKinds> sensor_input;
   std::vector<ValueReference> in_vrs;
-  std::vector<ValueReference> out_vrs;  ///< omega_cmd[1..4], then the figures
+  int rotors = 4;                       ///< the FMU's omega_cmd outputs: one per rotor of the vehicle
+  std::vector<ValueReference> out_vrs;  ///< omega_cmd[1..rotors], then the figures
   std::vector<std::string> out_names;   ///< the FMU variable of each out_vrs entry
   std::vector<std::string> figure_names;
   control::ReportedOutputs reported;             ///< where among figure_names the FMU reports its attitude setpoint
@@ -174,14 +175,30 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
   sh->description = describe_fmu(*sh->fmu);
   const ModelDescription& md = sh->fmu->description();
   const std::string name = fmu_name(*sh->fmu);
-  if (vehicle.rotor_count != 4) {
-    throw FmuError(
-        fmt::format("{}: an FMU controller commands four rotors (omega_cmd[1..4]); the vehicle has {} "
-                    "(layout {})",
-                    name, vehicle.rotor_count, model::to_string(vehicle.layout)));
-  }
   check_signal_keys(mapping.inputs, all_inputs(), "inputs");
   check_signal_keys(mapping.outputs, kOutputs, "outputs");
+  // One command per rotor: the scenario's names, else omega_cmd[1..N] as the FMU declares them.
+  const std::vector<std::string>* given_cmd = given(mapping.outputs, "omega_cmd");
+  if (given_cmd) {
+    sh->rotors = static_cast<int>(given_cmd->size());
+    if (sh->rotors < model::kMinRotors || sh->rotors > model::kMaxRotors) {
+      throw MappingError("outputs.omega_cmd", fmt::format("got {} names, expected 4 to 8 (one rotor speed command "
+                                                          "per rotor of the vehicle)",
+                                                          sh->rotors));
+    }
+  } else {
+    int n = 0;
+    while (n < model::kMaxRotors && md.find(names::kOmegaCmdAll[static_cast<std::size_t>(n)])) ++n;
+    sh->rotors = std::max(n, model::kMinRotors);  // fewer than four: refused by name below
+  }
+  if (vehicle.rotor_count != sh->rotors) {
+    throw FmuError(
+        fmt::format("{}: the FMU controller outputs {} rotor speed commands (omega_cmd[1..{}]); the "
+                    "vehicle has {} rotors (layout {})",
+                    name, sh->rotors, sh->rotors, vehicle.rotor_count, model::to_string(vehicle.layout)));
+  }
+  Signal command = kOutputs[0];
+  command.names = names::omega_cmd(sh->rotors);
   bool observes = false;
   for (std::size_t i = 0; i < kInputs.size(); ++i) {
     const SignalRefs r = resolve_signal(md, name, kInputs[i], Side::kInput, given(mapping.inputs, kInputs[i].name));
@@ -207,10 +224,9 @@ FmuController::FmuController(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping
                                              "{{p_W: [x, y, z]}}",
                                              name));
   }
-  sh->out_vrs = resolve_signal(md, name, kOutputs[0], Side::kOutput, given(mapping.outputs, "omega_cmd"));
+  sh->out_vrs = resolve_signal(md, name, command, Side::kOutput, given_cmd);
   const std::vector<std::string> omega_names =
-      given(mapping.outputs, "omega_cmd") ? *given(mapping.outputs, "omega_cmd")
-                                          : std::vector<std::string>(names::kOmegaCmd.begin(), names::kOmegaCmd.end());
+      given_cmd ? *given_cmd : std::vector<std::string>(command.names.begin(), command.names.end());
   sh->out_names = omega_names;
   // The controller's own figures: the FMU's other Real outputs.
   for (const Variable& v : md.variables) {
@@ -396,15 +412,20 @@ void FmuController::step(const control::Observation& o, const control::Reference
     throw sim::ControllerFailure(fmt::format("{}: control step {} (t = {:g} s) failed: {}{}", describe(), steps_, t,
                                              e.what(), logged.empty() ? "" : " (the FMU logged: " + logged + ")"));
   }
-  for (std::size_t i = 0; i < 4; ++i) {
+  const auto rotors = static_cast<std::size_t>(shared_->rotors);
+  for (std::size_t i = 0; i < rotors; ++i) {
     if (!std::isfinite(out_[i])) {
       throw sim::ControllerFailure(fmt::format("{}: control step {} (t = {:g} s): output '{}' is {}; not commanded",
                                                describe(), steps_, t, shared_->out_names[i], out_[i]));
     }
   }
   ++steps_;
-  for (std::size_t i = 0; i < shared_->figure_names.size() && i < out.outputs.size(); ++i) out.outputs[i] = out_[4 + i];
-  control::rotor_speeds_output(model_, r, Eigen::Vector4d(out_[0], out_[1], out_[2], out_[3]), shared_->reported, out);
+  for (std::size_t i = 0; i < shared_->figure_names.size() && i < out.outputs.size(); ++i) {
+    out.outputs[i] = out_[rotors + i];
+  }
+  model::RotorVector omega(shared_->rotors);
+  for (std::size_t i = 0; i < rotors; ++i) omega[static_cast<Eigen::Index>(i)] = out_[i];
+  control::rotor_speeds_output(model_, r, omega, shared_->reported, out);
 }
 
 void FmuController::put_sensors(const sensors::Readings& readings) {

@@ -15,7 +15,8 @@
 //           [deg], gnss.altitude_m [m], gnss.v[1..3] [m/s]; names::sensor_variable), set from
 //           observation.sensors: the newest sample, NaN (a flag 0) before the first; an FMU with an
 //           input of a sensor the vehicle does not carry is refused at load (check_sensors);
-//   outputs omega_cmd [rad/s] x4, required.
+//   outputs omega_cmd [rad/s] xN, required: one per rotor, omega_cmd[1..N] by default (or the names
+//           the scenario gives); an FMU whose N is not the vehicle's rotor count is refused at load.
 // The status's U is the wrench of omega_cmd on the controller's vehicle (eq. (4)); the tracked
 // attitude (roll_des, pitch_des, yaw_des) is the reference's; attitude_error is NaN; saturation flags
 // are off. The FMU's other Real outputs (and locals it reports) are the controller's own figures

@@ -49,13 +49,13 @@ Variable var(std::string name, ValueReference vr, Causality c, std::string unit,
 /// A point mass moving along z under the four rotors' thrust k_t sum(omega^2) and gravity, with the
 /// plant FMU's default variable names (a subset: no attitude, rates or specific force), stepped
 /// exactly: constant acceleration over a step.
-ModelDescription point_mass_description() {
+ModelDescription point_mass_description(int rotors = 4) {
   ModelDescription md;
   md.fmi_version = "2.0";
   md.model_name = "PointMass";
   md.model_identifier = "point_mass";
   ValueReference vr = 1;
-  for (auto n : names::kOmegaCmd) md.variables.push_back(var(std::string(n), vr++, Causality::kInput, "rad/s"));
+  for (auto n : names::omega_cmd(rotors)) md.variables.push_back(var(std::string(n), vr++, Causality::kInput, "rad/s"));
   for (auto n : names::kPosition) md.variables.push_back(var(std::string(n), vr++, Causality::kOutput, "m"));
   for (auto n : names::kVelocity) md.variables.push_back(var(std::string(n), vr++, Causality::kOutput, "m/s"));
   md.variables.push_back(var("vehicle.mass_kg", vr++, Causality::kParameter, "kg", Variability::kFixed, "1"));
@@ -80,7 +80,7 @@ class PointMassInstance final : public Instance {
     j_.calls.push_back("step");
     if (fail_at_ >= 0 && t >= fail_at_) throw FmuError("fmi2DoStep: Error (the FMU logged: it broke)");
     double sum = 0.0;
-    for (auto n : names::kOmegaCmd) sum += value(std::string(n)) * value(std::string(n));
+    for (auto n : names::kOmegaCmdAll) sum += value(std::string(n)) * value(std::string(n));  // 0: absent
     const double a = value("vehicle.kt_N_per_rad2_s2") * sum / value("vehicle.mass_kg") - value("vehicle.gravity_m_s2");
     z_ += v_ * h + 0.5 * a * h * h;
     v_ += a * h;
@@ -178,6 +178,50 @@ TEST(FmuPlantAsPlant, StepsThePointMassAndSetsVehicleAndInitialState) {
   EXPECT_NEAR(y.p_W.z(), 2.0 + 0.5 * a * 1.0, 1e-9);
   EXPECT_NEAR(y.v_W.z(), a * 1.0, 1e-9);
   EXPECT_EQ(x.omega_rad_s, model::Vector4::Constant(w));
+}
+
+TEST(FmuPlantAsPlant, AHexarotorFmuTakesSixCommandsAndRefusesAQuadrotorNamingBothCounts) {
+  Journal j;
+  auto fmu = std::make_shared<MemoryFmu>(point_mass_description(6), j);
+  const FmuPlant plant(fmu, in_memory());
+  EXPECT_EQ(plant.rotor_count(), 6);
+  EXPECT_EQ(plant.refs().omega_cmd.size(), 6u);
+  const sim::TickClock clock{10'000'000};
+  const model::VehicleParams quad;
+  EXPECT_EQ(plant.check(quad),
+            "point_mass.fmu: the FMU plant takes 6 rotor speed commands (omega_cmd[1..6]); the vehicle has 4 rotors "
+            "(layout plus)");
+  EXPECT_THROW(plant.make(quad, model::State{}, clock), FmuError);
+
+  model::VehicleParams hex;
+  hex.set_layout(model::RotorLayout::kHexX);
+  EXPECT_EQ(plant.check(hex), "");
+  model::State x0;
+  x0.p_W = {0.0, 0.0, 2.0};
+  x0.omega_rad_s = model::RotorVector::Constant(6, 100.0);
+  auto d = plant.make(hex, x0, clock);
+  EXPECT_EQ(j.set.at("omega_cmd[6]"), 100.0);  // the initial speeds, the sixth included
+  // Six different commands: z(t) = z0 + a t^2 / 2 with a = k_t sum(w_i^2) / m - g.
+  model::RotorVector w(6);
+  w << 3000.0, 2900.0, 3100.0, 3000.0, 2950.0, 3050.0;
+  const double a = hex.kt_N_per_rad2_s2 * w.squaredNorm() / hex.mass_kg - hex.gravity_m_s2;
+  for (sim::Tick k = 0; k < 100; ++k) d->step(k, w);
+  model::Outputs y;
+  model::State x;
+  d->outputs(100, y, x);
+  EXPECT_NEAR(y.p_W.z(), 2.0 + 0.5 * a * 1.0, 1e-9);
+  EXPECT_EQ(x.omega_rad_s, w);  // no omega output: the command acting
+  EXPECT_EQ(j.set.at("omega_cmd[6]"), 3050.0);
+
+  FmuMapping three;
+  three.inputs["omega_cmd"] = {"omega_cmd[1]", "omega_cmd[2]", "omega_cmd[3]"};
+  try {
+    FmuPlant p(fmu, in_memory(three));
+    ADD_FAILURE() << "three rotor commands were taken";
+  } catch (const MappingError& e) {
+    EXPECT_EQ(e.key(), "inputs.omega_cmd");
+    EXPECT_NE(std::string(e.what()).find("got 3 names, expected 4 to 8"), std::string::npos) << e.what();
+  }
 }
 
 TEST(FmuPlantAsPlant, ScenarioParametersWinAndAreChecked) {
@@ -319,7 +363,7 @@ TEST(FmuPlantAsPlant, LoadedPointMassErrorNamesTheTickAndWhatItLogged) {
 
 /// A proportional altitude controller FMU: omega_cmd[i] = base + gain (ref.p_W[3] - p_W[3]) (NaN
 /// when gain is negative), its error as the output "error.z".
-ModelDescription altitude_controller_description() {
+ModelDescription altitude_controller_description(int rotors = 4) {
   ModelDescription md;
   md.fmi_version = "2.0";
   md.model_name = "Altitude";
@@ -327,7 +371,8 @@ ModelDescription altitude_controller_description() {
   ValueReference vr = 1;
   for (auto n : names::kPosition) md.variables.push_back(var(std::string(n), vr++, Causality::kInput, "m"));
   for (auto n : names::kRefPosition) md.variables.push_back(var(std::string(n), vr++, Causality::kInput, "m"));
-  for (auto n : names::kOmegaCmd) md.variables.push_back(var(std::string(n), vr++, Causality::kOutput, "rad/s"));
+  for (auto n : names::omega_cmd(rotors))
+    md.variables.push_back(var(std::string(n), vr++, Causality::kOutput, "rad/s"));
   md.variables.push_back(var("error.z", vr++, Causality::kOutput, "m"));
   Variable gain = var("controller.gain", vr++, Causality::kParameter, "rad/s/m", Variability::kTunable, "100");
   gain.min = -10.0;
@@ -441,6 +486,33 @@ TEST(FmuControllerAsController, StepsSetsInputsAndReadsTheCommand) {
                                              "step 0.02 0.02"};
   EXPECT_EQ(std::vector<std::string>(j.calls.end() - 5, j.calls.end()),
             std::vector<std::string>(expected.begin(), expected.end()));
+}
+
+TEST(FmuControllerAsController, AHexarotorFmuCommandsSixRotorsAndRefusesAQuadrotorNamingBothCounts) {
+  Journal j;
+  auto fmu = std::make_shared<ControllerFmu>(j, altitude_controller_description(6));
+  try {
+    FmuController c(fmu, in_memory(), model::VehicleParams{});
+    ADD_FAILURE() << "a six-rotor controller FMU was taken for a quadrotor";
+  } catch (const FmuError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "altitude.fmu: the FMU controller outputs 6 rotor speed commands (omega_cmd[1..6]); the vehicle has 4 "
+              "rotors (layout plus)");
+  }
+  model::VehicleParams hex;
+  hex.set_layout(model::RotorLayout::kHexPlus);
+  FmuController c(fmu, in_memory(), hex);
+  ASSERT_EQ(c.output_names().size(), 1u);  // omega_cmd[5..6] are commands, not figures
+  EXPECT_EQ(c.output_names()[0], "error.z");
+  control::Observation o;
+  o.p_W = {0.0, 0.0, 1.0};
+  control::Reference r;
+  r.p_W = {0.0, 0.0, 3.0};
+  control::ControllerOutput out;
+  out.outputs.resize(1);
+  c.step(o, r, 0.02, out);
+  EXPECT_EQ(out.omega_rad_s, model::RotorVector::Constant(6, 400.0 + 100.0 * 2.0));
+  EXPECT_EQ(out.outputs[0], 2.0);
 }
 
 TEST(FmuControllerAsController, ParametersAllOrNothingFixedOnesUntilTheFirstStepCloneAfresh) {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -24,6 +25,24 @@ const std::vector<std::string>* given(const std::map<std::string, std::vector<st
                                       std::string_view name) {
   const auto it = m.find(name);
   return it == m.end() ? nullptr : &it->second;
+}
+
+/// The rotor count of the FMU: the scenario's omega_cmd names, else how many of omega_cmd[1..8] the FMU
+/// declares (fewer than four: four, which then fail to resolve by name). MappingError when the names
+/// given are not 4 to 8.
+int fmu_rotor_count(const ModelDescription& md, const std::vector<std::string>* given_cmd) {
+  if (given_cmd) {
+    const auto n = static_cast<int>(given_cmd->size());
+    if (n < model::kMinRotors || n > model::kMaxRotors) {
+      throw MappingError("inputs.omega_cmd", fmt::format("got {} names, expected 4 to 8 (one rotor speed command per "
+                                                         "rotor of the vehicle)",
+                                                         n));
+    }
+    return n;
+  }
+  int n = 0;
+  while (n < model::kMaxRotors && md.find(names::kOmegaCmdAll[static_cast<std::size_t>(n)])) ++n;
+  return std::max(n, model::kMinRotors);
 }
 
 /// The FMU variable names of an output signal: the scenario's or the defaults.
@@ -75,31 +94,32 @@ void set_vehicle(Instance& instance, const ModelDescription& md, const model::Ve
       case model::VehicleParameter::Kind::kSigns: {
         model::VehicleParams copy = vehicle;
         const std::array<int, model::kMaxRotors>& signs = p.signs(copy);
-        for (std::size_t r = 0; r < 4; ++r) {
+        for (std::size_t r = 0; r < static_cast<std::size_t>(vehicle.rotor_count); ++r) {
           const Variable* v = md.find(fmt::format("{}[{}]", name, r + 1));
           if (!settable(v)) continue;
           set_value(instance, *v, signs[r]);
         }
         break;
       }
-      case model::VehicleParameter::Kind::kRotors: break;  // four-rotor FMUs only: the layout says it
+      case model::VehicleParameter::Kind::kRotors: break;  // the layout and the FMU's rotor count say it
     }
   }
   if (!vrs.empty()) instance.set_real(vrs, values);
 }
 
 /// initial.<output variable> for the state quadcosim starts from, where the FMU declares it.
-void set_initial(Instance& instance, const ModelDescription& md, const FmuMapping& mapping, const model::State& x) {
+void set_initial(Instance& instance, const ModelDescription& md, const FmuMapping& mapping,
+                 std::span<const Signal> outputs, const model::State& x) {
   const std::array<double, 3> p{x.p_W.x(), x.p_W.y(), x.p_W.z()}, v{x.v_W.x(), x.v_W.y(), x.v_W.z()},
       w{x.w_B.x(), x.w_B.y(), x.w_B.z()};
-  const std::array<double, 4> q{x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()},
-      omega{x.omega_rad_s[0], x.omega_rad_s[1], x.omega_rad_s[2], x.omega_rad_s[3]};
+  const std::array<double, 4> q{x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
+  const double* omega = x.omega_rad_s.data();  // one per rotor: as many as the omega signal's names
   const std::array<std::pair<std::string_view, const double*>, 5> initial = {
-      {{"p_W", p.data()}, {"v_W", v.data()}, {"q_WB", q.data()}, {"w_B", w.data()}, {"omega", omega.data()}}};
+      {{"p_W", p.data()}, {"v_W", v.data()}, {"q_WB", q.data()}, {"w_B", w.data()}, {"omega", omega}}};
   std::vector<ValueReference> vrs;
   std::vector<double> values;
   for (const auto& [signal, value] : initial) {
-    for (const Signal& s : kPlantOutputs) {
+    for (const Signal& s : outputs) {
       if (s.name != signal) continue;
       const std::vector<std::string> out = output_names(mapping, s);
       for (std::size_t i = 0; i < out.size(); ++i) {
@@ -139,6 +159,7 @@ class FmuDynamics final : public sim::ExternalDynamics {
     add(refs.omega, at_omega_);
     values_.resize(vrs_.size());
     command_ = initial.omega_rad_s;
+    omega_ = model::RotorVector::Zero(initial.omega_rad_s.size());
     read(0);
   }
   ~FmuDynamics() override { --*alive_; }
@@ -149,22 +170,27 @@ class FmuDynamics final : public sim::ExternalDynamics {
     x.v_W = y_.v_W;
     x.q_WB = y_.q_WB;
     x.w_B = y_.w_B;
-    x.omega_rad_s = at_omega_ >= 0 ? omega_ : command_;
+    model::assign_rotors(x.omega_rad_s, at_omega_ >= 0 ? omega_ : command_);
   }
 
   void step(sim::Tick k, const model::RotorVector& omega_rad_s) override {
-    const double cmd[4] = {omega_rad_s[0], omega_rad_s[1], omega_rad_s[2], omega_rad_s[3]};
     try {
       // Inputs hold their value: the command is set when it changed (every control period, not
       // every plant tick); command_ is the one the FMU holds (the initial speeds at first).
-      if (model::Vector4(omega_rad_s.head<4>()) != command_) instance_->set_real(omega_cmd_, cmd);
+      if (omega_rad_s.size() != command_.size() || omega_rad_s != command_) {
+        if (static_cast<std::size_t>(omega_rad_s.size()) != omega_cmd_.size()) {
+          throw FmuError(
+              fmt::format("{} rotor speed commands for the FMU's {}", omega_rad_s.size(), omega_cmd_.size()));
+        }
+        instance_->set_real(omega_cmd_, std::span<const double>(omega_rad_s.data(), omega_cmd_.size()));
+      }
       instance_->do_step(clock_.seconds(k), clock_.period_s());
     } catch (const InstanceInterrupted&) {
       throw;  // a stop request, not the FMU's failure
     } catch (const std::exception& e) {
       throw FmuError(fmt::format("{}: step at tick {} (t = {:g} s) failed: {}", name_, k, clock_.seconds(k), e.what()));
     }
-    command_ = omega_rad_s.head<4>();
+    model::assign_rotors(command_, omega_rad_s);
     read(k + 1);
   }
 
@@ -191,7 +217,9 @@ class FmuDynamics final : public sim::ExternalDynamics {
     y_.w_B = at_w_ >= 0 ? Eigen::Vector3d(v[at_w_], v[at_w_ + 1], v[at_w_ + 2]) : Eigen::Vector3d::Zero();
     y_.specific_force_B = at_f_ >= 0 ? Eigen::Vector3d(v[at_f_], v[at_f_ + 1], v[at_f_ + 2])
                                      : Eigen::Vector3d(y_.q_WB.conjugate() * Eigen::Vector3d(0.0, 0.0, gravity_));
-    if (at_omega_ >= 0) omega_ = {v[at_omega_], v[at_omega_ + 1], v[at_omega_ + 2], v[at_omega_ + 3]};
+    if (at_omega_ >= 0) {
+      for (Eigen::Index i = 0; i < omega_.size(); ++i) omega_[i] = v[at_omega_ + i];
+    }
   }
 
   std::unique_ptr<Instance> instance_;
@@ -204,8 +232,8 @@ class FmuDynamics final : public sim::ExternalDynamics {
   double gravity_;
   sim::TickClock clock_;
   model::Outputs y_;
-  model::Vector4 omega_ = model::Vector4::Zero();
-  model::Vector4 command_ = model::Vector4::Zero();
+  model::RotorVector omega_;    ///< the rotor speeds the FMU outputs, one per rotor
+  model::RotorVector command_;  ///< the command the FMU holds, one per rotor
   std::shared_ptr<std::atomic<int>> alive_;
 };
 
@@ -219,24 +247,35 @@ FmuPlant::FmuPlant(std::shared_ptr<Fmu> fmu, const FmuMapping& mapping) : fmu_(s
   const std::string name = fmu_name(*fmu_);
   check_signal_keys(mapping.inputs, kPlantInputs, "inputs");
   check_signal_keys(mapping.outputs, kPlantOutputs, "outputs");
-  refs_.omega_cmd = resolve_signal(md, name, kPlantInputs[0], Side::kInput, given(mapping.inputs, "omega_cmd"));
+  // The rotor count: omega_cmd[1..N] (and omega[1..N]) for N = the FMU's.
+  rotor_count_ = fmu_rotor_count(md, given(mapping.inputs, "omega_cmd"));
+  Signal command = kPlantInputs[0];
+  command.names = names::omega_cmd(rotor_count_);
+  outputs_.assign(kPlantOutputs.begin(), kPlantOutputs.end());
+  outputs_.back().names = names::rotor_speed(rotor_count_);
+  refs_.omega_cmd = resolve_signal(md, name, command, Side::kInput, given(mapping.inputs, "omega_cmd"));
   SignalRefs* outs[] = {&refs_.p_W, &refs_.v_W, &refs_.q_WB, &refs_.w_B, &refs_.f_B, &refs_.omega};
-  for (std::size_t i = 0; i < kPlantOutputs.size(); ++i) {
-    *outs[i] = resolve_signal(md, name, kPlantOutputs[i], Side::kOutput, given(mapping.outputs, kPlantOutputs[i].name));
+  for (std::size_t i = 0; i < outputs_.size(); ++i) {
+    *outs[i] = resolve_signal(md, name, outputs_[i], Side::kOutput, given(mapping.outputs, outputs_[i].name));
   }
   parameters_ = check_parameters(md, name, mapping);
 }
 
 std::string FmuPlant::describe() const { return describe_fmu(*fmu_); }
 
+std::string FmuPlant::check(const model::VehicleParams& vehicle) const {
+  if (vehicle.rotor_count == rotor_count_) return {};
+  return fmt::format(
+      "{}: the FMU plant takes {} rotor speed commands (omega_cmd[1..{}]); the vehicle has {} rotors "
+      "(layout {})",
+      fmu_name(*fmu_), rotor_count_, rotor_count_, vehicle.rotor_count, model::to_string(vehicle.layout));
+}
+
 std::unique_ptr<sim::ExternalDynamics> FmuPlant::make(const model::VehicleParams& vehicle, const model::State& initial,
                                                       const sim::TickClock& clock) const {
   const ModelDescription& md = fmu_->description();
   const std::string name = fmu_name(*fmu_);
-  if (vehicle.rotor_count != 4) {
-    throw FmuError(fmt::format("{}: an FMU plant flies four rotors (omega_cmd[1..4]); the vehicle has {} (layout {})",
-                               name, vehicle.rotor_count, model::to_string(vehicle.layout)));
-  }
+  if (std::string err = check(vehicle); !err.empty()) throw FmuError(err);
   if (md.can_be_instantiated_only_once_per_process && alive_->load() > 0) {
     throw FmuError(
         fmt::format("{} can be instantiated only once per process (canBeInstantiatedOnlyOncePerProcess); "
@@ -258,20 +297,18 @@ std::unique_ptr<sim::ExternalDynamics> FmuPlant::make(const model::VehicleParams
   } undo{&alive};
   try {
     set_vehicle(*instance, md, vehicle);
-    set_initial(*instance, md, mapping_, initial);
+    set_initial(*instance, md, mapping_, outputs_, initial);
     for (const ParameterSetting& p : parameters_) set_value(*instance, *p.variable, p.number);
     instance->enter_initialization(0.0);
     // The command acting before the first one arrives is the initial rotor speeds (as the native
     // plant latches them): the outputs at t = 0 (the specific force) are computed under it.
-    const double omega0[4] = {initial.omega_rad_s[0], initial.omega_rad_s[1], initial.omega_rad_s[2],
-                              initial.omega_rad_s[3]};
-    instance->set_real(refs_.omega_cmd, omega0);
+    instance->set_real(refs_.omega_cmd, std::span<const double>(initial.omega_rad_s.data(), refs_.omega_cmd.size()));
     instance->exit_initialization();
   } catch (const std::exception& e) {
     throw FmuError(fmt::format("{}: initialisation failed: {}", describe(), e.what()));
   }
   std::vector<std::string> names;
-  for (const Signal& s : kPlantOutputs) {
+  for (const Signal& s : outputs_) {
     const SignalRefs* r = s.name == "p_W"    ? &refs_.p_W
                           : s.name == "v_W"  ? &refs_.v_W
                           : s.name == "q_WB" ? &refs_.q_WB

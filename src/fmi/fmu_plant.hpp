@@ -7,13 +7,15 @@
 //      variable name (last, so they win); enter initialisation at start time 0, set omega_cmd to
 //      the initial rotor speeds (the command acting until the first one arrives, as the native
 //      plant latches them), exit initialisation;
-//   2. per plant tick k: set the four rotor speed commands, do_step(t_k, period), get the outputs.
+//   2. per plant tick k: set the rotor speed commands, do_step(t_k, period), get the outputs.
 // Signals (default FMU names in fmi/quadrotor_variables.hpp, a scenario may name its own):
-//   inputs  omega_cmd [rad/s] x4, required;
+//   inputs  omega_cmd [rad/s] xN, required: N (4..8) is the FMU's, omega_cmd[1..N] by default (the
+//           count of the names the scenario gives, if it gives them); make() refuses a vehicle with
+//           another rotor count;
 //   outputs p_W [m] x3 and v_W [m/s] x3, required; q_WB [1] (w, x, y, z; default identity: level,
 //           nose along +x), w_B [rad/s] (default zero), f_B [m/s2] (default R_BW (0, 0, g): what
 //           the accelerometer of an unaccelerated vehicle at that attitude reads, (0, 0, g) when
-//           level), omega [rad/s] x4 (default: the command acting, as ideal motors give).
+//           level), omega [rad/s] xN (default: the command acting, as ideal motors give).
 // The quaternion is used as given (not normalised); a non-finite output ends the run with a
 // message naming the variable and the tick.
 #pragma once
@@ -42,6 +44,8 @@ class FmuPlant final : public sim::ExternalDynamicsFactory {
   std::unique_ptr<sim::ExternalDynamics> make(const model::VehicleParams& vehicle, const model::State& initial,
                                               const sim::TickClock& clock) const override;
   std::string describe() const override;
+  /// Refuses a vehicle whose rotor count is not the FMU's (rotor_count()), naming both.
+  std::string check(const model::VehicleParams& vehicle) const override;
 
   const std::shared_ptr<Fmu>& fmu() const { return fmu_; }
 
@@ -50,11 +54,15 @@ class FmuPlant final : public sim::ExternalDynamicsFactory {
     SignalRefs omega_cmd, p_W, v_W, q_WB, w_B, f_B, omega;
   };
   const Refs& refs() const { return refs_; }
+  /// How many rotors the FMU flies: its omega_cmd inputs (the scenario's names, else omega_cmd[1..N]).
+  int rotor_count() const { return rotor_count_; }
 
  private:
   std::shared_ptr<Fmu> fmu_;
   FmuMapping mapping_;
   Refs refs_;
+  int rotor_count_ = 4;
+  std::vector<Signal> outputs_;  ///< plant_outputs() with omega's names for rotor_count_ rotors
   std::vector<ParameterSetting> parameters_;
   /// Instances made so far (they name them) and alive now (an FMU that can be instantiated only once
   /// per process refuses a second one while the first lives).

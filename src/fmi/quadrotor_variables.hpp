@@ -6,14 +6,21 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <string>
 #include <string_view>
 
 namespace quadcosim::fmi::names {
 
-// Plant FMU inputs, controller FMU outputs: the four rotor speed commands [rad/s].
-inline constexpr std::array<std::string_view, 4> kOmegaCmd = {"omega_cmd[1]", "omega_cmd[2]", "omega_cmd[3]",
-                                                              "omega_cmd[4]"};
+// Plant FMU inputs, controller FMU outputs: one rotor speed command per rotor [rad/s], for the
+// vehicle's N rotors (4..8) omega_cmd[1..N]; kOmegaCmd is a quadrotor's four. kRotorNames is
+// model::kMaxRotors (this header stays free of Eigen; fmu_variables.cpp checks that they agree).
+inline constexpr std::size_t kRotorNames = 8;
+inline constexpr std::array<std::string_view, kRotorNames> kOmegaCmdAll = {
+    "omega_cmd[1]", "omega_cmd[2]", "omega_cmd[3]", "omega_cmd[4]",
+    "omega_cmd[5]", "omega_cmd[6]", "omega_cmd[7]", "omega_cmd[8]"};
+inline constexpr std::array<std::string_view, 4> kOmegaCmd = {kOmegaCmdAll[0], kOmegaCmdAll[1], kOmegaCmdAll[2],
+                                                              kOmegaCmdAll[3]};
 
 // Controller FMU outputs besides the command: what the latest control step tracked, under the names
 // control::ReportedOutputs reads (roll, pitch, yaw of the desired attitude [rad]; the tilt flag [1]),
@@ -33,8 +40,19 @@ inline constexpr std::array<std::string_view, 3> kSpecificForce = {"f_B[1]", "f_
 // Plant FMU outputs only.
 /// Roll, pitch, yaw (Z-Y-X Euler angles) [rad].
 inline constexpr std::array<std::string_view, 3> kEuler = {"euler[1]", "euler[2]", "euler[3]"};
-/// Rotor speeds reached (after the motors' lag) [rad/s].
-inline constexpr std::array<std::string_view, 4> kRotorSpeed = {"omega[1]", "omega[2]", "omega[3]", "omega[4]"};
+/// Rotor speeds reached (after the motors' lag) [rad/s]: omega[1..N]; kRotorSpeed is a quadrotor's four.
+inline constexpr std::array<std::string_view, kRotorNames> kRotorSpeedAll = {
+    "omega[1]", "omega[2]", "omega[3]", "omega[4]", "omega[5]", "omega[6]", "omega[7]", "omega[8]"};
+inline constexpr std::array<std::string_view, 4> kRotorSpeed = {kRotorSpeedAll[0], kRotorSpeedAll[1], kRotorSpeedAll[2],
+                                                                kRotorSpeedAll[3]};
+
+/// The names of the first `rotors` (at most model::kMaxRotors) commands or speeds.
+inline std::span<const std::string_view> omega_cmd(int rotors) {
+  return std::span(kOmegaCmdAll).first(static_cast<std::size_t>(rotors));
+}
+inline std::span<const std::string_view> rotor_speed(int rotors) {
+  return std::span(kRotorSpeedAll).first(static_cast<std::size_t>(rotors));
+}
 
 /// The plant FMU's outputs of its extra sensors (sensors/registry.hpp), when the scenario it was
 /// exported from configures them: "<sensor>.<column>", a vector's components 1-based

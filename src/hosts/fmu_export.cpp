@@ -52,12 +52,6 @@ fmi::FmuConfig fmu_config_from(const FmuExportOptions& o, std::vector<std::strin
   c.substeps = sim.plant.substeps;
   c.controller_divider = sim.controller_divider;
   if (!o.scenario.empty()) c.stop_time_s = sim.plant.clock.seconds(sim.duration_ticks);
-  if (sc.vehicle.rotor_count != 4) {
-    throw io::ConfigError(
-        fmt::format("fmu export: the FMUs (omega_cmd[1..4], omega[1..4], rotor_saturated[1..4]) carry four rotors; the "
-                    "scenario's vehicle has {} (layout {})",
-                    sc.vehicle.rotor_count, model::to_string(sc.vehicle.layout)));
-  }
   c.vehicle = sc.vehicle;
   c.initial = io::initial_state(sc);
   c.realism = sim.plant.realism;

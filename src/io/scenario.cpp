@@ -360,6 +360,7 @@ Scenario read_scenario(YamlSection root, const std::string& path, const Scenario
     sc.plant_fmu = read_fmu_spec(*p, std::filesystem::path(path).parent_path());
     p->reject_unknown_keys();
     sc.simulation.plant.external = make_plant_fmu(*p, *sc.plant_fmu, resolvers);
+    if (std::string err = sc.simulation.plant.external->check(sc.vehicle); !err.empty()) p->fail("fmu", err);
     if (std::string key = sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle); !key.empty()) {
       root.fail(key, "acts inside quadcosim's own plant model only, not with plant: {fmu: ...}");
     }
@@ -404,6 +405,7 @@ YAML::Node fmu_node(const FmuSpec& spec) {
 void use_plant_fmu(Scenario& sc, const FmuSpec& spec, const std::string& source, const ScenarioResolvers& resolvers) {
   YamlSection s(fmu_node(spec), source, "");
   sc.simulation.plant.external = make_plant_fmu(s, spec, resolvers);
+  if (std::string err = sc.simulation.plant.external->check(sc.vehicle); !err.empty()) s.fail("fmu", err);
   sc.plant_fmu = spec;
   if (std::string key = sim::external_plant_conflict(sc.simulation.plant.realism, sc.vehicle); !key.empty()) {
     throw ConfigError((sc.path.empty() ? std::string("scenario") : sc.path) + ": " + key +

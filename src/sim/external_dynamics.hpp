@@ -35,6 +35,9 @@ class ExternalDynamicsFactory {
                                                  const TickClock& clock) const = 0;
   /// For logs and reports: "FMU quadrotor.fmu (model 'Quadrotor', FMI 2.0)".
   virtual std::string describe() const = 0;
+  /// "" when make() can fly `vehicle`, else why not (the FMU has another rotor count): what a
+  /// scenario is checked by when it is loaded, so that the refusal is bad input, not a failed run.
+  virtual std::string check(const model::VehicleParams& /*vehicle*/) const { return {}; }
 };
 
 }  // namespace quadcosim::sim

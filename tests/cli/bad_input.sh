@@ -167,7 +167,12 @@ expect 2 "param_range.yaml: controller.roll_des: unknown parameter 'controller.r
 expect 2 "vehicle_bad.yaml: layout: got 'h'" lqr --vehicle vehicle_bad.yaml
 # Vehicles with other rotor counts: a singular rotor set, and the paths that fly quadrotors only.
 expect 2 "hex_singular.yaml: spin: ;;layout hex_x leaves the mixer singular" lqr --vehicle hex_singular.yaml
-expect 2 "carry four rotors;;has 6 (layout hex_x)" fmu export plant --scenario "$SRC/scenarios/tracking/circle_se3_firefly.yaml" --out ff.fmu
+# A hexarotor's FMUs (omega_cmd[1..6]) with the paper's quadrotor: both rotor counts named.
+"$QC" fmu export plant --scenario "$SRC/scenarios/tracking/circle_se3_firefly.yaml" --out ff.fmu > /dev/null
+"$QC" fmu export controller --scenario "$SRC/scenarios/tracking/circle_se3_firefly.yaml" --out ffc.fmu > /dev/null
+{ cat "$ALT"; echo; echo "plant: {fmu: ff.fmu}"; } > alt_ff.yaml
+expect 2 "alt_ff.yaml: plant.fmu: ff.fmu: the FMU plant takes 6 rotor speed commands (omega_cmd[1..6]);;the vehicle has 4 rotors (layout plus)" run alt_ff.yaml --out o --no-plots
+expect 2 "controller.fmu: ffc.fmu: the FMU controller outputs 6 rotor speed commands (omega_cmd[1..6]);;the vehicle has 4 rotors (layout plus)" run "$ALT" --controller fmu:ffc.fmu --out o --no-plots
 expect 2 "layout hex_x with 6 rotors;;quadrotor frames only" run sitl_hex.yaml --out sitl_hex --no-plots
 expect 2 "--commands: File does not exist: missing.csv" openloop --commands missing.csv --out t.csv
 expect 2 "short.csv:2: expected 5 values (t,w1,w2,w3,w4), got 4" openloop --commands short.csv --out t.csv

@@ -355,6 +355,75 @@ assert (start(a), start(c)) == ("10", "3"), (start(a), start(c))  # roll_step st
 PYEOF
     ;;
 
+  quadrotor_unchanged)  # the paper's FMUs declare what they always did, byte for byte (GUID included)
+    # sha256 of modelDescription.xml and resources/quadcosim.json, from the exports before the FMUs
+    # were sized by the rotor count (commit 64ebb29): the rotors past four must not move a byte of them.
+    while read -r kind version xml json; do
+      "$QC" fmu export "$kind" --fmi "$version" --scenario "$P/altitude_step.yaml" --out "$TMP/q.fmu" > /dev/null \
+        || fail "fmu export $kind --fmi $version failed"
+      "$PY" - "$TMP/q.fmu" "$xml" "$json" <<'PYEOF' || fail "$kind FMI $version: the quadrotor's FMU changed"
+import hashlib, sys, zipfile
+z = zipfile.ZipFile(sys.argv[1])
+for entry, want in (("modelDescription.xml", sys.argv[2]), ("resources/quadcosim.json", sys.argv[3])):
+    got = hashlib.sha256(z.read(entry)).hexdigest()
+    assert got == want, f"{entry}: sha256 {got}, expected {want}"
+PYEOF
+    done <<'EOF2'
+plant 2 931a2d57fb7c16ad39fd8b9569cb8d3b07df0d2564f546fc799a8320c54a6a8f d8aaefd524073b6cee55543b7f08127b29f719dc352465836de51388ebefad51
+plant 3 20a98b3b51034e7f898847bedb2bf48ee4ccf85b82d145b5c5953a7896a14864 3c1ba8f4761fb8d1f38762e3874db2c01d0e67413d4728dbb3177d8febbce863
+controller 2 a71065d04fb507574d59d320ecd5835fedb1c51556ebf9ce06d4bd4c907536ee a627c34cf5a909d88fc45d054490b1c720152dd1506821769a1be69d80374e17
+EOF2
+    ;;
+
+  export_rotors)  # a hexarotor's and a custom octorotor's FMUs: one command per rotor, the rotors in the JSON
+    "$QC" fmu export plant --scenario "$P/altitude_step.yaml" --out "$TMP/quad.fmu" > /dev/null || fail "quad export"
+    for spec in "plant 2 tracking/circle_se3_firefly" "plant 3 tracking/circle_se3_firefly" \
+                "controller 2 tracking/circle_se3_firefly" "controller 3 tracking/circle_se3_firefly" \
+                "plant 2 examples/octo_custom_step" "controller 3 examples/octo_custom_step"; do
+      read -r kind version scenario <<< "$spec"
+      out="$TMP/$kind$version.fmu"
+      "$QC" fmu export "$kind" --fmi "$version" --scenario "$SRC/scenarios/$scenario.yaml" --out "$out" > "$TMP/export.txt" \
+        || fail "fmu export $kind --fmi $version --scenario $scenario exited $?"
+      "$PY" - "$out" "$kind" "$version" "$TMP/quad.fmu" <<'PYEOF' || fail "$kind FMI $version of $scenario"
+import json, sys, zipfile
+import xml.etree.ElementTree as ET
+fmu, kind, version, quad = sys.argv[1:5]
+def variables(path):
+    root = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
+    elems = root.find("ModelVariables")
+    elems = list(elems) if version == "3" else elems.findall("ScalarVariable")
+    return {e.get("name"): (int(e.get("valueReference")), e.get("causality")) for e in elems}, root
+config = json.loads(zipfile.ZipFile(fmu).read("resources/quadcosim.json"))
+vehicle = config["vehicle"]
+n = len(vehicle["spin"])
+custom = vehicle["layout"] == "custom"
+assert (vehicle["layout"], n) in (("hex_x", 6), ("custom", 8)), (vehicle["layout"], n)
+assert ("rotors" in vehicle) == custom
+if custom:  # the scenario's X8: upper and lower rotors 8 cm apart on four arms
+    assert [r["position_m"][2] for r in vehicle["rotors"]] == [0.04, -0.04] * 4, vehicle["rotors"]
+    assert [r["spin"] for r in vehicle["rotors"]] == vehicle["spin"] == [1, -1, -1, 1, 1, -1, -1, 1]
+assert len(config["initial"]["omega"]) == n
+got, root = variables(fmu)
+side = "input" if kind == "plant" else "output"
+commands = sorted((vr, name) for name, (vr, c) in got.items() if name.startswith("omega_cmd"))
+assert [name for _, name in commands] == [f"omega_cmd[{i}]" for i in range(1, n + 1)], commands
+assert all(got[name][1] == side for _, name in commands)
+if kind == "plant":
+    for i in range(1, n + 1):
+        assert got[f"omega[{i}]"][1] == "output" and got[f"initial.omega[{i}]"][1] == "parameter", i
+    assert f"omega[{n + 1}]" not in got
+    # Each variable of the quadrotor's plant FMU keeps its value reference; rotors 5..N come after `period`.
+    if version == "2":
+        same, _ = variables(quad)
+        moved = [name for name, (vr, _) in same.items() if got.get(name, (None,))[0] != vr]
+        assert not moved, f"value references moved: {moved}"
+for i in range(5, n + 1):
+    assert got[f"omega_cmd[{i}]"][0] > got["period"][0], i
+print(f"ok: {kind} FMI {version}: {n} rotors, omega_cmd[1..{n}] {side}s")
+PYEOF
+    done
+    ;;
+
   bad_input)
     expect_error 2 "kind: rocket not in {plant,controller}" fmu export rocket --out "$TMP/x.fmu"
     expect_error 2 "--fmi: 4 not in {2,3}" fmu export plant --fmi 4 --out "$TMP/x.fmu"

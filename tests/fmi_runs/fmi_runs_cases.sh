@@ -33,6 +33,27 @@ plant_round_trip() {
   echo "$s: trajectory.csv byte-identical with the exported plant FMU ${*:-in-process}"
 }
 
+# A vehicle with more than four rotors, $1 a scenario file, its exported plant FMU (omega_cmd[1..N]) as
+# the plant: trajectory.csv byte-identical to the native run's, rotor columns w1..wN and cmd1..cmdN
+# included; $2: the rotor count the FMU must declare; further arguments: export flags (--fmi 3).
+plant_round_trip_rotors() {
+  local s="$1" n="$2"; shift 2
+  need_export
+  export_fmu "$s" plant "$tmp/plant.fmu" "$@"
+  python3 - "$tmp/plant.fmu" "$n" <<'PY' || fail "$(basename "$s"): the plant FMU does not have $n rotor commands"
+import re, sys, zipfile
+xml = zipfile.ZipFile(sys.argv[1]).read("modelDescription.xml").decode()
+names = re.findall(r'name="(omega_cmd\[\d+\])"', xml)
+assert names == [f"omega_cmd[{i}]" for i in range(1, int(sys.argv[2]) + 1)], names
+PY
+  with_key "$s" "plant: {fmu: plant.fmu}" "$tmp/fmu.yaml"
+  "$bin" run "$s" --out "$tmp/native" --no-plots > "$tmp/native.log" 2>&1 || fail "native run failed"
+  "$bin" run "$tmp/fmu.yaml" --out "$tmp/fmu" --no-plots > "$tmp/fmu.log" 2>&1 || fail "FMU plant run failed: $(tail -3 "$tmp/fmu.log")"
+  head -1 "$tmp/fmu/trajectory.csv" | grep -q ",w$n,cmd1," || fail "trajectory.csv has no w$n column"
+  cmp "$tmp/native/trajectory.csv" "$tmp/fmu/trajectory.csv" || fail "$(basename "$s"): trajectory.csv differs with the FMU plant"
+  echo "$(basename "$s"): trajectory.csv byte-identical with its $n-rotor plant FMU ${*:-(FMI 2)}"
+}
+
 # The paper altitude step with the exported paper controller as the controller. The state, rotor
 # speed, command, setpoint and flag columns (t .. cmd4, x_des .. z_des, safety, watchdog) must be
 # byte-identical; the other status columns (U, the tracked attitude, the saturation flags, att_err)
@@ -55,10 +76,10 @@ controller_round_trip() {
 }
 
 
-# The columns of trajectory.csv that the plant and the controller's command make (t .. cmd4) and the
+# The columns of trajectory.csv that the plant and the controller's command make (t .. cmdN) and the
 # node's flags: what must match when only the controller is an FMU (see controller_round_trip).
 state_columns() {
-  head -1 "$1" | tr ',' '\n' | grep -n -E '^(t|x|y|z|vx|vy|vz|qw|qx|qy|qz|roll|pitch|yaw|p|q|r|w[1-4]|cmd[1-4]|safety|watchdog)$' \
+  head -1 "$1" | tr ',' '\n' | grep -n -E '^(t|x|y|z|vx|vy|vz|qw|qx|qy|qz|roll|pitch|yaw|p|q|r|w[1-8]|cmd[1-8]|safety|watchdog)$' \
     | cut -d: -f1 | paste -sd,
 }
 
@@ -168,6 +189,9 @@ case "$case_name" in
   controller_trajectory_circle) controller_trajectory_round_trip circle_se3 ;;
   controller_trajectory_waypoints_fmi3) controller_trajectory_round_trip waypoints_se3 --fmi 3 ;;
   controller_trajectory_external) controller_trajectory_external ;;
+  plant_round_trip_hexarotor) plant_round_trip_rotors "$src/scenarios/tracking/circle_se3_firefly.yaml" 6 ;;
+  plant_round_trip_octorotor_fmi3) plant_round_trip_rotors "$src/scenarios/examples/octo_custom_step.yaml" 8 --fmi 3 ;;
+  controller_trajectory_hexarotor) controller_trajectory_round_trip circle_se3_firefly ;;
   node_fmu_flags)  # `plant --fmu` and `controller --fmu` over DDS lockstep: the native trajectory again
     need_export
     export_fmu "$paper/altitude_step.yaml" plant "$tmp/plant.fmu"

@@ -50,7 +50,7 @@ class ControllerModel final : public Model {
         ref_yaw_rate_(find_vr(md, "ref.yaw_rate")),
         ref_roll_(find_vr(md, "ref.roll")),
         ref_pitch_(find_vr(md, "ref.pitch")),
-        omega_cmd_(find_vrs(md, names::kOmegaCmd)),
+        omega_cmd_(find_vrs(md, names::omega_cmd(c.vehicle.rotor_count))),
         attitude_des_(find_vrs(md, names::kReportedAttitude)),
         tilt_saturated_(find_vr(md, names::kTiltSaturated)) {
     if (c.trajectory) {
@@ -157,7 +157,13 @@ class ControllerModel final : public Model {
       }
       controller_->step(o, r, dt_s_, output_);
     }
-    for (std::size_t i = 0; i < 4; ++i) v.number[omega_cmd_[i]] = output_.omega_rad_s[static_cast<Eigen::Index>(i)];
+    if (static_cast<std::size_t>(output_.omega_rad_s.size()) != omega_cmd_.size()) {
+      return "the controller's command has " + std::to_string(output_.omega_rad_s.size()) + " values for " +
+             std::to_string(omega_cmd_.size()) + " rotors (omega_cmd[1.." + std::to_string(omega_cmd_.size()) + "])";
+    }
+    for (std::size_t i = 0; i < omega_cmd_.size(); ++i) {
+      v.number[omega_cmd_[i]] = output_.omega_rad_s[static_cast<Eigen::Index>(i)];
+    }
     v.number[attitude_des_[0]] = output_.roll_des_rad;
     v.number[attitude_des_[1]] = output_.pitch_des_rad;
     v.number[attitude_des_[2]] = output_.yaw_des_rad;
@@ -197,7 +203,7 @@ class ControllerModel final : public Model {
   std::array<ValueReference, 4> q_;
   std::array<ValueReference, 3> w_, f_, ref_p_, ref_v_, ref_a_, ref_j_;
   ValueReference ref_yaw_, ref_yaw_rate_, ref_roll_, ref_pitch_;
-  std::array<ValueReference, 4> omega_cmd_;
+  std::vector<ValueReference> omega_cmd_;       ///< omega_cmd[1..N], one per rotor
   std::array<ValueReference, 3> attitude_des_;  ///< roll_des, pitch_des, yaw_des
   ValueReference tilt_saturated_;
   std::vector<ValueReference> figures_;  ///< the controller's output_names(), in order

@@ -94,12 +94,15 @@ std::string make_guid(const FmuConfig& config);
 /// canHandleVariableCommunicationStepSize false: a step must be a whole number of periods),
 /// DefaultExperiment (start 0, stopTime, stepSize one period) and the variables with their value
 /// references, causality, variability, initial, start, unit, description and bounds. Value reference
-/// 0 is `time` (causality independent); the others follow in the order below.
+/// 0 is `time` (causality independent); the others follow in the order below. N is the vehicle's
+/// rotor count (4..8): rotors 5..N come last, after `period` (omega_cmd[5..N], then for the plant
+/// omega[5..N] and initial.omega[5..N]), so that every variable of a quadrotor's FMU keeps its
+/// value reference and a quadrotor's description is what it was before N could differ.
 ///
 /// Plant FMU (period: the plant period):
-///   inputs       omega_cmd[1..4] [rad/s], start initial.omega
+///   inputs       omega_cmd[1..N] [rad/s], start initial.omega
 ///   outputs      p_W[1..3], v_W[1..3], q_WB[1..4] (w x y z), euler[1..3] (roll pitch yaw), w_B[1..3],
-///                f_B[1..3] (specific force), omega[1..4] (rotor speeds reached)
+///                f_B[1..3] (specific force), omega[1..N] (rotor speeds reached)
 ///   parameters   (fixed: they take effect when initialisation ends) vehicle.<name> for every numeric
 ///                vehicle parameter, initial.<output> for p_W, v_W, q_WB, w_B, omega, the realism
 ///                switches realism.wind, realism.rotor_faults, realism.sensor_noise (Boolean) and
@@ -108,11 +111,12 @@ std::string make_guid(const FmuConfig& config);
 ///   inputs       p_W, v_W, q_WB, w_B, f_B (the plant's outputs), ref.p_W, ref.v_W, ref.a_W, ref.j_W,
 ///                ref.yaw, ref.yaw_rate, ref.roll, ref.pitch (start: the setpoint, or the trajectory at
 ///                t = 0)
-///   outputs      omega_cmd[1..4] [rad/s] (discrete)
+///   outputs      omega_cmd[1..N] [rad/s] (discrete)
 ///   parameters   (tunable) controller.<name> for every declared controller parameter (Real, or String
 ///                for a choice); with a trajectory, (fixed) ref.external (Boolean, start false: the
 ///                trajectory is the reference; true: the ref.* inputs are, in position mode)
-/// Throws FmuError when the controller type is unknown or its parameters are refused.
+/// Throws FmuError when the controller type is unknown or its parameters are refused, or the vehicle's
+/// rotor count is not 4..8 or not that of initial.omega.
 ModelDescription describe(const FmuConfig& config);
 
 }  // namespace quadcosim::fmi

@@ -87,10 +87,43 @@ sim::SensorTiming read_timing(const Reader& r) {
   return {r.at("divider").integer<int>(), r.at("latency_ticks").integer<int>()};
 }
 
+/// A spin sign: 1 or -1.
+int read_spin(const Reader& e) {
+  const double s = e.number();
+  if (s != 1.0 && s != -1.0) e.fail("", "is not 1 or -1");
+  return static_cast<int>(s);
+}
+
+/// vehicle.rotors: a custom layout's 4 to 8 rotors, each {position_m: [x, y, z], spin: 1 or -1}.
+void read_rotors(const Reader& e, model::VehicleParams& v) {
+  if (!e.raw().is_array() || e.raw().size() < static_cast<std::size_t>(model::kMinRotors) ||
+      e.raw().size() > static_cast<std::size_t>(model::kMaxRotors)) {
+    e.fail("", "is not a list of 4 to 8 rotors {position_m: [x, y, z], spin: 1 or -1}");
+  }
+  v.rotor_count = static_cast<int>(e.raw().size());
+  for (std::size_t i = 0; i < e.raw().size(); ++i) {
+    const Reader rotor = Reader(e.raw()[i], e.path() + "[" + std::to_string(i) + "]").with_source(e.source());
+    if (!rotor.raw().is_object()) rotor.fail("", "is not {position_m: [x, y, z], spin: 1 or -1}");
+    v.rotor_positions_m[i] = rotor.at("position_m").vector<3>();
+    v.spin[i] = read_spin(rotor.at("spin"));
+  }
+}
+
 model::VehicleParams read_vehicle(const Reader& r) {
   model::VehicleParams v;
+  // In the table's order: the layout (which sets a standard layout's rotor count), the rotors (a custom
+  // layout's count, positions and spins), then one spin sign per rotor.
   for (const auto& p : model::vehicle_parameters()) {
-    if (p.kind == model::VehicleParameter::Kind::kRotors) continue;  // an exported FMU flies four rotors
+    if (p.kind == model::VehicleParameter::Kind::kRotors) {
+      const std::string key(p.name);
+      if (v.layout == model::RotorLayout::kCustom) {
+        read_rotors(r.at(key), v);
+      } else if (r.has(key)) {
+        r.at(key).fail("", std::string("is given, but layout ") + model::to_string(v.layout) +
+                               " places its rotors itself (rotors go with layout custom)");
+      }
+      continue;
+    }
     const Reader e = r.at(std::string(p.name));
     switch (p.kind) {
       case model::VehicleParameter::Kind::kNumber: p.ref(v) = e.number(); break;
@@ -103,17 +136,40 @@ model::VehicleParams read_vehicle(const Reader& r) {
         break;
       }
       case model::VehicleParameter::Kind::kSigns: {
-        const Eigen::Vector4d s = e.vector<4>();
-        for (int i = 0; i < 4; ++i) {
-          if (s[i] != 1.0 && s[i] != -1.0) e.fail("", "has an entry that is neither 1 nor -1");
-          v.spin[static_cast<std::size_t>(i)] = static_cast<int>(s[i]);
+        const auto n = static_cast<std::size_t>(v.rotor_count);
+        if (!e.raw().is_array() || e.raw().size() != n) {
+          e.fail("", "is not a list of " + std::to_string(n) + " signs (one per rotor of layout " +
+                         model::to_string(v.layout) + ")");
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+          const Reader sign = Reader(e.raw()[i], e.path() + "[" + std::to_string(i) + "]").with_source(e.source());
+          const int s = read_spin(sign);
+          if (v.layout == model::RotorLayout::kCustom && s != v.spin[i]) {
+            sign.fail("", "is " + std::to_string(s) + ", but rotors[" + std::to_string(i) + "].spin is " +
+                              std::to_string(v.spin[i]));
+          }
+          v.spin[i] = s;
         }
         break;
       }
-      case model::VehicleParameter::Kind::kRotors: break;  // an exported FMU flies four rotors
+      case model::VehicleParameter::Kind::kRotors: break;  // read above
     }
   }
+  // The rotor rules of a vehicle file (count, signs, distinct positions, a mixer of full rank).
+  if (std::string err = model::validate_rotors(v); !err.empty()) {
+    r.at(v.layout == model::RotorLayout::kCustom ? "rotors" : "spin").fail("", "is refused: " + err);
+  }
   return v;
+}
+
+/// `n` numbers, one per rotor.
+model::RotorVector read_rotor_vector(const Reader& e, int n) {
+  if (!e.raw().is_array() || e.raw().size() != static_cast<std::size_t>(n)) {
+    e.fail("", "not an array of " + std::to_string(n) + " numbers (one per rotor)");
+  }
+  model::RotorVector x(n);
+  for (int i = 0; i < n; ++i) x[i] = Reader(e.raw()[static_cast<std::size_t>(i)], e.path()).number();
+  return x;
 }
 
 trajectory::YawMode read_yaw_mode(const Reader& r, bool centre_allowed) {
@@ -237,7 +293,7 @@ FmuConfig config_from_json(std::string_view text, const std::string& source) {
   const Eigen::Vector4d q = init.at("q_WB").vector<4>();
   c.initial.q_WB = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
   c.initial.w_B = init.at("w_B").vector<3>();
-  c.initial.omega_rad_s = init.at("omega").vector<4>();
+  c.initial.omega_rad_s = read_rotor_vector(init.at("omega"), c.vehicle.rotor_count);
 
   const Reader re = r.at("realism");
   auto& m = c.realism;
@@ -274,7 +330,10 @@ FmuConfig config_from_json(std::string_view text, const std::string& source) {
   for (std::size_t i = 0; i < faults.raw().size(); ++i) {
     const Reader f = Reader(faults.raw()[i], faults.path() + "[" + std::to_string(i) + "]").with_source(source);
     sim::RotorFault rf{f.at("tick").integer<sim::Tick>(), f.at("rotor").integer<int>(), f.at("efficiency").number()};
-    if (rf.rotor < 0 || rf.rotor > 3) f.at("rotor").fail("", "must be 0..3");
+    if (rf.rotor < 0 || rf.rotor >= c.vehicle.rotor_count) {
+      f.at("rotor").fail("", "must be 0.." + std::to_string(c.vehicle.rotor_count - 1) + " (one of the vehicle's " +
+                                 std::to_string(c.vehicle.rotor_count) + " rotors)");
+    }
     m.faults.push_back(rf);
   }
   if (re.has("extra_sensors")) {  // absent from the configurations of FMUs exported before there were any

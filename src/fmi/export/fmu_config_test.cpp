@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <map>
 #include <set>
 #include <string>
@@ -275,3 +277,168 @@ TEST(FmuConfig, ControllerWithATrajectoryStartsOnIt) {
 
 }  // namespace
 }  // namespace quadcosim::fmi
+
+// A vehicle's rotors in the configuration: the layout, one spin sign per rotor and a custom layout's
+// positions, read back exactly; a bad rotor list is refused naming the field.
+namespace quadcosim::fmi::rotors {
+
+/// The variable `name` of `md`, or nullptr (ModelDescription::find is the importer's library's).
+const Variable* find(const ModelDescription& md, std::string_view name) {
+  for (const Variable& v : md.variables) {
+    if (v.name == name) return &v;
+  }
+  return nullptr;
+}
+
+/// `v` as describe() writes start values: the shortest text that reads back to the same double.
+std::string to_json_number(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+/// The custom coaxial X8 of scenarios/examples/octo_custom_step.yaml.
+model::VehicleParams octo_x8() {
+  model::VehicleParams v;
+  v.mass_kg = 2.4;
+  v.kt_N_per_rad2_s2 = 8.54858e-6;
+  v.km_Nm_per_rad2_s2 = 1.367773e-7;
+  v.set_layout(model::RotorLayout::kCustom);
+  v.rotor_count = 8;
+  const double a = 0.2475;
+  const std::array<Eigen::Vector3d, 8> p = {Eigen::Vector3d(a, a, 0.04),
+                                            {a, a, -0.04},
+                                            {a, -a, 0.04},
+                                            {a, -a, -0.04},
+                                            {-a, -a, 0.04},
+                                            {-a, -a, -0.04},
+                                            {-a, a, 0.04},
+                                            {-a, a, -0.04}};
+  const std::array<int, 8> spin = {1, -1, -1, 1, 1, -1, -1, 1};
+  for (std::size_t i = 0; i < 8; ++i) {
+    v.rotor_positions_m[i] = p[i];
+    v.spin[i] = spin[i];
+  }
+  return v;
+}
+
+model::VehicleParams hex_x() {
+  model::VehicleParams v;
+  v.set_layout(model::RotorLayout::kHexX);
+  v.spin = {1, -1, 1, -1, 1, -1, 1, -1};
+  return v;
+}
+
+FmuConfig with(const model::VehicleParams& v, FmuKind kind = FmuKind::kPlant) {
+  FmuConfig c;
+  c.kind = kind;
+  c.vehicle = v;
+  c.initial.omega_rad_s = model::RotorVector::LinSpaced(v.rotor_count, 100.0 / 3.0, 800.0 / 7.0);
+  c.realism.faults.push_back({10, v.rotor_count - 1, 0.5});
+  c.guid = make_guid(c);
+  return c;
+}
+
+TEST(FmuConfigRotors, LayoutSpinsAndCustomPositionsRoundTripExactly) {
+  for (const model::VehicleParams& v : {hex_x(), octo_x8()}) {
+    const FmuConfig c = with(v);
+    const std::string text = to_json(c);
+    const FmuConfig back = config_from_json(text, "test");
+    EXPECT_EQ(to_json(back), text);
+    EXPECT_EQ(make_guid(back), c.guid);
+    EXPECT_EQ(back.vehicle.layout, v.layout);
+    ASSERT_EQ(back.vehicle.rotor_count, v.rotor_count);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(v.rotor_count); ++i) {
+      EXPECT_EQ(back.vehicle.spin[i], v.spin[i]) << i;
+      if (v.layout == model::RotorLayout::kCustom) EXPECT_EQ(back.vehicle.rotor_positions_m[i], v.rotor_positions_m[i]);
+    }
+    ASSERT_EQ(back.initial.omega_rad_s.size(), v.rotor_count);
+    EXPECT_EQ(back.initial.omega_rad_s, c.initial.omega_rad_s);  // 100/3 .. 800/7: all 17 digits
+    EXPECT_EQ(back.realism.faults.at(0).rotor, v.rotor_count - 1);
+  }
+  // A standard layout writes no rotor list (a quadrotor's configuration is what it always was).
+  EXPECT_EQ(to_json(with(hex_x())).find("\"rotors\""), std::string::npos);
+  EXPECT_NE(to_json(with(octo_x8())).find("\"rotors\""), std::string::npos);
+}
+
+TEST(FmuConfigRotors, ABadRotorListNamesTheField) {
+  const std::string octo = to_json(with(octo_x8())), hex = to_json(with(hex_x()));
+  // The octorotor's rotors, its first entry and its spins as to_json wrote them (2-space indent).
+  const std::string first = "{\n        \"position_m\": [\n          0.2475,\n          0.2475,\n          0.04\n";
+  ASSERT_NE(octo.find(first), std::string::npos) << octo;
+  EXPECT_EQ(refused(replaced(octo, "\"custom\"", "\"hex_x\"")),
+            "cfg.json: 'vehicle.rotors' is given, but layout hex_x places its rotors itself (rotors go with layout "
+            "custom)");
+  EXPECT_EQ(refused(replaced(octo, "\"rotors\"", "\"rotor\"")), "cfg.json: 'vehicle.rotors' missing");
+  EXPECT_EQ(refused(replaced(octo, "\"rotors\": [", "\"rotors\": [], \"x\": [")),
+            "cfg.json: 'vehicle.rotors' is not a list of 4 to 8 rotors {position_m: [x, y, z], spin: 1 or -1}");
+  EXPECT_EQ(refused(replaced(octo, "0.2475,\n          0.04\n", "0.04\n")),
+            "cfg.json: 'vehicle.rotors[0].position_m' not an array of 3 numbers");
+  EXPECT_EQ(refused(replaced(octo, "\"spin\": 1", "\"spin\": 2")), "cfg.json: 'vehicle.rotors[0].spin' is not 1 or -1");
+  // Two rotors at one place: the vehicle file's rule (model::validate_rotors), at the rotor list.
+  const std::string same = replaced(octo, "0.2475,\n          0.04\n", "0.2475,\n          -0.04\n");
+  EXPECT_NE(refused(same).find("cfg.json: 'vehicle.rotors' is refused: rotors must"), std::string::npos)
+      << refused(same);
+  // The spins: one per rotor, as the rotor list gives them for a custom layout.
+  EXPECT_EQ(refused(replaced(hex, "\"spin\": [\n      1,", "\"spin\": [")),
+            "cfg.json: 'vehicle.spin' is not a list of 6 signs (one per rotor of layout hex_x)");
+  EXPECT_EQ(refused(replaced(octo, "\"spin\": [\n      1,", "\"spin\": [\n      -1,")),
+            "cfg.json: 'vehicle.spin[0]' is -1, but rotors[0].spin is 1");
+  // The initial rotor speeds and the faults follow the rotor count.
+  EXPECT_EQ(refused(replaced(hex, "\"omega\": [\n", "\"omega\": [\n      1,\n")),
+            "cfg.json: 'initial.omega' not an array of 6 numbers (one per rotor)");
+  EXPECT_EQ(refused(replaced(hex, "\"rotor\": 5", "\"rotor\": 6")),
+            "cfg.json: 'realism.faults[0].rotor' must be 0..5 (one of the vehicle's 6 rotors)");
+}
+
+TEST(FmuConfigRotors, AnNRotorFmuHasOneCommandPerRotorAndKeepsTheQuadrotorsReferences) {
+  for (const FmuKind kind : {FmuKind::kPlant, FmuKind::kController}) {
+    for (const model::VehicleParams& v : {hex_x(), octo_x8()}) {
+      const int n = v.rotor_count;
+      FmuConfig quad;
+      quad.kind = kind;
+      quad.controller_type = "se3";
+      quad.guid = make_guid(quad);
+      FmuConfig multi = with(v, kind);
+      multi.controller_type = "se3";
+      const ModelDescription md4 = describe(quad), md = describe(multi);
+      // Exactly omega_cmd[1..N] (plant: inputs; controller: outputs), in rotor order by value reference.
+      const Causality side = kind == FmuKind::kPlant ? Causality::kInput : Causality::kOutput;
+      std::vector<std::pair<ValueReference, std::string>> commands;
+      for (const Variable& var : md.variables) {
+        if (var.name.rfind("omega_cmd", 0) == 0) {
+          EXPECT_EQ(var.causality, side) << var.name;
+          commands.emplace_back(var.vr, var.name);
+        }
+      }
+      ASSERT_EQ(commands.size(), static_cast<std::size_t>(n));
+      std::sort(commands.begin(), commands.end());
+      for (int i = 0; i < n; ++i) EXPECT_EQ(commands[i].second, "omega_cmd[" + std::to_string(i + 1) + "]");
+      // Every variable of the quadrotor's FMU keeps its value reference; the rotors past four come after.
+      const std::size_t extra = static_cast<std::size_t>(n - 4) * (kind == FmuKind::kPlant ? 3 : 1);
+      ASSERT_EQ(md.variables.size(), md4.variables.size() + extra);
+      for (const Variable& var : md4.variables) {
+        const Variable* same = find(md, var.name);
+        ASSERT_NE(same, nullptr) << var.name;
+        EXPECT_EQ(same->vr, var.vr) << var.name;
+        EXPECT_EQ(same->causality, var.causality) << var.name;
+      }
+      for (std::size_t i = md4.variables.size(); i < md.variables.size(); ++i) {
+        EXPECT_EQ(md.variables[i].vr, i);
+        EXPECT_NE(md.variables[i].name.find("omega"), std::string::npos) << md.variables[i].name;
+      }
+      if (kind == FmuKind::kPlant) {
+        for (int i = 1; i <= n; ++i) {
+          const std::string k = "[" + std::to_string(i) + "]";
+          ASSERT_NE(find(md, "omega" + k), nullptr) << i;
+          EXPECT_EQ(find(md, "omega" + k)->causality, Causality::kOutput);
+          ASSERT_NE(find(md, "initial.omega" + k), nullptr) << i;
+          EXPECT_EQ(find(md, "initial.omega" + k)->start, to_json_number(multi.initial.omega_rad_s[i - 1]));
+        }
+        EXPECT_EQ(find(md, "omega[" + std::to_string(n + 1) + "]"), nullptr);
+      }
+    }
+  }
+}
+
+}  // namespace quadcosim::fmi::rotors

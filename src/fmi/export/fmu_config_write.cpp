@@ -76,10 +76,24 @@ json vehicle_json(const model::VehicleParams& v) {
     switch (p.kind) {
       case model::VehicleParameter::Kind::kNumber: j[name] = p.get(v); break;
       case model::VehicleParameter::Kind::kChoice: j[name] = std::string(p.choice_of(v)); break;
-      case model::VehicleParameter::Kind::kSigns:  // an exported FMU flies four rotors (fmu_export refuses others)
-        j[name] = std::array<int, 4>{v.spin[0], v.spin[1], v.spin[2], v.spin[3]};
+      case model::VehicleParameter::Kind::kSigns: {  // one per rotor (a quadrotor's four, as always)
+        json signs = json::array();
+        for (int i = 0; i < v.rotor_count; ++i) signs.push_back(v.spin[static_cast<std::size_t>(i)]);
+        j[name] = signs;
         break;
-      case model::VehicleParameter::Kind::kRotors: break;
+      }
+      case model::VehicleParameter::Kind::kRotors: {
+        // A custom layout's rotors as a vehicle file gives them (io/vehicle_yaml.cpp); a standard
+        // layout places its rotors itself, so its configuration (and GUID) stays as it was.
+        if (v.layout != model::RotorLayout::kCustom) break;
+        json rotors = json::array();
+        for (int i = 0; i < v.rotor_count; ++i) {
+          const auto r = static_cast<std::size_t>(i);
+          rotors.push_back({{"position_m", vec(v.rotor_positions_m[r])}, {"spin", v.spin[r]}});
+        }
+        j[name] = rotors;
+        break;
+      }
     }
   }
   return j;

@@ -84,8 +84,9 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
     for (auto n : names) outputs.push_back(vr_of(c, n));
   }
   for (auto n : names::kAttitude) outputs.push_back(vr_of(c, n));
-  for (auto n : names::kRotorSpeed) outputs.push_back(vr_of(c, n));
-  for (auto n : names::kOmegaCmd) cmd_vrs.push_back(vr_of(c, n));
+  const int rotors = c.vehicle.rotor_count;
+  for (auto n : names::rotor_speed(rotors)) outputs.push_back(vr_of(c, n));
+  for (auto n : names::omega_cmd(rotors)) cmd_vrs.push_back(vr_of(c, n));
   if (extra) {
     for (const char* n : {"magnetometer.field[1]", "magnetometer.field[2]", "magnetometer.field[3]",
                           "barometer.pressure", "barometer.altitude", "gnss.fix", "gnss.latitude_deg",
@@ -116,11 +117,8 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
                                   imu.orientation.w,
                                   imu.orientation.x,
                                   imu.orientation.y,
-                                  imu.orientation.z,
-                                  s[0],
-                                  s[1],
-                                  s[2],
-                                  s[3]};
+                                  imu.orientation.z};
+      want.insert(want.end(), s.data(), s.data() + s.size());
       if (extra) {  // the messages' fields, in the messages' units (degrees), the altitude by the ISA
         const double p0 = c.realism.extra_sensors.barometer->sea_level_pressure_Pa;
         for (const double x : {mag.magnetic_field.x, mag.magnetic_field.y, mag.magnetic_field.z, baro.fluid_pressure,
@@ -141,11 +139,12 @@ void compare_with_plant_node(FmuConfig c, bool sensor_noise) {
         ASSERT_EQ(std::memcmp(&got[i], &want[i], sizeof(double)), 0)
             << "output " << i << " at tick " << k << ": " << got[i] << " vs " << want[i];
       }
-      // The next command, to both: a slow wobble around hover.
+      // The next command, to both: a slow wobble around hover, on every other rotor.
       const double w = hover * (1.0 + 0.01 * std::sin(0.05 * static_cast<double>(k)));
-      const std::vector<double> cmd = {w, hover, w, hover};
+      std::vector<double> cmd;
+      for (int i = 0; i < rotors; ++i) cmd.push_back(i % 2 == 0 ? w : hover);
       commands.publish(msg::Float64MultiArray{cmd, {}, 0});
-      ASSERT_EQ(QC_FMI(fmi2SetReal)(fmu, cmd_vrs.data(), 4, cmd.data()), fmi2OK);
+      ASSERT_EQ(QC_FMI(fmi2SetReal)(fmu, cmd_vrs.data(), cmd.size(), cmd.data()), fmi2OK);
       if (k < 300) {
         ASSERT_EQ(QC_FMI(fmi2DoStep)(fmu, o.clock.seconds(k), 0.02, fmi2True), fmi2OK) << log.last();
       }
@@ -210,6 +209,15 @@ TEST(FmuPlantNode, WindGustsFaultsAndDragGiveThePlantNodesNumbers) {
   FmuConfig c = config_for(FmuKind::kPlant);
   c.realism = rough_air();
   compare_with_plant_node(c, /*sensor_noise=*/false);
+}
+
+TEST(FmuPlantNode, AHexarotorInWindGustsAFaultAndSensorNoiseGivesThePlantNodesNumbers) {
+  FmuConfig c = config_for(FmuKind::kPlant);
+  c.vehicle.set_layout(model::RotorLayout::kHexX);
+  c.initial.omega_rad_s = model::RotorVector::Zero(6);
+  c.realism = rough_air();
+  c.realism.faults.push_back({90, 5, 0.7});  // the sixth rotor, which a quadrotor's FMU does not have
+  compare_with_plant_node(c, /*sensor_noise=*/true);
 }
 
 TEST(FmuPlantNode, WithSensorNoiseTheOutputsAreThePublishedSamples) {

@@ -10,6 +10,8 @@
 
 namespace quadcosim::fmi {
 
+static_assert(names::kRotorNames == static_cast<std::size_t>(model::kMaxRotors), "one FMU variable name per rotor");
+
 namespace {
 
 std::string number_text(double v) {
@@ -66,10 +68,17 @@ struct Builder {
 
 Eigen::Vector4d wxyz(const Eigen::Quaterniond& q) { return {q.w(), q.x(), q.y(), q.z()}; }
 
+constexpr std::string_view kCommandInput =
+    "rotor speed command, held over the step; clamped to [omega_min, omega_max]; NaN/Inf refused";
+constexpr std::string_view kCommandOutput = "rotor speed command of the latest control step (0 before the first step)";
+constexpr std::string_view kSpeedOutput = "rotor speeds reached (after the motors' lag)";
+constexpr std::string_view kSpeedInitial = "rotor speeds (and the command before the first one is set)";
+
 void plant_variables(const FmuConfig& c, Builder& b) {
-  b.inputs(names::kOmegaCmd, "rad/s",
-           "rotor speed command, held over the step; clamped to [omega_min, omega_max]; NaN/Inf refused",
-           c.initial.omega_rad_s);
+  for (std::size_t i = 0; i < 4; ++i) {
+    b.input(names::kOmegaCmd[i], "rad/s", std::string(kCommandInput),
+            c.initial.omega_rad_s[static_cast<Eigen::Index>(i)]);
+  }
   const Variability cont = Variability::kContinuous;
   b.outputs(names::kPosition, cont, "m", "position, world frame (z up)");
   b.outputs(names::kVelocity, cont, "m/s", "velocity, world frame");
@@ -77,7 +86,7 @@ void plant_variables(const FmuConfig& c, Builder& b) {
   b.outputs(names::kEuler, cont, "rad", "roll, pitch, yaw (Z-Y-X Euler angles of q_WB)");
   b.outputs(names::kRates, cont, "rad/s", "body angular velocity");
   b.outputs(names::kSpecificForce, cont, "m/s2", "specific force, body frame (what an accelerometer reads)");
-  b.outputs(names::kRotorSpeed, cont, "rad/s", "rotor speeds reached (after the motors' lag)");
+  b.outputs(names::kRotorSpeed, cont, "rad/s", std::string(kSpeedOutput));
   // The extra sensors the scenario configures: each column of the newest sample, held between samples.
   sensors::for_each_configured(c.realism.extra_sensors, [&]<class Kind>(const typename Kind::Config&) {
     for (const auto& col : Kind::kColumns) {
@@ -109,7 +118,7 @@ void plant_variables(const FmuConfig& c, Builder& b) {
   initial(names::kVelocity, "m/s", "velocity", x.v_W);
   initial(names::kAttitude, "1", "attitude quaternion (w x y z, unit norm)", wxyz(x.q_WB));
   initial(names::kRates, "rad/s", "body angular velocity", x.w_B);
-  initial(names::kRotorSpeed, "rad/s", "rotor speeds (and the command before the first one is set)", x.omega_rad_s);
+  initial(names::kRotorSpeed, "rad/s", std::string(kSpeedInitial), x.omega_rad_s);
 
   auto flag = [&](std::string_view name, bool on, std::string what) {
     b.parameter(name, fixed, "", std::move(what), on ? "true" : "false").type = VariableType::kBoolean;
@@ -173,8 +182,7 @@ void controller_variables(const FmuConfig& c, Builder& b) {
   b.input("ref.yaw_rate", "rad/s", "reference yaw rate" + used, start.yaw_rate_rad_s);
   b.input("ref.roll", "rad", c.trajectory ? "unused (position mode)" : "roll setpoint (attitude mode)", roll);
   b.input("ref.pitch", "rad", c.trajectory ? "unused (position mode)" : "pitch setpoint (attitude mode)", pitch);
-  b.outputs(names::kOmegaCmd, Variability::kDiscrete, "rad/s",
-            "rotor speed command of the latest control step (0 before the first step)");
+  b.outputs(names::kOmegaCmd, Variability::kDiscrete, "rad/s", std::string(kCommandOutput));
 
   const control::ControllerConfig cc = controllers::make_config(c.controller_type, c.vehicle);
   std::unique_ptr<control::Controller> ctl = cc.controller->clone();
@@ -223,16 +231,58 @@ void controller_variables(const FmuConfig& c, Builder& b) {
   }
 }
 
+/// Rotors 5..N of a vehicle with more than four: after every other variable, so that each variable a
+/// quadrotor's FMU has keeps its value reference (an importer that knows the quadrotor's numbers finds
+/// them unchanged). The plant's commands, speeds and initial speeds; the controller's commands.
+void rotors_beyond_four(const FmuConfig& c, Builder& b) {
+  const auto n = static_cast<std::size_t>(c.vehicle.rotor_count);
+  const std::string pre(names::kInitialPrefix);
+  if (c.kind == FmuKind::kPlant) {
+    for (std::size_t i = 4; i < n; ++i) {
+      b.input(names::kOmegaCmdAll[i], "rad/s", std::string(kCommandInput),
+              c.initial.omega_rad_s[static_cast<Eigen::Index>(i)]);
+    }
+    for (std::size_t i = 4; i < n; ++i) {
+      b.output(names::kRotorSpeedAll[i], Variability::kContinuous, "rad/s", std::string(kSpeedOutput));
+    }
+    for (std::size_t i = 4; i < n; ++i) {
+      b.parameter(pre + std::string(names::kRotorSpeedAll[i]), Variability::kFixed, "rad/s",
+                  "initial " + std::string(kSpeedInitial),
+                  number_text(c.initial.omega_rad_s[static_cast<Eigen::Index>(i)]));
+    }
+  } else {
+    for (std::size_t i = 4; i < n; ++i) {
+      b.output(names::kOmegaCmdAll[i], Variability::kDiscrete, "rad/s", std::string(kCommandOutput));
+    }
+  }
+}
+
 }  // namespace
 
 ModelDescription describe(const FmuConfig& c) {
+  const int rotors = c.vehicle.rotor_count;
+  if (rotors < model::kMinRotors || rotors > model::kMaxRotors) {
+    throw FmuError("vehicle.rotor_count " + std::to_string(rotors) + ": an FMU carries 4 to 8 rotors");
+  }
+  if (c.initial.omega_rad_s.size() != rotors) {
+    throw FmuError("initial.omega has " + std::to_string(c.initial.omega_rad_s.size()) +
+                   " rotor speeds; the vehicle has " + std::to_string(rotors) + " rotors");
+  }
   ModelDescription md;
   md.version = c.fmi_version;
   md.fmi_version = c.fmi_version == FmiVersion::k2 ? "2.0" : "3.0";
   const bool plant = c.kind == FmuKind::kPlant;
   md.model_name = plant ? "quadcosim plant" : "quadcosim controller";
-  md.description = plant ? "quadcosim's 6-DOF quadrotor plant (integer-tick RK4), co-simulation"
-                         : "quadcosim's '" + c.controller_type + "' flight controller, co-simulation";
+  if (rotors == 4) {
+    md.description = plant ? "quadcosim's 6-DOF quadrotor plant (integer-tick RK4), co-simulation"
+                           : "quadcosim's '" + c.controller_type + "' flight controller, co-simulation";
+  } else {
+    const std::string vehicle =
+        std::to_string(rotors) + " rotors, layout " + std::string(model::to_string(c.vehicle.layout));
+    md.description = plant
+                         ? "quadcosim's 6-DOF multirotor plant (" + vehicle + "; integer-tick RK4), co-simulation"
+                         : "quadcosim's '" + c.controller_type + "' flight controller (" + vehicle + "), co-simulation";
+  }
   md.guid = c.guid;
   md.generation_tool = "quadcosim";
   md.model_identifier = std::string(model_identifier(c.kind));
@@ -255,6 +305,7 @@ ModelDescription describe(const FmuConfig& c) {
                            "the FMU's period: every communication step is a whole number of them");
   period.initial = Initial::kExact;
   period.start = number_text(static_cast<double>(period_ns) / 1e9);
+  rotors_beyond_four(c, b);
   return md;
 }
 

@@ -36,19 +36,19 @@ class PlantModel final : public Model {
   PlantModel(const FmuConfig& c, const ModelDescription& md)
       : config_(c),
         clock_{c.plant_period_ns},
-        omega_cmd_(find_vrs(md, names::kOmegaCmd)),
+        omega_cmd_(find_vrs(md, names::omega_cmd(c.vehicle.rotor_count))),
         p_(find_vrs(md, names::kPosition)),
         v_(find_vrs(md, names::kVelocity)),
         q_(find_vrs(md, names::kAttitude)),
         euler_(find_vrs(md, names::kEuler)),
         w_(find_vrs(md, names::kRates)),
         f_(find_vrs(md, names::kSpecificForce)),
-        omega_(find_vrs(md, names::kRotorSpeed)),
+        omega_(find_vrs(md, names::rotor_speed(c.vehicle.rotor_count))),
         init_p_(initial_vrs(md, names::kPosition)),
         init_v_(initial_vrs(md, names::kVelocity)),
         init_q_(initial_vrs(md, names::kAttitude)),
         init_w_(initial_vrs(md, names::kRates)),
-        init_omega_(initial_vrs(md, names::kRotorSpeed)),
+        init_omega_(find_vrs(md, names::rotor_speed(c.vehicle.rotor_count), names::kInitialPrefix)),
         wind_(find_vr(md, "realism.wind")),
         faults_(find_vr(md, "realism.rotor_faults")),
         noise_(find_vr(md, "realism.sensor_noise")),
@@ -100,7 +100,7 @@ class PlantModel final : public Model {
     }
     x.q_WB = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
     x.w_B = vector<3>(v, init_w_);
-    x.omega_rad_s = vector<4>(v, init_omega_);
+    x.omega_rad_s = rotors(v, init_omega_);
 
     sim::RealismConfig realism = config_.realism;
     if (v.number[wind_] == 0.0) realism.wind = {};
@@ -123,7 +123,7 @@ class PlantModel final : public Model {
   }
 
   std::string step(sim::Tick k, std::int64_t n, Values& v) override {
-    core_.set_latched(vector<4>(v, omega_cmd_));
+    core_.set_latched(rotors(v, omega_cmd_));
     for (sim::Tick i = k; i < k + n; ++i) {
       core_.integrate(clock_, i, config_.substeps);
       // The sensors sample every tick (their rates and latencies count ticks), also inside a step.
@@ -156,6 +156,15 @@ class PlantModel final : public Model {
   template <std::size_t N, class V>
   static void put(Values& v, const std::array<ValueReference, N>& vrs, const V& x) {
     for (std::size_t i = 0; i < N; ++i) v.number[vrs[i]] = x[static_cast<Eigen::Index>(i)];
+  }
+  /// One value per rotor.
+  static model::RotorVector rotors(const Values& v, const std::vector<ValueReference>& vrs) {
+    model::RotorVector x(static_cast<Eigen::Index>(vrs.size()));
+    for (std::size_t i = 0; i < vrs.size(); ++i) x[static_cast<Eigen::Index>(i)] = v.number[vrs[i]];
+    return x;
+  }
+  static void put(Values& v, const std::vector<ValueReference>& vrs, const model::RotorVector& x) {
+    for (std::size_t i = 0; i < vrs.size(); ++i) v.number[vrs[i]] = x[static_cast<Eigen::Index>(i)];
   }
 
   /// The true outputs at tick k; with sensor noise, also the sensors' samples of tick k.
@@ -202,15 +211,15 @@ class PlantModel final : public Model {
 
   FmuConfig config_;
   sim::TickClock clock_;
-  std::array<ValueReference, 4> omega_cmd_;
+  std::vector<ValueReference> omega_cmd_;  ///< omega_cmd[1..N], one per rotor
   std::array<ValueReference, 3> p_, v_;
   std::array<ValueReference, 4> q_;
   std::array<ValueReference, 3> euler_, w_, f_;
-  std::array<ValueReference, 4> omega_;
+  std::vector<ValueReference> omega_;  ///< omega[1..N]
   std::array<ValueReference, 3> init_p_, init_v_;
   std::array<ValueReference, 4> init_q_;
   std::array<ValueReference, 3> init_w_;
-  std::array<ValueReference, 4> init_omega_;
+  std::vector<ValueReference> init_omega_;  ///< initial.omega[1..N]
   ValueReference wind_, faults_, noise_, seed_;
   std::vector<std::pair<const model::VehicleParameter*, ValueReference>> vehicle_;
   std::array<std::vector<ValueReference>, std::tuple_size_v<sensors::Kinds>> extra_vrs_;  ///< by kind, per number

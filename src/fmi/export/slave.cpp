@@ -74,6 +74,13 @@ ValueReference find_vr(const ModelDescription& md, std::string_view name) {
   throw FmuError("the FMU has no variable '" + std::string(name) + "'");
 }
 
+std::vector<ValueReference> find_vrs(const ModelDescription& md, std::span<const std::string_view> names,
+                                     std::string_view prefix) {
+  std::vector<ValueReference> vrs;
+  for (const std::string_view n : names) vrs.push_back(find_vr(md, std::string(prefix) + std::string(n)));
+  return vrs;
+}
+
 std::unique_ptr<Model> make_model(const FmuConfig& config, const ModelDescription& md) {
   return config.kind == FmuKind::kPlant ? make_plant_model(config, md) : make_controller_model(config, md);
 }

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,11 @@ std::array<ValueReference, N> find_vrs(const ModelDescription& md, const std::ar
   for (std::size_t i = 0; i < N; ++i) vrs[i] = find_vr(md, names[i]);
   return vrs;
 }
+
+/// The same for a vehicle's rotors (names::omega_cmd(n), names::rotor_speed(n)), optionally with a
+/// prefix ("initial.").
+std::vector<ValueReference> find_vrs(const ModelDescription& md, std::span<const std::string_view> names,
+                                     std::string_view prefix = {});
 
 class Slave {
  public:
