@@ -13,10 +13,11 @@
 // once per FDM packet. Its clock is wall time scaled by the rate of FDM timestamps to wall time (simRate):
 // not quadcosim's, so the flight is not bit-for-bit repeatable (docs/sitl.md says how far).
 //
-// The pilot: AUX1 low and throttle 1000 us until arm_at_s, then AUX1 high (ARM; ANGLE is always on),
-// roll and pitch sticks at the reference's roll and pitch over Betaflight's angle limit (60 deg), yaw
-// centred, and the throttle stick from an altitude loop on the reference's height: the hover throttle
-// as feed-forward plus PID on the height error (gains for a natural frequency of 1.5 rad/s).
+// The pilot: AUX1 low and throttle 1000 us until arm_at_s, then AUX1 high (ARM; ANGLE is always on) with
+// the throttle still at 1000 us for 0.5 s (Betaflight arms only with the throttle low), then roll and pitch sticks at
+// the reference's roll and pitch over Betaflight's angle limit (60 deg), yaw centred, and the throttle stick from an
+// altitude loop on the reference's height: the hover throttle as feed-forward plus PID on the height error (gains for a
+// natural frequency of 1.5 rad/s).
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -50,7 +51,9 @@ namespace bf = betaflight;
 
 namespace {
 
-double bf_wall_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+double bf_wall_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 // A socket bound to 127.0.0.1:port, or -1 with errno.
 int bf_bind_local(int type, int port) {
@@ -80,6 +83,7 @@ sockaddr_in bf_local(int port) {
 constexpr double kAngleLimitRad = 60.0 * std::numbers::pi / 180.0;  // Betaflight's angle_limit default
 constexpr double kIdle = 0.055;         // its motor idle (dshot_idle_value 550: 5.5 %) at minimum throttle
 constexpr double kMinCheckUs = 1050.0;  // min_check: the throttle stick's zero
+constexpr double kArmHoldS = 0.5;       // [s] AUX1 high with the throttle low before the altitude loop
 
 }  // namespace
 
@@ -169,6 +173,7 @@ bf::RcSticks SitlController::betaflight_sticks(const control::Observation& obs, 
   bf::RcSticks s;
   if (t_s_ + 1e-9 < spec_.arm_at_s) return s;  // disarmed, throttle low
   s.arm = true;
+  if (t_s_ + 1e-9 < spec_.arm_at_s + kArmHoldS) return s;  // armed with the throttle low first
   s.roll_us = 1500.0 + 500.0 * ref.roll_rad / kAngleLimitRad;
   s.pitch_us = 1500.0 + 500.0 * ref.pitch_rad / kAngleLimitRad;
   // Height: thrust ~ u^2, so d(accel)/du = 2 g / u_hover; PID gains for omega_n = 1.5 rad/s, zeta = 0.8.
