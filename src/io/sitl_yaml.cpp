@@ -79,11 +79,12 @@ std::shared_ptr<const control::Controller> read_sitl_controller(YamlSection& c, 
   for (const char* key : {"etc_dir", "airframe", "instance", "settle_ms", "cpu"}) {
     if (!px4 && s.has(key)) s.fail(key, "is PX4's (firmware: px4)");
   }
-  for (const char* key : {"arm_at_s", "resend_ms"}) {
+  for (const char* key : {"arm_at_s", "resend_ms", "realtime_factor"}) {
     if (!betaflight && s.has(key)) s.fail(key, "is Betaflight's (firmware: betaflight)");
   }
   spec.arm_at_s = s.number("arm_at_s", spec.arm_at_s, 0.0, 1e6);
   spec.resend_ms = s.number("resend_ms", spec.resend_ms, 1.0, 60000.0);
+  spec.realtime_factor = s.number("realtime_factor", spec.realtime_factor, 0.0, 1000.0);
   if (s.has("etc_dir")) spec.etc_dir = resolved(s.text("etc_dir", ""), folder);
   spec.airframe = static_cast<int>(s.integer("airframe", spec.airframe, 1, 99999999));
   spec.instance = static_cast<int>(s.integer("instance", spec.instance, -1, 99));

@@ -26,8 +26,11 @@ struct SitlController::BfLink {
   bool answered = false;
   Eigen::Vector2d first_lon_lat = Eigen::Vector2d::Zero();
   double integral_m_s = 0.0;
-  double hover_u = 0.0;  ///< the motor value of the hover speed
-  long long resent = 0, stale = 0;
+  double armed_at_s = -1.0;  ///< [s] when its motors first turned (it arms them at idle); -1: not yet
+  bool motors_on = false;    ///< its last motor packet had a motor above 0
+  double hover_u = 0.0;      ///< the motor value of the hover speed
+  long long resent = 0, stale = 0, late = 0;
+  double next_send_wall_s = 0.0;  ///< [s, steady clock] when the next step's packets go (pacing)
 
   ~BfLink() {
     process.reset();

@@ -109,9 +109,10 @@ struct SitlSpec {
   /// run); -1: any; -2 (default): the last CPU this process may use.
   int cpu = -2;
   // Betaflight only.
-  double arm_at_s = 2.0;    ///< [s] simulated time at which the pilot raises AUX1 (ARM); before it, throttle low
-  double resend_ms = 20.0;  ///< [ms] wall time without a motor packet after which the FDM packet goes again
-  sensors::Geodetic site;   ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
+  double arm_at_s = 2.0;         ///< [s] simulated time at which the pilot raises AUX1 (ARM); before it, throttle low
+  double resend_ms = 100.0;      ///< [ms] wall time without a motor packet after which the FDM packet goes again
+  double realtime_factor = 1.0;  ///< steps paced at this many times real time (0: unpaced; docs/sitl.md)
+  sensors::Geodetic site;  ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
   std::vector<std::string> added;  ///< what the scenario lacked and was added for PX4 (noted when it starts)
 };
 
@@ -121,8 +122,10 @@ struct SitlSpec {
 inline constexpr const char* kPx4Outputs[] = {"frame", "u1", "u2", "u3", "u4", "armed", "mode", "mission"};
 
 /// The figures a Betaflight controller records: m1..m4 its motors 1..4 (0..1), throttle_us and arm the RC
-/// throttle and AUX1 sent, resent the FDM packets sent again, stale the motor packets dropped as late.
-inline constexpr const char* kBetaflightOutputs[] = {"m1", "m2", "m3", "m4", "throttle_us", "arm", "resent", "stale"};
+/// throttle and AUX1 sent, resent the FDM packets sent again, stale the motor packets dropped as late,
+/// late the steps whose answer came more than a pacing period late.
+inline constexpr const char* kBetaflightOutputs[] = {"m1",  "m2",     "m3",    "m4",  "throttle_us",
+                                                     "arm", "resent", "stale", "late"};
 
 /// The figures a SITL controller records (out.<name> in trajectory.csv).
 /// armed and mode are the firmware's last HEARTBEAT's; mission is the index of the mission item in progress.
@@ -185,6 +188,7 @@ class SitlController final : public control::Controller {
   struct BfLink;
   void start();
   void start_betaflight();
+  void wait_for_betaflight_msp();
   void step_betaflight(const control::Observation& observation, const control::Reference& reference, double dt_s,
                        control::ControllerOutput& out);
   betaflight::RcSticks betaflight_sticks(const control::Observation& obs, const control::Reference& ref, double dt_s);

@@ -1,6 +1,6 @@
 // A stand-in for Betaflight's SITL build (make TARGET=SITL), for the tests: the same fixed ports and
 // packets (src/platform/SIMULATOR: UDP 9003 fdm_packet in, 9004 rc_packet in, 9002 servo_packet out,
-// 9001 servo_packet_raw out, TCP 5761 listening as its UART1), the same `--config FILE` (the CLI lines
+// 9001 servo_packet_raw out, TCP 5761 as its UART1, answering MSP requests), the same `--config FILE` (the CLI lines
 // kept as eeprom.bin in the current folder, then exit 0), and one motor packet per FDM packet. It reads
 // the state as sitl.c's Gazebo bridge does, written out here from sitl.c and sitl_gyro.h, not with
 // quadcosim's code: gyro roll = rpy[0], pitch = -rpy[1], yaw = rpy[2]; the attitude quaternion with qy and
@@ -12,6 +12,7 @@
 // Options: --fake-pid-file PATH (its process id), --fake-hang-at N (no answer from FDM packet N, 1-based),
 // --fake-record PATH (one line per FDM packet: its 18 values, then the RC channels 1..5 it had).
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
   const int state = bind_udp_or_tcp(SOCK_DGRAM, bf::kStatePort);
   const int rc = bind_udp_or_tcp(SOCK_DGRAM, bf::kRcPort);
   const int cli = bind_udp_or_tcp(SOCK_STREAM, bf::kCliPort);
+  ::fcntl(cli, F_SETFL, O_NONBLOCK);
   const int out = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in motors_to{}, raw_to{};
   motors_to.sin_family = raw_to.sin_family = AF_INET;
@@ -108,9 +110,20 @@ int main(int argc, char** argv) {
   bool armed = false;
   long packets = 0;
   std::array<std::uint8_t, 512> buf{};
+  int msp = -1;  // a connection to its UART1: MSP requests ("$M<") get an MSP_API_VERSION answer
   for (;;) {
     pollfd p{state, POLLIN, 0};
-    if (::poll(&p, 1, 100) <= 0) continue;
+    if (::poll(&p, 1, 5) <= 0) {
+      if (msp < 0) msp = ::accept4(cli, nullptr, nullptr, SOCK_NONBLOCK);
+      char req[64];
+      const ssize_t m = msp >= 0 ? ::recv(msp, req, sizeof(req), MSG_DONTWAIT) : -1;
+      if (m == 0) ::close(msp), msp = -1;
+      if (m > 0 && std::string(req, static_cast<std::size_t>(m)).find("$M<") != std::string::npos) {
+        const char answer[] = {'$', 'M', '>', 3, 1, 0, 1, 47, 46};
+        ::send(msp, answer, sizeof(answer), MSG_NOSIGNAL);
+      }
+      continue;
+    }
     const ssize_t n = ::recv(state, buf.data(), buf.size(), 0);
     if (n != static_cast<ssize_t>(bf::kFdmPacketBytes)) continue;  // sitl.c drops other sizes
     ++packets;
