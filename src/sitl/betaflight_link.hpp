@@ -30,6 +30,7 @@ struct SitlController::BfLink {
   bool motors_on = false;    ///< its last motor packet had a motor above 0
   double hover_u = 0.0;      ///< the motor value of the hover speed
   long long resent = 0, stale = 0, late = 0;
+  double stamp_offset_s = 0.0;    ///< [s] added to its stamps: the tries at step 0 before its first answer
   double next_send_wall_s = 0.0;  ///< [s, steady clock] when the next step's packets go (pacing)
 
   ~BfLink() {

@@ -245,14 +245,14 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
   BfLink& l = *bf_;
   const bf::RcSticks sticks = betaflight_sticks(obs, reference, dt_s);
   // Its stamps: quadcosim's time plus the two packets of the prelude (below).
-  const double stamp_s = t_s_ + 2.0 * dt_s;
-  const auto rc = bf::encode_rc(stamp_s, bf::rc_channels(sticks));
+  const double stamp_s = t_s_ + l.stamp_offset_s + 2.0 * dt_s;
+  auto rc = bf::encode_rc(stamp_s, bf::rc_channels(sticks));
   const sensors::LocalTangentPlane plane(spec_.site);
   const sensors::Geodetic g = plane.to_geodetic(obs.p_W);
   const Eigen::Vector3d lla(g.longitude_rad * 180.0 / std::numbers::pi, g.latitude_rad * 180.0 / std::numbers::pi,
                             g.height_m);
   if (steps_ == 0) l.first_lon_lat = lla.head<2>();
-  const auto fdm =
+  auto fdm =
       bf::encode_fdm(bf::gazebo_fdm(stamp_s, obs.w_B, obs.specific_force_B, obs.q_WB, obs.v_W, lla, l.first_lon_lat));
   const sockaddr_in rc_to = bf_local(bf::kRcPort), fdm_to = bf_local(bf::kStatePort);
   auto send = [&] {
@@ -308,6 +308,14 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
     }
     if (now > resend_at) {
       ++l.resent;
+      if (!l.answered) {
+        // Not answered yet: each try a dt later in its time (the same state), so that its clock rate
+        // is set again (a packet with the last stamp leaves it as it is, stopped or not).
+        l.stamp_offset_s += dt_s;
+        rc = bf::encode_rc(t_s_ + 2.0 * dt_s + l.stamp_offset_s, bf::rc_channels(sticks));
+        fdm = bf::encode_fdm(bf::gazebo_fdm(t_s_ + 2.0 * dt_s + l.stamp_offset_s, obs.w_B, obs.specific_force_B,
+                                            obs.q_WB, obs.v_W, lla, l.first_lon_lat));
+      }
       send();
       l.next_send_wall_s = now + period_s;  // the next step a whole period after this one
       resend_at = now + spec_.resend_ms / 1000.0;
