@@ -163,8 +163,11 @@ Eigen::Vector4d omega_from_motors(const MotorMap& map, const std::array<float, 4
 std::vector<std::string> base_cli() {
   return {"mixer QUADX", "set motor_pwm_protocol = PWM",
           "set pwr_on_arm_grace = 0",  // arming is refused for 5 s after power-on otherwise
-          "aux 0 0 0 1700 2100 0 0",   // ARM (box 0) on AUX1 high
-          "aux 1 1 0 900 2100 0 0"};   // ANGLE (box 1) on AUX1 over its whole range: always
+          // It takes off "controlled" only after stick deflections above 15 %, which this pilot never gives;
+          // until then a large PID sum with a turn rate disarms it (seen after a stick step).
+          "set runaway_takeoff_prevention = OFF",
+          "aux 0 0 0 1700 2100 0 0",  // ARM (box 0) on AUX1 high
+          "aux 1 1 0 900 2100 0 0"};  // ANGLE (box 1) on AUX1 over its whole range: always
 }
 
 }  // namespace quadcosim::sitl::betaflight

@@ -101,7 +101,8 @@ Eigen::Vector4d omega_from_motors(const MotorMap& map, const std::array<float, 4
 
 /// The CLI lines quadcosim applies before the user's (docs/sitl.md): ARM on AUX1 (1700..2100 us), ANGLE
 /// mode always on (900..2100 us on AUX1), the QUADX mixer, the motor protocol PWM whose 1000..2000
-/// range the SITL target turns into 0..1, and no arming grace time after power-on (pwr_on_arm_grace 0).
+/// range the SITL target turns into 0..1, no arming grace time after power-on (pwr_on_arm_grace 0) and no
+/// runaway-takeoff prevention (it disarmed a hover after a stick step; docs/sitl.md).
 std::vector<std::string> base_cli();
 
 }  // namespace quadcosim::sitl::betaflight
