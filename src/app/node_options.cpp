@@ -26,11 +26,11 @@ void check_controller_choice(CLI::Option& option) {
 }
 
 void add_controller_type_option(CLI::App& cmd, std::string& type) {
-  check_controller_choice(
-      *cmd.add_option("--controller", type,
-                      "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
-                      "python:MODULE:CLASS, fmu:PATH or sitl:ardupilot|px4[:BINARY] (docs/sitl.md); the scenario's "
-                      "setpoints, reference and criteria stay"));
+  check_controller_choice(*cmd.add_option(
+      "--controller", type,
+      "the controller to fly in place of the scenario's: a type (`quadcosim params --list`), "
+      "python:MODULE:CLASS, fmu:PATH or sitl:ardupilot|px4|betaflight[:BINARY] (docs/sitl.md); the scenario's "
+      "setpoints, reference and criteria stay"));
 }
 
 void add_judge_option(CLI::App& cmd, std::string& judge) {

@@ -358,9 +358,10 @@ ControllerChoice parse_controller_choice(const std::string& text) {
     const std::string rest = text.size() > 5 ? text.substr(5) : "ardupilot";
     const std::size_t colon = rest.find(':');
     c.firmware = rest.substr(0, colon);
-    if (c.firmware != "ardupilot" && c.firmware != "px4") {
+    if (c.firmware != "ardupilot" && c.firmware != "px4" && c.firmware != "betaflight") {
       throw std::invalid_argument("got '" + text +
-                                  "', expected sitl:ardupilot[:BINARY] or sitl:px4[:BINARY] (docs/sitl.md)");
+                                  "', expected sitl:ardupilot[:BINARY], sitl:px4[:BINARY] or sitl:betaflight[:BINARY] "
+                                  "(docs/sitl.md)");
     }
     if (colon != std::string::npos) c.target = existing_file(text, rest.substr(colon + 1));
   } else if (text == "python") {
@@ -369,11 +370,12 @@ ControllerChoice parse_controller_choice(const std::string& text) {
     if (!controllers::find_controller_type(text)) {
       std::vector<std::string> types;
       for (const auto& t : controllers::controller_types()) types.emplace_back(t.name);
-      throw std::invalid_argument(
-          "got '" + text + "', expected a controller type (" + controllers::controller_type_names() +
-          "), python:MODULE:CLASS (a class written in Python), fmu:PATH (an FMU) or sitl:ardupilot|px4[:BINARY] "
-          "(a firmware's SITL build)" +
-          util::did_you_mean(text, types));
+      throw std::invalid_argument("got '" + text + "', expected a controller type (" +
+                                  controllers::controller_type_names() +
+                                  "), python:MODULE:CLASS (a class written in Python), fmu:PATH (an FMU) or "
+                                  "sitl:ardupilot|px4|betaflight[:BINARY] "
+                                  "(a firmware's SITL build)" +
+                                  util::did_you_mean(text, types));
     }
     c.target = text;
   }

@@ -24,12 +24,19 @@ std::shared_ptr<const control::Controller> read_sitl_controller(YamlSection& c, 
   YAML::Node empty(YAML::NodeType::Map);
   YamlSection s = section ? *section : YamlSection(empty, c.file(), c.key_path("sitl"));
   sitl::SitlSpec spec;
-  spec.firmware = s.choice("firmware", "ardupilot", {"ardupilot", "px4"});
+  spec.firmware = s.choice("firmware", "ardupilot", {"ardupilot", "px4", "betaflight"});
   const bool px4 = spec.firmware == "px4";
+  const bool betaflight = spec.firmware == "betaflight";
   std::string binary = s.text("binary", "");
   if (binary.empty()) {
-    const char* env = std::getenv(px4 ? kPx4SitlEnv : kArduPilotSitlEnv);
+    const char* env = std::getenv(px4 ? kPx4SitlEnv : betaflight ? kBetaflightSitlEnv : kArduPilotSitlEnv);
     if (!env || !*env) {
+      if (betaflight) {
+        s.fail("binary", std::string("missing; expected the path of Betaflight's SITL executable "
+                                     "(obj/main/betaflight_SITL.elf of `make TARGET=SITL`), here or in the "
+                                     "environment variable ") +
+                             kBetaflightSitlEnv);
+      }
       s.fail("binary", px4 ? std::string("missing; expected the path of PX4's SITL executable "
                                          "(build/px4_sitl_default/bin/px4), here or in the environment variable ") +
                                  kPx4SitlEnv
@@ -63,9 +70,21 @@ std::shared_ptr<const control::Controller> read_sitl_controller(YamlSection& c, 
                               "outputs as 0..1 (docs/sitl.md)"));
     }
   }
+  for (const char* key : {"home", "pwm_min_us", "pwm_max_us", "mission", "echo_statustext"}) {
+    if (betaflight && s.has(key)) {
+      s.fail(key, std::string("is not Betaflight's: it flies an RC pilot (arm_at_s, the reference's height) and "
+                              "outputs 0..1 (docs/sitl.md, \"Betaflight\")"));
+    }
+  }
   for (const char* key : {"etc_dir", "airframe", "instance", "settle_ms", "cpu"}) {
     if (!px4 && s.has(key)) s.fail(key, "is PX4's (firmware: px4)");
   }
+  for (const char* key : {"arm_at_s", "resend_ms", "realtime_factor"}) {
+    if (!betaflight && s.has(key)) s.fail(key, "is Betaflight's (firmware: betaflight)");
+  }
+  spec.arm_at_s = s.number("arm_at_s", spec.arm_at_s, 0.0, 1e6);
+  spec.resend_ms = s.number("resend_ms", spec.resend_ms, 1.0, 60000.0);
+  spec.realtime_factor = s.number("realtime_factor", spec.realtime_factor, 0.0, 1000.0);
   if (s.has("etc_dir")) spec.etc_dir = resolved(s.text("etc_dir", ""), folder);
   spec.airframe = static_cast<int>(s.integer("airframe", spec.airframe, 1, 99999999));
   spec.instance = static_cast<int>(s.integer("instance", spec.instance, -1, 99));

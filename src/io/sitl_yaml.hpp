@@ -18,6 +18,8 @@ namespace quadcosim::io {
 inline constexpr const char* kArduPilotSitlEnv = "QUADCOSIM_ARDUPILOT_SITL";
 /// The environment variable that names PX4's SITL executable (build/px4_sitl_default/bin/px4).
 inline constexpr const char* kPx4SitlEnv = "QUADCOSIM_PX4_SITL";
+/// The environment variable that names Betaflight's SITL executable (obj/main/betaflight_SITL.elf).
+inline constexpr const char* kBetaflightSitlEnv = "QUADCOSIM_BETAFLIGHT_SITL";
 
 /// The SITL controller the `sitl` section under `s` describes, for `vehicle`; relative paths are taken
 /// from `folder` (the scenario file's). Throws ConfigError at the key that is wrong (a missing binary

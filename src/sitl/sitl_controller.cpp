@@ -19,6 +19,8 @@
 #include <stdexcept>
 
 #include "isolation/child.hpp"
+#include "sitl/betaflight.hpp"
+#include "sitl/betaflight_link.hpp"
 #include "sitl/firmware_process.hpp"
 #include "sitl/frames.hpp"
 #include "sitl/json_codec.hpp"
@@ -32,10 +34,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string>& output_list(bool px4 = false) {
+const std::vector<std::string>& output_list(const std::string& firmware = "ardupilot") {
   static const std::vector<std::string> names(std::begin(kSitlOutputs), std::end(kSitlOutputs));
   static const std::vector<std::string> px4_names(std::begin(kPx4Outputs), std::end(kPx4Outputs));
-  return px4 ? px4_names : names;
+  static const std::vector<std::string> bf_names(std::begin(kBetaflightOutputs), std::end(kBetaflightOutputs));
+  return firmware == "px4" ? px4_names : firmware == "betaflight" ? bf_names : names;
 }
 
 // A socket on 127.0.0.1 at a port the system chooses; its port number.
@@ -139,10 +142,14 @@ int copter_mode_number(const std::string& name) {
 SitlController::SitlController(SitlSpec spec, const model::VehicleParams& vehicle)
     : spec_(std::move(spec)),
       model_(vehicle),
-      map_(motor_map_for(vehicle, spec_.pwm_min_us, spec_.pwm_max_us)),
-      reported_(control::ReportedOutputs::find(output_list(spec_.firmware == "px4"))) {
-  if (spec_.firmware != "ardupilot" && spec_.firmware != "px4") {
-    throw std::invalid_argument("firmware '" + spec_.firmware + "': expected ardupilot or px4");
+      map_(spec_.firmware == "betaflight" ? betaflight::motor_map_for(vehicle)
+                                          : motor_map_for(vehicle, spec_.pwm_min_us, spec_.pwm_max_us)),
+      reported_(control::ReportedOutputs::find(output_list(spec_.firmware))) {
+  if (spec_.firmware != "ardupilot" && spec_.firmware != "px4" && spec_.firmware != "betaflight") {
+    throw std::invalid_argument("firmware '" + spec_.firmware + "': expected ardupilot, px4 or betaflight");
+  }
+  if (betaflight() && !spec_.mission.empty()) {
+    throw std::invalid_argument("mission: Betaflight has no MAVLink link; its pilot is the RC (docs/sitl.md)");
   }
   if (spec_.binary.empty()) throw std::invalid_argument("binary: missing; expected the SITL executable's path");
   if (::access(spec_.binary.c_str(), X_OK) != 0 || fs::is_directory(spec_.binary)) {
@@ -199,11 +206,12 @@ std::string SitlController::set_parameters(std::span<const control::Setting> set
          "its params files)";
 }
 
-std::span<const std::string> SitlController::output_names() const { return output_list(px4()); }
+std::span<const std::string> SitlController::output_names() const { return output_list(spec_.firmware); }
 
 void SitlController::reset() {
   link_.reset();
   px4_.reset();
+  bf_.reset();
   counts_ = {};
   steps_ = 0;
   t_s_ = 0.0;
@@ -245,14 +253,12 @@ std::vector<std::string> SitlController::command_line(int json_port, int mavlink
 
 void SitlController::fail(const std::string& what) const {
   std::string msg = fmt::format("controller sitl ({} {}): {}", spec_.firmware, spec_.binary, what);
-  if (link_ && link_->process) {
-    msg += fmt::format("; its log {}:{}", link_->process->log_path(), link_->process->log_tail());
-    link_->temporary = false;  // keep the folder with the log
-  }
-  if (px4_ && px4_->process) {
-    msg += fmt::format("; its log {}:{}", px4_->process->log_path(), px4_->process->log_tail());
-    px4_->temporary = false;
-  }
+  const auto keep = [&](auto& link) {  // the folder stays, with the log the message names
+    if (!link || !link->process) return;
+    msg += fmt::format("; its log {}:{}", link->process->log_path(), link->process->log_tail());
+    link->temporary = false;
+  };
+  keep(link_), keep(px4_), keep(bf_);
   throw control::ControllerFailure(msg);
 }
 
@@ -362,8 +368,8 @@ void SitlController::service_mavlink() {
 
 void SitlController::step(const control::Observation& obs, const control::Reference& reference, double dt_s,
                           control::ControllerOutput& out) {
-  if (px4()) {
-    step_px4(obs, reference, dt_s, out);
+  if (px4() || betaflight()) {
+    px4() ? step_px4(obs, reference, dt_s, out) : step_betaflight(obs, reference, dt_s, out);
     return;
   }
   if (!link_) start();

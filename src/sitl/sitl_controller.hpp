@@ -28,6 +28,10 @@
 
 namespace quadcosim::sitl {
 
+namespace betaflight {
+struct RcSticks;
+}
+
 /// One command of a mission flown over the firmware's MAVLink link (docs/sitl.md), sent once the
 /// simulated time reaches at_s and the previous one was accepted (COMMAND_ACK result 0); a refused or
 /// unanswered command is sent again every second. The mission is looked at every 0.25 s of simulated
@@ -83,10 +87,11 @@ int copter_mode_number(const std::string& name);
 
 /// What a scenario's `controller: {sitl: {...}}` says (docs/scenarios.md).
 struct SitlSpec {
-  std::string firmware = "ardupilot";  ///< the flight stack: ardupilot (JSON protocol) or px4 (simulator_mavlink)
-  std::string binary;                  ///< the SITL executable (build/sitl/bin/arducopter, build/px4_sitl_*/bin/px4)
-  std::vector<std::string> params;     ///< parameter files (NAME VALUE lines), applied in order
-  std::string work_dir;                ///< where it runs (eeprom, logs); empty: a fresh temporary folder, removed after
+  /// The flight stack: ardupilot (JSON protocol), px4 (simulator_mavlink) or betaflight (its SITL's UDP packets).
+  std::string firmware = "ardupilot";
+  std::string binary;               ///< the SITL executable (build/sitl/bin/arducopter, build/px4_sitl_*/bin/px4)
+  std::vector<std::string> params;  ///< parameter files (NAME VALUE lines), applied in order
+  std::string work_dir;             ///< where it runs (eeprom, logs); empty: a fresh temporary folder, removed after
   std::string home = "-35.363261,149.165230,584,0";  ///< --home: latitude, longitude [deg], altitude [m], yaw
   double start_timeout_s = 30.0;                     ///< [s] wall time for its first servo packet
   double timeout_s = 5.0;                            ///< [s] wall time without a servo packet that ends the run
@@ -103,6 +108,10 @@ struct SitlSpec {
   /// The CPU it runs on (its real-time threads then take turns in priority order, the same on every
   /// run); -1: any; -2 (default): the last CPU this process may use.
   int cpu = -2;
+  // Betaflight only.
+  double arm_at_s = 2.0;         ///< [s] simulated time at which the pilot raises AUX1 (ARM); before it, throttle low
+  double resend_ms = 100.0;      ///< [ms] wall time without a motor packet after which the FDM packet goes again
+  double realtime_factor = 1.0;  ///< steps paced at this many times real time (0: unpaced; docs/sitl.md)
   sensors::Geodetic site;  ///< the world origin on the Earth (the GNSS's site): takeoff and goto altitudes, positions
   std::vector<std::string> added;  ///< what the scenario lacked and was added for PX4 (noted when it starts)
 };
@@ -111,6 +120,12 @@ struct SitlSpec {
 /// 1..4 (0..1), armed its HIL_ACTUATOR_CONTROLS' flag, mode its HEARTBEAT's custom_mode as seen at the
 /// last 0.25 s decision (-1 before the first), mission the index of the mission item in progress.
 inline constexpr const char* kPx4Outputs[] = {"frame", "u1", "u2", "u3", "u4", "armed", "mode", "mission"};
+
+/// The figures a Betaflight controller records: m1..m4 its motors 1..4 (0..1), throttle_us and arm the RC
+/// throttle and AUX1 sent, resent the FDM packets sent again, stale the motor packets dropped as late,
+/// late the steps whose answer came more than a pacing period late.
+inline constexpr const char* kBetaflightOutputs[] = {"m1",  "m2",     "m3",    "m4",  "throttle_us",
+                                                     "arm", "resent", "stale", "late"};
 
 /// The figures a SITL controller records (out.<name> in trajectory.csv).
 /// armed and mode are the firmware's last HEARTBEAT's; mission is the index of the mission item in progress.
@@ -140,6 +155,10 @@ class SitlController final : public control::Controller {
 
   const SitlSpec& spec() const { return spec_; }
   bool px4() const { return spec_.firmware == "px4"; }
+  bool betaflight() const { return spec_.firmware == "betaflight"; }
+  /// Betaflight's CLI lines: quadcosim's (betaflight::base_cli), the params files' (comments, save and
+  /// exit left out), then save.
+  std::vector<std::string> betaflight_cli() const;
   /// The same controller with `site` as its world origin on the Earth (PX4's takeoff and goto).
   std::shared_ptr<SitlController> with_site(const sensors::Geodetic& site, std::vector<std::string> added = {}) const;
   /// PX4's command line and environment (NAME=VALUE: PX4_SYS_AUTOSTART, PX4_PARAM_* of the vehicle's
@@ -166,7 +185,13 @@ class SitlController final : public control::Controller {
  private:
   struct Link;
   struct Px4Link;
+  struct BfLink;
   void start();
+  void start_betaflight();
+  void wait_for_betaflight_msp();
+  void step_betaflight(const control::Observation& observation, const control::Reference& reference, double dt_s,
+                       control::ControllerOutput& out);
+  betaflight::RcSticks betaflight_sticks(const control::Observation& obs, const control::Reference& ref, double dt_s);
   void start_px4();
   /// The folder the firmware runs in: spec_.work_dir (made when missing), or a fresh temporary one
   /// (`temporary` set: removed after a run that succeeded).
@@ -183,6 +208,7 @@ class SitlController final : public control::Controller {
   MotorMap map_;
   std::unique_ptr<Link> link_;
   std::unique_ptr<Px4Link> px4_;
+  std::unique_ptr<BfLink> bf_;
   Counts counts_;
   long long steps_ = 0;
   double t_s_ = 0.0;

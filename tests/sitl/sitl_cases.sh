@@ -361,9 +361,9 @@ PY
     grep -q "type: sitl" "$tmp/flag/scenario.yaml" && grep -q "binary: $fake" "$tmp/flag/scenario.yaml" ||
       fail "scenario.yaml does not say what flew: $(cat "$tmp/flag/scenario.yaml")"
     [ "$(tail -1 "$tmp/flag/trajectory.csv" | cut -d, -f4)" = "9.75240816326531" ] || fail "not the open-loop flight"
-    rc=0; "$bin" run "$tmp/paper.yaml" --controller "sitl:betaflight" --out "$tmp/x" > "$tmp/bf.log" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] && grep -q "expected sitl:ardupilot\[:BINARY\] or sitl:px4" "$tmp/bf.log" ||
-      fail "sitl:betaflight: exit $rc $(cat "$tmp/bf.log")"
+    rc=0; "$bin" run "$tmp/paper.yaml" --controller "sitl:inav" --out "$tmp/x" > "$tmp/bf.log" 2>&1 || rc=$?
+    [ "$rc" -eq 2 ] && grep -q "expected sitl:ardupilot\[:BINARY\], sitl:px4\[:BINARY\] or sitl:betaflight" "$tmp/bf.log" ||
+      fail "sitl:inav: exit $rc $(cat "$tmp/bf.log")"
     # A file whose gains sit directly under controller: (the paper controller's, the older form): they
     # move into its paper: section, checked and unused, and the firmware flies.
     sed -e "s/duration_s: .*/duration_s: 1/" "$src/tests/faults/hover_gusts.yaml" > "$tmp/flat.yaml"
