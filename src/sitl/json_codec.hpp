@@ -42,6 +42,9 @@ struct ServoPacket {
 /// Decodes one datagram. Throws DecodeError naming the size and magic found when it is not a 16- or
 /// 32-channel servo packet (a size that does not match its magic is refused too).
 ServoPacket decode_servo_packet(std::span<const std::uint8_t> bytes);
+/// The same into `packet` (its channel vector reused: no allocation once it has its size). On a
+/// DecodeError `packet` is left as it was.
+void decode_servo_packet(std::span<const std::uint8_t> bytes, ServoPacket& packet);
 
 /// Encodes a servo packet (what the firmware sends; the test firmware uses it). 16 or 32 channels.
 std::vector<std::uint8_t> encode_servo_packet(const ServoPacket& packet);
@@ -58,8 +61,10 @@ struct FdmState {
 
 /// The reply line: "\n{...}\n" with timestamp, imu.gyro, imu.accel_body, position, velocity,
 /// quaternion [w, x, y, z] and no_time_sync 1 (the firmware then never sleeps to hold real time).
-/// Numbers are written to round-trip (the same state, the same bytes).
+/// Numbers are written to round-trip (the same state, the same bytes), as nlohmann::json writes them.
 std::string encode_fdm_json(const FdmState& state);
+/// The same line written into `line` (cleared first): no allocation once it has grown (one a frame).
+void encode_fdm_json(const FdmState& state, std::string& line);
 
 /// Reads a reply line back (the test firmware's side). Throws DecodeError naming a missing or
 /// malformed key.
