@@ -59,6 +59,18 @@ struct FdmState {
   Eigen::Quaterniond q_NED_FRD = Eigen::Quaterniond::Identity();  ///< attitude body -> earth
 };
 
+/// The timestamp sent with the state at simulated time t_s: t_s stretched by kTimestampStretch.
+/// ArduPilot advances its clock (whole microseconds, uint64_t) by the difference of two timestamps,
+/// `time_now_us += deltat * 1.0e6`, which truncates: the difference of two rounded multiples of the
+/// period comes out a hair under the period about half the time, so its clock lost a microsecond now
+/// and then and its 400 Hz loop, finding its next sample not yet due, waited a whole frame more
+/// ("Main loop slow" at one frame per loop). Stretched, each difference is above the period by far
+/// more than the rounding (up to t of about 10^5 s), so with a period of whole microseconds its clock
+/// moves by exactly the period every frame. The stretch never accumulates in its clock (each frame's
+/// fraction of a microsecond is dropped); the state's own time is t_s.
+inline constexpr double kTimestampStretch = 1e-7;
+inline double fdm_timestamp_s(double t_s) { return t_s * (1.0 + kTimestampStretch); }
+
 /// The reply line: "\n{...}\n" with timestamp, imu.gyro, imu.accel_body, position, velocity,
 /// quaternion [w, x, y, z] and no_time_sync 1 (the firmware then never sleeps to hold real time).
 /// Numbers are written to round-trip (the same state, the same bytes), as nlohmann::json writes them.

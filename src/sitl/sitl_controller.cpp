@@ -381,7 +381,7 @@ void SitlController::step(const control::Observation& obs, const control::Refere
   if (l.have_pending) {
     service_mavlink();
     FdmState s;
-    s.timestamp_s = t_s_;
+    s.timestamp_s = fdm_timestamp_s(t_s_);  // its clock: exactly one period a frame
     s.gyro_FRD = flu_to_frd(obs.w_B);
     s.accel_FRD = flu_to_frd(obs.specific_force_B);
     s.p_NED = enu_to_ned(obs.p_W);

@@ -190,6 +190,35 @@ TEST(SitlCodec, ReplyLineIsTheJsonLibrarysText) {
   EXPECT_EQ(line.data(), buffer);  // no allocation in the loop
 }
 
+// ArduPilot's clock over frames, as SIM_JSON.cpp advances it: a uint64_t of microseconds to which
+// `deltat * 1.0e6` is added (the sum converted back, truncating), deltat the difference of two
+// timestamps. With the stretched timestamps it stands at exactly n periods after n frames, at 400,
+// 800 and 1000 Hz up to 10^6 frames; with the plain ones (n * dt) it falls behind.
+std::uint64_t firmware_clock_us(std::uint64_t clock_us, double last_s, double now_s) {
+  return static_cast<std::uint64_t>(static_cast<double>(clock_us) + (now_s - last_s) * 1.0e6);
+}
+
+TEST(SitlCodec, TimestampsMoveTheFirmwaresClockByWholePeriods) {
+  for (const int rate_hz : {400, 800, 1000}) {
+    const double dt_s = 1.0 / rate_hz;
+    const std::uint64_t period_us = 1'000'000 / rate_hz;
+    std::uint64_t clock_us = 0, plain_us = 0;
+    double last_s = 0.0, plain_last_s = 0.0;
+    long long behind = 0;
+    for (long long n = 1; n <= 1'000'000; ++n) {
+      const double t_s = static_cast<double>(n) * dt_s;                                  // the controller's step times
+      const double sent_s = std::atof(fmt::format("{}", fdm_timestamp_s(t_s)).c_str());  // as text and back
+      clock_us = firmware_clock_us(clock_us, last_s, sent_s);
+      last_s = sent_s;
+      ASSERT_EQ(clock_us, static_cast<std::uint64_t>(n) * period_us) << rate_hz << " Hz, frame " << n;
+      plain_us = firmware_clock_us(plain_us, plain_last_s, t_s);
+      plain_last_s = t_s;
+      if (plain_us < static_cast<std::uint64_t>(n) * period_us) ++behind;
+    }
+    EXPECT_GT(behind, 0) << rate_hz << " Hz: the plain timestamps kept the clock (the stretch would be moot)";
+  }
+}
+
 // ArduPilot reads the line by finding each key's text and scanning the value after `key":`, vectors
 // with sscanf "[%f, %f, %f]", flags with strtoull: the reply must survive exactly that.
 const char* after_key(const char* json, const char* section, const char* key) {
