@@ -124,28 +124,32 @@ void McapRecorder::add(sim::Transport& transport, const std::string& topic, bool
   });
 }
 
+// pending_ is a heap whose front is the earliest message in (time, channel, arrival) order: a tick
+// writes its settled messages without looking at the ~100 ms of newer ones buffered behind them.
+bool McapRecorder::later(const Pending& a, const Pending& b) {
+  if (a.t_ns != b.t_ns) return a.t_ns > b.t_ns;
+  if (a.channel != b.channel) return a.channel > b.channel;
+  return a.arrival > b.arrival;
+}
+
 void McapRecorder::push(std::uint16_t channel, std::int64_t t_ns, std::vector<std::uint8_t> cdr) {
   pending_.push_back({t_ns, channel, arrivals_++, std::move(cdr)});
+  std::push_heap(pending_.begin(), pending_.end(), later);
 }
 
 void McapRecorder::flush_before(std::int64_t sim_ns) {
-  auto ready =
-      std::stable_partition(pending_.begin(), pending_.end(), [sim_ns](const Pending& p) { return p.t_ns < sim_ns; });
-  std::sort(pending_.begin(), ready, [](const Pending& a, const Pending& b) {
-    if (a.t_ns != b.t_ns) return a.t_ns < b.t_ns;
-    if (a.channel != b.channel) return a.channel < b.channel;
-    return a.arrival < b.arrival;
-  });
-  for (auto it = pending_.begin(); it != ready; ++it) {
-    ChannelInfo& c = channels_[it->channel];
-    const auto t = static_cast<std::uint64_t>(std::max<std::int64_t>(it->t_ns, 0));
-    writer_.write(c.id, ++c.sequence, t, t, it->cdr.data(), it->cdr.size());
+  while (!pending_.empty() && pending_.front().t_ns < sim_ns) {
+    std::pop_heap(pending_.begin(), pending_.end(), later);
+    const Pending& p = pending_.back();
+    ChannelInfo& c = channels_[p.channel];
+    const auto t = static_cast<std::uint64_t>(std::max<std::int64_t>(p.t_ns, 0));
+    writer_.write(c.id, ++c.sequence, t, t, p.cdr.data(), p.cdr.size());
     ++c.count;
     ++written_;
     if (first_ns_ < 0 || static_cast<std::int64_t>(t) < first_ns_) first_ns_ = static_cast<std::int64_t>(t);
     last_ns_ = std::max(last_ns_, static_cast<std::int64_t>(t));
+    pending_.pop_back();
   }
-  pending_.erase(pending_.begin(), ready);
 }
 
 void McapRecorder::close() {

@@ -107,6 +107,8 @@ class McapRecorder {
     std::uint64_t arrival;
     std::vector<std::uint8_t> cdr;
   };
+  /// The order messages are written in, reversed (pending_'s heap order): (time, channel, arrival).
+  static bool later(const Pending& a, const Pending& b);
   struct ChannelInfo {
     std::string topic, type;
     std::uint16_t id;
@@ -132,7 +134,7 @@ class McapRecorder {
   McapWriter writer_;
   std::vector<std::string> only_;
   std::vector<ChannelInfo> channels_;  // indexed by position, not by MCAP id
-  std::vector<Pending> pending_;
+  std::vector<Pending> pending_;       ///< a heap by later(): the earliest at the front
   std::uint64_t arrivals_ = 0, written_ = 0, repeats_ = 0;
   std::int64_t last_stamp_ns_ = 0;
   std::int64_t first_ns_ = -1, last_ns_ = -1;

@@ -6,14 +6,37 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "io/mcap_recorder.hpp"
+#include "io/mcap_writer.hpp"
 #include "sim/inprocess_transport.hpp"
 #include "sim/level_messages.hpp"
 #include "sim/messages.hpp"
 
 namespace quadcosim::io {
 namespace {
+
+// MCAP's CRC-32: the standard check value of "123456789" (0xCBF43926), and a bit at a time (the
+// polynomial's definition) over every length 0..300 from every alignment 0..7.
+TEST(McapCrcTest, MatchesTheCheckValueAndABitwiseCrc) {
+  const std::string check = "123456789";
+  EXPECT_EQ(mcap_crc32({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}), 0xCBF43926u);
+  EXPECT_EQ(mcap_crc32({}), 0u);
+  std::vector<std::uint8_t> bytes(320);
+  std::mt19937 rng(3);
+  for (std::uint8_t& b : bytes) b = static_cast<std::uint8_t>(rng());
+  for (std::size_t start = 0; start < 8; ++start) {
+    for (std::size_t n = 0; n <= 300; ++n) {
+      std::uint32_t c = 0xFFFFFFFFu;
+      for (std::size_t i = start; i < start + n; ++i) {
+        c ^= bytes[i];
+        for (int k = 0; k < 8; ++k) c = (c & 1u) ? (c >> 1) ^ 0xEDB88320u : c >> 1;
+      }
+      ASSERT_EQ(mcap_crc32({bytes.data() + start, n}), c ^ 0xFFFFFFFFu) << "start " << start << ", " << n << " bytes";
+    }
+  }
+}
 
 TEST(McapRecorderTest, RecordsARepeatedTickOnceAndKeepsUnlabelledCommands) {
   const auto dir = std::filesystem::temp_directory_path() / ("mcap_rec_" + std::to_string(::getpid()));

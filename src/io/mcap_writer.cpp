@@ -38,20 +38,33 @@ enum Op : std::uint8_t {
 
 constexpr std::array<std::uint8_t, 8> kMagic = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
 
-// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), as zlib's crc32 and the spec use.
-constexpr std::array<std::uint32_t, 256> make_crc_table() {
-  std::array<std::uint32_t, 256> t{};
+// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), as zlib's crc32 and the spec use, eight
+// bytes a step ("slicing by 8": table k is the CRC of a byte followed by k zero bytes): the same
+// values as a byte at a time, several times faster (a run's recording passes every byte through it
+// twice: the chunk's CRC and the data section's).
+constexpr std::array<std::array<std::uint32_t, 256>, 8> make_crc_tables() {
+  std::array<std::array<std::uint32_t, 256>, 8> t{};
   for (std::uint32_t i = 0; i < 256; ++i) {
     std::uint32_t c = i;
     for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    t[i] = c;
+    t[0][i] = c;
+  }
+  for (std::size_t k = 1; k < 8; ++k) {
+    for (std::size_t i = 0; i < 256; ++i) t[k][i] = (t[k - 1][i] >> 8) ^ t[0][t[k - 1][i] & 0xFF];
   }
   return t;
 }
-constexpr auto kCrcTable = make_crc_table();
+constexpr auto kCrcTables = make_crc_tables();
 constexpr std::uint32_t kCrcInit = 0xFFFFFFFFu;
 std::uint32_t crc_update(std::uint32_t state, const std::uint8_t* p, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) state = kCrcTable[(state ^ p[i]) & 0xFF] ^ (state >> 8);
+  const auto& t = kCrcTables;
+  for (; n >= 8; p += 8, n -= 8) {
+    const std::uint32_t lo = state ^ (static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+                                      static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24);
+    state = t[7][lo & 0xFF] ^ t[6][(lo >> 8) & 0xFF] ^ t[5][(lo >> 16) & 0xFF] ^ t[4][lo >> 24] ^ t[3][p[4]] ^
+            t[2][p[5]] ^ t[1][p[6]] ^ t[0][p[7]];
+  }
+  for (; n > 0; ++p, --n) state = t[0][(state ^ *p) & 0xFF] ^ (state >> 8);
   return state;
 }
 std::uint32_t crc_final(std::uint32_t state) { return state ^ 0xFFFFFFFFu; }
@@ -115,6 +128,10 @@ std::array<std::uint8_t, 9> record_prefix(std::uint8_t opcode, std::uint64_t len
 }
 
 }  // namespace
+
+std::uint32_t mcap_crc32(std::span<const std::uint8_t> bytes) {
+  return crc_final(crc_update(kCrcInit, bytes.data(), bytes.size()));
+}
 
 McapWriter::McapWriter(const std::string& path, McapOptions options) : path_(path), options_(std::move(options)) {
   try {

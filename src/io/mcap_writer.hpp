@@ -30,12 +30,16 @@
 #include <cstdint>
 #include <cstdio>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
 struct ZSTD_CCtx_s;
 
 namespace quadcosim::io {
+
+/// CRC-32 (IEEE 802.3, zlib's crc32) of `bytes`: the checksum of MCAP's chunks and data section.
+std::uint32_t mcap_crc32(std::span<const std::uint8_t> bytes);
 
 struct McapOptions {
   /// Header profile. "ros2" (the MCAP registry's ROS 2 profile) makes add_schema accept only the

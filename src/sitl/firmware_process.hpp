@@ -48,4 +48,11 @@ class FirmwareProcess {
   std::string log_path_;
 };
 
+/// A socket on 127.0.0.1 at a port the system chooses (SOCK_DGRAM or SOCK_STREAM, close-on-exec);
+/// `port` its number. Throws std::runtime_error naming the call that failed.
+int loopback_socket(int type, int& port);
+
+/// The monotonic clock [s], for wall-time limits.
+double wall_clock_s();
+
 }  // namespace quadcosim::sitl

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <array>
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 namespace quadcosim::sitl {
@@ -22,7 +25,26 @@ void put16(std::vector<std::uint8_t>& b, std::uint16_t v) {
   b.push_back(static_cast<std::uint8_t>(v >> 8));
 }
 
-nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+// A number as nlohmann::json writes a double: "null" when not finite, else its to_chars.
+void put_number(std::string& out, double x) {
+  if (!std::isfinite(x)) {
+    out += "null";
+    return;
+  }
+  std::array<char, 64> buf{};
+  const char* end = nlohmann::detail::to_chars(buf.data(), buf.data() + buf.size(), x);
+  out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+}
+
+void put_vec(std::string& out, const Eigen::Vector3d& v) {
+  out.push_back('[');
+  put_number(out, v.x());
+  out.push_back(',');
+  put_number(out, v.y());
+  out.push_back(',');
+  put_number(out, v.z());
+  out.push_back(']');
+}
 
 Eigen::Vector3d read_vec(const nlohmann::json& j, const char* name) {
   if (!j.is_array() || j.size() != 3) throw DecodeError(fmt::format("JSON state: {} is not 3 numbers", name));
@@ -37,6 +59,12 @@ Eigen::Vector3d read_vec(const nlohmann::json& j, const char* name) {
 }  // namespace
 
 ServoPacket decode_servo_packet(std::span<const std::uint8_t> bytes) {
+  ServoPacket p;
+  decode_servo_packet(bytes, p);
+  return p;
+}
+
+void decode_servo_packet(std::span<const std::uint8_t> bytes, ServoPacket& p) {
   if (bytes.size() < 2) {
     throw DecodeError(fmt::format("servo packet: {} bytes, expected {} (16 channels) or {} (32 channels)", bytes.size(),
                                   kServoPacket16Bytes, kServoPacket32Bytes));
@@ -56,12 +84,10 @@ ServoPacket decode_servo_packet(std::span<const std::uint8_t> bytes) {
     throw DecodeError(fmt::format("servo packet: {} bytes with magic {} ({} channels), expected {}", bytes.size(),
                                   magic, channels, want));
   }
-  ServoPacket p;
   p.frame_rate_hz = u16(bytes, 2);
   p.frame_count = u32(bytes, 4);
   p.pwm_us.resize(channels);
   for (std::size_t i = 0; i < channels; ++i) p.pwm_us[i] = u16(bytes, 8 + 2 * i);
-  return p;
 }
 
 std::vector<std::uint8_t> encode_servo_packet(const ServoPacket& packet) {
@@ -77,17 +103,33 @@ std::vector<std::uint8_t> encode_servo_packet(const ServoPacket& packet) {
   return b;
 }
 
+void encode_fdm_json(const FdmState& s, std::string& line) {
+  // The text nlohmann::json's dump() gives for this object (keys sorted, numbers by its to_chars:
+  // shortest round-trip, "1.0" for integral values, "null" for NaN and infinities), written straight
+  // into the caller's buffer: no allocation once the buffer has grown.
+  line.clear();
+  line += "\n{\"imu\":{\"accel_body\":";
+  put_vec(line, s.accel_FRD);
+  line += ",\"gyro\":";
+  put_vec(line, s.gyro_FRD);
+  line += "},\"no_time_sync\":1,\"position\":";
+  put_vec(line, s.p_NED);
+  line += ",\"quaternion\":[";
+  put_number(line, s.q_NED_FRD.w());
+  for (const double c : {s.q_NED_FRD.x(), s.q_NED_FRD.y(), s.q_NED_FRD.z()}) {
+    line.push_back(',');
+    put_number(line, c);
+  }
+  line += "],\"timestamp\":";
+  put_number(line, s.timestamp_s);
+  line += ",\"velocity\":";
+  put_vec(line, s.v_NED);
+  line += "}\n";
+}
+
 std::string encode_fdm_json(const FdmState& s) {
-  nlohmann::json j;
-  j["timestamp"] = s.timestamp_s;
-  j["imu"] = {{"gyro", vec(s.gyro_FRD)}, {"accel_body", vec(s.accel_FRD)}};
-  j["position"] = vec(s.p_NED);
-  j["velocity"] = vec(s.v_NED);
-  j["quaternion"] = nlohmann::json::array({s.q_NED_FRD.w(), s.q_NED_FRD.x(), s.q_NED_FRD.y(), s.q_NED_FRD.z()});
-  j["no_time_sync"] = 1;
-  std::string line(1, '\n');
-  line.append(j.dump());
-  line.push_back('\n');
+  std::string line;
+  encode_fdm_json(s, line);
   return line;
 }
 

@@ -42,6 +42,9 @@ struct ServoPacket {
 /// Decodes one datagram. Throws DecodeError naming the size and magic found when it is not a 16- or
 /// 32-channel servo packet (a size that does not match its magic is refused too).
 ServoPacket decode_servo_packet(std::span<const std::uint8_t> bytes);
+/// The same into `packet` (its channel vector reused: no allocation once it has its size). On a
+/// DecodeError `packet` is left as it was.
+void decode_servo_packet(std::span<const std::uint8_t> bytes, ServoPacket& packet);
 
 /// Encodes a servo packet (what the firmware sends; the test firmware uses it). 16 or 32 channels.
 std::vector<std::uint8_t> encode_servo_packet(const ServoPacket& packet);
@@ -56,10 +59,24 @@ struct FdmState {
   Eigen::Quaterniond q_NED_FRD = Eigen::Quaterniond::Identity();  ///< attitude body -> earth
 };
 
+/// The timestamp sent with the state at simulated time t_s: t_s stretched by kTimestampStretch.
+/// ArduPilot advances its clock (whole microseconds, uint64_t) by the difference of two timestamps,
+/// `time_now_us += deltat * 1.0e6`, which truncates: the difference of two rounded multiples of the
+/// period comes out a hair under the period about half the time, so its clock lost a microsecond now
+/// and then and its 400 Hz loop, finding its next sample not yet due, waited a whole frame more
+/// ("Main loop slow" at one frame per loop). Stretched, each difference is above the period by far
+/// more than the rounding (up to t of about 10^5 s), so with a period of whole microseconds its clock
+/// moves by exactly the period every frame. The stretch never accumulates in its clock (each frame's
+/// fraction of a microsecond is dropped); the state's own time is t_s.
+inline constexpr double kTimestampStretch = 1e-7;
+inline double fdm_timestamp_s(double t_s) { return t_s * (1.0 + kTimestampStretch); }
+
 /// The reply line: "\n{...}\n" with timestamp, imu.gyro, imu.accel_body, position, velocity,
 /// quaternion [w, x, y, z] and no_time_sync 1 (the firmware then never sleeps to hold real time).
-/// Numbers are written to round-trip (the same state, the same bytes).
+/// Numbers are written to round-trip (the same state, the same bytes), as nlohmann::json writes them.
 std::string encode_fdm_json(const FdmState& state);
+/// The same line written into `line` (cleared first): no allocation once it has grown (one a frame).
+void encode_fdm_json(const FdmState& state, std::string& line);
 
 /// Reads a reply line back (the test firmware's side). Throws DecodeError naming a missing or
 /// malformed key.

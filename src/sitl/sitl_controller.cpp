@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -41,26 +42,14 @@ const std::vector<std::string>& output_list(const std::string& firmware = "ardup
   return firmware == "px4" ? px4_names : firmware == "betaflight" ? bf_names : names;
 }
 
-// A socket on 127.0.0.1 at a port the system chooses; its port number.
-int bound_socket(int type, int& port) {
-  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw std::runtime_error(std::string("socket: ") + std::strerror(errno));
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof(a);
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0 ||
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    const int e = errno;
-    ::close(fd);
-    throw std::runtime_error(std::string("bind on 127.0.0.1: ") + std::strerror(e));
-  }
-  port = ntohs(a.sin_port);
-  return fd;
-}
+// How long one blocking receive of a servo packet waits before the wait looks at the firmware's
+// process, a stop request and the deadline [us].
+constexpr int kReceiveSliceUs = 50'000;
 
-double wall_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+// The firmware's MAVLink link is read at each mission decision and otherwise once per this much
+// simulated time (ArduPilot writes its serial ports every 10 ms of its clock): reading it every
+// frame found it empty almost always, a system call for nothing.
+constexpr double kDrainPeriodS = 0.01;
 
 }  // namespace
 
@@ -87,6 +76,11 @@ struct SitlController::Link {
   // differ between two runs; at the decisions, which the mission already waits on, it does not.
   double shown_armed = 0.0, shown_mode = -1.0;
   std::ofstream statustext;
+  long long drained_at = -1;  ///< the 10 ms period of simulated time its MAVLink link was last read in
+  // Reused every frame (no allocation in the exchange): the datagram, its decoding, the reply line.
+  std::array<std::uint8_t, 512> datagram{};
+  ServoPacket packet;
+  std::string line;
 
   void send(std::uint32_t msgid, const std::vector<std::uint8_t>& payload) {
     if (tcp < 0) return;
@@ -279,12 +273,18 @@ void SitlController::start() {
   Link& l = *link_;
   l.work_dir = make_work_dir(l.temporary);
   try {
-    l.udp = bound_socket(SOCK_DGRAM, l.json_port);
-    l.listener = bound_socket(SOCK_STREAM, l.mavlink_port);
+    l.udp = loopback_socket(SOCK_DGRAM, l.json_port);
+    // Blocking receives that give up after a slice, to look at the process, a stop and the deadline.
+    const timeval slice{0, kReceiveSliceUs};
+    if (::setsockopt(l.udp, SOL_SOCKET, SO_RCVTIMEO, &slice, sizeof(slice)) != 0) {
+      throw std::runtime_error(std::string("setsockopt SO_RCVTIMEO: ") + std::strerror(errno));
+    }
+    l.line.reserve(1024);
+    l.listener = loopback_socket(SOCK_STREAM, l.mavlink_port);
     if (::listen(l.listener, 1) != 0) throw std::runtime_error(std::string("listen: ") + std::strerror(errno));
     ::fcntl(l.listener, F_SETFL, O_NONBLOCK);
     // A free UDP port for the firmware's RC input, released for it to bind.
-    const int rc = bound_socket(SOCK_DGRAM, l.rc_port);
+    const int rc = loopback_socket(SOCK_DGRAM, l.rc_port);
     ::close(rc);
   } catch (const std::exception& e) {
     fail(e.what());
@@ -309,15 +309,20 @@ void SitlController::start() {
 
 void SitlController::service_mavlink() {
   Link& l = *link_;
-  l.service_tcp();
-  while (auto f = l.parser.next()) {
-    take_gcs_frame(l, *f, t_s_, spec_.echo_statustext);
-  }
   // Decisions once the firmware has spoken on its link (its first HEARTBEAT), and then at whole
-  // multiples of 0.25 s of simulated time only (step counts, not wall time).
-  if (!l.have_heartbeat || l.tcp < 0) return;
+  // multiples of 0.25 s of simulated time only (step counts, not wall time). The link is read before
+  // each: a decision sees all that had come by then, as when it was read every frame.
   const long long decision = static_cast<long long>(std::floor(t_s_ / 0.25 + 1e-9));
-  if (decision < l.decisions) return;
+  const long long period = static_cast<long long>(std::floor(t_s_ / kDrainPeriodS + 1e-9));
+  const bool deciding = l.have_heartbeat && decision >= l.decisions;
+  if (deciding || period != l.drained_at || l.tcp < 0) {
+    l.drained_at = period;
+    l.service_tcp();
+    while (auto f = l.parser.next()) {
+      take_gcs_frame(l, *f, t_s_, spec_.echo_statustext);
+    }
+  }
+  if (!l.have_heartbeat || l.tcp < 0 || decision < l.decisions) return;
   l.decisions = decision + 1;
   l.shown_armed = l.heartbeat.armed() ? 1.0 : 0.0;
   l.shown_mode = static_cast<double>(l.heartbeat.custom_mode);
@@ -382,26 +387,31 @@ void SitlController::step(const control::Observation& obs, const control::Refere
   if (l.have_pending) {
     service_mavlink();
     FdmState s;
-    s.timestamp_s = t_s_;
+    s.timestamp_s = fdm_timestamp_s(t_s_);  // its clock: exactly one period a frame
     s.gyro_FRD = flu_to_frd(obs.w_B);
     s.accel_FRD = flu_to_frd(obs.specific_force_B);
     s.p_NED = enu_to_ned(obs.p_W);
     s.v_NED = enu_to_ned(obs.v_W);
     s.q_NED_FRD = attitude_ned_frd(obs.q_WB);
-    const std::string line = encode_fdm_json(s);
+    std::string& line = l.line;
+    encode_fdm_json(s, line);
     if (::sendto(l.udp, line.data(), line.size(), 0, reinterpret_cast<const sockaddr*>(&l.peer), sizeof(l.peer)) !=
         static_cast<ssize_t>(line.size())) {
       fail(fmt::format("step {} (t = {:.4f} s): cannot send the state: {}", steps_, t_s_, std::strerror(errno)));
     }
   }
 
-  // Its next servo packet: the rotor speeds over [t_n, t_n+1).
-  const double deadline = wall_s() + limit_s;
-  std::array<std::uint8_t, 512> buf{};
+  // Its next servo packet: the rotor speeds over [t_n, t_n+1). One blocking receive a frame when the
+  // packet comes (the socket's timeout is kReceiveSlice); the checks that cost system calls (the
+  // process's end, its MAVLink link) only after a slice without one, the others on every pass.
+  const double deadline = wall_clock_s() + limit_s;
+  bool quiet = first;  // before the first packet, every pass looks at everything
   for (;;) {
-    l.service_tcp();
-    if (auto end = l.process->ended()) {
-      fail(fmt::format("step {} (t = {:.4f} s): the firmware {}", steps_, t_s_, *end));
+    if (quiet) {
+      l.service_tcp();
+      if (auto end = l.process->ended()) {
+        fail(fmt::format("step {} (t = {:.4f} s): the firmware {}", steps_, t_s_, *end));
+      }
     }
     if (first) {
       // A firmware that panics while starting (ArduPilot's SITL then spins instead of exiting) says so
@@ -417,27 +427,25 @@ void SitlController::step(const control::Observation& obs, const control::Refere
           fmt::format("controller sitl ({} {}): step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM)",
                       spec_.firmware, spec_.binary, steps_, t_s_));
     }
-    const double left = deadline - wall_s();
-    if (left <= 0) {
+    if (deadline - wall_clock_s() <= 0) {
       fail(fmt::format("step {} (t = {:.4f} s): no servo packet for {:g} s (frame {}{})", steps_, t_s_, limit_s,
                        l.have_pending ? std::to_string(l.pending + 1) : std::string("0"),
                        first ? ": it never spoke on its JSON port" : ": it went silent"));
     }
-    pollfd p{l.udp, POLLIN, 0};
-    const int r = ::poll(&p, 1, static_cast<int>(std::min(left, 0.05) * 1000.0) + 1);
-    if (r <= 0) continue;
     sockaddr_in from{};
     socklen_t from_len = sizeof(from);
     const ssize_t n =
-        ::recvfrom(l.udp, buf.data(), buf.size(), MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&from), &from_len);
+        ::recvfrom(l.udp, l.datagram.data(), l.datagram.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len);
+    quiet = n < 0;  // the slice ran out (or a signal came): look at the rest before waiting again
     if (n < 0) continue;
+    std::span<const std::uint8_t> bytes(l.datagram.data(), static_cast<std::size_t>(n));
     if (l.have_peer && (from.sin_port != l.peer.sin_port || from.sin_addr.s_addr != l.peer.sin_addr.s_addr)) {
       ++counts_.foreign;
       continue;
     }
-    ServoPacket packet;
+    ServoPacket& packet = l.packet;
     try {
-      packet = decode_servo_packet(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
+      decode_servo_packet(bytes, packet);
     } catch (const DecodeError& e) {
       fail(fmt::format("step {} (t = {:.4f} s): {}", steps_, t_s_, e.what()));
     }
@@ -450,10 +458,11 @@ void SitlController::step(const control::Observation& obs, const control::Refere
       for (;;) {
         pollfd q{l.udp, POLLIN, 0};
         if (::poll(&q, 1, 0) <= 0) break;
-        const ssize_t m = ::recv(l.udp, buf.data(), buf.size(), MSG_DONTWAIT);
+        const ssize_t m = ::recv(l.udp, l.datagram.data(), l.datagram.size(), MSG_DONTWAIT);
         if (m <= 0) break;
         try {
-          const ServoPacket again = decode_servo_packet(std::span<const std::uint8_t>(buf.data(), std::size_t(m)));
+          const ServoPacket again =
+              decode_servo_packet(std::span<const std::uint8_t>(l.datagram.data(), std::size_t(m)));
           if (again.frame_count == packet.frame_count) {
             ++counts_.repeated;
           } else {

@@ -49,8 +49,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double wall_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
 // A socket bound to 127.0.0.1:port (0: one the system chooses), or -1.
 int bind_port(int type, int port) {
   const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
@@ -253,7 +251,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   };
   // Its simulator link connects first.
   if (l.sim < 0) {
-    const double deadline = wall_s() + spec_.start_timeout_s;
+    const double deadline = wall_clock_s() + spec_.start_timeout_s;
     while (l.sim < 0) {
       check_alive();
       const int fd = ::accept4(l.listener, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
@@ -261,7 +259,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
         l.sim = fd;
         break;
       }
-      if (wall_s() > deadline) {
+      if (wall_clock_s() > deadline) {
         fail(fmt::format("step 0: it did not connect to the simulator port {} within {:g} s", 4560 + l.instance,
                          spec_.start_timeout_s));
       }
@@ -272,13 +270,13 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   // Its threads asleep: what they do for the last time is done before the next starts.
   // Idle: asleep at every look over at least min_s (min_looks looks at least); false after max_s.
   auto wait_idle = [&](double min_s, double max_s, int min_looks) {
-    const double t0 = wall_s();
+    const double t0 = wall_clock_s();
     double idle_since = -1.0;
     int looks = 0;
     for (;;) {
       int processes = 0;
       const bool idle = l.process->idle(!l.group_settled, &processes);
-      const double now = wall_s();
+      const double now = wall_clock_s();
       if (idle) {
         if (idle_since < 0) idle_since = now;
         if (++looks >= min_looks && now - idle_since >= min_s) {
@@ -338,7 +336,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
   // Its answer for this time.
   std::optional<mavlink::HilActuatorControls> answer;
   const double limit_s = l.answered ? spec_.timeout_s : spec_.start_timeout_s;
-  const double deadline = wall_s() + limit_s;
+  const double deadline = wall_clock_s() + limit_s;
   std::array<std::uint8_t, 4096> buf{};
   bool quiet = false;
   while (!answer) {
@@ -385,7 +383,7 @@ void SitlController::step_px4(const control::Observation& obs, const control::Re
       pollfd p{l.sim, POLLIN, 0};
       ::poll(&p, 1, 20);
     }
-    if (wall_s() > deadline) {
+    if (wall_clock_s() > deadline) {
       fail(fmt::format("step {} (t = {:.4f} s): no HIL_ACTUATOR_CONTROLS for {:g} s ({})", steps_, t_s_, limit_s,
                        l.answered ? "it went silent" : "it never answered a HIL_SENSOR"));
     }

@@ -7,6 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <numbers>
+#include <random>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "model/mixer.hpp"
 #include "sitl/frames.hpp"
@@ -142,6 +146,77 @@ TEST(SitlCodec, EncodesTheReplyLine) {
             "\n{\"imu\":{\"accel_body\":[0.0,0.0,-9.81],\"gyro\":[0.1,-0.2,0.3]},\"no_time_sync\":1,"
             "\"position\":[1.0,2.0,-3.0],\"quaternion\":[1.0,0.0,0.0,0.0],\"timestamp\":0.0025,"
             "\"velocity\":[0.5,0.0,0.0]}\n");
+}
+
+// The line written without building a JSON object holds the bytes nlohmann::json's dump() gives for
+// the same object (the reference built here as a json value), for every kind of number: integral,
+// tiny, huge, negative zero, subnormal, not finite; into a reused buffer, which then stays put.
+TEST(SitlCodec, ReplyLineIsTheJsonLibrarysText) {
+  const auto reference = [](const FdmState& s) {
+    const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+    nlohmann::json j;
+    j["timestamp"] = s.timestamp_s;
+    j["imu"] = {{"gyro", vec(s.gyro_FRD)}, {"accel_body", vec(s.accel_FRD)}};
+    j["position"] = vec(s.p_NED);
+    j["velocity"] = vec(s.v_NED);
+    j["quaternion"] = nlohmann::json::array({s.q_NED_FRD.w(), s.q_NED_FRD.x(), s.q_NED_FRD.y(), s.q_NED_FRD.z()});
+    j["no_time_sync"] = 1;
+    return "\n" + j.dump() + "\n";
+  };
+  const double kinds[] = {0.0,          -0.0,     1.0,       -9.81,    0.0025, 1e-5, 1.5e-7, 123456789012345678.0,
+                          1e300,        -1e-300,  4.9e-324,  0.1,      1e15,   1e16, 1e-4,   -2.5e21,
+                          std::nan(""), HUGE_VAL, -HUGE_VAL, 1.0 / 3.0};
+  std::string line;
+  line.reserve(1024);
+  const char* const buffer = line.data();
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-12, 12);
+  for (int trial = 0; trial < 2000; ++trial) {
+    double v[16];
+    for (double& x : v) {
+      x = trial < 200 ? kinds[(trial + (&x - v)) % std::size(kinds)] : std::ldexp(mantissa(rng), exponent(rng) * 4);
+    }
+    FdmState s;
+    s.timestamp_s = v[0];
+    s.gyro_FRD = {v[1], v[2], v[3]};
+    s.accel_FRD = {v[4], v[5], v[6]};
+    s.p_NED = {v[7], v[8], v[9]};
+    s.v_NED = {v[10], v[11], v[12]};
+    s.q_NED_FRD = Eigen::Quaterniond(v[13], v[14], v[15], v[0]);
+    encode_fdm_json(s, line);
+    ASSERT_EQ(line, reference(s)) << "trial " << trial;
+  }
+  EXPECT_EQ(line.data(), buffer);  // no allocation in the loop
+}
+
+// ArduPilot's clock over frames, as SIM_JSON.cpp advances it: a uint64_t of microseconds to which
+// `deltat * 1.0e6` is added (the sum converted back, truncating), deltat the difference of two
+// timestamps. With the stretched timestamps it stands at exactly n periods after n frames, at 400,
+// 800 and 1000 Hz up to 10^6 frames; with the plain ones (n * dt) it falls behind.
+std::uint64_t firmware_clock_us(std::uint64_t clock_us, double last_s, double now_s) {
+  return static_cast<std::uint64_t>(static_cast<double>(clock_us) + (now_s - last_s) * 1.0e6);
+}
+
+TEST(SitlCodec, TimestampsMoveTheFirmwaresClockByWholePeriods) {
+  for (const int rate_hz : {400, 800, 1000}) {
+    const double dt_s = 1.0 / rate_hz;
+    const std::uint64_t period_us = 1'000'000 / rate_hz;
+    std::uint64_t clock_us = 0, plain_us = 0;
+    double last_s = 0.0, plain_last_s = 0.0;
+    long long behind = 0;
+    for (long long n = 1; n <= 1'000'000; ++n) {
+      const double t_s = static_cast<double>(n) * dt_s;                                  // the controller's step times
+      const double sent_s = std::atof(fmt::format("{}", fdm_timestamp_s(t_s)).c_str());  // as text and back
+      clock_us = firmware_clock_us(clock_us, last_s, sent_s);
+      last_s = sent_s;
+      ASSERT_EQ(clock_us, static_cast<std::uint64_t>(n) * period_us) << rate_hz << " Hz, frame " << n;
+      plain_us = firmware_clock_us(plain_us, plain_last_s, t_s);
+      plain_last_s = t_s;
+      if (plain_us < static_cast<std::uint64_t>(n) * period_us) ++behind;
+    }
+    EXPECT_GT(behind, 0) << rate_hz << " Hz: the plain timestamps kept the clock (the stretch would be moot)";
+  }
 }
 
 // ArduPilot reads the line by finding each key's text and scanning the value after `key":`, vectors

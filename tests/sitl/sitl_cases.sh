@@ -390,7 +390,7 @@ PY
     "$py" - "$tmp/r1/trajectory.csv" <<'PY' || fail "mission"
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
-rate = 800
+rate = round(1 / (float(rows[1]["t"]) - float(rows[0]["t"])))  # the scenario's frame rate (800 Hz shipped)
 at = lambda t: rows[round(t * rate)]
 armed = [float(r["t"]) for r in rows if r["out.armed"] == "1"]
 assert armed, "never armed"
