@@ -206,19 +206,36 @@ std::string FirmwareProcess::log_tail(int lines) const {
   return out;
 }
 
-int loopback_socket(int type, int& port) {
-  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw std::runtime_error(std::string("socket: ") + std::strerror(errno));
+sockaddr_in loopback_address(int port) {
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof(a);
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0 ||
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  return a;
+}
+
+int bind_loopback(int type, int port) {
+  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
+  if (fd < 0) return -1;
+  const sockaddr_in a = loopback_address(port);
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof(a)) != 0) {
     const int e = errno;
     ::close(fd);
-    throw std::runtime_error(std::string("bind on 127.0.0.1: ") + std::strerror(e));
+    errno = e;
+    return -1;
+  }
+  return fd;
+}
+
+int loopback_socket(int type, int& port) {
+  const int fd = bind_loopback(type, 0);
+  if (fd < 0) throw std::runtime_error(std::string("bind on 127.0.0.1: ") + std::strerror(errno));
+  sockaddr_in a{};
+  socklen_t len = sizeof(a);
+  if (::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+    const int e = errno;
+    ::close(fd);
+    throw std::runtime_error(std::string("getsockname on 127.0.0.1: ") + std::strerror(e));
   }
   port = ntohs(a.sin_port);
   return fd;

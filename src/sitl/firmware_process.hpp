@@ -5,6 +5,7 @@
 // its own (ArduPilot writes its eeprom and logs to the current folder).
 #pragma once
 
+#include <netinet/in.h>
 #include <sys/types.h>
 
 #include <map>
@@ -51,6 +52,11 @@ class FirmwareProcess {
 /// A socket on 127.0.0.1 at a port the system chooses (SOCK_DGRAM or SOCK_STREAM, close-on-exec);
 /// `port` its number. Throws std::runtime_error naming the call that failed.
 int loopback_socket(int type, int& port);
+/// A socket (close-on-exec) bound to 127.0.0.1:port (0: one the system chooses), or -1 with errno
+/// saying why (a port in use is an answer here, not an error: PX4's instances, Betaflight's fixed ports).
+int bind_loopback(int type, int port);
+/// 127.0.0.1:port.
+sockaddr_in loopback_address(int port);
 
 /// The monotonic clock [s], for wall-time limits.
 double wall_clock_s();

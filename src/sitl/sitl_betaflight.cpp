@@ -55,35 +55,6 @@ namespace bf = betaflight;
 
 namespace {
 
-double bf_wall_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-// A socket bound to 127.0.0.1:port, or -1 with errno.
-int bf_bind_local(int type, int port) {
-  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
-  if (fd < 0) return -1;
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
-    const int e = errno;
-    ::close(fd);
-    errno = e;
-    return -1;
-  }
-  return fd;
-}
-
-sockaddr_in bf_local(int port) {
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  return a;
-}
-
 constexpr double kAngleLimitRad = 60.0 * std::numbers::pi / 180.0;  // Betaflight's angle_limit default
 constexpr double kIdle = 0.055;         // its motor idle (dshot_idle_value 550: 5.5 %) at minimum throttle
 constexpr double kMinCheckUs = 1050.0;  // min_check: the throttle stick's zero
@@ -119,13 +90,13 @@ void SitlController::start_betaflight() {
                     "(docs/sitl.md, \"Betaflight\")",
                     type == SOCK_DGRAM ? "UDP" : "TCP", port, std::strerror(errno)));
   };
-  l.motors = bf_bind_local(SOCK_DGRAM, bf::kMotorPort);
+  l.motors = bind_loopback(SOCK_DGRAM, bf::kMotorPort);
   if (l.motors < 0) taken(SOCK_DGRAM, bf::kMotorPort);
-  l.raw = bf_bind_local(SOCK_DGRAM, bf::kPwmRawPort);
+  l.raw = bind_loopback(SOCK_DGRAM, bf::kPwmRawPort);
   if (l.raw < 0) taken(SOCK_DGRAM, bf::kPwmRawPort);
   for (const auto& [type, port] : {std::pair{SOCK_DGRAM, bf::kStatePort}, std::pair{SOCK_DGRAM, bf::kRcPort},
                                    std::pair{SOCK_STREAM, bf::kCliPort}}) {
-    const int fd = bf_bind_local(type, port);
+    const int fd = bind_loopback(type, port);
     if (fd < 0) taken(type, port);
     ::close(fd);
   }
@@ -142,10 +113,10 @@ void SitlController::start_betaflight() {
   {
     FirmwareProcess config({spec_.binary, "--config", cli.string()}, l.work_dir,
                            (fs::path(l.work_dir) / "config.log").string());
-    const double deadline = bf_wall_s() + spec_.start_timeout_s;
+    const double deadline = wall_clock_s() + spec_.start_timeout_s;
     std::optional<std::string> end;
     while (!(end = config.ended())) {
-      if (bf_wall_s() > deadline) {
+      if (wall_clock_s() > deadline) {
         fail(fmt::format("its --config run did not exit within {:g} s (log {})", spec_.start_timeout_s,
                          (fs::path(l.work_dir) / "config.log").string()));
       }
@@ -159,15 +130,7 @@ void SitlController::start_betaflight() {
   }
   std::vector<std::string> argv = {spec_.binary};
   argv.insert(argv.end(), spec_.args.begin(), spec_.args.end());
-  {
-    std::ofstream f(fs::path(l.work_dir) / "command_line.txt");
-    for (const std::string& a : argv) f << a << '\n';
-  }
-  try {
-    l.process = std::make_unique<FirmwareProcess>(argv, l.work_dir, (fs::path(l.work_dir) / "firmware.log").string());
-  } catch (const std::exception& e) {
-    fail(e.what());
-  }
+  l.process = launch(argv, l.work_dir);
   wait_for_betaflight_msp();
   const model::VehicleParams& v = model_.params();
   l.hover_u = std::sqrt(v.mass_kg * v.gravity_m_s2 / (4.0 * v.kt_N_per_rad2_s2)) / map_.omega_max_rad_s;
@@ -178,11 +141,11 @@ void SitlController::start_betaflight() {
 // an answer to an MSP request (MSP_API_VERSION, "$M<" 0 1 1) on its UART1, TCP 5761, which its
 // scheduler gives once it runs.
 void SitlController::wait_for_betaflight_msp() {
-  const double deadline = bf_wall_s() + spec_.start_timeout_s;
-  const sockaddr_in to = bf_local(bf::kCliPort);
+  const double deadline = wall_clock_s() + spec_.start_timeout_s;
+  const sockaddr_in to = loopback_address(bf::kCliPort);
   for (;;) {
     if (auto end = bf_->process->ended()) fail(fmt::format("while starting, the firmware {}", *end));
-    if (bf_wall_s() > deadline) {
+    if (wall_clock_s() > deadline) {
       fail(fmt::format("no answer to MSP on TCP {} within {:g} s: its start-up did not finish", bf::kCliPort,
                        spec_.start_timeout_s));
     }
@@ -191,8 +154,8 @@ void SitlController::wait_for_betaflight_msp() {
       const std::array<std::uint8_t, 6> request = {'$', 'M', '<', 0, 1, 1};
       ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
       std::string got;
-      const double until = bf_wall_s() + 0.2;
-      while (bf_wall_s() < until && got.find("$M>") == std::string::npos) {
+      const double until = wall_clock_s() + 0.2;
+      while (wall_clock_s() < until && got.find("$M>") == std::string::npos) {
         pollfd p{fd, POLLIN, 0};
         if (::poll(&p, 1, 20) <= 0) continue;
         std::array<char, 256> buf{};
@@ -254,7 +217,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
   if (steps_ == 0) l.first_lon_lat = lla.head<2>();
   auto fdm =
       bf::encode_fdm(bf::gazebo_fdm(stamp_s, obs.w_B, obs.specific_force_B, obs.q_WB, obs.v_W, lla, l.first_lon_lat));
-  const sockaddr_in rc_to = bf_local(bf::kRcPort), fdm_to = bf_local(bf::kStatePort);
+  const sockaddr_in rc_to = loopback_address(bf::kRcPort), fdm_to = loopback_address(bf::kStatePort);
   auto send = [&] {
     l.drain(l.motors, &l.stale);
     l.drain(l.raw, nullptr);
@@ -279,7 +242,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
     }
   }
   if (period_s > 0 && l.answered) {
-    const double wait_s = l.next_send_wall_s - bf_wall_s();
+    const double wait_s = l.next_send_wall_s - wall_clock_s();
     if (wait_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
     if (wait_s < -period_s) ++l.late;  // its answer came more than a period late: the schedule restarts here
   }
@@ -288,10 +251,10 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
     const bool on_time = sent_s - l.next_send_wall_s < period_s;
     l.next_send_wall_s = (on_time && l.answered ? l.next_send_wall_s : sent_s) + period_s;
   };
-  schedule(bf_wall_s());
+  schedule(wall_clock_s());
   const double limit_s = l.answered ? spec_.timeout_s : spec_.start_timeout_s;
-  const double deadline = bf_wall_s() + limit_s;
-  double resend_at = bf_wall_s() + spec_.resend_ms / 1000.0;
+  const double deadline = wall_clock_s() + limit_s;
+  double resend_at = wall_clock_s() + spec_.resend_ms / 1000.0;
   std::array<float, 4> motors{};
   std::array<std::uint8_t, 256> buf{};
   for (;;) {
@@ -301,7 +264,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
           fmt::format("controller sitl ({} {}): step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM)",
                       spec_.firmware, spec_.binary, steps_, t_s_));
     }
-    const double now = bf_wall_s();
+    const double now = wall_clock_s();
     if (now > deadline) {
       fail(fmt::format("step {} (t = {:.4f} s): no motor packet on UDP {} for {:g} s ({})", steps_, t_s_,
                        bf::kMotorPort, limit_s, l.answered ? "it went silent" : "it never answered an FDM packet"));

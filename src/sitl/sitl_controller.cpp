@@ -187,6 +187,19 @@ void SitlController::fail(const std::string& what) const {
   throw control::ControllerFailure(msg);
 }
 
+std::unique_ptr<FirmwareProcess> SitlController::launch(const std::vector<std::string>& argv,
+                                                        const std::string& work_dir) const {
+  {
+    std::ofstream f(fs::path(work_dir) / "command_line.txt");
+    for (const std::string& a : argv) f << a << '\n';
+  }
+  try {
+    return std::make_unique<FirmwareProcess>(argv, work_dir, (fs::path(work_dir) / "firmware.log").string());
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+}
+
 std::string SitlController::make_work_dir(bool& temporary) const {
   if (spec_.work_dir.empty()) {
     std::string tmpl = (fs::temp_directory_path() / "quadcosim-sitl-XXXXXX").string();
@@ -227,15 +240,7 @@ void SitlController::start() {
     if (!f) fail("cannot write " + generated);
   }
   const std::vector<std::string> argv = command_line(l.json_port, l.mavlink_port, l.rc_port, generated);
-  {
-    std::ofstream f(fs::path(l.work_dir) / "command_line.txt");
-    for (const std::string& a : argv) f << a << '\n';
-  }
-  try {
-    l.process = std::make_unique<FirmwareProcess>(argv, l.work_dir, (fs::path(l.work_dir) / "firmware.log").string());
-  } catch (const std::exception& e) {
-    fail(e.what());
-  }
+  l.process = launch(argv, l.work_dir);
 }
 
 void SitlController::service_mavlink() {

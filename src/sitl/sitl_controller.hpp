@@ -30,7 +30,8 @@ namespace quadcosim::sitl {
 
 namespace betaflight {
 struct RcSticks;
-}
+}  // namespace betaflight
+class FirmwareProcess;
 
 /// One command of a mission flown over the firmware's MAVLink link (docs/sitl.md), sent once the
 /// simulated time reaches at_s and the previous one was accepted (COMMAND_ACK result 0); a refused or
@@ -202,6 +203,9 @@ class SitlController final : public control::Controller {
   /// Reads the firmware's MAVLink messages; at decision times, advances the mission.
   void service_mavlink();
   [[noreturn]] void fail(const std::string& what) const;
+  /// Writes argv into work_dir/command_line.txt and starts it there (its output to firmware.log);
+  /// fails by name when it cannot be started.
+  std::unique_ptr<FirmwareProcess> launch(const std::vector<std::string>& argv, const std::string& work_dir) const;
 
   SitlSpec spec_;
   model::Quadrotor model_;

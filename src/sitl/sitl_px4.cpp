@@ -49,23 +49,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A socket bound to 127.0.0.1:port (0: one the system chooses), or -1.
-int bind_port(int type, int port) {
-  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
-  if (fd < 0) return -1;
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
 bool udp_port_free(int port) {
-  const int fd = bind_port(SOCK_DGRAM, port);
+  const int fd = bind_loopback(SOCK_DGRAM, port);
   if (fd < 0) return false;
   ::close(fd);
   return true;
@@ -116,7 +101,7 @@ void SitlController::start_px4() {
   const int first = spec_.instance >= 0 ? spec_.instance : 0;
   const int last = spec_.instance >= 0 ? spec_.instance : 99;
   for (int i = first; i <= last && l.listener < 0; ++i) {
-    const int fd = bind_port(SOCK_STREAM, 4560 + i);
+    const int fd = bind_loopback(SOCK_STREAM, 4560 + i);
     if (fd < 0) continue;
     if (udp_port_free(18570 + i) && udp_port_free(14580 + i) && udp_port_free(14280 + i) && udp_port_free(13030 + i) &&
         ::listen(fd, 1) == 0) {
@@ -133,7 +118,7 @@ void SitlController::start_px4() {
                                            "i, 14280 + i, 13030 + i all in use)"));
   }
   ::fcntl(l.listener, F_SETFL, O_NONBLOCK);
-  l.gcs = bind_port(SOCK_DGRAM, 0);
+  l.gcs = bind_loopback(SOCK_DGRAM, 0);
   if (l.gcs < 0) fail(std::string("cannot open a UDP socket: ") + std::strerror(errno));
   l.gcs_peer.sin_family = AF_INET;
   l.gcs_peer.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
