@@ -32,6 +32,8 @@ struct SitlController::BfLink {
   long long resent = 0, stale = 0, late = 0;
   double stamp_offset_s = 0.0;    ///< [s] added to its stamps: the tries at step 0 before its first answer
   double next_send_wall_s = 0.0;  ///< [s, steady clock] when the next step's packets go (pacing)
+  double answered_wall_s = 0.0;   ///< [s, steady clock] when its last motor packet came
+  std::array<float, 4> held{};    ///< its newest motor packet: what a step without its own answer flies
 
   ~BfLink() {
     process.reset();

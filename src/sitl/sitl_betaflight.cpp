@@ -8,10 +8,12 @@
 // Each step (period dt, t_n = n dt): the RC packet (stamped t_n), then the FDM packet (the state at t_n
 // in the Gazebo bridge's frames, betaflight.hpp), and the motor packet that answers it: its motors are
 // the rotor speeds over [t_n, t_n+1). Steps are paced at realtime_factor times real time (a step's packets
-// leave dt / realtime_factor of wall time after the last step's; 0: as soon as the answer came), which holds
-// Betaflight's clock rate (simRate) at that factor. Betaflight's packets carry no frame count, so stale packets are
-// dropped before each send (counted: out.stale), and a step without an answer within resend_ms wall
-// time sends the same FDM packet again (out.resent) until timeout_s. Betaflight sends one motor packet
+// leave dt / realtime_factor of wall time after the last step's whatever its answer did), which holds
+// Betaflight's clock rate (simRate) at that factor; a step whose answer has not come by the next send time
+// flies the newest motor packet before it (out.late). Unpaced (realtime_factor 0) and before the first
+// answer, each step waits for its answer: stale packets are dropped before each send (out.stale), and a
+// step without an answer within resend_ms wall time sends the same FDM packet again (out.resent) until
+// timeout_s. Betaflight sends one motor packet
 // per FDM packet (sitl.c's updateLock); built with ENABLE_SIMULATOR_GYROPID_SYNC its PID loop also runs
 // once per FDM packet. Its clock is wall time scaled by the rate of FDM timestamps to wall time (simRate):
 // not quadcosim's, so the flight is not bit-for-bit repeatable (docs/sitl.md says how far).
@@ -241,58 +243,98 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
       std::this_thread::sleep_for(std::chrono::duration<double>(period_s > 0 ? period_s : dt_s));
     }
   }
-  if (period_s > 0 && l.answered) {
-    const double wait_s = l.next_send_wall_s - wall_clock_s();
-    if (wait_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
-    if (wait_s < -period_s) ++l.late;  // its answer came more than a period late: the schedule restarts here
-  }
-  send();
-  auto schedule = [&](double sent_s) {
-    const bool on_time = sent_s - l.next_send_wall_s < period_s;
-    l.next_send_wall_s = (on_time && l.answered ? l.next_send_wall_s : sent_s) + period_s;
-  };
-  schedule(wall_clock_s());
-  const double limit_s = l.answered ? spec_.timeout_s : spec_.start_timeout_s;
-  const double deadline = wall_clock_s() + limit_s;
-  double resend_at = wall_clock_s() + spec_.resend_ms / 1000.0;
   std::array<float, 4> motors{};
   std::array<std::uint8_t, 256> buf{};
-  for (;;) {
+  auto alive = [&] {
     if (auto end = l.process->ended()) fail(fmt::format("step {} (t = {:.4f} s): the firmware {}", steps_, t_s_, *end));
     if (isolation::stop_requested()) {
       throw control::ControllerFailure(
           fmt::format("controller sitl ({} {}): step {} (t = {:.4f} s): interrupted (Ctrl-C or SIGTERM)",
                       spec_.firmware, spec_.binary, steps_, t_s_));
     }
-    const double now = wall_clock_s();
-    if (now > deadline) {
-      fail(fmt::format("step {} (t = {:.4f} s): no motor packet on UDP {} for {:g} s ({})", steps_, t_s_,
-                       bf::kMotorPort, limit_s, l.answered ? "it went silent" : "it never answered an FDM packet"));
-    }
-    if (now > resend_at) {
-      ++l.resent;
-      if (!l.answered) {
-        // Not answered yet: each try a dt later in its time (the same state), so that its clock rate
-        // is set again (a packet with the last stamp leaves it as it is, stopped or not).
-        l.stamp_offset_s += dt_s;
-        rc = bf::encode_rc(t_s_ + 2.0 * dt_s + l.stamp_offset_s, bf::rc_channels(sticks));
-        fdm = bf::encode_fdm(bf::gazebo_fdm(t_s_ + 2.0 * dt_s + l.stamp_offset_s, obs.w_B, obs.specific_force_B,
-                                            obs.q_WB, obs.v_W, lla, l.first_lon_lat));
-      }
-      send();
-      l.next_send_wall_s = now + period_s;  // the next step a whole period after this one
-      resend_at = now + spec_.resend_ms / 1000.0;
-    }
-    pollfd p{l.motors, POLLIN, 0};
-    if (::poll(&p, 1, 1) <= 0) continue;
-    const ssize_t n = ::recv(l.motors, buf.data(), buf.size(), MSG_DONTWAIT);
-    if (n < 0) continue;
+  };
+  auto decode = [&](ssize_t n) {
     try {
-      motors = bf::decode_motors(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
+      return bf::decode_motors(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
     } catch (const DecodeError& e) {
       fail(fmt::format("step {} (t = {:.4f} s): on UDP {}: {}", steps_, t_s_, bf::kMotorPort, e.what()));
     }
-    break;
+  };
+  if (period_s > 0 && l.answered) {
+    // Free-running once answered: step n's packets leave one period after step n-1's whatever the answers
+    // did, so Betaflight's simRate stays dt / P. Waiting for a late answer would send the next packets
+    // late, lower simRate, make its next PID loop come due later still and so the next answer: a run
+    // settles at a fraction of the factor (0.13x measured). A step whose answer has not come by the next
+    // step's send time flies the newest motor packet Betaflight sent before it (out.late counts them).
+    const double wait_s = l.next_send_wall_s - wall_clock_s();
+    if (wait_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
+    if (wait_s < -period_s) l.next_send_wall_s = wall_clock_s();  // quadcosim fell behind: restart the schedule
+    for (ssize_t n; (n = ::recv(l.motors, buf.data(), buf.size(), MSG_DONTWAIT)) > 0;) {
+      l.held = decode(n);  // answers that came after their step: the newest is what the firmware flies now
+      ++l.stale;
+    }
+    l.drain(l.raw, nullptr);
+    ::sendto(l.out, rc.data(), rc.size(), 0, reinterpret_cast<const sockaddr*>(&rc_to), sizeof(rc_to));
+    ::sendto(l.out, fdm.data(), fdm.size(), 0, reinterpret_cast<const sockaddr*>(&fdm_to), sizeof(fdm_to));
+    l.next_send_wall_s += period_s;
+    motors = l.held;
+    bool own = false;
+    for (double now = wall_clock_s(); now < l.next_send_wall_s; now = wall_clock_s()) {
+      alive();
+      const double left_s = std::min(l.next_send_wall_s - now, 0.05);
+      const timespec slice{0, static_cast<long>(left_s * 1e9)};
+      pollfd p{l.motors, POLLIN, 0};
+      if (::ppoll(&p, 1, &slice, nullptr) <= 0) continue;
+      const ssize_t n = ::recv(l.motors, buf.data(), buf.size(), MSG_DONTWAIT);
+      if (n <= 0) continue;
+      motors = l.held = decode(n);
+      own = true;
+      break;
+    }
+    if (own) {
+      l.answered_wall_s = wall_clock_s();
+    } else {
+      ++l.late;
+      if (wall_clock_s() - l.answered_wall_s > spec_.timeout_s) {
+        fail(fmt::format("step {} (t = {:.4f} s): no motor packet on UDP {} for {:g} s (it went silent)", steps_, t_s_,
+                         bf::kMotorPort, spec_.timeout_s));
+      }
+    }
+  } else {
+    send();
+    l.next_send_wall_s = wall_clock_s() + period_s;
+    const double limit_s = l.answered ? spec_.timeout_s : spec_.start_timeout_s;
+    const double deadline = wall_clock_s() + limit_s;
+    double resend_at = wall_clock_s() + spec_.resend_ms / 1000.0;
+    for (;;) {
+      alive();
+      const double now = wall_clock_s();
+      if (now > deadline) {
+        fail(fmt::format("step {} (t = {:.4f} s): no motor packet on UDP {} for {:g} s ({})", steps_, t_s_,
+                         bf::kMotorPort, limit_s, l.answered ? "it went silent" : "it never answered an FDM packet"));
+      }
+      if (now > resend_at) {
+        ++l.resent;
+        if (!l.answered) {
+          // Not answered yet: each try a dt later in its time (the same state), so that its clock rate
+          // is set again (a packet with the last stamp leaves it as it is, stopped or not).
+          l.stamp_offset_s += dt_s;
+          rc = bf::encode_rc(t_s_ + 2.0 * dt_s + l.stamp_offset_s, bf::rc_channels(sticks));
+          fdm = bf::encode_fdm(bf::gazebo_fdm(t_s_ + 2.0 * dt_s + l.stamp_offset_s, obs.w_B, obs.specific_force_B,
+                                              obs.q_WB, obs.v_W, lla, l.first_lon_lat));
+        }
+        send();
+        l.next_send_wall_s = now + period_s;  // the next step a whole period after this one
+        resend_at = now + spec_.resend_ms / 1000.0;
+      }
+      pollfd p{l.motors, POLLIN, 0};
+      if (::poll(&p, 1, 1) <= 0) continue;
+      const ssize_t n = ::recv(l.motors, buf.data(), buf.size(), MSG_DONTWAIT);
+      if (n < 0) continue;
+      motors = l.held = decode(n);
+      break;
+    }
+    l.answered_wall_s = wall_clock_s();
   }
   l.answered = true;
   l.motors_on = std::any_of(motors.begin(), motors.end(), [](float m) { return m > 0.0f; });

@@ -94,6 +94,37 @@ PY
     cmp "$tmp/a/trajectory.csv" "$tmp/b/trajectory.csv" || fail "two runs differ"
     echo "bf deterministic: trajectory.csv identical over two runs ($(wc -l < "$tmp/a/trajectory.csv") lines)"
     ;;
+  bf_paced)
+    # Paced at real time (realtime_factor 1, 3 s) with every 50th FDM packet answered 6 ms late (the step is
+    # 2.5 ms): the packets still leave one a step (none sent twice), and a step whose answer missed the next
+    # step's send time flies the motors it flew before (out.late counts it; the late answer is flown by the
+    # next step).
+    scenario paced --fake-late-every 50 --fake-record "$tmp/paced.rec"
+    sed -i -e 's/realtime_factor: 0 .*/realtime_factor: 1/' -e 's/duration_s: 12/duration_s: 3/' "$tmp/paced.yaml"
+    run paced 0
+    "$py" - "$tmp/paced/trajectory.csv" "$tmp/paced.rec" <<'PY' || fail "paced"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+rec = [list(map(float, line.split())) for line in open(sys.argv[2])]
+last = rows[-1]
+assert int(last["out.resent"]) == 0, last["out.resent"]
+# The prelude's two packets, then one per step, each stamp once.
+assert len(rec) == len(rows) + 2, (len(rec), len(rows))
+assert [round(x[0] - 0.005, 9) for x in rec[2:]] == [round(float(r["t"]), 9) for r in rows]
+delayed = len(rec) // 50
+late = int(last["out.late"])
+assert late >= delayed, (late, delayed)
+m = [[float(r[f"out.m{k}"]) for k in range(1, 5)] for r in rows]
+held = 0
+for k in range(1, len(rows)):
+    if int(rows[k]["out.late"]) > int(rows[k - 1]["out.late"]) and rows[k]["out.stale"] == rows[k - 1]["out.stale"]:
+        assert m[k] == m[k - 1], (rows[k]["t"], m[k], m[k - 1])
+        held += 1
+assert held >= 1, held
+print(f"bf paced: {len(rows)} steps, {delayed} answers delayed, {late} steps flew held motors "
+      f"({held} checked equal to the step before), stale {last['out.stale']}")
+PY
+    ;;
   bf_port_taken)
     # Another program holds UDP 9002 (Betaflight's motor port): the run is refused at once, naming the
     # port and why, and no firmware starts.

@@ -10,7 +10,9 @@
 // vehicle), through Betaflight's QUADX mixer table (mixer_init.c) on the throttle's motor value
 // 0.055 + 0.945 (T - 1050) / 950; disarmed, every motor is 0.
 // Options: --fake-pid-file PATH (its process id), --fake-hang-at N (no answer from FDM packet N, 1-based),
-// --fake-record PATH (one line per FDM packet: its 18 values, then the RC channels 1..5 it had).
+// --fake-record PATH (one line per FDM packet: its 18 values, then the RC channels 1..5 it had),
+// --fake-late-every N (every Nth FDM packet answered 6 ms after it came, as a Betaflight whose PID loop
+// came due late).
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -20,6 +22,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,6 +30,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "sitl/betaflight.hpp"
 
@@ -57,7 +61,7 @@ constexpr float kQuadX[4][4] = {{1, -1, 1, -1}, {1, -1, -1, 1}, {1, 1, 1, 1}, {1
 }  // namespace
 
 int main(int argc, char** argv) {
-  long hang_at = -1;
+  long hang_at = -1, late_every = -1;
   std::ofstream record;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -78,6 +82,7 @@ int main(int argc, char** argv) {
     }
     if (a == "--fake-pid-file") std::ofstream(next) << ::getpid() << '\n';
     if (a == "--fake-hang-at") hang_at = std::atol(next);
+    if (a == "--fake-late-every") late_every = std::atol(next);
     if (a == "--fake-record") record.open(next);
   }
   // The ARM range from eeprom.bin: `aux 0 0 CHANNEL LOW HIGH ...` (AUX1 is channel index 0).
@@ -177,6 +182,7 @@ int main(int argc, char** argv) {
         motor[static_cast<std::size_t>(m)] = static_cast<float>(std::clamp(v, 0.0, 1.0));
       }
     }
+    if (late_every > 0 && packets % late_every == 0) std::this_thread::sleep_for(std::chrono::milliseconds(6));
     const auto bytes = bf::encode_motors(motor);
     ::sendto(out, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&motors_to), sizeof(motors_to));
     std::array<std::uint8_t, 68> raw{};  // servo_packet_raw: motorCount, padding, 16 floats
