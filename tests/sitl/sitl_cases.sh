@@ -390,7 +390,7 @@ PY
     "$py" - "$tmp/r1/trajectory.csv" <<'PY' || fail "mission"
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
-rate = round(1 / (float(rows[1]["t"]) - float(rows[0]["t"])))  # the scenario's frame rate (800 Hz shipped)
+rate = round(1 / (float(rows[1]["t"]) - float(rows[0]["t"])))  # the scenario's frame rate (400 Hz shipped: one frame per ArduCopter loop)
 at = lambda t: rows[round(t * rate)]
 armed = [float(r["t"]) for r in rows if r["out.armed"] == "1"]
 assert armed, "never armed"
