@@ -7,7 +7,6 @@ packages=(
   build-essential cmake pkg-config libzstd-dev
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   cyclonedds-dev cyclonedds-tools
-  iceoryx  # iox-roudi: Cyclone's shared-memory transport (QUADCOSIM_DDS_SHM=1, docs/ros2.md; test dds.shared_memory)
   libxml2-dev libminizip-dev  # FMI: modelDescription.xml and .fmu archives (src/fmi)
   libwebsocketpp-dev libasio-dev  # --foxglove: the Foxglove WebSocket server (src/foxglove)
   libssl-dev openssl  # DDS Security keystores (libcrypto); openssl checks them in the tests

@@ -1,8 +1,6 @@
 // DDS transport tests on a private domain with localhost-only discovery.
 #include <gtest/gtest.h>
 
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <unistd.h>
 #include <cmath>
 #include <cstdio>
@@ -612,42 +610,6 @@ TEST(RosEnvironmentTest, ReadsDomainAndRange) {
   unsetenv("ROS_LOCALHOST_ONLY");
   unsetenv("ROS_STATIC_PEERS");
   unsetenv("ROS_DOMAIN_ID");
-}
-
-TEST(RosEnvironmentTest, SharedMemoryIsAskedForByOneAndCheckedForRouDi) {
-  unsetenv("QUADCOSIM_DDS_SHM");
-  EXPECT_FALSE(read_ros_environment().shared_memory);
-  EXPECT_EQ(cyclone_config(read_ros_environment()).find("SharedMemory"), std::string::npos);
-  setenv("QUADCOSIM_DDS_SHM", "1", 1);
-  const RosEnvironment e = read_ros_environment();
-  EXPECT_TRUE(e.shared_memory);
-  EXPECT_NE(cyclone_config(e).find("<SharedMemory><Enable>true</Enable>"), std::string::npos);
-  setenv("QUADCOSIM_DDS_SHM", "yes", 1);
-  try {
-    read_ros_environment();
-    ADD_FAILURE() << "QUADCOSIM_DDS_SHM=yes accepted";
-  } catch (const DdsError& err) {
-    EXPECT_NE(std::string(err.what()).find("QUADCOSIM_DDS_SHM='yes': expected 1"), std::string::npos) << err.what();
-  }
-  unsetenv("QUADCOSIM_DDS_SHM");
-  // No RouDi behind a path: refused at once, naming the path and what to do (Cyclone would wait 60 s
-  // and abort). A file that is not a socket reads as refused too.
-  const std::string missing = testing::TempDir() + "quadcosim-no-roudi";
-  const std::string why = roudi_unreachable(missing);
-  EXPECT_NE(why.find("does not answer on " + missing), std::string::npos) << why;
-  EXPECT_NE(why.find("iox-roudi"), std::string::npos) << why;
-  // A bound UNIX datagram socket answers.
-  const std::string bound = testing::TempDir() + "quadcosim-roudi-" + std::to_string(::getpid());
-  ::unlink(bound.c_str());
-  const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
-  sockaddr_un a{};
-  a.sun_family = AF_UNIX;
-  std::strncpy(a.sun_path, bound.c_str(), sizeof(a.sun_path) - 1);
-  ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof(a)), 0) << std::strerror(errno);
-  EXPECT_EQ(roudi_unreachable(bound), "");
-  ::close(fd);
-  ::unlink(bound.c_str());
-  EXPECT_NE(roudi_unreachable(bound), "");
 }
 
 }  // namespace

@@ -247,37 +247,29 @@ void DdsTransport::set_arrival_sink(std::function<void(std::size_t)> sink) {
 }
 
 void DdsTransport::deliver_serialised(Reader& r, ddsi_serdata* sd) {
-  // The message, decoded (the C sample's contents freed after the delivery).
-  alignas(std::max_align_t) unsigned char sample[1024] = {};
-  if (r.ops->descriptor->m_size > sizeof sample) throw DdsError("dds tap " + r.topic + ": sample too large");
-  if (!ddsi_serdata_to_sample(sd, sample, nullptr, nullptr)) throw DdsError("dds tap " + r.topic + ": undecodable");
-  struct Free {
-    unsigned char* s;
-    const dds_topic_descriptor_t* d;
-    ~Free() { dds_sample_free(s, d, DDS_FREE_CONTENTS); }
-  } const free_contents{sample, r.ops->descriptor};
   // The bytes as the writer serialised them: XCDR1, encapsulation header first. Cyclone pads them to
   // a multiple of 4 and counts the pad in the options' low bits; without both they are io::to_cdr's.
-  // A sample that came over shared memory (QUADCOSIM_DDS_SHM) holds only the header here, its bytes
-  // staying in iceoryx's chunk: Cyclone serialises the decoded sample again, the same bytes.
-  std::uint32_t size = ddsi_serdata_size(sd);
-  ddsi_serdata* again = size <= 4 ? ddsi_serdata_from_sample(sd->type, SDK_DATA, sample) : nullptr;
-  if (again != nullptr) size = ddsi_serdata_size(again);
+  const std::uint32_t size = ddsi_serdata_size(sd);
   r.wire_buffer.resize(size);
-  ddsi_serdata_to_ser(again != nullptr ? again : sd, 0, size, r.wire_buffer.data());
-  if (again != nullptr) ddsi_serdata_unref(again);
+  ddsi_serdata_to_ser(sd, 0, size, r.wire_buffer.data());
   std::size_t n = size;
   if (size >= 4) {
     n -= std::min<std::size_t>(r.wire_buffer[3] & 0x3u, size - 4);
     r.wire_buffer[3] = static_cast<std::uint8_t>(r.wire_buffer[3] & ~0x3u);
   }
   r.wire = sim::WireBytes(r.wire_buffer.data(), n);
+  // The message, decoded from the same bytes (the C sample's contents freed after the delivery).
+  alignas(std::max_align_t) unsigned char sample[1024] = {};
+  if (r.ops->descriptor->m_size > sizeof sample) throw DdsError("dds tap " + r.topic + ": sample too large");
+  if (!ddsi_serdata_to_sample(sd, sample, nullptr, nullptr)) throw DdsError("dds tap " + r.topic + ": undecodable");
   try {
     r.ops->deliver(sample, r.deliver);
   } catch (...) {
+    dds_sample_free(sample, r.ops->descriptor, DDS_FREE_CONTENTS);
     r.wire = {};
     throw;
   }
+  dds_sample_free(sample, r.ops->descriptor, DDS_FREE_CONTENTS);
   r.wire = {};
 }
 

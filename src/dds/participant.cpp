@@ -2,13 +2,8 @@
 
 #include "security/keystore.hpp"
 
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstdlib>
-#include <cstring>
 #include <iostream>
 #include <sstream>
 
@@ -66,11 +61,6 @@ RosEnvironment read_ros_environment(const std::string& enclave) {
   if (env("ROS_LOCALHOST_ONLY") == "1") e.range = DiscoveryRange::kLocalhost;
   e.static_peers = env("ROS_STATIC_PEERS");
   e.cyclonedds_uri = env("CYCLONEDDS_URI");
-  const std::string shm = env("QUADCOSIM_DDS_SHM");
-  if (shm != "" && shm != "0" && shm != "1") {
-    throw DdsError("QUADCOSIM_DDS_SHM='" + shm + "': expected 1 (Cyclone's shared-memory transport) or 0");
-  }
-  e.shared_memory = shm == "1";
   return e;
 }
 
@@ -91,34 +81,13 @@ std::string cyclone_config(const RosEnvironment& e) {
     if (!p.empty()) peers += "<Peer address=\"" + p + "\"/>";
   }
   if (!peers.empty()) x << "<Peers>" << peers << "</Peers>";
-  x << "</Discovery>";
-  if (e.shared_memory) x << "<SharedMemory><Enable>true</Enable><LogLevel>warn</LogLevel></SharedMemory>";
-  x << "</Domain></CycloneDDS>";
+  x << "</Discovery></Domain></CycloneDDS>";
   std::string config = x.str();
   if (!e.cyclonedds_uri.empty()) config += "," + e.cyclonedds_uri;
   return config;
 }
 
-std::string roudi_unreachable(const std::string& socket_path) {
-  const std::string fix =
-      ": start it (`iox-roudi &`, Debian package iceoryx) or unset QUADCOSIM_DDS_SHM (docs/ros2.md, Shared memory)";
-  sockaddr_un a{};
-  if (socket_path.size() >= sizeof(a.sun_path)) return "RouDi's socket path " + socket_path + " is too long";
-  a.sun_family = AF_UNIX;
-  std::memcpy(a.sun_path, socket_path.c_str(), socket_path.size() + 1);
-  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return std::string("cannot open a UNIX socket: ") + std::strerror(errno);
-  const int rc = ::connect(fd, reinterpret_cast<const sockaddr*>(&a), sizeof(a));
-  const int err = errno;
-  ::close(fd);
-  if (rc == 0) return "";
-  return "iceoryx's RouDi does not answer on " + socket_path + " (" + std::strerror(err) + ")" + fix;
-}
-
 Participant::Participant(const RosEnvironment& env) : domain_id_(env.domain_id) {
-  if (env.shared_memory) {
-    if (const std::string why = roudi_unreachable(); !why.empty()) throw DdsError("QUADCOSIM_DDS_SHM=1: " + why);
-  }
   const SecurityPlan security = plan_security(env.security, env.enclave);  // throws under Enforce
   if (!security.note.empty()) std::cerr << security.note << '\n';
   const std::string config = cyclone_config(env);

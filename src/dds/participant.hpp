@@ -37,9 +37,6 @@ struct RosEnvironment {
   DiscoveryRange range = DiscoveryRange::kSubnet;
   std::string static_peers;  ///< ';'-separated addresses
   std::string cyclonedds_uri;
-  /// QUADCOSIM_DDS_SHM=1: Cyclone's shared-memory transport (iceoryx) to the participants on this
-  /// machine that have it too; needs iceoryx's RouDi daemon running (docs/ros2.md, Shared memory).
-  bool shared_memory = false;
   std::string enclave = "/";     ///< the node's enclave (rcl --enclave): USER_DATA and security files
   SecurityEnvironment security;  ///< ROS_SECURITY_*
 };
@@ -53,10 +50,6 @@ RosEnvironment read_ros_environment(const std::string& enclave = "/");
 
 /// The Cyclone configuration XML for the environment, as rmw_cyclonedds builds it.
 std::string cyclone_config(const RosEnvironment& env);
-
-/// Empty when iceoryx's RouDi daemon answers on its socket (`socket_path`, iceoryx 2's /tmp/roudi),
-/// else why not, with what to do. Cyclone itself would wait 60 s for RouDi and then abort.
-std::string roudi_unreachable(const std::string& socket_path = "/tmp/roudi");
 
 /// RAII participant. Not copyable; deleting it deletes every entity it created.
 class Participant {

@@ -130,10 +130,6 @@ nlohmann::json run_bench(const BenchOptions& o, const io::ScenarioResolvers& res
   // The DDS parts again with the plant and the controller each on its own CPU (--cpus).
   const std::vector<int> pin = two_cpus();
   j["pinned_cpus"] = pin.empty() ? nlohmann::json(nullptr) : nlohmann::json(pin);
-  if (want("dds") || want("swarm_dds")) {
-    const char* shm = std::getenv("QUADCOSIM_DDS_SHM");  // the nodes' transport (ddsperf's stays UDP)
-    j["dds_shared_memory"] = shm != nullptr && std::string(shm) == "1";
-  }
   if (want("dds")) {
     const double s = o.seconds > 0 ? o.seconds : (q ? 4.0 : 120.0);
     for (const bool pinned : {false, true}) {

@@ -33,17 +33,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A swarm's processes stay off Cyclone's shared-memory transport: iceoryx's default limits (RouDi's
-// publishers and subscribers for every process on the machine) are met at about 64 vehicles, and
-// iceoryx then ends the process (abort), which no caller can catch.
-void refuse_shared_memory(const char* what) {
-  if (dds::read_ros_environment().shared_memory) {
-    throw dds::DdsError(std::string(what) +
-                        " --vehicles: QUADCOSIM_DDS_SHM=1 is for one vehicle per process (iceoryx's default "
-                        "limits end a swarm's process from about 64 vehicles, docs/ros2.md, Shared memory); unset it");
-  }
-}
-
 io::SwarmSpec node_spec(const io::Scenario& sc, int vehicles, const std::string& ns_prefix) {
   io::SwarmSpec spec = swarm_spec(sc, vehicles, 0);
   if (!ns_prefix.empty()) {
@@ -266,7 +255,6 @@ class ControllerShard {
 }  // namespace
 
 int run_plant_swarm(const PlantProcessOptions& o, io::Scenario sc) {
-  refuse_shared_memory("plant");
   const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
   const int threads = std::clamp(o.swarm.threads, 1, n);
@@ -333,7 +321,6 @@ int run_plant_swarm(const PlantProcessOptions& o, io::Scenario sc) {
 }
 
 int run_controller_swarm(const ControllerProcessOptions& o, io::Scenario sc) {
-  refuse_shared_memory("controller");
   const io::SwarmSpec spec = node_spec(sc, o.swarm.vehicles, o.swarm.ns_prefix);
   const int n = spec.layout.vehicles;
   const int threads = std::clamp(o.swarm.threads, 1, n);

@@ -131,47 +131,6 @@ case "$case_name" in
       "$tmp/plant.log" ||
       fail "no reason given: $(cat "$tmp/plant.log")"
     ;;
-  shared_memory)
-    # Cyclone's shared-memory transport (QUADCOSIM_DDS_SHM=1, iceoryx): the same bytes as in-process, the
-    # plant's sensor writers and the controller's command reader on iceoryx (Cyclone's own trace says
-    # so); without RouDi, refused at once, naming it (Cyclone alone would wait 60 s and abort).
-    command -v iox-roudi > /dev/null ||
-      { echo "SKIPPED: iox-roudi not found (Debian package iceoryx; scripts/install-deps.sh installs it)"; exit 77; }
-    roudi_up() { /usr/bin/python3 -c "import socket; socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM).connect('/tmp/roudi')" 2>/dev/null; }
-    ours=""
-    if ! roudi_up; then
-      iox-roudi > "$tmp/roudi.log" 2>&1 &
-      ours=$!
-      pids+=("$ours")
-      for _ in $(seq 100); do roudi_up && break; sleep 0.1; done
-      roudi_up || fail "iox-roudi did not come up"
-    fi
-    export QUADCOSIM_DDS_SHM=1
-    export CYCLONEDDS_URI="<CycloneDDS><Domain id=\"any\"><Tracing><Category>shm</Category><OutputFile>$tmp/cdds-\${CYCLONEDDS_PID}.trace</OutputFile></Tracing></Domain></CycloneDDS>"
-    identical altitude_step
-    grep -q "Writer's topic name will be DDS:Cyclone:rt/drone/Pose" "$tmp"/cdds-*.trace || fail "Pose not written over iceoryx"
-    grep -q "Reader's topic name will be DDS:Cyclone:rt/drone/motor_commands" "$tmp"/cdds-*.trace ||
-      fail "motor commands not read over iceoryx"
-    # A swarm is refused by name (iceoryx's limits would abort its processes from about 64 vehicles).
-    rc=0; timeout 60 "$bin" run "$src/scenarios/swarm/grid_takeoff.yaml" --vehicles 4 --out "$tmp/swarm" --no-plots \
-      --transport dds > "$tmp/swarm.log" 2>&1 || rc=$?
-    [ "$rc" -ne 0 ] || fail "a swarm ran on shared memory"
-    grep -q "plant --vehicles: QUADCOSIM_DDS_SHM=1 is for one vehicle per process" "$tmp/swarm.log" ||
-      fail "swarm message: $(cat "$tmp/swarm.log")"
-    if [ -n "$ours" ]; then
-      kill -TERM "$ours"
-      wait "$ours" 2>/dev/null || true
-      start=$SECONDS
-      rc=0; timeout 50 "$bin" run "$paper/altitude_step.yaml" --out "$tmp/none" --no-plots --transport dds \
-        > "$tmp/none.log" 2>&1 || rc=$?
-      [ "$rc" -ne 0 ] || fail "ran without RouDi"
-      [ $((SECONDS - start)) -lt 30 ] || fail "took $((SECONDS - start)) s to give up"
-      grep -q "QUADCOSIM_DDS_SHM=1: iceoryx's RouDi does not answer on /tmp/roudi" "$tmp/none.log" ||
-        fail "message: $(cat "$tmp/none.log")"
-      grep -o "QUADCOSIM_DDS_SHM=1: iceoryx's RouDi does not answer.*" "$tmp/none.log" | head -1
-    fi
-    echo "shared memory: in-process and over iceoryx the same bytes"
-    ;;
   identical_all_scenarios) identical_all ;;
   identical_altitude) identical altitude_step ;;
   identical_roll) identical roll_step ;;
