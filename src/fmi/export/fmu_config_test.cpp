@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fmi/export/fmu_config.hpp"
+#include "fmi/export/rotor_test_vehicles.hpp"
 #include "fmi/quadrotor_variables.hpp"
 #include "trajectory/spec.hpp"
 
@@ -282,6 +283,8 @@ TEST(FmuConfig, ControllerWithATrajectoryStartsOnIt) {
 // positions, read back exactly; a bad rotor list is refused naming the field.
 namespace quadcosim::fmi::rotors {
 
+using test::octo_x8;
+
 /// The variable `name` of `md`, or nullptr (ModelDescription::find is the importer's library's).
 const Variable* find(const ModelDescription& md, std::string_view name) {
   for (const Variable& v : md.variables) {
@@ -295,31 +298,6 @@ std::string to_json_number(double v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
-}
-
-/// The custom coaxial X8 of scenarios/examples/octo_custom_step.yaml.
-model::VehicleParams octo_x8() {
-  model::VehicleParams v;
-  v.mass_kg = 2.4;
-  v.kt_N_per_rad2_s2 = 8.54858e-6;
-  v.km_Nm_per_rad2_s2 = 1.367773e-7;
-  v.set_layout(model::RotorLayout::kCustom);
-  v.rotor_count = 8;
-  const double a = 0.2475;
-  const std::array<Eigen::Vector3d, 8> p = {Eigen::Vector3d(a, a, 0.04),
-                                            {a, a, -0.04},
-                                            {a, -a, 0.04},
-                                            {a, -a, -0.04},
-                                            {-a, -a, 0.04},
-                                            {-a, -a, -0.04},
-                                            {-a, a, 0.04},
-                                            {-a, a, -0.04}};
-  const std::array<int, 8> spin = {1, -1, -1, 1, 1, -1, -1, 1};
-  for (std::size_t i = 0; i < 8; ++i) {
-    v.rotor_positions_m[i] = p[i];
-    v.spin[i] = spin[i];
-  }
-  return v;
 }
 
 model::VehicleParams hex_x() {

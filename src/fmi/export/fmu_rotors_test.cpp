@@ -7,6 +7,7 @@
 #include "control/observation_test_support.hpp"
 #include "controllers/registry.hpp"
 #include "fmi/export/fmu_test_support.hpp"
+#include "fmi/export/rotor_test_vehicles.hpp"
 #include "fmi/quadrotor_variables.hpp"
 #include "model/quadrotor.hpp"
 #include "model/vehicle_presets.hpp"
@@ -16,29 +17,6 @@ namespace quadcosim::fmi::test {
 namespace {
 
 model::VehicleParams firefly() { return model::find_vehicle_preset("firefly")->params; }
-
-/// The custom coaxial X8 of scenarios/examples/octo_custom_step.yaml.
-model::VehicleParams octo_x8() {
-  model::VehicleParams v = firefly();
-  v.mass_kg = 2.4;
-  v.set_layout(model::RotorLayout::kCustom);
-  v.rotor_count = 8;
-  const double a = 0.2475;
-  const std::array<Eigen::Vector3d, 8> p = {Eigen::Vector3d(a, a, 0.04),
-                                            {a, a, -0.04},
-                                            {a, -a, 0.04},
-                                            {a, -a, -0.04},
-                                            {-a, -a, 0.04},
-                                            {-a, -a, -0.04},
-                                            {-a, a, 0.04},
-                                            {-a, a, -0.04}};
-  const std::array<int, 8> spin = {1, -1, -1, 1, 1, -1, -1, 1};
-  for (std::size_t i = 0; i < 8; ++i) {
-    v.rotor_positions_m[i] = p[i];
-    v.spin[i] = spin[i];
-  }
-  return v;
-}
 
 /// A plant FMU of `v` hovering at 2 m, its motors lagging (first order). (Drag, wind, gusts, a rotor
 /// fault and sensor noise on a hexarotor: FmuPlantNode.AHexarotor*, against the plant node.)
