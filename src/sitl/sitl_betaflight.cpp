@@ -220,8 +220,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
   auto fdm =
       bf::encode_fdm(bf::gazebo_fdm(stamp_s, obs.w_B, obs.specific_force_B, obs.q_WB, obs.v_W, lla, l.first_lon_lat));
   const sockaddr_in rc_to = loopback_address(bf::kRcPort), fdm_to = loopback_address(bf::kStatePort);
-  auto send = [&] {
-    l.drain(l.motors, &l.stale);
+  auto send = [&] {  // the raw PWM packets are never read: dropped before each send
     l.drain(l.raw, nullptr);
     ::sendto(l.out, rc.data(), rc.size(), 0, reinterpret_cast<const sockaddr*>(&rc_to), sizeof(rc_to));
     ::sendto(l.out, fdm.data(), fdm.size(), 0, reinterpret_cast<const sockaddr*>(&fdm_to), sizeof(fdm_to));
@@ -273,9 +272,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
       l.held = decode(n);  // answers that came after their step: the newest is what the firmware flies now
       ++l.stale;
     }
-    l.drain(l.raw, nullptr);
-    ::sendto(l.out, rc.data(), rc.size(), 0, reinterpret_cast<const sockaddr*>(&rc_to), sizeof(rc_to));
-    ::sendto(l.out, fdm.data(), fdm.size(), 0, reinterpret_cast<const sockaddr*>(&fdm_to), sizeof(fdm_to));
+    send();
     l.next_send_wall_s += period_s;
     motors = l.held;
     bool own = false;
@@ -301,6 +298,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
       }
     }
   } else {
+    l.drain(l.motors, &l.stale);  // waiting for its own answer: what came before it is stale
     send();
     l.next_send_wall_s = wall_clock_s() + period_s;
     const double limit_s = l.answered ? spec_.timeout_s : spec_.start_timeout_s;
@@ -323,6 +321,7 @@ void SitlController::step_betaflight(const control::Observation& obs, const cont
           fdm = bf::encode_fdm(bf::gazebo_fdm(t_s_ + 2.0 * dt_s + l.stamp_offset_s, obs.w_B, obs.specific_force_B,
                                               obs.q_WB, obs.v_W, lla, l.first_lon_lat));
         }
+        l.drain(l.motors, &l.stale);
         send();
         l.next_send_wall_s = now + period_s;  // the next step a whole period after this one
         resend_at = now + spec_.resend_ms / 1000.0;
