@@ -1,6 +1,5 @@
 #include "analysis/margins.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -9,6 +8,7 @@
 #include <stdexcept>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "control/eigenvalues.hpp"
 #include "model/angle.hpp"
 
 namespace quadcosim::analysis {
@@ -243,7 +243,7 @@ Eigen::MatrixXd Loop::closed_loop_matrix(double k) const {
 Eigen::VectorXcd closed_loop_poles(const Loop& loop, double gain) {
   const Eigen::MatrixXd A = loop.closed_loop_matrix(gain);
   if (A.rows() == 0) return {};
-  return Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
+  return control::eigenvalues(A);
 }
 
 int unstable_count(const Eigen::VectorXcd& poles, bool discrete, double tol) {
@@ -293,10 +293,8 @@ LoopMargins analyse_margins(const Loop& loop, const MarginOptions& options) {
   LoopMargins r;
 
   Eigen::VectorXcd open(loop.plant.A.rows() + loop.controller.A.rows());
-  if (loop.plant.A.rows() > 0)
-    open.head(loop.plant.A.rows()) = Eigen::EigenSolver<Eigen::MatrixXd>(loop.plant.A, false).eigenvalues();
-  if (loop.controller.A.rows() > 0)
-    open.tail(loop.controller.A.rows()) = Eigen::EigenSolver<Eigen::MatrixXd>(loop.controller.A, false).eigenvalues();
+  if (loop.plant.A.rows() > 0) open.head(loop.plant.A.rows()) = control::eigenvalues(loop.plant.A);
+  if (loop.controller.A.rows() > 0) open.tail(loop.controller.A.rows()) = control::eigenvalues(loop.controller.A);
   constexpr double kTol = 1e-7;
   r.open_loop_unstable_poles = unstable_count(open, discrete, kTol);
   for (Eigen::Index i = 0; i < open.size(); ++i) {

@@ -1,8 +1,7 @@
 #include "control/attitude_lqr.hpp"
 
-#include <Eigen/Eigenvalues>
-
 #include "control/care.hpp"
+#include "control/eigenvalues.hpp"
 
 namespace quadcosim::control {
 
@@ -15,7 +14,7 @@ AxisLqr design_axis_lqr(double inertia_kg_m2, const LqrWeights& w) {
   d.R = w.r;
   const Eigen::MatrixXd K = lqr_gain(d.A, d.B, d.Q, Eigen::MatrixXd::Constant(1, 1, w.r));
   d.K = K;
-  d.closed_loop_poles = Eigen::EigenSolver<Eigen::Matrix2d>(d.A - d.B * d.K).eigenvalues();
+  d.closed_loop_poles = eigenvalues(d.A - d.B * d.K);
   return d;
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "control/eigenvalues.hpp"
+
 namespace quadcosim::control {
 
 namespace {
@@ -80,12 +82,12 @@ Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, c
 
   if (!X.allFinite()) throw CareError("CARE: no finite solution");
   const Eigen::MatrixXd Acl = A - G * X;
-  Eigen::EigenSolver<Eigen::MatrixXd> es(Acl, false);
+  const Eigen::VectorXcd poles = eigenvalues(Acl);
   // Computed eigenvalues carry rounding errors of order eps ||Acl|| (times their condition number):
   // a pole closer to the imaginary axis than this margin cannot be told from one on it (e.g. an
   // uncontrollable undamped mode, which feedback cannot move), so it does not count as stable.
   const double margin = 1e-10 * (1.0 + Acl.norm());
-  if (es.eigenvalues().real().maxCoeff() >= -margin) {
+  if (poles.real().maxCoeff() >= -margin) {
     throw CareError("CARE: the solution does not stabilise the system; (A, B) is not stabilisable");
   }
   return X;

@@ -1,25 +1,15 @@
 // The inner loops' stability check (check_inner_loops, control/inner_loops.hpp): one-off design
-// numerics on Eigen's eigen-solver, compiled with the other design code (quadcosim_design,
+// numerics (control/eigenvalues.hpp), compiled with the other design code (quadcosim_design,
 // src/control/CMakeLists.txt) rather than with the per-tick loops.
 #include "control/inner_loops.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
+#include "control/eigenvalues.hpp"
+
 namespace quadcosim::control {
-
-namespace {
-
-/// Largest |eigenvalue| of a square matrix.
-template <class M>
-double spectral_radius(const M& a) {
-  Eigen::EigenSolver<M> solver(a, false);
-  return solver.eigenvalues().cwiseAbs().maxCoeff();
-}
-
-}  // namespace
 
 std::string check_inner_loops(const InnerLoopParams& p, const model::VehicleParams& vehicle, double period_s) {
   std::ostringstream err;
