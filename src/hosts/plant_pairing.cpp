@@ -94,9 +94,9 @@ bool PlantProcess::wait_for_controller() {
         const std::vector<std::string> now = sensors_subscribed_by(*peer, sensor_topics_all);
         if (now.size() != sensors.size()) settled_at = steady_ns() + kSettleNs;
         sensors = now;
-        // The run's own controller (a token) publishes its status, which tick 0's answer includes:
-        // matched too, or tick 0 would be taken without it.
-        if (!pair_token_.empty() && !controller_writes_status()) return false;
+        // The run's own controller (a token) publishes its status, which a recorded tick 0's answer
+        // includes: matched too, or tick 0 would be taken without it.
+        if (!pair_token_.empty() && !recording_.empty() && !controller_writes_status()) return false;
         return sensors.size() == sensor_topics_all.size() || (!sensors.empty() && steady_ns() >= settled_at);
       },
       timeout_ns());

@@ -67,19 +67,24 @@ PlantProcess::PlantProcess(const PlantProcessOptions& o, io::Scenario sc)
         k, clock_.seconds(k), static_cast<double>(label_ns) * 1e-9, label_ns);
     request_stop();
   });
-  transport_.subscribe_with_sender<msg::ControllerStatus>(topics_.controller_status,
-                                                          [this](const msg::ControllerStatus& m, sim::SenderId s) {
-                                                            if (!pairing_.accepts(topics_.controller_status, s))
-                                                              return;  // a stranger's says nothing of this run
-                                                            status_ = m;
-                                                            have_status_ = true;
-                                                          });
   RecordingOptions ro(io::RecordingOptions::for_run(sc_));
   ro.csv = o_.one_vehicle.record;
   ro.mcap = o_.one_vehicle.mcap;
   ro.foxglove = o_.foxglove;
   ro.who = "plant";
   recording_ = make_recording(ro, &transport_);
+  // The controller's status is written beside each tick by what records; a plant that records nothing
+  // does not read it (as a swarm's unrecorded vehicles), so the controller sends one datagram a control
+  // period fewer and no tick waits for it.
+  if (!recording_.empty()) {
+    transport_.subscribe_with_sender<msg::ControllerStatus>(topics_.controller_status,
+                                                            [this](const msg::ControllerStatus& m, sim::SenderId s) {
+                                                              if (!pairing_.accepts(topics_.controller_status, s))
+                                                                return;  // a stranger's says nothing of this run
+                                                              status_ = m;
+                                                              have_status_ = true;
+                                                            });
+  }
   if (!o_.one_vehicle.schedule_node.empty()) {
     scheduler_ = std::make_unique<dds::ParameterClient>(transport_.participant().handle(),
                                                         dds::parse_node_name(o_.one_vehicle.schedule_node));
