@@ -245,6 +245,38 @@ print(c[0], c[1] if len(c) > 1 else c[0])')
     [ "$sends" -lt 2000 ] || fail "$sends datagrams: the sensor samples between control ticks are not packed"
     ;;
 
+  status_when_recorded)  # the controller's status goes on the wire only to a plant that records it
+    # (docs/performance.md): 10 s, 500 control periods. A plant without --record reads no status, so the
+    # controller sends about one datagram a period (its command); with --record the status too (awaited:
+    # its columns are in the file). Counted at the controller's send calls, discovery included.
+    command -v strace > /dev/null || { echo "SKIP: strace is not installed (it counts the controller's datagrams)"; exit 77; }
+    declare -A sends
+    for mode in bare recorded; do
+      args=()
+      [ "$mode" = recorded ] && args=(--record "$tmp/p.csv")
+      strace -f -qq -e trace=sendmsg,sendto,sendmmsg -o "$tmp/sends_$mode.txt" \
+        "$bin" controller --scenario "$paper/altitude_step.yaml" > "$tmp/c_$mode.log" 2>&1 &
+      spid=$!
+      pids+=("$spid")
+      if ! "$bin" plant --scenario "$paper/altitude_step.yaml" --duration 10 "${args[@]}" > "$tmp/p_$mode.log" 2>&1; then
+        if grep -q "ptrace\|Operation not permitted" "$tmp/c_$mode.log"; then
+          echo "SKIP: strace cannot trace here: $(head -1 "$tmp/c_$mode.log")"; exit 77
+        fi
+        fail "plant ($mode) failed"
+      fi
+      grep -q "1000 ticks" "$tmp/p_$mode.log" || fail "unexpected run length ($mode)"
+      pkill -INT -P "$spid" 2>/dev/null || true  # the controller under strace; strace ends with it
+      wait "$spid" 2>/dev/null || true
+      sends[$mode]=$(grep -c "^[0-9]* *send" "$tmp/sends_$mode.txt")
+    done
+    echo "the controller's datagrams for 500 control periods: plant not recording ${sends[bare]}, recording ${sends[recorded]}"
+    [ "${sends[bare]}" -lt 800 ] || fail "${sends[bare]} datagrams to a plant that records nothing: the status is still sent"
+    [ "${sends[recorded]}" -gt 950 ] || fail "${sends[recorded]} datagrams to a recording plant: no status each period"
+    head -1 "$tmp/p.csv" | grep -q "out\.error\.z" || fail "the recording has no controller columns"
+    awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "out.error.z") c = i } NR > 3 && $c == "nan" { n++ }
+      END { exit n > 0 }' "$tmp/p.csv" || fail "controller columns missing in recorded rows"
+    ;;
+
   sensor_qos)  # best-effort sensor topics (ROS sensor-data QoS) on both sides: still the same bytes
     "$bin" run "$paper/roll_step.yaml" --out "$tmp/in" --no-plots > /dev/null
     "$bin" controller --scenario "$paper/roll_step.yaml" --sensor-qos > "$tmp/c.log" 2>&1 &
