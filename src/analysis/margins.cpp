@@ -241,9 +241,7 @@ Eigen::MatrixXd Loop::closed_loop_matrix(double k) const {
 }
 
 Eigen::VectorXcd closed_loop_poles(const Loop& loop, double gain) {
-  const Eigen::MatrixXd A = loop.closed_loop_matrix(gain);
-  if (A.rows() == 0) return {};
-  return control::eigenvalues(A);
+  return control::eigenvalues(loop.closed_loop_matrix(gain));  // none for a loop without states
 }
 
 int unstable_count(const Eigen::VectorXcd& poles, bool discrete, double tol) {
@@ -293,8 +291,7 @@ LoopMargins analyse_margins(const Loop& loop, const MarginOptions& options) {
   LoopMargins r;
 
   Eigen::VectorXcd open(loop.plant.A.rows() + loop.controller.A.rows());
-  if (loop.plant.A.rows() > 0) open.head(loop.plant.A.rows()) = control::eigenvalues(loop.plant.A);
-  if (loop.controller.A.rows() > 0) open.tail(loop.controller.A.rows()) = control::eigenvalues(loop.controller.A);
+  open << control::eigenvalues(loop.plant.A), control::eigenvalues(loop.controller.A);  // either may have none
   constexpr double kTol = 1e-7;
   r.open_loop_unstable_poles = unstable_count(open, discrete, kTol);
   for (Eigen::Index i = 0; i < open.size(); ++i) {
